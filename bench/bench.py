@@ -1,0 +1,125 @@
+#!/usr/bin/env python3
+"""shadebench benchmark: every configuration side by side in one run, on one
+daemon, interleaved across repeats so that machine noise spreads evenly.
+Reports medians of per-job medians and ratios to forward and to unlit, plus
+the daemon's own overhead (HTTP job against --once).
+
+  bench/bench.py [--frames N] [--repeat R] [--width W --height H] [--json FILE]
+
+Figures are measured on whatever GL device the daemon picks (shown first).
+On llvmpipe, GL_TIME_ELAPSED covers rasterization only (vertex work and
+compute shaders run outside the query on the CPU), so frame_ms (the
+present-to-present interval) is the figure to compare there; on a GPU both
+are meaningful."""
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"))
+import testlib  # noqa: E402
+
+ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap.add_argument("--frames", type=int, default=60)
+ap.add_argument("--warmup", type=int, default=10)
+ap.add_argument("--repeat", type=int, default=3)
+ap.add_argument("--width", type=int, default=1080)
+ap.add_argument("--height", type=int, default=720)
+ap.add_argument("--only", default="", help="comma-separated config names to run")
+ap.add_argument("--json", help="write every measurement here")
+args = ap.parse_args()
+
+CONFIGS = []
+for dyn in (False, True):
+    tag = "dynamic" if dyn else "static"
+    CONFIGS.append(("unlit/" + tag, {"technique": "unlit"}, dyn))
+    CONFIGS.append(("forward/" + tag, {"technique": "forward"}, dyn))
+    for res in (256, "auto"):
+        for d in (0, 20):
+            CONFIGS.append(("osl-%s/%s/d%d" % (res, tag, d),
+                            {"technique": "osl", "async_distance": d, "osl": {"resolution": res}}, dyn))
+if args.only:
+    wanted = set(args.only.split(","))
+    CONFIGS = [c for c in CONFIGS if c[0] in wanted or c[0].split("/")[0] in wanted]
+
+
+def job_for(extra, dyn):
+    job = {"frames": args.frames, "warmup_frames": args.warmup, "capture_interval": 0,
+           "scene": {"preset": "grid", "dynamic": dyn, "width": args.width, "height": args.height}}
+    job.update(extra)
+    return job
+
+
+d = testlib.Daemon()
+results = {name: [] for name, _, _ in CONFIGS}
+overhead = {"http": [], "once": []}
+try:
+    info = d.json("GET", "/v1/info")[1]["device"]
+    print("device: %s | %s | %s" % (info["gl_renderer"], info["gl_version"], info["egl_device"]))
+    print("scene: grid %dx%d, %d timed frames after %d warm-up, %d repeats\n"
+          % (args.width, args.height, args.frames, args.warmup, args.repeat))
+    for rep in range(args.repeat):
+        for name, extra, dyn in CONFIGS:
+            t0 = time.time()
+            job = d.run(job_for(extra, dyn))
+            if job["status"] != "done":
+                sys.exit("%s failed: %s" % (name, job.get("error")))
+            r = job["result"]
+            results[name].append(r)
+            print("  [%d/%d] %-24s frame %8.2f ms  gpu %8.2f ms  (%.0f s)"
+                  % (rep + 1, args.repeat, name, r["frame_ms"]["median"], r["gpu_ms"]["median"],
+                     time.time() - t0), flush=True)
+        # Daemon overhead: the same forward job over HTTP and in-process.
+        job = job_for({"technique": "forward"}, True)
+        overhead["http"].append(d.run(job)["result"])
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "job.json")
+            with open(path, "w") as f:
+                json.dump(job, f)
+            # The daemon holds the GL device meanwhile but is idle.
+            subprocess.run([testlib.SHADEBENCHD, "--once", path, "--out", tmp],
+                           check=True, capture_output=True)
+            with open(os.path.join(tmp, "result.json")) as f:
+                overhead["once"].append(json.load(f))
+finally:
+    d.stop()
+    d.cleanup()
+
+
+def med(runs, series):
+    return statistics.median(r[series]["median"] for r in runs)
+
+
+def cell(name, series, base):
+    if base not in results or not results[base]:
+        return "-"
+    return "%.2f" % (med(results[name], series) / med(results[base], series))
+
+
+print("\n| configuration | frame_ms median | gpu_ms median | frame / forward | frame / unlit "
+      "| gpu / forward | gpu / unlit | objects reshaded/frame | texels shaded/frame |")
+print("|---|---|---|---|---|---|---|---|---|")
+for name, _, dyn in CONFIGS:
+    tag = "dynamic" if dyn else "static"
+    fwd, unl = "forward/" + tag, "unlit/" + tag
+    o = results[name][0].get("osl")
+    objs = "%.1f" % statistics.median(r["osl"]["objects_reshaded_per_frame"]["mean"] for r in results[name]) if o else "-"
+    tex = "%.0f" % statistics.median(r["osl"]["texels_shaded_per_frame"]["mean"] for r in results[name]) if o else "-"
+    print("| %s | %.2f | %.3f | %s | %s | %s | %s | %s | %s |"
+          % (name, med(results[name], "frame_ms"), med(results[name], "gpu_ms"),
+             cell(name, "frame_ms", fwd), cell(name, "frame_ms", unl),
+             cell(name, "gpu_ms", fwd), cell(name, "gpu_ms", unl), objs, tex))
+
+http_wall = statistics.median(r["wall_s"] for r in overhead["http"])
+once_wall = statistics.median(r["wall_s"] for r in overhead["once"])
+print("\ndaemon overhead, forward/dynamic: HTTP job wall %.3f s, --once wall %.3f s, ratio %.3f; "
+      "frame_ms median ratio %.3f" % (http_wall, once_wall, http_wall / once_wall,
+                                       med(overhead["http"], "frame_ms") / med(overhead["once"], "frame_ms")))
+if args.json:
+    with open(args.json, "w") as f:
+        json.dump({"device": info, "args": vars(args), "results": results, "overhead": overhead}, f)

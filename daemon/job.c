@@ -1,0 +1,327 @@
+#define _POSIX_C_SOURCE 200809L
+#include "daemon/job.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+static bool fail(struct job_error *err, const char *field, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static bool fail(struct job_error *err, const char *field, const char *fmt, ...)
+{
+    snprintf(err->field, sizeof(err->field), "%s", field);
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err->message, sizeof(err->message), fmt, ap);
+    va_end(ap);
+    return false;
+}
+
+static size_t edit_distance(const char *a, const char *b)
+{
+    size_t la = strlen(a), lb = strlen(b);
+    if (la > 40 || lb > 40)
+        return 99;
+    size_t row[41];
+    for (size_t j = 0; j <= lb; j++)
+        row[j] = j;
+    for (size_t i = 1; i <= la; i++) {
+        size_t diag = row[0];
+        row[0] = i;
+        for (size_t j = 1; j <= lb; j++) {
+            size_t up = row[j];
+            size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
+            size_t best = diag + cost;
+            if (row[j] + 1 < best)
+                best = row[j] + 1;
+            if (row[j - 1] + 1 < best)
+                best = row[j - 1] + 1;
+            row[j] = best;
+            diag = up;
+        }
+    }
+    return row[lb];
+}
+
+/* Rejects keys not in known, suggesting the closest one for typos. */
+static bool check_keys(const json_t *obj, const char *prefix,
+                       const char *const *known, struct job_error *err)
+{
+    const char *key;
+    json_t *value;
+    json_object_foreach((json_t *)obj, key, value) {
+        bool found = false;
+        const char *closest = NULL;
+        size_t best = 3;
+        for (const char *const *k = known; *k; k++) {
+            if (strcmp(*k, key) == 0) {
+                found = true;
+                break;
+            }
+            size_t d = edit_distance(*k, key);
+            if (d < best) {
+                best = d;
+                closest = *k;
+            }
+        }
+        if (!found) {
+            char field[64];
+            snprintf(field, sizeof(field), "%s%.40s", prefix, key);
+            if (closest)
+                return fail(err, field, "unknown field (did you mean '%s%s'?)",
+                            prefix, closest);
+            return fail(err, field, "unknown field");
+        }
+    }
+    return true;
+}
+
+static bool get_int(const json_t *obj, const char *key, const char *field,
+                    long min, long max, int *out, struct job_error *err)
+{
+    json_t *v = json_object_get(obj, key);
+    if (!v)
+        return true;
+    /* Accept 300.0 from tools that write every number as a double, but never 300.5. */
+    double d;
+    if (json_is_integer(v))
+        d = (double)json_integer_value(v);
+    else if (json_is_real(v) && floor(json_real_value(v)) == json_real_value(v))
+        d = json_real_value(v);
+    else
+        return fail(err, field, "must be an integer from %ld to %ld", min, max);
+    if (d < (double)min || d > (double)max)
+        return fail(err, field, "must be an integer from %ld to %ld", min, max);
+    *out = (int)d;
+    return true;
+}
+
+static bool get_number(const json_t *obj, const char *key, const char *field,
+                       double min, double max, double *out,
+                       struct job_error *err)
+{
+    json_t *v = json_object_get(obj, key);
+    if (!v)
+        return true;
+    if (!json_is_number(v) || !isfinite(json_number_value(v)) ||
+        json_number_value(v) < min || json_number_value(v) > max)
+        return fail(err, field, "must be a number from %g to %g", min, max);
+    *out = json_number_value(v);
+    return true;
+}
+
+static bool get_bool(const json_t *obj, const char *key, const char *field,
+                     bool *out, struct job_error *err)
+{
+    json_t *v = json_object_get(obj, key);
+    if (!v)
+        return true;
+    if (!json_is_boolean(v))
+        return fail(err, field, "must be true or false");
+    *out = json_is_true(v);
+    return true;
+}
+
+static bool get_object(const json_t *obj, const char *key, const char *field,
+                       json_t **out, struct job_error *err)
+{
+    *out = json_object_get(obj, key);
+    if (*out && !json_is_object(*out))
+        return fail(err, field, "must be an object");
+    return true;
+}
+
+void job_spec_defaults(struct job_spec *out)
+{
+    memset(out, 0, sizeof(*out));
+    snprintf(out->technique, sizeof(out->technique), "forward");
+    out->frames = 300;
+    out->warmup_frames = 10;
+    out->capture_interval = 0;
+    out->async_distance = 0.0;
+    snprintf(out->scene.preset, sizeof(out->scene.preset), "grid");
+    out->scene.lights = 10;
+    out->scene.dynamic = false;
+    out->scene.width = 1080;
+    out->scene.height = 720;
+    out->scene.sphere_segments = 32;
+    out->osl.resolution = 256;
+    out->osl.texel_density = 1.0;
+    out->osl.reshade = OSL_RESHADE_TOUCHED;
+}
+
+static bool parse_scene(const json_t *scene, struct scene_spec *s,
+                        struct job_error *err)
+{
+    static const char *const keys[] = {"preset", "lights", "dynamic", "width",
+                                       "height", "sphere_segments", NULL};
+    if (!check_keys(scene, "scene.", keys, err))
+        return false;
+    json_t *preset = json_object_get(scene, "preset");
+    if (preset) {
+        if (!json_is_string(preset) || strcmp(json_string_value(preset), "grid") != 0)
+            return fail(err, "scene.preset", "must be one of: \"grid\"");
+        snprintf(s->preset, sizeof(s->preset), "%s", json_string_value(preset));
+    }
+    if (!get_int(scene, "lights", "scene.lights", 0, 1024, &s->lights, err) ||
+        !get_bool(scene, "dynamic", "scene.dynamic", &s->dynamic, err) ||
+        !get_int(scene, "width", "scene.width", 16, 8192, &s->width, err) ||
+        !get_int(scene, "height", "scene.height", 16, 8192, &s->height, err) ||
+        !get_int(scene, "sphere_segments", "scene.sphere_segments", 8, 256,
+                 &s->sphere_segments, err))
+        return false;
+    if (s->sphere_segments % 2)
+        return fail(err, "scene.sphere_segments", "must be an even integer from 8 to 256");
+    return true;
+}
+
+static bool parse_osl(const json_t *osl, struct osl_spec *o, struct job_error *err)
+{
+    static const char *const keys[] = {"resolution", "texel_density", "reshade", NULL};
+    if (!check_keys(osl, "osl.", keys, err))
+        return false;
+    json_t *res = json_object_get(osl, "resolution");
+    if (res) {
+        static const char rule[] =
+            "must be \"auto\" or a power of two from 8 to 1024";
+        if (json_is_string(res)) {
+            if (strcmp(json_string_value(res), "auto") != 0)
+                return fail(err, "osl.resolution", rule);
+            o->resolution = 0;
+        } else if (json_is_integer(res)) {
+            json_int_t r = json_integer_value(res);
+            if (r < 8 || r > 1024 || (r & (r - 1)) != 0)
+                return fail(err, "osl.resolution", rule);
+            o->resolution = (int)r;
+        } else {
+            return fail(err, "osl.resolution", rule);
+        }
+    }
+    if (!get_number(osl, "texel_density", "osl.texel_density", 0.0625, 16.0,
+                    &o->texel_density, err))
+        return false;
+    json_t *reshade = json_object_get(osl, "reshade");
+    if (reshade) {
+        const char *v = json_is_string(reshade) ? json_string_value(reshade) : "";
+        if (strcmp(v, "touched") == 0)
+            o->reshade = OSL_RESHADE_TOUCHED;
+        else if (strcmp(v, "all") == 0)
+            o->reshade = OSL_RESHADE_ALL;
+        else
+            return fail(err, "osl.reshade", "must be one of: \"touched\", \"all\"");
+    }
+    return true;
+}
+
+bool job_spec_parse(const json_t *body, const char *const *techniques,
+                    struct job_spec *out, struct job_error *err)
+{
+    static const char *const keys[] = {"technique", "frames", "warmup_frames",
+                                       "capture_interval", "async_distance",
+                                       "scene", "osl", NULL};
+    job_spec_defaults(out);
+    memset(err, 0, sizeof(*err));
+    if (!json_is_object(body))
+        return fail(err, "body", "the job must be a JSON object");
+    if (!check_keys(body, "", keys, err))
+        return false;
+
+    json_t *tech = json_object_get(body, "technique");
+    if (tech) {
+        bool known = false;
+        char list[200] = "";
+        for (const char *const *t = techniques; *t; t++) {
+            if (json_is_string(tech) && strcmp(*t, json_string_value(tech)) == 0)
+                known = true;
+            size_t used = strlen(list);
+            snprintf(list + used, sizeof(list) - used, "%s\"%s\"",
+                     used ? ", " : "", *t);
+        }
+        if (!known)
+            return fail(err, "technique", "must be one of: %s", list);
+        snprintf(out->technique, sizeof(out->technique), "%s",
+                 json_string_value(tech));
+    }
+    if (!get_int(body, "frames", "frames", 1, 1000000, &out->frames, err) ||
+        !get_int(body, "warmup_frames", "warmup_frames", 0, 10000,
+                 &out->warmup_frames, err) ||
+        !get_int(body, "capture_interval", "capture_interval", 0, 1000000,
+                 &out->capture_interval, err) ||
+        !get_number(body, "async_distance", "async_distance", 0.0, 1e6,
+                    &out->async_distance, err))
+        return false;
+
+    json_t *scene, *osl;
+    if (!get_object(body, "scene", "scene", &scene, err) ||
+        (scene && !parse_scene(scene, &out->scene, err)) ||
+        !get_object(body, "osl", "osl", &osl, err) ||
+        (osl && !parse_osl(osl, &out->osl, err)))
+        return false;
+
+    if (out->capture_interval > out->frames)
+        return fail(err, "capture_interval",
+                    "must be 0 (no captures) or at most frames (%d)", out->frames);
+    /* Captured frames are kept in memory until the timed run ends, so that
+     * encoding never lands inside the measurement: bound that memory. */
+    double bytes = (double)job_spec_capture_count(out) * out->scene.width *
+                   out->scene.height * 4.0;
+    if (bytes > JOB_MAX_CAPTURE_BYTES)
+        return fail(err, "capture_interval",
+                    "would keep %d captures of %dx%d (%.0f MiB) in memory; the "
+                    "limit is %.0f MiB, raise capture_interval",
+                    job_spec_capture_count(out), out->scene.width,
+                    out->scene.height, bytes / 1048576.0,
+                    JOB_MAX_CAPTURE_BYTES / 1048576.0);
+    return true;
+}
+
+bool job_spec_parse_text(const char *text, size_t len,
+                         const char *const *techniques, struct job_spec *out,
+                         struct job_error *err)
+{
+    json_error_t jerr;
+    json_t *body = json_loadb(text, len, JSON_REJECT_DUPLICATES, &jerr);
+    if (!body) {
+        job_spec_defaults(out);
+        return fail(err, "body", "malformed JSON at line %d, column %d: %s",
+                    jerr.line, jerr.column, jerr.text);
+    }
+    bool ok = job_spec_parse(body, techniques, out, err);
+    json_decref(body);
+    return ok;
+}
+
+int job_spec_capture_count(const struct job_spec *spec)
+{
+    return spec->capture_interval > 0 ? spec->frames / spec->capture_interval : 0;
+}
+
+bool job_spec_is_capture_frame(const struct job_spec *spec, int frame)
+{
+    return spec->capture_interval > 0 && frame > 0 &&
+           frame % spec->capture_interval == 0;
+}
+
+json_t *job_spec_to_json(const struct job_spec *spec)
+{
+    json_t *res = spec->osl.resolution ? json_integer(spec->osl.resolution)
+                                       : json_string("auto");
+    return json_pack(
+        "{s:s, s:i, s:i, s:i, s:f, s:{s:s, s:i, s:b, s:i, s:i, s:i}, s:{s:o, s:f, s:s}}",
+        "technique", spec->technique, "frames", spec->frames, "warmup_frames",
+        spec->warmup_frames, "capture_interval", spec->capture_interval,
+        "async_distance", spec->async_distance, "scene", "preset",
+        spec->scene.preset, "lights", spec->scene.lights, "dynamic",
+        spec->scene.dynamic, "width", spec->scene.width, "height",
+        spec->scene.height, "sphere_segments", spec->scene.sphere_segments,
+        "osl", "resolution", res, "texel_density", spec->osl.texel_density,
+        "reshade", spec->osl.reshade == OSL_RESHADE_ALL ? "all" : "touched");
+}
+
+json_t *job_error_to_json(const struct job_error *err)
+{
+    return json_pack("{s:{s:s, s:s}}", "error", "field", err->field, "message",
+                     err->message);
+}

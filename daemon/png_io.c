@@ -1,0 +1,147 @@
+#define _POSIX_C_SOURCE 200809L
+#include "daemon/png_io.h"
+
+#include <png.h>
+#include <setjmp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static bool write_rows(const char *path, png_bytep *rows, int width, int height,
+                       char *err, size_t errlen)
+{
+    char tmp[4096];
+    snprintf(tmp, sizeof(tmp), "%s.tmp", path);
+    FILE *f = fopen(tmp, "wb");
+    if (!f) {
+        snprintf(err, errlen, "cannot write %s", tmp);
+        return false;
+    }
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+    png_infop info = png ? png_create_info_struct(png) : NULL;
+    if (!info || setjmp(png_jmpbuf(png))) {
+        snprintf(err, errlen, "libpng failed writing %s", path);
+        png_destroy_write_struct(&png, &info);
+        fclose(f);
+        remove(tmp);
+        return false;
+    }
+    png_init_io(png, f);
+    /* Captures are written once and read often; fast filtering, modest zlib level. */
+    png_set_compression_level(png, 3);
+    png_set_IHDR(png, info, (png_uint_32)width, (png_uint_32)height, 8, PNG_COLOR_TYPE_RGB,
+                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_write_info(png, info);
+    png_write_image(png, rows);
+    png_write_end(png, NULL);
+    png_destroy_write_struct(&png, &info);
+    if (fclose(f) != 0 || rename(tmp, path) != 0) {
+        snprintf(err, errlen, "cannot finish %s", path);
+        remove(tmp);
+        return false;
+    }
+    return true;
+}
+
+bool png_write_gl_rgba(const char *path, const uint8_t *rgba, int width,
+                       int height, char *err, size_t errlen)
+{
+    uint8_t *rgb = malloc((size_t)width * (size_t)height * 3);
+    png_bytep *rows = malloc((size_t)height * sizeof(*rows));
+    bool ok = false;
+    if (!rgb || !rows) {
+        snprintf(err, errlen, "out of memory encoding %s", path);
+        goto out;
+    }
+    for (int y = 0; y < height; y++) {
+        const uint8_t *src = rgba + (size_t)(height - 1 - y) * (size_t)width * 4;
+        uint8_t *dst = rgb + (size_t)y * (size_t)width * 3;
+        for (int x = 0; x < width; x++) {
+            dst[x * 3 + 0] = src[x * 4 + 0];
+            dst[x * 3 + 1] = src[x * 4 + 1];
+            dst[x * 3 + 2] = src[x * 4 + 2];
+        }
+        rows[y] = dst;
+    }
+    ok = write_rows(path, rows, width, height, err, errlen);
+out:
+    free(rows);
+    free(rgb);
+    return ok;
+}
+
+bool png_write_rgb(const char *path, const struct image *img, char *err, size_t errlen)
+{
+    png_bytep *rows = malloc((size_t)img->height * sizeof(*rows));
+    if (!rows) {
+        snprintf(err, errlen, "out of memory encoding %s", path);
+        return false;
+    }
+    for (int y = 0; y < img->height; y++)
+        rows[y] = img->rgb + (size_t)y * (size_t)img->width * 3;
+    bool ok = write_rows(path, rows, img->width, img->height, err, errlen);
+    free(rows);
+    return ok;
+}
+
+bool png_read_rgb(const char *path, struct image *out, char *err, size_t errlen)
+{
+    memset(out, 0, sizeof(*out));
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, errlen, "%s: cannot open", path);
+        return false;
+    }
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+    png_infop info = png ? png_create_info_struct(png) : NULL;
+    png_bytep *rows = NULL;
+    uint8_t *rgba = NULL;
+    if (!info || setjmp(png_jmpbuf(png))) {
+        snprintf(err, errlen, "%s: not a readable PNG", path);
+        goto fail;
+    }
+    png_init_io(png, f);
+    png_read_info(png, info);
+    int depth = png_get_bit_depth(png, info), type = png_get_color_type(png, info);
+    if (depth != 8 || (type != PNG_COLOR_TYPE_RGB && type != PNG_COLOR_TYPE_RGBA)) {
+        snprintf(err, errlen, "%s: must be 8-bit RGB or RGBA (bit depth %d, colour type %d)",
+                 path, depth, type);
+        goto fail;
+    }
+    int w = (int)png_get_image_width(png, info), h = (int)png_get_image_height(png, info);
+    int channels = type == PNG_COLOR_TYPE_RGBA ? 4 : 3;
+    rgba = malloc((size_t)w * (size_t)h * (size_t)channels);
+    rows = malloc((size_t)h * sizeof(*rows));
+    out->rgb = malloc((size_t)w * (size_t)h * 3);
+    if (!rgba || !rows || !out->rgb) {
+        snprintf(err, errlen, "%s: out of memory", path);
+        goto fail;
+    }
+    for (int y = 0; y < h; y++)
+        rows[y] = rgba + (size_t)y * (size_t)w * (size_t)channels;
+    png_read_image(png, rows);
+    for (size_t i = 0; i < (size_t)w * (size_t)h; i++)
+        memcpy(out->rgb + i * 3, rgba + i * (size_t)channels, 3);
+    out->width = w;
+    out->height = h;
+    png_destroy_read_struct(&png, &info, NULL);
+    free(rows);
+    free(rgba);
+    fclose(f);
+    return true;
+fail:
+    png_destroy_read_struct(&png, &info, NULL);
+    free(rows);
+    free(rgba);
+    image_finish(out);
+    fclose(f);
+    return false;
+}
+
+void image_finish(struct image *img)
+{
+    if (!img)
+        return;
+    free(img->rgb);
+    memset(img, 0, sizeof(*img));
+}

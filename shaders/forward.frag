@@ -1,0 +1,11 @@
+// Thesis ForwardProg: every light evaluated for every fragment.
+in vec3 v_world;
+in vec3 v_normal;
+flat in int v_instance;
+layout(location = 0) out vec4 out_color;
+
+void main()
+{
+    vec3 albedo = instances[v_instance].albedo_mesh.rgb;
+    out_color = vec4(phong(v_world, normalize(v_normal), albedo, 0), 1.0);
+}

@@ -1,0 +1,23 @@
+// OSL rasterization pass: draw every object, shading comes from its atlas tile.
+layout(location = 0) in vec3 a_pos;
+layout(location = 2) in vec2 a_uv;
+layout(location = 3) in vec4 a_chart;
+
+layout(std430, binding = 3) readonly buffer TileBuffer { ivec4 tiles[]; };
+
+uniform mat4 u_view_proj;
+uniform int u_instance_base;
+
+out vec2 v_uv;
+flat out vec4 v_chart;
+flat out ivec4 v_tile;
+
+void main()
+{
+    int id = u_instance_base + gl_InstanceID;
+    Instance inst = instances[id];
+    v_uv = a_uv;
+    v_chart = a_chart;
+    v_tile = tiles[id];
+    gl_Position = u_view_proj * vec4(inst.pos_scale.xyz + inst.pos_scale.w * a_pos, 1.0);
+}

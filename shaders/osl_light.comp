@@ -1,0 +1,50 @@
+// OSL lighting pass: one 8x8 block of one object's tile per work group. The
+// work list holds one entry per object to shade: (instance, light row,
+// first block, blocks per tile row); a group finds its entry by binary search.
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(std430, binding = 3) readonly buffer TileBuffer { ivec4 tiles[]; };   // x, y, size, level
+layout(std430, binding = 4) readonly buffer WorkBuffer { uvec4 work[]; };
+layout(rgba8, binding = 0) writeonly uniform image2D u_atlas;
+
+uniform sampler2D u_position[2]; // per mesh, mip level l holds tiles of size base >> l
+uniform sampler2D u_normal[2];
+uniform int u_work_count;
+uniform int u_groups_x;
+
+void main()
+{
+    uint group = gl_WorkGroupID.y * uint(u_groups_x) + gl_WorkGroupID.x;
+    int lo = 0, hi = u_work_count - 1;
+    if (u_work_count == 0 || group >= work[hi].z + work[hi].w * work[hi].w)
+        return;
+    while (lo < hi) {
+        int mid = (lo + hi + 1) / 2;
+        if (work[mid].z <= group)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    uvec4 w = work[lo];
+    int instance = int(w.x);
+    uint local_block = group - w.z;
+    ivec2 texel = ivec2(local_block % w.w, local_block / w.w) * 8 + ivec2(gl_LocalInvocationID.xy);
+    ivec4 tile = tiles[instance];
+
+    Instance inst = instances[instance];
+    vec4 p, n;
+    // The mesh differs between groups of one dispatch, so no dynamic indexing.
+    if (int(inst.albedo_mesh.w) == 0) {
+        p = texelFetch(u_position[0], texel, tile.w);
+        n = texelFetch(u_normal[0], texel, tile.w);
+    } else {
+        p = texelFetch(u_position[1], texel, tile.w);
+        n = texelFetch(u_normal[1], texel, tile.w);
+    }
+    vec3 color = vec3(0.0);
+    if (p.w > 0.0) {
+        vec3 world = inst.pos_scale.xyz + inst.pos_scale.w * p.xyz;
+        color = phong(world, normalize(n.xyz), inst.albedo_mesh.rgb, int(w.y));
+    }
+    imageStore(u_atlas, tile.xy + texel, vec4(color, 1.0));
+}

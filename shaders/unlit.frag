@@ -1,0 +1,10 @@
+// The cost floor: same geometry and passes, flat per-object colour, no lights.
+in vec3 v_world;
+in vec3 v_normal;
+flat in int v_instance;
+layout(location = 0) out vec4 out_color;
+
+void main()
+{
+    out_color = vec4(instances[v_instance].albedo_mesh.rgb, 1.0);
+}

@@ -1,0 +1,96 @@
+"""Object Space Lighting end to end: it shows forward's image within the
+stated texture-sampling bound, async shading shades fewer texels, the
+lighting pass runs once for still lights, frame k is the same image however
+the run started, and bad OSL options answer 400."""
+
+import os
+
+import testlib
+from testlib import check
+
+testlib.skip_without_egl()
+
+# The bound stated in the README (measured on llvmpipe at 320x240, static scene).
+MEAN_BOUND = {"256": 0.1, "auto": 0.25}   # mean |difference| per channel, 0..255
+MAX_BOUND = 64                            # largest difference, any channel
+OUTLIERS = 0.002                          # share of pixels off by more than 8
+
+SCENE = {"width": 320, "height": 240}
+
+
+def capture(d, job, name):
+    done = d.run(job)
+    check(done["status"] == "done", "%s done: %s" % (name, done.get("error")))
+    path = os.path.join(d.tmp, name + ".png")
+    d.download(done["result"]["captures"][-1]["url"], path)
+    return done.get("result", {}), path
+
+
+d = testlib.Daemon()
+try:
+    static = {"frames": 4, "warmup_frames": 1, "capture_interval": 4, "scene": SCENE}
+    _, fwd = capture(d, dict(static, technique="forward"), "forward")
+    for res in ("256", "auto"):
+        osl = {"resolution": int(res) if res.isdigit() else res}
+        result, path = capture(d, dict(static, technique="osl", osl=osl), "osl-" + res)
+        diff = testlib.png_diff(fwd, path)
+        check(diff and max(diff["mean_abs"]) <= MEAN_BOUND[res],
+              "osl %s mean difference within %.2f: %s" % (res, MEAN_BOUND[res], diff))
+        check(diff and diff["max_abs"] <= MAX_BOUND, "osl %s max difference <= %d" % (res, MAX_BOUND))
+        o = result.get("osl", {})
+        check(o.get("objects_reshaded_per_frame", {}).get("max") == 0,
+              "still lights: no reshading after the first frame (%s)" % o.get("objects_reshaded_per_frame"))
+        check(o.get("initial_shading", {}).get("objects") == 512, "first frame shades all 512")
+        check(o.get("atlas", {}).get("bytes", 0) > 0, "atlas size reported")
+        check({"lighting", "raster"} <= set(result.get("gpu_sections_ms", {})),
+              "lighting and raster GPU times reported apart")
+        if res == "256":
+            check(o["atlas"]["width"] == 8192 and o["atlas"]["height"] == 4096,
+                  "thesis mode: 512 tiles of 256x256 = 8192x4096")
+            texels_256 = o["atlas"]["tile_texels"]
+        else:
+            check(o["atlas"]["tile_texels"] < texels_256 / 4,
+                  "auto shades far fewer texels than 256 at 320x240: %s" % o["atlas"])
+
+    # Async shading: d > 0 shades fewer texels than d = 0 with moving lights.
+    dyn = {"technique": "osl", "frames": 12, "warmup_frames": 3, "scene": dict(SCENE, dynamic=True),
+           "osl": {"resolution": 32}}
+    d0 = d.run(dict(dyn, async_distance=0))["result"]["osl"]
+    d20 = d.run(dict(dyn, async_distance=20))["result"]["osl"]
+    check(0 < d20["texels_shaded_per_frame"]["mean"] < d0["texels_shaded_per_frame"]["mean"],
+          "async 20 shades fewer texels than async 0: %s vs %s" %
+          (d20["texels_shaded_per_frame"], d0["texels_shaded_per_frame"]))
+    check(d0["objects_reshaded_per_frame"]["max"] < 512,
+          "only objects a moving light reaches are reshaded (%s)" % d0["objects_reshaded_per_frame"])
+    every = d.run(dict(dyn, async_distance=0, osl={"resolution": 32, "reshade": "all"}))
+    check(every["result"]["osl"]["objects_reshaded_per_frame"]["mean"] == 512,
+          "reshade=all reshades every object, as the thesis did")
+
+    # Frame k is a pure function of k, even with stale (async) shading.
+    pure = dict(dyn, async_distance=20, capture_interval=10, frames=10)
+    _, a = capture(d, dict(pure, warmup_frames=0), "pure-a")
+    _, b = capture(d, dict(pure, warmup_frames=7), "pure-b")
+    diff = testlib.png_diff(a, b)
+    check(diff and diff["max_abs"] == 0, "frame 10 identical with 0 or 7 warm-up frames: %s" % diff)
+
+    # Bad OSL options name their field; an atlas too big fails the job clearly.
+    for body, field in (({"technique": "osl", "osl": {"resolution": 100}}, "osl.resolution"),
+                        ({"technique": "osl", "osl": {"resolution": "fine"}}, "osl.resolution"),
+                        ({"technique": "osl", "async_distance": -1}, "async_distance"),
+                        ({"technique": "osl", "osl": {"texel_density": -2}}, "osl.texel_density"),
+                        ({"technique": "osl", "osl": {"rezolution": 64}}, "osl.rezolution")):
+        code, reply = d.json("POST", "/v1/jobs", body)
+        check(code == 400 and reply.get("error", {}).get("field") == field,
+              "%s -> 400 naming %s (got %d %s)" % (body, field, code, reply))
+    big = d.run({"technique": "osl", "frames": 1, "warmup_frames": 0, "scene": SCENE,
+                 "osl": {"resolution": 1024}})
+    check(big["status"] == "failed" and "atlas" in big.get("error", ""),
+          "an atlas beyond the device fails with a clear message: %s" % big.get("error"))
+    check(d.run(dict(static, technique="osl"))["status"] == "done", "daemon serves on")
+finally:
+    code = d.stop()
+check(code == 0, "daemon exits 0 (got %s)" % code)
+if testlib.failures:
+    d.dump_log()
+d.cleanup(keep=testlib.failures > 0)
+testlib.finish("e2e_osl")

@@ -219,15 +219,23 @@ static enum MHD_Result job_routes(struct http_server *s, struct MHD_Connection *
                              "use GET or DELETE on a job");
     }
 
-    const char *sub = slash + 1;
+    /* Per-capture images: URL folder -> file prefix in the job's directory. */
+    static const char *const kinds[][2] = {
+        {"frames/", "frame"}, {"reference/", "reference"}, {"ssim/", "ssim"}, {"flip/", "flip"},
+    };
+    const char *sub = slash + 1, *prefix = NULL;
     char dir[PATH_MAX], path[PATH_MAX + 64];
     enum job_status status;
     bool csv = strcmp(sub, "timings.csv") == 0;
     int frame = 0;
     char tail[8] = "";
-    bool png = strncmp(sub, "frames/", 7) == 0 &&
-               sscanf(sub + 7, "%9d%7s", &frame, tail) == 2 && strcmp(tail, ".png") == 0 &&
-               frame > 0;
+    for (size_t k = 0; k < sizeof(kinds) / sizeof(kinds[0]) && !prefix; k++) {
+        size_t len = strlen(kinds[k][0]);
+        if (strncmp(sub, kinds[k][0], len) == 0 &&
+            sscanf(sub + len, "%9d%7s", &frame, tail) == 2 && strcmp(tail, ".png") == 0 && frame > 0)
+            prefix = kinds[k][1];
+    }
+    bool png = prefix != NULL;
     if (!csv && !png)
         return respond_error(c, MHD_HTTP_NOT_FOUND, "url", "no such resource");
     if (!get)
@@ -241,10 +249,11 @@ static enum MHD_Result job_routes(struct http_server *s, struct MHD_Connection *
         snprintf(path, sizeof(path), "%s/timings.csv", dir);
         return respond_file(c, path, "text/csv");
     }
-    snprintf(path, sizeof(path), "%s/frame-%06d.png", dir, frame);
+    snprintf(path, sizeof(path), "%s/%s-%06d.png", dir, prefix, frame);
     if (access(path, R_OK) != 0)
         return respond_error(c, MHD_HTTP_NOT_FOUND, "frame",
-                             "this frame was not captured (see result.captures)");
+                             "no such image: this frame was not captured, or the job has no "
+                             "reference or that metric (see result.captures)");
     return respond_file(c, path, "image/png");
 }
 
@@ -391,11 +400,11 @@ struct http_server *http_server_create(const char *listen, struct queue *q,
     if (ai->ai_family == AF_INET6)
         flags |= MHD_USE_IPv6;
     s->mhd = MHD_start_daemon(flags, (uint16_t)port, NULL, NULL, on_request, s,
+                              MHD_OPTION_EXTERNAL_LOGGER, on_mhd_log, s,
                               MHD_OPTION_SOCK_ADDR, ai->ai_addr,
                               MHD_OPTION_CONNECTION_LIMIT, (unsigned)MAX_CONNECTIONS,
                               MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)60,
                               MHD_OPTION_NOTIFY_COMPLETED, on_completed, s,
-                              MHD_OPTION_EXTERNAL_LOGGER, on_mhd_log, s,
                               MHD_OPTION_END);
     freeaddrinfo(ai);
     if (!s->mhd) {

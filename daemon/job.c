@@ -133,6 +133,26 @@ static bool get_object(const json_t *obj, const char *key, const char *field,
     return true;
 }
 
+/* A technique name from the registry; null gives "" where allowed. */
+static bool get_technique(const json_t *v, const char *field, const char *const *techniques,
+                          bool nullable, char *out, size_t cap, struct job_error *err)
+{
+    if (nullable && json_is_null(v)) {
+        out[0] = '\0';
+        return true;
+    }
+    char list[200] = "";
+    for (const char *const *t = techniques; *t; t++) {
+        if (json_is_string(v) && strcmp(*t, json_string_value(v)) == 0) {
+            snprintf(out, cap, "%s", *t);
+            return true;
+        }
+        size_t used = strlen(list);
+        snprintf(list + used, sizeof(list) - used, "%s\"%s\"", used ? ", " : "", *t);
+    }
+    return fail(err, field, "must be one of: %s%s", list, nullable ? ", or null" : "");
+}
+
 void job_spec_defaults(struct job_spec *out)
 {
     memset(out, 0, sizeof(*out));
@@ -150,6 +170,89 @@ void job_spec_defaults(struct job_spec *out)
     out->osl.resolution = 256;
     out->osl.texel_density = 1.0;
     out->osl.reshade = OSL_RESHADE_TOUCHED;
+    out->reference[0] = '\0';
+    metrics_options_defaults(&out->metrics);
+}
+
+static const char *const METRIC_NAMES[] = {"ssim", "pdiff", "psnr", "flip", NULL};
+
+static bool parse_pdiff(const json_t *v, struct pdiff_options *p, struct job_error *err)
+{
+    static const char *const keys[] = {"fov", "threshold_pixels", "gamma", "luminance",
+                                       "color_factor", "luminance_only", NULL};
+    int threshold = (int)p->threshold_pixels;
+    if (!check_keys(v, "metrics.pdiff.", keys, err) ||
+        !get_number(v, "fov", "metrics.pdiff.fov", 0.1, 179.0, &p->fov, err) ||
+        !get_int(v, "threshold_pixels", "metrics.pdiff.threshold_pixels", 0, 1000000000,
+                 &threshold, err) ||
+        !get_number(v, "gamma", "metrics.pdiff.gamma", 0.1, 10.0, &p->gamma, err) ||
+        !get_number(v, "luminance", "metrics.pdiff.luminance", 0.01, 100000.0,
+                    &p->luminance, err) ||
+        !get_number(v, "color_factor", "metrics.pdiff.color_factor", 0.0, 100.0,
+                    &p->color_factor, err) ||
+        !get_bool(v, "luminance_only", "metrics.pdiff.luminance_only", &p->luminance_only, err))
+        return false;
+    p->threshold_pixels = threshold;
+    return true;
+}
+
+/* "metrics": ["ssim", "flip"] computes those only; {"pdiff": {"fov": 30},
+ * "flip": false} configures or switches off single metrics, others stay on. */
+static bool parse_metrics(const json_t *v, struct metrics_options *m, struct job_error *err)
+{
+    if (json_is_array(v)) {
+        m->which = 0;
+        size_t i;
+        json_t *name;
+        json_array_foreach(v, i, name) {
+            unsigned bit = 0;
+            for (int k = 0; METRIC_NAMES[k]; k++)
+                if (json_is_string(name) && strcmp(json_string_value(name), METRIC_NAMES[k]) == 0)
+                    bit = 1u << k;
+            if (!bit)
+                return fail(err, "metrics", "must list metrics from: \"ssim\", \"pdiff\", "
+                            "\"psnr\", \"flip\"");
+            m->which |= bit;
+        }
+        if (!m->which)
+            return fail(err, "metrics", "must name at least one metric");
+        return true;
+    }
+    if (!json_is_object(v))
+        return fail(err, "metrics", "must be an object or a list of metric names");
+    if (!check_keys(v, "metrics.", METRIC_NAMES, err))
+        return false;
+    for (int k = 0; METRIC_NAMES[k]; k++) {
+        json_t *opt = json_object_get(v, METRIC_NAMES[k]);
+        char field[32];
+        snprintf(field, sizeof(field), "metrics.%s", METRIC_NAMES[k]);
+        if (!opt)
+            continue;
+        if (json_is_boolean(opt)) {
+            if (json_is_true(opt))
+                m->which |= 1u << k;
+            else
+                m->which &= ~(1u << k);
+            continue;
+        }
+        bool configurable = (1u << k) == METRIC_PDIFF || (1u << k) == METRIC_FLIP;
+        if (!json_is_object(opt) || !configurable)
+            return fail(err, field, configurable ? "must be true, false or an options object"
+                                                 : "must be true or false");
+        m->which |= 1u << k;
+        if ((1u << k) == METRIC_PDIFF && !parse_pdiff(opt, &m->pdiff, err))
+            return false;
+        if ((1u << k) == METRIC_FLIP) {
+            static const char *const keys[] = {"pixels_per_degree", NULL};
+            if (!check_keys(opt, "metrics.flip.", keys, err) ||
+                !get_number(opt, "pixels_per_degree", "metrics.flip.pixels_per_degree", 1.0,
+                            1000.0, &m->flip_ppd, err))
+                return false;
+        }
+    }
+    if (!m->which)
+        return fail(err, "metrics", "switches every metric off: leave out reference instead");
+    return true;
 }
 
 static bool parse_scene(const json_t *scene, struct scene_spec *s,
@@ -220,7 +323,7 @@ bool job_spec_parse(const json_t *body, const char *const *techniques,
 {
     static const char *const keys[] = {"technique", "frames", "warmup_frames",
                                        "capture_interval", "async_distance",
-                                       "scene", "osl", NULL};
+                                       "scene", "osl", "reference", "metrics", NULL};
     job_spec_defaults(out);
     memset(err, 0, sizeof(*err));
     if (!json_is_object(body))
@@ -229,21 +332,16 @@ bool job_spec_parse(const json_t *body, const char *const *techniques,
         return false;
 
     json_t *tech = json_object_get(body, "technique");
-    if (tech) {
-        bool known = false;
-        char list[200] = "";
-        for (const char *const *t = techniques; *t; t++) {
-            if (json_is_string(tech) && strcmp(*t, json_string_value(tech)) == 0)
-                known = true;
-            size_t used = strlen(list);
-            snprintf(list + used, sizeof(list) - used, "%s\"%s\"",
-                     used ? ", " : "", *t);
-        }
-        if (!known)
-            return fail(err, "technique", "must be one of: %s", list);
-        snprintf(out->technique, sizeof(out->technique), "%s",
-                 json_string_value(tech));
-    }
+    if (tech && !get_technique(tech, "technique", techniques, false, out->technique,
+                               sizeof(out->technique), err))
+        return false;
+    json_t *ref = json_object_get(body, "reference");
+    if (ref && !get_technique(ref, "reference", techniques, true, out->reference,
+                              sizeof(out->reference), err))
+        return false;
+    json_t *metrics = json_object_get(body, "metrics");
+    if (metrics && !parse_metrics(metrics, &out->metrics, err))
+        return false;
     if (!get_int(body, "frames", "frames", 1, 1000000, &out->frames, err) ||
         !get_int(body, "warmup_frames", "warmup_frames", 0, 10000,
                  &out->warmup_frames, err) ||
@@ -260,6 +358,14 @@ bool job_spec_parse(const json_t *body, const char *const *techniques,
         (osl && !parse_osl(osl, &out->osl, err)))
         return false;
 
+    if (out->reference[0] && out->capture_interval == 0)
+        return fail(err, "reference", "needs capture_interval > 0: metrics compare the "
+                    "captured frames with the reference's");
+    if (metrics && !out->reference[0])
+        return fail(err, "metrics", "needs a reference technique to compare with");
+    if (out->reference[0] && (out->metrics.which & METRIC_SSIM) &&
+        (out->scene.width < SSIM_WINDOW || out->scene.height < SSIM_WINDOW))
+        return fail(err, "metrics.ssim", "needs frames of at least 11x11 pixels");
     if (out->capture_interval > out->frames)
         return fail(err, "capture_interval",
                     "must be 0 (no captures) or at most frames (%d)", out->frames);
@@ -304,11 +410,34 @@ bool job_spec_is_capture_frame(const struct job_spec *spec, int frame)
            frame % spec->capture_interval == 0;
 }
 
+static json_t *metrics_to_json(const struct metrics_options *m)
+{
+    json_t *o = json_object();
+    const struct pdiff_options *p = &m->pdiff;
+    if (m->which & METRIC_SSIM)
+        json_object_set_new(o, "ssim", json_true());
+    if (m->which & METRIC_PDIFF)
+        json_object_set_new(o, "pdiff",
+                            json_pack("{s:f, s:I, s:f, s:f, s:f, s:b}", "fov", p->fov,
+                                      "threshold_pixels", (json_int_t)p->threshold_pixels,
+                                      "gamma", p->gamma, "luminance", p->luminance,
+                                      "color_factor", p->color_factor, "luminance_only",
+                                      p->luminance_only));
+    if (m->which & METRIC_PSNR)
+        json_object_set_new(o, "psnr", json_true());
+    if (m->which & METRIC_FLIP)
+        json_object_set_new(o, "flip", json_pack("{s:f}", "pixels_per_degree", m->flip_ppd));
+    for (int k = 0; METRIC_NAMES[k]; k++)
+        if (!(m->which & (1u << k)))
+            json_object_set_new(o, METRIC_NAMES[k], json_false());
+    return o;
+}
+
 json_t *job_spec_to_json(const struct job_spec *spec)
 {
     json_t *res = spec->osl.resolution ? json_integer(spec->osl.resolution)
                                        : json_string("auto");
-    return json_pack(
+    json_t *out = json_pack(
         "{s:s, s:i, s:i, s:i, s:f, s:{s:s, s:i, s:b, s:i, s:i, s:i}, s:{s:o, s:f, s:s}}",
         "technique", spec->technique, "frames", spec->frames, "warmup_frames",
         spec->warmup_frames, "capture_interval", spec->capture_interval,
@@ -318,6 +447,11 @@ json_t *job_spec_to_json(const struct job_spec *spec)
         spec->scene.height, "sphere_segments", spec->scene.sphere_segments,
         "osl", "resolution", res, "texel_density", spec->osl.texel_density,
         "reshade", spec->osl.reshade == OSL_RESHADE_ALL ? "all" : "touched");
+    json_object_set_new(out, "reference",
+                        spec->reference[0] ? json_string(spec->reference) : json_null());
+    if (spec->reference[0])
+        json_object_set_new(out, "metrics", metrics_to_json(&spec->metrics));
+    return out;
 }
 
 json_t *job_error_to_json(const struct job_error *err)

@@ -8,6 +8,8 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "daemon/metrics/metrics.h"
+
 #define JOB_MAX_BODY_BYTES (64 * 1024)
 #define JOB_MAX_CAPTURE_BYTES (1024.0 * 1024.0 * 1024.0)
 
@@ -38,6 +40,8 @@ struct job_spec {
     double async_distance;
     struct scene_spec scene;
     struct osl_spec osl;
+    char reference[32];            /* technique to compare captures with; "" for none */
+    struct metrics_options metrics; /* used when reference is set */
 };
 
 /* A rejection names the offending field (dotted path) and the rule it broke. */

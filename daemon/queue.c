@@ -144,6 +144,7 @@ struct job *queue_next(struct queue *q)
     }
     if (job) {
         job->status = JOB_RUNNING;
+        job->phase = "rendering";
         job->started = now_s();
         q->queued--;
         pthread_cond_broadcast(&q->changed);
@@ -156,6 +157,13 @@ void queue_progress(struct queue *q, struct job *job, int frames_done)
 {
     pthread_mutex_lock(&q->lock);
     job->frames_done = frames_done;
+    pthread_mutex_unlock(&q->lock);
+}
+
+void queue_set_phase(struct queue *q, struct job *job, const char *phase)
+{
+    pthread_mutex_lock(&q->lock);
+    job->phase = phase;
     pthread_mutex_unlock(&q->lock);
 }
 
@@ -177,6 +185,10 @@ void queue_stop(struct queue *q)
 {
     pthread_mutex_lock(&q->lock);
     q->stopping = true;
+    /* A running job stops at its next frame rather than holding up the exit. */
+    for (size_t i = 0; i < q->count; i++)
+        if (q->jobs[i]->status == JOB_RUNNING)
+            atomic_store(&q->jobs[i]->cancel, true);
     pthread_cond_broadcast(&q->changed);
     pthread_mutex_unlock(&q->lock);
 }
@@ -233,6 +245,8 @@ static json_t *job_json_locked(const struct job *job, bool full)
                           job->frames_done, "frames_total", job->frames_total, "created",
                           iso_time(job->created), "started", iso_time(job->started),
                           "finished", iso_time(job->finished));
+    if (job->status == JOB_RUNNING && job->phase)
+        json_object_set_new(o, "phase", json_string(job->phase));
     if (job->error[0])
         json_object_set_new(o, "error", json_string(job->error));
     if (full) {

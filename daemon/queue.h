@@ -18,6 +18,7 @@ struct job {
     char id[24];
     struct job_spec spec;
     enum job_status status;
+    const char *phase; /* while running: "rendering", "reference" or "metrics" */
     int frames_done, frames_total;
     atomic_bool cancel;
     char error[1024];
@@ -42,9 +43,12 @@ enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *sp
  * queue is stopping (returns NULL). */
 struct job *queue_next(struct queue *q);
 void queue_progress(struct queue *q, struct job *job, int frames_done);
+/* phase must be a string literal. */
+void queue_set_phase(struct queue *q, struct job *job, const char *phase);
 /* Takes ownership of result. */
 void queue_finish(struct queue *q, struct job *job, enum job_status status,
                   const char *error, json_t *result);
+/* No more jobs start; a running job is asked to stop at its next frame. */
 void queue_stop(struct queue *q);
 
 enum queue_cancel_result { CANCEL_DONE, CANCEL_REQUESTED, CANCEL_FINISHED, CANCEL_NOT_FOUND };

@@ -17,12 +17,14 @@
 #include "daemon/gpu_scene.h"
 #include "daemon/gpu_timer.h"
 #include "daemon/log.h"
+#include "daemon/metrics_worker.h"
 #include "daemon/png_io.h"
 #include "daemon/stats.h"
 #include "daemon/technique.h"
 
 struct runner {
     struct queue *queue;
+    struct metrics_worker *metrics;
     int device;
     bool gl_debug;
     pthread_t thread;
@@ -264,6 +266,59 @@ out:
     return result;
 }
 
+/* Renders the reference technique at exactly the captured frame indices,
+ * after the timed run (its time is in no figure). Each frame gets a fresh
+ * technique instance, since frame k is a pure function of k: a stateful
+ * technique (OSL) then shows what it would at frame k in a run of its own. */
+static bool render_reference(struct run *run, enum job_status *status)
+{
+    const struct job_spec *spec = run->spec;
+    const struct technique *ref = technique_find(spec->reference);
+    int w = spec->scene.width, h = spec->scene.height;
+    uint8_t *pixels = malloc((size_t)w * (size_t)h * 4);
+    struct gpu_timer *timer = ref ? gpu_timer_create(technique_section_count(ref), 1) : NULL;
+    bool ok = false;
+    if (!ref || !pixels || !timer) {
+        snprintf(run->err, sizeof(run->err), "reference %s: cannot prepare it", spec->reference);
+        goto out;
+    }
+    struct technique_ctx ctx = {spec, &run->scene, &run->gpu, timer};
+    for (int k = spec->capture_interval; k <= spec->frames; k += spec->capture_interval) {
+        if (atomic_load(&run->job->cancel)) {
+            *status = JOB_CANCELLED;
+            snprintf(run->err, sizeof(run->err), "cancelled while rendering the reference");
+            goto out;
+        }
+        void *state = NULL;
+        char why[900] = "";
+        if (!ref->create(&ctx, &state, why, sizeof(why))) {
+            snprintf(run->err, sizeof(run->err), "reference %s cannot run: %s", ref->name, why);
+            goto out;
+        }
+        glBindFramebuffer(GL_FRAMEBUFFER, run->fbo);
+        glViewport(0, 0, w, h);
+        gpu_timer_begin_frame(timer);
+        bool drawn = ref->render(state, &ctx, k, why, sizeof(why));
+        gpu_timer_end_frame(timer);
+        if (drawn)
+            glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, pixels);
+        ref->destroy(state);
+        if (!drawn || gl_error_take("reference rendering", why, sizeof(why))) {
+            snprintf(run->err, sizeof(run->err), "reference %s failed: %s", ref->name, why);
+            goto out;
+        }
+        char path[PATH_MAX + 32];
+        snprintf(path, sizeof(path), "%s/reference-%06d.png", run->job->dir, k);
+        if (!png_write_gl_rgba(path, pixels, w, h, run->err, sizeof(run->err)))
+            goto out;
+    }
+    ok = true;
+out:
+    gpu_timer_destroy(timer);
+    free(pixels);
+    return ok;
+}
+
 static void run_job(struct runner *r, struct job *job)
 {
     struct run run = {.runner = r, .job = job, .spec = &job->spec};
@@ -370,14 +425,29 @@ static void run_job(struct runner *r, struct job *job)
     if (gl_error_take("rendering", run.err, sizeof(run.err)))
         goto done;
     result = write_outputs(&run, wall_s, capture_s);
+    if (result && spec->reference[0]) {
+        /* Free the measured technique's resources before the reference's. */
+        run.tech->destroy(run.state);
+        run.state = NULL;
+        queue_set_phase(r->queue, job, "reference");
+        if (!render_reference(&run, &status)) {
+            json_decref(result);
+            result = NULL;
+        }
+    }
     if (result)
         status = JOB_DONE;
 done:
     if (status != JOB_DONE)
         LOG(LOG_WARN, "job %s %s: %s", job->id, job_status_name(status), run.err);
     else
-        LOG(LOG_INFO, "job %s done", job->id);
+        LOG(LOG_INFO, "job %s rendered", job->id);
     teardown(&run);
+    if (status == JOB_DONE && spec->reference[0]) {
+        queue_set_phase(r->queue, job, "metrics");
+        metrics_worker_submit(r->metrics, job, result);
+        return;
+    }
     queue_finish(r->queue, job, status, status == JOB_DONE ? NULL : run.err, result);
 }
 
@@ -420,6 +490,12 @@ struct runner *runner_create(struct queue *q, int device, bool gl_debug,
         return NULL;
     }
     r->queue = q;
+    r->metrics = metrics_worker_create(q);
+    if (!r->metrics) {
+        snprintf(err, errlen, "cannot start the metrics thread");
+        free(r);
+        return NULL;
+    }
     r->device = device;
     r->gl_debug = gl_debug;
     atomic_init(&r->alive, false);
@@ -427,6 +503,7 @@ struct runner *runner_create(struct queue *q, int device, bool gl_debug,
     pthread_cond_init(&r->ready_cond, NULL);
     if (pthread_create(&r->thread, NULL, runner_main, r) != 0) {
         snprintf(err, errlen, "cannot start the render thread");
+        metrics_worker_destroy(r->metrics);
         free(r);
         return NULL;
     }
@@ -437,6 +514,7 @@ struct runner *runner_create(struct queue *q, int device, bool gl_debug,
     if (r->ready < 0) {
         snprintf(err, errlen, "%s", r->error);
         pthread_join(r->thread, NULL);
+        metrics_worker_destroy(r->metrics);
         free(r);
         return NULL;
     }
@@ -449,6 +527,8 @@ void runner_destroy(struct runner *r)
         return;
     queue_stop(r->queue);
     pthread_join(r->thread, NULL);
+    /* After the render thread: it is the only one that hands work over. */
+    metrics_worker_destroy(r->metrics);
     json_decref(r->device_json);
     pthread_cond_destroy(&r->ready_cond);
     pthread_mutex_destroy(&r->lock);

@@ -14,12 +14,7 @@ testlib.skip_without_egl()
 SMALL = {"frames": 4, "warmup_frames": 0, "scene": {"width": 64, "height": 48}}
 
 
-def rejected(d, body, field, status=400, what=None):
-    code, reply = d.json("POST", "/v1/jobs", body)
-    err = reply.get("error", {}) if isinstance(reply, dict) else {}
-    ok = code == status and err.get("field") == field and len(err.get("message", "")) > 5
-    check(ok, "%s -> %d naming %r (got %d %s)" % (what or body, status, field, code, reply))
-
+rejected = testlib.rejects
 
 d = testlib.Daemon()
 try:
@@ -113,9 +108,5 @@ try:
     check(d.run(SMALL)["status"] == "done", "a new job runs after all of that")
     check(d.alive(), "daemon alive")
 finally:
-    code = d.stop()
-check(code == 0, "daemon exits 0 (got %s)" % code)
-if testlib.failures:
-    d.dump_log()
-d.cleanup(keep=testlib.failures > 0)
+    testlib.stop_and_check(d)
 testlib.finish("e2e_badinput")

@@ -79,18 +79,12 @@ try:
                         ({"technique": "osl", "async_distance": -1}, "async_distance"),
                         ({"technique": "osl", "osl": {"texel_density": -2}}, "osl.texel_density"),
                         ({"technique": "osl", "osl": {"rezolution": 64}}, "osl.rezolution")):
-        code, reply = d.json("POST", "/v1/jobs", body)
-        check(code == 400 and reply.get("error", {}).get("field") == field,
-              "%s -> 400 naming %s (got %d %s)" % (body, field, code, reply))
+        testlib.rejects(d, body, field)
     big = d.run({"technique": "osl", "frames": 1, "warmup_frames": 0, "scene": SCENE,
                  "osl": {"resolution": 1024}})
     check(big["status"] == "failed" and "atlas" in big.get("error", ""),
           "an atlas beyond the device fails with a clear message: %s" % big.get("error"))
     check(d.run(dict(static, technique="osl"))["status"] == "done", "daemon serves on")
 finally:
-    code = d.stop()
-check(code == 0, "daemon exits 0 (got %s)" % code)
-if testlib.failures:
-    d.dump_log()
-d.cleanup(keep=testlib.failures > 0)
+    testlib.stop_and_check(d)
 testlib.finish("e2e_osl")

@@ -138,6 +138,23 @@ class Daemon:
         return status
 
 
+def rejects(d, body, field, status=400, what=None):
+    """POST body as a job; it must be refused with status, naming field."""
+    code, reply = d.json("POST", "/v1/jobs", body)
+    err = reply.get("error", {}) if isinstance(reply, dict) else {}
+    return check(code == status and err.get("field") == field and len(err.get("message", "")) > 5,
+                 "%s -> %d naming %r (got %d %s)" % (what or body, status, field, code, reply))
+
+
+def stop_and_check(d):
+    """SIGTERM the daemon, which must exit 0; keep its files if anything failed."""
+    code = d.stop()
+    check(code == 0, "daemon exits 0 on SIGTERM (got %s)" % code)
+    if failures:
+        d.dump_log()
+    d.cleanup(keep=failures > 0)
+
+
 def png_info(path):
     out = subprocess.run([PNG_TOOL, "info", path], capture_output=True, text=True)
     return json.loads(out.stdout) if out.returncode == 0 else None

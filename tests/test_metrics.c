@@ -56,18 +56,20 @@ static void test_ssim(void)
     CHECK(s.map && s.map_w == 54 && s.map_h == 38);
     free(s.map);
 
-    /* Flat images: only the luminance term is left, exactly. */
+    /* Flat images: only the luminance term is left (float accumulation: the
+     * scikit-image agreement test bounds the error at 1e-4; flat images are
+     * the worst case, measured at 3.4e-5). */
     struct image f1 = make(20, 20, 200, 200, 200), f2 = make(20, 20, 190, 190, 190);
     CHECK(ssim_compute(&f1, &f2, false, &s, err, sizeof(err)));
     double c1 = 2.55 * 2.55;
-    CHECK_NEAR(s.luma, (2.0 * 200 * 190 + c1) / (200.0 * 200 + 190.0 * 190 + c1), 1e-9);
+    CHECK_NEAR(s.luma, (2.0 * 200 * 190 + c1) / (200.0 * 200 + 190.0 * 190 + c1), 5e-5);
 
     /* Symmetric, and falling as the difference grows. */
     struct image n1 = noisy(&a, 5, 1), n2 = noisy(&a, 25, 2), n3 = noisy(&a, 80, 3);
     struct ssim_result s1, s2, s3, back;
     CHECK(ssim_compute(&a, &n1, false, &s1, err, sizeof(err)));
     CHECK(ssim_compute(&n1, &a, false, &back, err, sizeof(err)));
-    CHECK_NEAR(s1.luma, back.luma, 1e-12);
+    CHECK_NEAR(s1.luma, back.luma, 1e-6);
     CHECK(ssim_compute(&a, &n2, false, &s2, err, sizeof(err)));
     CHECK(ssim_compute(&a, &n3, false, &s3, err, sizeof(err)));
     CHECK(1.0 > s1.luma && s1.luma > s2.luma && s2.luma > s3.luma);

@@ -1,3 +1,4 @@
+#define _DEFAULT_SOURCE /* M_SQRT1_2 */
 /* LDR-FLIP: P. Andersson, J. Nilsson, T. Akenine-Moller, M. Oskarsson,
  * K. Astrom and M. D. Fairchild, "FLIP: A Difference Evaluator for
  * Alternating Images", HPG 2020. Constants as published (and as in NVIDIA's
@@ -56,55 +57,55 @@ static void mat3(const double m[3][3], const double in[3], double out[3])
         out[r] = m[r][0] * in[0] + m[r][1] * in[1] + m[r][2] * in[2];
 }
 
-static void linear_to_hunt_lab(const double rgb[3], double lab[3])
+/* Per-pixel colour work is in float, as in NVIDIA's C++ reference. */
+static void linear_to_hunt_lab(const double rgb[3], float lab[3])
 {
-    double xyz[3], f[3];
+    double xyz[3];
+    float f[3];
     mat3(RGB2XYZ, rgb, xyz);
-    const double delta = 6.0 / 29.0, d3 = delta * delta * delta, factor = 1.0 / (3.0 * delta * delta);
+    const float delta = 6.0f / 29.0f, d3 = delta * delta * delta,
+                factor = 1.0f / (3.0f * delta * delta);
     for (int i = 0; i < 3; i++) {
-        double v = xyz[i] * INV_WHITE[i];
-        f[i] = v > d3 ? cbrt(v) : factor * v + 4.0 / 29.0;
+        float v = (float)(xyz[i] * INV_WHITE[i]);
+        f[i] = v > d3 ? cbrtf(v) : factor * v + 4.0f / 29.0f;
     }
-    lab[0] = 116.0 * f[1] - 16.0;
-    lab[1] = 0.01 * lab[0] * 500.0 * (f[0] - f[1]);
-    lab[2] = 0.01 * lab[0] * 200.0 * (f[1] - f[2]);
+    lab[0] = 116.0f * f[1] - 16.0f;
+    lab[1] = 0.01f * lab[0] * 500.0f * (f[0] - f[1]);
+    lab[2] = 0.01f * lab[0] * 200.0f * (f[1] - f[2]);
 }
 
-static double hyab(const double a[3], const double b[3])
+static float hyab(const float a[3], const float b[3])
 {
-    double dl = a[0] - b[0], da = a[1] - b[1], db = a[2] - b[2];
-    return fabs(dl) + sqrt(da * da + db * db);
+    float dl = a[0] - b[0], da = a[1] - b[1], db = a[2] - b[2];
+    return fabsf(dl) + sqrtf(da * da + db * db);
 }
 
-/* Separable filter with replicated borders: dst = ky (x) kx * src. */
-static void filter(float *dst, const float *src, float *tmp, int w, int h, const float *kx,
-                   int rx, const float *ky, int ry)
+/* Separable filter with replicated borders: dst = ky (x) kx * src. Taps
+ * run outermost so the inner loops vectorize; row holds one padded row. */
+METRICS_SIMD static void filter(float *dst, const float *src, float *tmp, float *row, int w, int h,
+                   const float *kx, int rx, const float *ky, int ry)
 {
     for (int y = 0; y < h; y++) {
-        const float *row = src + (size_t)y * (size_t)w;
+        const float *in = src + (size_t)y * (size_t)w;
         float *out = tmp + (size_t)y * (size_t)w;
-        for (int x = 0; x < w; x++) {
-            float s = 0;
-            if (x >= rx && x < w - rx) {
-                const float *p = row + x - rx;
-                for (int i = 0; i <= 2 * rx; i++)
-                    s += kx[i] * p[i];
-            } else {
-                for (int i = -rx; i <= rx; i++) {
-                    int xx = x + i < 0 ? 0 : (x + i >= w ? w - 1 : x + i);
-                    s += kx[i + rx] * row[xx];
-                }
-            }
-            out[x] = s;
+        for (int x = -rx; x < w + rx; x++)
+            row[x + rx] = in[x < 0 ? 0 : (x >= w ? w - 1 : x)];
+        for (int x = 0; x < w; x++)
+            out[x] = 0.0f;
+        for (int i = 0; i <= 2 * rx; i++) {
+            const float k = kx[i], *r = row + i;
+            for (int x = 0; x < w; x++)
+                out[x] += k * r[x];
         }
     }
     for (int y = 0; y < h; y++) {
         float *out = dst + (size_t)y * (size_t)w;
-        memset(out, 0, (size_t)w * sizeof(float));
+        for (int x = 0; x < w; x++)
+            out[x] = 0.0f;
         for (int j = -ry; j <= ry; j++) {
             int yy = y + j < 0 ? 0 : (y + j >= h ? h - 1 : y + j);
             const float *in = tmp + (size_t)yy * (size_t)w;
-            float k = ky[j + ry];
+            const float k = ky[j + ry];
             for (int x = 0; x < w; x++)
                 out[x] += k * in[x];
         }
@@ -144,13 +145,13 @@ static void make_csf(struct csf_filter *f, double ppd, double a1, double b1, dou
         f->weight[t] = (float)(mass[t] / total);
 }
 
-static void apply_csf(float *plane, float *acc, float *tmp, float *tmp2, int w, int h,
-                      const struct csf_filter *f)
+static void apply_csf(float *plane, float *acc, float *tmp, float *tmp2, float *row, int w,
+                      int h, const struct csf_filter *f)
 {
     size_t n = (size_t)w * (size_t)h;
     memset(acc, 0, n * sizeof(float));
     for (int t = 0; t < f->terms; t++) {
-        filter(tmp2, plane, tmp, w, h, f->kernel[t], f->radius, f->kernel[t], f->radius);
+        filter(tmp2, plane, tmp, row, w, h, f->kernel[t], f->radius, f->kernel[t], f->radius);
         for (size_t i = 0; i < n; i++)
             acc[i] += f->weight[t] * tmp2[i];
     }
@@ -195,24 +196,49 @@ static void make_features(struct feature_filter *f, double ppd)
 
 /* Edge and point magnitudes of a luminance plane. */
 static void features(const float *y, float *edge, float *point, float *tmp, float *a, float *b,
-                     int w, int h, const struct feature_filter *f)
+                     float *row, int w, int h, const struct feature_filter *f)
 {
     size_t n = (size_t)w * (size_t)h;
     int r = f->radius;
-    filter(a, y, tmp, w, h, f->edge, r, f->gauss, r);
-    filter(b, y, tmp, w, h, f->gauss, r, f->edge, r);
+    filter(a, y, tmp, row, w, h, f->edge, r, f->gauss, r);
+    filter(b, y, tmp, row, w, h, f->gauss, r, f->edge, r);
     for (size_t i = 0; i < n; i++)
-        edge[i] = hypotf(a[i], b[i]);
-    filter(a, y, tmp, w, h, f->point, r, f->gauss, r);
-    filter(b, y, tmp, w, h, f->gauss, r, f->point, r);
+        edge[i] = sqrtf(a[i] * a[i] + b[i] * b[i]);
+    filter(a, y, tmp, row, w, h, f->point, r, f->gauss, r);
+    filter(b, y, tmp, row, w, h, f->gauss, r, f->point, r);
     for (size_t i = 0; i < n; i++)
-        point[i] = hypotf(a[i], b[i]);
+        point[i] = sqrtf(a[i] * a[i] + b[i] * b[i]);
 }
 
-static int cmp_float(const void *a, const void *b)
+/* Sorts non-negative floats: their bit patterns order as unsigned integers,
+ * so two 16-bit radix passes do it in linear time. */
+static bool sort_nonnegative(float *v, size_t n)
 {
-    float x = *(const float *)a, y = *(const float *)b;
-    return (x > y) - (x < y);
+    uint32_t *a = (uint32_t *)v, *b = malloc(n * sizeof(uint32_t));
+    size_t *count = calloc(65536, sizeof(size_t));
+    if (!b || !count) {
+        free(b);
+        free(count);
+        return false;
+    }
+    for (int pass = 0; pass < 2; pass++) {
+        int shift = pass * 16;
+        memset(count, 0, 65536 * sizeof(size_t));
+        for (size_t i = 0; i < n; i++)
+            count[(a[i] >> shift) & 0xffff]++;
+        size_t pos = 0;
+        for (size_t k = 0; k < 65536; k++) {
+            size_t c = count[k];
+            count[k] = pos;
+            pos += c;
+        }
+        for (size_t i = 0; i < n; i++)
+            b[count[(a[i] >> shift) & 0xffff]++] = a[i];
+        memcpy(a, b, n * sizeof(uint32_t));
+    }
+    free(b);
+    free(count);
+    return true;
 }
 
 /* FLIP's weighted percentile: each error weighted by itself; the first
@@ -242,13 +268,14 @@ bool flip_compute(const struct image *ref, const struct image *test, double ppd,
     }
     int w = ref->width, h = ref->height;
     size_t n = (size_t)w * (size_t)h;
-    /* planes: 3 colour + 1 luminance per image, error map, 4 scratch */
-    float *buf = malloc(n * sizeof(float) * 13);
+    /* planes: 3 colour + 1 luminance per image, error map, 4 scratch, a row */
+    float *buf = malloc(n * sizeof(float) * 13 + ((size_t)w + 2 * MAX_RADIUS + 2) * sizeof(float));
     if (!buf) {
         snprintf(err, errlen, "flip: out of memory");
         return false;
     }
     float *img[2][4], *map = buf + n * 8, *s0 = map + n, *s1 = s0 + n, *s2 = s1 + n, *s3 = s2 + n;
+    float *row = s3 + n;
     for (int k = 0; k < 2; k++)
         for (int c = 0; c < 4; c++)
             img[k][c] = buf + n * (size_t)(k * 4 + c);
@@ -276,17 +303,24 @@ bool flip_compute(const struct image *ref, const struct image *test, double ppd,
             img[k][3][i] = (float)y;                  /* (Yy + 16) / 116 */
         }
         for (int c = 0; c < 3; c++)
-            apply_csf(img[k][c], s0, s1, s2, w, h, &csf[c]);
+            apply_csf(img[k][c], s0, s1, s2, row, w, h, &csf[c]);
     }
 
     /* Colour difference, written into map. */
-    double lab_g[3], lab_b[3];
+    float lab_g[3], lab_b[3];
     linear_to_hunt_lab((double[3]){0, 1, 0}, lab_g);
     linear_to_hunt_lab((double[3]){0, 0, 1}, lab_b);
     const double qc = 0.7, qf = 0.5, pc = 0.4, pt = 0.95;
-    double cmax = pow(hyab(lab_g, lab_b), qc), pccmax = pc * cmax;
+    const float cmax = powf(hyab(lab_g, lab_b), (float)qc), pccmax = (float)pc * cmax;
     for (size_t i = 0; i < n; i++) {
-        double lab[2][3];
+        /* Same filtered colour in both images: no colour error, and none in
+         * the final value either (0 raised to 1 - feature error). */
+        if (img[0][0][i] == img[1][0][i] && img[0][1][i] == img[1][1][i] &&
+            img[0][2][i] == img[1][2][i]) {
+            map[i] = 0.0f;
+            continue;
+        }
+        float lab[2][3];
         for (int k = 0; k < 2; k++) {
             double yv = (img[k][0][i] + 16.0) / 116.0;
             double xyz[3] = {(yv + img[k][1][i] / 500.0) * WHITE[0], yv * WHITE[1],
@@ -297,33 +331,45 @@ bool flip_compute(const struct image *ref, const struct image *test, double ppd,
                 rgb[c] = rgb[c] < 0 ? 0 : (rgb[c] > 1 ? 1 : rgb[c]);
             linear_to_hunt_lab(rgb, lab[k]);
         }
-        double e = pow(hyab(lab[0], lab[1]), qc);
-        map[i] = (float)(e < pccmax ? pt / pccmax * e
-                                    : pt + (e - pccmax) / (cmax - pccmax) * (1.0 - pt));
+        float e = powf(hyab(lab[0], lab[1]), (float)qc);
+        map[i] = e < pccmax ? (float)pt / pccmax * e
+                            : (float)pt + (e - pccmax) / (cmax - pccmax) * (1.0f - (float)pt);
     }
 
     /* Feature difference; the colour planes of both images are free now. */
     float *edge_r = img[0][0], *point_r = img[0][1], *edge_t = img[1][0], *point_t = img[1][1];
-    features(img[0][3], edge_r, point_r, s0, s1, s2, w, h, &feat);
-    features(img[1][3], edge_t, point_t, s0, s1, s2, w, h, &feat);
+    features(img[0][3], edge_r, point_r, s0, s1, s2, row, w, h, &feat);
+    features(img[1][3], edge_t, point_t, s0, s1, s2, row, w, h, &feat);
     double sum = 0;
     out->min = INFINITY;
     out->max = 0;
     for (size_t i = 0; i < n; i++) {
-        double de = fabs((double)edge_r[i] - edge_t[i]), dp = fabs((double)point_r[i] - point_t[i]);
-        double f = pow((de > dp ? de : dp) / sqrt(2.0), qf);
-        double v = pow(map[i], 1.0 - f);
+        if (map[i] == 0.0f) {
+            out->min = 0.0;
+            continue;
+        }
+        float de = fabsf(edge_r[i] - edge_t[i]), dp = fabsf(point_r[i] - point_t[i]);
+        float f = powf((de > dp ? de : dp) * (float)M_SQRT1_2, (float)qf);
+        double v = powf(map[i], 1.0f - f);
         map[i] = (float)v;
         sum += v;
         out->min = v < out->min ? v : out->min;
         out->max = v > out->max ? v : out->max;
     }
     out->mean = sum / (double)n;
-    memcpy(s3, map, n * sizeof(float));
-    qsort(s3, n, sizeof(float), cmp_float);
-    out->weighted_q1 = weighted_percentile(s3, n, sum, 0.25);
-    out->weighted_median = weighted_percentile(s3, n, sum, 0.50);
-    out->weighted_q3 = weighted_percentile(s3, n, sum, 0.75);
+    /* Zeros weigh nothing in the weighted percentiles: sort the rest only. */
+    size_t nonzero = 0;
+    for (size_t i = 0; i < n; i++)
+        if (map[i] > 0.0f)
+            s3[nonzero++] = map[i];
+    if (!sort_nonnegative(s3, nonzero)) {
+        snprintf(err, errlen, "flip: out of memory");
+        free(buf);
+        return false;
+    }
+    out->weighted_q1 = weighted_percentile(s3, nonzero, sum, 0.25);
+    out->weighted_median = weighted_percentile(s3, nonzero, sum, 0.50);
+    out->weighted_q3 = weighted_percentile(s3, nonzero, sum, 0.75);
     if (keep_map) {
         out->map = malloc(n * sizeof(float));
         if (out->map)

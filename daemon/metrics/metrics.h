@@ -13,6 +13,14 @@
 
 #include "daemon/png_io.h"
 
+/* Hot filter loops are also built for AVX2/FMA and picked at load time
+ * (GCC target_clones), so one binary runs everywhere and fast where it can. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define METRICS_SIMD __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define METRICS_SIMD
+#endif
+
 /* SSIM's window: 11x11 Gaussian, sigma 1.5 (Wang et al. 2004, section III-C). */
 #define SSIM_WINDOW 11
 

@@ -98,24 +98,32 @@ static int mirror(int v, int n)
     return v;
 }
 
-/* Level i+1 = level i blurred (separable, so two 1-D passes). */
-static void blur(float *dst, const float *src, float *tmp, int w, int h)
+/* Level i+1 = level i blurred (separable: two 1-D passes, taps outermost so
+ * the inner loops vectorize). Borders mirror as perceptualdiff's do. */
+METRICS_SIMD static void blur(float *dst, const float *src, float *tmp, float *row, int w, int h)
 {
     static const float k[5] = {0.05f, 0.25f, 0.4f, 0.25f, 0.05f};
-    for (int y = 0; y < h; y++)
-        for (int x = 0; x < w; x++) {
-            float s = 0;
-            for (int i = -2; i <= 2; i++)
-                s += k[i + 2] * src[(size_t)y * (size_t)w + (size_t)mirror(x + i, w)];
-            tmp[(size_t)y * (size_t)w + (size_t)x] = s;
+    for (int y = 0; y < h; y++) {
+        const float *in = src + (size_t)y * (size_t)w;
+        float *out = tmp + (size_t)y * (size_t)w;
+        for (int x = -2; x < w + 2; x++)
+            row[x + 2] = in[mirror(x, w)];
+        for (int x = 0; x < w; x++)
+            out[x] = 0.0f;
+        for (int i = 0; i < 5; i++)
+            for (int x = 0; x < w; x++)
+                out[x] += k[i] * row[x + i];
+    }
+    for (int y = 0; y < h; y++) {
+        float *out = dst + (size_t)y * (size_t)w;
+        for (int x = 0; x < w; x++)
+            out[x] = 0.0f;
+        for (int j = -2; j <= 2; j++) {
+            const float *in = tmp + (size_t)mirror(y + j, h) * (size_t)w;
+            for (int x = 0; x < w; x++)
+                out[x] += k[j + 2] * in[x];
         }
-    for (int y = 0; y < h; y++)
-        for (int x = 0; x < w; x++) {
-            float s = 0;
-            for (int j = -2; j <= 2; j++)
-                s += k[j + 2] * tmp[(size_t)mirror(y + j, h) * (size_t)w + (size_t)x];
-            dst[(size_t)y * (size_t)w + (size_t)x] = s;
-        }
+    }
 }
 
 bool pdiff_compute(const struct image *a, const struct image *b,
@@ -134,30 +142,29 @@ bool pdiff_compute(const struct image *a, const struct image *b,
         out->identical = true;
         return true;
     }
-    /* Two pyramids of LEVELS planes, a* and b* of both images, one scratch. */
-    float *buf = malloc(n * sizeof(float) * (2 * LEVELS + 5));
+    /* Two pyramids of LEVELS planes and one scratch plane. */
+    float *buf = malloc(n * sizeof(float) * (2 * LEVELS + 1) + ((size_t)w + 4) * sizeof(float));
     if (!buf) {
         snprintf(err, errlen, "pdiff: out of memory");
         return false;
     }
-    float *la = buf, *lb = la + n * LEVELS, *aa = lb + n * LEVELS, *ab = aa + n,
-          *ba = ab + n, *bb = ba + n, *tmp = bb + n;
-    const float gamma = (float)o->gamma, lum = (float)o->luminance;
+    float *la = buf, *lb = la + n * LEVELS, *tmp = lb + n * LEVELS, *row = tmp + n;
+    /* pow(c / 255, gamma) for every 8-bit value: the same float as computing it. */
+    float linear[256];
+    for (int v = 0; v < 256; v++)
+        linear[v] = powf(v / 255.0f, (float)o->gamma);
+    const float lum = (float)o->luminance;
     for (size_t i = 0; i < n; i++) {
         float x, y, z;
         const uint8_t *p = a->rgb + i * 3, *q = b->rgb + i * 3;
-        adobe_rgb_to_xyz(powf(p[0] / 255.0f, gamma), powf(p[1] / 255.0f, gamma),
-                         powf(p[2] / 255.0f, gamma), &x, &y, &z);
-        xyz_to_ab(x, y, z, &aa[i], &ab[i]);
+        adobe_rgb_to_xyz(linear[p[0]], linear[p[1]], linear[p[2]], &x, &y, &z);
         la[i] = y * lum;
-        adobe_rgb_to_xyz(powf(q[0] / 255.0f, gamma), powf(q[1] / 255.0f, gamma),
-                         powf(q[2] / 255.0f, gamma), &x, &y, &z);
-        xyz_to_ab(x, y, z, &ba[i], &bb[i]);
+        adobe_rgb_to_xyz(linear[q[0]], linear[q[1]], linear[q[2]], &x, &y, &z);
         lb[i] = y * lum;
     }
     for (int l = 1; l < LEVELS; l++) {
-        blur(la + n * (size_t)l, la + n * (size_t)(l - 1), tmp, w, h);
-        blur(lb + n * (size_t)l, lb + n * (size_t)(l - 1), tmp, w, h);
+        blur(la + n * (size_t)l, la + n * (size_t)(l - 1), tmp, row, w, h);
+        blur(lb + n * (size_t)l, lb + n * (size_t)(l - 1), tmp, row, w, h);
     }
 
     /* Pixels spanning one degree at this field of view, and the pyramid level
@@ -182,6 +189,11 @@ bool pdiff_compute(const struct image *a, const struct image *b,
 
     long failed = 0;
     for (size_t i = 0; i < n; i++) {
+        /* Identical colours give a zero luminance and colour difference, which
+         * pass both tests whatever the threshold: no need to compute it. */
+        const uint8_t *p = a->rgb + i * 3, *q = b->rgb + i * 3;
+        if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2])
+            continue;
         float adapt = (la[n * (size_t)adapt_level + i] + lb[n * (size_t)adapt_level + i]) * 0.5f;
         if (adapt < 1e-5f)
             adapt = 1e-5f;
@@ -206,7 +218,12 @@ bool pdiff_compute(const struct image *a, const struct image *b,
         bool pass = delta <= factor * tvi(adapt);
         if (!o->luminance_only) {
             float color_scale = adapt < 10.0f ? 0.0f : (float)o->color_factor;
-            float da = aa[i] - ba[i], db = ab[i] - bb[i];
+            float x, y, z, aa, ab, ba, bb;
+            adobe_rgb_to_xyz(linear[p[0]], linear[p[1]], linear[p[2]], &x, &y, &z);
+            xyz_to_ab(x, y, z, &aa, &ab);
+            adobe_rgb_to_xyz(linear[q[0]], linear[q[1]], linear[q[2]], &x, &y, &z);
+            xyz_to_ab(x, y, z, &ba, &bb);
+            float da = aa - ba, db = ab - bb;
             if ((da * da + db * db) * color_scale > factor)
                 pass = false;
         }

@@ -115,11 +115,15 @@ for name, _, dyn in CONFIGS:
              cell(name, "frame_ms", fwd), cell(name, "frame_ms", unl),
              cell(name, "gpu_ms", fwd), cell(name, "gpu_ms", unl), objs, tex))
 
-http_wall = statistics.median(r["wall_s"] for r in overhead["http"])
-once_wall = statistics.median(r["wall_s"] for r in overhead["once"])
-print("\ndaemon overhead, forward/dynamic: HTTP job wall %.3f s, --once wall %.3f s, ratio %.3f; "
-      "frame_ms median ratio %.3f" % (http_wall, once_wall, http_wall / once_wall,
-                                       med(overhead["http"], "frame_ms") / med(overhead["once"], "frame_ms")))
+# Each HTTP job ran right before its --once twin: the median of the paired
+# ratios is robust to the machine drifting over a long run.
+pairs = list(zip(overhead["http"], overhead["once"]))
+wall_ratio = statistics.median(h["wall_s"] / o["wall_s"] for h, o in pairs)
+frame_ratio = statistics.median(h["frame_ms"]["median"] / o["frame_ms"]["median"] for h, o in pairs)
+print("\ndaemon overhead, forward/dynamic, %d pairs: HTTP job / --once = %.3f (wall_s), %.3f "
+      "(frame_ms median); walls %s s against %s s"
+      % (len(pairs), wall_ratio, frame_ratio,
+         "/".join("%.2f" % h["wall_s"] for h, _ in pairs), "/".join("%.2f" % o["wall_s"] for _, o in pairs)))
 if args.json:
     with open(args.json, "w") as f:
         json.dump({"device": info, "args": vars(args), "results": results, "overhead": overhead}, f)

@@ -10,10 +10,10 @@ from testlib import check
 
 testlib.skip_without_egl()
 
-# The bound stated in the README (measured on llvmpipe at 320x240, static scene).
-MEAN_BOUND = {"256": 0.1, "auto": 0.25}   # mean |difference| per channel, 0..255
-MAX_BOUND = 64                            # largest difference, any channel
-OUTLIERS = 0.002                          # share of pixels off by more than 8
+# The bound stated in the README (static scene; measured on llvmpipe at
+# 320x240: mean 0.007 and 0.033, largest 13 and 39, for 256 and auto).
+MEAN_BOUND = {"256": 0.05, "auto": 0.1}   # mean |difference| per channel, 0..255
+MAX_BOUND = 48                            # largest difference, any channel
 
 SCENE = {"width": 320, "height": 240}
 

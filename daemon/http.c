@@ -5,6 +5,7 @@
 #include <fcntl.h>
 #include <microhttpd.h>
 #include <netdb.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,7 +29,39 @@ struct http_server {
     struct queue *queue;
     struct runner *runner;
     int port;
+    pthread_mutex_t token_lock;
+    char token[512];
 };
+
+/* Compares in time that depends on the expected token's length only, never
+ * on where the first differing byte is. */
+static bool token_matches(const char *given, const char *expected)
+{
+    size_t given_len = strlen(given), expected_len = strlen(expected);
+    unsigned char diff = given_len != expected_len;
+    for (size_t i = 0; i < expected_len; i++)
+        diff |= (unsigned char)(expected[i] ^ (i < given_len ? given[i] : 0));
+    return diff == 0;
+}
+
+static bool authorized(struct http_server *s, struct MHD_Connection *c)
+{
+    pthread_mutex_lock(&s->token_lock);
+    bool ok = s->token[0] == '\0';
+    if (!ok) {
+        const char *auth = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Authorization");
+        ok = auth && strncmp(auth, "Bearer ", 7) == 0 && token_matches(auth + 7, s->token);
+    }
+    pthread_mutex_unlock(&s->token_lock);
+    return ok;
+}
+
+void http_server_set_token(struct http_server *s, const char *token)
+{
+    pthread_mutex_lock(&s->token_lock);
+    snprintf(s->token, sizeof(s->token), "%s", token ? token : "");
+    pthread_mutex_unlock(&s->token_lock);
+}
 
 struct request {
     char *body;
@@ -49,6 +82,8 @@ static enum MHD_Result respond_text(struct MHD_Connection *c, unsigned status,
     MHD_add_response_header(resp, "Cache-Control", "no-store");
     if (status == MHD_HTTP_METHOD_NOT_ALLOWED)
         MHD_add_response_header(resp, "Allow", "GET, HEAD, POST, DELETE");
+    if (status == MHD_HTTP_UNAUTHORIZED)
+        MHD_add_response_header(resp, "WWW-Authenticate", "Bearer realm=\"shadebench\"");
     enum MHD_Result ret = MHD_queue_response(c, status, resp);
     MHD_destroy_response(resp);
     return ret;
@@ -304,6 +339,10 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
         if (!req)
             return MHD_NO;
         *con_cls = req;
+        /* Refuse before reading any body. */
+        if (strcmp(url, "/healthz") != 0 && !authorized(s, c))
+            return respond_error(c, MHD_HTTP_UNAUTHORIZED, "Authorization",
+                                 "this daemon needs \"Authorization: Bearer <token>\"");
         const char *cl = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Content-Length");
         if (cl && strtoull(cl, NULL, 10) > JOB_MAX_BODY_BYTES) {
             /* Answer before reading the body; MHD closes the connection after. */
@@ -395,6 +434,7 @@ struct http_server *http_server_create(const char *listen, struct queue *q,
     }
     s->queue = q;
     s->runner = r;
+    pthread_mutex_init(&s->token_lock, NULL);
     unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_THREAD_PER_CONNECTION |
                      MHD_USE_ERROR_LOG;
     if (ai->ai_family == AF_INET6)
@@ -409,6 +449,7 @@ struct http_server *http_server_create(const char *listen, struct queue *q,
     freeaddrinfo(ai);
     if (!s->mhd) {
         snprintf(err, errlen, "cannot listen on %s (address in use or not allowed?)", listen);
+        pthread_mutex_destroy(&s->token_lock);
         free(s);
         return NULL;
     }
@@ -422,6 +463,7 @@ void http_server_destroy(struct http_server *s)
     if (!s)
         return;
     MHD_stop_daemon(s->mhd);
+    pthread_mutex_destroy(&s->token_lock);
     free(s);
 }
 

@@ -15,6 +15,10 @@ struct http_server;
 struct http_server *http_server_create(const char *listen, struct queue *q,
                                        struct runner *r, char *err, size_t errlen);
 void http_server_destroy(struct http_server *s);
+
+/* When token is non-empty, every endpoint but /healthz needs
+ * "Authorization: Bearer <token>". Safe to call while serving (SIGHUP). */
+void http_server_set_token(struct http_server *s, const char *token);
 int http_server_port(const struct http_server *s);
 
 #endif

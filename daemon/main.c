@@ -17,19 +17,25 @@
 #include "daemon/log.h"
 #include "daemon/queue.h"
 #include "daemon/runner.h"
+#include "daemon/service.h"
 #include "daemon/technique.h"
 
 struct options {
-    const char *listen;
-    const char *state_dir;
+    char listen[256];
+    char state_dir[1024];
+    char token_file[1024];
     const char *once;
     const char *out;
     const char *port_file;
     int device;
     int queue_size;
+    int keep_jobs;
+    double keep_days;
     bool list_devices;
     bool gl_debug;
 };
+
+#define DEFAULT_CONFIG "/etc/shadebench/shadebenchd.conf"
 
 static void usage(FILE *f)
 {
@@ -42,13 +48,23 @@ static void usage(FILE *f)
             "  --device N           use EGL device N (see --list-devices; default: first\n"
             "                       hardware device, then software, then surfaceless)\n"
             "  --queue-size N       jobs that may wait at once (default 64)\n"
+            "  --token FILE         require \"Authorization: Bearer <token>\" with the token in\n"
+            "                       FILE on every endpoint but /healthz (SIGHUP rereads it)\n"
+            "  --keep-jobs N        keep the newest N finished jobs, remove older ones' files\n"
+            "  --keep-days D        remove finished jobs older than D days\n"
+            "  --config FILE        settings file (default " DEFAULT_CONFIG " if present)\n"
             "  --port-file FILE     write the bound port to FILE once listening\n"
             "  --list-devices       print the EGL devices and exit\n"
             "  --once JOB.json      run one job without HTTP, then exit\n"
             "  --out DIR            with --once: where result.json and frames go\n"
             "  --gl-debug           request a debug GL context\n"
             "  --log-level LEVEL    debug, info, warn or error (default info)\n"
-            "  --version, --help\n");
+            "  --version, --help\n\n"
+            "Settings come from, in rising order: defaults, the config file (lines of\n"
+            "\"key = value\": listen, state-dir, device, queue-size, token, keep-jobs,\n"
+            "keep-days, log-level), the environment (SHADEBENCH_LISTEN, SHADEBENCH_STATE_DIR,\n"
+            "SHADEBENCH_DEVICE, SHADEBENCH_QUEUE_SIZE, SHADEBENCH_TOKEN_FILE,\n"
+            "SHADEBENCH_KEEP_JOBS, SHADEBENCH_KEEP_DAYS, SHADEBENCH_LOG_LEVEL), the flags.\n");
 }
 
 static bool parse_int(const char *s, int min, int max, int *out)
@@ -59,6 +75,123 @@ static bool parse_int(const char *s, int min, int max, int *out)
         return false;
     *out = (int)v;
     return true;
+}
+
+static bool parse_number(const char *s, double min, double max, double *out)
+{
+    char *end;
+    double v = strtod(s, &end);
+    if (!*s || *end || !(v >= min && v <= max))
+        return false;
+    *out = v;
+    return true;
+}
+
+/* One setting by name, from any source; origin names it in errors. */
+static bool apply_setting(struct options *o, const char *key, const char *value,
+                          const char *origin)
+{
+    const char *rule = NULL;
+    if (strcmp(key, "listen") == 0)
+        snprintf(o->listen, sizeof(o->listen), "%s", value);
+    else if (strcmp(key, "state-dir") == 0)
+        snprintf(o->state_dir, sizeof(o->state_dir), "%s", value);
+    else if (strcmp(key, "token") == 0 || strcmp(key, "token-file") == 0)
+        snprintf(o->token_file, sizeof(o->token_file), "%s", value);
+    else if (strcmp(key, "device") == 0) {
+        if (!parse_int(value, 0, 15, &o->device))
+            rule = "must be an integer from 0 to 15";
+    } else if (strcmp(key, "queue-size") == 0) {
+        if (!parse_int(value, 1, 100000, &o->queue_size))
+            rule = "must be an integer from 1 to 100000";
+    } else if (strcmp(key, "keep-jobs") == 0) {
+        if (!parse_int(value, 0, 100000000, &o->keep_jobs))
+            rule = "must be an integer from 0 (keep all)";
+    } else if (strcmp(key, "keep-days") == 0) {
+        if (!parse_number(value, 0, 1e6, &o->keep_days))
+            rule = "must be a number of days from 0 (keep all)";
+    } else if (strcmp(key, "log-level") == 0) {
+        static const char *const levels[] = {"debug", "info", "warn", "error"};
+        rule = "must be debug, info, warn or error";
+        for (int i = 0; i < 4; i++)
+            if (strcmp(value, levels[i]) == 0) {
+                log_set_level((enum log_level)i);
+                rule = NULL;
+            }
+    } else {
+        fprintf(stderr, "shadebenchd: %s: unknown setting %s\n", origin, key);
+        return false;
+    }
+    if (rule)
+        fprintf(stderr, "shadebenchd: %s: %s %s\n", origin, key, rule);
+    return rule == NULL;
+}
+
+static char *trim(char *s)
+{
+    while (*s == ' ' || *s == '\t')
+        s++;
+    char *end = s + strlen(s);
+    while (end > s && (end[-1] == ' ' || end[-1] == '\t' || end[-1] == '\n' || end[-1] == '\r'))
+        *--end = '\0';
+    return s;
+}
+
+static bool load_config(struct options *o, const char *path, bool required)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        if (required)
+            fprintf(stderr, "shadebenchd: cannot read the config file %s\n", path);
+        return !required;
+    }
+    char line[2048], origin[1100];
+    bool ok = true;
+    for (int n = 1; ok && fgets(line, sizeof(line), f); n++) {
+        char *l = trim(line);
+        if (!*l || *l == '#')
+            continue;
+        char *eq = strchr(l, '=');
+        snprintf(origin, sizeof(origin), "%s:%d", path, n);
+        if (!eq) {
+            fprintf(stderr, "shadebenchd: %s: expected \"key = value\"\n", origin);
+            ok = false;
+            break;
+        }
+        *eq = '\0';
+        ok = apply_setting(o, trim(l), trim(eq + 1), origin);
+    }
+    fclose(f);
+    return ok;
+}
+
+static bool load_environment(struct options *o)
+{
+    static const char *const keys[] = {"listen", "state-dir", "device", "queue-size",
+                                       "token-file", "keep-jobs", "keep-days", "log-level", NULL};
+    for (const char *const *k = keys; *k; k++) {
+        char name[64] = "SHADEBENCH_";
+        size_t n = strlen(name);
+        for (const char *c = *k; *c && n < sizeof(name) - 1; c++)
+            name[n++] = *c == '-' ? '_' : (char)(*c - 'a' + 'A');
+        name[n] = '\0';
+        const char *v = getenv(name);
+        if (v && *v && !apply_setting(o, *k, v, name))
+            return false;
+    }
+    return true;
+}
+
+/* Reads the bearer token (surrounding whitespace dropped). */
+static bool read_token(const char *path, char *token, size_t cap)
+{
+    size_t len = 0;
+    char *text = fs_read_file(path, cap - 1, &len);
+    if (!text)
+        return false;
+    snprintf(token, cap, "%s", trim(text));
+    free(text);
+    return token[0] != '\0';
 }
 
 static int list_devices(void)
@@ -151,10 +284,14 @@ static int run_once(const struct options *o)
 
 static int serve(const struct options *o)
 {
-    char state_dir[PATH_MAX];
+    char state_dir[PATH_MAX], token[512] = "";
     const char *env = getenv("STATE_DIRECTORY");
     snprintf(state_dir, sizeof(state_dir), "%s",
-             o->state_dir ? o->state_dir : (env && *env ? env : "/var/lib/shadebench"));
+             o->state_dir[0] ? o->state_dir : (env && *env ? env : "/var/lib/shadebench"));
+    if (o->token_file[0] && !read_token(o->token_file, token, sizeof(token))) {
+        LOG(LOG_ERROR, "cannot read a token from %s", o->token_file);
+        return 1;
+    }
     if (!fs_mkdir_p(state_dir)) {
         LOG(LOG_ERROR, "cannot create the state directory %s", state_dir);
         return 1;
@@ -164,14 +301,29 @@ static int serve(const struct options *o)
     sigemptyset(&set);
     sigaddset(&set, SIGINT);
     sigaddset(&set, SIGTERM);
+    sigaddset(&set, SIGHUP);
     pthread_sigmask(SIG_BLOCK, &set, NULL);
     signal(SIGPIPE, SIG_IGN);
 
     char err[512];
     struct queue *q = queue_create(state_dir, o->queue_size);
-    struct runner *r = q ? runner_create(q, o->device, o->gl_debug, err, sizeof(err)) : NULL;
+    if (!q) {
+        LOG(LOG_ERROR, "out of memory");
+        return 1;
+    }
+    queue_set_retention(q, o->keep_jobs, o->keep_days);
+    /* Earlier jobs first: finished ones are served again, queued ones run. */
+    int loaded = queue_load(q, technique_names(), err, sizeof(err));
+    if (loaded < 0) {
+        LOG(LOG_ERROR, "%s", err);
+        queue_destroy(q);
+        return 1;
+    }
+    if (loaded > 0)
+        LOG(LOG_INFO, "loaded %d job(s) from %s", loaded, state_dir);
+    struct runner *r = runner_create(q, o->device, o->gl_debug, err, sizeof(err));
     if (!r) {
-        LOG(LOG_ERROR, "%s", q ? err : "out of memory");
+        LOG(LOG_ERROR, "%s", err);
         queue_destroy(q);
         return 1;
     }
@@ -190,9 +342,23 @@ static int serve(const struct options *o)
         if (!fs_write_atomic(o->port_file, buf, (size_t)n))
             LOG(LOG_WARN, "cannot write %s", o->port_file);
     }
+    http_server_set_token(http, token);
+    service_ready();
     int sig = 0;
-    sigwait(&set, &sig);
+    for (;;) {
+        sigwait(&set, &sig);
+        if (sig != SIGHUP)
+            break;
+        /* SIGHUP: reread the token so that it can be rotated without a restart. */
+        if (o->token_file[0] && read_token(o->token_file, token, sizeof(token))) {
+            http_server_set_token(http, token);
+            LOG(LOG_INFO, "SIGHUP: token reread from %s", o->token_file);
+        } else {
+            LOG(LOG_INFO, "SIGHUP: nothing to reload");
+        }
+    }
     LOG(LOG_INFO, "signal %d: stopping", sig);
+    service_stopping();
     http_server_destroy(http);
     runner_destroy(r);
     queue_destroy(q);
@@ -201,14 +367,20 @@ static int serve(const struct options *o)
 
 int main(int argc, char **argv)
 {
-    struct options o = {.listen = "127.0.0.1:8460", .device = -1, .queue_size = 64};
-    enum { OPT_LISTEN = 256, OPT_STATE, OPT_DEVICE, OPT_QUEUE, OPT_PORT_FILE, OPT_LIST,
-           OPT_ONCE, OPT_OUT, OPT_DEBUG, OPT_LOG, OPT_VERSION, OPT_HELP };
+    struct options o = {.device = -1, .queue_size = 64};
+    snprintf(o.listen, sizeof(o.listen), "127.0.0.1:8460");
+    enum { OPT_LISTEN = 256, OPT_STATE, OPT_DEVICE, OPT_QUEUE, OPT_TOKEN, OPT_KEEP_JOBS,
+           OPT_KEEP_DAYS, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_ONCE, OPT_OUT, OPT_DEBUG,
+           OPT_LOG, OPT_VERSION, OPT_HELP };
     static const struct option longopts[] = {
         {"listen", required_argument, NULL, OPT_LISTEN},
         {"state-dir", required_argument, NULL, OPT_STATE},
         {"device", required_argument, NULL, OPT_DEVICE},
         {"queue-size", required_argument, NULL, OPT_QUEUE},
+        {"token", required_argument, NULL, OPT_TOKEN},
+        {"keep-jobs", required_argument, NULL, OPT_KEEP_JOBS},
+        {"keep-days", required_argument, NULL, OPT_KEEP_DAYS},
+        {"config", required_argument, NULL, OPT_CONFIG},
         {"port-file", required_argument, NULL, OPT_PORT_FILE},
         {"list-devices", no_argument, NULL, OPT_LIST},
         {"once", required_argument, NULL, OPT_ONCE},
@@ -219,49 +391,50 @@ int main(int argc, char **argv)
         {"help", no_argument, NULL, OPT_HELP},
         {NULL, 0, NULL, 0},
     };
+    /* Flags win over everything, so they are applied last: collect them first. */
+    struct { const char *key, *value; } flags[32];
+    int nflags = 0;
+    const char *config = getenv("SHADEBENCH_CONFIG");
+    bool config_required = config && *config;
     int c;
     while ((c = getopt_long(argc, argv, "", longopts, NULL)) != -1) {
+        const char *key = NULL;
         switch (c) {
-        case OPT_LISTEN: o.listen = optarg; break;
-        case OPT_STATE: o.state_dir = optarg; break;
-        case OPT_DEVICE:
-            if (!parse_int(optarg, 0, 15, &o.device)) {
-                fprintf(stderr, "shadebenchd: --device must be an integer from 0 to 15\n");
-                return 2;
-            }
-            break;
-        case OPT_QUEUE:
-            if (!parse_int(optarg, 1, 100000, &o.queue_size)) {
-                fprintf(stderr, "shadebenchd: --queue-size must be an integer from 1 to 100000\n");
-                return 2;
-            }
-            break;
+        case OPT_LISTEN: key = "listen"; break;
+        case OPT_STATE: key = "state-dir"; break;
+        case OPT_DEVICE: key = "device"; break;
+        case OPT_QUEUE: key = "queue-size"; break;
+        case OPT_TOKEN: key = "token"; break;
+        case OPT_KEEP_JOBS: key = "keep-jobs"; break;
+        case OPT_KEEP_DAYS: key = "keep-days"; break;
+        case OPT_LOG: key = "log-level"; break;
+        case OPT_CONFIG: config = optarg; config_required = true; break;
         case OPT_PORT_FILE: o.port_file = optarg; break;
         case OPT_LIST: o.list_devices = true; break;
         case OPT_ONCE: o.once = optarg; break;
         case OPT_OUT: o.out = optarg; break;
         case OPT_DEBUG: o.gl_debug = true; break;
-        case OPT_LOG: {
-            static const char *const levels[] = {"debug", "info", "warn", "error"};
-            int found = -1;
-            for (int i = 0; i < 4; i++)
-                if (strcmp(optarg, levels[i]) == 0)
-                    found = i;
-            if (found < 0) {
-                fprintf(stderr, "shadebenchd: --log-level must be debug, info, warn or error\n");
-                return 2;
-            }
-            log_set_level((enum log_level)found);
-            break;
-        }
         case OPT_VERSION: printf("shadebenchd %s\n", PACKAGE_VERSION); return 0;
         case OPT_HELP: usage(stdout); return 0;
         default: usage(stderr); return 2;
+        }
+        if (key && nflags < 32) {
+            flags[nflags].key = key;
+            flags[nflags++].value = optarg;
         }
     }
     if (optind < argc) {
         fprintf(stderr, "shadebenchd: unexpected argument %s\n", argv[optind]);
         return 2;
+    }
+    if (!load_config(&o, config_required ? config : DEFAULT_CONFIG, config_required) ||
+        !load_environment(&o))
+        return 2;
+    for (int i = 0; i < nflags; i++) {
+        char origin[32];
+        snprintf(origin, sizeof(origin), "--%s", flags[i].key);
+        if (!apply_setting(&o, flags[i].key, flags[i].value, origin))
+            return 2;
     }
     if (o.list_devices)
         return list_devices();

@@ -2,13 +2,17 @@
 #include "daemon/queue.h"
 
 #include "daemon/fsutil.h"
+#include "daemon/log.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
+#include <unistd.h>
 
 struct queue {
     pthread_mutex_t lock;
@@ -18,6 +22,8 @@ struct queue {
     int queued, max_queued;
     unsigned serial;
     bool stopping;
+    int keep_jobs;
+    double keep_days;
     char state_dir[PATH_MAX];
 };
 
@@ -30,9 +36,14 @@ static double now_s(void)
 
 const char *job_status_name(enum job_status s)
 {
-    static const char *const names[] = {"queued", "running", "done", "failed", "cancelled"};
+    static const char *const names[] = {"queued",    "running",  "done",
+                                        "failed",    "cancelled", "interrupted"};
     return names[s];
 }
+
+static json_t *job_json_locked(const struct job *job, bool full);
+static void persist_locked(const struct job *job);
+static void apply_retention(struct queue *q);
 
 struct queue *queue_create(const char *state_dir, int max_queued)
 {
@@ -105,13 +116,27 @@ enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *sp
     gmtime_r(&t, &tm);
     char stamp[16];
     strftime(stamp, sizeof(stamp), "%Y%m%d-%H%M%S", &tm);
-    snprintf(job->id, sizeof(job->id), "%.15s-%04u", stamp, ++q->serial % 10000u);
-    if (dir_override)
-        snprintf(job->dir, sizeof(job->dir), "%s", dir_override);
-    else
+    /* A fresh directory per job: an id that is taken (after a restart in the
+     * same second) just moves on to the next serial number. */
+    bool made = false;
+    for (int attempt = 0; attempt < 10000 && !made; attempt++) {
+        snprintf(job->id, sizeof(job->id), "%.15s-%04u", stamp, ++q->serial % 10000u);
+        if (dir_override) {
+            snprintf(job->dir, sizeof(job->dir), "%s", dir_override);
+            made = fs_mkdir_p(job->dir);
+            break;
+        }
         snprintf(job->dir, sizeof(job->dir), "%.*s/jobs/%s",
                  (int)(sizeof(job->dir) - sizeof(job->id) - 8), q->state_dir, job->id);
-    if (!fs_mkdir_p(job->dir)) {
+        char parent[PATH_MAX];
+        snprintf(parent, sizeof(parent), "%.*s/jobs", (int)(sizeof(parent) - 8), q->state_dir);
+        if (!fs_mkdir_p(parent))
+            break;
+        made = mkdir(job->dir, 0755) == 0;
+        if (!made && errno != EEXIST)
+            break;
+    }
+    if (!made) {
         free(job);
         res = QUEUE_IO_ERROR;
         goto out;
@@ -123,6 +148,7 @@ enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *sp
     atomic_init(&job->cancel, false);
     q->jobs[q->count++] = job;
     q->queued++;
+    persist_locked(job);
     snprintf(id_out, 24, "%s", job->id);
     pthread_cond_broadcast(&q->changed);
 out:
@@ -147,6 +173,7 @@ struct job *queue_next(struct queue *q)
         job->phase = "rendering";
         job->started = now_s();
         q->queued--;
+        persist_locked(job);
         pthread_cond_broadcast(&q->changed);
     }
     pthread_mutex_unlock(&q->lock);
@@ -177,8 +204,10 @@ void queue_finish(struct queue *q, struct job *job, enum job_status status,
         snprintf(job->error, sizeof(job->error), "%s", error);
     json_decref(job->result);
     job->result = result;
+    persist_locked(job);
     pthread_cond_broadcast(&q->changed);
     pthread_mutex_unlock(&q->lock);
+    apply_retention(q);
 }
 
 void queue_stop(struct queue *q)
@@ -206,6 +235,7 @@ enum queue_cancel_result queue_cancel(struct queue *q, const char *id)
         job->finished = now_s();
         snprintf(job->error, sizeof(job->error), "cancelled before it started");
         q->queued--;
+        persist_locked(job);
         res = CANCEL_DONE;
         pthread_cond_broadcast(&q->changed);
         break;
@@ -262,6 +292,205 @@ static bool finished(const struct job *job)
     return job->status != JOB_QUEUED && job->status != JOB_RUNNING;
 }
 
+/* job.json: the job's state, written whenever it changes (the result lives
+ * in result.json beside it, written before the job is marked done). */
+static void persist_locked(const struct job *job)
+{
+    json_t *o = job_json_locked(job, false);
+    json_object_set_new(o, "spec", job_spec_to_json(&job->spec));
+    json_object_set_new(o, "times_unix",
+                        json_pack("[f, f, f]", job->created, job->started, job->finished));
+    char path[PATH_MAX + 16];
+    snprintf(path, sizeof(path), "%s/job.json", job->dir);
+    if (!fs_write_json_atomic(path, o))
+        LOG(LOG_ERROR, "job %s: cannot write %s", job->id, path);
+    json_decref(o);
+}
+
+static enum job_status status_from_name(const char *name)
+{
+    for (int s = JOB_QUEUED; s <= JOB_INTERRUPTED; s++)
+        if (name && strcmp(name, job_status_name((enum job_status)s)) == 0)
+            return (enum job_status)s;
+    return JOB_INTERRUPTED;
+}
+
+static int by_id(const void *a, const void *b)
+{
+    return strcmp((*(struct job *const *)a)->id, (*(struct job *const *)b)->id);
+}
+
+static bool load_job(struct queue *q, const char *id, const char *const *techniques)
+{
+    char dir[PATH_MAX], path[PATH_MAX + 16];
+    if (strlen(id) >= sizeof(((struct job *)0)->id))
+        return false;
+    snprintf(dir, sizeof(dir), "%.*s/jobs/%.23s", (int)(sizeof(dir) - 40), q->state_dir, id);
+    snprintf(path, sizeof(path), "%s/job.json", dir);
+    json_error_t jerr;
+    json_t *o = json_load_file(path, 0, &jerr);
+    if (!o)
+        return false;
+    struct job_spec spec;
+    struct job_error err;
+    struct job *job = NULL;
+    const char *jid = json_string_value(json_object_get(o, "id"));
+    if (!jid || strcmp(jid, id) != 0 || strlen(id) >= sizeof(job->id) ||
+        !job_spec_parse(json_object_get(o, "spec"), techniques, &spec, &err)) {
+        LOG(LOG_WARN, "skipping %s: not a job this daemon can read (%s %s)", path, err.field,
+            err.message);
+        json_decref(o);
+        return false;
+    }
+    if (q->count == q->cap) {
+        size_t cap = q->cap ? q->cap * 2 : 64;
+        struct job **jobs = realloc(q->jobs, cap * sizeof(*jobs));
+        if (!jobs) {
+            json_decref(o);
+            return false;
+        }
+        q->jobs = jobs;
+        q->cap = cap;
+    }
+    job = calloc(1, sizeof(*job));
+    if (!job) {
+        json_decref(o);
+        return false;
+    }
+    snprintf(job->id, sizeof(job->id), "%s", id);
+    snprintf(job->dir, sizeof(job->dir), "%s", dir);
+    job->spec = spec;
+    job->status = status_from_name(json_string_value(json_object_get(o, "status")));
+    json_t *progress = json_object_get(o, "progress");
+    job->frames_total = spec.frames;
+    job->frames_done = (int)json_integer_value(json_object_get(progress, "frames_done"));
+    json_t *times = json_object_get(o, "times_unix");
+    job->created = json_real_value(json_array_get(times, 0));
+    job->started = json_real_value(json_array_get(times, 1));
+    job->finished = json_real_value(json_array_get(times, 2));
+    const char *error = json_string_value(json_object_get(o, "error"));
+    if (error)
+        snprintf(job->error, sizeof(job->error), "%s", error);
+    atomic_init(&job->cancel, false);
+    json_decref(o);
+
+    bool changed = false;
+    if (job->status == JOB_RUNNING) {
+        job->status = JOB_INTERRUPTED;
+        job->finished = now_s();
+        snprintf(job->error, sizeof(job->error),
+                 "interrupted: the daemon stopped (killed or crashed) while this job ran; "
+                 "its files may be incomplete, submit it again to measure it");
+        changed = true;
+    } else if (job->status == JOB_DONE) {
+        snprintf(path, sizeof(path), "%s/result.json", dir);
+        job->result = json_load_file(path, 0, &jerr);
+        if (!job->result) {
+            job->status = JOB_FAILED;
+            snprintf(job->error, sizeof(job->error), "result.json is missing or damaged: %s",
+                     jerr.text);
+            changed = true;
+        }
+    } else if (job->status == JOB_QUEUED) {
+        q->queued++;
+    }
+    if (changed)
+        persist_locked(job);
+    q->jobs[q->count++] = job;
+    return true;
+}
+
+int queue_load(struct queue *q, const char *const *techniques, char *err, size_t errlen)
+{
+    char jobs_dir[PATH_MAX];
+    snprintf(jobs_dir, sizeof(jobs_dir), "%.*s/jobs", (int)(sizeof(jobs_dir) - 8), q->state_dir);
+    DIR *d = opendir(jobs_dir);
+    if (!d) {
+        if (errno == ENOENT)
+            return 0;
+        snprintf(err, errlen, "cannot read %s: %s", jobs_dir, strerror(errno));
+        return -1;
+    }
+    int loaded = 0;
+    pthread_mutex_lock(&q->lock);
+    struct dirent *e;
+    while ((e = readdir(d)))
+        if (e->d_name[0] != '.' && load_job(q, e->d_name, techniques))
+            loaded++;
+    closedir(d);
+    qsort(q->jobs, q->count, sizeof(*q->jobs), by_id);
+    pthread_cond_broadcast(&q->changed);
+    pthread_mutex_unlock(&q->lock);
+    apply_retention(q);
+    return loaded;
+}
+
+void queue_set_retention(struct queue *q, int keep_jobs, double keep_days)
+{
+    pthread_mutex_lock(&q->lock);
+    q->keep_jobs = keep_jobs;
+    q->keep_days = keep_days;
+    pthread_mutex_unlock(&q->lock);
+}
+
+/* Removes a finished job's directory: the files in it, then the directory. */
+static void remove_job_dir(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (d) {
+        struct dirent *e;
+        char path[PATH_MAX + 300];
+        while ((e = readdir(d)))
+            if (e->d_name[0] != '.') {
+                snprintf(path, sizeof(path), "%s/%s", dir, e->d_name);
+                unlink(path);
+            }
+        closedir(d);
+    }
+    if (rmdir(dir) != 0)
+        LOG(LOG_WARN, "retention: cannot remove %s: %s", dir, strerror(errno));
+}
+
+static void apply_retention(struct queue *q)
+{
+    pthread_mutex_lock(&q->lock);
+    if (!q->state_dir[0] || (q->keep_jobs <= 0 && q->keep_days <= 0)) {
+        pthread_mutex_unlock(&q->lock);
+        return;
+    }
+    size_t finished_count = 0;
+    for (size_t i = 0; i < q->count; i++)
+        finished_count += finished(q->jobs[i]);
+    double cutoff = q->keep_days > 0 ? now_s() - q->keep_days * 86400.0 : -1.0;
+    struct job **victims = calloc(q->count ? q->count : 1, sizeof(*victims));
+    size_t nv = 0, kept = 0;
+    if (!victims) {
+        pthread_mutex_unlock(&q->lock);
+        return;
+    }
+    /* Jobs are in submission order, so the oldest finished ones come first. */
+    size_t excess = q->keep_jobs > 0 && finished_count > (size_t)q->keep_jobs
+                        ? finished_count - (size_t)q->keep_jobs
+                        : 0;
+    for (size_t i = 0; i < q->count; i++) {
+        struct job *job = q->jobs[i];
+        bool old = finished(job) && (nv < excess || (cutoff > 0 && job->finished < cutoff));
+        if (old)
+            victims[nv++] = job;
+        else
+            q->jobs[kept++] = job;
+    }
+    q->count = kept;
+    pthread_mutex_unlock(&q->lock);
+    for (size_t i = 0; i < nv; i++) {
+        LOG(LOG_INFO, "retention: removing job %s", victims[i]->id);
+        remove_job_dir(victims[i]->dir);
+        json_decref(victims[i]->result);
+        free(victims[i]);
+    }
+    free(victims);
+}
+
 json_t *queue_job_json(struct queue *q, const char *id, double wait_s)
 {
     json_t *out = NULL;
@@ -272,9 +501,13 @@ json_t *queue_job_json(struct queue *q, const char *id, double wait_s)
     deadline.tv_nsec = (long)((secs - (double)deadline.tv_sec) * 1e9);
     pthread_mutex_lock(&q->lock);
     struct job *job = find_locked(q, id);
-    while (job && wait_s > 0 && !finished(job) && !q->stopping)
-        if (pthread_cond_timedwait(&q->changed, &q->lock, &deadline) == ETIMEDOUT)
+    while (job && wait_s > 0 && !finished(job) && !q->stopping) {
+        int rc = pthread_cond_timedwait(&q->changed, &q->lock, &deadline);
+        /* Look it up again: retention may have removed it meanwhile. */
+        job = find_locked(q, id);
+        if (rc == ETIMEDOUT)
             break;
+    }
     if (job)
         out = job_json_locked(job, true);
     pthread_mutex_unlock(&q->lock);

@@ -2,8 +2,10 @@
 #define SHADEBENCH_QUEUE_H
 
 /* The job store and the queue between HTTP threads and the render thread.
- * GL-free. Jobs are never freed while the queue lives, so a job pointer
- * handed to the render thread stays valid. */
+ * GL-free. Every change of a job's state is written to its directory
+ * (job.json: temporary file, fsync, rename) so that a restarted daemon finds
+ * every job again. Only finished jobs are ever freed (by retention), so a
+ * job pointer handed to the render or metrics thread stays valid. */
 
 #include <jansson.h>
 #include <limits.h>
@@ -12,7 +14,7 @@
 
 #include "daemon/job.h"
 
-enum job_status { JOB_QUEUED, JOB_RUNNING, JOB_DONE, JOB_FAILED, JOB_CANCELLED };
+enum job_status { JOB_QUEUED, JOB_RUNNING, JOB_DONE, JOB_FAILED, JOB_CANCELLED, JOB_INTERRUPTED };
 
 struct job {
     char id[24];
@@ -33,6 +35,16 @@ enum queue_submit_result { QUEUE_OK, QUEUE_FULL, QUEUE_STOPPING, QUEUE_IO_ERROR 
 
 /* state_dir may be NULL for --once, where out_dir names the single job's dir. */
 struct queue *queue_create(const char *state_dir, int max_queued);
+
+/* Retention of finished jobs: keep at most keep_jobs of them (0: all) and
+ * none finished more than keep_days ago (0: forever). Their directories are
+ * removed; nothing else is ever deleted. */
+void queue_set_retention(struct queue *q, int keep_jobs, double keep_days);
+
+/* Reloads the jobs under state_dir/jobs: finished ones are served as before,
+ * queued ones run, and one that was running when the daemon died is marked
+ * interrupted. Returns the number of jobs loaded, or -1 with err filled. */
+int queue_load(struct queue *q, const char *const *techniques, char *err, size_t errlen);
 void queue_destroy(struct queue *q);
 int queue_max_queued(const struct queue *q);
 

@@ -19,6 +19,7 @@
 #include "daemon/log.h"
 #include "daemon/metrics_worker.h"
 #include "daemon/png_io.h"
+#include "daemon/service.h"
 #include "daemon/stats.h"
 #include "daemon/technique.h"
 
@@ -329,6 +330,8 @@ static void run_job(struct runner *r, struct job *job)
 
     LOG(LOG_INFO, "job %s: %s, %d+%d frames at %dx%d", job->id, spec->technique, w0, n,
         spec->scene.width, spec->scene.height);
+    service_status("running job %s (%s, %d frames at %dx%d)", job->id, spec->technique, n,
+                   spec->scene.width, spec->scene.height);
     gl_error_take("previous job", run.err, sizeof(run.err));
     run.err[0] = '\0';
     run.tech = technique_find(spec->technique);
@@ -443,6 +446,7 @@ done:
     else
         LOG(LOG_INFO, "job %s rendered", job->id);
     teardown(&run);
+    service_status("idle; last job %s %s", job->id, job_status_name(status));
     if (status == JOB_DONE && spec->reference[0]) {
         queue_set_phase(r->queue, job, "metrics");
         metrics_worker_submit(r->metrics, job, result);

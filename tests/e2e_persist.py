@@ -1,0 +1,94 @@
+"""Results survive the daemon: kill -9 it mid-job, restart on the same state
+directory, and every finished job is served byte for byte as before, the
+killed job is "interrupted" with a message, a queued job runs; SIGTERM
+cancels the running job and exits 0; retention removes only the oldest
+finished jobs' directories."""
+
+import hashlib
+import os
+import signal
+import time
+
+import testlib
+from testlib import check
+
+testlib.skip_without_egl()
+SMALL = {"frames": 6, "warmup_frames": 1, "capture_interval": 3,
+         "scene": {"width": 128, "height": 96, "dynamic": True}}
+LONG = {"frames": 1000000, "warmup_frames": 0, "scene": {"width": 32, "height": 32}}
+
+
+def digest_dir(path):
+    out = {}
+    for name in sorted(os.listdir(path)):
+        if name == "job.json":
+            continue  # rewritten on purpose when the state changes
+        with open(os.path.join(path, name), "rb") as f:
+            out[name] = hashlib.sha256(f.read()).hexdigest()
+    return out
+
+
+def wait_running(d, job_id):
+    deadline = time.time() + 30
+    while d.json("GET", "/v1/jobs/" + job_id)[1]["status"] != "running" and time.time() < deadline:
+        time.sleep(0.05)
+
+
+first = testlib.Daemon()
+state = first.state
+done_id = first.submit(dict(SMALL, reference="forward"))
+done_before = first.wait(done_id)
+check(done_before["status"] == "done", "first job done")
+files_before = digest_dir(os.path.join(state, "jobs", done_id))
+check("result.json" in files_before and "frame-000006.png" in files_before, "its files are on disk")
+killed_id = first.submit(LONG)
+wait_running(first, killed_id)
+queued_id = first.submit(SMALL)
+first.proc.send_signal(signal.SIGKILL)
+first.proc.wait()
+first.log.close()
+
+# A new daemon on the same state directory.
+second = testlib.Daemon("--state-dir", state)
+try:
+    status, again = second.json("GET", "/v1/jobs/" + done_id)
+    check(status == 200 and again["status"] == "done", "the finished job is served after kill -9")
+    check(again.get("result") == done_before.get("result"), "its result is unchanged")
+    check(digest_dir(os.path.join(state, "jobs", done_id)) == files_before,
+          "its files are byte-for-byte intact")
+    png = os.path.join(second.tmp, "f.png")
+    check(second.download("/v1/jobs/%s/flip/6.png" % done_id, png) == 200, "its images are served")
+    status, killed = second.json("GET", "/v1/jobs/" + killed_id)
+    check(killed["status"] == "interrupted" and "interrupted" in killed.get("error", ""),
+          "the killed job is interrupted, with a message: %s" % killed.get("error"))
+    check(second.wait(queued_id)["status"] == "done", "the queued job ran after the restart")
+    listed = [j["id"] for j in second.json("GET", "/v1/jobs")[1]["jobs"]]
+    check(listed == sorted(listed) and {done_id, killed_id, queued_id} <= set(listed),
+          "every job is listed, oldest first")
+    new_id = second.submit(SMALL)
+    check(new_id not in (done_id, killed_id, queued_id), "new ids never clash with reloaded ones")
+    check(second.wait(new_id)["status"] == "done", "and new jobs run")
+
+    # SIGTERM with a job running: it is cancelled, state written, exit 0.
+    term_id = second.submit(LONG)
+    wait_running(second, term_id)
+    t0 = time.time()
+finally:
+    code = second.stop()
+check(code == 0 and time.time() - t0 < 30, "SIGTERM mid-job exits 0 quickly (%s)" % code)
+
+third = testlib.Daemon("--state-dir", state, "--keep-jobs", "2")
+try:
+    status, term = third.json("GET", "/v1/jobs/" + term_id)
+    check(status == 200 and term["status"] == "cancelled", "the SIGTERMed job is cancelled: %s" % term.get("status"))
+    remaining = sorted(os.listdir(os.path.join(state, "jobs")))
+    check(remaining == sorted([new_id, term_id]), "--keep-jobs 2 keeps the newest two finished: %s" % remaining)
+    check(third.json("GET", "/v1/jobs/" + done_id)[0] == 404, "a removed job is gone from the API")
+    check(os.path.isdir(state), "the state directory itself stays")
+finally:
+    third.stop()
+check(third.proc.returncode == 0, "daemon exits 0")
+second.cleanup()
+first.cleanup(keep=testlib.failures > 0)
+third.cleanup()
+testlib.finish("e2e_persist")

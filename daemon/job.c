@@ -170,8 +170,33 @@ void job_spec_defaults(struct job_spec *out)
     out->osl.resolution = 256;
     out->osl.texel_density = 1.0;
     out->osl.reshade = OSL_RESHADE_TOUCHED;
+    out->repeat = 1;
+    out->repeat_auto = false;
     out->reference[0] = '\0';
     metrics_options_defaults(&out->metrics);
+}
+
+/* "repeat": N, or {"auto": true, "max": M}. */
+static bool parse_repeat(const json_t *v, struct job_spec *out, struct job_error *err)
+{
+    if (json_is_object(v)) {
+        static const char *const keys[] = {"auto", "max", NULL};
+        out->repeat = 30;
+        if (!check_keys(v, "repeat.", keys, err) ||
+            !get_bool(v, "auto", "repeat.auto", &out->repeat_auto, err) ||
+            !get_int(v, "max", "repeat.max", 3, 1000, &out->repeat, err))
+            return false;
+        if (!out->repeat_auto)
+            return fail(err, "repeat.auto", "must be true (or give repeat as a number of runs)");
+        return true;
+    }
+    json_t *wrapped = json_pack("{s:O}", "repeat", v);
+    bool ok = get_int(wrapped, "repeat", "repeat", 1, 1000, &out->repeat, err);
+    json_decref(wrapped);
+    if (!ok)
+        snprintf(err->message, sizeof(err->message),
+                 "must be a number of runs from 1 to 1000, or {\"auto\": true, \"max\": N}");
+    return ok;
 }
 
 static const char *const METRIC_NAMES[] = {"ssim", "pdiff", "psnr", "flip", NULL};
@@ -323,7 +348,8 @@ bool job_spec_parse(const json_t *body, const char *const *techniques,
 {
     static const char *const keys[] = {"technique", "frames", "warmup_frames",
                                        "capture_interval", "async_distance",
-                                       "scene", "osl", "reference", "metrics", NULL};
+                                       "scene", "osl", "reference", "metrics", "repeat",
+                                       NULL};
     job_spec_defaults(out);
     memset(err, 0, sizeof(*err));
     if (!json_is_object(body))
@@ -341,6 +367,9 @@ bool job_spec_parse(const json_t *body, const char *const *techniques,
         return false;
     json_t *metrics = json_object_get(body, "metrics");
     if (metrics && !parse_metrics(metrics, &out->metrics, err))
+        return false;
+    json_t *repeat = json_object_get(body, "repeat");
+    if (repeat && !parse_repeat(repeat, out, err))
         return false;
     if (!get_int(body, "frames", "frames", 1, 1000000, &out->frames, err) ||
         !get_int(body, "warmup_frames", "warmup_frames", 0, 10000,
@@ -399,6 +428,8 @@ bool job_spec_parse_text(const char *text, size_t len,
     return ok;
 }
 
+int job_spec_runs(const struct job_spec *spec) { return spec->repeat; }
+
 int job_spec_capture_count(const struct job_spec *spec)
 {
     return spec->capture_interval > 0 ? spec->frames / spec->capture_interval : 0;
@@ -447,6 +478,9 @@ json_t *job_spec_to_json(const struct job_spec *spec)
         spec->scene.height, "sphere_segments", spec->scene.sphere_segments,
         "osl", "resolution", res, "texel_density", spec->osl.texel_density,
         "reshade", spec->osl.reshade == OSL_RESHADE_ALL ? "all" : "touched");
+    json_object_set_new(out, "repeat",
+                        spec->repeat_auto ? json_pack("{s:b, s:i}", "auto", 1, "max", spec->repeat)
+                                          : json_integer(spec->repeat));
     json_object_set_new(out, "reference",
                         spec->reference[0] ? json_string(spec->reference) : json_null());
     if (spec->reference[0])

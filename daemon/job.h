@@ -40,6 +40,8 @@ struct job_spec {
     double async_distance;
     struct scene_spec scene;
     struct osl_spec osl;
+    int repeat;                    /* runs of the job; with repeat_auto, the most */
+    bool repeat_auto;              /* stop once the 95% interval is within 2.5% */
     char reference[32];            /* technique to compare captures with; "" for none */
     struct metrics_options metrics; /* used when reference is set */
 };
@@ -67,6 +69,9 @@ json_t *job_spec_to_json(const struct job_spec *spec);
 
 /* Number of timed frames that get captured. */
 int job_spec_capture_count(const struct job_spec *spec);
+
+/* Runs the job is planned for (the most, with automatic repeats). */
+int job_spec_runs(const struct job_spec *spec);
 
 /* True when timed frame (1-based) is captured. */
 bool job_spec_is_capture_frame(const struct job_spec *spec, int frame);

@@ -143,7 +143,7 @@ enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *sp
     }
     job->spec = *spec;
     job->status = JOB_QUEUED;
-    job->frames_total = spec->frames;
+    job->frames_total = spec->frames * job_spec_runs(spec);
     job->created = now_s();
     atomic_init(&job->cancel, false);
     q->jobs[q->count++] = job;
@@ -362,7 +362,7 @@ static bool load_job(struct queue *q, const char *id, const char *const *techniq
     job->spec = spec;
     job->status = status_from_name(json_string_value(json_object_get(o, "status")));
     json_t *progress = json_object_get(o, "progress");
-    job->frames_total = spec.frames;
+    job->frames_total = spec.frames * job_spec_runs(&spec);
     job->frames_done = (int)json_integer_value(json_object_get(progress, "frames_done"));
     json_t *times = json_object_get(o, "times_unix");
     job->created = json_real_value(json_array_get(times, 0));

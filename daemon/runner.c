@@ -48,10 +48,10 @@ static json_t *stats_json(const double *v, size_t n)
 {
     struct stats s;
     stats_compute(v, n, &s);
-    return json_pack("{s:I, s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:f}", "n",
+    return json_pack("{s:I, s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:[f, f]}", "n",
                      (json_int_t)s.n, "mean", s.mean, "median", s.median, "stddev",
                      s.stddev, "min", s.min, "max", s.max, "p5", s.p5, "p95", s.p95,
-                     "p99", s.p99, "cv", s.cv);
+                     "p99", s.p99, "cv", s.cv, "median_ci95", s.median_lo, s.median_hi);
 }
 
 static const char *gl_str(GLenum name)
@@ -320,66 +320,58 @@ out:
     return ok;
 }
 
-static void run_job(struct runner *r, struct job *job)
+/* One measured run: builds the scene and the technique, renders the warm-up
+ * and timed frames (capturing only when asked: the first run), and leaves
+ * the figures in run. run_index and planned place it in the job's progress. */
+static bool measure(struct runner *r, struct run *run, bool capture, int run_index,
+                    int planned, double *wall_s, double *capture_s, enum job_status *status)
 {
-    struct run run = {.runner = r, .job = job, .spec = &job->spec};
-    const struct job_spec *spec = &job->spec;
-    enum job_status status = JOB_FAILED;
-    json_t *result = NULL;
+    const struct job_spec *spec = run->spec;
+    struct job *job = run->job;
     int w0 = spec->warmup_frames, n = spec->frames;
-
-    LOG(LOG_INFO, "job %s: %s, %d+%d frames at %dx%d", job->id, spec->technique, w0, n,
-        spec->scene.width, spec->scene.height);
-    service_status("running job %s (%s, %d frames at %dx%d)", job->id, spec->technique, n,
-                   spec->scene.width, spec->scene.height);
-    gl_error_take("previous job", run.err, sizeof(run.err));
-    run.err[0] = '\0';
-    run.tech = technique_find(spec->technique);
-    if (!run.tech) {
-        snprintf(run.err, sizeof(run.err), "technique %s is not available", spec->technique);
-        goto done;
+    (void)planned;
+    run->scene_ok = scene_create(&run->scene, &spec->scene);
+    run->capture_count = capture ? job_spec_capture_count(spec) : 0;
+    run->captures = calloc((size_t)run->capture_count + 1, sizeof(*run->captures));
+    run->cpu_ms = calloc((size_t)n, sizeof(double));
+    run->frame_ms = calloc((size_t)n, sizeof(double));
+    if (!run->scene_ok || !run->captures || !run->cpu_ms || !run->frame_ms) {
+        snprintf(run->err, sizeof(run->err), "out of memory preparing the job");
+        return false;
     }
-    run.scene_ok = scene_create(&run.scene, &spec->scene);
-    run.capture_count = job_spec_capture_count(spec);
-    run.captures = calloc((size_t)run.capture_count + 1, sizeof(*run.captures));
-    run.cpu_ms = calloc((size_t)n, sizeof(double));
-    run.frame_ms = calloc((size_t)n, sizeof(double));
-    if (!run.scene_ok || !run.captures || !run.cpu_ms || !run.frame_ms) {
-        snprintf(run.err, sizeof(run.err), "out of memory preparing the job");
-        goto done;
+    if (!gpu_scene_init(&run->gpu, &run->scene, run->err, sizeof(run->err)) ||
+        !setup_framebuffer(run))
+        return false;
+    run->timer = gpu_timer_create(technique_section_count(run->tech), (int64_t)w0 + n);
+    if (!run->timer) {
+        snprintf(run->err, sizeof(run->err), "cannot create GPU timer queries");
+        return false;
     }
-    if (!gpu_scene_init(&run.gpu, &run.scene, run.err, sizeof(run.err)) ||
-        !setup_framebuffer(&run))
-        goto done;
-    run.timer = gpu_timer_create(technique_section_count(run.tech), (int64_t)w0 + n);
-    if (!run.timer) {
-        snprintf(run.err, sizeof(run.err), "cannot create GPU timer queries");
-        goto done;
-    }
-    struct technique_ctx ctx = {spec, &run.scene, &run.gpu, run.timer};
-    if (!run.tech->create(&ctx, &run.state, run.err, sizeof(run.err)))
-        goto done;
-    if (gl_error_take("setup", run.err, sizeof(run.err)))
-        goto done;
+    struct technique_ctx ctx = {spec, &run->scene, &run->gpu, run->timer};
+    if (!run->tech->create(&ctx, &run->state, run->err, sizeof(run->err)) ||
+        gl_error_take("setup", run->err, sizeof(run->err)))
+        return false;
 
     size_t frame_bytes = (size_t)spec->scene.width * (size_t)spec->scene.height * 4;
-    for (int c = 0; c < run.capture_count; c++)
-        if (!(run.captures[c] = malloc(frame_bytes))) {
-            snprintf(run.err, sizeof(run.err), "out of memory for captures");
-            goto done;
+    for (int c = 0; c < run->capture_count; c++)
+        if (!(run->captures[c] = malloc(frame_bytes))) {
+            snprintf(run->err, sizeof(run->err), "out of memory for captures");
+            return false;
         }
 
-    glBindFramebuffer(GL_FRAMEBUFFER, run.fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, run->fbo);
     glViewport(0, 0, spec->scene.width, spec->scene.height);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    double wall_start = 0, capture_s = 0, frame_begin = 0;
+    double wall_start = 0, frame_begin = 0;
     int captured = 0;
+    *capture_s = 0;
     for (int seq = 0; seq < w0 + n; seq++) {
         int64_t k = (int64_t)seq - w0 + 1;
         if (atomic_load(&job->cancel)) {
-            status = JOB_CANCELLED;
-            snprintf(run.err, sizeof(run.err), "cancelled at frame %" PRId64, k);
-            goto done;
+            *status = JOB_CANCELLED;
+            snprintf(run->err, sizeof(run->err), "cancelled at frame %" PRId64 " of run %d", k,
+                     run_index + 1);
+            return false;
         }
         if (k == 1) {
             /* Warm-up work still queued must not be billed to the timed frames. */
@@ -388,7 +380,7 @@ static void run_job(struct runner *r, struct job *job)
         }
         /* Bound the frames in flight like a swap chain would; the wait is part
          * of the frame interval, never of the CPU submit time. */
-        GLsync *fence = &run.fences[seq % FRAMES_IN_FLIGHT];
+        GLsync *fence = &run->fences[seq % FRAMES_IN_FLIGHT];
         if (*fence) {
             glClientWaitSync(*fence, GL_SYNC_FLUSH_COMMANDS_BIT, UINT64_MAX);
             glDeleteSync(*fence);
@@ -396,42 +388,157 @@ static void run_job(struct runner *r, struct job *job)
         }
         double t0 = mono_s();
         if (k >= 2)
-            run.frame_ms[k - 2] += (t0 - frame_begin) * 1e3;
+            run->frame_ms[k - 2] += (t0 - frame_begin) * 1e3;
         frame_begin = t0;
-        gpu_timer_begin_frame(run.timer);
-        bool ok = run.tech->render(run.state, &ctx, k, run.err, sizeof(run.err));
-        gpu_timer_end_frame(run.timer);
+        gpu_timer_begin_frame(run->timer);
+        bool ok = run->tech->render(run->state, &ctx, k, run->err, sizeof(run->err));
+        gpu_timer_end_frame(run->timer);
         glFlush(); /* where a swap would hand the frame to the GPU */
         double t1 = mono_s();
         *fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
         if (!ok)
-            goto done;
+            return false;
         if (k >= 1)
-            run.cpu_ms[k - 1] = (t1 - t0) * 1e3;
-        if (job_spec_is_capture_frame(spec, (int)k)) {
+            run->cpu_ms[k - 1] = (t1 - t0) * 1e3;
+        if (run->capture_count && job_spec_is_capture_frame(spec, (int)k)) {
             double c0 = mono_s();
             glReadPixels(0, 0, spec->scene.width, spec->scene.height, GL_RGBA,
-                         GL_UNSIGNED_BYTE, run.captures[captured++]);
+                         GL_UNSIGNED_BYTE, run->captures[captured++]);
             double c = mono_s() - c0;
-            capture_s += c;
-            run.frame_ms[k - 1] -= c * 1e3;
+            *capture_s += c;
+            run->frame_ms[k - 1] -= c * 1e3;
         }
-        if ((seq & 15) == 15 && gl_error_take("rendering", run.err, sizeof(run.err)))
-            goto done;
-        queue_progress(r->queue, job, k > 0 ? (int)k : 0);
+        if ((seq & 15) == 15 && gl_error_take("rendering", run->err, sizeof(run->err)))
+            return false;
+        queue_progress(r->queue, job, run_index * n + (k > 0 ? (int)k : 0));
     }
     glFinish();
     double wall_end = mono_s();
-    run.frame_ms[n - 1] += (wall_end - frame_begin) * 1e3;
-    double wall_s = wall_end - wall_start;
-    gpu_timer_drain(run.timer);
-    if (gl_error_take("rendering", run.err, sizeof(run.err)))
+    run->frame_ms[n - 1] += (wall_end - frame_begin) * 1e3;
+    *wall_s = wall_end - wall_start;
+    gpu_timer_drain(run->timer);
+    return !gl_error_take("rendering", run->err, sizeof(run->err));
+}
+
+/* Median of each series in one run's figures, for the across-run summary. */
+static json_t *run_summary(int index, double wall_s, json_t *frame, json_t *gpu, json_t *cpu)
+{
+    return json_pack("{s:i, s:f, s:o, s:o, s:o}", "run", index, "wall_s", wall_s, "frame_ms",
+                     frame, "gpu_ms", gpu, "cpu_ms", cpu);
+}
+
+static json_t *across_runs(const double *medians, size_t n)
+{
+    struct stats s;
+    stats_compute(medians, n, &s);
+    double lo, hi;
+    json_t *ci = stats_mean_ci95(medians, n, &lo, &hi) ? json_pack("[f, f]", lo, hi) : json_null();
+    return json_pack("{s:f, s:f, s:f, s:f, s:f, s:o}", "mean", s.mean, "median", s.median,
+                     "stddev", s.stddev, "min", s.min, "max", s.max, "ci95", ci);
+}
+
+/* Runs 2..N of a repeated job, each with the scene rebuilt; with automatic
+ * repeats, stops as soon as the frame-time interval has tightened. Adds
+ * result.runs and result.repeat, and rewrites result.json. */
+static bool repeat_runs(struct runner *r, struct run *first, json_t *result,
+                        enum job_status *status)
+{
+    const struct job_spec *spec = first->spec;
+    int planned = spec->repeat, n = spec->frames, w0 = spec->warmup_frames;
+    double *med = calloc((size_t)planned * 3, sizeof(double)); /* frame, gpu, cpu */
+    double *gpu = malloc((size_t)n * sizeof(double));
+    json_t *runs = json_array();
+    static const char *const series[3] = {"frame_ms", "gpu_ms", "cpu_ms"};
+    bool ok = med && gpu;
+    if (!ok)
+        snprintf(first->err, sizeof(first->err), "out of memory for repeats");
+    for (int k = 0; ok && k < 3; k++)
+        med[k * planned] = json_real_value(json_object_get(json_object_get(result, series[k]), "median"));
+    if (ok)
+        json_array_append_new(runs, run_summary(1, json_real_value(json_object_get(result, "wall_s")),
+                                                json_deep_copy(json_object_get(result, "frame_ms")),
+                                                json_deep_copy(json_object_get(result, "gpu_ms")),
+                                                json_deep_copy(json_object_get(result, "cpu_ms"))));
+    int done = 1;
+    while (ok && done < planned && !(spec->repeat_auto && stats_is_stable(med, (size_t)done, 0.025))) {
+        struct run extra = {.runner = r, .job = first->job, .spec = spec, .tech = first->tech};
+        double wall_s = 0, capture_s = 0;
+        ok = measure(r, &extra, false, done, planned, &wall_s, &capture_s, status);
+        if (ok) {
+            for (int i = 0; i < n; i++)
+                gpu[i] = gpu_timer_ms(extra.timer, w0 + i, -1);
+            json_t *f = stats_json(extra.frame_ms, (size_t)n), *g = stats_json(gpu, (size_t)n),
+                   *c = stats_json(extra.cpu_ms, (size_t)n);
+            med[done] = json_real_value(json_object_get(f, "median"));
+            med[planned + done] = json_real_value(json_object_get(g, "median"));
+            med[2 * planned + done] = json_real_value(json_object_get(c, "median"));
+            json_array_append_new(runs, run_summary(done + 1, wall_s, f, g, c));
+            done++;
+        } else {
+            char why[900];
+            snprintf(why, sizeof(why), "%.890s", extra.err);
+            snprintf(first->err, sizeof(first->err), "run %d: %s", done + 1, why);
+        }
+        teardown(&extra);
+    }
+    if (ok) {
+        bool stable = stats_is_stable(med, (size_t)done, 0.025);
+        json_t *rep = json_pack("{s:i, s:i, s:b, s:b, s:s, s:s}", "runs", done, "planned", planned,
+                                "auto", spec->repeat_auto, "stable", stable, "rule_series",
+                                "frame_ms", "rule",
+                                "stable when the 95% confidence interval (Student's t) of the mean "
+                                "of per-run median frame_ms is within 2.5% of it, from 3 runs");
+        for (int k = 0; k < 3; k++)
+            json_object_set_new(rep, series[k], across_runs(med + k * planned, (size_t)done));
+        json_object_set_new(result, "repeat", rep);
+        json_object_set_new(result, "runs", runs);
+        runs = NULL;
+        queue_progress(r->queue, first->job, planned * n);
+        char path[PATH_MAX + 16];
+        snprintf(path, sizeof(path), "%s/result.json", first->job->dir);
+        if (!fs_write_json_atomic(path, result)) {
+            snprintf(first->err, sizeof(first->err), "cannot write %.900s", path);
+            ok = false;
+        }
+    }
+    json_decref(runs);
+    free(med);
+    free(gpu);
+    return ok;
+}
+
+static void run_job(struct runner *r, struct job *job)
+{
+    struct run run = {.runner = r, .job = job, .spec = &job->spec};
+    const struct job_spec *spec = &job->spec;
+    enum job_status status = JOB_FAILED;
+    json_t *result = NULL;
+
+    LOG(LOG_INFO, "job %s: %s, %d+%d frames at %dx%d, %d run(s)", job->id, spec->technique,
+        spec->warmup_frames, spec->frames, spec->scene.width, spec->scene.height,
+        job_spec_runs(spec));
+    service_status("running job %s (%s, %d frames at %dx%d)", job->id, spec->technique,
+                   spec->frames, spec->scene.width, spec->scene.height);
+    gl_error_take("previous job", run.err, sizeof(run.err));
+    run.err[0] = '\0';
+    run.tech = technique_find(spec->technique);
+    if (!run.tech) {
+        snprintf(run.err, sizeof(run.err), "technique %s is not available", spec->technique);
+        goto done;
+    }
+    double wall_s = 0, capture_s = 0;
+    if (!measure(r, &run, true, 0, job_spec_runs(spec), &wall_s, &capture_s, &status))
         goto done;
     result = write_outputs(&run, wall_s, capture_s);
+    /* The first run's technique is done with: free it before more runs or the
+     * reference claim the device's memory. */
+    run.tech->destroy(run.state);
+    run.state = NULL;
+    if (result && spec->repeat > 1 && !repeat_runs(r, &run, result, &status)) {
+        json_decref(result);
+        result = NULL;
+    }
     if (result && spec->reference[0]) {
-        /* Free the measured technique's resources before the reference's. */
-        run.tech->destroy(run.state);
-        run.state = NULL;
         queue_set_phase(r->queue, job, "reference");
         if (!render_reference(&run, &status)) {
             json_decref(result);

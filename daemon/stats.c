@@ -50,6 +50,46 @@ bool stats_compute(const double *samples, size_t n, struct stats *out)
     out->p95 = stats_percentile_sorted(sorted, n, 95.0);
     out->p99 = stats_percentile_sorted(sorted, n, 99.0);
     out->cv = mean != 0.0 ? out->stddev / mean : 0.0;
+    if (n < 6) {
+        out->median_lo = out->min;
+        out->median_hi = out->max;
+    } else {
+        double spread = 1.96 * sqrt((double)n);
+        long lo = (long)floor(((double)n - spread) / 2.0);
+        long hi = (long)ceil(1.0 + ((double)n + spread) / 2.0);
+        lo = lo < 1 ? 1 : lo;
+        hi = hi > (long)n ? (long)n : hi;
+        out->median_lo = sorted[lo - 1];
+        out->median_hi = sorted[hi - 1];
+    }
     free(sorted);
     return true;
+}
+
+/* Two-sided 97.5% quantiles of Student's t for 1 to 30 degrees of freedom. */
+static const double T975[31] = {
+    0,     12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228,
+    2.201, 2.179,  2.160, 2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080,
+    2.074, 2.069,  2.064, 2.060, 2.056, 2.052, 2.048, 2.045, 2.042,
+};
+
+bool stats_mean_ci95(const double *samples, size_t n, double *lo, double *hi)
+{
+    struct stats s;
+    if (n < 2 || !stats_compute(samples, n, &s))
+        return false;
+    double t = n - 1 <= 30 ? T975[n - 1] : 1.96;
+    double half = t * s.stddev / sqrt((double)n);
+    *lo = s.mean - half;
+    *hi = s.mean + half;
+    return true;
+}
+
+bool stats_is_stable(const double *run_medians, size_t n, double tolerance)
+{
+    double lo, hi;
+    if (n < 3 || !stats_mean_ci95(run_medians, n, &lo, &hi))
+        return false;
+    double mean = (lo + hi) / 2.0;
+    return mean > 0 && (hi - lo) / 2.0 <= tolerance * mean;
 }

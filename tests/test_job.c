@@ -58,6 +58,15 @@ int main(void)
     json_decref(j);
 
     CHECK(parse("{\"frames\":300.0}", &spec, &err) && spec.frames == 300);
+    CHECK(parse("{\"repeat\":5}", &spec, &err) && spec.repeat == 5 && !spec.repeat_auto);
+    CHECK(parse("{\"repeat\":{\"auto\":true,\"max\":12}}", &spec, &err) && spec.repeat == 12 &&
+          spec.repeat_auto && job_spec_runs(&spec) == 12);
+    CHECK(parse("{\"repeat\":{\"auto\":true}}", &spec, &err) && spec.repeat == 30);
+    rejects("{\"repeat\":0}", "repeat");
+    rejects("{\"repeat\":\"many\"}", "repeat");
+    rejects("{\"repeat\":{\"auto\":false}}", "repeat.auto");
+    rejects("{\"repeat\":{\"auto\":true,\"max\":2}}", "repeat.max");
+    rejects("{\"repeat\":{\"atuo\":true}}", "repeat.atuo");
 
     rejects("", "body");
     rejects("{", "body");

@@ -35,6 +35,24 @@ int main(void)
     CHECK(stats_compute(even, 4, &s));
     CHECK_NEAR(s.median, 2.5, 1e-12);
 
+    /* Median interval of 1..100: ranks floor(40.2) = 40 and ceil(60.8) = 61. */
+    CHECK(stats_compute(v, 100, &s));
+    CHECK(s.median_lo == 40.0 && s.median_hi == 61.0);
+    CHECK(stats_compute(even, 4, &s) && s.median_lo == 1.0 && s.median_hi == 4.0);
+
+    /* Mean interval: 10, 12, 14 has mean 12, sd 2: 12 -+ 4.303 * 2 / sqrt(3). */
+    double three[3] = {10, 12, 14}, lo, hi;
+    CHECK(stats_mean_ci95(three, 3, &lo, &hi));
+    CHECK_NEAR(lo, 12.0 - 4.303 * 2.0 / sqrt(3.0), 1e-9);
+    CHECK_NEAR(hi, 12.0 + 4.303 * 2.0 / sqrt(3.0), 1e-9);
+    CHECK(!stats_mean_ci95(three, 1, &lo, &hi));
+
+    /* The repeat rule: tight runs are stable, noisy ones and too few are not. */
+    double tight[5] = {10.0, 10.1, 9.9, 10.05, 9.95}, noisy[5] = {10, 13, 8, 12, 9};
+    CHECK(stats_is_stable(tight, 5, 0.025));
+    CHECK(!stats_is_stable(noisy, 5, 0.025));
+    CHECK(!stats_is_stable(tight, 2, 0.025));
+
     CHECK(!stats_compute(v, 0, &s));
     CHECK(s.n == 0);
     return check_finish("test_stats");

@@ -419,6 +419,14 @@ int queue_load(struct queue *q, const char *const *techniques, char *err, size_t
             loaded++;
     closedir(d);
     qsort(q->jobs, q->count, sizeof(*q->jobs), by_id);
+    /* New ids continue after the loaded ones, so that ids keep sorting in
+     * submission order even within the second of a restart. */
+    for (size_t i = 0; i < q->count; i++) {
+        const char *dash = strrchr(q->jobs[i]->id, '-');
+        unsigned serial = dash ? (unsigned)strtoul(dash + 1, NULL, 10) : 0;
+        if (serial > q->serial)
+            q->serial = serial;
+    }
     pthread_cond_broadcast(&q->changed);
     pthread_mutex_unlock(&q->lock);
     apply_retention(q);
@@ -431,6 +439,12 @@ void queue_set_retention(struct queue *q, int keep_jobs, double keep_days)
     q->keep_jobs = keep_jobs;
     q->keep_days = keep_days;
     pthread_mutex_unlock(&q->lock);
+}
+
+static int by_time(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
 }
 
 /* Removes a finished job's directory: the files in it, then the directory. */
@@ -468,13 +482,28 @@ static void apply_retention(struct queue *q)
         pthread_mutex_unlock(&q->lock);
         return;
     }
-    /* Jobs are in submission order, so the oldest finished ones come first. */
+    /* Over the count limit: the jobs that finished earliest go first. The
+     * finish time of the newest one to go is the count cutoff. */
     size_t excess = q->keep_jobs > 0 && finished_count > (size_t)q->keep_jobs
                         ? finished_count - (size_t)q->keep_jobs
                         : 0;
+    double count_cutoff = -1.0;
+    if (excess) {
+        double *times = malloc(finished_count * sizeof(double));
+        size_t nt = 0;
+        for (size_t i = 0; times && i < q->count; i++)
+            if (finished(q->jobs[i]))
+                times[nt++] = q->jobs[i]->finished;
+        if (times) {
+            qsort(times, nt, sizeof(double), by_time);
+            count_cutoff = times[excess - 1];
+        }
+        free(times);
+    }
     for (size_t i = 0; i < q->count; i++) {
         struct job *job = q->jobs[i];
-        bool old = finished(job) && (nv < excess || (cutoff > 0 && job->finished < cutoff));
+        bool old = finished(job) && ((job->finished <= count_cutoff && nv < excess) ||
+                                     (cutoff > 0 && job->finished < cutoff));
         if (old)
             victims[nv++] = job;
         else

@@ -82,7 +82,10 @@ try:
     status, term = third.json("GET", "/v1/jobs/" + term_id)
     check(status == 200 and term["status"] == "cancelled", "the SIGTERMed job is cancelled: %s" % term.get("status"))
     remaining = sorted(os.listdir(os.path.join(state, "jobs")))
-    check(remaining == sorted([new_id, term_id]), "--keep-jobs 2 keeps the newest two finished: %s" % remaining)
+    check(remaining == sorted([new_id, term_id]),
+          "--keep-jobs 2 keeps the newest two finished (%s, %s): %s; statuses %s"
+          % (new_id, term_id, remaining,
+             [(j["id"], j["status"]) for j in third.json("GET", "/v1/jobs")[1]["jobs"]]))
     check(third.json("GET", "/v1/jobs/" + done_id)[0] == 404, "a removed job is gone from the API")
     check(os.path.isdir(state), "the state directory itself stays")
 finally:

@@ -28,6 +28,7 @@ struct http_server {
     struct MHD_Daemon *mhd;
     struct queue *queue;
     struct runner *runner;
+    struct sweeps *sweeps;
     int port;
     pthread_mutex_t token_lock;
     char token[512];
@@ -292,6 +293,77 @@ static enum MHD_Result job_routes(struct http_server *s, struct MHD_Connection *
     return respond_file(c, path, "image/png");
 }
 
+static enum MHD_Result sweep_routes(struct http_server *s, struct MHD_Connection *c,
+                                    const char *method, const char *rest, struct request *req)
+{
+    bool get = strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
+    if (!*rest) {
+        if (strcmp(method, "POST") == 0) {
+            if (req->too_large)
+                return respond_error(c, MHD_HTTP_CONTENT_TOO_LARGE, "body",
+                                     "the sweep must be at most 65536 bytes");
+            json_error_t jerr;
+            json_t *body = json_loadb(req->body ? req->body : "", req->len, JSON_REJECT_DUPLICATES, &jerr);
+            if (!body) {
+                char msg[256];
+                snprintf(msg, sizeof(msg), "malformed JSON at line %d, column %d: %s", jerr.line,
+                         jerr.column, jerr.text);
+                return respond_error(c, MHD_HTTP_BAD_REQUEST, "body", msg);
+            }
+            struct sweep_spec spec;
+            struct job_error err;
+            if (!sweep_spec_parse(body, technique_names(), &spec, &err)) {
+                sweep_spec_finish(&spec);
+                json_decref(body);
+                return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
+            }
+            char id[24];
+            bool ok = sweeps_submit(s->sweeps, &spec, body, id);
+            sweep_spec_finish(&spec);
+            json_decref(body);
+            if (!ok)
+                return respond_error(c, MHD_HTTP_TOO_MANY_REQUESTS, "body",
+                                     "too many sweeps are waiting; retry later");
+            char url[64];
+            snprintf(url, sizeof(url), "/v1/sweeps/%s", id);
+            return respond_json(c, MHD_HTTP_ACCEPTED,
+                                json_pack("{s:s, s:s, s:s}", "id", id, "status", "queued", "url", url));
+        }
+        if (get)
+            return respond_json(c, MHD_HTTP_OK, sweeps_list_json(s->sweeps));
+        return respond_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "method",
+                             "use GET to list sweeps or POST to start one");
+    }
+    size_t id_len = strcspn(rest, "/");
+    if (!valid_id(rest, id_len) || rest[id_len])
+        return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such sweep");
+    char id[24];
+    memcpy(id, rest, id_len);
+    id[id_len] = '\0';
+    if (get) {
+        double wait;
+        if (!parse_wait(c, &wait))
+            return respond_error(c, MHD_HTTP_BAD_REQUEST, "wait",
+                                 "must be a number of seconds from 0 to 3600");
+        json_t *sw = sweeps_json(s->sweeps, id, wait);
+        return sw ? respond_json(c, MHD_HTTP_OK, sw)
+                  : respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such sweep");
+    }
+    if (strcmp(method, "DELETE") == 0) {
+        switch (sweeps_cancel(s->sweeps, id)) {
+        case CANCEL_NOT_FOUND:
+            return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such sweep");
+        case CANCEL_FINISHED:
+            return respond_error(c, MHD_HTTP_CONFLICT, "id", "the sweep has already finished");
+        case CANCEL_DONE:
+            return respond_json(c, MHD_HTTP_OK, sweeps_json(s->sweeps, id, 0));
+        case CANCEL_REQUESTED:
+            return respond_json(c, MHD_HTTP_ACCEPTED, sweeps_json(s->sweeps, id, 5));
+        }
+    }
+    return respond_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "method", "use GET or DELETE on a sweep");
+}
+
 static enum MHD_Result route(struct http_server *s, struct MHD_Connection *c,
                              const char *url, const char *method, struct request *req)
 {
@@ -323,6 +395,10 @@ static enum MHD_Result route(struct http_server *s, struct MHD_Connection *c,
     }
     if (strncmp(url, "/v1/jobs/", 9) == 0)
         return job_routes(s, c, method, url + 9);
+    if (strcmp(url, "/v1/sweeps") == 0)
+        return sweep_routes(s, c, method, "", req);
+    if (strncmp(url, "/v1/sweeps/", 11) == 0)
+        return sweep_routes(s, c, method, url + 11, req);
     return respond_error(c, MHD_HTTP_NOT_FOUND, "url", "no such route");
 }
 
@@ -394,7 +470,8 @@ static void on_mhd_log(void *cls, const char *fmt, va_list ap)
 }
 
 struct http_server *http_server_create(const char *listen, struct queue *q,
-                                       struct runner *r, char *err, size_t errlen)
+                                       struct runner *r, struct sweeps *sweeps, char *err,
+                                       size_t errlen)
 {
     char host[256];
     const char *colon = strrchr(listen, ':');
@@ -434,6 +511,7 @@ struct http_server *http_server_create(const char *listen, struct queue *q,
     }
     s->queue = q;
     s->runner = r;
+    s->sweeps = sweeps;
     pthread_mutex_init(&s->token_lock, NULL);
     unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_THREAD_PER_CONNECTION |
                      MHD_USE_ERROR_LOG;

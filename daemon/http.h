@@ -8,12 +8,14 @@
 
 #include "daemon/queue.h"
 #include "daemon/runner.h"
+#include "daemon/sweeps.h"
 
 struct http_server;
 
 /* listen is "HOST:PORT" or "[V6]:PORT"; port 0 picks a free one. */
 struct http_server *http_server_create(const char *listen, struct queue *q,
-                                       struct runner *r, char *err, size_t errlen);
+                                       struct runner *r, struct sweeps *sweeps, char *err,
+                                       size_t errlen);
 void http_server_destroy(struct http_server *s);
 
 /* When token is non-empty, every endpoint but /healthz needs

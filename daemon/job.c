@@ -167,6 +167,7 @@ void job_spec_defaults(struct job_spec *out)
     out->scene.width = 1080;
     out->scene.height = 720;
     out->scene.sphere_segments = 32;
+    out->scene.light_speed = 1.0;
     out->osl.resolution = 256;
     out->osl.texel_density = 1.0;
     out->osl.reshade = OSL_RESHADE_TOUCHED;
@@ -284,7 +285,7 @@ static bool parse_scene(const json_t *scene, struct scene_spec *s,
                         struct job_error *err)
 {
     static const char *const keys[] = {"preset", "lights", "dynamic", "width",
-                                       "height", "sphere_segments", NULL};
+                                       "height", "sphere_segments", "light_speed", NULL};
     if (!check_keys(scene, "scene.", keys, err))
         return false;
     json_t *preset = json_object_get(scene, "preset");
@@ -298,7 +299,8 @@ static bool parse_scene(const json_t *scene, struct scene_spec *s,
         !get_int(scene, "width", "scene.width", 16, 8192, &s->width, err) ||
         !get_int(scene, "height", "scene.height", 16, 8192, &s->height, err) ||
         !get_int(scene, "sphere_segments", "scene.sphere_segments", 8, 256,
-                 &s->sphere_segments, err))
+                 &s->sphere_segments, err) ||
+        !get_number(scene, "light_speed", "scene.light_speed", 0.0, 100.0, &s->light_speed, err))
         return false;
     if (s->sphere_segments % 2)
         return fail(err, "scene.sphere_segments", "must be an even integer from 8 to 256");
@@ -469,13 +471,14 @@ json_t *job_spec_to_json(const struct job_spec *spec)
     json_t *res = spec->osl.resolution ? json_integer(spec->osl.resolution)
                                        : json_string("auto");
     json_t *out = json_pack(
-        "{s:s, s:i, s:i, s:i, s:f, s:{s:s, s:i, s:b, s:i, s:i, s:i}, s:{s:o, s:f, s:s}}",
+        "{s:s, s:i, s:i, s:i, s:f, s:{s:s, s:i, s:b, s:i, s:i, s:i, s:f}, s:{s:o, s:f, s:s}}",
         "technique", spec->technique, "frames", spec->frames, "warmup_frames",
         spec->warmup_frames, "capture_interval", spec->capture_interval,
         "async_distance", spec->async_distance, "scene", "preset",
         spec->scene.preset, "lights", spec->scene.lights, "dynamic",
         spec->scene.dynamic, "width", spec->scene.width, "height",
-        spec->scene.height, "sphere_segments", spec->scene.sphere_segments,
+        spec->scene.height, "sphere_segments", spec->scene.sphere_segments, "light_speed",
+        spec->scene.light_speed,
         "osl", "resolution", res, "texel_density", spec->osl.texel_density,
         "reshade", spec->osl.reshade == OSL_RESHADE_ALL ? "all" : "touched");
     json_object_set_new(out, "repeat",

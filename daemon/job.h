@@ -24,6 +24,7 @@ struct scene_spec {
     bool dynamic;
     int width, height;
     int sphere_segments; /* longitudinal segments; rings = segments / 2 */
+    double light_speed;  /* scales how fast dynamic lights circle (1 = default) */
 };
 
 struct osl_spec {

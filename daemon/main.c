@@ -18,6 +18,7 @@
 #include "daemon/queue.h"
 #include "daemon/runner.h"
 #include "daemon/service.h"
+#include "daemon/sweeps.h"
 #include "daemon/technique.h"
 
 struct options {
@@ -327,9 +328,12 @@ static int serve(const struct options *o)
         queue_destroy(q);
         return 1;
     }
-    struct http_server *http = http_server_create(o->listen, q, r, err, sizeof(err));
+    struct sweeps *sweeps = sweeps_create(q, technique_names());
+    struct http_server *http =
+        sweeps ? http_server_create(o->listen, q, r, sweeps, err, sizeof(err)) : NULL;
     if (!http) {
-        LOG(LOG_ERROR, "%s", err);
+        LOG(LOG_ERROR, "%s", sweeps ? err : "cannot start the sweep thread");
+        sweeps_destroy(sweeps);
         runner_destroy(r);
         queue_destroy(q);
         return 1;
@@ -360,6 +364,7 @@ static int serve(const struct options *o)
     LOG(LOG_INFO, "signal %d: stopping", sig);
     service_stopping();
     http_server_destroy(http);
+    sweeps_destroy(sweeps);
     runner_destroy(r);
     queue_destroy(q);
     return 0;

@@ -65,7 +65,7 @@ bool osl_schedule_due(const struct osl_schedule *s, int i, int64_t frame)
 
 bool osl_touched(const struct scene *scene, int i, int64_t frame)
 {
-    if (!scene->spec.dynamic)
+    if (!scene->spec.dynamic || scene->spec.light_speed <= 0)
         return false;
     const float *c = scene->instances[i].pos;
     float bound = scene_instance_bound(scene, i);
@@ -91,7 +91,7 @@ int osl_schedule_plan(const struct osl_schedule *s, const struct scene *scene,
             out[n++].time = osl_schedule_last(s, i, frame);
             continue;
         }
-        if (!scene->spec.dynamic || !osl_schedule_due(s, i, frame))
+        if (!scene->spec.dynamic || scene->spec.light_speed <= 0 || !osl_schedule_due(s, i, frame))
             continue;
         if (mode == OSL_RESHADE_TOUCHED && !osl_touched(scene, i, frame) &&
             !osl_touched(scene, i, frame - s->period[i]))

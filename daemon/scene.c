@@ -141,8 +141,13 @@ bool scene_create(struct scene *out, const struct scene_spec *spec)
          * close to the 90 the thesis reports (chapter 4.1). */
         l->radius = 5.0f;
         hsv_to_rgb(i * 0.618033988749895, 0.6, 1.6, l->color);
-        l->period = 180 + 40 * (i % 7);
-        l->phase = (i * 37) % l->period;
+        /* Whole frames per revolution keep positions exact for any frame
+         * index; light_speed divides the period (0 holds the lights still). */
+        int base_period = 180 + 40 * (i % 7);
+        l->period = spec->light_speed > 0
+                        ? (int)fmax(1.0, lround(base_period / spec->light_speed))
+                        : base_period;
+        l->phase = (i * 37) % base_period % l->period;
     }
 
     out->eye[0] = 0.0f, out->eye[1] = 28.0f, out->eye[2] = 22.0f;
@@ -175,7 +180,7 @@ void scene_light_position(const struct scene *s, int light, int64_t frame,
                           float out[3])
 {
     const struct scene_light *l = &s->lights[light];
-    int64_t t = s->spec.dynamic ? frame : 0;
+    int64_t t = s->spec.dynamic && s->spec.light_speed > 0 ? frame : 0;
     int64_t step = (t + l->phase) % l->period;
     if (step < 0)
         step += l->period;

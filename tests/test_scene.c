@@ -1,4 +1,5 @@
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "daemon/job.h"
@@ -86,6 +87,21 @@ int main(void)
         CHECK(memcmp(a, b, sizeof(a)) != 0);
         CHECK(a[2] == s.lights[l].centre[2]); /* circles stay in the XY plane */
     }
+    /* light_speed 2 halves each revolution; 0 holds the lights still. */
+    struct scene fast, still;
+    struct scene_spec fs = spec.scene, ss = spec.scene;
+    fs.light_speed = 2.0;
+    ss.light_speed = 0.0;
+    CHECK(scene_create(&fast, &fs) && scene_create(&still, &ss));
+    for (int l = 0; l < fast.light_count; l++) {
+        CHECK(abs(2 * fast.lights[l].period - s.lights[l].period) <= 1);
+        scene_light_position(&still, l, 0, a);
+        scene_light_position(&still, l, 77, b);
+        CHECK(memcmp(a, b, sizeof(a)) == 0);
+    }
+    scene_finish(&fast);
+    scene_finish(&still);
+
     /* Distances put the far corner in the thesis's "every third frame" band at d = 20. */
     float far = 0, near = 1e9f;
     for (int i = 0; i < s.instance_count; i++) {

@@ -1,0 +1,93 @@
+"""Sweeps end to end: a grid over async_distance on a small dynamic OSL
+scene whose table behaves as the schedule says, a find that returns the
+light speed at which PerceptualDiff starts failing, cancelling with the
+finished points kept, and bad sweeps answered 400 naming the field."""
+
+import time
+
+import testlib
+from testlib import check
+
+testlib.skip_without_egl()
+BASE = {"technique": "osl", "frames": 8, "warmup_frames": 2, "async_distance": 20,
+        "osl": {"resolution": "auto"}, "scene": {"dynamic": True, "width": 200, "height": 150}}
+
+
+def post(d, body):
+    status, reply = d.json("POST", "/v1/sweeps", body)
+    if status != 202:
+        raise RuntimeError("sweep refused: %d %s" % (status, reply))
+    return reply["id"]
+
+
+def wait(d, sweep_id, timeout=900):
+    deadline = time.time() + timeout
+    while True:
+        sw = d.json("GET", "/v1/sweeps/%s?wait=30" % sweep_id)[1]
+        if sw["status"] not in ("queued", "running") or time.time() > deadline:
+            return sw
+
+
+d = testlib.Daemon()
+try:
+    # A grid over async_distance: 0 and 80 both reshade every object every
+    # frame here (no object is 80 units away), 5 leaves them stale for 7 to
+    # 11 frames: the table must show exactly that.
+    sw = wait(d, post(d, {"base": BASE, "vary": {"async_distance": [0, 5, 80]}}))
+    check(sw["status"] == "done", "grid sweep done: %s" % sw.get("error"))
+    rows = sw["points"]
+    check(len(rows) == 3 and [r["values"]["async_distance"] for r in rows] == [0, 5, 80], "one row per value")
+    for r in rows:
+        check(r["status"] == "done" and r["frame_ms"]["median"] > 0 and len(r["frame_ms"]["ci95"]) == 2,
+              "row has a median frame time with its interval: %s" % r.get("frame_ms"))
+        check("worst_ssim" in r and "worst_flip" in r and "pdiff_failed_captures" in r, "row has quality")
+    check(rows[0]["worst_ssim"] == rows[2]["worst_ssim"], "d 0 and d 80 give the same image")
+    check(rows[1]["worst_ssim"] < rows[0]["worst_ssim"] and rows[1]["worst_flip"] > rows[0]["worst_flip"],
+          "stale shading at d 5 costs quality: SSIM %s vs %s" % (rows[1]["worst_ssim"], rows[0]["worst_ssim"]))
+    job = d.json("GET", "/v1/jobs/" + rows[1]["job"])[1]
+    check(job["status"] == "done" and job["spec"]["reference"] == "forward", "each point is a job with a reference")
+
+    # Breaking point: the largest light speed at which OSL (d 20) still passes.
+    sw = wait(d, post(d, {"base": BASE, "find": {"param": "scene.light_speed", "from": 0, "to": 16,
+                                                  "while": "pdiff_pass", "steps": 7}}))
+    check(sw["status"] == "done", "find done: %s" % sw.get("error"))
+    bp = sw.get("result", {}).get("breaking_point", {})
+    check(bp.get("param") == "scene.light_speed" and bp.get("criterion") == "pdiff_pass", "breaking point named")
+    check(bp.get("outcome") == "boundary" and 0 <= bp["value"] < bp["first_failing"] <= 16,
+          "a boundary inside the range: %s" % bp)
+    probes = sw["points"]
+    check(len(probes) == bp["probes"] and all("criterion_holds" in p for p in probes),
+          "every probe is in the table with its verdict")
+    holds = {p["values"]["scene.light_speed"]: p["criterion_holds"] for p in probes}
+    check(holds.get(0) is True and holds.get(16) is False, "holds with still lights, fails when fast: %s" % holds)
+    check(all(v is True for k, v in holds.items() if k <= bp["value"]) and
+          all(v is False for k, v in holds.items() if k >= bp["first_failing"]), "probes agree with the boundary")
+
+    # Cancel: the finished points stay readable.
+    long_id = post(d, {"base": dict(BASE, frames=60), "vary": {"scene.lights": [1, 2, 3, 4, 5, 6, 7, 8]}})
+    deadline = time.time() + 120
+    while d.json("GET", "/v1/sweeps/" + long_id)[1]["progress"]["points_done"] < 1 and time.time() < deadline:
+        time.sleep(0.2)
+    status, body = d.json("DELETE", "/v1/sweeps/" + long_id)
+    check(status in (200, 202), "cancel accepted")
+    sw = wait(d, long_id)
+    check(sw["status"] == "cancelled" and 1 <= len(sw["points"]) < 8, "cancelled, finished points kept: %d" % len(sw["points"]))
+    check(d.json("DELETE", "/v1/sweeps/" + long_id)[0] == 409, "cancelling a finished sweep is 409")
+    listed = [s["id"] for s in d.json("GET", "/v1/sweeps")[1]["sweeps"]]
+    check(long_id in listed and len(listed) == 3, "list has the sweeps")
+
+    # Bad sweeps name the field.
+    for body, field in (({"base": BASE, "vary": {"async_distance": list(range(16)), "scene.lights": list(range(1, 18))}}, "vary"),
+                        ({"base": BASE, "vary": {"scene.lightz": [1]}}, "vary.scene.lightz"),
+                        ({"base": BASE, "vary": {"async_distance": [0, "far"]}}, "vary.async_distance[1]"),
+                        ({"base": BASE, "find": {"param": "technique", "from": 0, "to": 1, "while": "pdiff_pass"}}, "find.param"),
+                        ({"base": BASE, "find": {"param": "async_distance", "from": 0, "to": 1, "while": "nice"}}, "find.while"),
+                        ({"base": {"frames": -1}, "vary": {"frames": [1]}}, "base"),
+                        ({"vary": {"frames": [1]}}, "base")):
+        code, reply = d.json("POST", "/v1/sweeps", body)
+        check(code == 400 and reply.get("error", {}).get("field") == field,
+              "%s -> 400 naming %s (got %d %s)" % (str(body)[:80], field, code, reply))
+    check(d.json("GET", "/v1/sweeps/99999999-999999-9999")[0] == 404, "unknown sweep is 404")
+finally:
+    testlib.stop_and_check(d)
+testlib.finish("e2e_sweep")

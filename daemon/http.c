@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "config.h"
+#include "daemon/charts.h"
 #include "daemon/job.h"
 #include "daemon/log.h"
 #include "daemon/technique.h"
@@ -212,6 +213,34 @@ static bool parse_wait(struct MHD_Connection *c, double *wait)
     return true;
 }
 
+/* ".../charts/NAME.svg" or ".png": renders from the JSON of a sweep or job. */
+static enum MHD_Result respond_chart(struct MHD_Connection *c, const json_t *subject,
+                                     const char *file, bool is_sweep)
+{
+    char name[32];
+    const char *dot = strrchr(file, '.');
+    if (!dot || (size_t)(dot - file) >= sizeof(name) ||
+        (strcmp(dot, ".svg") != 0 && strcmp(dot, ".png") != 0))
+        return respond_error(c, MHD_HTTP_NOT_FOUND, "chart", "charts are NAME.svg or NAME.png");
+    snprintf(name, sizeof(name), "%.*s", (int)(dot - file), file);
+    enum chart_format format = strcmp(dot, ".svg") == 0 ? CHART_SVG : CHART_PNG;
+    struct chart_options o = {0};
+    o.series = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "series");
+    if (o.series && strcmp(o.series, "frame_ms") && strcmp(o.series, "gpu_ms") && strcmp(o.series, "cpu_ms"))
+        return respond_error(c, MHD_HTTP_BAD_REQUEST, "series", "must be frame_ms, gpu_ms or cpu_ms");
+    const char *y = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "y");
+    if (y && strcmp(y, "ssim") && strcmp(y, "flip"))
+        return respond_error(c, MHD_HTTP_BAD_REQUEST, "y", "must be ssim or flip");
+    o.flip = y && strcmp(y, "flip") == 0;
+    char err[256];
+    size_t len = 0;
+    char *data = is_sweep ? charts_sweep(subject, name, format, &o, &len, err, sizeof(err))
+                          : charts_job(subject, name, format, &o, &len, err, sizeof(err));
+    if (!data)
+        return respond_error(c, MHD_HTTP_NOT_FOUND, "chart", err);
+    return respond_text(c, MHD_HTTP_OK, data, len, format == CHART_SVG ? "image/svg+xml" : "image/png");
+}
+
 static enum MHD_Result job_routes(struct http_server *s, struct MHD_Connection *c,
                                   const char *method, const char *rest)
 {
@@ -255,6 +284,19 @@ static enum MHD_Result job_routes(struct http_server *s, struct MHD_Connection *
                              "use GET or DELETE on a job");
     }
 
+    if (strncmp(slash + 1, "charts/", 7) == 0) {
+        if (!get)
+            return respond_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "method", "use GET");
+        json_t *job = queue_job_json(s->queue, id, 0);
+        if (!job)
+            return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
+        enum MHD_Result ret =
+            json_object_get(job, "result")
+                ? respond_chart(c, job, slash + 8, false)
+                : respond_error(c, MHD_HTTP_CONFLICT, "id", "the job has no result yet");
+        json_decref(job);
+        return ret;
+    }
     /* Per-capture images: URL folder -> file prefix in the job's directory. */
     static const char *const kinds[][2] = {
         {"frames/", "frame"}, {"reference/", "reference"}, {"ssim/", "ssim"}, {"flip/", "flip"},
@@ -335,11 +377,26 @@ static enum MHD_Result sweep_routes(struct http_server *s, struct MHD_Connection
                              "use GET to list sweeps or POST to start one");
     }
     size_t id_len = strcspn(rest, "/");
-    if (!valid_id(rest, id_len) || rest[id_len])
+    if (!valid_id(rest, id_len))
         return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such sweep");
     char id[24];
     memcpy(id, rest, id_len);
     id[id_len] = '\0';
+    if (rest[id_len]) {
+        const char *sub = rest + id_len + 1;
+        if (!get)
+            return respond_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "method", "use GET");
+        json_t *sw = sweeps_json(s->sweeps, id, 0);
+        if (!sw)
+            return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such sweep");
+        enum MHD_Result ret;
+        if (strncmp(sub, "charts/", 7) == 0)
+            ret = respond_chart(c, sw, sub + 7, true);
+        else
+            ret = respond_error(c, MHD_HTTP_NOT_FOUND, "url", "no such resource");
+        json_decref(sw);
+        return ret;
+    }
     if (get) {
         double wait;
         if (!parse_wait(c, &wait))

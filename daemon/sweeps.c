@@ -48,9 +48,11 @@ static double now_s(void)
 static json_t *point_row(const json_t *job, json_t *values)
 {
     json_t *r = json_object_get(job, "result");
-    json_t *row = json_pack("{s:o, s:s, s:s}", "values", values, "job",
+    json_t *spec = json_object_get(job, "spec");
+    json_t *row = json_pack("{s:o, s:s, s:s, s:O}", "values", values, "job",
                             json_string_value(json_object_get(job, "id")), "status",
-                            json_string_value(json_object_get(job, "status")));
+                            json_string_value(json_object_get(job, "status")), "technique",
+                            json_object_get(spec, "technique"));
     if (json_object_get(job, "error"))
         json_object_set(row, "error", json_object_get(job, "error"));
     if (!r)
@@ -62,12 +64,16 @@ static json_t *point_row(const json_t *job, json_t *values)
         json_t *across = rep ? json_object_get(rep, series[k]) : NULL;
         /* Repeated jobs: the mean of run medians and its interval; single runs:
          * the median and its distribution-free interval. */
-        json_object_set_new(
-            row, series[k],
+        json_t *cell =
             across ? json_pack("{s:O, s:O, s:s}", "median", json_object_get(across, "mean"), "ci95",
                                json_object_get(across, "ci95"), "over", "runs")
                    : json_pack("{s:O, s:O, s:s}", "median", json_object_get(st, "median"), "ci95",
-                               json_object_get(st, "median_ci95"), "over", "frames"));
+                               json_object_get(st, "median_ci95"), "over", "frames");
+        /* The distribution of the (first run's) frames, for the charts. */
+        static const char *const keep[] = {"min", "p5", "p95", "p99", "max"};
+        for (int i = 0; i < 5; i++)
+            json_object_set(cell, keep[i], json_object_get(st, keep[i]));
+        json_object_set_new(row, series[k], cell);
     }
     if (rep)
         json_object_set(row, "stable", json_object_get(rep, "stable"));

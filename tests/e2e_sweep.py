@@ -3,7 +3,9 @@ scene whose table behaves as the schedule says, a find that returns the
 light speed at which PerceptualDiff starts failing, cancelling with the
 finished points kept, and bad sweeps answered 400 naming the field."""
 
+import os
 import time
+import xml.etree.ElementTree as ET
 
 import testlib
 from testlib import check
@@ -44,7 +46,27 @@ try:
     check(rows[0]["worst_ssim"] == rows[2]["worst_ssim"], "d 0 and d 80 give the same image")
     check(rows[1]["worst_ssim"] < rows[0]["worst_ssim"] and rows[1]["worst_flip"] > rows[0]["worst_flip"],
           "stale shading at d 5 costs quality: SSIM %s vs %s" % (rows[1]["worst_ssim"], rows[0]["worst_ssim"]))
+    grid_id = sw["id"]
+    for name in ("speed_accuracy", "time_vs_param", "distribution"):
+        svg, png = os.path.join(d.tmp, name + ".svg"), os.path.join(d.tmp, name + ".png")
+        check(d.download("/v1/sweeps/%s/charts/%s.svg" % (grid_id, name), svg) == 200, "%s.svg served" % name)
+        check(d.download("/v1/sweeps/%s/charts/%s.png" % (grid_id, name), png) == 200, "%s.png served" % name)
+        try:
+            root = ET.parse(svg).getroot()
+            check(root.tag.endswith("svg") and len(list(root.iter())) > 20, "%s.svg is an SVG drawing" % name)
+        except ET.ParseError as e:
+            check(False, "%s.svg parses: %s" % (name, e))
+        info = testlib.png_info(png)
+        check(info and info["width"] == 900 and info["height"] == 560 and info["colours"] > 5,
+              "%s.png is a 900x560 chart: %s" % (name, info))
+    check(d.download("/v1/sweeps/%s/charts/speed_accuracy.svg?y=flip&series=cpu_ms" % grid_id,
+                     os.path.join(d.tmp, "flip.svg")) == 200, "FLIP and cpu_ms variants")
+    check(d.json("GET", "/v1/sweeps/%s/charts/nope.svg" % grid_id)[0] == 404, "unknown chart is 404")
+    check(d.json("GET", "/v1/sweeps/%s/charts/time_vs_param.svg?series=fps" % grid_id)[0] == 400,
+          "bad series is 400")
     job = d.json("GET", "/v1/jobs/" + rows[1]["job"])[1]
+    check(d.download("/v1/jobs/%s/charts/distribution.png" % rows[1]["job"],
+                     os.path.join(d.tmp, "job.png")) == 200, "a job's distribution chart")
     check(job["status"] == "done" and job["spec"]["reference"] == "forward", "each point is a job with a reference")
 
     # Breaking point: the largest light speed at which OSL (d 20) still passes.

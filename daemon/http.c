@@ -16,6 +16,7 @@
 #include "config.h"
 #include "daemon/charts.h"
 #include "daemon/job.h"
+#include "daemon/report.h"
 #include "daemon/log.h"
 #include "daemon/technique.h"
 
@@ -241,6 +242,26 @@ static enum MHD_Result respond_chart(struct MHD_Connection *c, const json_t *sub
     return respond_text(c, MHD_HTTP_OK, data, len, format == CHART_SVG ? "image/svg+xml" : "image/png");
 }
 
+static bool point_job_dir(void *ctx, const char *job_id, char *dir, size_t cap, int *last_frame)
+{
+    struct http_server *s = ctx;
+    enum job_status status;
+    if (!queue_job_dir(s->queue, job_id, dir, cap, &status))
+        return false;
+    json_t *job = queue_job_json(s->queue, job_id, 0);
+    json_t *caps = json_object_get(json_object_get(job, "result"), "captures");
+    *last_frame = (int)json_integer_value(json_object_get(json_array_get(caps, json_array_size(caps) - 1), "frame"));
+    json_decref(job);
+    return true;
+}
+
+static enum MHD_Result respond_html(struct MHD_Connection *c, char *html, size_t len)
+{
+    if (!html)
+        return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "report", "out of memory");
+    return respond_text(c, MHD_HTTP_OK, html, len, "text/html; charset=utf-8");
+}
+
 static enum MHD_Result job_routes(struct http_server *s, struct MHD_Connection *c,
                                   const char *method, const char *rest)
 {
@@ -284,6 +305,23 @@ static enum MHD_Result job_routes(struct http_server *s, struct MHD_Connection *
                              "use GET or DELETE on a job");
     }
 
+    if (strcmp(slash + 1, "report.html") == 0) {
+        if (!get)
+            return respond_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "method", "use GET");
+        char dir[PATH_MAX];
+        enum job_status status;
+        json_t *job = queue_job_json(s->queue, id, 0);
+        if (!job || !queue_job_dir(s->queue, id, dir, sizeof(dir), &status)) {
+            json_decref(job);
+            return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
+        }
+        json_t *device = runner_device_json(s->runner);
+        size_t len = 0;
+        char *html = report_job_html(job, dir, device, &len);
+        json_decref(device);
+        json_decref(job);
+        return respond_html(c, html, len);
+    }
     if (strncmp(slash + 1, "charts/", 7) == 0) {
         if (!get)
             return respond_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "method", "use GET");
@@ -390,9 +428,15 @@ static enum MHD_Result sweep_routes(struct http_server *s, struct MHD_Connection
         if (!sw)
             return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such sweep");
         enum MHD_Result ret;
-        if (strncmp(sub, "charts/", 7) == 0)
+        if (strncmp(sub, "charts/", 7) == 0) {
             ret = respond_chart(c, sw, sub + 7, true);
-        else
+        } else if (strcmp(sub, "report.html") == 0) {
+            json_t *device = runner_device_json(s->runner);
+            size_t len = 0;
+            char *html = report_sweep_html(sw, device, point_job_dir, s, &len);
+            json_decref(device);
+            ret = respond_html(c, html, len);
+        } else
             ret = respond_error(c, MHD_HTTP_NOT_FOUND, "url", "no such resource");
         json_decref(sw);
         return ret;

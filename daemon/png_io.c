@@ -145,3 +145,83 @@ void image_finish(struct image *img)
     free(img->rgb);
     memset(img, 0, sizeof(*img));
 }
+
+struct mem_sink {
+    unsigned char *data;
+    size_t len, cap;
+    bool failed;
+};
+
+static void mem_write(png_structp png, png_bytep data, png_size_t length)
+{
+    struct mem_sink *m = png_get_io_ptr(png);
+    if (m->len + length > m->cap) {
+        size_t cap = (m->len + length) * 2;
+        unsigned char *grown = realloc(m->data, cap);
+        if (!grown) {
+            m->failed = true;
+            return;
+        }
+        m->data = grown;
+        m->cap = cap;
+    }
+    memcpy(m->data + m->len, data, length);
+    m->len += length;
+}
+
+static void mem_flush(png_structp png) { (void)png; }
+
+unsigned char *png_encode_thumbnail(const struct image *img, int max_width, size_t *len)
+{
+    int factor = 1;
+    while (img->width / factor > max_width)
+        factor++;
+    int w = img->width / factor, h = img->height / factor;
+    if (w < 1 || h < 1)
+        return NULL;
+    uint8_t *small = malloc((size_t)w * (size_t)h * 3);
+    png_bytep *rows = malloc((size_t)h * sizeof(*rows));
+    struct mem_sink sink = {0};
+    png_structp png = NULL;
+    png_infop info = NULL;
+    if (!small || !rows)
+        goto fail;
+    for (int y = 0; y < h; y++) {
+        for (int x = 0; x < w; x++)
+            for (int c = 0; c < 3; c++) {
+                unsigned sum = 0;
+                for (int dy = 0; dy < factor; dy++)
+                    for (int dx = 0; dx < factor; dx++)
+                        sum += img->rgb[((size_t)(y * factor + dy) * (size_t)img->width +
+                                         (size_t)(x * factor + dx)) * 3 + (size_t)c];
+                small[((size_t)y * (size_t)w + (size_t)x) * 3 + (size_t)c] =
+                    (uint8_t)(sum / (unsigned)(factor * factor));
+            }
+        rows[y] = small + (size_t)y * (size_t)w * 3;
+    }
+    png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+    info = png ? png_create_info_struct(png) : NULL;
+    if (!info || setjmp(png_jmpbuf(png)))
+        goto fail;
+    png_set_write_fn(png, &sink, mem_write, mem_flush);
+    png_set_IHDR(png, info, (png_uint_32)w, (png_uint_32)h, 8, PNG_COLOR_TYPE_RGB,
+                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_write_info(png, info);
+    png_write_image(png, rows);
+    png_write_end(png, NULL);
+    png_destroy_write_struct(&png, &info);
+    free(rows);
+    free(small);
+    if (sink.failed) {
+        free(sink.data);
+        return NULL;
+    }
+    *len = sink.len;
+    return sink.data;
+fail:
+    png_destroy_write_struct(&png, &info);
+    free(rows);
+    free(small);
+    free(sink.data);
+    return NULL;
+}

@@ -24,4 +24,8 @@ bool png_write_rgb(const char *path, const struct image *img, char *err, size_t 
 bool png_read_rgb(const char *path, struct image *out, char *err, size_t errlen);
 void image_finish(struct image *img);
 
+/* Encodes img, shrunk by a box filter to at most max_width pixels wide, as a
+ * PNG in memory (for thumbnails in report pages). malloc'ed; NULL on failure. */
+unsigned char *png_encode_thumbnail(const struct image *img, int max_width, size_t *len);
+
 #endif

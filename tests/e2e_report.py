@@ -1,0 +1,73 @@
+"""Report pages in a real browser: headless Chromium loads a sweep's and a
+job's report.html from the daemon, logs no console message, and the
+screenshot shows the page. The pages are self-contained: every image is
+embedded, nothing is fetched."""
+
+import os
+import re
+import shutil
+import subprocess
+import tempfile
+import time
+
+import testlib
+from testlib import check
+
+testlib.skip_without_egl()
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+BASE = {"technique": "osl", "frames": 6, "warmup_frames": 1, "osl": {"resolution": "auto"},
+        "scene": {"dynamic": True, "width": 160, "height": 120}}
+
+
+def browse(url, shot):
+    profile = tempfile.mkdtemp(prefix="shadebench-chromium-")
+    try:
+        # The flags keep headless Chromium off the network and the GPU.
+        out = subprocess.run([CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
+                              "--no-first-run", "--disable-background-networking",
+                              "--disable-component-update", "--disable-sync",
+                              "--user-data-dir=" + profile, "--enable-logging=stderr", "--v=0",
+                              "--window-size=1280,2000", "--screenshot=" + shot, url],
+                             capture_output=True, text=True, timeout=180)
+    finally:
+        shutil.rmtree(profile, ignore_errors=True)
+    console = [l for l in out.stderr.splitlines() if "CONSOLE" in l]
+    return out.returncode, console
+
+
+check(CHROMIUM is not None, "chromium is installed (tools/setup installs it)")
+d = testlib.Daemon()
+try:
+    status, reply = d.json("POST", "/v1/sweeps", {"base": BASE, "vary": {"async_distance": [0, 20]}})
+    sweep_id = reply["id"]
+    deadline = time.time() + 600
+    while True:
+        sw = d.json("GET", "/v1/sweeps/%s?wait=30" % sweep_id)[1]
+        if sw["status"] not in ("queued", "running") or time.time() > deadline:
+            break
+    check(sw["status"] == "done", "sweep done")
+    job_id = sw["points"][1]["job"]
+    for kind, path in (("sweep", "/v1/sweeps/%s/report.html" % sweep_id),
+                       ("job", "/v1/jobs/%s/report.html" % job_id)):
+        status, headers, raw = d.request("GET", path)
+        html = raw.decode()
+        check(status == 200 and headers.get("Content-Type", "").startswith("text/html"), "%s report served" % kind)
+        check("<table>" in html, "%s report has its table" % kind)
+        sources = re.findall(r'(?:src|href)="([^"]*)"', html)
+        check(sources and all(s.startswith("data:image/png;base64,") for s in sources),
+              "%s report embeds everything (%d images, no external links)" % (kind, len(sources)))
+        check("<script" not in html, "%s report has no scripts" % kind)
+        check("&quot;technique&quot;" in html and "<pre>" in html, "%s report shows the exact JSON" % kind)
+        if kind == "sweep":
+            check(html.count("data:image/png") >= 4 + 2 * 4, "charts and thumbnails of both points")
+        if CHROMIUM:
+            shot = os.path.join(d.tmp, kind + ".png")
+            rc, console = browse(d.base + path, shot)
+            check(rc == 0, "chromium loaded the %s report" % kind)
+            check(not console, "no console messages: %s" % console[:3])
+            info = testlib.png_info(shot) if os.path.exists(shot) else None
+            check(info and info["width"] == 1280 and info["colours"] > 50,
+                  "the %s screenshot shows the page: %s" % (kind, info))
+finally:
+    testlib.stop_and_check(d)
+testlib.finish("e2e_report")

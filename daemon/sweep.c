@@ -120,6 +120,43 @@ static bool parse_criterion(const char *text, struct sweep_spec *s)
     return true;
 }
 
+/* The thesis's experiment (chapter 3.3): forward and OSL (256 texels an
+ * object, async distance 20) with still and moving lights on the grid at
+ * 1080x720, repeated, captures judged with SSIM and PerceptualDiff at 22.6
+ * degrees. frames and repeat may be lowered to fit a slow machine. */
+static json_t *thesis_sweep(const json_t *body, struct job_error *err)
+{
+    const char *key;
+    json_t *v;
+    json_object_foreach((json_t *)body, key, v) if (strcmp(key, "preset") && strcmp(key, "frames") &&
+                                                  strcmp(key, "repeat")) {
+        fail(err, key, "unknown field (the thesis preset takes frames and repeat)");
+        return NULL;
+    }
+    json_t *frames = json_object_get(body, "frames"), *repeat = json_object_get(body, "repeat");
+    if (frames && (!json_is_integer(frames) || json_integer_value(frames) < 1 ||
+                   json_integer_value(frames) > 100000)) {
+        fail(err, "frames", "must be an integer from 1 to 100000");
+        return NULL;
+    }
+    if (repeat && (!json_is_integer(repeat) || json_integer_value(repeat) < 1 ||
+                   json_integer_value(repeat) > 1000)) {
+        fail(err, "repeat", "must be an integer from 1 to 1000");
+        return NULL;
+    }
+    json_int_t n = frames ? json_integer_value(frames) : 300;
+    json_t *base = json_pack(
+        "{s:s, s:I, s:i, s:I, s:f, s:{s:i}, s:I, s:s, s:{s:b, s:{s:f}, s:b, s:b},"
+        " s:{s:s, s:i, s:b, s:i, s:i}}",
+        "technique", "forward", "frames", n, "warmup_frames", 10, "capture_interval",
+        n >= 3 ? n / 3 : n, "async_distance", 20.0, "osl", "resolution", 256, "repeat",
+        repeat ? json_integer_value(repeat) : (json_int_t)5, "reference", "forward", "metrics",
+        "ssim", 1, "pdiff", "fov", 22.6, "psnr", 0, "flip", 0, "scene", "preset", "grid", "lights",
+        10, "dynamic", 0, "width", 1080, "height", 720);
+    return json_pack("{s:o, s:{s:[b, b], s:[s, s]}}", "base", base, "vary", "scene.dynamic", 0, 1,
+                     "technique", "forward", "osl");
+}
+
 bool sweep_spec_parse(const json_t *body, const char *const *techniques, struct sweep_spec *out,
                       struct job_error *err)
 {
@@ -127,6 +164,18 @@ bool sweep_spec_parse(const json_t *body, const char *const *techniques, struct 
     memset(err, 0, sizeof(*err));
     if (!json_is_object(body))
         return fail(err, "body", "the sweep must be a JSON object");
+    json_t *preset = json_object_get(body, "preset");
+    if (preset) {
+        if (!json_is_string(preset) || strcmp(json_string_value(preset), "thesis") != 0)
+            return fail(err, "preset", "must be \"thesis\"");
+        json_t *expanded = thesis_sweep(body, err);
+        if (!expanded)
+            return false;
+        bool ok = sweep_spec_parse(expanded, techniques, out, err);
+        json_decref(expanded);
+        out->thesis = ok;
+        return ok;
+    }
     const char *key;
     json_t *v;
     json_object_foreach((json_t *)body, key, v) if (strcmp(key, "base") && strcmp(key, "vary") &&

@@ -3,7 +3,8 @@
 
 /* Sweep specifications (GL-free): a base job and one or two job fields to
  * vary over listed values (a grid), or one numeric field to bisect for the
- * largest value at which a quality criterion still holds. */
+ * largest value at which a quality criterion still holds, or the thesis's
+ * experiment as a preset. */
 
 #include <jansson.h>
 #include <stdbool.h>
@@ -31,6 +32,7 @@ struct sweep_spec {
     enum sweep_criterion criterion;
     double threshold;
     char criterion_text[64];
+    bool thesis; /* {"preset": "thesis"}: the thesis's experiment */
 };
 
 bool sweep_spec_parse(const json_t *body, const char *const *techniques, struct sweep_spec *out,

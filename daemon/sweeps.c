@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "daemon/log.h"
+#include "daemon/stats.h"
 
 struct sweep {
     char id[24];
@@ -77,6 +78,20 @@ static json_t *point_row(const json_t *job, json_t *values)
     }
     if (rep)
         json_object_set(row, "stable", json_object_get(rep, "stable"));
+    /* Execution time of the timed frames, over runs: what the thesis tabled. */
+    json_t *runs = json_object_get(r, "runs");
+    size_t nruns = runs ? json_array_size(runs) : 1;
+    double *walls = malloc(nruns * sizeof(double));
+    if (walls) {
+        for (size_t i = 0; i < nruns; i++)
+            walls[i] = json_number_value(json_object_get(runs ? json_array_get(runs, i) : r, "wall_s"));
+        struct stats st;
+        stats_compute(walls, nruns, &st);
+        json_object_set_new(row, "wall_s", json_pack("{s:I, s:f, s:f, s:f}", "runs", (json_int_t)nruns,
+                                                     "mean", st.mean, "median", st.median, "stddev",
+                                                     st.stddev));
+        free(walls);
+    }
     json_t *q = json_object_get(r, "quality");
     if (q) {
         json_object_set(row, "worst_ssim", json_object_get(json_object_get(q, "worst_ssim"), "value"));
@@ -337,6 +352,8 @@ static json_t *sweep_json_locked(const struct sweep *sw, bool full)
                           (json_int_t)sw->spec.npoints);
     if (sw->current_job[0])
         json_object_set_new(o, "current_job", json_string(sw->current_job));
+    if (sw->spec.thesis)
+        json_object_set_new(o, "preset", json_string("thesis"));
     if (sw->error[0])
         json_object_set_new(o, "error", json_string(sw->error));
     if (full) {

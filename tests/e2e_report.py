@@ -47,8 +47,33 @@ try:
             break
     check(sw["status"] == "done", "sweep done")
     job_id = sw["points"][1]["job"]
+
+    # The thesis preset, cut down to fit a CPU renderer: 4 points at 1080x720.
+    status, reply = d.json("POST", "/v1/sweeps", {"preset": "thesis", "frames": 2, "repeat": 2})
+    check(status == 202, "thesis preset accepted: %s" % reply)
+    thesis_id = reply["id"]
+    while True:
+        th = d.json("GET", "/v1/sweeps/%s?wait=30" % thesis_id)[1]
+        if th["status"] not in ("queued", "running") or time.time() > deadline:
+            break
+    check(th["status"] == "done" and len(th["points"]) == 4, "thesis preset ran its 4 points: %s" % th.get("error"))
+    combos = {(p["technique"], p["values"]["scene.dynamic"]) for p in th["points"]}
+    check(combos == {("forward", False), ("forward", True), ("osl", False), ("osl", True)},
+          "forward and OSL, still and moving lights")
+    check(all(p["wall_s"]["runs"] == 2 and p["worst_ssim"] is not None for p in th["points"]),
+          "every point repeated twice and judged")
+    osl_job = d.json("GET", "/v1/jobs/" + [p for p in th["points"] if p["technique"] == "osl"][0]["job"])[1]
+    check(osl_job["spec"]["async_distance"] == 20 and osl_job["spec"]["osl"]["resolution"] == 256 and
+          osl_job["spec"]["metrics"]["pdiff"]["fov"] == 22.6 and osl_job["spec"]["scene"]["width"] == 1080,
+          "the thesis's settings: async 20, 256 texels, PerceptualDiff at 22.6 degrees, 1080x720")
+    for body, field in (({"preset": "sponza"}, "preset"), ({"preset": "thesis", "frames": 0}, "frames"),
+                        ({"preset": "thesis", "lights": 3}, "lights")):
+        code, r = d.json("POST", "/v1/sweeps", body)
+        check(code == 400 and r.get("error", {}).get("field") == field, "%s -> 400 naming %s" % (body, field))
+
     for kind, path in (("sweep", "/v1/sweeps/%s/report.html" % sweep_id),
-                       ("job", "/v1/jobs/%s/report.html" % job_id)):
+                       ("job", "/v1/jobs/%s/report.html" % job_id),
+                       ("thesis", "/v1/sweeps/%s/report.html" % thesis_id)):
         status, headers, raw = d.request("GET", path)
         html = raw.decode()
         check(status == 200 and headers.get("Content-Type", "").startswith("text/html"), "%s report served" % kind)
@@ -60,6 +85,13 @@ try:
         check("&quot;technique&quot;" in html and "<pre>" in html, "%s report shows the exact JSON" % kind)
         if kind == "sweep":
             check(html.count("data:image/png") >= 4 + 2 * 4, "charts and thumbnails of both points")
+        if kind == "thesis":
+            check("experiment on this device" in html and "OSL (256, async 20)" in html and
+                  "moving lights" in html and "still lights" in html, "the thesis's tables")
+            # 4 charts; per point the frame, the reference and the SSIM map (the
+            # thesis computed no FLIP, so there is no FLIP map).
+            check('alt="frame-time distributions"' in html and html.count("data:image/png") >= 4 + 4 * 3,
+                  "timing distributions and captures of both techniques")
         if CHROMIUM:
             shot = os.path.join(d.tmp, kind + ".png")
             rc, console = browse(d.base + path, shot)

@@ -73,6 +73,38 @@ static void text(cairo_t *cr, double x, double y, const char *s, double size, do
     cairo_show_text(cr, s);
 }
 
+struct frame {
+    struct range rx, ry;
+    double x0, x1, y0, y1;
+};
+
+/* Joins the points of one series (or, with series < 0, the Pareto points)
+ * in order of x. */
+static void polyline_by_x(cairo_t *cr, const struct chart *c, int series, const struct frame *f)
+{
+    bool first = true;
+    double last_x = -INFINITY;
+    for (;;) {
+        int best = -1;
+        for (int i = 0; i < c->n; i++) {
+            const struct point *p = &c->pts[i];
+            bool member = series < 0 ? p->pareto : p->series == series;
+            if (member && p->x > last_x && (best < 0 || p->x < c->pts[best].x))
+                best = i;
+        }
+        if (best < 0)
+            break;
+        double px = map(c->pts[best].x, f->rx, f->x0, f->x1), py = map(c->pts[best].y, f->ry, f->y0, f->y1);
+        if (first)
+            cairo_move_to(cr, px, py);
+        else
+            cairo_line_to(cr, px, py);
+        first = false;
+        last_x = c->pts[best].x;
+    }
+    cairo_stroke(cr);
+}
+
 static void draw(cairo_t *cr, const struct chart *c)
 {
     cairo_set_source_rgb(cr, 1, 1, 1);
@@ -157,6 +189,7 @@ static void draw(cairo_t *cr, const struct chart *c)
         return;
     }
 
+    const struct frame frame = {rx, ry, x0, x1, y0, y1};
     /* The Pareto front first, under the points. */
     int npareto = 0;
     for (int i = 0; i < c->n; i++)
@@ -166,52 +199,16 @@ static void draw(cairo_t *cr, const struct chart *c)
         cairo_set_line_width(cr, 1.5);
         double dash[] = {6, 4};
         cairo_set_dash(cr, dash, 2, 0);
-        bool first = true;
-        double last_x = -INFINITY;
-        for (int k = 0; k < npareto; k++) {
-            int best = -1;
-            for (int i = 0; i < c->n; i++)
-                if (c->pts[i].pareto && c->pts[i].x > last_x && (best < 0 || c->pts[i].x < c->pts[best].x))
-                    best = i;
-            if (best < 0)
-                break;
-            double px = map(c->pts[best].x, rx, x0, x1), py = map(c->pts[best].y, ry, y0, y1);
-            if (first)
-                cairo_move_to(cr, px, py);
-            else
-                cairo_line_to(cr, px, py);
-            first = false;
-            last_x = c->pts[best].x;
-        }
-        cairo_stroke(cr);
+        polyline_by_x(cr, c, -1, &frame);
         cairo_set_dash(cr, NULL, 0, 0);
     }
 
     for (int s = 0; s < c->nseries; s++) {
         const double *col = PALETTE[s % MAX_SERIES];
         if (c->lines) {
-            /* Points of a series in x order. */
             cairo_set_source_rgb(cr, col[0], col[1], col[2]);
             cairo_set_line_width(cr, 2);
-            bool first = true;
-            double last_x = -INFINITY;
-            for (;;) {
-                int best = -1;
-                for (int i = 0; i < c->n; i++)
-                    if (c->pts[i].series == s && c->pts[i].x > last_x &&
-                        (best < 0 || c->pts[i].x < c->pts[best].x))
-                        best = i;
-                if (best < 0)
-                    break;
-                double px = map(c->pts[best].x, rx, x0, x1), py = map(c->pts[best].y, ry, y0, y1);
-                if (first)
-                    cairo_move_to(cr, px, py);
-                else
-                    cairo_line_to(cr, px, py);
-                first = false;
-                last_x = c->pts[best].x;
-            }
-            cairo_stroke(cr);
+            polyline_by_x(cr, c, s, &frame);
         }
         for (int i = 0; i < c->n; i++) {
             const struct point *p = &c->pts[i];

@@ -6,10 +6,8 @@
 #include <stdio.h>
 #include <string.h>
 
-static bool fail(struct job_error *err, const char *field, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
 
-static bool fail(struct job_error *err, const char *field, const char *fmt, ...)
+bool job_error_set(struct job_error *err, const char *field, const char *fmt, ...)
 {
     snprintf(err->field, sizeof(err->field), "%s", field);
     va_list ap;
@@ -70,9 +68,9 @@ static bool check_keys(const json_t *obj, const char *prefix,
             char field[64];
             snprintf(field, sizeof(field), "%s%.40s", prefix, key);
             if (closest)
-                return fail(err, field, "unknown field (did you mean '%s%s'?)",
+                return job_error_set(err, field, "unknown field (did you mean '%s%s'?)",
                             prefix, closest);
-            return fail(err, field, "unknown field");
+            return job_error_set(err, field, "unknown field");
         }
     }
     return true;
@@ -91,9 +89,9 @@ static bool get_int(const json_t *obj, const char *key, const char *field,
     else if (json_is_real(v) && floor(json_real_value(v)) == json_real_value(v))
         d = json_real_value(v);
     else
-        return fail(err, field, "must be an integer from %ld to %ld", min, max);
+        return job_error_set(err, field, "must be an integer from %ld to %ld", min, max);
     if (d < (double)min || d > (double)max)
-        return fail(err, field, "must be an integer from %ld to %ld", min, max);
+        return job_error_set(err, field, "must be an integer from %ld to %ld", min, max);
     *out = (int)d;
     return true;
 }
@@ -107,7 +105,7 @@ static bool get_number(const json_t *obj, const char *key, const char *field,
         return true;
     if (!json_is_number(v) || !isfinite(json_number_value(v)) ||
         json_number_value(v) < min || json_number_value(v) > max)
-        return fail(err, field, "must be a number from %g to %g", min, max);
+        return job_error_set(err, field, "must be a number from %g to %g", min, max);
     *out = json_number_value(v);
     return true;
 }
@@ -119,7 +117,7 @@ static bool get_bool(const json_t *obj, const char *key, const char *field,
     if (!v)
         return true;
     if (!json_is_boolean(v))
-        return fail(err, field, "must be true or false");
+        return job_error_set(err, field, "must be true or false");
     *out = json_is_true(v);
     return true;
 }
@@ -129,7 +127,7 @@ static bool get_object(const json_t *obj, const char *key, const char *field,
 {
     *out = json_object_get(obj, key);
     if (*out && !json_is_object(*out))
-        return fail(err, field, "must be an object");
+        return job_error_set(err, field, "must be an object");
     return true;
 }
 
@@ -150,7 +148,7 @@ static bool get_technique(const json_t *v, const char *field, const char *const 
         size_t used = strlen(list);
         snprintf(list + used, sizeof(list) - used, "%s\"%s\"", used ? ", " : "", *t);
     }
-    return fail(err, field, "must be one of: %s%s", list, nullable ? ", or null" : "");
+    return job_error_set(err, field, "must be one of: %s%s", list, nullable ? ", or null" : "");
 }
 
 void job_spec_defaults(struct job_spec *out)
@@ -188,7 +186,7 @@ static bool parse_repeat(const json_t *v, struct job_spec *out, struct job_error
             !get_int(v, "max", "repeat.max", 3, 1000, &out->repeat, err))
             return false;
         if (!out->repeat_auto)
-            return fail(err, "repeat.auto", "must be true (or give repeat as a number of runs)");
+            return job_error_set(err, "repeat.auto", "must be true (or give repeat as a number of runs)");
         return true;
     }
     json_t *wrapped = json_pack("{s:O}", "repeat", v);
@@ -236,16 +234,16 @@ static bool parse_metrics(const json_t *v, struct metrics_options *m, struct job
                 if (json_is_string(name) && strcmp(json_string_value(name), METRIC_NAMES[k]) == 0)
                     bit = 1u << k;
             if (!bit)
-                return fail(err, "metrics", "must list metrics from: \"ssim\", \"pdiff\", "
+                return job_error_set(err, "metrics", "must list metrics from: \"ssim\", \"pdiff\", "
                             "\"psnr\", \"flip\"");
             m->which |= bit;
         }
         if (!m->which)
-            return fail(err, "metrics", "must name at least one metric");
+            return job_error_set(err, "metrics", "must name at least one metric");
         return true;
     }
     if (!json_is_object(v))
-        return fail(err, "metrics", "must be an object or a list of metric names");
+        return job_error_set(err, "metrics", "must be an object or a list of metric names");
     if (!check_keys(v, "metrics.", METRIC_NAMES, err))
         return false;
     for (int k = 0; METRIC_NAMES[k]; k++) {
@@ -263,7 +261,7 @@ static bool parse_metrics(const json_t *v, struct metrics_options *m, struct job
         }
         bool configurable = (1u << k) == METRIC_PDIFF || (1u << k) == METRIC_FLIP;
         if (!json_is_object(opt) || !configurable)
-            return fail(err, field, configurable ? "must be true, false or an options object"
+            return job_error_set(err, field, configurable ? "must be true, false or an options object"
                                                  : "must be true or false");
         m->which |= 1u << k;
         if ((1u << k) == METRIC_PDIFF && !parse_pdiff(opt, &m->pdiff, err))
@@ -277,7 +275,7 @@ static bool parse_metrics(const json_t *v, struct metrics_options *m, struct job
         }
     }
     if (!m->which)
-        return fail(err, "metrics", "switches every metric off: leave out reference instead");
+        return job_error_set(err, "metrics", "switches every metric off: leave out reference instead");
     return true;
 }
 
@@ -291,7 +289,7 @@ static bool parse_scene(const json_t *scene, struct scene_spec *s,
     json_t *preset = json_object_get(scene, "preset");
     if (preset) {
         if (!json_is_string(preset) || strcmp(json_string_value(preset), "grid") != 0)
-            return fail(err, "scene.preset", "must be one of: \"grid\"");
+            return job_error_set(err, "scene.preset", "must be one of: \"grid\"");
         snprintf(s->preset, sizeof(s->preset), "%s", json_string_value(preset));
     }
     if (!get_int(scene, "lights", "scene.lights", 0, 1024, &s->lights, err) ||
@@ -303,7 +301,7 @@ static bool parse_scene(const json_t *scene, struct scene_spec *s,
         !get_number(scene, "light_speed", "scene.light_speed", 0.0, 100.0, &s->light_speed, err))
         return false;
     if (s->sphere_segments % 2)
-        return fail(err, "scene.sphere_segments", "must be an even integer from 8 to 256");
+        return job_error_set(err, "scene.sphere_segments", "must be an even integer from 8 to 256");
     return true;
 }
 
@@ -318,15 +316,15 @@ static bool parse_osl(const json_t *osl, struct osl_spec *o, struct job_error *e
             "must be \"auto\" or a power of two from 8 to 1024";
         if (json_is_string(res)) {
             if (strcmp(json_string_value(res), "auto") != 0)
-                return fail(err, "osl.resolution", rule);
+                return job_error_set(err, "osl.resolution", rule);
             o->resolution = 0;
         } else if (json_is_integer(res)) {
             json_int_t r = json_integer_value(res);
             if (r < 8 || r > 1024 || (r & (r - 1)) != 0)
-                return fail(err, "osl.resolution", rule);
+                return job_error_set(err, "osl.resolution", rule);
             o->resolution = (int)r;
         } else {
-            return fail(err, "osl.resolution", rule);
+            return job_error_set(err, "osl.resolution", rule);
         }
     }
     if (!get_number(osl, "texel_density", "osl.texel_density", 0.0625, 16.0,
@@ -340,7 +338,7 @@ static bool parse_osl(const json_t *osl, struct osl_spec *o, struct job_error *e
         else if (strcmp(v, "all") == 0)
             o->reshade = OSL_RESHADE_ALL;
         else
-            return fail(err, "osl.reshade", "must be one of: \"touched\", \"all\"");
+            return job_error_set(err, "osl.reshade", "must be one of: \"touched\", \"all\"");
     }
     return true;
 }
@@ -355,7 +353,7 @@ bool job_spec_parse(const json_t *body, const char *const *techniques,
     job_spec_defaults(out);
     memset(err, 0, sizeof(*err));
     if (!json_is_object(body))
-        return fail(err, "body", "the job must be a JSON object");
+        return job_error_set(err, "body", "the job must be a JSON object");
     if (!check_keys(body, "", keys, err))
         return false;
 
@@ -390,22 +388,22 @@ bool job_spec_parse(const json_t *body, const char *const *techniques,
         return false;
 
     if (out->reference[0] && out->capture_interval == 0)
-        return fail(err, "reference", "needs capture_interval > 0: metrics compare the "
+        return job_error_set(err, "reference", "needs capture_interval > 0: metrics compare the "
                     "captured frames with the reference's");
     if (metrics && !out->reference[0])
-        return fail(err, "metrics", "needs a reference technique to compare with");
+        return job_error_set(err, "metrics", "needs a reference technique to compare with");
     if (out->reference[0] && (out->metrics.which & METRIC_SSIM) &&
         (out->scene.width < SSIM_WINDOW || out->scene.height < SSIM_WINDOW))
-        return fail(err, "metrics.ssim", "needs frames of at least 11x11 pixels");
+        return job_error_set(err, "metrics.ssim", "needs frames of at least 11x11 pixels");
     if (out->capture_interval > out->frames)
-        return fail(err, "capture_interval",
+        return job_error_set(err, "capture_interval",
                     "must be 0 (no captures) or at most frames (%d)", out->frames);
     /* Captured frames are kept in memory until the timed run ends, so that
      * encoding never lands inside the measurement: bound that memory. */
     double bytes = (double)job_spec_capture_count(out) * out->scene.width *
                    out->scene.height * 4.0;
     if (bytes > JOB_MAX_CAPTURE_BYTES)
-        return fail(err, "capture_interval",
+        return job_error_set(err, "capture_interval",
                     "would keep %d captures of %dx%d (%.0f MiB) in memory; the "
                     "limit is %.0f MiB, raise capture_interval",
                     job_spec_capture_count(out), out->scene.width,
@@ -422,7 +420,7 @@ bool job_spec_parse_text(const char *text, size_t len,
     json_t *body = json_loadb(text, len, JSON_REJECT_DUPLICATES, &jerr);
     if (!body) {
         job_spec_defaults(out);
-        return fail(err, "body", "malformed JSON at line %d, column %d: %s",
+        return job_error_set(err, "body", "malformed JSON at line %d, column %d: %s",
                     jerr.line, jerr.column, jerr.text);
     }
     bool ok = job_spec_parse(body, techniques, out, err);

@@ -77,6 +77,11 @@ int job_spec_runs(const struct job_spec *spec);
 /* True when timed frame (1-based) is captured. */
 bool job_spec_is_capture_frame(const struct job_spec *spec, int frame);
 
+/* Fills err (field and formatted message); returns false, for "return
+ * job_error_set(...)". */
+bool job_error_set(struct job_error *err, const char *field, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
 /* {"error": {"field": ..., "message": ...}}. New reference. */
 json_t *job_error_to_json(const struct job_error *err);
 

@@ -25,17 +25,6 @@ static const struct {
 };
 enum { NPARAMS = sizeof(PARAMS) / sizeof(PARAMS[0]) };
 
-static bool fail(struct job_error *err, const char *field, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-static bool fail(struct job_error *err, const char *field, const char *fmt, ...)
-{
-    snprintf(err->field, sizeof(err->field), "%s", field);
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err->message, sizeof(err->message), fmt, ap);
-    va_end(ap);
-    return false;
-}
 
 static int param_index(const char *path)
 {
@@ -52,7 +41,7 @@ static bool unknown_param(struct job_error *err, const char *field)
         size_t used = strlen(list);
         snprintf(list + used, sizeof(list) - used, "%s%s", i ? ", " : "", PARAMS[i].path);
     }
-    return fail(err, field, "not a parameter a sweep can vary; one of: %s", list);
+    return job_error_set(err, field, "not a parameter a sweep can vary; one of: %s", list);
 }
 
 /* A copy of job with the field at a dotted path set to value. */
@@ -99,7 +88,7 @@ static bool check_point(const json_t *job, const char *const *techniques, const 
     struct job_error inner;
     if (job_spec_parse(job, techniques, &spec, &inner))
         return true;
-    return fail(err, field, "%s: %s", inner.field, inner.message);
+    return job_error_set(err, field, "%s: %s", inner.field, inner.message);
 }
 
 static bool parse_criterion(const char *text, struct sweep_spec *s)
@@ -130,18 +119,18 @@ static json_t *thesis_sweep(const json_t *body, struct job_error *err)
     json_t *v;
     json_object_foreach((json_t *)body, key, v) if (strcmp(key, "preset") && strcmp(key, "frames") &&
                                                   strcmp(key, "repeat")) {
-        fail(err, key, "unknown field (the thesis preset takes frames and repeat)");
+        job_error_set(err, key, "unknown field (the thesis preset takes frames and repeat)");
         return NULL;
     }
     json_t *frames = json_object_get(body, "frames"), *repeat = json_object_get(body, "repeat");
     if (frames && (!json_is_integer(frames) || json_integer_value(frames) < 1 ||
                    json_integer_value(frames) > 100000)) {
-        fail(err, "frames", "must be an integer from 1 to 100000");
+        job_error_set(err, "frames", "must be an integer from 1 to 100000");
         return NULL;
     }
     if (repeat && (!json_is_integer(repeat) || json_integer_value(repeat) < 1 ||
                    json_integer_value(repeat) > 1000)) {
-        fail(err, "repeat", "must be an integer from 1 to 1000");
+        job_error_set(err, "repeat", "must be an integer from 1 to 1000");
         return NULL;
     }
     json_int_t n = frames ? json_integer_value(frames) : 300;
@@ -163,11 +152,11 @@ bool sweep_spec_parse(const json_t *body, const char *const *techniques, struct 
     memset(out, 0, sizeof(*out));
     memset(err, 0, sizeof(*err));
     if (!json_is_object(body))
-        return fail(err, "body", "the sweep must be a JSON object");
+        return job_error_set(err, "body", "the sweep must be a JSON object");
     json_t *preset = json_object_get(body, "preset");
     if (preset) {
         if (!json_is_string(preset) || strcmp(json_string_value(preset), "thesis") != 0)
-            return fail(err, "preset", "must be \"thesis\"");
+            return job_error_set(err, "preset", "must be \"thesis\"");
         json_t *expanded = thesis_sweep(body, err);
         if (!expanded)
             return false;
@@ -180,21 +169,21 @@ bool sweep_spec_parse(const json_t *body, const char *const *techniques, struct 
     json_t *v;
     json_object_foreach((json_t *)body, key, v) if (strcmp(key, "base") && strcmp(key, "vary") &&
                                                   strcmp(key, "find"))
-        return fail(err, key, "unknown field (a sweep has base and vary, or base and find)");
+        return job_error_set(err, key, "unknown field (a sweep has base and vary, or base and find)");
     json_t *base = json_object_get(body, "base");
     if (!json_is_object(base))
-        return fail(err, "base", "must be a job object");
+        return job_error_set(err, "base", "must be a job object");
     if (!check_point(base, techniques, "base", err))
         return false;
     json_t *vary = json_object_get(body, "vary"), *find = json_object_get(body, "find");
     if (!!vary == !!find)
-        return fail(err, vary ? "find" : "vary", "give exactly one of vary and find");
+        return job_error_set(err, vary ? "find" : "vary", "give exactly one of vary and find");
     out->base = json_incref(base);
 
     if (vary) {
         out->kind = SWEEP_VARY;
         if (!json_is_object(vary) || json_object_size(vary) < 1 || json_object_size(vary) > 2)
-            return fail(err, "vary", "must be an object of one or two parameters, each with a list of values");
+            return job_error_set(err, "vary", "must be an object of one or two parameters, each with a list of values");
         out->npoints = 1;
         json_object_foreach(vary, key, v) {
             char field[96];
@@ -202,12 +191,12 @@ bool sweep_spec_parse(const json_t *body, const char *const *techniques, struct 
             if (param_index(key) < 0)
                 return unknown_param(err, field);
             if (!json_is_array(v) || json_array_size(v) == 0)
-                return fail(err, field, "must be a non-empty list of values");
+                return job_error_set(err, field, "must be a non-empty list of values");
             snprintf(out->params[out->nparams], sizeof(out->params[0]), "%s", key);
             out->values[out->nparams++] = json_incref(v);
             out->npoints *= json_array_size(v);
             if (out->npoints > SWEEP_MAX_POINTS)
-                return fail(err, "vary", "makes more than %d points", SWEEP_MAX_POINTS);
+                return job_error_set(err, "vary", "makes more than %d points", SWEEP_MAX_POINTS);
             size_t i;
             json_t *value;
             json_array_foreach(v, i, value) {
@@ -224,42 +213,42 @@ bool sweep_spec_parse(const json_t *body, const char *const *techniques, struct 
 
     out->kind = SWEEP_FIND;
     if (!json_is_object(find))
-        return fail(err, "find", "must be an object: param, from, to, while");
+        return job_error_set(err, "find", "must be an object: param, from, to, while");
     json_object_foreach(find, key, v) if (strcmp(key, "param") && strcmp(key, "from") &&
                                           strcmp(key, "to") && strcmp(key, "while") &&
                                           strcmp(key, "steps")) {
         char field[64];
         snprintf(field, sizeof(field), "find.%.40s", key);
-        return fail(err, field, "unknown field (param, from, to, while, steps)");
+        return job_error_set(err, field, "unknown field (param, from, to, while, steps)");
     }
     const char *param = json_string_value(json_object_get(find, "param"));
     int p = param ? param_index(param) : -1;
     if (p < 0)
-        return param ? unknown_param(err, "find.param") : fail(err, "find.param", "must name a parameter");
+        return param ? unknown_param(err, "find.param") : job_error_set(err, "find.param", "must name a parameter");
     if (PARAMS[p].type != PARAM_INT && PARAMS[p].type != PARAM_NUMBER)
-        return fail(err, "find.param", "%s is not numeric: find bisects a numeric parameter", param);
+        return job_error_set(err, "find.param", "%s is not numeric: find bisects a numeric parameter", param);
     snprintf(out->params[0], sizeof(out->params[0]), "%s", param);
     out->nparams = 1;
     out->integer = PARAMS[p].type == PARAM_INT;
     json_t *from = json_object_get(find, "from"), *to = json_object_get(find, "to");
     if (!json_is_number(from))
-        return fail(err, "find.from", "must be a number");
+        return job_error_set(err, "find.from", "must be a number");
     if (!json_is_number(to) || json_number_value(to) <= json_number_value(from))
-        return fail(err, "find.to", "must be a number above find.from");
+        return job_error_set(err, "find.to", "must be a number above find.from");
     out->from = json_number_value(from);
     out->to = json_number_value(to);
     if (out->integer && (out->from != floor(out->from) || out->to != floor(out->to)))
-        return fail(err, out->from != floor(out->from) ? "find.from" : "find.to",
+        return job_error_set(err, out->from != floor(out->from) ? "find.from" : "find.to",
                     "must be an integer: %s is an integer parameter", param);
     const char *crit = json_string_value(json_object_get(find, "while"));
     if (!crit || !parse_criterion(crit, out))
-        return fail(err, "find.while", "must be one of \"pdiff_pass\", \"stable\", "
+        return job_error_set(err, "find.while", "must be one of \"pdiff_pass\", \"stable\", "
                     "\"ssim_min >= X\", \"flip_max <= X\"");
     out->max_probes = 10;
     json_t *steps = json_object_get(find, "steps");
     if (steps) {
         if (!json_is_integer(steps) || json_integer_value(steps) < 2 || json_integer_value(steps) > 64)
-            return fail(err, "find.steps", "must be an integer from 2 to 64 (probes at most)");
+            return job_error_set(err, "find.steps", "must be an integer from 2 to 64 (probes at most)");
         out->max_probes = (int)json_integer_value(steps);
     }
     out->npoints = (size_t)out->max_probes;

@@ -185,6 +185,7 @@ static void run_sweep(struct sweeps *s, struct sweep *sw)
 {
     bool ok = true;
     if (sw->spec.kind == SWEEP_VARY) {
+        json_t *passing = json_array();
         for (size_t i = 0; ok && i < sw->spec.npoints; i++) {
             json_t *values, *body = sweep_point_job(&sw->spec, i, &values);
             json_t *job = run_point(s, sw, body);
@@ -194,9 +195,31 @@ static void run_sweep(struct sweeps *s, struct sweep *sw)
                 ok = false;
                 break;
             }
-            add_row(s, sw, point_row(job, values));
+            json_t *row = point_row(job, values);
+            if (json_is_integer(json_object_get(row, "pdiff_failed_captures")) &&
+                json_integer_value(json_object_get(row, "pdiff_failed_captures")) == 0)
+                json_array_append(passing, json_object_get(row, "values"));
+            add_row(s, sw, row);
             json_decref(job);
         }
+        /* With one numeric parameter, the question the thesis answered by hand:
+         * the largest value whose captures all pass PerceptualDiff. */
+        json_t *best = NULL;
+        size_t k;
+        json_t *values;
+        if (sw->spec.nparams == 1)
+            json_array_foreach(passing, k, values) {
+                json_t *v = json_object_get(values, sw->spec.params[0]);
+                if (json_is_number(v) && (!best || json_number_value(v) > json_number_value(best)))
+                    best = v;
+            }
+        pthread_mutex_lock(&s->lock);
+        sw->result = json_pack("{s:o}", "pdiff_passing", passing);
+        if (sw->spec.nparams == 1)
+            json_object_set_new(sw->result, "largest_pdiff_pass",
+                                json_pack("{s:s, s:O}", "param", sw->spec.params[0], "value",
+                                          best ? best : json_null()));
+        pthread_mutex_unlock(&s->lock);
     } else {
         struct probe_ctx ctx = {s, sw};
         struct bisect_result r;

@@ -46,6 +46,10 @@ try:
     check(rows[0]["worst_ssim"] == rows[2]["worst_ssim"], "d 0 and d 80 give the same image")
     check(rows[1]["worst_ssim"] < rows[0]["worst_ssim"] and rows[1]["worst_flip"] > rows[0]["worst_flip"],
           "stale shading at d 5 costs quality: SSIM %s vs %s" % (rows[1]["worst_ssim"], rows[0]["worst_ssim"]))
+    largest = sw.get("result", {}).get("largest_pdiff_pass", {})
+    passing = [r["values"]["async_distance"] for r in rows if r.get("pdiff_failed_captures") == 0]
+    check(largest.get("param") == "async_distance" and largest.get("value") == (max(passing) if passing else None),
+          "largest async distance that passes PerceptualDiff: %s (passing %s)" % (largest, passing))
     grid_id = sw["id"]
     for name in ("speed_accuracy", "time_vs_param", "distribution"):
         svg, png = os.path.join(d.tmp, name + ".svg"), os.path.join(d.tmp, name + ".png")

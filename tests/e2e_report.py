@@ -8,7 +8,6 @@ import re
 import shutil
 import subprocess
 import tempfile
-import time
 
 import testlib
 from testlib import check
@@ -40,11 +39,7 @@ d = testlib.Daemon()
 try:
     status, reply = d.json("POST", "/v1/sweeps", {"base": BASE, "vary": {"async_distance": [0, 20]}})
     sweep_id = reply["id"]
-    deadline = time.time() + 600
-    while True:
-        sw = d.json("GET", "/v1/sweeps/%s?wait=30" % sweep_id)[1]
-        if sw["status"] not in ("queued", "running") or time.time() > deadline:
-            break
+    sw = d.wait_sweep(sweep_id)
     check(sw["status"] == "done", "sweep done")
     job_id = sw["points"][1]["job"]
 
@@ -52,10 +47,7 @@ try:
     status, reply = d.json("POST", "/v1/sweeps", {"preset": "thesis", "frames": 2, "repeat": 2})
     check(status == 202, "thesis preset accepted: %s" % reply)
     thesis_id = reply["id"]
-    while True:
-        th = d.json("GET", "/v1/sweeps/%s?wait=30" % thesis_id)[1]
-        if th["status"] not in ("queued", "running") or time.time() > deadline:
-            break
+    th = d.wait_sweep(thesis_id)
     check(th["status"] == "done" and len(th["points"]) == 4, "thesis preset ran its 4 points: %s" % th.get("error"))
     combos = {(p["technique"], p["values"]["scene.dynamic"]) for p in th["points"]}
     check(combos == {("forward", False), ("forward", True), ("osl", False), ("osl", True)},

@@ -22,12 +22,8 @@ def post(d, body):
     return reply["id"]
 
 
-def wait(d, sweep_id, timeout=900):
-    deadline = time.time() + timeout
-    while True:
-        sw = d.json("GET", "/v1/sweeps/%s?wait=30" % sweep_id)[1]
-        if sw["status"] not in ("queued", "running") or time.time() > deadline:
-            return sw
+def wait(d, sweep_id):
+    return d.wait_sweep(sweep_id)
 
 
 d = testlib.Daemon()

@@ -130,6 +130,13 @@ class Daemon:
     def run(self, job):
         return self.wait(self.submit(job))
 
+    def wait_sweep(self, sweep_id, timeout=900):
+        deadline = time.time() + timeout
+        while True:
+            status, body = self.json("GET", "/v1/sweeps/%s?wait=30" % sweep_id)
+            if body.get("status") not in ("queued", "running") or time.time() > deadline:
+                return body
+
     def download(self, path, dest):
         status, _, raw = self.request("GET", path)
         if status == 200:

@@ -84,7 +84,9 @@ try:
     check(len(failures) == 2 and "PerceptualDiff" in failures[0].get("message") and "SSIM" in failures[0].get("message"),
           "JUnit failures name PerceptualDiff and SSIM: %s" % [f.get("message") for f in failures])
 
-    # Baselines: the same job passes; one with 20x the lights is a regression.
+    # Baselines: the same job passes; one with 20x the lights (3.5 times
+    # slower on llvmpipe) is a regression. The 60% allowance keeps the first
+    # check clear of noise from tests running in parallel.
     base_job = {"technique": "forward", "frames": 40, "warmup_frames": 5, "scene": SCENE}
     base_dir = os.path.join(d.tmp, "base")
     out = client("submit", write_job("base", base_job), "--wait", "--out", base_dir)
@@ -92,13 +94,13 @@ try:
     baseline = os.path.join(base_dir, "result.json")
     gate_junit = os.path.join(d.tmp, "gate.xml")
     out = client("submit", write_job("same", base_job), "--wait", "--baseline", baseline,
-                 "--max-slowdown", "25%", "--junit", gate_junit)
+                 "--max-slowdown", "60%", "--junit", gate_junit)
     check(out.returncode == 0, "same job against its baseline passes: %s" % out.stderr[-400:])
     names = [c.get("name") for c in ET.parse(gate_junit).getroot().findall(".//testcase")]
     check("median frame_ms vs baseline" in names, "JUnit has the timing gate: %s" % names)
     slow_job = dict(base_job, scene=dict(SCENE, lights=200))
     out = client("submit", write_job("slow", slow_job), "--wait", "--baseline", baseline,
-                 "--max-slowdown", "25%", "--junit", gate_junit)
+                 "--max-slowdown", "60%", "--junit", gate_junit)
     check(out.returncode == 1 and "REGRESSION" in out.stderr, "200 lights is a regression: %s" % out.stderr[-400:])
     fail = ET.parse(gate_junit).getroot().find(".//failure")
     check(fail is not None and "slower by" in fail.get("message", ""), "JUnit explains the regression")

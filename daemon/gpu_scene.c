@@ -112,25 +112,30 @@ void gpu_scene_set_light_rows(struct gpu_scene *g, const int64_t *frames, int ro
     g->uploaded_frame = rows == 1 ? frames[0] : INT64_MIN;
 }
 
-void gpu_scene_bind(const struct gpu_scene *g, GLuint prog)
+struct scene_program gpu_scene_program(const struct gpu_scene *g, GLuint prog)
 {
     const struct scene *s = g->scene;
-    glUseProgram(prog);
+    glProgramUniformMatrix4fv(prog, glGetUniformLocation(prog, "u_view_proj"), 1, GL_FALSE,
+                              s->view_proj);
+    glProgramUniform3fv(prog, glGetUniformLocation(prog, "u_eye"), 1, s->eye);
+    glProgramUniform1i(prog, glGetUniformLocation(prog, "u_light_count"), s->light_count);
+    return (struct scene_program){prog, glGetUniformLocation(prog, "u_instance_base")};
+}
+
+void gpu_scene_bind(const struct gpu_scene *g, const struct scene_program *p)
+{
+    glUseProgram(p->prog);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, g->instance_buffer);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, g->light_buffer);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, g->position_buffer);
-    glUniformMatrix4fv(glGetUniformLocation(prog, "u_view_proj"), 1, GL_FALSE, s->view_proj);
-    glUniform3fv(glGetUniformLocation(prog, "u_eye"), 1, s->eye);
-    glUniform1i(glGetUniformLocation(prog, "u_light_count"), s->light_count);
 }
 
-void gpu_scene_draw(const struct gpu_scene *g, GLuint prog)
+void gpu_scene_draw(const struct gpu_scene *g, const struct scene_program *p)
 {
     const struct scene *s = g->scene;
-    GLint base_loc = glGetUniformLocation(prog, "u_instance_base");
     int base = 0;
     for (int m = 0; m < SCENE_MESH_COUNT; m++) {
-        glUniform1i(base_loc, base);
+        glUniform1i(p->instance_base, base);
         glBindVertexArray(g->vao[m]);
         glDrawElementsInstanced(GL_TRIANGLES, (GLsizei)s->meshes[m].index_count,
                                 GL_UNSIGNED_INT, NULL, s->mesh_instance_count[m]);

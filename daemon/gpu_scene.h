@@ -27,10 +27,21 @@ void gpu_scene_finish(struct gpu_scene *g);
  * that light the current frame only. Skips the upload when unchanged. */
 void gpu_scene_set_light_rows(struct gpu_scene *g, const int64_t *frames, int rows);
 
-/* Binds the scene buffers and sets the shared uniforms of prog. */
-void gpu_scene_bind(const struct gpu_scene *g, GLuint prog);
+/* A program that reads the scene, with the uniforms the scene sets. */
+struct scene_program {
+    GLuint prog;
+    GLint instance_base; /* -1 for programs that draw no instances */
+};
+
+/* Sets the scene's uniforms on prog once (camera and light count are fixed
+ * for a job), so that frames only bind: no uniform lookups in the timed
+ * region. */
+struct scene_program gpu_scene_program(const struct gpu_scene *g, GLuint prog);
+
+/* Uses the program and binds the scene buffers. */
+void gpu_scene_bind(const struct gpu_scene *g, const struct scene_program *p);
 
 /* Instanced draw of every object, one call per mesh. */
-void gpu_scene_draw(const struct gpu_scene *g, GLuint prog);
+void gpu_scene_draw(const struct gpu_scene *g, const struct scene_program *p);
 
 #endif

@@ -2,6 +2,7 @@
 #include "daemon/queue.h"
 
 #include "daemon/fsutil.h"
+#include "daemon/clock.h"
 #include "daemon/log.h"
 
 #include <dirent.h>
@@ -26,13 +27,6 @@ struct queue {
     double keep_days;
     char state_dir[PATH_MAX];
 };
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_REALTIME, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec / 1e9;
-}
 
 const char *job_status_name(enum job_status s)
 {
@@ -144,7 +138,7 @@ enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *sp
     job->spec = *spec;
     job->status = JOB_QUEUED;
     job->frames_total = spec->frames * job_spec_runs(spec);
-    job->created = now_s();
+    job->created = clock_unix_s();
     atomic_init(&job->cancel, false);
     q->jobs[q->count++] = job;
     q->queued++;
@@ -171,7 +165,7 @@ struct job *queue_next(struct queue *q)
     if (job) {
         job->status = JOB_RUNNING;
         job->phase = "rendering";
-        job->started = now_s();
+        job->started = clock_unix_s();
         q->queued--;
         persist_locked(job);
         pthread_cond_broadcast(&q->changed);
@@ -199,7 +193,7 @@ void queue_finish(struct queue *q, struct job *job, enum job_status status,
 {
     pthread_mutex_lock(&q->lock);
     job->status = status;
-    job->finished = now_s();
+    job->finished = clock_unix_s();
     if (error)
         snprintf(job->error, sizeof(job->error), "%s", error);
     json_decref(job->result);
@@ -232,7 +226,7 @@ enum queue_cancel_result queue_cancel(struct queue *q, const char *id)
     switch (job->status) {
     case JOB_QUEUED:
         job->status = JOB_CANCELLED;
-        job->finished = now_s();
+        job->finished = clock_unix_s();
         snprintf(job->error, sizeof(job->error), "cancelled before it started");
         q->queued--;
         persist_locked(job);
@@ -377,7 +371,7 @@ static bool load_job(struct queue *q, const char *id, const char *const *techniq
     bool changed = false;
     if (job->status == JOB_RUNNING) {
         job->status = JOB_INTERRUPTED;
-        job->finished = now_s();
+        job->finished = clock_unix_s();
         snprintf(job->error, sizeof(job->error),
                  "interrupted: the daemon stopped (killed or crashed) while this job ran; "
                  "its files may be incomplete, submit it again to measure it");
@@ -475,7 +469,7 @@ static void apply_retention(struct queue *q)
     size_t finished_count = 0;
     for (size_t i = 0; i < q->count; i++)
         finished_count += finished(q->jobs[i]);
-    double cutoff = q->keep_days > 0 ? now_s() - q->keep_days * 86400.0 : -1.0;
+    double cutoff = q->keep_days > 0 ? clock_unix_s() - q->keep_days * 86400.0 : -1.0;
     struct job **victims = calloc(q->count ? q->count : 1, sizeof(*victims));
     size_t nv = 0, kept = 0;
     if (!victims) {
@@ -523,11 +517,7 @@ static void apply_retention(struct queue *q)
 json_t *queue_job_json(struct queue *q, const char *id, double wait_s)
 {
     json_t *out = NULL;
-    struct timespec deadline;
-    clock_gettime(CLOCK_REALTIME, &deadline);
-    double secs = (double)deadline.tv_sec + deadline.tv_nsec / 1e9 + wait_s;
-    deadline.tv_sec = (time_t)secs;
-    deadline.tv_nsec = (long)((secs - (double)deadline.tv_sec) * 1e9);
+    struct timespec deadline = clock_deadline(wait_s);
     pthread_mutex_lock(&q->lock);
     struct job *job = find_locked(q, id);
     while (job && wait_s > 0 && !finished(job) && !q->stopping) {

@@ -322,14 +322,13 @@ out:
 
 /* One measured run: builds the scene and the technique, renders the warm-up
  * and timed frames (capturing only when asked: the first run), and leaves
- * the figures in run. run_index and planned place it in the job's progress. */
+ * the figures in run. run_index places it in the job's progress. */
 static bool measure(struct runner *r, struct run *run, bool capture, int run_index,
-                    int planned, double *wall_s, double *capture_s, enum job_status *status)
+                    double *wall_s, double *capture_s, enum job_status *status)
 {
     const struct job_spec *spec = run->spec;
     struct job *job = run->job;
     int w0 = spec->warmup_frames, n = spec->frames;
-    (void)planned;
     run->scene_ok = scene_create(&run->scene, &spec->scene);
     run->capture_count = capture ? job_spec_capture_count(spec) : 0;
     run->captures = calloc((size_t)run->capture_count + 1, sizeof(*run->captures));
@@ -463,7 +462,7 @@ static bool repeat_runs(struct runner *r, struct run *first, json_t *result,
     while (ok && done < planned && !(spec->repeat_auto && stats_is_stable(med, (size_t)done, 0.025))) {
         struct run extra = {.runner = r, .job = first->job, .spec = spec, .tech = first->tech};
         double wall_s = 0, capture_s = 0;
-        ok = measure(r, &extra, false, done, planned, &wall_s, &capture_s, status);
+        ok = measure(r, &extra, false, done, &wall_s, &capture_s, status);
         if (ok) {
             for (int i = 0; i < n; i++)
                 gpu[i] = gpu_timer_ms(extra.timer, w0 + i, -1);
@@ -527,7 +526,7 @@ static void run_job(struct runner *r, struct job *job)
         goto done;
     }
     double wall_s = 0, capture_s = 0;
-    if (!measure(r, &run, true, 0, job_spec_runs(spec), &wall_s, &capture_s, &status))
+    if (!measure(r, &run, true, 0, &wall_s, &capture_s, &status))
         goto done;
     result = write_outputs(&run, wall_s, capture_s);
     /* The first run's technique is done with: free it before more runs or the

@@ -10,6 +10,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "daemon/clock.h"
 #include "daemon/log.h"
 #include "daemon/stats.h"
 
@@ -37,13 +38,6 @@ struct sweeps {
     unsigned serial;
     bool stopping;
 };
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_REALTIME, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec / 1e9;
-}
 
 /* One row of the table from a finished point job. */
 static json_t *point_row(const json_t *job, json_t *values)
@@ -244,7 +238,7 @@ static void run_sweep(struct sweeps *s, struct sweep *sw)
     sw->status = ok ? JOB_DONE : (atomic_load(&sw->cancel) ? JOB_CANCELLED : JOB_FAILED);
     if (sw->status == JOB_CANCELLED)
         snprintf(sw->error, sizeof(sw->error), "cancelled; the finished points stay");
-    sw->finished = now_s();
+    sw->finished = clock_unix_s();
     sw->current_job[0] = '\0';
     pthread_cond_broadcast(&s->changed);
     pthread_mutex_unlock(&s->lock);
@@ -346,7 +340,7 @@ bool sweeps_submit(struct sweeps *s, struct sweep_spec *spec, const json_t *body
     sw->body = json_deep_copy(body);
     sw->points = json_array();
     sw->status = JOB_QUEUED;
-    sw->created = now_s();
+    sw->created = clock_unix_s();
     atomic_init(&sw->cancel, false);
     s->all[s->count++] = sw;
     snprintf(id_out, 24, "%s", sw->id);
@@ -395,11 +389,7 @@ static bool sweep_finished(const struct sweep *sw)
 
 json_t *sweeps_json(struct sweeps *s, const char *id, double wait_s)
 {
-    struct timespec deadline;
-    clock_gettime(CLOCK_REALTIME, &deadline);
-    double secs = (double)deadline.tv_sec + deadline.tv_nsec / 1e9 + wait_s;
-    deadline.tv_sec = (time_t)secs;
-    deadline.tv_nsec = (long)((secs - (double)deadline.tv_sec) * 1e9);
+    struct timespec deadline = clock_deadline(wait_s);
     pthread_mutex_lock(&s->lock);
     struct sweep *sw = find_locked(s, id);
     while (sw && wait_s > 0 && !sweep_finished(sw) && !s->stopping)
@@ -433,7 +423,7 @@ enum queue_cancel_result sweeps_cancel(struct sweeps *s, const char *id)
             r = CANCEL_FINISHED;
         } else if (sw->status == JOB_QUEUED) {
             sw->status = JOB_CANCELLED;
-            sw->finished = now_s();
+            sw->finished = clock_unix_s();
             snprintf(sw->error, sizeof(sw->error), "cancelled before it started");
             r = CANCEL_DONE;
             pthread_cond_broadcast(&s->changed);

@@ -6,8 +6,7 @@ static const char *const sections[] = {"frame", NULL};
 static bool forward_create(const struct technique_ctx *ctx, void **state,
                            char *err, size_t errlen)
 {
-    (void)ctx;
-    return single_pass_create("forward", "forward.frag", state, err, errlen);
+    return single_pass_create(ctx, "forward", "forward.frag", state, err, errlen);
 }
 
 const struct technique technique_forward = {

@@ -25,7 +25,9 @@ static const char *const sections[] = {"lighting", "raster", NULL};
 static const double OSL_MAX_ATLAS_BYTES = 1024.0 * 1024.0 * 1024.0;
 
 struct osl {
-    GLuint texgen_prog, light_prog, draw_prog;
+    GLuint texgen_prog;
+    struct scene_program light, draw;
+    GLint work_count_loc, groups_x_loc; /* the lighting pass's per-frame uniforms */
     GLuint position_tex[SCENE_MESH_COUNT], normal_tex[SCENE_MESH_COUNT];
     int base_size[SCENE_MESH_COUNT]; /* level 0 edge of each mesh's textures */
     GLuint atlas, tile_buffer, work_buffer;
@@ -45,8 +47,7 @@ struct osl {
     double texels_max;
     int initial_objects;
     double initial_texels;
-    int *reshaded_per_frame;
-    int frames_cap;
+    int frames; /* timed frames of the job */
 };
 
 static int log2i(int v)
@@ -191,10 +192,9 @@ static bool osl_create(const struct technique_ctx *ctx, void **state, char *err,
     o->tiles = calloc((size_t)n, sizeof(*o->tiles));
     o->plan = calloc((size_t)n, sizeof(*o->plan));
     o->work = calloc((size_t)n * 4, sizeof(GLuint));
-    o->frames_cap = ctx->spec->frames;
-    o->reshaded_per_frame = calloc((size_t)o->frames_cap, sizeof(int));
+    o->frames = ctx->spec->frames;
     double *dist = calloc((size_t)n, sizeof(double));
-    if (!o->tiles || !o->plan || !o->work || !o->reshaded_per_frame || !dist) {
+    if (!o->tiles || !o->plan || !o->work || !dist) {
         free(dist);
         goto oom;
     }
@@ -221,10 +221,27 @@ static bool osl_create(const struct technique_ctx *ctx, void **state, char *err,
         {GL_VERTEX_SHADER, {"scene_common.glsl", "osl_draw.vert"}},
         {GL_FRAGMENT_SHADER, {"osl_draw.frag"}},
     };
+    GLuint light_prog = 0, draw_prog = 0;
     if (!(o->texgen_prog = gl_program_build("osl texgen", texgen, 2, NULL, err, errlen)) ||
-        !(o->light_prog = gl_program_build("osl lighting", light, 1, NULL, err, errlen)) ||
-        !(o->draw_prog = gl_program_build("osl draw", draw, 2, NULL, err, errlen)))
+        !(light_prog = gl_program_build("osl lighting", light, 1, NULL, err, errlen)) ||
+        !(draw_prog = gl_program_build("osl draw", draw, 2, NULL, err, errlen))) {
+        glDeleteProgram(light_prog);
         goto fail;
+    }
+    o->light = gpu_scene_program(ctx->gpu, light_prog);
+    o->draw = gpu_scene_program(ctx->gpu, draw_prog);
+    o->work_count_loc = glGetUniformLocation(light_prog, "u_work_count");
+    o->groups_x_loc = glGetUniformLocation(light_prog, "u_groups_x");
+    /* Texture units never change: position and normal of mesh m on units
+     * 1 + 2m and 2 + 2m for the lighting pass, the atlas on unit 0. */
+    for (int m = 0; m < SCENE_MESH_COUNT; m++) {
+        char name[32];
+        snprintf(name, sizeof(name), "u_position[%d]", m);
+        glProgramUniform1i(light_prog, glGetUniformLocation(light_prog, name), 1 + m * 2);
+        snprintf(name, sizeof(name), "u_normal[%d]", m);
+        glProgramUniform1i(light_prog, glGetUniformLocation(light_prog, name), 2 + m * 2);
+    }
+    glProgramUniform1i(draw_prog, glGetUniformLocation(draw_prog, "u_atlas"), 0);
 
     if (!generate_textures(o, ctx)) {
         snprintf(err, errlen, "osl: texture generation framebuffer incomplete");
@@ -237,6 +254,8 @@ static bool osl_create(const struct technique_ctx *ctx, void **state, char *err,
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glProgramUniform2f(o->draw.prog, glGetUniformLocation(o->draw.prog, "u_atlas_size"),
+                       (float)o->atlas_w, (float)o->atlas_h);
 
     GLint *tile_data = calloc((size_t)n * 4, sizeof(GLint));
     if (!tile_data)
@@ -293,26 +312,21 @@ static double light_pass(struct osl *o, const struct technique_ctx *ctx, int64_t
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, o->work_buffer);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)((size_t)count * 4 * sizeof(GLuint)),
                  o->work, GL_STREAM_DRAW);
-    gpu_scene_bind(ctx->gpu, o->light_prog);
+    gpu_scene_bind(ctx->gpu, &o->light);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, o->tile_buffer);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, o->work_buffer);
     glBindImageTexture(0, o->atlas, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
     for (int m = 0; m < SCENE_MESH_COUNT; m++) {
-        char name[32];
         glActiveTexture(GL_TEXTURE1 + m * 2);
         glBindTexture(GL_TEXTURE_2D, o->position_tex[m]);
-        snprintf(name, sizeof(name), "u_position[%d]", m);
-        glUniform1i(glGetUniformLocation(o->light_prog, name), 1 + m * 2);
         glActiveTexture(GL_TEXTURE2 + m * 2);
         glBindTexture(GL_TEXTURE_2D, o->normal_tex[m]);
-        snprintf(name, sizeof(name), "u_normal[%d]", m);
-        glUniform1i(glGetUniformLocation(o->light_prog, name), 2 + m * 2);
     }
     glActiveTexture(GL_TEXTURE0);
     uint32_t gx = blocks < (uint32_t)o->groups_x_max ? blocks : (uint32_t)o->groups_x_max;
     uint32_t gy = (blocks + gx - 1) / gx;
-    glUniform1i(glGetUniformLocation(o->light_prog, "u_work_count"), count);
-    glUniform1i(glGetUniformLocation(o->light_prog, "u_groups_x"), (GLint)gx);
+    glUniform1i(o->work_count_loc, count);
+    glUniform1i(o->groups_x_loc, (GLint)gx);
     glDispatchCompute(gx, gy, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
     return texels;
@@ -330,19 +344,16 @@ static bool osl_render(void *state, const struct technique_ctx *ctx, int64_t fra
         o->initial_objects = count;
         o->initial_texels = texels;
     }
-    if (frame >= 1 && frame <= o->frames_cap) {
-        bool initial = !o->shaded_once;
+    if (frame >= 1 && frame <= o->frames) {
         o->timed_frames++;
         /* The first frame drawn shades everything once; that is set-up, reported
          * apart, unless there was no warm-up to absorb it. */
-        o->reshaded_per_frame[frame - 1] = count;
         o->reshaded_sum += count;
         o->texels_sum += texels;
         if (count > o->reshaded_max)
             o->reshaded_max = count;
         if (texels > o->texels_max)
             o->texels_max = texels;
-        (void)initial;
     }
     o->shaded_once = true;
 
@@ -351,14 +362,11 @@ static bool osl_render(void *state, const struct technique_ctx *ctx, int64_t fra
     glEnable(GL_CULL_FACE);
     glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    gpu_scene_bind(ctx->gpu, o->draw_prog);
+    gpu_scene_bind(ctx->gpu, &o->draw);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, o->tile_buffer);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, o->atlas);
-    glUniform1i(glGetUniformLocation(o->draw_prog, "u_atlas"), 0);
-    glUniform2f(glGetUniformLocation(o->draw_prog, "u_atlas_size"), (float)o->atlas_w,
-                (float)o->atlas_h);
-    gpu_scene_draw(ctx->gpu, o->draw_prog);
+    gpu_scene_draw(ctx->gpu, &o->draw);
     return true;
 }
 
@@ -401,8 +409,8 @@ static void osl_destroy(void *state)
     if (!o)
         return;
     glDeleteProgram(o->texgen_prog);
-    glDeleteProgram(o->light_prog);
-    glDeleteProgram(o->draw_prog);
+    glDeleteProgram(o->light.prog);
+    glDeleteProgram(o->draw.prog);
     glDeleteTextures(SCENE_MESH_COUNT, o->position_tex);
     glDeleteTextures(SCENE_MESH_COUNT, o->normal_tex);
     glDeleteTextures(1, &o->atlas);
@@ -413,7 +421,6 @@ static void osl_destroy(void *state)
     free(o->plan);
     free(o->work);
     free(o->rows);
-    free(o->reshaded_per_frame);
     free(o);
 }
 

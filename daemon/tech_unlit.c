@@ -7,8 +7,7 @@ static const char *const sections[] = {"frame", NULL};
 static bool unlit_create(const struct technique_ctx *ctx, void **state,
                          char *err, size_t errlen)
 {
-    (void)ctx;
-    return single_pass_create("unlit", "unlit.frag", state, err, errlen);
+    return single_pass_create(ctx, "unlit", "unlit.frag", state, err, errlen);
 }
 
 const struct technique technique_unlit = {

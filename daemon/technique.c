@@ -40,11 +40,11 @@ int technique_section_count(const struct technique *t)
 }
 
 struct single_pass {
-    GLuint program;
+    struct scene_program program;
 };
 
-bool single_pass_create(const char *label, const char *frag, void **state,
-                        char *err, size_t errlen)
+bool single_pass_create(const struct technique_ctx *ctx, const char *label, const char *frag,
+                        void **state, char *err, size_t errlen)
 {
     struct single_pass *sp = calloc(1, sizeof(*sp));
     if (!sp)
@@ -53,11 +53,12 @@ bool single_pass_create(const char *label, const char *frag, void **state,
         {GL_VERTEX_SHADER, {"scene_common.glsl", "scene.vert"}},
         {GL_FRAGMENT_SHADER, {"scene_common.glsl", frag}},
     };
-    sp->program = gl_program_build(label, stages, 2, NULL, err, errlen);
-    if (!sp->program) {
+    GLuint prog = gl_program_build(label, stages, 2, NULL, err, errlen);
+    if (!prog) {
         free(sp);
         return false;
     }
+    sp->program = gpu_scene_program(ctx->gpu, prog);
     *state = sp;
     return true;
 }
@@ -72,8 +73,8 @@ bool single_pass_render(void *state, const struct technique_ctx *ctx,
     glEnable(GL_CULL_FACE);
     glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    gpu_scene_bind(ctx->gpu, sp->program);
-    gpu_scene_draw(ctx->gpu, sp->program);
+    gpu_scene_bind(ctx->gpu, &sp->program);
+    gpu_scene_draw(ctx->gpu, &sp->program);
     return true;
 }
 
@@ -82,6 +83,6 @@ void single_pass_destroy(void *state)
     struct single_pass *sp = state;
     if (!sp)
         return;
-    glDeleteProgram(sp->program);
+    glDeleteProgram(sp->program.prog);
     free(sp);
 }

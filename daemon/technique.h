@@ -46,8 +46,8 @@ int technique_section_count(const struct technique *t);
 
 /* Shared by the single-pass techniques (forward, unlit): scene.vert plus
  * one fragment shader. */
-bool single_pass_create(const char *label, const char *frag, void **state,
-                        char *err, size_t errlen);
+bool single_pass_create(const struct technique_ctx *ctx, const char *label, const char *frag,
+                        void **state, char *err, size_t errlen);
 bool single_pass_render(void *state, const struct technique_ctx *ctx,
                         int64_t frame, char *err, size_t errlen);
 void single_pass_destroy(void *state);

@@ -10,8 +10,8 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "daemon/metrics/metrics.h"
-#include "daemon/png_io.h"
+#include "daemon/quality/metrics.h"
+#include "common/png_io.h"
 
 static void usage(FILE *f)
 {

@@ -18,7 +18,7 @@
 
 #include "client/stats_test.h"
 #include "config.h"
-#include "daemon/fsutil.h"
+#include "common/fsutil.h"
 
 enum { EXIT_PASS = 0, EXIT_FAIL = 1, EXIT_ERROR = 2 };
 

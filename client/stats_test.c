@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "daemon/stats.h"
+#include "common/stats.h"
 
 struct ranked {
     double v;

@@ -10,16 +10,16 @@
 #include <epoxy/gl.h>
 
 #include "config.h"
-#include "daemon/egl.h"
-#include "daemon/fsutil.h"
-#include "daemon/http.h"
-#include "daemon/job.h"
-#include "daemon/log.h"
-#include "daemon/queue.h"
-#include "daemon/runner.h"
+#include "daemon/gpu/egl.h"
+#include "common/fsutil.h"
+#include "daemon/api/http.h"
+#include "daemon/jobs/job_spec.h"
+#include "common/log.h"
+#include "daemon/jobs/queue.h"
+#include "daemon/harness/runner.h"
 #include "daemon/service.h"
-#include "daemon/sweeps.h"
-#include "daemon/technique.h"
+#include "daemon/jobs/sweeps.h"
+#include "daemon/techniques/technique.h"
 
 struct options {
     char listen[256];

@@ -1,0 +1,145 @@
+#include "daemon/gpu/gpu_scene.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+bool gpu_scene_init(struct gpu_scene *g, const struct scene *s, char *err, size_t errlen)
+{
+    memset(g, 0, sizeof(*g));
+    g->scene = s;
+    g->uploaded_frame = INT64_MIN;
+    glGenVertexArrays(SCENE_MESH_COUNT, g->vao);
+    glGenBuffers(SCENE_MESH_COUNT, g->vbo);
+    glGenBuffers(SCENE_MESH_COUNT, g->ebo);
+    for (int m = 0; m < SCENE_MESH_COUNT; m++) {
+        const struct mesh *mesh = &s->meshes[m];
+        glBindVertexArray(g->vao[m]);
+        glBindBuffer(GL_ARRAY_BUFFER, g->vbo[m]);
+        glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(mesh->vertex_count * sizeof(struct mesh_vertex)),
+                     mesh->vertices, GL_STATIC_DRAW);
+        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g->ebo[m]);
+        glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(mesh->index_count * sizeof(uint32_t)),
+                     mesh->indices, GL_STATIC_DRAW);
+        GLsizei stride = sizeof(struct mesh_vertex);
+        glEnableVertexAttribArray(0);
+        glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride,
+                              (void *)offsetof(struct mesh_vertex, pos));
+        glEnableVertexAttribArray(1);
+        glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride,
+                              (void *)offsetof(struct mesh_vertex, normal));
+        glEnableVertexAttribArray(2);
+        glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride,
+                              (void *)offsetof(struct mesh_vertex, uv));
+        glEnableVertexAttribArray(3);
+        glVertexAttribPointer(3, 4, GL_FLOAT, GL_FALSE, stride,
+                              (void *)offsetof(struct mesh_vertex, chart));
+    }
+    glBindVertexArray(0);
+
+    size_t n = (size_t)s->instance_count;
+    float *inst = calloc(n * 8, sizeof(float));
+    size_t lights = (size_t)(s->light_count ? s->light_count : 1);
+    float *light = calloc(lights * 4, sizeof(float));
+    g->position_scratch = calloc(lights * 4, sizeof(float));
+    if (!inst || !light || !g->position_scratch) {
+        free(inst);
+        free(light);
+        snprintf(err, errlen, "out of memory for scene buffers");
+        gpu_scene_finish(g);
+        return false;
+    }
+    for (size_t i = 0; i < n; i++) {
+        const struct scene_instance *in = &s->instances[i];
+        memcpy(&inst[i * 8], in->pos, sizeof(in->pos));
+        inst[i * 8 + 3] = in->scale;
+        memcpy(&inst[i * 8 + 4], in->albedo, sizeof(in->albedo));
+        inst[i * 8 + 7] = (float)in->mesh;
+    }
+    for (int i = 0; i < s->light_count; i++) {
+        memcpy(&light[i * 4], s->lights[i].color, sizeof(s->lights[i].color));
+        light[i * 4 + 3] = s->lights[i].radius;
+    }
+    glGenBuffers(1, &g->instance_buffer);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->instance_buffer);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(n * 8 * sizeof(float)), inst, GL_STATIC_DRAW);
+    glGenBuffers(1, &g->light_buffer);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->light_buffer);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(lights * 4 * sizeof(float)), light, GL_STATIC_DRAW);
+    glGenBuffers(1, &g->position_buffer);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    free(inst);
+    free(light);
+    return true;
+}
+
+void gpu_scene_finish(struct gpu_scene *g)
+{
+    if (!g || !g->scene)
+        return;
+    glDeleteVertexArrays(SCENE_MESH_COUNT, g->vao);
+    glDeleteBuffers(SCENE_MESH_COUNT, g->vbo);
+    glDeleteBuffers(SCENE_MESH_COUNT, g->ebo);
+    glDeleteBuffers(1, &g->instance_buffer);
+    glDeleteBuffers(1, &g->light_buffer);
+    glDeleteBuffers(1, &g->position_buffer);
+    free(g->position_scratch);
+    memset(g, 0, sizeof(*g));
+}
+
+void gpu_scene_set_light_rows(struct gpu_scene *g, const int64_t *frames, int rows)
+{
+    const struct scene *s = g->scene;
+    if (rows == 1 && g->position_rows == 1 &&
+        (g->uploaded_frame == frames[0] || (!s->spec.dynamic && g->uploaded_frame != INT64_MIN)))
+        return;
+    size_t row_floats = (size_t)(s->light_count ? s->light_count : 1) * 4;
+    GLsizeiptr bytes = (GLsizeiptr)(row_floats * sizeof(float) * (size_t)rows);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->position_buffer);
+    /* Orphan the old storage so a frame still in flight never forces a wait. */
+    glBufferData(GL_SHADER_STORAGE_BUFFER, bytes, NULL, GL_STREAM_DRAW);
+    for (int r = 0; r < rows; r++) {
+        for (int i = 0; i < s->light_count; i++) {
+            scene_light_position(s, i, frames[r], &g->position_scratch[i * 4]);
+            g->position_scratch[i * 4 + 3] = 1.0f;
+        }
+        glBufferSubData(GL_SHADER_STORAGE_BUFFER,
+                        (GLintptr)(row_floats * sizeof(float) * (size_t)r),
+                        (GLsizeiptr)(row_floats * sizeof(float)), g->position_scratch);
+    }
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    g->position_rows = rows;
+    g->uploaded_frame = rows == 1 ? frames[0] : INT64_MIN;
+}
+
+struct scene_program gpu_scene_program(const struct gpu_scene *g, GLuint prog)
+{
+    const struct scene *s = g->scene;
+    glProgramUniformMatrix4fv(prog, glGetUniformLocation(prog, "u_view_proj"), 1, GL_FALSE,
+                              s->view_proj);
+    glProgramUniform3fv(prog, glGetUniformLocation(prog, "u_eye"), 1, s->eye);
+    glProgramUniform1i(prog, glGetUniformLocation(prog, "u_light_count"), s->light_count);
+    return (struct scene_program){prog, glGetUniformLocation(prog, "u_instance_base")};
+}
+
+void gpu_scene_bind(const struct gpu_scene *g, const struct scene_program *p)
+{
+    glUseProgram(p->prog);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, g->instance_buffer);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, g->light_buffer);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, g->position_buffer);
+}
+
+void gpu_scene_draw(const struct gpu_scene *g, const struct scene_program *p)
+{
+    const struct scene *s = g->scene;
+    int base = 0;
+    for (int m = 0; m < SCENE_MESH_COUNT; m++) {
+        glUniform1i(p->instance_base, base);
+        glBindVertexArray(g->vao[m]);
+        glDrawElementsInstanced(GL_TRIANGLES, (GLsizei)s->meshes[m].index_count,
+                                GL_UNSIGNED_INT, NULL, s->mesh_instance_count[m]);
+        base += s->mesh_instance_count[m];
+    }
+    glBindVertexArray(0);
+}

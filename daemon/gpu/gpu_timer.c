@@ -1,0 +1,125 @@
+#include "daemon/gpu/gpu_timer.h"
+
+#include <stdlib.h>
+
+struct ring_slot {
+    GLuint queries[GPU_TIMER_MAX_SECTIONS];
+    bool issued[GPU_TIMER_MAX_SECTIONS];
+    int64_t frame; /* -1 when nothing is waiting to be read */
+};
+
+struct gpu_timer {
+    int sections;
+    int64_t frames, next_frame;
+    int current; /* running section, -1 when none */
+    struct ring_slot ring[GPU_TIMER_RING];
+    double *ms; /* frames * sections */
+    int64_t stalls;
+};
+
+struct gpu_timer *gpu_timer_create(int sections, int64_t frames)
+{
+    if (sections < 1 || sections > GPU_TIMER_MAX_SECTIONS || frames < 1)
+        return NULL;
+    struct gpu_timer *t = calloc(1, sizeof(*t));
+    if (!t)
+        return NULL;
+    t->ms = calloc((size_t)frames * (size_t)sections, sizeof(double));
+    if (!t->ms) {
+        free(t);
+        return NULL;
+    }
+    t->sections = sections;
+    t->frames = frames;
+    t->current = -1;
+    for (int i = 0; i < GPU_TIMER_RING; i++) {
+        glGenQueries(sections, t->ring[i].queries);
+        t->ring[i].frame = -1;
+    }
+    return t;
+}
+
+void gpu_timer_destroy(struct gpu_timer *t)
+{
+    if (!t)
+        return;
+    for (int i = 0; i < GPU_TIMER_RING; i++)
+        glDeleteQueries(t->sections, t->ring[i].queries);
+    free(t->ms);
+    free(t);
+}
+
+static void read_slot(struct gpu_timer *t, struct ring_slot *slot)
+{
+    if (slot->frame < 0)
+        return;
+    for (int s = 0; s < t->sections; s++) {
+        if (!slot->issued[s])
+            continue;
+        GLint available = 0;
+        glGetQueryObjectiv(slot->queries[s], GL_QUERY_RESULT_AVAILABLE, &available);
+        if (!available)
+            t->stalls++;
+        GLuint64 ns = 0;
+        glGetQueryObjectui64v(slot->queries[s], GL_QUERY_RESULT, &ns);
+        t->ms[slot->frame * t->sections + s] = (double)ns / 1e6;
+    }
+    slot->frame = -1;
+}
+
+void gpu_timer_begin_frame(struct gpu_timer *t)
+{
+    struct ring_slot *slot = &t->ring[t->next_frame % GPU_TIMER_RING];
+    read_slot(t, slot);
+    for (int s = 0; s < t->sections; s++)
+        slot->issued[s] = false;
+    slot->frame = t->next_frame < t->frames ? t->next_frame : -1;
+    t->current = -1;
+    gpu_timer_section(t, 0);
+}
+
+void gpu_timer_section(struct gpu_timer *t, int s)
+{
+    if (s == t->current || s < 0 || s >= t->sections)
+        return;
+    struct ring_slot *slot = &t->ring[t->next_frame % GPU_TIMER_RING];
+    if (t->current >= 0)
+        glEndQuery(GL_TIME_ELAPSED);
+    /* A section entered twice in one frame would need two queries; keep the
+     * first and leave later work to the section that is running. */
+    if (slot->issued[s]) {
+        t->current = -1;
+        return;
+    }
+    glBeginQuery(GL_TIME_ELAPSED, slot->queries[s]);
+    slot->issued[s] = true;
+    t->current = s;
+}
+
+void gpu_timer_end_frame(struct gpu_timer *t)
+{
+    if (t->current >= 0)
+        glEndQuery(GL_TIME_ELAPSED);
+    t->current = -1;
+    t->next_frame++;
+}
+
+void gpu_timer_drain(struct gpu_timer *t)
+{
+    for (int i = 0; i < GPU_TIMER_RING; i++)
+        read_slot(t, &t->ring[i]);
+}
+
+double gpu_timer_ms(const struct gpu_timer *t, int64_t f, int s)
+{
+    if (f < 0 || f >= t->frames)
+        return 0.0;
+    if (s >= 0)
+        return s < t->sections ? t->ms[f * t->sections + s] : 0.0;
+    double sum = 0.0;
+    for (int i = 0; i < t->sections; i++)
+        sum += t->ms[f * t->sections + i];
+    return sum;
+}
+
+int64_t gpu_timer_stalls(const struct gpu_timer *t) { return t->stalls; }

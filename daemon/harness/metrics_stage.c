@@ -1,0 +1,219 @@
+#define _POSIX_C_SOURCE 200809L
+#include "daemon/harness/metrics_stage.h"
+
+#include <limits.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "common/fsutil.h"
+#include "common/log.h"
+#include "daemon/quality/metrics.h"
+#include "common/png_io.h"
+
+struct task {
+    struct job *job;
+    json_t *result;
+    struct task *next;
+};
+
+struct metrics_worker {
+    struct queue *queue;
+    pthread_t thread;
+    pthread_mutex_t lock;
+    pthread_cond_t wake;
+    struct task *head, *tail;
+    bool stopping;
+};
+
+/* Fills capture's metrics and URLs; updates the job-wide summary. */
+static bool score_capture(const struct job *job, json_t *capture, json_t *summary, char *err,
+                          size_t errlen)
+{
+    int frame = (int)json_integer_value(json_object_get(capture, "frame"));
+    char test_path[PATH_MAX + 32], ref_path[PATH_MAX + 32], ssim_path[PATH_MAX + 32],
+        flip_path[PATH_MAX + 32], url[128];
+    snprintf(test_path, sizeof(test_path), "%s/frame-%06d.png", job->dir, frame);
+    snprintf(ref_path, sizeof(ref_path), "%s/reference-%06d.png", job->dir, frame);
+    snprintf(ssim_path, sizeof(ssim_path), "%s/ssim-%06d.png", job->dir, frame);
+    snprintf(flip_path, sizeof(flip_path), "%s/flip-%06d.png", job->dir, frame);
+    struct image ref = {0}, test = {0};
+    bool ok = png_read_rgb(ref_path, &ref, err, errlen) &&
+              png_read_rgb(test_path, &test, err, errlen);
+    const struct metrics_options *o = &job->spec.metrics;
+    json_t *m = ok ? metrics_compare(&ref, &test, o, (o->which & METRIC_SSIM) ? ssim_path : NULL,
+                                     (o->which & METRIC_FLIP) ? flip_path : NULL, err, errlen)
+                   : NULL;
+    image_finish(&ref);
+    image_finish(&test);
+    if (!m)
+        return false;
+    json_object_set_new(capture, "metrics", m);
+    snprintf(url, sizeof(url), "/v1/jobs/%s/reference/%d.png", job->id, frame);
+    json_object_set_new(capture, "reference_url", json_string(url));
+    if (o->which & METRIC_SSIM) {
+        snprintf(url, sizeof(url), "/v1/jobs/%s/ssim/%d.png", job->id, frame);
+        json_object_set_new(capture, "ssim_map_url", json_string(url));
+    }
+    if (o->which & METRIC_FLIP) {
+        snprintf(url, sizeof(url), "/v1/jobs/%s/flip/%d.png", job->id, frame);
+        json_object_set_new(capture, "flip_map_url", json_string(url));
+    }
+
+    /* Worst cases over the captures, and which frame they came from. */
+    json_t *ssim = json_object_get(m, "ssim");
+    json_t *worst = json_object_get(summary, "worst_ssim");
+    if (ssim && (!worst || json_real_value(ssim) < json_real_value(json_object_get(worst, "value"))))
+        json_object_set_new(summary, "worst_ssim",
+                            json_pack("{s:f, s:i}", "value", json_real_value(ssim), "frame", frame));
+    json_t *smin = json_object_get(m, "ssim_min");
+    worst = json_object_get(summary, "worst_ssim_min");
+    if (smin && (!worst || json_real_value(json_object_get(smin, "value")) <
+                               json_real_value(json_object_get(worst, "value")))) {
+        json_t *w = json_deep_copy(smin);
+        json_object_set_new(w, "frame", json_integer(frame));
+        json_object_set_new(summary, "worst_ssim_min", w);
+    }
+    json_t *flip = json_object_get(m, "flip");
+    worst = json_object_get(summary, "worst_flip");
+    double fmean = flip ? json_real_value(json_object_get(flip, "mean")) : 0;
+    if (flip && (!worst || fmean > json_real_value(json_object_get(worst, "mean"))))
+        json_object_set_new(summary, "worst_flip",
+                            json_pack("{s:f, s:f, s:i}", "mean", fmean, "max",
+                                      json_real_value(json_object_get(flip, "max")), "frame", frame));
+    json_t *pdiff = json_object_get(m, "pdiff");
+    if (pdiff && !json_is_true(json_object_get(pdiff, "pass")))
+        json_array_append_new(json_object_get(summary, "pdiff_failed_frames"), json_integer(frame));
+    json_t *psnr = json_object_get(m, "psnr");
+    json_t *overall = psnr ? json_object_get(psnr, "overall") : NULL;
+    worst = json_object_get(summary, "worst_psnr");
+    if (overall && json_is_real(overall) &&
+        (!worst || json_is_null(json_object_get(worst, "value")) ||
+         json_real_value(overall) < json_real_value(json_object_get(worst, "value"))))
+        json_object_set_new(summary, "worst_psnr",
+                            json_pack("{s:f, s:i}", "value", json_real_value(overall), "frame", frame));
+    return true;
+}
+
+static void run_task(struct metrics_worker *w, struct task *t)
+{
+    struct job *job = t->job;
+    char err[512] = "";
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    json_t *summary = json_pack("{s:s, s:i, s:[]}", "reference", job->spec.reference,
+                                "captures_compared", 0, "pdiff_failed_frames");
+    json_t *captures = json_object_get(t->result, "captures");
+    size_t i;
+    json_t *capture;
+    bool ok = true;
+    json_array_foreach(captures, i, capture) {
+        if (!(ok = score_capture(job, capture, summary, err, sizeof(err))))
+            break;
+        json_object_set_new(summary, "captures_compared", json_integer((json_int_t)i + 1));
+    }
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    if (ok) {
+        json_t *failed = json_object_get(summary, "pdiff_failed_frames");
+        json_object_set_new(summary, "pdiff_failed_captures",
+                            json_integer((json_int_t)json_array_size(failed)));
+        json_object_set_new(summary, "metrics_s",
+                            json_real((double)(t1.tv_sec - t0.tv_sec) +
+                                      (double)(t1.tv_nsec - t0.tv_nsec) / 1e9));
+        json_object_set_new(t->result, "quality", summary);
+        summary = NULL;
+        char path[PATH_MAX + 16];
+        snprintf(path, sizeof(path), "%s/result.json", job->dir);
+        if (!fs_write_json_atomic(path, t->result)) {
+            ok = false;
+            snprintf(err, sizeof(err), "cannot write %.400s", path);
+        }
+    }
+    json_decref(summary);
+    if (ok) {
+        LOG(LOG_INFO, "job %s done: metrics for %zu captures", job->id, json_array_size(captures));
+        queue_finish(w->queue, job, JOB_DONE, NULL, t->result);
+    } else {
+        LOG(LOG_WARN, "job %s failed in metrics: %s", job->id, err);
+        char msg[600];
+        snprintf(msg, sizeof(msg), "metrics: %s", err);
+        queue_finish(w->queue, job, JOB_FAILED, msg, NULL);
+        json_decref(t->result);
+    }
+}
+
+static void *worker_main(void *arg)
+{
+    struct metrics_worker *w = arg;
+    pthread_mutex_lock(&w->lock);
+    for (;;) {
+        while (!w->head && !w->stopping)
+            pthread_cond_wait(&w->wake, &w->lock);
+        struct task *t = w->head;
+        if (!t)
+            break; /* stopping, and nothing left */
+        w->head = t->next;
+        if (!w->head)
+            w->tail = NULL;
+        pthread_mutex_unlock(&w->lock);
+        run_task(w, t);
+        free(t);
+        pthread_mutex_lock(&w->lock);
+    }
+    pthread_mutex_unlock(&w->lock);
+    return NULL;
+}
+
+struct metrics_worker *metrics_worker_create(struct queue *q)
+{
+    struct metrics_worker *w = calloc(1, sizeof(*w));
+    if (!w)
+        return NULL;
+    w->queue = q;
+    pthread_mutex_init(&w->lock, NULL);
+    pthread_cond_init(&w->wake, NULL);
+    if (pthread_create(&w->thread, NULL, worker_main, w) != 0) {
+        pthread_cond_destroy(&w->wake);
+        pthread_mutex_destroy(&w->lock);
+        free(w);
+        return NULL;
+    }
+    return w;
+}
+
+void metrics_worker_destroy(struct metrics_worker *w)
+{
+    if (!w)
+        return;
+    pthread_mutex_lock(&w->lock);
+    w->stopping = true;
+    pthread_cond_broadcast(&w->wake);
+    pthread_mutex_unlock(&w->lock);
+    pthread_join(w->thread, NULL);
+    pthread_cond_destroy(&w->wake);
+    pthread_mutex_destroy(&w->lock);
+    free(w);
+}
+
+void metrics_worker_submit(struct metrics_worker *w, struct job *job, json_t *result)
+{
+    struct task *t = calloc(1, sizeof(*t));
+    if (!t) {
+        queue_finish(w->queue, job, JOB_FAILED, "metrics: out of memory", NULL);
+        json_decref(result);
+        return;
+    }
+    t->job = job;
+    t->result = result;
+    pthread_mutex_lock(&w->lock);
+    if (w->tail)
+        w->tail->next = t;
+    else
+        w->head = t;
+    w->tail = t;
+    pthread_cond_signal(&w->wake);
+    pthread_mutex_unlock(&w->lock);
+}

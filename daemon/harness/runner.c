@@ -1,0 +1,650 @@
+#define _POSIX_C_SOURCE 200809L
+#include "daemon/harness/runner.h"
+
+#include <epoxy/gl.h>
+#include <inttypes.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "config.h"
+#include "daemon/gpu/egl.h"
+#include "common/fsutil.h"
+#include "daemon/gpu/glutil.h"
+#include "daemon/gpu/gpu_scene.h"
+#include "daemon/gpu/gpu_timer.h"
+#include "common/log.h"
+#include "daemon/harness/metrics_stage.h"
+#include "common/png_io.h"
+#include "daemon/service.h"
+#include "common/stats.h"
+#include "daemon/techniques/technique.h"
+
+struct runner {
+    struct queue *queue;
+    struct metrics_worker *metrics;
+    int device;
+    bool gl_debug;
+    pthread_t thread;
+    pthread_mutex_t lock;
+    pthread_cond_t ready_cond;
+    int ready; /* 0 starting, 1 up, -1 failed */
+    atomic_bool alive;
+    char error[512];
+    json_t *device_json; /* immutable once ready */
+};
+
+static double mono_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec / 1e9;
+}
+
+static json_t *stats_json(const double *v, size_t n)
+{
+    struct stats s;
+    stats_compute(v, n, &s);
+    return json_pack("{s:I, s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:[f, f]}", "n",
+                     (json_int_t)s.n, "mean", s.mean, "median", s.median, "stddev",
+                     s.stddev, "min", s.min, "max", s.max, "p5", s.p5, "p95", s.p95,
+                     "p99", s.p99, "cv", s.cv, "median_ci95", s.median_lo, s.median_hi);
+}
+
+static const char *gl_str(GLenum name)
+{
+    const char *s = (const char *)glGetString(name);
+    return s ? s : "";
+}
+
+static json_t *collect_device(struct egl_context *egl)
+{
+    GLint max_tex = 0, max_rb = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
+    glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_rb);
+    return json_pack("{s:s, s:s, s:s, s:s, s:s, s:s, s:s, s:s, s:i, s:i}",
+                     "egl_platform", egl_context_platform(egl), "egl_device",
+                     egl_context_device(egl), "egl_vendor", egl_context_egl_vendor(egl),
+                     "egl_version", egl_context_egl_version(egl), "gl_vendor",
+                     gl_str(GL_VENDOR), "gl_renderer", gl_str(GL_RENDERER), "gl_version",
+                     gl_str(GL_VERSION), "glsl_version", gl_str(GL_SHADING_LANGUAGE_VERSION),
+                     "max_texture_size", max_tex, "max_renderbuffer_size", max_rb);
+}
+
+/* Frames the GPU may run behind the CPU, as a double-buffered swap chain allows. */
+#define FRAMES_IN_FLIGHT 2
+
+struct run {
+    struct runner *runner;
+    struct job *job;
+    const struct job_spec *spec;
+    const struct technique *tech;
+    struct scene scene;
+    bool scene_ok;
+    struct gpu_scene gpu;
+    GLuint fbo, color_rb, depth_rb;
+    struct gpu_timer *timer;
+    void *state;
+    uint8_t **captures;
+    int capture_count;
+    double *cpu_ms;
+    double *frame_ms;
+    GLsync fences[FRAMES_IN_FLIGHT];
+    char err[1024];
+};
+
+static bool setup_framebuffer(struct run *run)
+{
+    int w = run->spec->scene.width, h = run->spec->scene.height;
+    GLint max_rb = 0, dims[2] = {0, 0};
+    glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_rb);
+    glGetIntegerv(GL_MAX_VIEWPORT_DIMS, dims);
+    if (w > max_rb || h > max_rb || w > dims[0] || h > dims[1]) {
+        snprintf(run->err, sizeof(run->err),
+                 "scene.width/height %dx%d exceed this device's limits "
+                 "(GL_MAX_RENDERBUFFER_SIZE %d, GL_MAX_VIEWPORT_DIMS %dx%d)",
+                 w, h, max_rb, dims[0], dims[1]);
+        return false;
+    }
+    glGenFramebuffers(1, &run->fbo);
+    glGenRenderbuffers(1, &run->color_rb);
+    glGenRenderbuffers(1, &run->depth_rb);
+    glBindRenderbuffer(GL_RENDERBUFFER, run->color_rb);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
+    glBindRenderbuffer(GL_RENDERBUFFER, run->depth_rb);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
+    glBindFramebuffer(GL_FRAMEBUFFER, run->fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, run->color_rb);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, run->depth_rb);
+    GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE) {
+        snprintf(run->err, sizeof(run->err), "framebuffer %dx%d incomplete (0x%04x)", w, h, status);
+        return false;
+    }
+    return true;
+}
+
+static void teardown(struct run *run)
+{
+    if (run->tech && run->state)
+        run->tech->destroy(run->state);
+    gpu_timer_destroy(run->timer);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (run->fbo)
+        glDeleteFramebuffers(1, &run->fbo);
+    if (run->color_rb)
+        glDeleteRenderbuffers(1, &run->color_rb);
+    if (run->depth_rb)
+        glDeleteRenderbuffers(1, &run->depth_rb);
+    gpu_scene_finish(&run->gpu);
+    if (run->scene_ok)
+        scene_finish(&run->scene);
+    for (int i = 0; run->captures && i < run->capture_count; i++)
+        free(run->captures[i]);
+    free(run->captures);
+    free(run->cpu_ms);
+    free(run->frame_ms);
+    for (int i = 0; i < FRAMES_IN_FLIGHT; i++)
+        if (run->fences[i])
+            glDeleteSync(run->fences[i]);
+    /* Leave no error behind for the next job to trip over. */
+    char drop[16];
+    gl_error_take("teardown", drop, sizeof(drop));
+}
+
+/* Encodes the captures and writes timings.csv and the result. Outside
+ * every timed region. */
+static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
+{
+    const struct job_spec *spec = run->spec;
+    const struct job *job = run->job;
+    int n = spec->frames, w0 = spec->warmup_frames;
+    int sections = technique_section_count(run->tech);
+    double *gpu = malloc((size_t)n * sizeof(double));
+    double *sec = malloc((size_t)n * sizeof(double));
+    json_t *captures = json_array(), *result = NULL;
+    char path[PATH_MAX + 64]; /* job dir + file name */
+    if (!gpu || !sec) {
+        snprintf(run->err, sizeof(run->err), "out of memory for statistics");
+        goto out;
+    }
+    for (int i = 0; i < n; i++)
+        gpu[i] = gpu_timer_ms(run->timer, w0 + i, -1);
+
+    int c = 0;
+    for (int k = 1; k <= n; k++) {
+        if (!job_spec_is_capture_frame(spec, k))
+            continue;
+        char name[64], url[128];
+        snprintf(name, sizeof(name), "frame-%06d.png", k);
+        snprintf(url, sizeof(url), "/v1/jobs/%s/frames/%d.png", job->id, k);
+        snprintf(path, sizeof(path), "%s/%s", job->dir, name);
+        if (!png_write_gl_rgba(path, run->captures[c], spec->scene.width,
+                               spec->scene.height, run->err, sizeof(run->err)))
+            goto out;
+        free(run->captures[c]);
+        run->captures[c++] = NULL;
+        json_array_append_new(captures, json_pack("{s:i, s:s, s:s}", "frame", k, "url",
+                                                  url, "file", name));
+    }
+
+    /* timings.csv: one row per timed frame. */
+    size_t cap = (size_t)n * (80 + 24 * (size_t)sections) + 256, used = 0;
+    char *csv = malloc(cap);
+    if (!csv) {
+        snprintf(run->err, sizeof(run->err), "out of memory for timings.csv");
+        goto out;
+    }
+    used += (size_t)snprintf(csv + used, cap - used, "frame,gpu_ms,cpu_ms,frame_ms");
+    for (int s = 0; sections > 1 && s < sections; s++)
+        used += (size_t)snprintf(csv + used, cap - used, ",gpu_%s_ms", run->tech->sections[s]);
+    used += (size_t)snprintf(csv + used, cap - used, "\n");
+    for (int i = 0; i < n; i++) {
+        used += (size_t)snprintf(csv + used, cap - used, "%d,%.6f,%.6f,%.6f", i + 1, gpu[i],
+                                 run->cpu_ms[i], run->frame_ms[i]);
+        for (int s = 0; sections > 1 && s < sections; s++)
+            used += (size_t)snprintf(csv + used, cap - used, ",%.6f",
+                                     gpu_timer_ms(run->timer, w0 + i, s));
+        used += (size_t)snprintf(csv + used, cap - used, "\n");
+    }
+    snprintf(path, sizeof(path), "%s/timings.csv", job->dir);
+    bool csv_ok = fs_write_atomic(path, csv, used);
+    free(csv);
+    if (!csv_ok) {
+        snprintf(run->err, sizeof(run->err), "cannot write %.900s", path);
+        goto out;
+    }
+
+    double timed_wall = wall_s - capture_s;
+    result = json_pack(
+        "{s:s, s:i, s:i, s:f, s:f, s:f, s:o, s:o, s:o, s:I, s:i, s:i, s:o, s:s, s:s, s:I, s:O}",
+        "technique", run->tech->name, "frames", n, "warmup_frames", w0, "wall_s",
+        timed_wall, "wall_s_including_captures", wall_s, "fps",
+        timed_wall > 0 ? n / timed_wall : 0.0, "gpu_ms", stats_json(gpu, (size_t)n),
+        "cpu_ms", stats_json(run->cpu_ms, (size_t)n), "frame_ms",
+        stats_json(run->frame_ms, (size_t)n), "triangles_per_frame",
+        (json_int_t)scene_triangles(&run->scene), "instances", run->scene.instance_count,
+        "lights", run->scene.light_count, "captures", captures, "capture_policy",
+        "each captured frame is read back with glReadPixels after its GPU timer "
+        "query has ended and its CPU time was taken; the readback time is "
+        "subtracted from wall_s (wall_s_including_captures keeps it), and PNG "
+        "encoding happens after the last timed frame",
+        "timing_method",
+        "gpu_ms: GL_TIME_ELAPSED per frame from a ring of 8 queries read back a ring "
+        "later; cpu_ms: CLOCK_MONOTONIC around the frame's submission and glFlush; "
+        "frame_ms: CLOCK_MONOTONIC between frame starts with at most 2 frames in "
+        "flight (fence-bounded, as a swap chain), readback time excluded",
+        "timer_query_stalls", (json_int_t)gpu_timer_stalls(run->timer), "device",
+        run->runner->device_json);
+    captures = NULL;
+    if (sections > 1) {
+        json_t *by_section = json_object();
+        for (int s = 0; s < sections; s++) {
+            for (int i = 0; i < n; i++)
+                sec[i] = gpu_timer_ms(run->timer, w0 + i, s);
+            json_object_set_new(by_section, run->tech->sections[s], stats_json(sec, (size_t)n));
+        }
+        json_object_set_new(result, "gpu_sections_ms", by_section);
+    }
+    if (run->tech->describe) {
+        json_t *d = run->tech->describe(run->state);
+        if (d)
+            json_object_set_new(result, run->tech->name, d);
+    }
+    snprintf(path, sizeof(path), "%s/result.json", job->dir);
+    if (!fs_write_json_atomic(path, result)) {
+        snprintf(run->err, sizeof(run->err), "cannot write %.900s", path);
+        json_decref(result);
+        result = NULL;
+    }
+out:
+    json_decref(captures);
+    free(gpu);
+    free(sec);
+    return result;
+}
+
+/* Renders the reference technique at exactly the captured frame indices,
+ * after the timed run (its time is in no figure). Each frame gets a fresh
+ * technique instance, since frame k is a pure function of k: a stateful
+ * technique (OSL) then shows what it would at frame k in a run of its own. */
+static bool render_reference(struct run *run, enum job_status *status)
+{
+    const struct job_spec *spec = run->spec;
+    const struct technique *ref = technique_find(spec->reference);
+    int w = spec->scene.width, h = spec->scene.height;
+    uint8_t *pixels = malloc((size_t)w * (size_t)h * 4);
+    struct gpu_timer *timer = ref ? gpu_timer_create(technique_section_count(ref), 1) : NULL;
+    bool ok = false;
+    if (!ref || !pixels || !timer) {
+        snprintf(run->err, sizeof(run->err), "reference %s: cannot prepare it", spec->reference);
+        goto out;
+    }
+    struct technique_ctx ctx = {spec, &run->scene, &run->gpu, timer};
+    for (int k = spec->capture_interval; k <= spec->frames; k += spec->capture_interval) {
+        if (atomic_load(&run->job->cancel)) {
+            *status = JOB_CANCELLED;
+            snprintf(run->err, sizeof(run->err), "cancelled while rendering the reference");
+            goto out;
+        }
+        void *state = NULL;
+        char why[900] = "";
+        if (!ref->create(&ctx, &state, why, sizeof(why))) {
+            snprintf(run->err, sizeof(run->err), "reference %s cannot run: %s", ref->name, why);
+            goto out;
+        }
+        glBindFramebuffer(GL_FRAMEBUFFER, run->fbo);
+        glViewport(0, 0, w, h);
+        gpu_timer_begin_frame(timer);
+        bool drawn = ref->render(state, &ctx, k, why, sizeof(why));
+        gpu_timer_end_frame(timer);
+        if (drawn)
+            glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, pixels);
+        ref->destroy(state);
+        if (!drawn || gl_error_take("reference rendering", why, sizeof(why))) {
+            snprintf(run->err, sizeof(run->err), "reference %s failed: %s", ref->name, why);
+            goto out;
+        }
+        char path[PATH_MAX + 32];
+        snprintf(path, sizeof(path), "%s/reference-%06d.png", run->job->dir, k);
+        if (!png_write_gl_rgba(path, pixels, w, h, run->err, sizeof(run->err)))
+            goto out;
+    }
+    ok = true;
+out:
+    gpu_timer_destroy(timer);
+    free(pixels);
+    return ok;
+}
+
+/* One measured run: builds the scene and the technique, renders the warm-up
+ * and timed frames (capturing only when asked: the first run), and leaves
+ * the figures in run. run_index places it in the job's progress. */
+static bool measure(struct runner *r, struct run *run, bool capture, int run_index,
+                    double *wall_s, double *capture_s, enum job_status *status)
+{
+    const struct job_spec *spec = run->spec;
+    struct job *job = run->job;
+    int w0 = spec->warmup_frames, n = spec->frames;
+    run->scene_ok = scene_create(&run->scene, &spec->scene);
+    run->capture_count = capture ? job_spec_capture_count(spec) : 0;
+    run->captures = calloc((size_t)run->capture_count + 1, sizeof(*run->captures));
+    run->cpu_ms = calloc((size_t)n, sizeof(double));
+    run->frame_ms = calloc((size_t)n, sizeof(double));
+    if (!run->scene_ok || !run->captures || !run->cpu_ms || !run->frame_ms) {
+        snprintf(run->err, sizeof(run->err), "out of memory preparing the job");
+        return false;
+    }
+    if (!gpu_scene_init(&run->gpu, &run->scene, run->err, sizeof(run->err)) ||
+        !setup_framebuffer(run))
+        return false;
+    run->timer = gpu_timer_create(technique_section_count(run->tech), (int64_t)w0 + n);
+    if (!run->timer) {
+        snprintf(run->err, sizeof(run->err), "cannot create GPU timer queries");
+        return false;
+    }
+    struct technique_ctx ctx = {spec, &run->scene, &run->gpu, run->timer};
+    if (!run->tech->create(&ctx, &run->state, run->err, sizeof(run->err)) ||
+        gl_error_take("setup", run->err, sizeof(run->err)))
+        return false;
+
+    size_t frame_bytes = (size_t)spec->scene.width * (size_t)spec->scene.height * 4;
+    for (int c = 0; c < run->capture_count; c++)
+        if (!(run->captures[c] = malloc(frame_bytes))) {
+            snprintf(run->err, sizeof(run->err), "out of memory for captures");
+            return false;
+        }
+
+    glBindFramebuffer(GL_FRAMEBUFFER, run->fbo);
+    glViewport(0, 0, spec->scene.width, spec->scene.height);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    double wall_start = 0, frame_begin = 0;
+    int captured = 0;
+    *capture_s = 0;
+    for (int seq = 0; seq < w0 + n; seq++) {
+        int64_t k = (int64_t)seq - w0 + 1;
+        if (atomic_load(&job->cancel)) {
+            *status = JOB_CANCELLED;
+            snprintf(run->err, sizeof(run->err), "cancelled at frame %" PRId64 " of run %d", k,
+                     run_index + 1);
+            return false;
+        }
+        if (k == 1) {
+            /* Warm-up work still queued must not be billed to the timed frames. */
+            glFinish();
+            wall_start = mono_s();
+        }
+        /* Bound the frames in flight like a swap chain would; the wait is part
+         * of the frame interval, never of the CPU submit time. */
+        GLsync *fence = &run->fences[seq % FRAMES_IN_FLIGHT];
+        if (*fence) {
+            glClientWaitSync(*fence, GL_SYNC_FLUSH_COMMANDS_BIT, UINT64_MAX);
+            glDeleteSync(*fence);
+            *fence = NULL;
+        }
+        double t0 = mono_s();
+        if (k >= 2)
+            run->frame_ms[k - 2] += (t0 - frame_begin) * 1e3;
+        frame_begin = t0;
+        gpu_timer_begin_frame(run->timer);
+        bool ok = run->tech->render(run->state, &ctx, k, run->err, sizeof(run->err));
+        gpu_timer_end_frame(run->timer);
+        glFlush(); /* where a swap would hand the frame to the GPU */
+        double t1 = mono_s();
+        *fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+        if (!ok)
+            return false;
+        if (k >= 1)
+            run->cpu_ms[k - 1] = (t1 - t0) * 1e3;
+        if (run->capture_count && job_spec_is_capture_frame(spec, (int)k)) {
+            double c0 = mono_s();
+            glReadPixels(0, 0, spec->scene.width, spec->scene.height, GL_RGBA,
+                         GL_UNSIGNED_BYTE, run->captures[captured++]);
+            double c = mono_s() - c0;
+            *capture_s += c;
+            run->frame_ms[k - 1] -= c * 1e3;
+        }
+        if ((seq & 15) == 15 && gl_error_take("rendering", run->err, sizeof(run->err)))
+            return false;
+        queue_progress(r->queue, job, run_index * n + (k > 0 ? (int)k : 0));
+    }
+    glFinish();
+    double wall_end = mono_s();
+    run->frame_ms[n - 1] += (wall_end - frame_begin) * 1e3;
+    *wall_s = wall_end - wall_start;
+    gpu_timer_drain(run->timer);
+    return !gl_error_take("rendering", run->err, sizeof(run->err));
+}
+
+/* Median of each series in one run's figures, for the across-run summary. */
+static json_t *run_summary(int index, double wall_s, json_t *frame, json_t *gpu, json_t *cpu)
+{
+    return json_pack("{s:i, s:f, s:o, s:o, s:o}", "run", index, "wall_s", wall_s, "frame_ms",
+                     frame, "gpu_ms", gpu, "cpu_ms", cpu);
+}
+
+static json_t *across_runs(const double *medians, size_t n)
+{
+    struct stats s;
+    stats_compute(medians, n, &s);
+    double lo, hi;
+    json_t *ci = stats_mean_ci95(medians, n, &lo, &hi) ? json_pack("[f, f]", lo, hi) : json_null();
+    return json_pack("{s:f, s:f, s:f, s:f, s:f, s:o}", "mean", s.mean, "median", s.median,
+                     "stddev", s.stddev, "min", s.min, "max", s.max, "ci95", ci);
+}
+
+/* Runs 2..N of a repeated job, each with the scene rebuilt; with automatic
+ * repeats, stops as soon as the frame-time interval has tightened. Adds
+ * result.runs and result.repeat, and rewrites result.json. */
+static bool repeat_runs(struct runner *r, struct run *first, json_t *result,
+                        enum job_status *status)
+{
+    const struct job_spec *spec = first->spec;
+    int planned = spec->repeat, n = spec->frames, w0 = spec->warmup_frames;
+    double *med = calloc((size_t)planned * 3, sizeof(double)); /* frame, gpu, cpu */
+    double *gpu = malloc((size_t)n * sizeof(double));
+    json_t *runs = json_array();
+    static const char *const series[3] = {"frame_ms", "gpu_ms", "cpu_ms"};
+    bool ok = med && gpu;
+    if (!ok)
+        snprintf(first->err, sizeof(first->err), "out of memory for repeats");
+    for (int k = 0; ok && k < 3; k++)
+        med[k * planned] = json_real_value(json_object_get(json_object_get(result, series[k]), "median"));
+    if (ok)
+        json_array_append_new(runs, run_summary(1, json_real_value(json_object_get(result, "wall_s")),
+                                                json_deep_copy(json_object_get(result, "frame_ms")),
+                                                json_deep_copy(json_object_get(result, "gpu_ms")),
+                                                json_deep_copy(json_object_get(result, "cpu_ms"))));
+    int done = 1;
+    while (ok && done < planned && !(spec->repeat_auto && stats_is_stable(med, (size_t)done, 0.025))) {
+        struct run extra = {.runner = r, .job = first->job, .spec = spec, .tech = first->tech};
+        double wall_s = 0, capture_s = 0;
+        ok = measure(r, &extra, false, done, &wall_s, &capture_s, status);
+        if (ok) {
+            for (int i = 0; i < n; i++)
+                gpu[i] = gpu_timer_ms(extra.timer, w0 + i, -1);
+            json_t *f = stats_json(extra.frame_ms, (size_t)n), *g = stats_json(gpu, (size_t)n),
+                   *c = stats_json(extra.cpu_ms, (size_t)n);
+            med[done] = json_real_value(json_object_get(f, "median"));
+            med[planned + done] = json_real_value(json_object_get(g, "median"));
+            med[2 * planned + done] = json_real_value(json_object_get(c, "median"));
+            json_array_append_new(runs, run_summary(done + 1, wall_s, f, g, c));
+            done++;
+        } else {
+            char why[900];
+            snprintf(why, sizeof(why), "%.890s", extra.err);
+            snprintf(first->err, sizeof(first->err), "run %d: %s", done + 1, why);
+        }
+        teardown(&extra);
+    }
+    if (ok) {
+        bool stable = stats_is_stable(med, (size_t)done, 0.025);
+        json_t *rep = json_pack("{s:i, s:i, s:b, s:b, s:s, s:s}", "runs", done, "planned", planned,
+                                "auto", spec->repeat_auto, "stable", stable, "rule_series",
+                                "frame_ms", "rule",
+                                "stable when the 95% confidence interval (Student's t) of the mean "
+                                "of per-run median frame_ms is within 2.5% of it, from 3 runs");
+        for (int k = 0; k < 3; k++)
+            json_object_set_new(rep, series[k], across_runs(med + k * planned, (size_t)done));
+        json_object_set_new(result, "repeat", rep);
+        json_object_set_new(result, "runs", runs);
+        runs = NULL;
+        queue_progress(r->queue, first->job, planned * n);
+        char path[PATH_MAX + 16];
+        snprintf(path, sizeof(path), "%s/result.json", first->job->dir);
+        if (!fs_write_json_atomic(path, result)) {
+            snprintf(first->err, sizeof(first->err), "cannot write %.900s", path);
+            ok = false;
+        }
+    }
+    json_decref(runs);
+    free(med);
+    free(gpu);
+    return ok;
+}
+
+static void run_job(struct runner *r, struct job *job)
+{
+    struct run run = {.runner = r, .job = job, .spec = &job->spec};
+    const struct job_spec *spec = &job->spec;
+    enum job_status status = JOB_FAILED;
+    json_t *result = NULL;
+
+    LOG(LOG_INFO, "job %s: %s, %d+%d frames at %dx%d, %d run(s)", job->id, spec->technique,
+        spec->warmup_frames, spec->frames, spec->scene.width, spec->scene.height,
+        job_spec_runs(spec));
+    service_status("running job %s (%s, %d frames at %dx%d)", job->id, spec->technique,
+                   spec->frames, spec->scene.width, spec->scene.height);
+    gl_error_take("previous job", run.err, sizeof(run.err));
+    run.err[0] = '\0';
+    run.tech = technique_find(spec->technique);
+    if (!run.tech) {
+        snprintf(run.err, sizeof(run.err), "technique %s is not available", spec->technique);
+        goto done;
+    }
+    double wall_s = 0, capture_s = 0;
+    if (!measure(r, &run, true, 0, &wall_s, &capture_s, &status))
+        goto done;
+    result = write_outputs(&run, wall_s, capture_s);
+    /* The first run's technique is done with: free it before more runs or the
+     * reference claim the device's memory. */
+    run.tech->destroy(run.state);
+    run.state = NULL;
+    if (result && spec->repeat > 1 && !repeat_runs(r, &run, result, &status)) {
+        json_decref(result);
+        result = NULL;
+    }
+    if (result && spec->reference[0]) {
+        queue_set_phase(r->queue, job, "reference");
+        if (!render_reference(&run, &status)) {
+            json_decref(result);
+            result = NULL;
+        }
+    }
+    if (result)
+        status = JOB_DONE;
+done:
+    if (status != JOB_DONE)
+        LOG(LOG_WARN, "job %s %s: %s", job->id, job_status_name(status), run.err);
+    else
+        LOG(LOG_INFO, "job %s rendered", job->id);
+    teardown(&run);
+    service_status("idle; last job %s %s", job->id, job_status_name(status));
+    if (status == JOB_DONE && spec->reference[0]) {
+        queue_set_phase(r->queue, job, "metrics");
+        metrics_worker_submit(r->metrics, job, result);
+        return;
+    }
+    queue_finish(r->queue, job, status, status == JOB_DONE ? NULL : run.err, result);
+}
+
+static void *runner_main(void *arg)
+{
+    struct runner *r = arg;
+    char err[512] = "";
+    struct egl_context *egl = egl_context_create(r->device, r->gl_debug, err, sizeof(err));
+    pthread_mutex_lock(&r->lock);
+    if (egl) {
+        gl_debug_install();
+        r->device_json = collect_device(egl);
+        r->ready = 1;
+        atomic_store(&r->alive, true);
+    } else {
+        snprintf(r->error, sizeof(r->error), "%s", err);
+        r->ready = -1;
+    }
+    pthread_cond_broadcast(&r->ready_cond);
+    pthread_mutex_unlock(&r->lock);
+    if (!egl)
+        return NULL;
+    LOG(LOG_INFO, "GL context on %s (%s): %s, %s", egl_context_device(egl),
+        egl_context_platform(egl), gl_str(GL_RENDERER), gl_str(GL_VERSION));
+
+    struct job *job;
+    while ((job = queue_next(r->queue)))
+        run_job(r, job);
+    atomic_store(&r->alive, false);
+    egl_context_destroy(egl);
+    return NULL;
+}
+
+struct runner *runner_create(struct queue *q, int device, bool gl_debug,
+                             char *err, size_t errlen)
+{
+    struct runner *r = calloc(1, sizeof(*r));
+    if (!r) {
+        snprintf(err, errlen, "out of memory");
+        return NULL;
+    }
+    r->queue = q;
+    r->metrics = metrics_worker_create(q);
+    if (!r->metrics) {
+        snprintf(err, errlen, "cannot start the metrics thread");
+        free(r);
+        return NULL;
+    }
+    r->device = device;
+    r->gl_debug = gl_debug;
+    atomic_init(&r->alive, false);
+    pthread_mutex_init(&r->lock, NULL);
+    pthread_cond_init(&r->ready_cond, NULL);
+    if (pthread_create(&r->thread, NULL, runner_main, r) != 0) {
+        snprintf(err, errlen, "cannot start the render thread");
+        metrics_worker_destroy(r->metrics);
+        free(r);
+        return NULL;
+    }
+    pthread_mutex_lock(&r->lock);
+    while (r->ready == 0)
+        pthread_cond_wait(&r->ready_cond, &r->lock);
+    pthread_mutex_unlock(&r->lock);
+    if (r->ready < 0) {
+        snprintf(err, errlen, "%s", r->error);
+        pthread_join(r->thread, NULL);
+        metrics_worker_destroy(r->metrics);
+        free(r);
+        return NULL;
+    }
+    return r;
+}
+
+void runner_destroy(struct runner *r)
+{
+    if (!r)
+        return;
+    queue_stop(r->queue);
+    pthread_join(r->thread, NULL);
+    /* After the render thread: it is the only one that hands work over. */
+    metrics_worker_destroy(r->metrics);
+    json_decref(r->device_json);
+    pthread_cond_destroy(&r->ready_cond);
+    pthread_mutex_destroy(&r->lock);
+    free(r);
+}
+
+bool runner_alive(struct runner *r) { return atomic_load(&r->alive); }
+
+json_t *runner_device_json(struct runner *r) { return json_incref(r->device_json); }

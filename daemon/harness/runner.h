@@ -1,0 +1,26 @@
+#ifndef SHADEBENCH_RUNNER_H
+#define SHADEBENCH_RUNNER_H
+
+/* The render thread: the only thread that makes the GL context current. It
+ * takes jobs from the queue and runs them: warm-up, timed frames, captures
+ * (outside the timed region), statistics, files. */
+
+#include <jansson.h>
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "daemon/jobs/queue.h"
+
+struct runner;
+
+/* Starts the render thread and waits until its context is up (or failed). */
+struct runner *runner_create(struct queue *q, int device, bool gl_debug,
+                             char *err, size_t errlen);
+/* Stops the queue, lets the running job see it, joins. Accepts NULL. */
+void runner_destroy(struct runner *r);
+
+bool runner_alive(struct runner *r);
+/* Device and driver strings, as reported in every result. New reference. */
+json_t *runner_device_json(struct runner *r);
+
+#endif

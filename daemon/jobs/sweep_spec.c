@@ -1,0 +1,368 @@
+#define _POSIX_C_SOURCE 200809L
+#include "daemon/jobs/sweep_spec.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum param_type { PARAM_INT, PARAM_NUMBER, PARAM_BOOL, PARAM_CHOICE };
+
+/* Every job field a sweep may vary. */
+static const struct {
+    const char *path;
+    enum param_type type;
+} PARAMS[] = {
+    {"technique", PARAM_CHOICE},        {"reference", PARAM_CHOICE},
+    {"frames", PARAM_INT},              {"warmup_frames", PARAM_INT},
+    {"capture_interval", PARAM_INT},    {"async_distance", PARAM_NUMBER},
+    {"scene.lights", PARAM_INT},        {"scene.dynamic", PARAM_BOOL},
+    {"scene.width", PARAM_INT},         {"scene.height", PARAM_INT},
+    {"scene.sphere_segments", PARAM_INT}, {"scene.light_speed", PARAM_NUMBER},
+    {"osl.resolution", PARAM_CHOICE},   {"osl.texel_density", PARAM_NUMBER},
+    {"osl.reshade", PARAM_CHOICE},
+};
+enum { NPARAMS = sizeof(PARAMS) / sizeof(PARAMS[0]) };
+
+
+static int param_index(const char *path)
+{
+    for (int i = 0; i < (int)NPARAMS; i++)
+        if (strcmp(PARAMS[i].path, path) == 0)
+            return i;
+    return -1;
+}
+
+static bool unknown_param(struct job_error *err, const char *field)
+{
+    char list[400] = "";
+    for (int i = 0; i < (int)NPARAMS; i++) {
+        size_t used = strlen(list);
+        snprintf(list + used, sizeof(list) - used, "%s%s", i ? ", " : "", PARAMS[i].path);
+    }
+    return job_error_set(err, field, "not a parameter a sweep can vary; one of: %s", list);
+}
+
+/* A copy of job with the field at a dotted path set to value. */
+static json_t *with_field(const json_t *job, const char *path, json_t *value)
+{
+    json_t *copy = json_deep_copy(job);
+    const char *dot = strchr(path, '.');
+    if (!dot) {
+        json_object_set(copy, path, value);
+        return copy;
+    }
+    char head[40];
+    snprintf(head, sizeof(head), "%.*s", (int)(dot - path), path);
+    json_t *inner = json_object_get(copy, head);
+    if (!json_is_object(inner)) {
+        inner = json_object();
+        json_object_set_new(copy, head, inner);
+    }
+    json_object_set(inner, dot + 1, value);
+    return copy;
+}
+
+/* Every point measures quality against a reference (forward unless the base
+ * names one), on at least its last frame. */
+static json_t *point_defaults(const struct sweep_spec *s, json_t *job)
+{
+    if (!json_object_get(job, "reference") || json_is_null(json_object_get(job, "reference")))
+        json_object_set_new(job, "reference", json_string("forward"));
+    json_t *ci = json_object_get(job, "capture_interval");
+    if (!ci || json_integer_value(ci) == 0) {
+        json_t *frames = json_object_get(job, "frames");
+        json_object_set_new(job, "capture_interval",
+                            json_integer(frames ? json_integer_value(frames) : 300));
+    }
+    if (s->kind == SWEEP_FIND && s->criterion == CRITERION_STABLE && !json_object_get(job, "repeat"))
+        json_object_set_new(job, "repeat", json_pack("{s:b, s:i}", "auto", 1, "max", 10));
+    return job;
+}
+
+static bool check_point(const json_t *job, const char *const *techniques, const char *field,
+                        struct job_error *err)
+{
+    struct job_spec spec;
+    struct job_error inner;
+    if (job_spec_parse(job, techniques, &spec, &inner))
+        return true;
+    return job_error_set(err, field, "%s: %s", inner.field, inner.message);
+}
+
+static bool parse_criterion(const char *text, struct sweep_spec *s)
+{
+    double x;
+    char tail[2];
+    snprintf(s->criterion_text, sizeof(s->criterion_text), "%s", text);
+    if (strcmp(text, "pdiff_pass") == 0)
+        s->criterion = CRITERION_PDIFF_PASS;
+    else if (strcmp(text, "stable") == 0)
+        s->criterion = CRITERION_STABLE;
+    else if (sscanf(text, "ssim_min >= %lf%1s", &x, tail) == 1 && x >= -1 && x <= 1)
+        s->criterion = CRITERION_SSIM_MIN, s->threshold = x;
+    else if (sscanf(text, "flip_max <= %lf%1s", &x, tail) == 1 && x >= 0 && x <= 1)
+        s->criterion = CRITERION_FLIP_MAX, s->threshold = x;
+    else
+        return false;
+    return true;
+}
+
+/* The thesis's experiment (chapter 3.3): forward and OSL (256 texels an
+ * object, async distance 20) with still and moving lights on the grid at
+ * 1080x720, repeated, captures judged with SSIM and PerceptualDiff at 22.6
+ * degrees. frames and repeat may be lowered to fit a slow machine. */
+static json_t *thesis_sweep(const json_t *body, struct job_error *err)
+{
+    const char *key;
+    json_t *v;
+    json_object_foreach((json_t *)body, key, v) if (strcmp(key, "preset") && strcmp(key, "frames") &&
+                                                  strcmp(key, "repeat")) {
+        job_error_set(err, key, "unknown field (the thesis preset takes frames and repeat)");
+        return NULL;
+    }
+    json_t *frames = json_object_get(body, "frames"), *repeat = json_object_get(body, "repeat");
+    if (frames && (!json_is_integer(frames) || json_integer_value(frames) < 1 ||
+                   json_integer_value(frames) > 100000)) {
+        job_error_set(err, "frames", "must be an integer from 1 to 100000");
+        return NULL;
+    }
+    if (repeat && (!json_is_integer(repeat) || json_integer_value(repeat) < 1 ||
+                   json_integer_value(repeat) > 1000)) {
+        job_error_set(err, "repeat", "must be an integer from 1 to 1000");
+        return NULL;
+    }
+    json_int_t n = frames ? json_integer_value(frames) : 300;
+    json_t *base = json_pack(
+        "{s:s, s:I, s:i, s:I, s:f, s:{s:i}, s:I, s:s, s:{s:b, s:{s:f}, s:b, s:b},"
+        " s:{s:s, s:i, s:b, s:i, s:i}}",
+        "technique", "forward", "frames", n, "warmup_frames", 10, "capture_interval",
+        n >= 3 ? n / 3 : n, "async_distance", 20.0, "osl", "resolution", 256, "repeat",
+        repeat ? json_integer_value(repeat) : (json_int_t)5, "reference", "forward", "metrics",
+        "ssim", 1, "pdiff", "fov", 22.6, "psnr", 0, "flip", 0, "scene", "preset", "grid", "lights",
+        10, "dynamic", 0, "width", 1080, "height", 720);
+    return json_pack("{s:o, s:{s:[b, b], s:[s, s]}}", "base", base, "vary", "scene.dynamic", 0, 1,
+                     "technique", "forward", "osl");
+}
+
+bool sweep_spec_parse(const json_t *body, const char *const *techniques, struct sweep_spec *out,
+                      struct job_error *err)
+{
+    memset(out, 0, sizeof(*out));
+    memset(err, 0, sizeof(*err));
+    if (!json_is_object(body))
+        return job_error_set(err, "body", "the sweep must be a JSON object");
+    json_t *preset = json_object_get(body, "preset");
+    if (preset) {
+        if (!json_is_string(preset) || strcmp(json_string_value(preset), "thesis") != 0)
+            return job_error_set(err, "preset", "must be \"thesis\"");
+        json_t *expanded = thesis_sweep(body, err);
+        if (!expanded)
+            return false;
+        bool ok = sweep_spec_parse(expanded, techniques, out, err);
+        json_decref(expanded);
+        out->thesis = ok;
+        return ok;
+    }
+    const char *key;
+    json_t *v;
+    json_object_foreach((json_t *)body, key, v) if (strcmp(key, "base") && strcmp(key, "vary") &&
+                                                  strcmp(key, "find"))
+        return job_error_set(err, key, "unknown field (a sweep has base and vary, or base and find)");
+    json_t *base = json_object_get(body, "base");
+    if (!json_is_object(base))
+        return job_error_set(err, "base", "must be a job object");
+    if (!check_point(base, techniques, "base", err))
+        return false;
+    json_t *vary = json_object_get(body, "vary"), *find = json_object_get(body, "find");
+    if (!!vary == !!find)
+        return job_error_set(err, vary ? "find" : "vary", "give exactly one of vary and find");
+    out->base = json_incref(base);
+
+    if (vary) {
+        out->kind = SWEEP_VARY;
+        if (!json_is_object(vary) || json_object_size(vary) < 1 || json_object_size(vary) > 2)
+            return job_error_set(err, "vary", "must be an object of one or two parameters, each with a list of values");
+        out->npoints = 1;
+        json_object_foreach(vary, key, v) {
+            char field[96];
+            snprintf(field, sizeof(field), "vary.%.40s", key);
+            if (param_index(key) < 0)
+                return unknown_param(err, field);
+            if (!json_is_array(v) || json_array_size(v) == 0)
+                return job_error_set(err, field, "must be a non-empty list of values");
+            snprintf(out->params[out->nparams], sizeof(out->params[0]), "%s", key);
+            out->values[out->nparams++] = json_incref(v);
+            out->npoints *= json_array_size(v);
+            if (out->npoints > SWEEP_MAX_POINTS)
+                return job_error_set(err, "vary", "makes more than %d points", SWEEP_MAX_POINTS);
+            size_t i;
+            json_t *value;
+            json_array_foreach(v, i, value) {
+                snprintf(field, sizeof(field), "vary.%.40s[%zu]", key, i);
+                json_t *job = with_field(base, key, value);
+                bool ok = check_point(job, techniques, field, err);
+                json_decref(job);
+                if (!ok)
+                    return false;
+            }
+        }
+        return true;
+    }
+
+    out->kind = SWEEP_FIND;
+    if (!json_is_object(find))
+        return job_error_set(err, "find", "must be an object: param, from, to, while");
+    json_object_foreach(find, key, v) if (strcmp(key, "param") && strcmp(key, "from") &&
+                                          strcmp(key, "to") && strcmp(key, "while") &&
+                                          strcmp(key, "steps")) {
+        char field[64];
+        snprintf(field, sizeof(field), "find.%.40s", key);
+        return job_error_set(err, field, "unknown field (param, from, to, while, steps)");
+    }
+    const char *param = json_string_value(json_object_get(find, "param"));
+    int p = param ? param_index(param) : -1;
+    if (p < 0)
+        return param ? unknown_param(err, "find.param") : job_error_set(err, "find.param", "must name a parameter");
+    if (PARAMS[p].type != PARAM_INT && PARAMS[p].type != PARAM_NUMBER)
+        return job_error_set(err, "find.param", "%s is not numeric: find bisects a numeric parameter", param);
+    snprintf(out->params[0], sizeof(out->params[0]), "%s", param);
+    out->nparams = 1;
+    out->integer = PARAMS[p].type == PARAM_INT;
+    json_t *from = json_object_get(find, "from"), *to = json_object_get(find, "to");
+    if (!json_is_number(from))
+        return job_error_set(err, "find.from", "must be a number");
+    if (!json_is_number(to) || json_number_value(to) <= json_number_value(from))
+        return job_error_set(err, "find.to", "must be a number above find.from");
+    out->from = json_number_value(from);
+    out->to = json_number_value(to);
+    if (out->integer && (out->from != floor(out->from) || out->to != floor(out->to)))
+        return job_error_set(err, out->from != floor(out->from) ? "find.from" : "find.to",
+                    "must be an integer: %s is an integer parameter", param);
+    const char *crit = json_string_value(json_object_get(find, "while"));
+    if (!crit || !parse_criterion(crit, out))
+        return job_error_set(err, "find.while", "must be one of \"pdiff_pass\", \"stable\", "
+                    "\"ssim_min >= X\", \"flip_max <= X\"");
+    out->max_probes = 10;
+    json_t *steps = json_object_get(find, "steps");
+    if (steps) {
+        if (!json_is_integer(steps) || json_integer_value(steps) < 2 || json_integer_value(steps) > 64)
+            return job_error_set(err, "find.steps", "must be an integer from 2 to 64 (probes at most)");
+        out->max_probes = (int)json_integer_value(steps);
+    }
+    out->npoints = (size_t)out->max_probes;
+    for (int end = 0; end < 2; end++) {
+        json_t *job = sweep_probe_job(out, end ? out->to : out->from);
+        bool ok = check_point(job, techniques, end ? "find.to" : "find.from", err);
+        json_decref(job);
+        if (!ok)
+            return false;
+    }
+    return true;
+}
+
+void sweep_spec_finish(struct sweep_spec *s)
+{
+    if (!s)
+        return;
+    json_decref(s->base);
+    for (int i = 0; i < 2; i++)
+        json_decref(s->values[i]);
+    memset(s, 0, sizeof(*s));
+}
+
+json_t *sweep_point_job(const struct sweep_spec *s, size_t index, json_t **values)
+{
+    json_t *job = json_deep_copy(s->base);
+    *values = json_object();
+    /* Row-major: the last parameter varies fastest. */
+    for (int p = s->nparams - 1; p >= 0; p--) {
+        size_t n = json_array_size(s->values[p]);
+        json_t *value = json_array_get(s->values[p], index % n);
+        index /= n;
+        json_t *next = with_field(job, s->params[p], value);
+        json_decref(job);
+        job = next;
+        json_object_set(*values, s->params[p], value);
+    }
+    return point_defaults(s, job);
+}
+
+json_t *sweep_probe_job(const struct sweep_spec *s, double v)
+{
+    json_t *value = s->integer ? json_integer((json_int_t)llround(v)) : json_real(v);
+    json_t *job = with_field(s->base, s->params[0], value);
+    json_decref(value);
+    return point_defaults(s, job);
+}
+
+bool sweep_criterion_holds(const struct sweep_spec *s, const json_t *result)
+{
+    json_t *q = json_object_get(result, "quality");
+    switch (s->criterion) {
+    case CRITERION_PDIFF_PASS:
+        return q && json_integer_value(json_object_get(q, "pdiff_failed_captures")) == 0;
+    case CRITERION_SSIM_MIN: {
+        json_t *w = json_object_get(json_object_get(q, "worst_ssim_min"), "value");
+        return w && json_number_value(w) >= s->threshold;
+    }
+    case CRITERION_FLIP_MAX: {
+        json_t *w = json_object_get(json_object_get(q, "worst_flip"), "max");
+        return w && json_number_value(w) <= s->threshold;
+    }
+    case CRITERION_STABLE:
+        return json_is_true(json_object_get(json_object_get(result, "repeat"), "stable"));
+    }
+    return false;
+}
+
+void sweep_bisect(double from, double to, bool integer, int max_probes,
+                  int (*holds)(double v, void *ctx), void *ctx, struct bisect_result *out)
+{
+    memset(out, 0, sizeof(*out));
+    int h = holds(from, ctx);
+    out->probes = 1;
+    if (h < 0) {
+        out->outcome = BISECT_ABORTED;
+        return;
+    }
+    if (h == 0) {
+        out->outcome = BISECT_FAILS_EVERYWHERE;
+        out->first_failing = from;
+        return;
+    }
+    h = holds(to, ctx);
+    out->probes = 2;
+    if (h < 0) {
+        out->outcome = BISECT_ABORTED;
+        out->value = from;
+        return;
+    }
+    if (h == 1) {
+        out->outcome = BISECT_HOLDS_EVERYWHERE;
+        out->value = to;
+        return;
+    }
+    double lo = from, hi = to, resolution = integer ? 1.0 : (to - from) / 1000.0;
+    while (hi - lo > resolution && out->probes < max_probes) {
+        double mid = integer ? floor((lo + hi) / 2.0) : (lo + hi) / 2.0;
+        if (mid <= lo || mid >= hi)
+            break;
+        h = holds(mid, ctx);
+        out->probes++;
+        if (h < 0) {
+            out->outcome = BISECT_ABORTED;
+            out->value = lo;
+            out->first_failing = hi;
+            return;
+        }
+        if (h)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    out->outcome = BISECT_BOUNDARY;
+    out->value = lo;
+    out->first_failing = hi;
+}

@@ -1,0 +1,67 @@
+#ifndef SHADEBENCH_SWEEP_H
+#define SHADEBENCH_SWEEP_H
+
+/* Sweep specifications (GL-free): a base job and one or two job fields to
+ * vary over listed values (a grid), or one numeric field to bisect for the
+ * largest value at which a quality criterion still holds, or the thesis's
+ * experiment as a preset. */
+
+#include <jansson.h>
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "daemon/jobs/job_spec.h"
+
+#define SWEEP_MAX_POINTS 256
+
+enum sweep_kind { SWEEP_VARY, SWEEP_FIND };
+
+enum sweep_criterion { CRITERION_PDIFF_PASS, CRITERION_SSIM_MIN, CRITERION_FLIP_MAX, CRITERION_STABLE };
+
+struct sweep_spec {
+    enum sweep_kind kind;
+    json_t *base;           /* the base job, as given */
+    int nparams;
+    char params[2][40];     /* dotted paths */
+    json_t *values[2];      /* arrays, for SWEEP_VARY */
+    size_t npoints;
+    /* SWEEP_FIND */
+    double from, to;
+    bool integer;
+    int max_probes;
+    enum sweep_criterion criterion;
+    double threshold;
+    char criterion_text[64];
+    bool thesis; /* {"preset": "thesis"}: the thesis's experiment */
+};
+
+bool sweep_spec_parse(const json_t *body, const char *const *techniques, struct sweep_spec *out,
+                      struct job_error *err);
+void sweep_spec_finish(struct sweep_spec *s);
+
+/* The job of grid point index (row-major over the parameters); *values gets
+ * {"path": value, ...}. New references. */
+json_t *sweep_point_job(const struct sweep_spec *s, size_t index, json_t **values);
+
+/* The job of a find probe at value v. New reference. */
+json_t *sweep_probe_job(const struct sweep_spec *s, double v);
+
+/* Does a finished job's result meet the criterion? */
+bool sweep_criterion_holds(const struct sweep_spec *s, const json_t *result);
+
+/* Bisection for the largest value in [from, to] at which holds() is true,
+ * for a criterion that holds below some boundary and fails above it. Probes
+ * both ends first. Stops when the interval is one step wide (integers) or
+ * 1/1000 of the range, or after max_probes probes. */
+enum bisect_outcome { BISECT_BOUNDARY, BISECT_HOLDS_EVERYWHERE, BISECT_FAILS_EVERYWHERE, BISECT_ABORTED };
+struct bisect_result {
+    enum bisect_outcome outcome;
+    double value; /* the largest value seen to hold (BOUNDARY, HOLDS_EVERYWHERE) */
+    double first_failing;
+    int probes;
+};
+/* holds returns 1 (holds), 0 (fails) or -1 (abort: cancelled or failed). */
+void sweep_bisect(double from, double to, bool integer, int max_probes,
+                  int (*holds)(double v, void *ctx), void *ctx, struct bisect_result *out);
+
+#endif

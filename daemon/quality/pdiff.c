@@ -1,0 +1,236 @@
+/* PerceptualDiff: H. Yee, "A perceptual metric for production testing",
+ * Journal of Graphics Tools 9(4), 2004, as implemented in Yee's
+ * perceptualdiff (metric.cpp, lpyramid.cpp), whose float arithmetic this
+ * follows step by step:
+ *  - RGB is linearised with pow(c / 255, gamma) and taken as Adobe RGB (1998)
+ *    with a D65 white, converted to XYZ with Lindbloom's matrix and to CIE
+ *    L*a*b*; luminance is Y times the display luminance (cd/m^2);
+ *  - an 8-level "Laplacian pyramid" at full resolution: each level is the
+ *    previous one blurred by the separable kernel [0.05 0.25 0.4 0.25 0.05]
+ *    with mirrored borders;
+ *  - contrast sensitivity is Barten's CSF (SPIE 1989), visual masking Daly's
+ *    (1993), the threshold-versus-intensity curve Ward Larson's (1997);
+ *  - a pixel fails when its luminance difference exceeds factor * TVI, or its
+ *    colour difference (a*, b* squared, times color_factor) exceeds factor,
+ *    the colour test being off in scotopic regions (adaptation < 10 cd/m^2);
+ *  - the images pass when fewer than threshold_pixels pixels fail. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "daemon/quality/metrics.h"
+
+enum { LEVELS = 8 }; /* MAX_PYR_LEVELS in perceptualdiff */
+
+static const float PI_F = 3.14159265f;
+
+void pdiff_defaults(struct pdiff_options *o)
+{
+    o->fov = 22.6;        /* the thesis: 20 cm wide image seen from 50 cm */
+    o->threshold_pixels = 100;
+    o->gamma = 2.2;
+    o->luminance = 100.0;
+    o->color_factor = 1.0;
+    o->luminance_only = false;
+}
+
+/* Threshold versus intensity, Ward Larson, SIGGRAPH 1997 (cd/m^2). */
+static float tvi(float adaptation)
+{
+    float log_a = log10f(adaptation), r;
+    if (log_a < -3.94f)
+        r = -2.86f;
+    else if (log_a < -1.44f)
+        r = powf(0.405f * log_a + 1.6f, 2.18f) - 2.86f;
+    else if (log_a < -0.0184f)
+        r = log_a - 0.395f;
+    else if (log_a < 1.9f)
+        r = powf(0.249f * log_a + 0.65f, 2.7f) - 0.72f;
+    else
+        r = log_a - 1.255f;
+    return powf(10.0f, r);
+}
+
+/* Contrast sensitivity, Barten, SPIE 1989: cycles per degree, luminance. */
+static float csf(float cpd, float lum)
+{
+    float a = 440.0f * powf(1.0f + 0.7f / lum, -0.2f);
+    float b = 0.3f * powf(1.0f + 100.0f / lum, 0.15f);
+    return a * cpd * expf(-b * cpd) * sqrtf(1.0f + 0.06f * expf(b * cpd));
+}
+
+/* Visual masking, Daly 1993. */
+static float mask(float contrast)
+{
+    float a = powf(392.498f * contrast, 0.7f);
+    float b = powf(0.0153f * a, 4.0f);
+    return powf(1.0f + b, 0.25f);
+}
+
+/* Adobe RGB (1998), D65, to XYZ (matrix from brucelindbloom.com). */
+static void adobe_rgb_to_xyz(float r, float g, float b, float *x, float *y, float *z)
+{
+    *x = r * 0.576700f + g * 0.185556f + b * 0.188212f;
+    *y = r * 0.297361f + g * 0.627355f + b * 0.0752847f;
+    *z = r * 0.0270328f + g * 0.0706879f + b * 0.991248f;
+}
+
+static void xyz_to_ab(float x, float y, float z, float *a, float *b)
+{
+    static float white[3];
+    if (white[0] == 0.0f)
+        adobe_rgb_to_xyz(1, 1, 1, &white[0], &white[1], &white[2]);
+    const float epsilon = 216.0f / 24389.0f, kappa = 24389.0f / 27.0f;
+    float r[3] = {x / white[0], y / white[1], z / white[2]}, f[3];
+    for (int i = 0; i < 3; i++)
+        f[i] = r[i] > epsilon ? powf(r[i], 1.0f / 3.0f) : (kappa * r[i] + 16.0f) / 116.0f;
+    *a = 500.0f * (f[0] - f[1]);
+    *b = 200.0f * (f[1] - f[2]);
+}
+
+static int mirror(int v, int n)
+{
+    if (v < 0)
+        v = -v;
+    if (v >= n)
+        v = 2 * n - v - 1;
+    return v;
+}
+
+/* Level i+1 = level i blurred (separable: two 1-D passes, taps outermost so
+ * the inner loops vectorize). Borders mirror as perceptualdiff's do. */
+METRICS_SIMD static void blur(float *dst, const float *src, float *tmp, float *row, int w, int h)
+{
+    static const float k[5] = {0.05f, 0.25f, 0.4f, 0.25f, 0.05f};
+    for (int y = 0; y < h; y++) {
+        const float *in = src + (size_t)y * (size_t)w;
+        float *out = tmp + (size_t)y * (size_t)w;
+        for (int x = -2; x < w + 2; x++)
+            row[x + 2] = in[mirror(x, w)];
+        for (int x = 0; x < w; x++)
+            out[x] = 0.0f;
+        for (int i = 0; i < 5; i++)
+            for (int x = 0; x < w; x++)
+                out[x] += k[i] * row[x + i];
+    }
+    for (int y = 0; y < h; y++) {
+        float *out = dst + (size_t)y * (size_t)w;
+        for (int x = 0; x < w; x++)
+            out[x] = 0.0f;
+        for (int j = -2; j <= 2; j++) {
+            const float *in = tmp + (size_t)mirror(y + j, h) * (size_t)w;
+            for (int x = 0; x < w; x++)
+                out[x] += k[j + 2] * in[x];
+        }
+    }
+}
+
+bool pdiff_compute(const struct image *a, const struct image *b,
+                   const struct pdiff_options *o, struct pdiff_result *out, char *err,
+                   size_t errlen)
+{
+    memset(out, 0, sizeof(*out));
+    if (a->width != b->width || a->height != b->height) {
+        snprintf(err, errlen, "pdiff: image sizes differ");
+        return false;
+    }
+    int w = a->width, h = a->height;
+    size_t n = (size_t)w * (size_t)h;
+    if (memcmp(a->rgb, b->rgb, n * 3) == 0) {
+        out->pass = true;
+        out->identical = true;
+        return true;
+    }
+    /* Two pyramids of LEVELS planes and one scratch plane. */
+    float *buf = malloc(n * sizeof(float) * (2 * LEVELS + 1) + ((size_t)w + 4) * sizeof(float));
+    if (!buf) {
+        snprintf(err, errlen, "pdiff: out of memory");
+        return false;
+    }
+    float *la = buf, *lb = la + n * LEVELS, *tmp = lb + n * LEVELS, *row = tmp + n;
+    /* pow(c / 255, gamma) for every 8-bit value: the same float as computing it. */
+    float linear[256];
+    for (int v = 0; v < 256; v++)
+        linear[v] = powf(v / 255.0f, (float)o->gamma);
+    const float lum = (float)o->luminance;
+    for (size_t i = 0; i < n; i++) {
+        float x, y, z;
+        const uint8_t *p = a->rgb + i * 3, *q = b->rgb + i * 3;
+        adobe_rgb_to_xyz(linear[p[0]], linear[p[1]], linear[p[2]], &x, &y, &z);
+        la[i] = y * lum;
+        adobe_rgb_to_xyz(linear[q[0]], linear[q[1]], linear[q[2]], &x, &y, &z);
+        lb[i] = y * lum;
+    }
+    for (int l = 1; l < LEVELS; l++) {
+        blur(la + n * (size_t)l, la + n * (size_t)(l - 1), tmp, row, w, h);
+        blur(lb + n * (size_t)l, lb + n * (size_t)(l - 1), tmp, row, w, h);
+    }
+
+    /* Pixels spanning one degree at this field of view, and the pyramid level
+     * whose blur matches that adaptation area. */
+    float one_degree = 2.0f * tanf((float)o->fov * 0.5f * PI_F / 180.0f) * 180.0f / PI_F;
+    float ppd = (float)w / one_degree;
+    int adapt_level = 0;
+    float npix = 1.0f;
+    for (int i = 0; i < LEVELS; i++) {
+        adapt_level = i;
+        if (npix > one_degree)
+            break;
+        npix *= 2;
+    }
+    float cpd[LEVELS], f_freq[LEVELS - 2];
+    cpd[0] = 0.5f * ppd;
+    for (int i = 1; i < LEVELS; i++)
+        cpd[i] = 0.5f * cpd[i - 1];
+    float csf_max = csf(3.248f, 100.0f);
+    for (int i = 0; i < LEVELS - 2; i++)
+        f_freq[i] = csf_max / csf(cpd[i], 100.0f);
+
+    long failed = 0;
+    for (size_t i = 0; i < n; i++) {
+        /* Identical colours give a zero luminance and colour difference, which
+         * pass both tests whatever the threshold: no need to compute it. */
+        const uint8_t *p = a->rgb + i * 3, *q = b->rgb + i * 3;
+        if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2])
+            continue;
+        float adapt = (la[n * (size_t)adapt_level + i] + lb[n * (size_t)adapt_level + i]) * 0.5f;
+        if (adapt < 1e-5f)
+            adapt = 1e-5f;
+        float sum_contrast = 0, factor = 0;
+        for (int l = 0; l < LEVELS - 2; l++) {
+            float n1 = fabsf(la[n * (size_t)l + i] - la[n * (size_t)(l + 1) + i]);
+            float n2 = fabsf(lb[n * (size_t)l + i] - lb[n * (size_t)(l + 1) + i]);
+            float numerator = n1 > n2 ? n1 : n2;
+            float d1 = fabsf(la[n * (size_t)(l + 2) + i]), d2 = fabsf(lb[n * (size_t)(l + 2) + i]);
+            float denominator = d1 > d2 ? d1 : d2;
+            if (denominator < 1e-5f)
+                denominator = 1e-5f;
+            float contrast = numerator / denominator;
+            factor += contrast * f_freq[l] * mask(contrast * csf(cpd[l], adapt));
+            sum_contrast += contrast;
+        }
+        if (sum_contrast < 1e-5f)
+            sum_contrast = 1e-5f;
+        factor /= sum_contrast;
+        factor = factor < 1.0f ? 1.0f : (factor > 10.0f ? 10.0f : factor);
+        float delta = fabsf(la[i] - lb[i]);
+        bool pass = delta <= factor * tvi(adapt);
+        if (!o->luminance_only) {
+            float color_scale = adapt < 10.0f ? 0.0f : (float)o->color_factor;
+            float x, y, z, aa, ab, ba, bb;
+            adobe_rgb_to_xyz(linear[p[0]], linear[p[1]], linear[p[2]], &x, &y, &z);
+            xyz_to_ab(x, y, z, &aa, &ab);
+            adobe_rgb_to_xyz(linear[q[0]], linear[q[1]], linear[q[2]], &x, &y, &z);
+            xyz_to_ab(x, y, z, &ba, &bb);
+            float da = aa - ba, db = ab - bb;
+            if ((da * da + db * db) * color_scale > factor)
+                pass = false;
+        }
+        failed += !pass;
+    }
+    free(buf);
+    out->failing_pixels = failed;
+    out->pass = failed < o->threshold_pixels;
+    return true;
+}

@@ -1,0 +1,436 @@
+/* Object Space Lighting (thesis OSLProg, chapters 2.1.1 and 3.1.2):
+ *  1. texture generation: each model rasterized in UV space into object-space
+ *     position and normal textures (once per model and tile size);
+ *  2. lighting: a compute pass shades the texels of the objects due this
+ *     frame into one shared atlas, one tile per instance;
+ *  3. rasterization: every object drawn sampling its tile.
+ * Beyond the thesis: osl.resolution "auto" sizes each tile from the object's
+ * size on screen, and osl.reshade "touched" reshades only objects a moving
+ * light reaches (see daemon/osl_schedule.h). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "daemon/gpu/glutil.h"
+#include "common/log.h"
+#include "daemon/techniques/osl/osl_atlas.h"
+#include "daemon/techniques/osl/osl_schedule.h"
+#include "daemon/techniques/technique.h"
+
+enum { SECTION_LIGHTING, SECTION_RASTER };
+static const char *const sections[] = {"lighting", "raster", NULL};
+
+/* Atlas memory ceiling; the device's texture size limit applies as well. */
+static const double OSL_MAX_ATLAS_BYTES = 1024.0 * 1024.0 * 1024.0;
+
+struct osl {
+    GLuint texgen_prog;
+    struct scene_program light, draw;
+    GLint work_count_loc, groups_x_loc; /* the lighting pass's per-frame uniforms */
+    GLuint position_tex[SCENE_MESH_COUNT], normal_tex[SCENE_MESH_COUNT];
+    int base_size[SCENE_MESH_COUNT]; /* level 0 edge of each mesh's textures */
+    GLuint atlas, tile_buffer, work_buffer;
+    int atlas_w, atlas_h;
+    int groups_x_max;
+    struct osl_tile *tiles;
+    struct osl_schedule schedule;
+    struct osl_work *plan;
+    GLuint *work; /* 4 uints per planned object */
+    int64_t *rows;
+    bool shaded_once;
+
+    /* Figures for timed frames (frame >= 1). */
+    int timed_frames;
+    double reshaded_sum, texels_sum;
+    int reshaded_max;
+    double texels_max;
+    int initial_objects;
+    double initial_texels;
+    int frames; /* timed frames of the job */
+};
+
+static int log2i(int v)
+{
+    int l = 0;
+    while ((1 << (l + 1)) <= v)
+        l++;
+    return l;
+}
+
+static bool check_limits(struct osl *o, const struct job_spec *spec, int *max_tex,
+                         char *err, size_t errlen)
+{
+    GLint size[2], count[2], invocations = 0, images = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, max_tex);
+    glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_SIZE, 0, &size[0]);
+    glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_SIZE, 1, &size[1]);
+    glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &count[0]);
+    glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 1, &count[1]);
+    glGetIntegerv(GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS, &invocations);
+    glGetIntegerv(GL_MAX_COMPUTE_IMAGE_UNIFORMS, &images);
+    if (size[0] < 8 || size[1] < 8 || invocations < 64 || images < 1) {
+        snprintf(err, errlen, "osl: the compute limits of this device (work group "
+                 "%dx%d, %d invocations, %d images) are below the 8x8 groups and one "
+                 "image the lighting pass needs", size[0], size[1], invocations, images);
+        return false;
+    }
+    int largest = spec->osl.resolution ? spec->osl.resolution : OSL_TILE_MAX;
+    if (largest > *max_tex) {
+        snprintf(err, errlen, "osl.resolution %d exceeds GL_MAX_TEXTURE_SIZE %d",
+                 largest, *max_tex);
+        return false;
+    }
+    o->groups_x_max = count[0];
+    /* Worst case: every object shaded in one dispatch. */
+    double blocks = 0;
+    for (int i = 0; i < o->schedule.count; i++)
+        blocks += (double)(o->tiles[i].size / 8) * (o->tiles[i].size / 8);
+    if (blocks > (double)count[0] * count[1]) {
+        snprintf(err, errlen, "osl: %.0f work groups exceed this device's compute "
+                 "limit of %dx%d", blocks, count[0], count[1]);
+        return false;
+    }
+    return true;
+}
+
+static bool choose_tiles(struct osl *o, const struct technique_ctx *ctx, int max_tex,
+                         char *err, size_t errlen)
+{
+    const struct scene *s = ctx->scene;
+    int n = s->instance_count;
+    int *sizes = malloc((size_t)n * sizeof(int));
+    if (!sizes) {
+        snprintf(err, errlen, "out of memory");
+        return false;
+    }
+    for (int i = 0; i < n; i++) {
+        if (ctx->spec->osl.resolution) {
+            sizes[i] = ctx->spec->osl.resolution;
+            continue;
+        }
+        double ppu = scene_projected_diameter(s, i) / (2.0 * scene_instance_bound(s, i));
+        const struct mesh *m = &s->meshes[s->instances[i].mesh];
+        sizes[i] = osl_auto_tile_size(ppu, m->uv_per_unit / s->instances[i].scale,
+                                      ctx->spec->osl.texel_density);
+    }
+    bool ok = osl_atlas_pack(sizes, n, max_tex, OSL_MAX_ATLAS_BYTES, o->tiles, &o->atlas_w,
+                             &o->atlas_h, err, errlen);
+    free(sizes);
+    return ok;
+}
+
+static bool generate_textures(struct osl *o, const struct technique_ctx *ctx)
+{
+    const struct scene *s = ctx->scene;
+    GLuint fbo;
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glUseProgram(o->texgen_prog);
+    static const GLenum bufs[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, bufs);
+    bool ok = true;
+    for (int m = 0; m < SCENE_MESH_COUNT && ok; m++) {
+        int base = 0, smallest = OSL_TILE_MAX;
+        for (int i = 0; i < s->instance_count; i++)
+            if ((int)s->instances[i].mesh == m) {
+                if (o->tiles[i].size > base)
+                    base = o->tiles[i].size;
+                if (o->tiles[i].size < smallest)
+                    smallest = o->tiles[i].size;
+            }
+        if (!base)
+            continue;
+        o->base_size[m] = base;
+        int levels = log2i(base) - log2i(smallest) + 1;
+        glGenTextures(1, &o->position_tex[m]);
+        glGenTextures(1, &o->normal_tex[m]);
+        GLuint texs[2] = {o->position_tex[m], o->normal_tex[m]};
+        for (int t = 0; t < 2; t++) {
+            glBindTexture(GL_TEXTURE_2D, texs[t]);
+            glTexStorage2D(GL_TEXTURE_2D, levels, GL_RGBA32F, base, base);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST_MIPMAP_NEAREST);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        }
+        /* One rasterization per tile size in use: a level is its own UV-space
+         * render, never a filtered copy, so every texel is an exact sample. */
+        for (int l = 0; l < levels && ok; l++) {
+            int size = base >> l;
+            bool used = false;
+            for (int i = 0; i < s->instance_count && !used; i++)
+                used = (int)s->instances[i].mesh == m && o->tiles[i].size == size;
+            if (!used)
+                continue;
+            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texs[0], l);
+            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, texs[1], l);
+            ok = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+            glViewport(0, 0, size, size);
+            glClearColor(0, 0, 0, 0);
+            glClear(GL_COLOR_BUFFER_BIT);
+            glBindVertexArray(ctx->gpu->vao[m]);
+            glDrawElements(GL_TRIANGLES, (GLsizei)s->meshes[m].index_count, GL_UNSIGNED_INT, NULL);
+        }
+    }
+    glBindVertexArray(0);
+    glDeleteFramebuffers(1, &fbo);
+    return ok;
+}
+
+static void osl_destroy(void *state);
+
+static bool osl_create(const struct technique_ctx *ctx, void **state, char *err,
+                       size_t errlen)
+{
+    const struct scene *s = ctx->scene;
+    int n = s->instance_count;
+    struct osl *o = calloc(1, sizeof(*o));
+    if (!o)
+        goto oom;
+    *state = o;
+    o->tiles = calloc((size_t)n, sizeof(*o->tiles));
+    o->plan = calloc((size_t)n, sizeof(*o->plan));
+    o->work = calloc((size_t)n * 4, sizeof(GLuint));
+    o->frames = ctx->spec->frames;
+    double *dist = calloc((size_t)n, sizeof(double));
+    if (!o->tiles || !o->plan || !o->work || !dist) {
+        free(dist);
+        goto oom;
+    }
+    for (int i = 0; i < n; i++)
+        dist[i] = scene_instance_distance(s, i);
+    bool sched = osl_schedule_init(&o->schedule, dist, n, ctx->spec->async_distance);
+    free(dist);
+    o->rows = calloc((size_t)o->schedule.max_period, sizeof(int64_t));
+    if (!sched || !o->rows)
+        goto oom;
+
+    int max_tex = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
+    if (!choose_tiles(o, ctx, max_tex, err, errlen) ||
+        !check_limits(o, ctx->spec, &max_tex, err, errlen))
+        goto fail;
+
+    const struct gl_stage texgen[] = {
+        {GL_VERTEX_SHADER, {"osl_texgen.vert"}},
+        {GL_FRAGMENT_SHADER, {"osl_texgen.frag"}},
+    };
+    const struct gl_stage light[] = {{GL_COMPUTE_SHADER, {"scene_common.glsl", "osl_light.comp"}}};
+    const struct gl_stage draw[] = {
+        {GL_VERTEX_SHADER, {"scene_common.glsl", "osl_draw.vert"}},
+        {GL_FRAGMENT_SHADER, {"osl_draw.frag"}},
+    };
+    GLuint light_prog = 0, draw_prog = 0;
+    if (!(o->texgen_prog = gl_program_build("osl texgen", texgen, 2, NULL, err, errlen)) ||
+        !(light_prog = gl_program_build("osl lighting", light, 1, NULL, err, errlen)) ||
+        !(draw_prog = gl_program_build("osl draw", draw, 2, NULL, err, errlen))) {
+        glDeleteProgram(light_prog);
+        goto fail;
+    }
+    o->light = gpu_scene_program(ctx->gpu, light_prog);
+    o->draw = gpu_scene_program(ctx->gpu, draw_prog);
+    o->work_count_loc = glGetUniformLocation(light_prog, "u_work_count");
+    o->groups_x_loc = glGetUniformLocation(light_prog, "u_groups_x");
+    /* Texture units never change: position and normal of mesh m on units
+     * 1 + 2m and 2 + 2m for the lighting pass, the atlas on unit 0. */
+    for (int m = 0; m < SCENE_MESH_COUNT; m++) {
+        char name[32];
+        snprintf(name, sizeof(name), "u_position[%d]", m);
+        glProgramUniform1i(light_prog, glGetUniformLocation(light_prog, name), 1 + m * 2);
+        snprintf(name, sizeof(name), "u_normal[%d]", m);
+        glProgramUniform1i(light_prog, glGetUniformLocation(light_prog, name), 2 + m * 2);
+    }
+    glProgramUniform1i(draw_prog, glGetUniformLocation(draw_prog, "u_atlas"), 0);
+
+    if (!generate_textures(o, ctx)) {
+        snprintf(err, errlen, "osl: texture generation framebuffer incomplete");
+        goto fail;
+    }
+    glGenTextures(1, &o->atlas);
+    glBindTexture(GL_TEXTURE_2D, o->atlas);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA8, o->atlas_w, o->atlas_h);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glProgramUniform2f(o->draw.prog, glGetUniformLocation(o->draw.prog, "u_atlas_size"),
+                       (float)o->atlas_w, (float)o->atlas_h);
+
+    GLint *tile_data = calloc((size_t)n * 4, sizeof(GLint));
+    if (!tile_data)
+        goto oom;
+    for (int i = 0; i < n; i++) {
+        int m = s->instances[i].mesh;
+        tile_data[i * 4 + 0] = o->tiles[i].x;
+        tile_data[i * 4 + 1] = o->tiles[i].y;
+        tile_data[i * 4 + 2] = o->tiles[i].size;
+        tile_data[i * 4 + 3] = log2i(o->base_size[m]) - log2i(o->tiles[i].size);
+    }
+    glGenBuffers(1, &o->tile_buffer);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, o->tile_buffer);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)((size_t)n * 4 * sizeof(GLint)),
+                 tile_data, GL_STATIC_DRAW);
+    free(tile_data);
+    glGenBuffers(1, &o->work_buffer);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, o->work_buffer);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)((size_t)n * 4 * sizeof(GLuint)),
+                 NULL, GL_STREAM_DRAW);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    return true;
+oom:
+    snprintf(err, errlen, "osl: out of memory");
+fail:
+    osl_destroy(o);
+    *state = NULL;
+    return false;
+}
+
+/* Dispatches the lighting pass for the planned objects. Returns texels shaded. */
+static double light_pass(struct osl *o, const struct technique_ctx *ctx, int64_t frame,
+                         int count)
+{
+    int rows = 1;
+    uint32_t blocks = 0;
+    double texels = 0;
+    for (int k = 0; k < count; k++) {
+        int i = o->plan[k].instance, per_row = o->tiles[i].size / 8;
+        int row = (int)(frame - o->plan[k].time);
+        if (row + 1 > rows)
+            rows = row + 1;
+        o->work[k * 4 + 0] = (GLuint)i;
+        o->work[k * 4 + 1] = (GLuint)row;
+        o->work[k * 4 + 2] = blocks;
+        o->work[k * 4 + 3] = (GLuint)per_row;
+        blocks += (uint32_t)(per_row * per_row);
+        texels += (double)o->tiles[i].size * o->tiles[i].size;
+    }
+    for (int r = 0; r < rows; r++)
+        o->rows[r] = frame - r;
+    gpu_scene_set_light_rows(ctx->gpu, o->rows, rows);
+
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, o->work_buffer);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)((size_t)count * 4 * sizeof(GLuint)),
+                 o->work, GL_STREAM_DRAW);
+    gpu_scene_bind(ctx->gpu, &o->light);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, o->tile_buffer);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, o->work_buffer);
+    glBindImageTexture(0, o->atlas, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
+    for (int m = 0; m < SCENE_MESH_COUNT; m++) {
+        glActiveTexture(GL_TEXTURE1 + m * 2);
+        glBindTexture(GL_TEXTURE_2D, o->position_tex[m]);
+        glActiveTexture(GL_TEXTURE2 + m * 2);
+        glBindTexture(GL_TEXTURE_2D, o->normal_tex[m]);
+    }
+    glActiveTexture(GL_TEXTURE0);
+    uint32_t gx = blocks < (uint32_t)o->groups_x_max ? blocks : (uint32_t)o->groups_x_max;
+    uint32_t gy = (blocks + gx - 1) / gx;
+    glUniform1i(o->work_count_loc, count);
+    glUniform1i(o->groups_x_loc, (GLint)gx);
+    glDispatchCompute(gx, gy, 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    return texels;
+}
+
+static bool osl_render(void *state, const struct technique_ctx *ctx, int64_t frame,
+                       char *err, size_t errlen)
+{
+    (void)err, (void)errlen;
+    struct osl *o = state;
+    int count = osl_schedule_plan(&o->schedule, ctx->scene, frame, !o->shaded_once,
+                                  ctx->spec->osl.reshade, o->plan);
+    double texels = count ? light_pass(o, ctx, frame, count) : 0.0;
+    if (!o->shaded_once) {
+        o->initial_objects = count;
+        o->initial_texels = texels;
+    }
+    if (frame >= 1 && frame <= o->frames) {
+        o->timed_frames++;
+        /* The first frame drawn shades everything once; that is set-up, reported
+         * apart, unless there was no warm-up to absorb it. */
+        o->reshaded_sum += count;
+        o->texels_sum += texels;
+        if (count > o->reshaded_max)
+            o->reshaded_max = count;
+        if (texels > o->texels_max)
+            o->texels_max = texels;
+    }
+    o->shaded_once = true;
+
+    gpu_timer_section(ctx->timer, SECTION_RASTER);
+    glEnable(GL_DEPTH_TEST);
+    glEnable(GL_CULL_FACE);
+    glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    gpu_scene_bind(ctx->gpu, &o->draw);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, o->tile_buffer);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, o->atlas);
+    gpu_scene_draw(ctx->gpu, &o->draw);
+    return true;
+}
+
+static json_t *osl_describe(void *state)
+{
+    struct osl *o = state;
+    int n = o->schedule.count;
+    json_t *tiles = json_object(), *periods = json_object();
+    double tile_texels = 0;
+    for (int i = 0; i < n; i++) {
+        char key[16];
+        snprintf(key, sizeof(key), "%d", o->tiles[i].size);
+        json_t *c = json_object_get(tiles, key);
+        json_object_set_new(tiles, key, json_integer(c ? json_integer_value(c) + 1 : 1));
+        snprintf(key, sizeof(key), "%d", o->schedule.period[i]);
+        c = json_object_get(periods, key);
+        json_object_set_new(periods, key, json_integer(c ? json_integer_value(c) + 1 : 1));
+        tile_texels += (double)o->tiles[i].size * o->tiles[i].size;
+    }
+    double frames = o->timed_frames ? o->timed_frames : 1;
+    double texgen_bytes = 0;
+    for (int m = 0; m < SCENE_MESH_COUNT; m++)
+        texgen_bytes += o->base_size[m] ? 2.0 * 16.0 * o->base_size[m] * o->base_size[m] * 4.0 / 3.0 : 0;
+    return json_pack(
+        "{s:{s:f, s:i}, s:{s:f, s:f, s:f}, s:{s:i, s:i, s:f, s:f, s:f}, s:o, s:o, s:{s:i, s:f}, s:f}",
+        "objects_reshaded_per_frame", "mean", o->reshaded_sum / frames, "max", o->reshaded_max,
+        "texels_shaded_per_frame", "mean", o->texels_sum / frames, "max", o->texels_max,
+        "total", o->texels_sum,
+        "atlas", "width", o->atlas_w, "height", o->atlas_h, "texels",
+        (double)o->atlas_w * o->atlas_h, "bytes", (double)o->atlas_w * o->atlas_h * 4.0,
+        "tile_texels", tile_texels,
+        "tiles_by_size", tiles, "objects_by_period", periods,
+        "initial_shading", "objects", o->initial_objects, "texels", o->initial_texels,
+        "texgen_bytes", texgen_bytes);
+}
+
+static void osl_destroy(void *state)
+{
+    struct osl *o = state;
+    if (!o)
+        return;
+    glDeleteProgram(o->texgen_prog);
+    glDeleteProgram(o->light.prog);
+    glDeleteProgram(o->draw.prog);
+    glDeleteTextures(SCENE_MESH_COUNT, o->position_tex);
+    glDeleteTextures(SCENE_MESH_COUNT, o->normal_tex);
+    glDeleteTextures(1, &o->atlas);
+    glDeleteBuffers(1, &o->tile_buffer);
+    glDeleteBuffers(1, &o->work_buffer);
+    osl_schedule_finish(&o->schedule);
+    free(o->tiles);
+    free(o->plan);
+    free(o->work);
+    free(o->rows);
+    free(o);
+}
+
+const struct technique technique_osl = {
+    .name = "osl",
+    .summary = "object space lighting: texgen, compute lighting into a shared atlas, "
+               "rasterization sampling it; async shading by camera distance",
+    .sections = sections,
+    .create = osl_create,
+    .render = osl_render,
+    .describe = osl_describe,
+    .destroy = osl_destroy,
+};

@@ -1,0 +1,103 @@
+#include "daemon/techniques/osl/osl_schedule.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+int osl_period(double distance, double async_distance)
+{
+    if (async_distance <= 0.0)
+        return 1;
+    double p = floor(distance / async_distance) + 1.0;
+    return p > 1e6 ? 1000000 : (int)p;
+}
+
+bool osl_schedule_init(struct osl_schedule *s, const double *distances, int count,
+                       double async_distance)
+{
+    memset(s, 0, sizeof(*s));
+    s->period = calloc((size_t)count, sizeof(int));
+    s->offset = calloc((size_t)count, sizeof(int));
+    if (!s->period || !s->offset) {
+        osl_schedule_finish(s);
+        return false;
+    }
+    s->count = count;
+    s->max_period = 1;
+    for (int i = 0; i < count; i++) {
+        s->period[i] = osl_period(distances[i], async_distance);
+        if (s->period[i] > s->max_period)
+            s->max_period = s->period[i];
+    }
+    /* Round-robin offsets within each period group: a group of n objects with
+     * period p reshades about n/p of them each frame. */
+    for (int i = 0; i < count; i++) {
+        int seen = 0;
+        for (int j = 0; j < i; j++)
+            seen += s->period[j] == s->period[i];
+        s->offset[i] = seen % s->period[i];
+    }
+    return true;
+}
+
+void osl_schedule_finish(struct osl_schedule *s)
+{
+    if (!s)
+        return;
+    free(s->period);
+    free(s->offset);
+    memset(s, 0, sizeof(*s));
+}
+
+int64_t osl_schedule_last(const struct osl_schedule *s, int i, int64_t frame)
+{
+    int64_t p = s->period[i];
+    int64_t m = (frame + s->offset[i]) % p;
+    if (m < 0)
+        m += p;
+    return frame - m;
+}
+
+bool osl_schedule_due(const struct osl_schedule *s, int i, int64_t frame)
+{
+    return osl_schedule_last(s, i, frame) == frame;
+}
+
+bool osl_touched(const struct scene *scene, int i, int64_t frame)
+{
+    if (!scene->spec.dynamic || scene->spec.light_speed <= 0)
+        return false;
+    const float *c = scene->instances[i].pos;
+    float bound = scene_instance_bound(scene, i);
+    for (int l = 0; l < scene->light_count; l++) {
+        float p[3];
+        scene_light_position(scene, l, frame, p);
+        float d[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+        float reach = scene->lights[l].radius + bound;
+        if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < reach * reach)
+            return true;
+    }
+    return false;
+}
+
+int osl_schedule_plan(const struct osl_schedule *s, const struct scene *scene,
+                      int64_t frame, bool initial, enum osl_reshade mode,
+                      struct osl_work *out)
+{
+    int n = 0;
+    for (int i = 0; i < s->count; i++) {
+        if (initial) {
+            out[n].instance = i;
+            out[n++].time = osl_schedule_last(s, i, frame);
+            continue;
+        }
+        if (!scene->spec.dynamic || scene->spec.light_speed <= 0 || !osl_schedule_due(s, i, frame))
+            continue;
+        if (mode == OSL_RESHADE_TOUCHED && !osl_touched(scene, i, frame) &&
+            !osl_touched(scene, i, frame - s->period[i]))
+            continue;
+        out[n].instance = i;
+        out[n++].time = frame;
+    }
+    return n;
+}

@@ -1,0 +1,172 @@
+"""Shared helpers for the end-to-end tests: a daemon on a free loopback
+port, HTTP calls, and PNG checks through tests/tools/png-tool. Standard library
+only, so the tests run on a bare Debian python3."""
+
+import ctypes.util
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.error
+import urllib.request
+
+SHADEBENCHD = os.environ.get("SHADEBENCHD", "./shadebenchd")
+PNG_TOOL = os.environ.get("PNG_TOOL", "./tests/tools/png-tool")
+
+failures = 0
+checks = 0
+
+
+def skip_without_egl():
+    # Skipping is allowed only where EGL is entirely absent; .ci/run counts a
+    # skip as a failure anyway.
+    if ctypes.util.find_library("EGL") is None:
+        print("SKIP: no libEGL on this machine")
+        sys.exit(77)
+
+
+def check(cond, what):
+    global failures, checks
+    checks += 1
+    if not cond:
+        failures += 1
+        print("FAIL:", what, flush=True)
+    return cond
+
+
+def finish(name):
+    print("%s: %d checks, %d failed" % (name, checks, failures))
+    sys.exit(1 if failures else 0)
+
+
+class Daemon:
+    """shadebenchd on 127.0.0.1 with a free port and its own state dir."""
+
+    def __init__(self, *args, env=None):
+        self.tmp = tempfile.mkdtemp(prefix="shadebench-test-")
+        self.state = os.path.join(self.tmp, "state")
+        port_file = os.path.join(self.tmp, "port")
+        self.log_path = os.path.join(self.tmp, "daemon.log")
+        self.log = open(self.log_path, "w")
+        full_env = dict(os.environ)
+        full_env.update(env or {})
+        self.proc = subprocess.Popen(
+            [SHADEBENCHD, "--listen", "127.0.0.1:0", "--port-file", port_file,
+             "--state-dir", self.state] + list(args),
+            stdout=self.log, stderr=subprocess.STDOUT, env=full_env)
+        deadline = time.time() + 60
+        while not os.path.exists(port_file):
+            if self.proc.poll() is not None or time.time() > deadline:
+                self.dump_log()
+                raise RuntimeError("shadebenchd did not start")
+            time.sleep(0.05)
+        with open(port_file) as f:
+            self.port = int(f.read())
+        self.base = "http://127.0.0.1:%d" % self.port
+
+    def dump_log(self):
+        if not self.log.closed:
+            self.log.flush()
+        with open(self.log_path) as f:
+            sys.stdout.write(f.read()[-6000:])
+
+    def alive(self):
+        return self.proc.poll() is None
+
+    def stop(self):
+        """SIGTERM; returns the exit code (0 expected)."""
+        if self.proc.poll() is None:
+            self.proc.send_signal(signal.SIGTERM)
+            try:
+                self.proc.wait(timeout=60)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+        self.log.close()
+        return self.proc.returncode
+
+    def cleanup(self, keep=False):
+        if not keep:
+            shutil.rmtree(self.tmp, ignore_errors=True)
+
+    def request(self, method, path, body=None, headers=None, timeout=120):
+        data = body
+        if isinstance(body, (dict, list)):
+            data = json.dumps(body).encode()
+        elif isinstance(body, str):
+            data = body.encode()
+        req = urllib.request.Request(self.base + path, data=data, method=method,
+                                     headers=headers or {})
+        try:
+            with urllib.request.urlopen(req, timeout=timeout) as resp:
+                return resp.status, dict(resp.headers), resp.read()
+        except urllib.error.HTTPError as e:
+            return e.code, dict(e.headers), e.read()
+
+    def json(self, method, path, body=None, **kw):
+        status, headers, raw = self.request(method, path, body, **kw)
+        try:
+            return status, json.loads(raw)
+        except ValueError:
+            return status, {"_raw": raw.decode(errors="replace")}
+
+    def submit(self, job):
+        status, body = self.json("POST", "/v1/jobs", job)
+        if status != 202:
+            raise RuntimeError("submit failed: %d %s" % (status, body))
+        return body["id"]
+
+    def wait(self, job_id, timeout=600):
+        deadline = time.time() + timeout
+        while True:
+            status, body = self.json("GET", "/v1/jobs/%s?wait=60" % job_id)
+            if body.get("status") not in ("queued", "running") or time.time() > deadline:
+                return body
+
+    def run(self, job):
+        return self.wait(self.submit(job))
+
+    def wait_sweep(self, sweep_id, timeout=900):
+        deadline = time.time() + timeout
+        while True:
+            status, body = self.json("GET", "/v1/sweeps/%s?wait=30" % sweep_id)
+            if body.get("status") not in ("queued", "running") or time.time() > deadline:
+                return body
+
+    def download(self, path, dest):
+        status, _, raw = self.request("GET", path)
+        if status == 200:
+            with open(dest, "wb") as f:
+                f.write(raw)
+        return status
+
+
+def rejects(d, body, field, status=400, what=None):
+    """POST body as a job; it must be refused with status, naming field."""
+    code, reply = d.json("POST", "/v1/jobs", body)
+    err = reply.get("error", {}) if isinstance(reply, dict) else {}
+    return check(code == status and err.get("field") == field and len(err.get("message", "")) > 5,
+                 "%s -> %d naming %r (got %d %s)" % (what or body, status, field, code, reply))
+
+
+def stop_and_check(d):
+    """SIGTERM the daemon, which must exit 0; keep its files if anything failed."""
+    code = d.stop()
+    check(code == 0, "daemon exits 0 on SIGTERM (got %s)" % code)
+    if failures:
+        d.dump_log()
+    d.cleanup(keep=failures > 0)
+
+
+def png_info(path):
+    out = subprocess.run([PNG_TOOL, "info", path], capture_output=True, text=True)
+    return json.loads(out.stdout) if out.returncode == 0 else None
+
+
+def png_diff(a, b):
+    out = subprocess.run([PNG_TOOL, "diff", a, b], capture_output=True, text=True)
+    return json.loads(out.stdout) if out.returncode == 0 else None

@@ -1,0 +1,109 @@
+#include <string.h>
+
+#include "daemon/jobs/job_spec.h"
+#include "tests/unit/check.h"
+
+static const char *const techniques[] = {"forward", "unlit", "osl", NULL};
+
+static bool parse(const char *text, struct job_spec *spec, struct job_error *err)
+{
+    return job_spec_parse_text(text, strlen(text), techniques, spec, err);
+}
+
+/* The request is rejected, and the error names field. */
+static void rejects(const char *text, const char *field)
+{
+    struct job_spec spec;
+    struct job_error err;
+    bool ok = parse(text, &spec, &err);
+    CHECK(!ok);
+    CHECK(strcmp(err.field, field) == 0);
+    CHECK(err.message[0] != '\0');
+    if (ok || strcmp(err.field, field) != 0)
+        fprintf(stderr, "  for %s: got field '%s' (%s)\n", text, err.field, err.message);
+}
+
+int main(void)
+{
+    struct job_spec spec;
+    struct job_error err;
+
+    CHECK(parse("{}", &spec, &err));
+    CHECK(strcmp(spec.technique, "forward") == 0);
+    CHECK(spec.frames == 300 && spec.warmup_frames == 10 && spec.capture_interval == 0);
+    CHECK(spec.scene.width == 1080 && spec.scene.height == 720 && spec.scene.lights == 10);
+    CHECK(!spec.scene.dynamic && spec.osl.resolution == 256);
+
+    CHECK(parse("{\"technique\":\"osl\",\"frames\":40,\"warmup_frames\":0,"
+                "\"capture_interval\":20,\"async_distance\":20,"
+                "\"scene\":{\"preset\":\"grid\",\"lights\":3,\"dynamic\":true,"
+                "\"width\":320,\"height\":240,\"sphere_segments\":16},"
+                "\"osl\":{\"resolution\":\"auto\",\"texel_density\":2,\"reshade\":\"all\"}}",
+                &spec, &err));
+    CHECK(strcmp(spec.technique, "osl") == 0 && spec.frames == 40 && spec.warmup_frames == 0);
+    CHECK(spec.async_distance == 20.0 && spec.scene.dynamic && spec.scene.lights == 3);
+    CHECK(spec.osl.resolution == 0 && spec.osl.texel_density == 2.0);
+    CHECK(spec.osl.reshade == OSL_RESHADE_ALL && spec.scene.sphere_segments == 16);
+    CHECK(job_spec_capture_count(&spec) == 2);
+    CHECK(job_spec_is_capture_frame(&spec, 20) && job_spec_is_capture_frame(&spec, 40));
+    CHECK(!job_spec_is_capture_frame(&spec, 10) && !job_spec_is_capture_frame(&spec, 0));
+
+    /* The spec as understood round-trips through JSON. */
+    json_t *j = job_spec_to_json(&spec);
+    char *text = json_dumps(j, 0);
+    struct job_spec again;
+    CHECK(parse(text, &again, &err));
+    CHECK(memcmp(&again, &spec, sizeof(spec)) == 0);
+    free(text);
+    json_decref(j);
+
+    CHECK(parse("{\"frames\":300.0}", &spec, &err) && spec.frames == 300);
+    CHECK(parse("{\"repeat\":5}", &spec, &err) && spec.repeat == 5 && !spec.repeat_auto);
+    CHECK(parse("{\"repeat\":{\"auto\":true,\"max\":12}}", &spec, &err) && spec.repeat == 12 &&
+          spec.repeat_auto && job_spec_runs(&spec) == 12);
+    CHECK(parse("{\"repeat\":{\"auto\":true}}", &spec, &err) && spec.repeat == 30);
+    rejects("{\"repeat\":0}", "repeat");
+    rejects("{\"repeat\":\"many\"}", "repeat");
+    rejects("{\"repeat\":{\"auto\":false}}", "repeat.auto");
+    rejects("{\"repeat\":{\"auto\":true,\"max\":2}}", "repeat.max");
+    rejects("{\"repeat\":{\"atuo\":true}}", "repeat.atuo");
+
+    rejects("", "body");
+    rejects("{", "body");
+    rejects("[1,2]", "body");
+    rejects("{\"frames\":1,\"frames\":2}", "body");
+    rejects("{\"frame\":10}", "frame");
+    rejects("{\"technique\":\"deferred\"}", "technique");
+    rejects("{\"technique\":3}", "technique");
+    rejects("{\"frames\":\"300\"}", "frames");
+    rejects("{\"frames\":0}", "frames");
+    rejects("{\"frames\":10.5}", "frames");
+    rejects("{\"frames\":2000000}", "frames");
+    rejects("{\"warmup_frames\":-1}", "warmup_frames");
+    rejects("{\"capture_interval\":-5}", "capture_interval");
+    rejects("{\"frames\":10,\"capture_interval\":11}", "capture_interval");
+    rejects("{\"frames\":100000,\"capture_interval\":1}", "capture_interval");
+    rejects("{\"async_distance\":-1}", "async_distance");
+    rejects("{\"async_distance\":\"far\"}", "async_distance");
+    rejects("{\"scene\":5}", "scene");
+    rejects("{\"scene\":{\"width\":8}}", "scene.width");
+    rejects("{\"scene\":{\"height\":9000}}", "scene.height");
+    rejects("{\"scene\":{\"lights\":-1}}", "scene.lights");
+    rejects("{\"scene\":{\"dynamic\":\"yes\"}}", "scene.dynamic");
+    rejects("{\"scene\":{\"preset\":\"sponza\"}}", "scene.preset");
+    rejects("{\"scene\":{\"sphere_segments\":15}}", "scene.sphere_segments");
+    rejects("{\"scene\":{\"widht\":300}}", "scene.widht");
+    rejects("{\"osl\":{\"resolution\":100}}", "osl.resolution");
+    rejects("{\"osl\":{\"resolution\":2048}}", "osl.resolution");
+    rejects("{\"osl\":{\"resolution\":\"high\"}}", "osl.resolution");
+    rejects("{\"osl\":{\"texel_density\":0}}", "osl.texel_density");
+    rejects("{\"osl\":{\"reshade\":\"some\"}}", "osl.reshade");
+    rejects("{\"osl\":{\"resolutoin\":256}}", "osl.resolutoin");
+
+    /* A typo gets a suggestion. */
+    parse("{\"frame\":10}", &spec, &err);
+    CHECK(strstr(err.message, "'frames'") != NULL);
+    parse("{\"scene\":{\"widht\":300}}", &spec, &err);
+    CHECK(strstr(err.message, "'scene.width'") != NULL);
+    return check_finish("test_job");
+}

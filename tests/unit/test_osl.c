@@ -1,0 +1,158 @@
+#include <stdlib.h>
+#include <string.h>
+
+#include "daemon/jobs/job_spec.h"
+#include "daemon/techniques/osl/osl_atlas.h"
+#include "daemon/techniques/osl/osl_schedule.h"
+#include "daemon/scene/scene.h"
+#include "tests/unit/check.h"
+
+static void check_packing(const int *sizes, int n, int w, int h, const struct osl_tile *t)
+{
+    for (int i = 0; i < n; i++) {
+        CHECK(t[i].size == sizes[i]);
+        CHECK(t[i].x >= 0 && t[i].y >= 0 && t[i].x + t[i].size <= w && t[i].y + t[i].size <= h);
+        CHECK(t[i].x % t[i].size == 0 && t[i].y % t[i].size == 0);
+        for (int j = i + 1; j < n; j++) {
+            bool apart = t[i].x + t[i].size <= t[j].x || t[j].x + t[j].size <= t[i].x ||
+                         t[i].y + t[i].size <= t[j].y || t[j].y + t[j].size <= t[i].y;
+            CHECK(apart);
+        }
+    }
+}
+
+static void test_atlas(void)
+{
+    enum { N = 512 };
+    int sizes[N];
+    struct osl_tile tiles[N];
+    int w, h;
+    char err[256];
+    for (int i = 0; i < N; i++)
+        sizes[i] = 256;
+    /* The thesis: 512 tiles of 256x256 = two 4096x4096 mega textures. */
+    CHECK(osl_atlas_pack(sizes, N, 16384, 1e12, tiles, &w, &h, err, sizeof(err)));
+    CHECK(w == 8192 && h == 4096);
+    check_packing(sizes, N, w, h, tiles);
+
+    /* Mixed sizes in scrambled order still pack tightly and never overlap. */
+    static const int pool[] = {8, 1024, 64, 16, 256, 32, 128, 8, 512};
+    double area = 0;
+    for (int i = 0; i < N; i++) {
+        sizes[i] = pool[(i * 7) % 9];
+        area += (double)sizes[i] * sizes[i];
+    }
+    CHECK(osl_atlas_pack(sizes, N, 16384, 1e12, tiles, &w, &h, err, sizeof(err)));
+    check_packing(sizes, N, w, h, tiles);
+    CHECK((double)w * h < 2 * area + 1);
+
+    /* Too big for the device, or for the memory limit: a clear failure. */
+    for (int i = 0; i < N; i++)
+        sizes[i] = 1024;
+    CHECK(!osl_atlas_pack(sizes, N, 16384, 1e12, tiles, &w, &h, err, sizeof(err)));
+    CHECK(strstr(err, "osl.resolution") != NULL);
+    for (int i = 0; i < N; i++)
+        sizes[i] = 256;
+    CHECK(!osl_atlas_pack(sizes, N, 4096, 1e12, tiles, &w, &h, err, sizeof(err)));
+    CHECK(!osl_atlas_pack(sizes, N, 16384, 64.0 * 1048576, tiles, &w, &h, err, sizeof(err)));
+    sizes[3] = 100;
+    CHECK(!osl_atlas_pack(sizes, N, 16384, 1e12, tiles, &w, &h, err, sizeof(err)));
+
+    /* Auto sizing: about one texel per pixel, powers of two, clamped. */
+    CHECK(osl_auto_tile_size(10.0, 1.0 / 10.0, 1.0) == 128);
+    CHECK(osl_auto_tile_size(10.0, 1.0 / 10.0, 2.0) == 256);
+    CHECK(osl_auto_tile_size(0.01, 1.0, 1.0) == OSL_TILE_MIN);
+    CHECK(osl_auto_tile_size(1e6, 1.0, 1.0) == OSL_TILE_MAX);
+    CHECK(osl_auto_tile_size(90.0, 1.0, 1.0) == 64);  /* log2(90) = 6.49 */
+    CHECK(osl_auto_tile_size(91.0, 1.0, 1.0) == 128); /* log2(91) = 6.51 */
+}
+
+static void test_schedule(void)
+{
+    /* Thesis 3: "if set to 10 ... an object 35 units away would update every 4th frame". */
+    CHECK(osl_period(35.0, 10.0) == 4);
+    CHECK(osl_period(9.9, 10.0) == 1);
+    CHECK(osl_period(10.0, 10.0) == 2);
+    CHECK(osl_period(55.0, 20.0) == 3);
+    CHECK(osl_period(1000.0, 0.0) == 1);
+
+    enum { N = 30 };
+    double dist[N];
+    for (int i = 0; i < N; i++)
+        dist[i] = i < 10 ? 5.0 : (i < 20 ? 25.0 : 45.0); /* periods 1, 2, 3 at d = 20 */
+    struct osl_schedule s;
+    CHECK(osl_schedule_init(&s, dist, N, 20.0));
+    CHECK(s.max_period == 3);
+    for (int64_t k = -7; k < 40; k++) {
+        int due = 0;
+        for (int i = 0; i < N; i++) {
+            int64_t last = osl_schedule_last(&s, i, k);
+            CHECK(last <= k && k - last < s.period[i]);
+            CHECK(osl_schedule_due(&s, i, last));
+            CHECK(osl_schedule_due(&s, i, k) == (last == k));
+            due += osl_schedule_due(&s, i, k);
+        }
+        /* Staggered: 10 + 10/2 + 10/3 objects a frame, give or take one per group. */
+        CHECK(due >= 10 + 5 + 3 && due <= 10 + 5 + 4);
+    }
+    osl_schedule_finish(&s);
+}
+
+static void test_plan(void)
+{
+    struct job_spec spec;
+    job_spec_defaults(&spec);
+    struct scene scene;
+    CHECK(scene_create(&scene, &spec.scene));
+    int n = scene.instance_count;
+    double *dist = malloc((size_t)n * sizeof(double));
+    struct osl_work *plan = malloc((size_t)n * sizeof(*plan));
+    for (int i = 0; i < n; i++)
+        dist[i] = scene_instance_distance(&scene, i);
+
+    /* Static lights: one initial shading, then nothing. */
+    struct osl_schedule s0, s20;
+    CHECK(osl_schedule_init(&s0, dist, n, 0.0));
+    CHECK(osl_schedule_init(&s20, dist, n, 20.0));
+    CHECK(osl_schedule_plan(&s0, &scene, 1, true, OSL_RESHADE_TOUCHED, plan) == n);
+    for (int k = 2; k < 10; k++)
+        CHECK(osl_schedule_plan(&s0, &scene, k, false, OSL_RESHADE_ALL, plan) == 0);
+    scene_finish(&scene);
+
+    spec.scene.dynamic = true;
+    CHECK(scene_create(&scene, &spec.scene));
+    long touched0 = 0, all0 = 0, touched20 = 0;
+    for (int k = 1; k <= 60; k++) {
+        int t0 = osl_schedule_plan(&s0, &scene, k, false, OSL_RESHADE_TOUCHED, plan);
+        for (int j = 0; j < t0; j++) {
+            int i = plan[j].instance;
+            CHECK(plan[j].time == k);
+            CHECK(osl_touched(&scene, i, k) || osl_touched(&scene, i, k - 1));
+        }
+        touched0 += t0;
+        all0 += osl_schedule_plan(&s0, &scene, k, false, OSL_RESHADE_ALL, plan);
+        touched20 += osl_schedule_plan(&s20, &scene, k, false, OSL_RESHADE_TOUCHED, plan);
+    }
+    CHECK(all0 == 60L * n);           /* the thesis's every-object reshading */
+    CHECK(touched0 > 0 && touched0 < all0);
+    CHECK(touched20 < touched0);       /* async distance reshades less */
+
+    /* Initial shading at any frame uses each object's last due frame. */
+    int count = osl_schedule_plan(&s20, &scene, 100, true, OSL_RESHADE_TOUCHED, plan);
+    CHECK(count == n);
+    for (int j = 0; j < count; j++)
+        CHECK(plan[j].time == osl_schedule_last(&s20, plan[j].instance, 100));
+    osl_schedule_finish(&s0);
+    osl_schedule_finish(&s20);
+    scene_finish(&scene);
+    free(dist);
+    free(plan);
+}
+
+int main(void)
+{
+    test_atlas();
+    test_schedule();
+    test_plan();
+    return check_finish("test_osl");
+}

@@ -1,0 +1,126 @@
+#include <math.h>
+#include <string.h>
+
+#include "daemon/jobs/sweep_spec.h"
+#include "tests/unit/check.h"
+
+static const char *const techniques[] = {"forward", "unlit", "osl", NULL};
+
+static int calls;
+static double boundary;
+
+/* A synthetic monotone criterion: holds up to the boundary. */
+static int below_boundary(double v, void *ctx)
+{
+    (void)ctx;
+    calls++;
+    return v <= boundary;
+}
+
+static int abort_third(double v, void *ctx)
+{
+    (void)v, (void)ctx;
+    return ++calls >= 3 ? -1 : (calls == 1);
+}
+
+static bool parse(const char *text, struct sweep_spec *s, struct job_error *err)
+{
+    json_t *body = json_loads(text, 0, NULL);
+    bool ok = body && sweep_spec_parse(body, techniques, s, err);
+    json_decref(body);
+    return ok;
+}
+
+static void rejects(const char *text, const char *field)
+{
+    struct sweep_spec s;
+    struct job_error err;
+    bool ok = parse(text, &s, &err);
+    CHECK(!ok && strcmp(err.field, field) == 0);
+    if (ok || strcmp(err.field, field) != 0)
+        fprintf(stderr, "  for %s: got '%s' (%s)\n", text, err.field, err.message);
+    sweep_spec_finish(&s);
+}
+
+int main(void)
+{
+    struct bisect_result r;
+    /* Integer parameter: finds the boundary exactly, in about log2 probes. */
+    boundary = 37;
+    calls = 0;
+    sweep_bisect(0, 100, true, 20, below_boundary, NULL, &r);
+    CHECK(r.outcome == BISECT_BOUNDARY && r.value == 37 && r.first_failing == 38);
+    CHECK(r.probes == calls && r.probes <= 2 + 7);
+    /* Real-valued: within 1/1000 of the range. */
+    boundary = 0.4242;
+    sweep_bisect(0, 1, false, 40, below_boundary, NULL, &r);
+    CHECK(r.outcome == BISECT_BOUNDARY && r.value <= 0.4242 && 0.4242 - r.value <= 0.001);
+    /* Limited probes still give a value that holds. */
+    boundary = 37;
+    sweep_bisect(0, 100, true, 4, below_boundary, NULL, &r);
+    CHECK(r.probes == 4 && r.value <= 37 && r.first_failing > 37);
+    /* Holds everywhere, fails everywhere, aborted. */
+    boundary = 1000;
+    sweep_bisect(0, 100, true, 10, below_boundary, NULL, &r);
+    CHECK(r.outcome == BISECT_HOLDS_EVERYWHERE && r.value == 100 && r.probes == 2);
+    boundary = -1;
+    sweep_bisect(0, 100, true, 10, below_boundary, NULL, &r);
+    CHECK(r.outcome == BISECT_FAILS_EVERYWHERE && r.probes == 1);
+    calls = 0;
+    sweep_bisect(0, 100, true, 10, abort_third, NULL, &r);
+    CHECK(r.outcome == BISECT_ABORTED);
+
+    /* A two-parameter grid, row-major, with point defaults filled in. */
+    struct sweep_spec s;
+    struct job_error err;
+    CHECK(parse("{\"base\":{\"technique\":\"osl\",\"frames\":20},"
+                "\"vary\":{\"async_distance\":[0,5,10],\"scene.lights\":[4,8]}}", &s, &err));
+    CHECK(s.kind == SWEEP_VARY && s.npoints == 6 && s.nparams == 2);
+    json_t *values, *job = sweep_point_job(&s, 3, &values);
+    CHECK(json_integer_value(json_object_get(values, "async_distance")) == 5);
+    CHECK(json_integer_value(json_object_get(values, "scene.lights")) == 8);
+    CHECK(json_integer_value(json_object_get(json_object_get(job, "scene"), "lights")) == 8);
+    CHECK(strcmp(json_string_value(json_object_get(job, "reference")), "forward") == 0);
+    CHECK(json_integer_value(json_object_get(job, "capture_interval")) == 20);
+    json_decref(values);
+    json_decref(job);
+    sweep_spec_finish(&s);
+
+    /* find: numeric parameter, criterion parsed, probes built. */
+    CHECK(parse("{\"base\":{\"technique\":\"osl\"},\"find\":{\"param\":\"async_distance\","
+                "\"from\":0,\"to\":100,\"while\":\"ssim_min >= 0.95\"}}", &s, &err));
+    CHECK(s.kind == SWEEP_FIND && !s.integer && s.criterion == CRITERION_SSIM_MIN && s.threshold == 0.95);
+    json_t *result = json_pack("{s:{s:{s:f}}}", "quality", "worst_ssim_min", "value", 0.97);
+    CHECK(sweep_criterion_holds(&s, result));
+    json_decref(result);
+    result = json_pack("{s:{s:{s:f}}}", "quality", "worst_ssim_min", "value", 0.90);
+    CHECK(!sweep_criterion_holds(&s, result));
+    json_decref(result);
+    sweep_spec_finish(&s);
+    CHECK(parse("{\"base\":{},\"find\":{\"param\":\"scene.lights\",\"from\":1,\"to\":64,"
+                "\"while\":\"stable\"}}", &s, &err) && s.integer);
+    job = sweep_probe_job(&s, 17);
+    CHECK(json_object_get(job, "repeat") != NULL);
+    json_decref(job);
+    sweep_spec_finish(&s);
+
+    /* Bad input names the field. */
+    rejects("[]", "body");
+    rejects("{\"base\":{},\"vary\":{\"async_distance\":[1]},\"find\":{}}", "find");
+    rejects("{\"base\":{}}", "vary");
+    rejects("{\"base\":{\"frames\":0},\"vary\":{\"frames\":[1]}}", "base");
+    rejects("{\"base\":{},\"vary\":{\"scene.lightz\":[1,2]}}", "vary.scene.lightz");
+    rejects("{\"base\":{},\"vary\":{\"async_distance\":[]}}", "vary.async_distance");
+    rejects("{\"base\":{},\"vary\":{\"async_distance\":[0,\"far\"]}}", "vary.async_distance[1]");
+    rejects("{\"base\":{},\"vary\":{\"technique\":[\"forward\",\"deferred\"]}}", "vary.technique[1]");
+    rejects("{\"base\":{},\"vary\":{\"scene.lights\":[1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17],"
+            "\"async_distance\":[0,1,2,3,4,5,6,7,8,9,10,11,12,13,14,15]}}", "vary");
+    rejects("{\"base\":{},\"vary\":{\"a\":[1],\"b\":[2],\"c\":[3]}}", "vary");
+    rejects("{\"base\":{},\"find\":{\"param\":\"technique\",\"from\":0,\"to\":1,\"while\":\"pdiff_pass\"}}", "find.param");
+    rejects("{\"base\":{},\"find\":{\"param\":\"async_distance\",\"from\":5,\"to\":1,\"while\":\"pdiff_pass\"}}", "find.to");
+    rejects("{\"base\":{},\"find\":{\"param\":\"scene.lights\",\"from\":0.5,\"to\":9,\"while\":\"pdiff_pass\"}}", "find.from");
+    rejects("{\"base\":{},\"find\":{\"param\":\"async_distance\",\"from\":0,\"to\":9,\"while\":\"pretty\"}}", "find.while");
+    rejects("{\"base\":{},\"find\":{\"param\":\"scene.lights\",\"from\":0,\"to\":5000,\"while\":\"stable\"}}", "find.to");
+    rejects("{\"base\":{},\"vary\":{\"frames\":[1]},\"extra\":1}", "extra");
+    return check_finish("test_sweep");
+}

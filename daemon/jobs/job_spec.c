@@ -7,130 +7,6 @@
 #include <string.h>
 
 
-bool job_error_set(struct job_error *err, const char *field, const char *fmt, ...)
-{
-    snprintf(err->field, sizeof(err->field), "%s", field);
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err->message, sizeof(err->message), fmt, ap);
-    va_end(ap);
-    return false;
-}
-
-static size_t edit_distance(const char *a, const char *b)
-{
-    size_t la = strlen(a), lb = strlen(b);
-    if (la > 40 || lb > 40)
-        return 99;
-    size_t row[41];
-    for (size_t j = 0; j <= lb; j++)
-        row[j] = j;
-    for (size_t i = 1; i <= la; i++) {
-        size_t diag = row[0];
-        row[0] = i;
-        for (size_t j = 1; j <= lb; j++) {
-            size_t up = row[j];
-            size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
-            size_t best = diag + cost;
-            if (row[j] + 1 < best)
-                best = row[j] + 1;
-            if (row[j - 1] + 1 < best)
-                best = row[j - 1] + 1;
-            row[j] = best;
-            diag = up;
-        }
-    }
-    return row[lb];
-}
-
-/* Rejects keys not in known, suggesting the closest one for typos. */
-static bool check_keys(const json_t *obj, const char *prefix,
-                       const char *const *known, struct job_error *err)
-{
-    const char *key;
-    json_t *value;
-    json_object_foreach((json_t *)obj, key, value) {
-        bool found = false;
-        const char *closest = NULL;
-        size_t best = 3;
-        for (const char *const *k = known; *k; k++) {
-            if (strcmp(*k, key) == 0) {
-                found = true;
-                break;
-            }
-            size_t d = edit_distance(*k, key);
-            if (d < best) {
-                best = d;
-                closest = *k;
-            }
-        }
-        if (!found) {
-            char field[64];
-            snprintf(field, sizeof(field), "%s%.40s", prefix, key);
-            if (closest)
-                return job_error_set(err, field, "unknown field (did you mean '%s%s'?)",
-                            prefix, closest);
-            return job_error_set(err, field, "unknown field");
-        }
-    }
-    return true;
-}
-
-static bool get_int(const json_t *obj, const char *key, const char *field,
-                    long min, long max, int *out, struct job_error *err)
-{
-    json_t *v = json_object_get(obj, key);
-    if (!v)
-        return true;
-    /* Accept 300.0 from tools that write every number as a double, but never 300.5. */
-    double d;
-    if (json_is_integer(v))
-        d = (double)json_integer_value(v);
-    else if (json_is_real(v) && floor(json_real_value(v)) == json_real_value(v))
-        d = json_real_value(v);
-    else
-        return job_error_set(err, field, "must be an integer from %ld to %ld", min, max);
-    if (d < (double)min || d > (double)max)
-        return job_error_set(err, field, "must be an integer from %ld to %ld", min, max);
-    *out = (int)d;
-    return true;
-}
-
-static bool get_number(const json_t *obj, const char *key, const char *field,
-                       double min, double max, double *out,
-                       struct job_error *err)
-{
-    json_t *v = json_object_get(obj, key);
-    if (!v)
-        return true;
-    if (!json_is_number(v) || !isfinite(json_number_value(v)) ||
-        json_number_value(v) < min || json_number_value(v) > max)
-        return job_error_set(err, field, "must be a number from %g to %g", min, max);
-    *out = json_number_value(v);
-    return true;
-}
-
-static bool get_bool(const json_t *obj, const char *key, const char *field,
-                     bool *out, struct job_error *err)
-{
-    json_t *v = json_object_get(obj, key);
-    if (!v)
-        return true;
-    if (!json_is_boolean(v))
-        return job_error_set(err, field, "must be true or false");
-    *out = json_is_true(v);
-    return true;
-}
-
-static bool get_object(const json_t *obj, const char *key, const char *field,
-                       json_t **out, struct job_error *err)
-{
-    *out = json_object_get(obj, key);
-    if (*out && !json_is_object(*out))
-        return job_error_set(err, field, "must be an object");
-    return true;
-}
-
 /* A technique name from the registry; null gives "" where allowed. */
 static bool get_technique(const json_t *v, const char *field, const char *const *techniques,
                           bool nullable, char *out, size_t cap, struct job_error *err)
@@ -159,13 +35,7 @@ void job_spec_defaults(struct job_spec *out)
     out->warmup_frames = 10;
     out->capture_interval = 0;
     out->async_distance = 0.0;
-    snprintf(out->scene.preset, sizeof(out->scene.preset), "grid");
-    out->scene.lights = 10;
-    out->scene.dynamic = false;
-    out->scene.width = 1080;
-    out->scene.height = 720;
-    out->scene.sphere_segments = 32;
-    out->scene.light_speed = 1.0;
+    scene_spec_defaults(&out->scene);
     out->osl.resolution = 256;
     out->osl.texel_density = 1.0;
     out->osl.reshade = OSL_RESHADE_TOUCHED;
@@ -181,16 +51,16 @@ static bool parse_repeat(const json_t *v, struct job_spec *out, struct job_error
     if (json_is_object(v)) {
         static const char *const keys[] = {"auto", "max", NULL};
         out->repeat = 30;
-        if (!check_keys(v, "repeat.", keys, err) ||
-            !get_bool(v, "auto", "repeat.auto", &out->repeat_auto, err) ||
-            !get_int(v, "max", "repeat.max", 3, 1000, &out->repeat, err))
+        if (!jf_check_keys(v, "repeat.", keys, err) ||
+            !jf_get_bool(v, "auto", "repeat.auto", &out->repeat_auto, err) ||
+            !jf_get_int(v, "max", "repeat.max", 3, 1000, &out->repeat, err))
             return false;
         if (!out->repeat_auto)
             return job_error_set(err, "repeat.auto", "must be true (or give repeat as a number of runs)");
         return true;
     }
     json_t *wrapped = json_pack("{s:O}", "repeat", v);
-    bool ok = get_int(wrapped, "repeat", "repeat", 1, 1000, &out->repeat, err);
+    bool ok = jf_get_int(wrapped, "repeat", "repeat", 1, 1000, &out->repeat, err);
     json_decref(wrapped);
     if (!ok)
         snprintf(err->message, sizeof(err->message),
@@ -205,16 +75,16 @@ static bool parse_pdiff(const json_t *v, struct pdiff_options *p, struct job_err
     static const char *const keys[] = {"fov", "threshold_pixels", "gamma", "luminance",
                                        "color_factor", "luminance_only", NULL};
     int threshold = (int)p->threshold_pixels;
-    if (!check_keys(v, "metrics.pdiff.", keys, err) ||
-        !get_number(v, "fov", "metrics.pdiff.fov", 0.1, 179.0, &p->fov, err) ||
-        !get_int(v, "threshold_pixels", "metrics.pdiff.threshold_pixels", 0, 1000000000,
+    if (!jf_check_keys(v, "metrics.pdiff.", keys, err) ||
+        !jf_get_number(v, "fov", "metrics.pdiff.fov", 0.1, 179.0, &p->fov, err) ||
+        !jf_get_int(v, "threshold_pixels", "metrics.pdiff.threshold_pixels", 0, 1000000000,
                  &threshold, err) ||
-        !get_number(v, "gamma", "metrics.pdiff.gamma", 0.1, 10.0, &p->gamma, err) ||
-        !get_number(v, "luminance", "metrics.pdiff.luminance", 0.01, 100000.0,
+        !jf_get_number(v, "gamma", "metrics.pdiff.gamma", 0.1, 10.0, &p->gamma, err) ||
+        !jf_get_number(v, "luminance", "metrics.pdiff.luminance", 0.01, 100000.0,
                     &p->luminance, err) ||
-        !get_number(v, "color_factor", "metrics.pdiff.color_factor", 0.0, 100.0,
+        !jf_get_number(v, "color_factor", "metrics.pdiff.color_factor", 0.0, 100.0,
                     &p->color_factor, err) ||
-        !get_bool(v, "luminance_only", "metrics.pdiff.luminance_only", &p->luminance_only, err))
+        !jf_get_bool(v, "luminance_only", "metrics.pdiff.luminance_only", &p->luminance_only, err))
         return false;
     p->threshold_pixels = threshold;
     return true;
@@ -244,7 +114,7 @@ static bool parse_metrics(const json_t *v, struct metrics_options *m, struct job
     }
     if (!json_is_object(v))
         return job_error_set(err, "metrics", "must be an object or a list of metric names");
-    if (!check_keys(v, "metrics.", METRIC_NAMES, err))
+    if (!jf_check_keys(v, "metrics.", METRIC_NAMES, err))
         return false;
     for (int k = 0; METRIC_NAMES[k]; k++) {
         json_t *opt = json_object_get(v, METRIC_NAMES[k]);
@@ -268,8 +138,8 @@ static bool parse_metrics(const json_t *v, struct metrics_options *m, struct job
             return false;
         if ((1u << k) == METRIC_FLIP) {
             static const char *const keys[] = {"pixels_per_degree", NULL};
-            if (!check_keys(opt, "metrics.flip.", keys, err) ||
-                !get_number(opt, "pixels_per_degree", "metrics.flip.pixels_per_degree", 1.0,
+            if (!jf_check_keys(opt, "metrics.flip.", keys, err) ||
+                !jf_get_number(opt, "pixels_per_degree", "metrics.flip.pixels_per_degree", 1.0,
                             1000.0, &m->flip_ppd, err))
                 return false;
         }
@@ -279,36 +149,10 @@ static bool parse_metrics(const json_t *v, struct metrics_options *m, struct job
     return true;
 }
 
-static bool parse_scene(const json_t *scene, struct scene_spec *s,
-                        struct job_error *err)
-{
-    static const char *const keys[] = {"preset", "lights", "dynamic", "width",
-                                       "height", "sphere_segments", "light_speed", NULL};
-    if (!check_keys(scene, "scene.", keys, err))
-        return false;
-    json_t *preset = json_object_get(scene, "preset");
-    if (preset) {
-        if (!json_is_string(preset) || strcmp(json_string_value(preset), "grid") != 0)
-            return job_error_set(err, "scene.preset", "must be one of: \"grid\"");
-        snprintf(s->preset, sizeof(s->preset), "%s", json_string_value(preset));
-    }
-    if (!get_int(scene, "lights", "scene.lights", 0, 1024, &s->lights, err) ||
-        !get_bool(scene, "dynamic", "scene.dynamic", &s->dynamic, err) ||
-        !get_int(scene, "width", "scene.width", 16, 8192, &s->width, err) ||
-        !get_int(scene, "height", "scene.height", 16, 8192, &s->height, err) ||
-        !get_int(scene, "sphere_segments", "scene.sphere_segments", 8, 256,
-                 &s->sphere_segments, err) ||
-        !get_number(scene, "light_speed", "scene.light_speed", 0.0, 100.0, &s->light_speed, err))
-        return false;
-    if (s->sphere_segments % 2)
-        return job_error_set(err, "scene.sphere_segments", "must be an even integer from 8 to 256");
-    return true;
-}
-
 static bool parse_osl(const json_t *osl, struct osl_spec *o, struct job_error *err)
 {
     static const char *const keys[] = {"resolution", "texel_density", "reshade", NULL};
-    if (!check_keys(osl, "osl.", keys, err))
+    if (!jf_check_keys(osl, "osl.", keys, err))
         return false;
     json_t *res = json_object_get(osl, "resolution");
     if (res) {
@@ -327,7 +171,7 @@ static bool parse_osl(const json_t *osl, struct osl_spec *o, struct job_error *e
             return job_error_set(err, "osl.resolution", rule);
         }
     }
-    if (!get_number(osl, "texel_density", "osl.texel_density", 0.0625, 16.0,
+    if (!jf_get_number(osl, "texel_density", "osl.texel_density", 0.0625, 16.0,
                     &o->texel_density, err))
         return false;
     json_t *reshade = json_object_get(osl, "reshade");
@@ -354,7 +198,7 @@ bool job_spec_parse(const json_t *body, const char *const *techniques,
     memset(err, 0, sizeof(*err));
     if (!json_is_object(body))
         return job_error_set(err, "body", "the job must be a JSON object");
-    if (!check_keys(body, "", keys, err))
+    if (!jf_check_keys(body, "", keys, err))
         return false;
 
     json_t *tech = json_object_get(body, "technique");
@@ -371,19 +215,19 @@ bool job_spec_parse(const json_t *body, const char *const *techniques,
     json_t *repeat = json_object_get(body, "repeat");
     if (repeat && !parse_repeat(repeat, out, err))
         return false;
-    if (!get_int(body, "frames", "frames", 1, 1000000, &out->frames, err) ||
-        !get_int(body, "warmup_frames", "warmup_frames", 0, 10000,
+    if (!jf_get_int(body, "frames", "frames", 1, 1000000, &out->frames, err) ||
+        !jf_get_int(body, "warmup_frames", "warmup_frames", 0, 10000,
                  &out->warmup_frames, err) ||
-        !get_int(body, "capture_interval", "capture_interval", 0, 1000000,
+        !jf_get_int(body, "capture_interval", "capture_interval", 0, 1000000,
                  &out->capture_interval, err) ||
-        !get_number(body, "async_distance", "async_distance", 0.0, 1e6,
+        !jf_get_number(body, "async_distance", "async_distance", 0.0, 1e6,
                     &out->async_distance, err))
         return false;
 
     json_t *scene, *osl;
-    if (!get_object(body, "scene", "scene", &scene, err) ||
-        (scene && !parse_scene(scene, &out->scene, err)) ||
-        !get_object(body, "osl", "osl", &osl, err) ||
+    if (!jf_get_object(body, "scene", "scene", &scene, err) ||
+        (scene && !scene_spec_parse(scene, &out->scene, err)) ||
+        !jf_get_object(body, "osl", "osl", &osl, err) ||
         (osl && !parse_osl(osl, &out->osl, err)))
         return false;
 
@@ -469,14 +313,10 @@ json_t *job_spec_to_json(const struct job_spec *spec)
     json_t *res = spec->osl.resolution ? json_integer(spec->osl.resolution)
                                        : json_string("auto");
     json_t *out = json_pack(
-        "{s:s, s:i, s:i, s:i, s:f, s:{s:s, s:i, s:b, s:i, s:i, s:i, s:f}, s:{s:o, s:f, s:s}}",
+        "{s:s, s:i, s:i, s:i, s:f, s:o, s:{s:o, s:f, s:s}}",
         "technique", spec->technique, "frames", spec->frames, "warmup_frames",
         spec->warmup_frames, "capture_interval", spec->capture_interval,
-        "async_distance", spec->async_distance, "scene", "preset",
-        spec->scene.preset, "lights", spec->scene.lights, "dynamic",
-        spec->scene.dynamic, "width", spec->scene.width, "height",
-        spec->scene.height, "sphere_segments", spec->scene.sphere_segments, "light_speed",
-        spec->scene.light_speed,
+        "async_distance", spec->async_distance, "scene", scene_spec_to_json(&spec->scene),
         "osl", "resolution", res, "texel_density", spec->osl.texel_density,
         "reshade", spec->osl.reshade == OSL_RESHADE_ALL ? "all" : "touched");
     json_object_set_new(out, "repeat",
@@ -489,8 +329,3 @@ json_t *job_spec_to_json(const struct job_spec *spec)
     return out;
 }
 
-json_t *job_error_to_json(const struct job_error *err)
-{
-    return json_pack("{s:{s:s, s:s}}", "error", "field", err->field, "message",
-                     err->message);
-}

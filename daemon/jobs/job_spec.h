@@ -8,7 +8,9 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "common/json_fields.h"
 #include "daemon/quality/metrics.h"
+#include "daemon/scene/scene_spec.h"
 
 #define JOB_MAX_BODY_BYTES (64 * 1024)
 #define JOB_MAX_CAPTURE_BYTES (1024.0 * 1024.0 * 1024.0)
@@ -18,14 +20,6 @@ enum osl_reshade {
     OSL_RESHADE_ALL,     /* every due object, as the thesis measured */
 };
 
-struct scene_spec {
-    char preset[16];
-    int lights;
-    bool dynamic;
-    int width, height;
-    int sphere_segments; /* longitudinal segments; rings = segments / 2 */
-    double light_speed;  /* scales how fast dynamic lights circle (1 = default) */
-};
 
 struct osl_spec {
     int resolution; /* tile edge in texels; 0 means "auto" */
@@ -47,11 +41,6 @@ struct job_spec {
     struct metrics_options metrics; /* used when reference is set */
 };
 
-/* A rejection names the offending field (dotted path) and the rule it broke. */
-struct job_error {
-    char field[64];
-    char message[256];
-};
 
 /* Fills defaults, then applies and validates the body. techniques is a
  * NULL-terminated list of accepted technique names. */
@@ -77,12 +66,6 @@ int job_spec_runs(const struct job_spec *spec);
 /* True when timed frame (1-based) is captured. */
 bool job_spec_is_capture_frame(const struct job_spec *spec, int frame);
 
-/* Fills err (field and formatted message); returns false, for "return
- * job_error_set(...)". */
-bool job_error_set(struct job_error *err, const char *field, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
 
-/* {"error": {"field": ..., "message": ...}}. New reference. */
-json_t *job_error_to_json(const struct job_error *err);
 
 #endif

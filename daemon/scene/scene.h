@@ -7,7 +7,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "daemon/jobs/job_spec.h"
+#include "daemon/scene/scene_spec.h"
 #include "daemon/scene/mesh.h"
 
 enum scene_mesh { SCENE_MESH_SPHERE, SCENE_MESH_CUBE, SCENE_MESH_COUNT };

@@ -50,8 +50,8 @@ bool single_pass_create(const struct technique_ctx *ctx, const char *label, cons
     if (!sp)
         return false;
     const struct gl_stage stages[] = {
-        {GL_VERTEX_SHADER, {"scene_common.glsl", "scene.vert"}},
-        {GL_FRAGMENT_SHADER, {"scene_common.glsl", frag}},
+        {GL_VERTEX_SHADER, {"scene_data.glsl", "scene.vert"}},
+        {GL_FRAGMENT_SHADER, {"scene_data.glsl", "lighting.glsl", frag}},
     };
     GLuint prog = gl_program_build(label, stages, 2, NULL, err, errlen);
     if (!prog) {

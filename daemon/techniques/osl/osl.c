@@ -216,9 +216,9 @@ static bool osl_create(const struct technique_ctx *ctx, void **state, char *err,
         {GL_VERTEX_SHADER, {"osl_texgen.vert"}},
         {GL_FRAGMENT_SHADER, {"osl_texgen.frag"}},
     };
-    const struct gl_stage light[] = {{GL_COMPUTE_SHADER, {"scene_common.glsl", "osl_light.comp"}}};
+    const struct gl_stage light[] = {{GL_COMPUTE_SHADER, {"scene_data.glsl", "lighting.glsl", "osl_light.comp"}}};
     const struct gl_stage draw[] = {
-        {GL_VERTEX_SHADER, {"scene_common.glsl", "osl_draw.vert"}},
+        {GL_VERTEX_SHADER, {"scene_data.glsl", "osl_draw.vert"}},
         {GL_FRAGMENT_SHADER, {"osl_draw.frag"}},
     };
     GLuint light_prog = 0, draw_prog = 0;

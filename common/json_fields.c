@@ -1,0 +1,161 @@
+#define _POSIX_C_SOURCE 200809L
+#include "common/json_fields.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+bool job_error_set(struct job_error *err, const char *field, const char *fmt, ...)
+{
+    snprintf(err->field, sizeof(err->field), "%s", field);
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err->message, sizeof(err->message), fmt, ap);
+    va_end(ap);
+    return false;
+}
+
+static size_t edit_distance(const char *a, const char *b)
+{
+    size_t la = strlen(a), lb = strlen(b);
+    if (la > 40 || lb > 40)
+        return 99;
+    size_t row[41];
+    for (size_t j = 0; j <= lb; j++)
+        row[j] = j;
+    for (size_t i = 1; i <= la; i++) {
+        size_t diag = row[0];
+        row[0] = i;
+        for (size_t j = 1; j <= lb; j++) {
+            size_t up = row[j];
+            size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
+            size_t best = diag + cost;
+            if (row[j] + 1 < best)
+                best = row[j] + 1;
+            if (row[j - 1] + 1 < best)
+                best = row[j - 1] + 1;
+            row[j] = best;
+            diag = up;
+        }
+    }
+    return row[lb];
+}
+
+/* Rejects keys not in known, suggesting the closest one for typos. */
+bool jf_check_keys(const json_t *obj, const char *prefix, const char *const *known,
+                   struct job_error *err)
+{
+    const char *key;
+    json_t *value;
+    json_object_foreach((json_t *)obj, key, value) {
+        bool found = false;
+        const char *closest = NULL;
+        size_t best = 3;
+        for (const char *const *k = known; *k; k++) {
+            if (strcmp(*k, key) == 0) {
+                found = true;
+                break;
+            }
+            size_t d = edit_distance(*k, key);
+            if (d < best) {
+                best = d;
+                closest = *k;
+            }
+        }
+        if (!found) {
+            char field[64];
+            snprintf(field, sizeof(field), "%s%.40s", prefix, key);
+            if (closest)
+                return job_error_set(err, field, "unknown field (did you mean '%s%s'?)",
+                            prefix, closest);
+            return job_error_set(err, field, "unknown field");
+        }
+    }
+    return true;
+}
+
+bool jf_get_int(const json_t *obj, const char *key, const char *field,
+                    long min, long max, int *out, struct job_error *err)
+{
+    json_t *v = json_object_get(obj, key);
+    if (!v)
+        return true;
+    /* Accept 300.0 from tools that write every number as a double, but never 300.5. */
+    double d;
+    if (json_is_integer(v))
+        d = (double)json_integer_value(v);
+    else if (json_is_real(v) && floor(json_real_value(v)) == json_real_value(v))
+        d = json_real_value(v);
+    else
+        return job_error_set(err, field, "must be an integer from %ld to %ld", min, max);
+    if (d < (double)min || d > (double)max)
+        return job_error_set(err, field, "must be an integer from %ld to %ld", min, max);
+    *out = (int)d;
+    return true;
+}
+
+bool jf_get_number(const json_t *obj, const char *key, const char *field,
+                       double min, double max, double *out,
+                       struct job_error *err)
+{
+    json_t *v = json_object_get(obj, key);
+    if (!v)
+        return true;
+    if (!json_is_number(v) || !isfinite(json_number_value(v)) ||
+        json_number_value(v) < min || json_number_value(v) > max)
+        return job_error_set(err, field, "must be a number from %g to %g", min, max);
+    *out = json_number_value(v);
+    return true;
+}
+
+bool jf_get_bool(const json_t *obj, const char *key, const char *field,
+                     bool *out, struct job_error *err)
+{
+    json_t *v = json_object_get(obj, key);
+    if (!v)
+        return true;
+    if (!json_is_boolean(v))
+        return job_error_set(err, field, "must be true or false");
+    *out = json_is_true(v);
+    return true;
+}
+
+bool jf_get_object(const json_t *obj, const char *key, const char *field,
+                       json_t **out, struct job_error *err)
+{
+    *out = json_object_get(obj, key);
+    if (*out && !json_is_object(*out))
+        return job_error_set(err, field, "must be an object");
+    return true;
+}
+
+bool jf_get_choice(const json_t *obj, const char *key, const char *field,
+                   const char *const *choices, int *out, struct job_error *err)
+{
+    json_t *v = json_object_get(obj, key);
+    if (!v)
+        return true;
+    for (int i = 0; json_is_string(v) && choices[i]; i++)
+        if (strcmp(json_string_value(v), choices[i]) == 0) {
+            *out = i;
+            return true;
+        }
+    char list[256];
+    jf_list_choices(choices, list, sizeof(list));
+    return job_error_set(err, field, "must be one of: %s", list);
+}
+
+void jf_list_choices(const char *const *choices, char *buf, size_t cap)
+{
+    size_t used = 0;
+    buf[0] = '\0';
+    for (int i = 0; choices[i] && used < cap; i++)
+        used += (size_t)snprintf(buf + used, cap - used, "%s\"%s\"", i ? ", " : "", choices[i]);
+}
+
+json_t *job_error_to_json(const struct job_error *err)
+{
+    return json_pack("{s:{s:s, s:s}}", "error", "field", err->field, "message",
+                     err->message);
+}

@@ -1,0 +1,49 @@
+#ifndef SHADEBENCH_JSON_FIELDS_H
+#define SHADEBENCH_JSON_FIELDS_H
+
+/* The validation toolkit every JSON spec parser uses (jobs, scenes,
+ * technique options, sweeps): typed getters that leave the default in place
+ * when a key is absent, and rejections that name the field (a dotted path)
+ * and the rule it broke. GL-free; any thread. */
+
+#include <jansson.h>
+#include <stdbool.h>
+#include <stddef.h>
+
+/* A rejection names the offending field (dotted path) and the rule it broke. */
+struct job_error {
+    char field[64];
+    char message[256];
+};
+
+/* Fills err (field and formatted message); returns false, for "return
+ * job_error_set(...)". */
+bool job_error_set(struct job_error *err, const char *field, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/* {"error": {"field": ..., "message": ...}}. New reference. */
+json_t *job_error_to_json(const struct job_error *err);
+
+/* Rejects keys of obj not in known (NULL-terminated), suggesting the closest
+ * known key for typos; prefix is the object's path with a trailing dot. */
+bool jf_check_keys(const json_t *obj, const char *prefix, const char *const *known,
+                   struct job_error *err);
+
+/* Each getter leaves *out untouched when key is absent. Integers accept 300.0
+ * but never 300.5. */
+bool jf_get_int(const json_t *obj, const char *key, const char *field, long min, long max,
+                int *out, struct job_error *err);
+bool jf_get_number(const json_t *obj, const char *key, const char *field, double min,
+                   double max, double *out, struct job_error *err);
+bool jf_get_bool(const json_t *obj, const char *key, const char *field, bool *out,
+                 struct job_error *err);
+bool jf_get_object(const json_t *obj, const char *key, const char *field, json_t **out,
+                   struct job_error *err);
+/* A string from choices (NULL-terminated); *out gets its index. */
+bool jf_get_choice(const json_t *obj, const char *key, const char *field,
+                   const char *const *choices, int *out, struct job_error *err);
+
+/* "a", "b" and "c" as `"a", "b", "c"` into buf, for rule messages. */
+void jf_list_choices(const char *const *choices, char *buf, size_t cap);
+
+#endif

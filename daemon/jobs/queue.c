@@ -314,7 +314,7 @@ static int by_id(const void *a, const void *b)
     return strcmp((*(struct job *const *)a)->id, (*(struct job *const *)b)->id);
 }
 
-static bool load_job(struct queue *q, const char *id, const char *const *techniques)
+static bool load_job(struct queue *q, const char *id, const struct technique_catalog *techniques)
 {
     char dir[PATH_MAX], path[PATH_MAX + 16];
     if (strlen(id) >= sizeof(((struct job *)0)->id))
@@ -394,7 +394,7 @@ static bool load_job(struct queue *q, const char *id, const char *const *techniq
     return true;
 }
 
-int queue_load(struct queue *q, const char *const *techniques, char *err, size_t errlen)
+int queue_load(struct queue *q, const struct technique_catalog *techniques, char *err, size_t errlen)
 {
     char jobs_dir[PATH_MAX];
     snprintf(jobs_dir, sizeof(jobs_dir), "%.*s/jobs", (int)(sizeof(jobs_dir) - 8), q->state_dir);

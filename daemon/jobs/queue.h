@@ -44,7 +44,7 @@ void queue_set_retention(struct queue *q, int keep_jobs, double keep_days);
 /* Reloads the jobs under state_dir/jobs: finished ones are served as before,
  * queued ones run, and one that was running when the daemon died is marked
  * interrupted. Returns the number of jobs loaded, or -1 with err filled. */
-int queue_load(struct queue *q, const char *const *techniques, char *err, size_t errlen);
+int queue_load(struct queue *q, const struct technique_catalog *techniques, char *err, size_t errlen);
 void queue_destroy(struct queue *q);
 int queue_max_queued(const struct queue *q);
 

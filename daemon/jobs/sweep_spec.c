@@ -9,7 +9,8 @@
 
 enum param_type { PARAM_INT, PARAM_NUMBER, PARAM_BOOL, PARAM_CHOICE };
 
-/* Every job field a sweep may vary. */
+/* Every job field a sweep may vary, besides each technique's options
+ * ("<technique>.<option>", from the catalogue). */
 static const struct {
     const char *path;
     enum param_type type;
@@ -20,47 +21,58 @@ static const struct {
     {"scene.lights", PARAM_INT},        {"scene.dynamic", PARAM_BOOL},
     {"scene.width", PARAM_INT},         {"scene.height", PARAM_INT},
     {"scene.sphere_segments", PARAM_INT}, {"scene.light_speed", PARAM_NUMBER},
-    {"osl.resolution", PARAM_CHOICE},   {"osl.texel_density", PARAM_NUMBER},
-    {"osl.reshade", PARAM_CHOICE},
+    {"look.lighting", PARAM_CHOICE},    {"look.hdr", PARAM_CHOICE},
 };
 enum { NPARAMS = sizeof(PARAMS) / sizeof(PARAMS[0]) };
 
-
-static int param_index(const char *path)
+/* The type of a sweepable path; false when a sweep cannot vary it. */
+static bool param_type(const struct technique_catalog *techniques, const char *path,
+                       enum param_type *type)
 {
     for (int i = 0; i < (int)NPARAMS; i++)
-        if (strcmp(PARAMS[i].path, path) == 0)
-            return i;
-    return -1;
+        if (strcmp(PARAMS[i].path, path) == 0) {
+            *type = PARAMS[i].type;
+            return true;
+        }
+    const struct technique_option *opt = technique_catalog_option(techniques, path);
+    if (!opt)
+        return false;
+    *type = opt->type == TOPT_INT ? PARAM_INT : opt->type == TOPT_NUMBER ? PARAM_NUMBER
+                                              : PARAM_CHOICE;
+    return true;
 }
 
-static bool unknown_param(struct job_error *err, const char *field)
+static bool unknown_param(const struct technique_catalog *techniques, struct job_error *err,
+                          const char *field)
 {
-    char list[400] = "";
+    char list[200] = "";
     for (int i = 0; i < (int)NPARAMS; i++) {
         size_t used = strlen(list);
         snprintf(list + used, sizeof(list) - used, "%s%s", i ? ", " : "", PARAMS[i].path);
     }
-    return job_error_set(err, field, "not a parameter a sweep can vary; one of: %s", list);
+    (void)techniques;
+    return job_error_set(err, field, "not a parameter a sweep can vary; one of: %s, or "
+                         "TECHNIQUE.OPTION (see /v1/info)", list);
 }
 
-/* A copy of job with the field at a dotted path set to value. */
+/* A copy of job with the field at a dotted path set to value, creating the
+ * objects between. */
 static json_t *with_field(const json_t *job, const char *path, json_t *value)
 {
-    json_t *copy = json_deep_copy(job);
-    const char *dot = strchr(path, '.');
-    if (!dot) {
-        json_object_set(copy, path, value);
-        return copy;
+    json_t *copy = json_deep_copy(job), *obj = copy;
+    const char *dot;
+    while ((dot = strchr(path, '.'))) {
+        char head[64];
+        snprintf(head, sizeof(head), "%.*s", (int)(dot - path), path);
+        json_t *inner = json_object_get(obj, head);
+        if (!json_is_object(inner)) {
+            inner = json_object();
+            json_object_set_new(obj, head, inner);
+        }
+        obj = inner;
+        path = dot + 1;
     }
-    char head[40];
-    snprintf(head, sizeof(head), "%.*s", (int)(dot - path), path);
-    json_t *inner = json_object_get(copy, head);
-    if (!json_is_object(inner)) {
-        inner = json_object();
-        json_object_set_new(copy, head, inner);
-    }
-    json_object_set(inner, dot + 1, value);
+    json_object_set(obj, path, value);
     return copy;
 }
 
@@ -81,7 +93,7 @@ static json_t *point_defaults(const struct sweep_spec *s, json_t *job)
     return job;
 }
 
-static bool check_point(const json_t *job, const char *const *techniques, const char *field,
+static bool check_point(const json_t *job, const struct technique_catalog *techniques, const char *field,
                         struct job_error *err)
 {
     struct job_spec spec;
@@ -146,7 +158,7 @@ static json_t *thesis_sweep(const json_t *body, struct job_error *err)
                      "technique", "forward", "osl");
 }
 
-bool sweep_spec_parse(const json_t *body, const char *const *techniques, struct sweep_spec *out,
+bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techniques, struct sweep_spec *out,
                       struct job_error *err)
 {
     memset(out, 0, sizeof(*out));
@@ -188,8 +200,9 @@ bool sweep_spec_parse(const json_t *body, const char *const *techniques, struct 
         json_object_foreach(vary, key, v) {
             char field[96];
             snprintf(field, sizeof(field), "vary.%.40s", key);
-            if (param_index(key) < 0)
-                return unknown_param(err, field);
+            enum param_type unused;
+            if (!param_type(techniques, key, &unused))
+                return unknown_param(techniques, err, field);
             if (!json_is_array(v) || json_array_size(v) == 0)
                 return job_error_set(err, field, "must be a non-empty list of values");
             snprintf(out->params[out->nparams], sizeof(out->params[0]), "%s", key);
@@ -222,14 +235,16 @@ bool sweep_spec_parse(const json_t *body, const char *const *techniques, struct 
         return job_error_set(err, field, "unknown field (param, from, to, while, steps)");
     }
     const char *param = json_string_value(json_object_get(find, "param"));
-    int p = param ? param_index(param) : -1;
-    if (p < 0)
-        return param ? unknown_param(err, "find.param") : job_error_set(err, "find.param", "must name a parameter");
-    if (PARAMS[p].type != PARAM_INT && PARAMS[p].type != PARAM_NUMBER)
+    enum param_type type;
+    if (!param)
+        return job_error_set(err, "find.param", "must name a parameter");
+    if (!param_type(techniques, param, &type))
+        return unknown_param(techniques, err, "find.param");
+    if (type != PARAM_INT && type != PARAM_NUMBER)
         return job_error_set(err, "find.param", "%s is not numeric: find bisects a numeric parameter", param);
     snprintf(out->params[0], sizeof(out->params[0]), "%s", param);
     out->nparams = 1;
-    out->integer = PARAMS[p].type == PARAM_INT;
+    out->integer = type == PARAM_INT;
     json_t *from = json_object_get(find, "from"), *to = json_object_get(find, "to");
     if (!json_is_number(from))
         return job_error_set(err, "find.from", "must be a number");

@@ -1,11 +1,13 @@
 // OSL lighting pass: one 8x8 block of one object's tile per work group. The
 // work list holds one entry per object to shade: (instance, light row,
 // first block, blocks per tile row); a group finds its entry by binary search.
+#include "lighting.glsl"
+
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std430, binding = 3) readonly buffer TileBuffer { ivec4 tiles[]; };   // x, y, size, level
-layout(std430, binding = 4) readonly buffer WorkBuffer { uvec4 work[]; };
-layout(rgba8, binding = 0) writeonly uniform image2D u_atlas;
+layout(std430, binding = SB_SSBO_OSL_TILES) readonly buffer TileBuffer { ivec4 tiles[]; };   // x, y, size, level
+layout(std430, binding = SB_SSBO_OSL_WORK) readonly buffer WorkBuffer { uvec4 work[]; };
+layout(rgba8, binding = SB_IMG_OSL_ATLAS) writeonly uniform image2D u_atlas;
 
 uniform sampler2D u_position[2]; // per mesh, mip level l holds tiles of size base >> l
 uniform sampler2D u_normal[2];
@@ -44,7 +46,7 @@ void main()
     vec3 color = vec3(0.0);
     if (p.w > 0.0) {
         vec3 world = inst.pos_scale.xyz + inst.pos_scale.w * p.xyz;
-        color = phong(world, normalize(n.xyz), inst.albedo_mesh.rgb, int(w.y));
+        color = shade_all_lights(world, normalize(n.xyz), inst.albedo_mesh.rgb, int(w.y));
     }
     imageStore(u_atlas, tile.xy + texel, vec4(color, 1.0));
 }

@@ -23,7 +23,7 @@ try:
     rejected(d, "{", "body", what="truncated JSON")
     rejected(d, "[]", "body", what="array body")
     rejected(d, '{"frames": 3, "frames": 4}', "body", what="duplicate key")
-    rejected(d, {"technique": "deferred"}, "technique")
+    rejected(d, {"technique": "no_such_technique"}, "technique")
     rejected(d, {"technique": None}, "technique")
     rejected(d, {"frames": "300"}, "frames")
     rejected(d, {"frames": 0}, "frames")

@@ -1,7 +1,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "daemon/jobs/job_spec.h"
 #include "daemon/techniques/osl/osl_atlas.h"
 #include "daemon/techniques/osl/osl_schedule.h"
 #include "daemon/scene/scene.h"
@@ -100,8 +99,10 @@ static void test_schedule(void)
 
 static void test_plan(void)
 {
-    struct job_spec spec;
-    job_spec_defaults(&spec);
+    struct {
+        struct scene_spec scene;
+    } spec;
+    scene_spec_defaults(&spec.scene);
     struct scene scene;
     CHECK(scene_create(&scene, &spec.scene));
     int n = scene.instance_count;

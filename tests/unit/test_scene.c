@@ -2,7 +2,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "daemon/jobs/job_spec.h"
 #include "daemon/scene/scene.h"
 #include "tests/unit/check.h"
 
@@ -39,8 +38,10 @@ static void check_mesh(const struct mesh *m)
 
 int main(void)
 {
-    struct job_spec spec;
-    job_spec_defaults(&spec);
+    struct {
+        struct scene_spec scene;
+    } spec;
+    scene_spec_defaults(&spec.scene);
     struct scene s;
     CHECK(scene_create(&s, &spec.scene));
     CHECK(s.instance_count == 512);

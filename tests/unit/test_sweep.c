@@ -2,9 +2,10 @@
 #include <string.h>
 
 #include "daemon/jobs/sweep_spec.h"
+#include "tests/unit/catalog_fixture.h"
 #include "tests/unit/check.h"
 
-static const char *const techniques[] = {"forward", "unlit", "osl", NULL};
+#define techniques fixture_catalog()
 
 static int calls;
 static double boundary;

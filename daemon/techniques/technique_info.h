@@ -22,7 +22,7 @@
 /* Techniques a catalogue may hold. */
 #define TECHNIQUE_MAX 32
 /* Named passes a technique may declare (the harness adds its own). */
-#define TECHNIQUE_MAX_PASSES 12
+#define TECHNIQUE_MAX_PASSES 16
 
 enum topt_type {
     TOPT_INT,          /* int; min..max */

@@ -101,6 +101,7 @@ struct run {
     int resolve_pass;
     GLuint ldr_fbo;
     struct technique_env env;
+    struct technique_products products;
     char defines[128];
     void *state;
     uint8_t **captures;
@@ -160,6 +161,7 @@ static bool setup_targets(struct run *run)
         .width = w,
         .height = h,
         .defines = run->defines,
+        .products = &run->products,
     };
     return true;
 }
@@ -378,6 +380,7 @@ static bool render_reference(struct run *run, enum job_status *status)
     memcpy(rr.defines, run->defines, sizeof(rr.defines));
     rr.env.defines = rr.defines;
     rr.env.passes = &rr.passes;
+    rr.env.products = &rr.products;
     bool ok = false;
     if (!ref || !pixels || !setup_technique(&rr, ref, job_spec_reference_options(spec), 1)) {
         snprintf(run->err, sizeof(run->err), "reference %s: cannot prepare it: %.900s",

@@ -21,6 +21,22 @@
 #include "daemon/techniques/catalog.h"
 #include "daemon/techniques/technique_info.h"
 
+/* What a technique may publish for the harness after create (0 = none):
+ * post effects read normals from a g-buffer when there is one (SSAO), else
+ * rebuild them from the depth texture; a light-culling technique publishes
+ * how many lights it evaluated per pixel, which the harness captures as a
+ * heat map beside the colour captures. */
+enum technique_normal_encoding {
+    TECHNIQUE_NORMAL_FLOAT3,     /* rgb = world-space unit normal */
+    TECHNIQUE_NORMAL_OCTAHEDRAL, /* rg = octahedral world-space normal in [-1, 1] */
+};
+
+struct technique_products {
+    GLuint normal_tex;
+    int normal_encoding; /* enum technique_normal_encoding */
+    GLuint heat_tex;     /* GL_R32UI, width x height: light evaluations this frame */
+};
+
 /* What the harness hands a technique; valid from create to destroy. */
 struct technique_env {
     const struct job_spec *spec;
@@ -37,6 +53,8 @@ struct technique_env {
     /* #define lines for the look (lighting model), to pass to
      * gl_program_build for every program that lights. */
     const char *defines;
+    /* Zeroed by the harness before create; the technique fills what it has. */
+    struct technique_products *products;
 };
 
 struct technique {

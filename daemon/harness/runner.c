@@ -584,7 +584,8 @@ static void *runner_main(void *arg)
         egl_context_platform(egl), gl_str(GL_RENDERER), gl_str(GL_VERSION));
 
     struct job *job;
-    while ((job = queue_next(r->queue)))
+    /* Store hook: the metrics and files of earlier jobs finish before the next job is timed. */
+    while ((metrics_worker_wait_idle(r->metrics), job = queue_next(r->queue)))
         run_job(r, job);
     atomic_store(&r->alive, false);
     egl_context_destroy(egl);

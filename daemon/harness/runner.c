@@ -17,6 +17,7 @@
 #include "daemon/gpu/gpu_scene.h"
 #include "daemon/gpu/gpu_timer.h"
 #include "common/log.h"
+#include "daemon/harness/interference.h"
 #include "daemon/harness/metrics_stage.h"
 #include "common/png_io.h"
 #include "daemon/service.h"
@@ -93,6 +94,7 @@ struct run {
     double *cpu_ms;
     double *frame_ms;
     GLsync fences[FRAMES_IN_FLIGHT];
+    struct interference_sample interference[2]; /* store hook: start and end of the timed region */
     char err[1024];
 };
 
@@ -249,6 +251,9 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
         }
         json_object_set_new(result, "gpu_sections_ms", by_section);
     }
+    /* Store hook: what could have disturbed the timed region. */
+    json_object_set_new(result, "interference",
+                        interference_json(&run->interference[0], &run->interference[1]));
     if (run->tech->describe) {
         json_t *d = run->tech->describe(run->state);
         if (d)
@@ -375,6 +380,7 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
         if (k == 1) {
             /* Warm-up work still queued must not be billed to the timed frames. */
             glFinish();
+            interference_sample(&run->interference[0]); /* store hook, outside the timing */
             wall_start = mono_s();
         }
         /* Bound the frames in flight like a swap chain would; the wait is part
@@ -413,6 +419,7 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
     }
     glFinish();
     double wall_end = mono_s();
+    interference_sample(&run->interference[1]); /* store hook, outside the timing */
     run->frame_ms[n - 1] += (wall_end - frame_begin) * 1e3;
     *wall_s = wall_end - wall_start;
     gpu_timer_drain(run->timer);
@@ -458,6 +465,9 @@ static bool repeat_runs(struct runner *r, struct run *first, json_t *result,
                                                 json_deep_copy(json_object_get(result, "frame_ms")),
                                                 json_deep_copy(json_object_get(result, "gpu_ms")),
                                                 json_deep_copy(json_object_get(result, "cpu_ms"))));
+    if (ok) /* store hook: each run's interference */
+        json_object_set_new(json_array_get(runs, 0), "interference",
+                            json_deep_copy(json_object_get(result, "interference")));
     int done = 1;
     while (ok && done < planned && !(spec->repeat_auto && stats_is_stable(med, (size_t)done, 0.025))) {
         struct run extra = {.runner = r, .job = first->job, .spec = spec, .tech = first->tech};
@@ -472,6 +482,8 @@ static bool repeat_runs(struct runner *r, struct run *first, json_t *result,
             med[planned + done] = json_real_value(json_object_get(g, "median"));
             med[2 * planned + done] = json_real_value(json_object_get(c, "median"));
             json_array_append_new(runs, run_summary(done + 1, wall_s, f, g, c));
+            json_object_set_new(json_array_get(runs, done), "interference", /* store hook */
+                                interference_json(&extra.interference[0], &extra.interference[1]));
             done++;
         } else {
             char why[900];

@@ -11,6 +11,7 @@
 #include <time.h>
 
 #include "config.h"
+#include "common/clock.h"
 #include "daemon/gpu/egl.h"
 #include "common/fsutil.h"
 #include "daemon/gpu/bindings.h"
@@ -21,6 +22,7 @@
 #include "daemon/gpu/pass.h"
 #include "daemon/gpu/targets.h"
 #include "common/log.h"
+#include "daemon/harness/interference.h"
 #include "daemon/harness/metrics_stage.h"
 #include "common/png_io.h"
 #include "daemon/service.h"
@@ -47,13 +49,6 @@ struct runner {
     struct gpu_frame_block frame_block;
     GLuint empty_vao, resolve_prog;
 };
-
-static double mono_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec / 1e9;
-}
 
 static json_t *stats_json(const double *v, size_t n)
 {
@@ -109,6 +104,7 @@ struct run {
     double *cpu_ms;
     double *frame_ms;
     GLsync fences[FRAMES_IN_FLIGHT];
+    struct interference_sample interference[2]; /* store hook: start and end of the timed region */
     char err[1024];
 };
 
@@ -346,6 +342,9 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
                                                   look_lighting_name(run->spec->look.lighting),
                                                   "hdr", hdr_name(run->spec->look.hdr)));
     json_object_set_new(result, "targets_bytes", json_real(gpu_targets_bytes(run->runner->targets)));
+    /* Store hook: what could have disturbed the timed region. */
+    json_object_set_new(result, "interference",
+                        interference_json(&run->interference[0], &run->interference[1]));
     if (run->tech->describe) {
         json_t *d = run->tech->describe(run->state);
         if (d)
@@ -477,7 +476,8 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
         if (k == 1) {
             /* Warm-up work still queued must not be billed to the timed frames. */
             glFinish();
-            wall_start = mono_s();
+            interference_sample(&run->interference[0]); /* store hook, outside the timing */
+            wall_start = clock_mono_s();
         }
         /* Bound the frames in flight like a swap chain would; the wait is part
          * of the frame interval, never of the CPU submit time. */
@@ -487,7 +487,7 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
             glDeleteSync(*fence);
             *fence = NULL;
         }
-        double t0 = mono_s();
+        double t0 = clock_mono_s();
         if (k >= 2)
             run->frame_ms[k - 2] += (t0 - frame_begin) * 1e3;
         frame_begin = t0;
@@ -498,18 +498,18 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
         resolve(run);
         gpu_timer_end_frame(run->timer);
         glFlush(); /* where a swap would hand the frame to the GPU */
-        double t1 = mono_s();
+        double t1 = clock_mono_s();
         *fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
         if (!ok)
             return false;
         if (k >= 1)
             run->cpu_ms[k - 1] = (t1 - t0) * 1e3;
         if (run->capture_count && job_spec_is_capture_frame(spec, (int)k)) {
-            double c0 = mono_s();
+            double c0 = clock_mono_s();
             glBindFramebuffer(GL_READ_FRAMEBUFFER, run->ldr_fbo);
             glReadPixels(0, 0, spec->scene.width, spec->scene.height, GL_RGBA,
                          GL_UNSIGNED_BYTE, run->captures[captured++]);
-            double c = mono_s() - c0;
+            double c = clock_mono_s() - c0;
             *capture_s += c;
             run->frame_ms[k - 1] -= c * 1e3;
         }
@@ -518,7 +518,8 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
         queue_progress(r->queue, job, run_index * n + (k > 0 ? (int)k : 0));
     }
     glFinish();
-    double wall_end = mono_s();
+    double wall_end = clock_mono_s();
+    interference_sample(&run->interference[1]); /* store hook, outside the timing */
     run->frame_ms[n - 1] += (wall_end - frame_begin) * 1e3;
     *wall_s = wall_end - wall_start;
     gpu_timer_drain(run->timer);
@@ -564,6 +565,9 @@ static bool repeat_runs(struct runner *r, struct run *first, json_t *result,
                                                 json_deep_copy(json_object_get(result, "frame_ms")),
                                                 json_deep_copy(json_object_get(result, "gpu_ms")),
                                                 json_deep_copy(json_object_get(result, "cpu_ms"))));
+    if (ok) /* store hook: each run's interference */
+        json_object_set_new(json_array_get(runs, 0), "interference",
+                            json_deep_copy(json_object_get(result, "interference")));
     int done = 1;
     while (ok && done < planned && !(spec->repeat_auto && stats_is_stable(med, (size_t)done, 0.025))) {
         struct run extra = {.runner = r, .job = first->job, .spec = spec, .tech = first->tech};
@@ -578,6 +582,8 @@ static bool repeat_runs(struct runner *r, struct run *first, json_t *result,
             med[planned + done] = json_real_value(json_object_get(g, "median"));
             med[2 * planned + done] = json_real_value(json_object_get(c, "median"));
             json_array_append_new(runs, run_summary(done + 1, wall_s, f, g, c));
+            json_object_set_new(json_array_get(runs, done), "interference", /* store hook */
+                                interference_json(&extra.interference[0], &extra.interference[1]));
             done++;
         } else {
             char why[900];
@@ -722,7 +728,8 @@ static void *runner_main(void *arg)
         egl_context_platform(egl), gl_str(GL_RENDERER), gl_str(GL_VERSION));
 
     struct job *job;
-    while ((job = queue_next(r->queue)))
+    /* Store hook: the metrics and files of earlier jobs finish before the next job is timed. */
+    while ((metrics_worker_wait_idle(r->metrics), job = queue_next(r->queue)))
         run_job(r, job);
     atomic_store(&r->alive, false);
     harness_gl_finish(r);

@@ -103,6 +103,33 @@ static bool check_point(const json_t *job, const struct technique_catalog *techn
     return job_error_set(err, field, "%s: %s", inner.field, inner.message);
 }
 
+/* Point p of a grid, exactly as it will be submitted; the error names the
+ * combination ("vary", point 3: frames=2, capture_interval=5) and the job
+ * field and rule it breaks. */
+static bool check_combination(const struct sweep_spec *s, size_t p, const struct technique_catalog *techniques,
+                              struct job_error *err)
+{
+    json_t *values, *job = sweep_point_job(s, p, &values);
+    struct job_spec spec;
+    struct job_error inner;
+    bool ok = job_spec_parse(job, techniques, &spec, &inner);
+    if (!ok) {
+        char combo[160] = "";
+        size_t used = 0;
+        for (int i = 0; i < s->nparams && used < sizeof(combo); i++) {
+            char *v = json_dumps(json_object_get(values, s->params[i]), JSON_ENCODE_ANY | JSON_COMPACT);
+            used += (size_t)snprintf(combo + used, sizeof(combo) - used, "%s%s=%.40s",
+                                     i ? ", " : "", s->params[i], v ? v : "?");
+            free(v);
+        }
+        job_error_set(err, "vary", "point %zu (%s) is not a valid job: %s: %s", p + 1, combo,
+                      inner.field, inner.message);
+    }
+    json_decref(values);
+    json_decref(job);
+    return ok;
+}
+
 static bool parse_criterion(const char *text, struct sweep_spec *s)
 {
     double x;
@@ -199,7 +226,7 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
         out->npoints = 1;
         json_object_foreach(vary, key, v) {
             char field[96];
-            snprintf(field, sizeof(field), "vary.%.40s", key);
+            snprintf(field, sizeof(field), "vary.%.*s", (int)jf_utf8_prefix(key, 40), key);
             enum param_type unused;
             if (!param_type(techniques, key, &unused))
                 return unknown_param(techniques, err, field);
@@ -213,7 +240,8 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
             size_t i;
             json_t *value;
             json_array_foreach(v, i, value) {
-                snprintf(field, sizeof(field), "vary.%.40s[%zu]", key, i);
+                snprintf(field, sizeof(field), "vary.%.*s[%zu]", (int)jf_utf8_prefix(key, 40),
+                         key, i);
                 json_t *job = with_field(base, key, value);
                 bool ok = check_point(job, techniques, field, err);
                 json_decref(job);
@@ -221,6 +249,12 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
                     return false;
             }
         }
+        /* Each value may be fine alone and a combination still refused
+         * (frames 2 with capture_interval 5): every point is parsed as the
+         * job it will run, so that no sweep fails after earlier points ran. */
+        for (size_t p = 0; p < out->npoints; p++)
+            if (!check_combination(out, p, techniques, err))
+                return false;
         return true;
     }
 
@@ -231,7 +265,7 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
                                           strcmp(key, "to") && strcmp(key, "while") &&
                                           strcmp(key, "steps")) {
         char field[64];
-        snprintf(field, sizeof(field), "find.%.40s", key);
+        snprintf(field, sizeof(field), "find.%.*s", (int)jf_utf8_prefix(key, 40), key);
         return job_error_set(err, field, "unknown field (param, from, to, while, steps)");
     }
     const char *param = json_string_value(json_object_get(find, "param"));

@@ -27,6 +27,19 @@ struct osl_spec {
     enum osl_reshade reshade;
 };
 
+/* labels: free-form tags for history (commit, branch, driver version). Keys
+ * are 1 to 32 characters of [A-Za-z0-9_.-] so that they fit a query
+ * (?label.KEY=VALUE); values are strings of at most 128 bytes without
+ * control characters. They never change what is measured. */
+#define JOB_MAX_LABELS 16
+#define JOB_LABEL_KEY_MAX 32
+#define JOB_LABEL_VALUE_MAX 128
+
+struct job_label {
+    char key[JOB_LABEL_KEY_MAX + 1];
+    char value[JOB_LABEL_VALUE_MAX + 1];
+};
+
 struct job_spec {
     char technique[32];
     int frames;
@@ -39,6 +52,8 @@ struct job_spec {
     bool repeat_auto;              /* stop once the 95% interval is within 2.5% */
     char reference[32];            /* technique to compare captures with; "" for none */
     struct metrics_options metrics; /* used when reference is set */
+    int nlabels;                   /* sorted by key */
+    struct job_label labels[JOB_MAX_LABELS];
 };
 
 

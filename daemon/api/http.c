@@ -15,6 +15,7 @@
 
 #include "config.h"
 #include "daemon/api/charts.h"
+#include "daemon/api/job_filter.h"
 #include "daemon/jobs/job_spec.h"
 #include "daemon/api/report.h"
 #include "common/log.h"
@@ -233,6 +234,21 @@ static enum MHD_Result respond_chart(struct MHD_Connection *c, const json_t *sub
     if (!data)
         return respond_error(c, MHD_HTTP_NOT_FOUND, "chart", err);
     return respond_text(c, MHD_HTTP_OK, data, len, format == CHART_SVG ? "image/svg+xml" : "image/png");
+}
+
+struct list_args {
+    struct job_filter filter;
+    struct job_error err;
+    bool ok;
+};
+
+static enum MHD_Result list_arg(void *cls, enum MHD_ValueKind kind, const char *key,
+                                const char *value)
+{
+    (void)kind;
+    struct list_args *a = cls;
+    a->ok = a->ok && job_filter_add(&a->filter, key, value, &a->err);
+    return a->ok ? MHD_YES : MHD_NO;
 }
 
 static bool point_job_dir(void *ctx, const char *job_id, char *dir, size_t cap, int *last_frame)
@@ -482,8 +498,16 @@ static enum MHD_Result route(struct http_server *s, struct MHD_Connection *c,
                                      "the job must be at most 65536 bytes");
             return submit_job(s, c, req);
         }
-        if (get)
-            return respond_json(c, MHD_HTTP_OK, queue_list_json(s->queue));
+        if (get) {
+            /* ?technique=&status=&label.KEY=VALUE&since= (daemon/api/job_filter.h) */
+            struct list_args a = {.ok = true};
+            job_filter_init(&a.filter);
+            MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, list_arg, &a);
+            if (!a.ok)
+                return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&a.err));
+            return respond_json(c, MHD_HTTP_OK,
+                                queue_list_json_with(s->queue, job_filter_visit, &a.filter));
+        }
         return respond_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "method",
                              "use GET to list jobs or POST to submit one");
     }

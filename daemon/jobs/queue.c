@@ -797,6 +797,24 @@ json_t *queue_list_json(struct queue *q)
     return json_pack("{s:o}", "jobs", list);
 }
 
+json_t *queue_list_json_with(struct queue *q, queue_list_fn fn, void *ctx)
+{
+    json_t *list = json_array();
+    pthread_mutex_lock(&q->lock);
+    for (size_t i = 0; i < q->count; i++) {
+        const struct job *job = q->jobs[i];
+        json_t *entry = job_json_locked(job, false), *labels = json_object();
+        for (int k = 0; k < job->spec.nlabels; k++)
+            json_object_set_new(labels, job->spec.labels[k].key,
+                                json_string(job->spec.labels[k].value));
+        json_object_set_new(entry, "labels", labels);
+        if ((entry = fn(entry, job->result, ctx)))
+            json_array_append_new(list, entry);
+    }
+    pthread_mutex_unlock(&q->lock);
+    return json_pack("{s:o}", "jobs", list);
+}
+
 bool queue_job_dir(struct queue *q, const char *id, char *dir, size_t cap,
                    enum job_status *status)
 {

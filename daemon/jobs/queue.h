@@ -110,6 +110,14 @@ enum queue_cancel_result queue_cancel(struct queue *q, const char *id);
 json_t *queue_job_json(struct queue *q, const char *id, double wait_s);
 json_t *queue_list_json(struct queue *q);
 
+/* The list with a say per job, for filters and figures: fn gets the job's
+ * list entry with its "labels" (its own reference) and its result
+ * (borrowed, NULL until done), under the store's lock, so it must be quick
+ * and must not keep result. It returns the entry to list (it may add to it)
+ * or NULL to leave the job out (releasing the entry). */
+typedef json_t *(*queue_list_fn)(json_t *entry, const json_t *result, void *ctx);
+json_t *queue_list_json_with(struct queue *q, queue_list_fn fn, void *ctx);
+
 /* Copies the job's directory; false when there is no such job. */
 bool queue_job_dir(struct queue *q, const char *id, char *dir, size_t cap,
                    enum job_status *status);

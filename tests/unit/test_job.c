@@ -146,6 +146,39 @@ int main(void)
     rejects("{\"look\":{\"hdr\":\"rgb8\"}}", "look.hdr");
     rejects("{\"look\":{\"tonemap\":\"aces\"}}", "look.tonemap");
 
+    /* Labels: sorted by key, kept in the spec as understood, and round-tripped. */
+    CHECK(parse("{\"labels\":{\"commit\":\"abc123\",\"branch\":\"main\",\"ci.run\":\"\"}}",
+                &spec, &err));
+    CHECK(spec.nlabels == 3 && strcmp(spec.labels[0].key, "branch") == 0 &&
+          strcmp(spec.labels[1].key, "ci.run") == 0 && strcmp(spec.labels[2].value, "abc123") == 0);
+    j = job_spec_to_json(&spec);
+    CHECK(strcmp(json_string_value(json_object_get(json_object_get(j, "labels"), "commit")),
+                 "abc123") == 0);
+    text = json_dumps(j, 0);
+    CHECK(parse(text, &again, &err) && memcmp(&again, &spec, sizeof(spec)) == 0);
+    free(text);
+    json_decref(j);
+    CHECK(parse("{}", &spec, &err) && spec.nlabels == 0);
+    j = job_spec_to_json(&spec);
+    CHECK(json_object_size(json_object_get(j, "labels")) == 0);
+    json_decref(j);
+    rejects("{\"labels\":[\"main\"]}", "labels");
+    rejects("{\"labels\":{\"commit\":5}}", "labels.commit");
+    rejects("{\"labels\":{\"bad key\":\"x\"}}", "labels.bad key");
+    rejects("{\"labels\":{\"\":\"x\"}}", "labels.");
+    rejects("{\"labels\":{\"k\":\"a\\nb\"}}", "labels.k");
+    {
+        char big[400];
+        snprintf(big, sizeof(big), "{\"labels\":{\"v\":\"%0200d\"}}", 0);
+        rejects(big, "labels.v");
+        char many[600] = "{\"labels\":{";
+        for (int i = 0; i < JOB_MAX_LABELS + 1; i++)
+            snprintf(many + strlen(many), sizeof(many) - strlen(many), "%s\"k%d\":\"v\"",
+                     i ? "," : "", i);
+        strcat(many, "}}");
+        rejects(many, "labels");
+    }
+
     /* A typo gets a suggestion. */
     parse("{\"frame\":10}", &spec, &err);
     CHECK(strstr(err.message, "'frames'") != NULL);

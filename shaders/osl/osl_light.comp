@@ -7,8 +7,10 @@ layout(std430, binding = 3) readonly buffer TileBuffer { ivec4 tiles[]; };   // 
 layout(std430, binding = 4) readonly buffer WorkBuffer { uvec4 work[]; };
 layout(rgba8, binding = 0) writeonly uniform image2D u_atlas;
 
-uniform sampler2D u_position[2]; // per mesh, mip level l holds tiles of size base >> l
-uniform sampler2D u_normal[2];
+// Per mesh (SCENE_MESH_COUNT: sphere, cube, plane); mip level l holds tiles
+// of size base >> l.
+uniform sampler2D u_position[3];
+uniform sampler2D u_normal[3];
 uniform int u_work_count;
 uniform int u_groups_x;
 
@@ -34,12 +36,16 @@ void main()
     Instance inst = instances[instance];
     vec4 p, n;
     // The mesh differs between groups of one dispatch, so no dynamic indexing.
-    if (int(inst.albedo_mesh.w) == 0) {
+    int mesh = int(inst.albedo_mesh.w);
+    if (mesh == 0) {
         p = texelFetch(u_position[0], texel, tile.w);
         n = texelFetch(u_normal[0], texel, tile.w);
-    } else {
+    } else if (mesh == 1) {
         p = texelFetch(u_position[1], texel, tile.w);
         n = texelFetch(u_normal[1], texel, tile.w);
+    } else {
+        p = texelFetch(u_position[2], texel, tile.w);
+        n = texelFetch(u_normal[2], texel, tile.w);
     }
     vec3 color = vec3(0.0);
     if (p.w > 0.0) {

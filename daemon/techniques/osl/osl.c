@@ -19,6 +19,10 @@
 #include "daemon/techniques/technique.h"
 
 enum { SECTION_LIGHTING, SECTION_RASTER };
+
+/* shaders/osl/osl_light.comp has one position and one normal sampler per
+ * mesh and selects them by branch: keep both in step. */
+_Static_assert(SCENE_MESH_COUNT == 3, "osl_light.comp samples exactly three meshes");
 static const char *const sections[] = {"lighting", "raster", NULL};
 
 /* Atlas memory ceiling; the device's texture size limit applies as well. */

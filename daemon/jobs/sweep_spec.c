@@ -20,6 +20,12 @@ static const struct {
     {"scene.lights", PARAM_INT},        {"scene.dynamic", PARAM_BOOL},
     {"scene.width", PARAM_INT},         {"scene.height", PARAM_INT},
     {"scene.sphere_segments", PARAM_INT}, {"scene.light_speed", PARAM_NUMBER},
+    {"scene.preset", PARAM_CHOICE},     {"scene.light_layout", PARAM_CHOICE},
+    {"scene.light_radius", PARAM_NUMBER}, {"scene.light_intensity", PARAM_NUMBER},
+    {"scene.tessellation_error_px", PARAM_NUMBER}, {"scene.camera", PARAM_CHOICE},
+    {"scene.materials", PARAM_CHOICE},  {"scene.specular", PARAM_NUMBER},
+    {"scene.shininess", PARAM_NUMBER},  {"scene.metallic", PARAM_NUMBER},
+    {"scene.roughness", PARAM_NUMBER},
     {"osl.resolution", PARAM_CHOICE},   {"osl.texel_density", PARAM_NUMBER},
     {"osl.reshade", PARAM_CHOICE},
 };

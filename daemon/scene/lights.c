@@ -60,8 +60,8 @@ static void place_grid(const struct scene_box *b, int n, int i, float out[3])
 }
 
 /* About sqrt(n)/2 clusters at hashed centres (kept 15% inside the volume),
- * each light near its cluster's centre: a bell of width 6% of the volume
- * across and 15% of its height, clamped to the volume. */
+ * each light near its cluster's centre: a bell of width 3% of the volume
+ * across and 10% of its height, clamped to the volume. */
 static void place_clustered(const struct scene_box *b, int n, int i, float out[3])
 {
     int clusters = (int)fmax(1.0, lround(sqrt((double)n) / 2.0));
@@ -72,7 +72,7 @@ static void place_clustered(const struct scene_box *b, int n, int i, float out[3
         double bell = scene_hash01((uint32_t)i, 31u + (uint32_t)a) +
                       scene_hash01((uint32_t)i, 41u + (uint32_t)a) +
                       scene_hash01((uint32_t)i, 51u + (uint32_t)a) - 1.5;
-        double sigma = size * (a == 1 ? 0.15 : 0.06);
+        double sigma = size * (a == 1 ? 0.1 : 0.03);
         out[a] = (float)fmin(fmax(centre + 2.0 * sigma * bell, lo), (double)b->max[a]);
     }
 }

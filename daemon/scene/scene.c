@@ -233,22 +233,26 @@ static bool point_in_clip(const float view_proj[16], const float p[3])
     return c[3] > 0 && fabsf(c[0]) <= c[3] && fabsf(c[1]) <= c[3] && fabsf(c[2]) <= c[3];
 }
 
+bool scene_instance_in_view(const struct scene *s, int i, const struct scene_camera *c)
+{
+    const struct scene_instance *in = &s->instances[i];
+    float half[3];
+    instance_half_extent(in, half);
+    for (int corner = 0; corner < 8; corner++) {
+        float p[3];
+        for (int k = 0; k < 3; k++)
+            p[k] = in->pos[k] + (corner >> k & 1 ? half[k] : -half[k]);
+        if (!point_in_clip(c->view_proj, p))
+            return false;
+    }
+    return true;
+}
+
 int scene_instances_in_view(const struct scene *s, const struct scene_camera *c)
 {
     int n = 0;
-    for (int i = 0; i < s->instance_count; i++) {
-        const struct scene_instance *in = &s->instances[i];
-        float half[3];
-        instance_half_extent(in, half);
-        bool inside = true;
-        for (int corner = 0; corner < 8 && inside; corner++) {
-            float p[3];
-            for (int k = 0; k < 3; k++)
-                p[k] = in->pos[k] + (corner >> k & 1 ? half[k] : -half[k]);
-            inside = point_in_clip(c->view_proj, p);
-        }
-        n += inside;
-    }
+    for (int i = 0; i < s->instance_count; i++)
+        n += scene_instance_in_view(s, i, c);
     return n;
 }
 

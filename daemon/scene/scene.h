@@ -138,7 +138,9 @@ int scene_auto_segments(double radius_px, double bound_px);
 /* Triangles submitted per drawn frame. */
 uint64_t scene_triangles(const struct scene *s);
 
-/* Instances whose bounding sphere lies entirely inside camera c's frustum. */
+/* True when instance i's axis-aligned box lies entirely inside camera c's
+ * frustum; scene_instances_in_view counts such instances. */
+bool scene_instance_in_view(const struct scene *s, int i, const struct scene_camera *c);
 int scene_instances_in_view(const struct scene *s, const struct scene_camera *c);
 /* True when every instance's bounding sphere lies inside the frame-0 frustum. */
 bool scene_all_in_view(const struct scene *s);

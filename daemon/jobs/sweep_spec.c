@@ -22,6 +22,12 @@ static const struct {
     {"scene.width", PARAM_INT},         {"scene.height", PARAM_INT},
     {"scene.sphere_segments", PARAM_INT}, {"scene.light_speed", PARAM_NUMBER},
     {"look.lighting", PARAM_CHOICE},    {"look.hdr", PARAM_CHOICE},
+    {"scene.preset", PARAM_CHOICE},     {"scene.light_layout", PARAM_CHOICE},
+    {"scene.light_radius", PARAM_NUMBER}, {"scene.light_intensity", PARAM_NUMBER},
+    {"scene.tessellation_error_px", PARAM_NUMBER}, {"scene.camera", PARAM_CHOICE},
+    {"scene.materials", PARAM_CHOICE},  {"scene.specular", PARAM_NUMBER},
+    {"scene.shininess", PARAM_NUMBER},  {"scene.metallic", PARAM_NUMBER},
+    {"scene.roughness", PARAM_NUMBER},
 };
 enum { NPARAMS = sizeof(PARAMS) / sizeof(PARAMS[0]) };
 

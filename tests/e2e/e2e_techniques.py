@@ -1,7 +1,8 @@
 """The technique contract, over the registry as /v1/info describes it, so a
 technique added later is tested without new test code:
 - conformance: every technique but unlit, at default options, agrees with
-  forward under the same look (SSIM bound), runs every pass it declares plus
+  forward under the same look (SSIM bound), on the grid and on the lights
+  preset with an orbiting camera, runs every pass it declares plus
   the harness's resolve, and reports them in the result and timings.csv;
 - options: /v1/info documents each option (type, default, rule); the defaults
   are accepted and come back in the spec unchanged; a bad value of each
@@ -86,6 +87,15 @@ try:
         if name != "unlit":
             ssim = result.get("quality", {}).get("worst_ssim", {}).get("value", 0)
             check(ssim >= SSIM_BOUND, "%s agrees with forward: SSIM %.5f >= %s" % (name, ssim, SSIM_BOUND))
+            # The many-lights scene under a moving camera: the frame block's
+            # camera reaches every pass of the technique.
+            moving = dict(JOB, technique=name, reference="forward",
+                          scene=dict(SCENE, preset="lights", lights=64, camera="orbit"))
+            done = d.run(moving)
+            ssim = done.get("result", {}).get("quality", {}).get("worst_ssim", {}).get("value", 0)
+            check(done.get("status") == "done" and ssim >= SSIM_BOUND,
+                  "%s agrees with forward on lights with an orbiting camera: SSIM %.5f (%s)"
+                  % (name, ssim, done.get("error")))
 
         # A bad value of each option is refused, naming it.
         for oname, opt in t.get("options", {}).items():

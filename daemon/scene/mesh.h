@@ -1,7 +1,9 @@
 #ifndef SHADEBENCH_MESH_H
 #define SHADEBENCH_MESH_H
 
-/* Procedural meshes with UV layouts for object-space shading. GL-free.
+/* Procedural meshes with UV layouts for object-space shading. GL-free; a
+ * mesh belongs to the thread that built it, and reading one is safe from
+ * any number of threads.
  * Every chart is an axis-aligned rectangle in UV space that the mesh's
  * triangles cover completely, so a texel whose centre lies inside a chart is
  * always written by the UV-space rasterization; samplers clamp to those

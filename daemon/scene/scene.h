@@ -146,7 +146,8 @@ bool scene_all_in_view(const struct scene *s);
 /* The scene as built, for the job's result: instances (by mesh), lights
  * (count, layout, radius, volume, how many reach each object, how many are
  * on screen), triangles per frame, the sphere tessellation ("auto": its
- * choice, radius and error), the camera path and the bounds. New reference. */
+ * choice, radius and error), the camera path and the bounds. New reference,
+ * or NULL when out of memory. Costs instances x lights distance tests. */
 json_t *scene_describe(const struct scene *s);
 
 #endif

@@ -54,8 +54,14 @@ try:
     names = [t.get("name") for t in techs]
     check(status == 200 and {"forward", "unlit", "osl"} <= set(names), "info lists techniques: %s" % names)
 
+    sweepable = info.get("sweepable", {})
+    check(sweepable.get("scene.lights") == "integer" and sweepable.get("osl.resolution") == "choice",
+          "info lists what sweeps may vary: %s" % sorted(sweepable)[:8])
+
     for t in techs:
         name = t["name"]
+        for oname in t.get("options", {}):
+            check("%s.%s" % (name, oname) in sweepable, "%s.%s is sweepable" % (name, oname))
         check(t.get("summary") and t.get("passes"), "%s: summary and passes documented" % name)
         for oname, opt in t.get("options", {}).items():
             check(all(k in opt for k in ("type", "default", "rule", "summary")),

@@ -20,7 +20,7 @@ from testlib import check
 testlib.skip_without_egl()
 SMALL = {"frames": 5, "warmup_frames": 1, "scene": {"width": 64, "height": 48}}
 WITH_REF = dict(SMALL, capture_interval=5, reference="forward")
-SLOW_BASE = {"frames": 400, "warmup_frames": 0, "scene": {"width": 64, "height": 48}}
+SLOW_BASE = {"frames": 100, "warmup_frames": 0, "scene": {"width": 64, "height": 48}}
 
 
 def read(path, mode="r"):

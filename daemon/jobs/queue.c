@@ -373,8 +373,6 @@ void queue_finish(struct queue *q, struct job *job, enum job_status status,
 
     pthread_mutex_lock(&q->lock);
     if (requeue) {
-        LOG(LOG_INFO, "job %s: stopped by the daemon's exit; back to the head of the queue",
-            job->id);
         job->status = JOB_QUEUED;
         job->phase = NULL;
         job->started = 0;
@@ -400,6 +398,9 @@ void queue_finish(struct queue *q, struct job *job, enum job_status status,
     pthread_mutex_unlock(&q->lock);
     if (again)
         write_snapshot(q, &snap, NULL, 0);
+    if (requeue)
+        LOG(LOG_INFO, "job %s: stopped by the daemon's exit; back to the head of the queue",
+            job->id);
     apply_retention(q);
 }
 

@@ -671,11 +671,26 @@ static void load_job(void *ctx, const char *id, const char *dir)
         json_decref(o);
 
         if (job->status == JOB_RUNNING) {
-            job->status = JOB_INTERRUPTED;
-            job->finished = clock_unix_s();
-            snprintf(job->error, sizeof(job->error),
-                     "interrupted: the daemon stopped (killed or crashed) while this job ran; "
-                     "its files may be incomplete, submit it again to measure it");
+            /* A complete result.json is the last thing a job writes before it
+             * is done: the daemon died (or the disk was full) between that
+             * and writing job.json. Anything less was cut short. */
+            snprintf(path, sizeof(path), "%s/result.json", dir);
+            json_t *result = access(path, F_OK) == 0 ? record_read(path, why, sizeof(why)) : NULL;
+            if (result && result_complete(&job->spec, result)) {
+                job->status = JOB_DONE;
+                job->result = result;
+                job->finished = file_mtime(path);
+                atomic_store(&job->frames_done, job->frames_total);
+                LOG(LOG_WARN, "job %s: job.json says running, but its result.json is complete: "
+                    "done", id);
+            } else {
+                json_decref(result);
+                job->status = JOB_INTERRUPTED;
+                job->finished = clock_unix_s();
+                snprintf(job->error, sizeof(job->error),
+                         "interrupted: the daemon stopped (killed or crashed) while this job ran; "
+                         "its files may be incomplete, submit it again to measure it");
+            }
             changed = true;
         } else if (job->status == JOB_DONE) {
             snprintf(path, sizeof(path), "%s/result.json", dir);

@@ -58,10 +58,11 @@ def wait_for(pred, timeout=60):
 first = testlib.Daemon()
 state = first.state
 jobs_dir = os.path.join(state, "jobs")
-names = ["empty", "garbage", "truncated", "with_ref", "bad_result", "nothing_left"]
+names = ["empty", "garbage", "truncated", "with_ref", "bad_result", "nothing_left",
+         "died_after_result", "died_before_metrics"]
 ids, before = {}, {}
 for name in names:
-    ids[name] = first.submit(WITH_REF if name == "with_ref" else SMALL)
+    ids[name] = first.submit(WITH_REF if name in ("with_ref", "died_before_metrics") else SMALL)
 for name in names:
     before[name] = first.wait(ids[name])
     check(before[name]["status"] == "done", "%s: done first" % name)
@@ -78,6 +79,15 @@ write(os.path.join(jd["with_ref"], "job.json"), text[: len(text) // 3])
 write(os.path.join(jd["bad_result"], "result.json"), "{\"frames\": ")
 os.remove(os.path.join(jd["nothing_left"], "job.json"))
 os.remove(os.path.join(jd["nothing_left"], "spec.json"))
+# Killed between writing result.json and job.json: complete, so done; killed
+# before the metrics completed it: interrupted.
+for name in ("died_after_result", "died_before_metrics"):
+    record = json.loads(read(os.path.join(jd[name], "job.json")))
+    record["status"] = "running"
+    write(os.path.join(jd[name], "job.json"), json.dumps(record))
+result = json.loads(read(os.path.join(jd["died_before_metrics"], "result.json")))
+del result["quality"]
+write(os.path.join(jd["died_before_metrics"], "result.json"), json.dumps(result))
 os.mkdir(os.path.join(jobs_dir, "not-a-job"))
 os.mkdir(os.path.join(jobs_dir, "20990101-000000-0042"))  # an id, but empty
 tmp_files = [os.path.join(jd["empty"], "job.json.tmp"), os.path.join(jd["garbage"], "timings.csv.tmp"),
@@ -117,6 +127,11 @@ try:
           "a damaged result.json: job failed, saying where the file went: %s" % job.get("error"))
     check(any(ids["bad_result"] in e and "result.json" in e for e in q), "the damaged result.json is quarantined")
 
+    job = second.json("GET", "/v1/jobs/" + ids["died_after_result"])[1]
+    check(job.get("status") == "done" and job.get("result") == before["died_after_result"]["result"],
+          "running on disk with a complete result.json: done (%s)" % job.get("status"))
+    job = second.json("GET", "/v1/jobs/" + ids["died_before_metrics"])[1]
+    check(job.get("status") == "interrupted", "running on disk, metrics missing: interrupted (%s)" % job.get("status"))
     check(second.json("GET", "/v1/jobs/" + ids["nothing_left"])[0] == 404, "a job that cannot be rebuilt is not served")
     moved = [e for e in q if e.startswith("jobs-" + ids["nothing_left"]) and not e.endswith(".reason")]
     check(len(moved) == 1 and os.path.exists(os.path.join(quarantine, moved[0], "result.json")),

@@ -401,7 +401,8 @@ static enum MHD_Result sweep_routes(struct http_server *s, struct MHD_Connection
             sweep_spec_finish(&spec);
             json_decref(body);
             if (r == QUEUE_IO_ERROR) /* not persisted, so not accepted */
-                return respond_error(c, MHD_HTTP_INSUFFICIENT_STORAGE, "state_dir", queue_submit_error());
+                return respond_error(c, MHD_HTTP_INSUFFICIENT_STORAGE, "state_dir",
+                                     queue_submit_error());
             if (r != QUEUE_OK)
                 return respond_error(c, MHD_HTTP_TOO_MANY_REQUESTS, "body",
                                      "too many sweeps are waiting; retry later");

@@ -76,8 +76,8 @@ try:
             r = b["result"]
             interf = r.get("interference", {})
             after = None
-            if a:
-                after = interf.get("timed_start_unix", 0) >= unix(a["finished"])
+            if a:  # B's timed region (or, from a daemon without it, B's start) after A finished
+                after = interf.get("timed_start_unix", unix(b["started"])) >= unix(a["finished"])
             (alone if case == "alone" else behind).append(r["frame_ms"]["median"])
             rounds.append({"round": i + 1, "case": case, "frame_ms": r["frame_ms"]["median"],
                            "b_timed_after_a_finished": after, "interference": interf,

@@ -183,9 +183,8 @@ static enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *
     }
     case QUEUE_STOPPING:
         return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "body", "the daemon is stopping");
-    default:
-        return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "body",
-                             "cannot create the job's directory under the state directory");
+    default: /* QUEUE_IO_ERROR: not persisted, so not accepted */
+        return respond_error(c, MHD_HTTP_INSUFFICIENT_STORAGE, "state_dir", queue_submit_error());
     }
     char url[64];
     snprintf(url, sizeof(url), "/v1/jobs/%s", id);
@@ -408,10 +407,13 @@ static enum MHD_Result sweep_routes(struct http_server *s, struct MHD_Connection
                 return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
             }
             char id[24];
-            bool ok = sweeps_submit(s->sweeps, &spec, body, id);
+            enum queue_submit_result r = sweeps_submit(s->sweeps, &spec, body, id);
             sweep_spec_finish(&spec);
             json_decref(body);
-            if (!ok)
+            if (r == QUEUE_IO_ERROR) /* not persisted, so not accepted */
+                return respond_error(c, MHD_HTTP_INSUFFICIENT_STORAGE, "state_dir",
+                                     queue_submit_error());
+            if (r != QUEUE_OK)
                 return respond_error(c, MHD_HTTP_TOO_MANY_REQUESTS, "body",
                                      "too many sweeps are waiting; retry later");
             char url[64];

@@ -13,6 +13,7 @@
 #include "common/log.h"
 #include "daemon/quality/metrics.h"
 #include "common/png_io.h"
+#include "daemon/harness/telemetry.h"
 
 struct task {
     struct job *job;
@@ -116,6 +117,8 @@ static void run_task(struct metrics_worker *w, struct task *t)
         json_object_set_new(summary, "captures_compared", json_integer((json_int_t)i + 1));
     }
     clock_gettime(CLOCK_MONOTONIC, &t1);
+    telemetry_metrics((double)(t1.tv_sec - t0.tv_sec) + (double)(t1.tv_nsec - t0.tv_nsec) / 1e9,
+                      (unsigned)json_integer_value(json_object_get(summary, "captures_compared")));
     if (ok) {
         json_t *failed = json_object_get(summary, "pdiff_failed_frames");
         json_object_set_new(summary, "pdiff_failed_captures",

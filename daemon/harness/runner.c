@@ -17,6 +17,7 @@
 #include "daemon/gpu/gpu_scene.h"
 #include "daemon/gpu/gpu_timer.h"
 #include "common/log.h"
+#include "daemon/harness/telemetry.h"
 #include "daemon/harness/metrics_stage.h"
 #include "common/png_io.h"
 #include "daemon/service.h"
@@ -410,6 +411,7 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
         if ((seq & 15) == 15 && gl_error_take("rendering", run->err, sizeof(run->err)))
             return false;
         queue_progress(r->queue, job, run_index * n + (k > 0 ? (int)k : 0));
+        telemetry_frames(1);
     }
     glFinish();
     double wall_end = mono_s();
@@ -584,8 +586,11 @@ static void *runner_main(void *arg)
         egl_context_platform(egl), gl_str(GL_RENDERER), gl_str(GL_VERSION));
 
     struct job *job;
-    while ((job = queue_next(r->queue)))
+    while ((job = queue_next(r->queue))) {
+        double busy_from = telemetry_now();
         run_job(r, job);
+        telemetry_render_busy(telemetry_now() - busy_from);
+    }
     atomic_store(&r->alive, false);
     egl_context_destroy(egl);
     return NULL;

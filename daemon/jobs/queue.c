@@ -26,7 +26,17 @@ struct queue {
     int keep_jobs;
     double keep_days;
     char state_dir[PATH_MAX];
+    void (*listener)(void *ctx);
+    void *listener_ctx;
 };
+
+void queue_set_listener(struct queue *q, void (*fn)(void *ctx), void *ctx)
+{
+    q->listener = fn;
+    q->listener_ctx = ctx;
+}
+
+#define NOTIFY_LISTENER(q) ((q)->listener ? (q)->listener((q)->listener_ctx) : (void)0)
 
 const char *job_status_name(enum job_status s)
 {
@@ -200,6 +210,7 @@ void queue_finish(struct queue *q, struct job *job, enum job_status status,
     job->result = result;
     persist_locked(job);
     pthread_cond_broadcast(&q->changed);
+    NOTIFY_LISTENER(q);
     pthread_mutex_unlock(&q->lock);
     apply_retention(q);
 }
@@ -213,6 +224,7 @@ void queue_stop(struct queue *q)
         if (q->jobs[i]->status == JOB_RUNNING)
             atomic_store(&q->jobs[i]->cancel, true);
     pthread_cond_broadcast(&q->changed);
+    NOTIFY_LISTENER(q);
     pthread_mutex_unlock(&q->lock);
 }
 
@@ -232,6 +244,7 @@ enum queue_cancel_result queue_cancel(struct queue *q, const char *id)
         persist_locked(job);
         res = CANCEL_DONE;
         pthread_cond_broadcast(&q->changed);
+        NOTIFY_LISTENER(q);
         break;
     case JOB_RUNNING:
         atomic_store(&job->cancel, true);

@@ -23,6 +23,7 @@
 #include "daemon/api/routes.h"
 #include "daemon/harness/telemetry.h"
 #include "daemon/jobs/job_spec.h"
+#include "daemon/quality/metrics.h"
 #include "daemon/techniques/technique.h"
 
 #ifndef MHD_HTTP_CONTENT_TOO_LARGE
@@ -217,8 +218,31 @@ static enum MHD_Result respond_file(struct MHD_Connection *c, const char *path,
     return ret;
 }
 
+/* The daemon's memory budget: what its own buffers can reach at the limits
+ * the API accepts, by part. The GL driver's memory (framebuffers, textures,
+ * compiled shaders) is the driver's and not counted. */
+static json_t *memory_json(const struct http_server *s, double *total)
+{
+    const double side = 8192.0, frame = side * side * 4.0;
+    /* The render thread's captures (bounded per job) and one read-back frame
+     * for the reference; its per-frame series (3 doubles a frame, 1,000,000
+     * frames at most). */
+    double captures = JOB_MAX_CAPTURE_BYTES, render = frame + 1e6 * 3 * sizeof(double);
+    /* The metrics thread scores the previous job while the next renders: its
+     * bound at the largest image and the widest FLIP filter. */
+    double metrics = metrics_memory_bytes(8192, 8192, 1000.0);
+    /* libmicrohttpd's per-connection pool plus a body buffer, per connection. */
+    double http = (double)s->limits.max_connections * (CONNECTION_MEMORY + JOB_MAX_BODY_BYTES);
+    *total = captures + render + metrics + http;
+    return json_pack("{s:f, s:f, s:f, s:f, s:f, s:s}", "budget_bytes", *total, "captures_bytes",
+                     captures, "render_bytes", render, "metrics_bytes", metrics, "http_bytes",
+                     http, "excludes", "the GL driver's own memory");
+}
+
 static json_t *info_json(struct http_server *s)
 {
+    double total;
+    json_t *memory = memory_json(s, &total);
     json_t *techs = json_array();
     for (const struct technique *const *t = technique_registry; *t; t++) {
         json_t *sections = json_array();
@@ -229,15 +253,18 @@ static json_t *info_json(struct http_server *s)
                                                "gpu_sections", sections));
     }
     const struct http_limits *l = &s->limits;
-    return json_pack("{s:s, s:s, s:s, s:o, s:o, s:{s:i, s:i, s:i, s:I, s:I, s:f, s:f, s:I}}",
-                     "name", "shadebenchd", "version", PACKAGE_VERSION, "api", "v1", "device",
+    return json_pack("{s:s, s:s, s:s, s:o, s:o, s:o, s:{s:i, s:i, s:i, s:I, s:I, s:f, s:f, s:I, "
+                     "s:I, s:I}}",
+                     "name", "shadebenchd", "version", PACKAGE_VERSION, "api", "v1", "memory",
+                     memory, "device",
                      runner_device_json(s->runner), "techniques", techs, "limits",
                      "max_body_bytes", JOB_MAX_BODY_BYTES, "max_queued_jobs",
                      queue_max_queued(s->queue), "max_wait_s", MAX_WAIT_S, "max_connections",
                      (json_int_t)l->max_connections, "max_connections_per_ip",
                      (json_int_t)l->max_connections_per_ip, "header_timeout_s",
                      l->header_timeout_s, "body_timeout_s", l->body_timeout_s,
-                     "max_token_bytes", (json_int_t)HTTP_MAX_TOKEN_BYTES);
+                     "max_token_bytes", (json_int_t)HTTP_MAX_TOKEN_BYTES, "max_captures",
+                     (json_int_t)JOB_MAX_CAPTURES, "max_image_pixels", (json_int_t)IMAGE_MAX_PIXELS);
 }
 
 /* GET /metrics: Prometheus text format 0.0.4. */
@@ -313,6 +340,11 @@ static enum MHD_Result respond_metrics(struct http_server *s, struct MHD_Connect
             fprintf(f, "shadebench_http_requests_total{route=\"%s\",code=\"%s\"} %llu\n",
                     route_label((enum route_kind)r), code, n);
         }
+    double budget;
+    json_decref(memory_json(s, &budget));
+    fprintf(f, "# HELP shadebench_memory_budget_bytes The daemon's memory budget (parts in /v1/info).\n"
+               "# TYPE shadebench_memory_budget_bytes gauge\n"
+               "shadebench_memory_budget_bytes %.0f\n", budget);
     if (fclose(f) != 0 || !text) {
         free(text);
         return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "metrics", "out of memory");

@@ -242,6 +242,9 @@ bool job_spec_parse(const json_t *body, const char *const *techniques,
     if (out->capture_interval > out->frames)
         return job_error_set(err, "capture_interval",
                     "must be 0 (no captures) or at most frames (%d)", out->frames);
+    if (job_spec_capture_count(out) > JOB_MAX_CAPTURES)
+        return job_error_set(err, "capture_interval", "would capture %d frames; at most %d a job",
+                             job_spec_capture_count(out), JOB_MAX_CAPTURES);
     /* Captured frames are kept in memory until the timed run ends, so that
      * encoding never lands inside the measurement: bound that memory. */
     double bytes = (double)job_spec_capture_count(out) * out->scene.width *

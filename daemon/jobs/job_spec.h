@@ -14,6 +14,7 @@
 
 #define JOB_MAX_BODY_BYTES (64 * 1024)
 #define JOB_MAX_CAPTURE_BYTES (1024.0 * 1024.0 * 1024.0)
+#define JOB_MAX_CAPTURES 1000
 
 enum osl_reshade {
     OSL_RESHADE_TOUCHED, /* only objects a moving light reaches */

@@ -301,4 +301,89 @@ out = testlib.subprocess.run([testlib.SHADEBENCHD, "--listen", "127.0.0.1:0", "-
 check(out.returncode != 0 and "longer than the 4096 bytes" in out.stderr,
       "a 5000-byte token is refused at start, saying why: %r" % out.stderr[-200:])
 testlib.shutil.rmtree(tmpdir, ignore_errors=True)
+
+# Memory: shadebench-compare states its budget and stays within it; images
+# over 8192x8192 are refused before they are decoded.
+import struct
+import zlib
+
+
+def png_bytes(width, height, rows):
+    def chunk(kind, data):
+        return (struct.pack(">I", len(data)) + kind + data +
+                struct.pack(">I", zlib.crc32(kind + data) & 0xffffffff))
+    raw_rows = b"".join(b"\0" + r for r in rows)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)) +
+            chunk(b"IDAT", zlib.compress(raw_rows, 9)) + chunk(b"IEND", b""))
+
+
+COMPARE = os.environ.get("SHADEBENCH_COMPARE", "./shadebench-compare")
+tmpdir = testlib.tempfile.mkdtemp(prefix="shadebench-mem-")
+try:
+    huge = os.path.join(tmpdir, "huge.png")
+    with open(huge, "wb") as f:
+        f.write(png_bytes(100000, 100000, [b"\0" * 300]))
+    out = testlib.subprocess.run([COMPARE, huge, huge], capture_output=True, text=True)
+    check(out.returncode == 2 and "over the limit" in out.stderr,
+          "compare refuses a 100000x100000 PNG at once: %r" % out.stderr)
+    side = 2048
+    rows_a = [bytes((x * 7 + y * 3 + c * 50) % 256 for x in range(side) for c in range(3))
+              for y in range(0, side, 64)]
+    a_path, b_path = os.path.join(tmpdir, "a.png"), os.path.join(tmpdir, "b.png")
+    with open(a_path, "wb") as f:
+        f.write(png_bytes(side, side, [rows_a[(y // 64)] for y in range(side)]))
+    with open(b_path, "wb") as f:
+        f.write(png_bytes(side, side, [rows_a[(y // 64 + 1) % len(rows_a)] for y in range(side)]))
+    # Measured in a fresh process: this one's children include daemons.
+    probe = ("import resource, subprocess, sys\n"
+             "out = subprocess.run(sys.argv[1:], capture_output=True, text=True)\n"
+             "sys.stderr.write('%d\\n' % resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)\n"
+             "sys.stdout.write(out.stdout)\n"
+             "sys.exit(out.returncode)\n")
+    out = testlib.subprocess.run([testlib.sys.executable, "-c", probe, COMPARE, a_path, b_path,
+                                  "--diff-out", tmpdir], capture_output=True, text=True)
+    peak = int(out.stderr.strip().splitlines()[-1]) * 1024
+    res = json.loads(out.stdout) if out.returncode in (0, 1) else {}
+    budget = res.get("memory_budget_bytes", 0)
+    # The process's own baseline (code, libraries, libpng) comes on top.
+    print("compare %dx%d: peak %.1f MiB, stated budget %.1f MiB" % (side, side, peak / 2**20,
+                                                                   budget / 2**20))
+    check(budget > 0 and peak <= budget + 32 * 2**20,
+          "compare at %d^2 peaks at %.0f MiB, within its stated %.0f MiB (+32 MiB of process)"
+          % (side, peak / 2**20, budget / 2**20))
+finally:
+    testlib.shutil.rmtree(tmpdir, ignore_errors=True)
+
+# Cancel in the metrics phase: the job ends cancelled within a metric tile,
+# not done after every capture was scored.
+d = testlib.Daemon()
+try:
+    status, info = d.json("GET", "/v1/info")
+    mem = info.get("memory", {})
+    check(mem.get("budget_bytes", 0) > mem.get("metrics_bytes", 0) > 0 and
+          info.get("limits", {}).get("max_captures") == 1000,
+          "/v1/info states the memory budget by part: %s" % mem)
+    job = d.submit({"frames": 12, "warmup_frames": 0, "capture_interval": 1, "reference": "forward",
+                    "scene": {"width": 1024, "height": 1024, "lights": 2}})
+    deadline = time.time() + 120
+    phase = None
+    while time.time() < deadline:
+        body = d.json("GET", "/v1/jobs/" + job)[1]
+        phase = body.get("phase")
+        if phase == "metrics" or body.get("status") not in ("queued", "running"):
+            break
+        time.sleep(0.05)
+    check(phase == "metrics", "the job reaches its metrics phase (%s)" % phase)
+    time.sleep(0.3)
+    t0 = time.time()
+    status, body = d.json("DELETE", "/v1/jobs/" + job)
+    final = d.wait(job)
+    took = time.time() - t0
+    print("cancel in the metrics phase: %s after %.2f s: %s" % (final["status"], took, final.get("error")))
+    check(final["status"] == "cancelled" and "metrics" in final.get("error", ""),
+          "DELETE in the metrics phase ends the job cancelled: %s %s" % (final["status"], final.get("error")))
+    check(took < 2.0, "within a metric tile (%.2f s)" % took)
+    check(d.json("GET", "/healthz")[0] == 200, "daemon healthy after")
+finally:
+    testlib.stop_and_check(d)
 testlib.finish("e2e_hardening")

@@ -101,6 +101,12 @@ int main(void)
     rejects("{\"osl\":{\"reshade\":\"some\"}}", "osl.reshade");
     rejects("{\"osl\":{\"resolutoin\":256}}", "osl.resolutoin");
 
+    /* At most 1000 captures a job, however small the frames. */
+    rejects("{\"frames\":100000,\"capture_interval\":99,\"scene\":{\"width\":16,\"height\":16}}",
+            "capture_interval");
+    CHECK(parse("{\"frames\":100000,\"capture_interval\":100,\"scene\":{\"width\":16,"
+                "\"height\":16}}", &spec, &err) && job_spec_capture_count(&spec) == 1000);
+
     /* A typo gets a suggestion. */
     parse("{\"frame\":10}", &spec, &err);
     CHECK(strstr(err.message, "'frames'") != NULL);

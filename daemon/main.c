@@ -35,6 +35,7 @@ struct options {
     double keep_days;
     int max_connections;
     int max_connections_per_ip;
+    double job_timeout;
     bool list_devices;
     bool gl_debug;
 };
@@ -56,6 +57,8 @@ static void usage(FILE *f)
             "                       FILE on every endpoint but /healthz (SIGHUP rereads it)\n"
             "  --keep-jobs N        keep the newest N finished jobs, remove older ones' files\n"
             "  --keep-days D        remove finished jobs older than D days\n"
+            "  --job-timeout S      running time a job may take when it gives no timeout_s\n"
+            "                       (default 86400; 0: no limit)\n"
             "  --max-connections N  HTTP connections open at once, in total (default 4096)\n"
             "  --max-connections-per-ip N\n"
             "                       HTTP connections open at once from one address (default 64)\n"
@@ -69,10 +72,12 @@ static void usage(FILE *f)
             "  --version, --help\n\n"
             "Settings come from, in rising order: defaults, the config file (lines of\n"
             "\"key = value\": listen, state-dir, device, queue-size, token, keep-jobs,\n"
-            "keep-days, max-connections, max-connections-per-ip, log-level), the environment (SHADEBENCH_LISTEN, SHADEBENCH_STATE_DIR,\n"
+            "keep-days, job-timeout, max-connections, max-connections-per-ip, log-level),\n"
+            "the environment (SHADEBENCH_LISTEN, SHADEBENCH_STATE_DIR,\n"
             "SHADEBENCH_DEVICE, SHADEBENCH_QUEUE_SIZE, SHADEBENCH_TOKEN_FILE,\n"
-            "SHADEBENCH_KEEP_JOBS, SHADEBENCH_KEEP_DAYS, SHADEBENCH_MAX_CONNECTIONS,\n"
-            "SHADEBENCH_MAX_CONNECTIONS_PER_IP, SHADEBENCH_LOG_LEVEL), the flags.\n");
+            "SHADEBENCH_KEEP_JOBS, SHADEBENCH_KEEP_DAYS, SHADEBENCH_JOB_TIMEOUT,\n"
+            "SHADEBENCH_MAX_CONNECTIONS, SHADEBENCH_MAX_CONNECTIONS_PER_IP,\n"
+            "SHADEBENCH_LOG_LEVEL), the flags.\n");
 }
 
 static bool parse_int(const char *s, int min, int max, int *out)
@@ -118,6 +123,9 @@ static bool apply_setting(struct options *o, const char *key, const char *value,
     } else if (strcmp(key, "keep-days") == 0) {
         if (!parse_number(value, 0, 1e6, &o->keep_days))
             rule = "must be a number of days from 0 (keep all)";
+    } else if (strcmp(key, "job-timeout") == 0) {
+        if (!parse_number(value, 0, 1e7, &o->job_timeout))
+            rule = "must be a number of seconds from 0 (no limit) to 10000000";
     } else if (strcmp(key, "max-connections") == 0) {
         if (!parse_int(value, 16, 1000000, &o->max_connections))
             rule = "must be an integer from 16 to 1000000";
@@ -182,7 +190,8 @@ static bool load_config(struct options *o, const char *path, bool required)
 static bool load_environment(struct options *o)
 {
     static const char *const keys[] = {"listen", "state-dir", "device", "queue-size",
-                                       "token-file", "keep-jobs", "keep-days", "max-connections",
+                                       "token-file", "keep-jobs", "keep-days", "job-timeout",
+                                       "max-connections",
                                        "max-connections-per-ip", "log-level", NULL};
     for (const char *const *k = keys; *k; k++) {
         char name[64] = "SHADEBENCH_";
@@ -430,10 +439,10 @@ static int serve(const struct options *o)
 
 int main(int argc, char **argv)
 {
-    struct options o = {.device = -1, .queue_size = 64};
+    struct options o = {.device = -1, .queue_size = 64, .job_timeout = 86400};
     snprintf(o.listen, sizeof(o.listen), "127.0.0.1:8460");
     enum { OPT_LISTEN = 256, OPT_STATE, OPT_DEVICE, OPT_QUEUE, OPT_TOKEN, OPT_KEEP_JOBS,
-           OPT_KEEP_DAYS, OPT_MAX_CONN, OPT_MAX_CONN_IP, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_ONCE, OPT_OUT, OPT_DEBUG,
+           OPT_KEEP_DAYS, OPT_JOB_TIMEOUT, OPT_MAX_CONN, OPT_MAX_CONN_IP, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_ONCE, OPT_OUT, OPT_DEBUG,
            OPT_LOG, OPT_VERSION, OPT_HELP };
     static const struct option longopts[] = {
         {"listen", required_argument, NULL, OPT_LISTEN},
@@ -443,6 +452,7 @@ int main(int argc, char **argv)
         {"token", required_argument, NULL, OPT_TOKEN},
         {"keep-jobs", required_argument, NULL, OPT_KEEP_JOBS},
         {"keep-days", required_argument, NULL, OPT_KEEP_DAYS},
+        {"job-timeout", required_argument, NULL, OPT_JOB_TIMEOUT},
         {"max-connections", required_argument, NULL, OPT_MAX_CONN},
         {"max-connections-per-ip", required_argument, NULL, OPT_MAX_CONN_IP},
         {"config", required_argument, NULL, OPT_CONFIG},
@@ -472,6 +482,7 @@ int main(int argc, char **argv)
         case OPT_TOKEN: key = "token"; break;
         case OPT_KEEP_JOBS: key = "keep-jobs"; break;
         case OPT_KEEP_DAYS: key = "keep-days"; break;
+        case OPT_JOB_TIMEOUT: key = "job-timeout"; break;
         case OPT_MAX_CONN: key = "max-connections"; break;
         case OPT_MAX_CONN_IP: key = "max-connections-per-ip"; break;
         case OPT_LOG: key = "log-level"; break;
@@ -503,6 +514,7 @@ int main(int argc, char **argv)
         if (!apply_setting(&o, flags[i].key, flags[i].value, origin))
             return 2;
     }
+    job_spec_set_default_timeout(o.job_timeout);
     if (o.list_devices)
         return list_devices();
     if (o.once) {

@@ -13,6 +13,7 @@
 #include "common/log.h"
 #include "daemon/quality/metrics.h"
 #include "common/png_io.h"
+#include "daemon/harness/deadline.h"
 #include "daemon/harness/telemetry.h"
 
 struct task {
@@ -31,11 +32,11 @@ struct metrics_worker {
 };
 
 /* The metric loops ask between tiles: a DELETE (or SIGTERM) sets the job's
- * cancel flag. */
+ * cancel flag, and the job's timeout_s may run out. */
 static bool cancel_requested(void *ctx)
 {
     const struct job *job = ctx;
-    return atomic_load(&job->cancel);
+    return atomic_load(&job->cancel) || job_timed_out(job);
 }
 
 /* Fills capture's metrics and URLs; updates the job-wide summary. */
@@ -120,11 +121,11 @@ static void run_task(struct metrics_worker *w, struct task *t)
     json_t *captures = json_object_get(t->result, "captures");
     size_t i;
     json_t *capture;
-    bool ok = true, cancelled = false;
+    bool ok = true, cancelled = false, timed_out = false;
     json_array_foreach(captures, i, capture) {
-        if ((cancelled = atomic_load(&job->cancel)) ||
-            !(ok = score_capture(job, capture, summary, err, sizeof(err)))) {
-            cancelled = cancelled || atomic_load(&job->cancel);
+        if (cancel_requested(job) || !(ok = score_capture(job, capture, summary, err, sizeof(err)))) {
+            cancelled = atomic_load(&job->cancel);
+            timed_out = !cancelled && job_timed_out(job);
             ok = false;
             break;
         }
@@ -153,6 +154,12 @@ static void run_task(struct metrics_worker *w, struct task *t)
     if (ok) {
         LOG(LOG_INFO, "job %s done: metrics for %zu captures", job->id, json_array_size(captures));
         queue_finish(w->queue, job, JOB_DONE, NULL, t->result);
+    } else if (timed_out) {
+        char msg[200];
+        job_timeout_message(job, "metrics", msg, sizeof(msg));
+        LOG(LOG_WARN, "job %s failed: %s", job->id, msg);
+        queue_finish(w->queue, job, JOB_FAILED, msg, NULL);
+        json_decref(t->result);
     } else if (cancelled) {
         LOG(LOG_INFO, "job %s cancelled in the metrics phase (%zu of %zu captures scored)", job->id,
             i, json_array_size(captures));

@@ -17,6 +17,7 @@
 #include "daemon/gpu/gpu_scene.h"
 #include "daemon/gpu/gpu_timer.h"
 #include "common/log.h"
+#include "daemon/harness/deadline.h"
 #include "daemon/harness/telemetry.h"
 #include "daemon/harness/metrics_stage.h"
 #include "common/png_io.h"
@@ -291,6 +292,10 @@ static bool render_reference(struct run *run, enum job_status *status)
             snprintf(run->err, sizeof(run->err), "cancelled while rendering the reference");
             goto out;
         }
+        if (job_timed_out(run->job)) {
+            job_timeout_message(run->job, "reference", run->err, sizeof(run->err));
+            goto out;
+        }
         void *state = NULL;
         char why[900] = "";
         if (!ref->create(&ctx, &state, why, sizeof(why))) {
@@ -371,6 +376,10 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
             *status = JOB_CANCELLED;
             snprintf(run->err, sizeof(run->err), "cancelled at frame %" PRId64 " of run %d", k,
                      run_index + 1);
+            return false;
+        }
+        if (job_timed_out(job)) {
+            job_timeout_message(job, "rendering", run->err, sizeof(run->err));
             return false;
         }
         if (k == 1) {

@@ -27,6 +27,11 @@ static bool get_technique(const json_t *v, const char *field, const char *const 
     return job_error_set(err, field, "must be one of: %s%s", list, nullable ? ", or null" : "");
 }
 
+static double default_timeout_s;
+
+void job_spec_set_default_timeout(double seconds) { default_timeout_s = seconds; }
+double job_spec_default_timeout(void) { return default_timeout_s; }
+
 void job_spec_defaults(struct job_spec *out)
 {
     memset(out, 0, sizeof(*out));
@@ -43,6 +48,7 @@ void job_spec_defaults(struct job_spec *out)
     out->repeat_auto = false;
     out->reference[0] = '\0';
     metrics_options_defaults(&out->metrics);
+    out->timeout_s = default_timeout_s;
 }
 
 /* "repeat": N, or {"auto": true, "max": M}. */
@@ -193,7 +199,7 @@ bool job_spec_parse(const json_t *body, const char *const *techniques,
     static const char *const keys[] = {"technique", "frames", "warmup_frames",
                                        "capture_interval", "async_distance",
                                        "scene", "osl", "reference", "metrics", "repeat",
-                                       NULL};
+                                       "timeout_s", NULL};
     job_spec_defaults(out);
     memset(err, 0, sizeof(*err));
     if (!json_is_object(body))
@@ -221,7 +227,8 @@ bool job_spec_parse(const json_t *body, const char *const *techniques,
         !jf_get_int(body, "capture_interval", "capture_interval", 0, 1000000,
                  &out->capture_interval, err) ||
         !jf_get_number(body, "async_distance", "async_distance", 0.0, 1e6,
-                    &out->async_distance, err))
+                    &out->async_distance, err) ||
+        !jf_get_number(body, "timeout_s", "timeout_s", 0.0, 1e7, &out->timeout_s, err))
         return false;
 
     json_t *scene, *osl;
@@ -327,6 +334,7 @@ json_t *job_spec_to_json(const struct job_spec *spec)
                                           : json_integer(spec->repeat));
     json_object_set_new(out, "reference",
                         spec->reference[0] ? json_string(spec->reference) : json_null());
+    json_object_set_new(out, "timeout_s", json_real(spec->timeout_s));
     if (spec->reference[0])
         json_object_set_new(out, "metrics", metrics_to_json(&spec->metrics));
     return out;

@@ -40,7 +40,13 @@ struct job_spec {
     bool repeat_auto;              /* stop once the 95% interval is within 2.5% */
     char reference[32];            /* technique to compare captures with; "" for none */
     struct metrics_options metrics; /* used when reference is set */
+    double timeout_s;              /* running time allowed, all phases; 0: no limit */
 };
+
+/* The timeout_s a job gets when it names none (--job-timeout). Set once at
+ * start-up, before any thread parses jobs. */
+void job_spec_set_default_timeout(double seconds);
+double job_spec_default_timeout(void);
 
 
 /* Fills defaults, then applies and validates the body. techniques is a

@@ -384,6 +384,32 @@ try:
           "DELETE in the metrics phase ends the job cancelled: %s %s" % (final["status"], final.get("error")))
     check(took < 2.0, "within a metric tile (%.2f s)" % took)
     check(d.json("GET", "/healthz")[0] == 200, "daemon healthy after")
+
+    # timeout_s fails a job that runs too long, naming the phase: rendering
+    # here, and whichever phase a slower job is in when its time runs out.
+    t0 = time.time()
+    body = d.run(dict(LONG, timeout_s=1))
+    took = time.time() - t0
+    check(body["status"] == "failed" and "timeout" in body.get("error", "") and
+          "rendering phase" in body.get("error", "") and took < 5,
+          "timeout_s 1 fails a long job in the rendering phase (%.1f s): %s" % (took, body.get("error")))
+    check(body["spec"]["timeout_s"] == 1, "the spec shows timeout_s")
+    job = d.submit({"frames": 6, "warmup_frames": 0, "capture_interval": 1, "reference": "forward",
+                    "timeout_s": 6, "scene": {"width": 1536, "height": 1536, "lights": 1}})
+    seen = []
+    while True:
+        body = d.json("GET", "/v1/jobs/" + job)[1]
+        if body.get("status") not in ("queued", "running"):
+            break
+        if body.get("phase") and (not seen or seen[-1] != body["phase"]):
+            seen.append(body["phase"])
+        time.sleep(0.05)
+    named = [p for p in ("rendering", "reference", "metrics") if "the %s phase" % p in body.get("error", "")]
+    print("timeout_s 6 with %s: %s" % (" -> ".join(seen), body.get("error")))
+    check(body["status"] == "failed" and len(named) == 1 and named[0] in seen,
+          "a timeout names the phase the job was in (%s): %s" % (seen, body.get("error")))
+    status, info = d.json("GET", "/v1/info")
+    check(info["limits"].get("default_job_timeout_s") == 86400, "the default timeout is in /v1/info")
 finally:
     testlib.stop_and_check(d)
 testlib.finish("e2e_hardening")

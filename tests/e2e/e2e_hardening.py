@@ -394,7 +394,8 @@ try:
           "rendering phase" in body.get("error", "") and took < 5,
           "timeout_s 1 fails a long job in the rendering phase (%.1f s): %s" % (took, body.get("error")))
     check(body["spec"]["timeout_s"] == 1, "the spec shows timeout_s")
-    job = d.submit({"frames": 6, "warmup_frames": 0, "capture_interval": 1, "reference": "forward",
+    job = d.submit({"technique": "unlit", "frames": 6, "warmup_frames": 0, "capture_interval": 1,
+                    "reference": "forward",
                     "timeout_s": 6, "scene": {"width": 1536, "height": 1536, "lights": 1}})
     seen = []
     while True:

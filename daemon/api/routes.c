@@ -73,9 +73,10 @@ static bool take_chart(const char *s, struct route *r)
 static bool take_frame(const char *s, struct route *r)
 {
     int frame = 0, digits = 0;
-    while (s[digits] >= '0' && s[digits] <= '9' && digits < 10)
+    /* Nine digits at most: their value always fits an int. */
+    while (digits < 9 && s[digits] >= '0' && s[digits] <= '9')
         frame = frame * 10 + (s[digits] - '0'), digits++;
-    if (digits == 0 || digits > 9 || strcmp(s + digits, ".png") != 0 || frame <= 0)
+    if (digits == 0 || strcmp(s + digits, ".png") != 0 || frame <= 0)
         return false;
     r->frame = frame;
     return true;

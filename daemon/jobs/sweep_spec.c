@@ -13,15 +13,16 @@ enum param_type { PARAM_INT, PARAM_NUMBER, PARAM_BOOL, PARAM_CHOICE };
 static const struct {
     const char *path;
     enum param_type type;
+    int step; /* integers: valid values are from + k step (sphere segments are even) */
 } PARAMS[] = {
-    {"technique", PARAM_CHOICE},        {"reference", PARAM_CHOICE},
-    {"frames", PARAM_INT},              {"warmup_frames", PARAM_INT},
-    {"capture_interval", PARAM_INT},    {"async_distance", PARAM_NUMBER},
-    {"scene.lights", PARAM_INT},        {"scene.dynamic", PARAM_BOOL},
-    {"scene.width", PARAM_INT},         {"scene.height", PARAM_INT},
-    {"scene.sphere_segments", PARAM_INT}, {"scene.light_speed", PARAM_NUMBER},
-    {"osl.resolution", PARAM_CHOICE},   {"osl.texel_density", PARAM_NUMBER},
-    {"osl.reshade", PARAM_CHOICE},
+    {"technique", PARAM_CHOICE, 0},        {"reference", PARAM_CHOICE, 0},
+    {"frames", PARAM_INT, 1},              {"warmup_frames", PARAM_INT, 1},
+    {"capture_interval", PARAM_INT, 1},    {"async_distance", PARAM_NUMBER, 0},
+    {"scene.lights", PARAM_INT, 1},        {"scene.dynamic", PARAM_BOOL, 0},
+    {"scene.width", PARAM_INT, 1},         {"scene.height", PARAM_INT, 1},
+    {"scene.sphere_segments", PARAM_INT, 2}, {"scene.light_speed", PARAM_NUMBER, 0},
+    {"osl.resolution", PARAM_CHOICE, 0},   {"osl.texel_density", PARAM_NUMBER, 0},
+    {"osl.reshade", PARAM_CHOICE, 0},
 };
 enum { NPARAMS = sizeof(PARAMS) / sizeof(PARAMS[0]) };
 
@@ -264,6 +265,7 @@ bool sweep_spec_parse(const json_t *body, const char *const *techniques, struct 
     snprintf(out->params[0], sizeof(out->params[0]), "%s", param);
     out->nparams = 1;
     out->integer = PARAMS[p].type == PARAM_INT;
+    out->step = PARAMS[p].step;
     json_t *from = json_object_get(find, "from"), *to = json_object_get(find, "to");
     if (!json_is_number(from))
         return job_error_set(err, "find.from", "must be a number");
@@ -325,6 +327,11 @@ json_t *sweep_point_job(const struct sweep_spec *s, size_t index, json_t **value
 
 json_t *sweep_probe_job(const struct sweep_spec *s, double v)
 {
+    /* Bisection halves the range; on a field with a step (sphere segments
+     * are even) a probe goes down to the step's grid, so that it is valid
+     * whenever both ends are. */
+    if (s->integer && s->step > 1)
+        v = s->from + floor((llround(v) - s->from) / s->step) * s->step;
     json_t *value = s->integer ? json_integer((json_int_t)llround(v)) : json_real(v);
     json_t *job = with_field(s->base, s->params[0], value);
     json_decref(value);

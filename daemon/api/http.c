@@ -217,7 +217,7 @@ static bool parse_wait(struct MHD_Connection *c, double *wait)
 
 /* ".../charts/NAME.svg" or ".png": renders from the JSON of a sweep or job. */
 static enum MHD_Result respond_chart(struct MHD_Connection *c, const json_t *subject,
-                                     const char *file, bool is_sweep)
+                                     const char *file, bool is_sweep, const json_t *device)
 {
     char name[32];
     const char *dot = strrchr(file, '.');
@@ -226,7 +226,7 @@ static enum MHD_Result respond_chart(struct MHD_Connection *c, const json_t *sub
         return respond_error(c, MHD_HTTP_NOT_FOUND, "chart", "charts are NAME.svg or NAME.png");
     snprintf(name, sizeof(name), "%.*s", (int)(dot - file), file);
     enum chart_format format = strcmp(dot, ".svg") == 0 ? CHART_SVG : CHART_PNG;
-    struct chart_options o = {0};
+    struct chart_options o = {.device = device};
     o.series = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "series");
     if (o.series && strcmp(o.series, "frame_ms") && strcmp(o.series, "gpu_ms") && strcmp(o.series, "cpu_ms"))
         return respond_error(c, MHD_HTTP_BAD_REQUEST, "series", "must be frame_ms, gpu_ms or cpu_ms");
@@ -346,7 +346,7 @@ static enum MHD_Result job_routes(struct http_server *s, struct MHD_Connection *
             return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
         enum MHD_Result ret =
             json_object_get(job, "result")
-                ? respond_chart(c, job, slash + 8, false)
+                ? respond_chart(c, job, slash + 8, false, NULL)
                 : respond_error(c, MHD_HTTP_CONFLICT, "id", "the job has no result yet");
         json_decref(job);
         return ret;
@@ -445,7 +445,9 @@ static enum MHD_Result sweep_routes(struct http_server *s, struct MHD_Connection
             return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such sweep");
         enum MHD_Result ret;
         if (strncmp(sub, "charts/", 7) == 0) {
-            ret = respond_chart(c, sw, sub + 7, true);
+            json_t *device = runner_device_json(s->runner);
+            ret = respond_chart(c, sw, sub + 7, true, device);
+            json_decref(device);
         } else if (strcmp(sub, "report.html") == 0) {
             json_t *device = runner_device_json(s->runner);
             size_t len = 0;

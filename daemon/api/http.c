@@ -347,6 +347,7 @@ static enum MHD_Result job_routes(struct http_server *s, struct MHD_Connection *
     /* Per-capture images: URL folder -> file prefix in the job's directory. */
     static const char *const kinds[][2] = {
         {"frames/", "frame"}, {"reference/", "reference"}, {"ssim/", "ssim"}, {"flip/", "flip"},
+        {"heatmap/", "heatmap"}, /* light evaluations per pixel (result.heatmap) */
     };
     const char *sub = slash + 1, *prefix = NULL;
     char dir[PATH_MAX], path[PATH_MAX + 64];

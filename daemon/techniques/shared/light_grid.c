@@ -92,10 +92,10 @@ static bool check_device(const struct light_grid *g, const struct technique_env 
     if (max > 0 && index_bytes > max) {
         snprintf(err, errlen,
                  "%s: %d cells x %d lights each need a %.1f MiB index buffer; this device "
-                 "allows %.1f MiB per storage buffer (GL_MAX_SHADER_STORAGE_BLOCK_SIZE)",
-                 tiles ? grid_field
-                       : field_name(cfg, field2, sizeof(field2), "max_lights_per_cluster"),
-                 g->cells, cfg->max_per_cell, mib(index_bytes), mib(max));
+                 "allows %.1f MiB per storage buffer (GL_MAX_SHADER_STORAGE_BLOCK_SIZE): use "
+                 "fewer cells or a smaller %s",
+                 grid_field, g->cells, cfg->max_per_cell, mib(index_bytes), mib(max),
+                 field_name(cfg, field2, sizeof(field2), "max_lights_per_cluster"));
         return false;
     }
     long long groups_cells = (g->cells + GROUP - 1) / GROUP;

@@ -25,6 +25,7 @@
 #define SB_TEX_DEPTH 1
 #define SB_TEX_GBUFFER0 2 /* 2..5: g-buffer planes */
 #define SB_TEX_GBUFFER1 3
+#define SB_TEX_GBUFFER2 4
 #define SB_TEX_OSL_ATLAS 0
 #define SB_TEX_OSL_MESH 1 /* 1 + 2m: position of mesh m, 2 + 2m: normal */
 

@@ -22,6 +22,12 @@ static const struct {
     {"scene.width", PARAM_INT},         {"scene.height", PARAM_INT},
     {"scene.sphere_segments", PARAM_INT}, {"scene.light_speed", PARAM_NUMBER},
     {"look.lighting", PARAM_CHOICE},    {"look.hdr", PARAM_CHOICE},
+    {"scene.preset", PARAM_CHOICE},     {"scene.light_layout", PARAM_CHOICE},
+    {"scene.light_radius", PARAM_NUMBER}, {"scene.light_intensity", PARAM_NUMBER},
+    {"scene.tessellation_error_px", PARAM_NUMBER}, {"scene.camera", PARAM_CHOICE},
+    {"scene.materials", PARAM_CHOICE},  {"scene.specular", PARAM_NUMBER},
+    {"scene.shininess", PARAM_NUMBER},  {"scene.metallic", PARAM_NUMBER},
+    {"scene.roughness", PARAM_NUMBER},
 };
 enum { NPARAMS = sizeof(PARAMS) / sizeof(PARAMS[0]) };
 
@@ -45,14 +51,29 @@ static bool param_type(const struct technique_catalog *techniques, const char *p
 static bool unknown_param(const struct technique_catalog *techniques, struct job_error *err,
                           const char *field)
 {
-    char list[200] = "";
-    for (int i = 0; i < (int)NPARAMS; i++) {
-        size_t used = strlen(list);
-        snprintf(list + used, sizeof(list) - used, "%s%s", i ? ", " : "", PARAMS[i].path);
-    }
     (void)techniques;
-    return job_error_set(err, field, "not a parameter a sweep can vary; one of: %s, or "
-                         "TECHNIQUE.OPTION (see /v1/info)", list);
+    return job_error_set(err, field, "not a parameter a sweep can vary: scene, look and "
+                         "top-level job fields, or TECHNIQUE.OPTION; GET /v1/info lists "
+                         "them under \"sweepable\"");
+}
+
+json_t *sweep_params_json(const struct technique_catalog *techniques)
+{
+    static const char *const types[] = {"integer", "number", "boolean", "choice"};
+    json_t *o = json_object();
+    for (int i = 0; i < (int)NPARAMS; i++)
+        json_object_set_new(o, PARAMS[i].path, json_string(types[PARAMS[i].type]));
+    for (int t = 0; t < techniques->count; t++) {
+        const struct technique_info *info = techniques->infos[t];
+        for (const struct technique_option *opt = info->options; opt && opt->name; opt++) {
+            char path[128];
+            enum param_type type;
+            snprintf(path, sizeof(path), "%s.%s", info->name, opt->name);
+            if (param_type(techniques, path, &type))
+                json_object_set_new(o, path, json_string(types[type]));
+        }
+    }
+    return o;
 }
 
 /* A copy of job with the field at a dotted path set to value, creating the

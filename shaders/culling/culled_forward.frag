@@ -16,8 +16,9 @@ void main()
     // gl_FragCoord.w is 1 / clip w, and clip w is the view depth.
     int cell = grid_cell(gl_FragCoord.xy, 1.0 / gl_FragCoord.w);
     uint evaluations;
-    vec3 albedo = instances[v_instance].albedo_mesh.rgb;
-    vec3 color = shade_cell(cell, v_world, normalize(v_normal), albedo, evaluations);
+    Material m = instance_material(v_instance);
+    vec3 color = shade_cell(cell, v_world, normalize(v_normal), m.albedo, m.specular, m.shininess,
+                            evaluations);
     heat_add(ivec2(gl_FragCoord.xy), evaluations);
     out_color = vec4(color, 1.0);
 }

@@ -9,8 +9,9 @@
 //     float, channels scaled by powers of 1/255 and unpacked with fract),
 //   GBUFFER_ALBEDO_PACK_BASE10 (r: seed 001's second, three decimal digits a
 //     channel in one float).
-// Position is never stored: it is rebuilt from the depth texture with the
-// frame block's inverse view-projection.
+// A third plane holds the material's specular weight and exponent (rg,
+// 32-bit floats: exact). Position is never stored: it is rebuilt from the
+// depth texture with the frame block's inverse view-projection.
 #include "frame.glsl"
 
 vec2 gbuffer_sign_not_zero(vec2 v)
@@ -91,9 +92,11 @@ vec3 gbuffer_position(vec2 frag, float depth)
 layout(binding = SB_TEX_DEPTH) uniform sampler2D u_gbuffer_depth;
 layout(binding = SB_TEX_GBUFFER0) uniform sampler2D u_gbuffer_albedo;
 layout(binding = SB_TEX_GBUFFER1) uniform sampler2D u_gbuffer_normal;
+layout(binding = SB_TEX_GBUFFER2) uniform sampler2D u_gbuffer_material;
 
 struct Surface {
     vec3 P, N, albedo;
+    float specular, shininess;
 };
 
 // False for background pixels (nothing drawn: depth 1).
@@ -105,5 +108,8 @@ bool gbuffer_surface(ivec2 pixel, out Surface s)
     s.P = gbuffer_position(vec2(pixel) + 0.5, depth);
     s.N = gbuffer_decode_normal(texelFetch(u_gbuffer_normal, pixel, 0));
     s.albedo = gbuffer_decode_albedo(texelFetch(u_gbuffer_albedo, pixel, 0));
+    vec2 m = texelFetch(u_gbuffer_material, pixel, 0).rg;
+    s.specular = m.r;
+    s.shininess = m.g;
     return true;
 }

@@ -26,7 +26,7 @@ int main(void)
     struct scene_spec spec;
     scene_spec_defaults(&spec);
     struct scene s;
-    CHECK(scene_create(&s, &spec));
+    CHECK(scene_init(&s, &spec));
     int w = spec.width, h = spec.height;
     srand(7);
     int tight_seen = 0, full = 0, empty = 0;

@@ -138,7 +138,7 @@ int main(void)
     rejects("{\"base\":{},\"find\":{\"param\":\"async_distance\",\"from\":5,\"to\":1,\"while\":\"pdiff_pass\"}}", "find.to");
     rejects("{\"base\":{},\"find\":{\"param\":\"scene.lights\",\"from\":0.5,\"to\":9,\"while\":\"pdiff_pass\"}}", "find.from");
     rejects("{\"base\":{},\"find\":{\"param\":\"async_distance\",\"from\":0,\"to\":9,\"while\":\"pretty\"}}", "find.while");
-    rejects("{\"base\":{},\"find\":{\"param\":\"scene.lights\",\"from\":0,\"to\":5000,\"while\":\"stable\"}}", "find.to");
+    rejects("{\"base\":{},\"find\":{\"param\":\"scene.lights\",\"from\":0,\"to\":70000,\"while\":\"stable\"}}", "find.to");
     rejects("{\"base\":{},\"vary\":{\"frames\":[1]},\"extra\":1}", "extra");
     return check_finish("test_sweep");
 }

@@ -79,10 +79,14 @@ bool gbuffer_init(struct gbuffer *g, const struct technique_env *env,
                                                         g->normal_format, env->width,
                                                         env->height, err, errlen)
                                   : 0;
-    GLuint planes[2] = {g->albedo_tex, g->normal_tex};
-    g->fbo = g->normal_tex ? gpu_targets_fbo(env->targets, "gbuffer", planes, 2,
-                                             env->output_depth, err, errlen)
-                           : 0;
+    g->material_tex = g->normal_tex ? gpu_targets_texture(env->targets, "gbuffer.material",
+                                                          GL_RG32F, env->width, env->height,
+                                                          err, errlen)
+                                    : 0;
+    GLuint planes[3] = {g->albedo_tex, g->normal_tex, g->material_tex};
+    g->fbo = g->material_tex ? gpu_targets_fbo(env->targets, "gbuffer", planes, 3,
+                                               env->output_depth, err, errlen)
+                             : 0;
     if (!g->fbo)
         return false;
     const struct gl_stage stages[] = {
@@ -117,6 +121,7 @@ void gbuffer_draw(const struct gbuffer *g, const struct technique_env *env, int 
     gpu_pass_begin(env->passes, pass, g->fbo, env->width, env->height);
     glClearBufferfv(GL_COLOR, 0, zero);
     glClearBufferfv(GL_COLOR, 1, zero);
+    glClearBufferfv(GL_COLOR, 2, zero);
     glClear(GL_DEPTH_BUFFER_BIT);
     gpu_scene_bind(env->gpu, &g->program);
     gpu_scene_draw(env->gpu, &g->program);
@@ -131,16 +136,19 @@ void gbuffer_bind(const struct gbuffer *g, const struct technique_env *env)
     glBindTexture(GL_TEXTURE_2D, g->albedo_tex);
     glActiveTexture(GL_TEXTURE0 + SB_TEX_GBUFFER1);
     glBindTexture(GL_TEXTURE_2D, g->normal_tex);
+    glActiveTexture(GL_TEXTURE0 + SB_TEX_GBUFFER2);
+    glBindTexture(GL_TEXTURE_2D, g->material_tex);
     glActiveTexture(GL_TEXTURE0);
 }
 
 json_t *gbuffer_describe(const struct gbuffer *g)
 {
-    return json_pack("{s:s, s:s, s:s, s:s, s:f, s:s}", "normal",
+    return json_pack("{s:s, s:s, s:s, s:s, s:s, s:f, s:s}", "normal",
                      gbuffer_normal_choices[g->opt.normal], "normal_format",
                      format_name(g->normal_format), "albedo",
                      gbuffer_albedo_choices[g->opt.albedo], "albedo_format",
-                     format_name(g->albedo_format), "bytes_per_pixel",
-                     format_bytes(g->albedo_format) + format_bytes(g->normal_format) + 4.0,
+                     format_name(g->albedo_format), "material_format",
+                     "rg32f (specular, shininess)", "bytes_per_pixel",
+                     format_bytes(g->albedo_format) + format_bytes(g->normal_format) + 8.0 + 4.0,
                      "position", "rebuilt from the 24-bit depth texture with inv_view_proj");
 }

@@ -3,7 +3,8 @@
 
 /* The g-buffer every deferred technique draws (deferred, tiled deferred,
  * clustered deferred): an albedo plane and a normal plane in the layouts the
- * job's gbuffer options choose (shaders/deferred/gbuffer.glsl), over the
+ * job's gbuffer options choose (shaders/deferred/gbuffer.glsl) and a
+ * material plane (specular weight and exponent, exact), over the
  * output's depth texture, from which lighting rebuilds positions with the
  * frame block's inverse view-projection. Lossless layouts publish their
  * normals in env->products for post effects. Render thread only. */
@@ -17,7 +18,7 @@
 
 struct gbuffer {
     struct gbuffer_options opt;
-    GLuint albedo_tex, normal_tex, fbo;
+    GLuint albedo_tex, normal_tex, material_tex, fbo;
     GLenum albedo_format, normal_format;
     struct scene_program program;
     /* The layout's #defines and the look's, for every program that reads the

@@ -34,21 +34,34 @@ static const char *field_name(const struct light_grid_config *cfg, char *buf, si
  * coarser (Filament's froxelizer starts its slices at a "light near" for
  * the same reason); the first and last slices still reach the clip planes,
  * so every pixel has a cell. */
-static void slice_range(const struct scene *s, float out[2])
+static void slice_range(const struct scene *s, const struct scene_camera *cam, float out[2])
 {
-    float lo = s->far_z, hi = s->near_z;
+    float lo = cam->far_z, hi = cam->near_z;
     for (int i = 0; i < s->instance_count; i++) {
-        const float *p = s->instances[i].pos, *v = s->view;
+        const float *p = s->instances[i].pos, *v = cam->view;
         float z = -(v[2] * p[0] + v[6] * p[1] + v[10] * p[2] + v[14]);
         float r = scene_instance_bound(s, i);
         lo = fminf(lo, z - r);
         hi = fmaxf(hi, z + r);
     }
-    lo = fmaxf(lo, s->near_z);
-    hi = fminf(hi, s->far_z);
+    lo = fmaxf(lo, cam->near_z);
+    hi = fminf(hi, cam->far_z);
     if (!(hi > lo * 1.001f))
-        lo = s->near_z, hi = s->far_z;
+        lo = cam->near_z, hi = cam->far_z;
     out[0] = lo, out[1] = hi;
+}
+
+/* The slices' depth range and scale for camera cam, into the block. */
+static void set_slices(struct light_grid *g, const struct scene *s, const struct scene_camera *cam)
+{
+    float range[2];
+    slice_range(s, cam, range);
+    bool exponential = g->cfg.slices == CLUSTER_SLICES_EXPONENTIAL;
+    double span = exponential ? log(range[1] / range[0]) : range[1] - range[0];
+    g->block.slices[0] = range[0];
+    g->block.slices[1] = range[1];
+    g->block.slices[2] = (float)(g->block.dims[2] / span);
+    g->block.slices[3] = exponential ? 1.0f : 0.0f;
 }
 
 static GLuint make_buffer(double bytes, double *total)
@@ -125,6 +138,7 @@ bool light_grid_init(struct light_grid *g, const struct technique_env *env,
     g->width = env->width, g->height = env->height;
     g->lights = env->scene->light_count;
     g->frames = env->spec->frames;
+    g->camera_moves = scene_camera_moves(env->scene);
     bool tiles = cfg->kind == LIGHT_GRID_TILES;
     bool cpu = tiles && cfg->binning == LIGHT_BINNING_CPU;
     char field[96];
@@ -159,19 +173,16 @@ bool light_grid_init(struct light_grid *g, const struct technique_env *env,
     } else {
         g->capacity = (long long)g->cells * cfg->max_per_cell;
     }
-    float range[2];
-    slice_range(env->scene, range);
-    double span = cfg->slices == CLUSTER_SLICES_EXPONENTIAL ? log(range[1] / range[0])
-                                                            : range[1] - range[0];
     g->block = (struct light_grid_block){
         .dims = {dims[0], dims[1], dims[2], g->cells},
         .tile = {(float)tw, (float)th, 1.0f / (float)tw, 1.0f / (float)th},
-        .slices = {range[0], range[1], (float)(dims[2] / span),
-                   cfg->slices == CLUSTER_SLICES_EXPONENTIAL ? 1.0f : 0.0f},
         .lists = {tiles ? 0 : cfg->max_per_cell, (int32_t)g->capacity, g->words,
                   tiles || cfg->overflow == CLUSTER_OVERFLOW_FALLBACK},
         .counts = {g->lights, 0, 0, 0},
     };
+    struct scene_camera cam;
+    scene_camera_at(env->scene, 0, &cam);
+    set_slices(g, env->scene, &cam);
     double bits_bytes = cpu ? 0 : (double)g->cells * g->words * 4.0;
     if (!check_device(g, env, bits_bytes, (double)g->capacity * 4.0, err, errlen))
         return false;
@@ -249,7 +260,7 @@ static int stats_slot(const struct light_grid *g, int64_t frame)
  * bounds: the depth buffer lives on the GPU) appended to the tiles it
  * covers, in light order, then uploaded. */
 static void build_cpu(struct light_grid *g, const struct technique_env *env, int64_t frame,
-                      int slot)
+                      int slot, const struct scene_camera *cam)
 {
     const struct scene *s = env->scene;
     const int tw = (int)g->block.tile[0], th = (int)g->block.tile[1], tx = g->block.dims[0];
@@ -258,8 +269,9 @@ static void build_cpu(struct light_grid *g, const struct technique_env *env, int
         float p[3];
         int *r = &g->rects[i * 4];
         scene_light_position(s, i, frame, p);
-        if (!light_rect(LIGHT_BOUNDS_SCISSOR_TIGHT, p, s->lights[i].radius, s->view, s->proj,
-                        s->view_proj, s->near_z, s->far_z, g->width, g->height, r)) {
+        if (!light_rect(LIGHT_BOUNDS_SCISSOR_TIGHT, p, s->lights[i].radius, cam->view,
+                        cam->proj, cam->view_proj, cam->near_z, cam->far_z, g->width, g->height,
+                        r)) {
             r[0] = 1, r[2] = 0; /* no tile */
             continue;
         }
@@ -316,13 +328,19 @@ void light_grid_build(struct light_grid *g, const struct technique_env *env, int
 {
     double t0 = clock_mono_s();
     int slot = stats_slot(g, frame);
+    bool cpu = g->cfg.kind == LIGHT_GRID_TILES && g->cfg.binning == LIGHT_BINNING_CPU;
+    struct scene_camera cam;
+    if (cpu || g->camera_moves)
+        scene_camera_at(env->scene, frame, &cam);
+    if (g->camera_moves && g->cfg.kind == LIGHT_GRID_CLUSTERS)
+        set_slices(g, env->scene, &cam);
     g->block.counts[1] = slot;
     glBindBuffer(GL_UNIFORM_BUFFER, g->ubo);
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof(g->block), &g->block);
     glBindBuffer(GL_UNIFORM_BUFFER, 0);
     glBindBufferBase(GL_UNIFORM_BUFFER, SB_UBO_LIGHT_GRID, g->ubo);
-    if (g->cfg.kind == LIGHT_GRID_TILES && g->cfg.binning == LIGHT_BINNING_CPU) {
-        build_cpu(g, env, frame, slot);
+    if (cpu) {
+        build_cpu(g, env, frame, slot, &cam);
     } else {
         /* Zero this frame's record and the bits. */
         glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->stats_buf);

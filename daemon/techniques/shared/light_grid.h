@@ -60,6 +60,7 @@ struct light_grid {
     struct light_grid_config cfg;
     struct light_grid_block block;
     int cells, words, lights, width, height, frames;
+    bool camera_moves; /* slices follow the camera's depth range every frame */
     long long capacity; /* index entries */
     GLuint ubo, tile_depth_buf, bits_buf, stats_buf;
     /* CPU binning cycles through a ring of grids so that an upload never

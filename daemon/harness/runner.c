@@ -108,8 +108,6 @@ struct run {
     char err[1024];
 };
 
-static const char *hdr_name(int hdr) { return hdr == LOOK_HDR_RGBA16F ? "rgba16f" : "rgba32f"; }
-
 /* The output every technique draws into (HDR colour and a depth texture
  * later passes may sample) and the 8-bit image the resolve writes, from the
  * runner's pool: allocated once per size and format, not per job. */
@@ -338,9 +336,7 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
         json_object_set_new(by_section, run->passes.names[s], stats_json(sec, (size_t)n));
     }
     json_object_set_new(result, "gpu_sections_ms", by_section);
-    json_object_set_new(result, "look", json_pack("{s:s, s:s}", "lighting",
-                                                  look_lighting_name(run->spec->look.lighting),
-                                                  "hdr", hdr_name(run->spec->look.hdr)));
+    json_object_set_new(result, "look", look_spec_to_json(&run->spec->look));
     json_object_set_new(result, "targets_bytes", json_real(gpu_targets_bytes(run->runner->targets)));
     /* Store hook: what could have disturbed the timed region. */
     json_object_set_new(result, "interference",

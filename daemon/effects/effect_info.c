@@ -21,9 +21,10 @@ static const struct technique_option bloom_options_table[] = {
     {.name = "radius", .type = TOPT_INT, .def = 4, .min = 2, .max = 32,
      .summary = "Gaussian taps each side of the centre (sigma = radius / 2)",
      .offset = offsetof(struct bloom_options, radius)},
-    {.name = "intensity", .type = TOPT_NUMBER, .def = 1.0, .min = 0.0, .max = 1e9,
-     .summary = "scale of the blurred light added back; large values overflow a 16-bit "
-                "target (look.hdr rgba16f) on purpose",
+    {.name = "intensity", .type = TOPT_NUMBER, .def = 1.0, .min = 0.0, .max = 1e30,
+     .summary = "scale of the blurred light added back; huge values overflow a 16-bit "
+                "target (look.hdr rgba16f), and chained, even a 32-bit one, on purpose: "
+                "the result counts the non-finite pixels",
      .offset = offsetof(struct bloom_options, intensity)},
     {.name = "downsample", .type = TOPT_INT, .def = 0, .min = 0, .max = 5,
      .summary = "0 blurs at full size; n blurs a mip chain of n halvings and adds the levels "

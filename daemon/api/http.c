@@ -154,9 +154,11 @@ static json_t *info_json(struct http_server *s)
 {
     /* From the GL-free catalogue: HTTP threads never touch GL. */
     json_t *techs = technique_catalog_json(technique_catalog());
-    return json_pack("{s:s, s:s, s:s, s:o, s:o, s:{s:i, s:i, s:i}}", "name", "shadebenchd",
+    return json_pack("{s:s, s:s, s:s, s:o, s:o, s:o, s:{s:i, s:i, s:i}}", "name", "shadebenchd",
                      "version", PACKAGE_VERSION, "api", "v1", "device",
-                     runner_device_json(s->runner), "techniques", techs, "limits",
+                     runner_device_json(s->runner), "techniques", techs,
+                     "effects", effect_catalog_json(), /* post hook: look.post's effects */
+                     "limits",
                      "max_body_bytes", JOB_MAX_BODY_BYTES, "max_queued_jobs",
                      queue_max_queued(s->queue), "max_wait_s", MAX_WAIT_S);
 }

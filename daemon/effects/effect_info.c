@@ -171,7 +171,11 @@ static struct technique_info shim(const struct effect_info *e, const char *path)
 static bool parse_entry(const json_t *entry, const char *path, struct post_effect *out,
                         struct job_error *err)
 {
-    static const char *const names[] = {"bloom", "toon", "ssao", NULL};
+    const char *names[EFFECT_REGISTRY_MAX + 1];
+    int count = 0;
+    for (; effect_infos[count] && count < EFFECT_REGISTRY_MAX; count++)
+        names[count] = effect_infos[count]->name;
+    names[count] = NULL;
     char list[120];
     jf_list_choices(names, list, sizeof(list));
     const char *name = NULL;
@@ -277,9 +281,9 @@ json_t *effect_catalog_json(void)
 {
     /* Described by the techniques' own code: same shape as /v1/info's
      * "techniques", so clients read both alike. */
-    struct technique_info shims[TECHNIQUE_MAX];
+    struct technique_info shims[EFFECT_REGISTRY_MAX];
     struct technique_catalog c = {.count = 0};
-    for (int i = 0; effect_infos[i] && i < TECHNIQUE_MAX; i++) {
+    for (int i = 0; effect_infos[i] && i < EFFECT_REGISTRY_MAX; i++) {
         shims[i] = shim(effect_infos[i], effect_infos[i]->name);
         c.infos[c.count++] = &shims[i];
     }

@@ -19,6 +19,9 @@
 #include "common/json_fields.h"
 #include "daemon/techniques/technique_info.h"
 
+/* Effects the registry may hold (at most TECHNIQUE_MAX, as /v1/info lists
+ * them through a technique catalogue). */
+#define EFFECT_REGISTRY_MAX 16
 /* Effects one look may chain. */
 #define POST_MAX_EFFECTS 8
 /* Named passes one effect instance may run in a frame. */

@@ -81,7 +81,7 @@ try:
     print("device: %s | %s" % (info["gl_renderer"], info["gl_version"]))
     print("scene: grid %dx%d, moving lights, %d timed frames after %d warm-up, %d repeats\n"
           % (args.width, args.height, args.frames, args.warmup, args.repeat))
-    t_start = time.time()
+    t_start, load0 = time.time(), os.getloadavg()[0]
     for rep in range(args.repeat):
         for name, job in CONFIGS:
             t0 = time.time()
@@ -93,12 +93,18 @@ try:
             print("  [%d/%d] %-22s frame %9.2f ms  gpu %9.2f ms  (%.0f s)"
                   % (rep + 1, args.repeat, name, r["frame_ms"]["median"], r["gpu_ms"]["median"],
                      time.time() - t0), flush=True)
-    print("\n(%.0f s in all)\n" % (time.time() - t_start))
+    print("\n(%.0f s in all; load average %.2f before, %.2f after, on %d cores)\n"
+          % (time.time() - t_start, load0, os.getloadavg()[0], os.cpu_count()))
 
     def m(name, f):
         return med([f(r) for r in results[name]])
 
-    print("## Bloom: separable against 2d (medians of job medians, ms)\n")
+    def paired(a, b, f):
+        """Median over repeats of f(b) / f(a), each pair run side by side."""
+        return med([f(y) / f(x) for x, y in zip(results[a], results[b]) if f(x) > 0])
+
+    print("## Bloom: separable against 2d (medians over repeats of job medians, ms; ratios "
+          "paired within each repeat)\n")
     print("| radius | taps 2d / separable | sep. blur | 2d blur | blur ratio 2d/sep. | "
           "arithmetic limit (2r+1)/2 | whole bloom ratio | frame_ms sep. | frame_ms 2d | frame ratio |")
     print("|---|---|---|---|---|---|---|---|---|---|")
@@ -108,9 +114,12 @@ try:
         ws, w2 = m(sep, lambda x: section(x, "bloom.")), m(two, lambda x: section(x, "bloom."))
         fs, f2 = m(sep, lambda x: x["frame_ms"]["median"]), m(two, lambda x: x["frame_ms"]["median"])
         taps = (2 * r + 1)
+        ratio = paired(sep, two, lambda x: section(x, "bloom.blur"))
+        whole = paired(sep, two, lambda x: section(x, "bloom."))
+        frame = paired(sep, two, lambda x: x["frame_ms"]["median"])
         print("| %d (%dx%d) | %d / %d | %.2f | %.2f | %.2f | %.1f | %.2f | %.2f | %.2f | %.2f |"
-              % (r, taps, taps, taps * taps, 2 * taps, bs, b2, b2 / bs, taps / 2.0, w2 / ws, fs, f2,
-                 f2 / fs))
+              % (r, taps, taps, taps * taps, 2 * taps, bs, b2, ratio, taps / 2.0, whole, fs, f2,
+                 frame))
 
     print("\n## SSAO: cost and quality against samples\n")
     print("| samples | ssao.ao ms | ssao.blur ms | both | frame_ms | SSIM against 64 samples |")

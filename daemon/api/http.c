@@ -15,6 +15,7 @@
 
 #include "config.h"
 #include "daemon/api/charts.h"
+#include "daemon/api/job_filter.h"
 #include "daemon/jobs/job_spec.h"
 #include "daemon/api/report.h"
 #include "common/log.h"
@@ -154,11 +155,11 @@ static json_t *info_json(struct http_server *s)
 {
     /* From the GL-free catalogue: HTTP threads never touch GL. */
     json_t *techs = technique_catalog_json(technique_catalog());
-    return json_pack("{s:s, s:s, s:s, s:o, s:o, s:o, s:{s:i, s:i, s:i}}", "name", "shadebenchd",
-                     "version", PACKAGE_VERSION, "api", "v1", "device",
+    return json_pack("{s:s, s:s, s:s, s:o, s:o, s:o, s:o, s:{s:i, s:i, s:i}}", "name",
+                     "shadebenchd", "version", PACKAGE_VERSION, "api", "v1", "device",
                      runner_device_json(s->runner), "techniques", techs,
                      "effects", effect_catalog_json(), /* post hook: look.post's effects */
-                     "limits",
+                     "sweepable", sweep_params_json(technique_catalog()), "limits",
                      "max_body_bytes", JOB_MAX_BODY_BYTES, "max_queued_jobs",
                      queue_max_queued(s->queue), "max_wait_s", MAX_WAIT_S);
 }
@@ -183,9 +184,8 @@ static enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *
     }
     case QUEUE_STOPPING:
         return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "body", "the daemon is stopping");
-    default:
-        return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "body",
-                             "cannot create the job's directory under the state directory");
+    default: /* QUEUE_IO_ERROR: not persisted, so not accepted */
+        return respond_error(c, MHD_HTTP_INSUFFICIENT_STORAGE, "state_dir", queue_submit_error());
     }
     char url[64];
     snprintf(url, sizeof(url), "/v1/jobs/%s", id);
@@ -235,6 +235,21 @@ static enum MHD_Result respond_chart(struct MHD_Connection *c, const json_t *sub
     if (!data)
         return respond_error(c, MHD_HTTP_NOT_FOUND, "chart", err);
     return respond_text(c, MHD_HTTP_OK, data, len, format == CHART_SVG ? "image/svg+xml" : "image/png");
+}
+
+struct list_args {
+    struct job_filter filter;
+    struct job_error err;
+    bool ok;
+};
+
+static enum MHD_Result list_arg(void *cls, enum MHD_ValueKind kind, const char *key,
+                                const char *value)
+{
+    (void)kind;
+    struct list_args *a = cls;
+    a->ok = a->ok && job_filter_add(&a->filter, key, value, &a->err);
+    return a->ok ? MHD_YES : MHD_NO;
 }
 
 static bool point_job_dir(void *ctx, const char *job_id, char *dir, size_t cap, int *last_frame)
@@ -393,10 +408,13 @@ static enum MHD_Result sweep_routes(struct http_server *s, struct MHD_Connection
                 return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
             }
             char id[24];
-            bool ok = sweeps_submit(s->sweeps, &spec, body, id);
+            enum queue_submit_result r = sweeps_submit(s->sweeps, &spec, body, id);
             sweep_spec_finish(&spec);
             json_decref(body);
-            if (!ok)
+            if (r == QUEUE_IO_ERROR) /* not persisted, so not accepted */
+                return respond_error(c, MHD_HTTP_INSUFFICIENT_STORAGE, "state_dir",
+                                     queue_submit_error());
+            if (r != QUEUE_OK)
                 return respond_error(c, MHD_HTTP_TOO_MANY_REQUESTS, "body",
                                      "too many sweeps are waiting; retry later");
             char url[64];
@@ -484,8 +502,16 @@ static enum MHD_Result route(struct http_server *s, struct MHD_Connection *c,
                                      "the job must be at most 65536 bytes");
             return submit_job(s, c, req);
         }
-        if (get)
-            return respond_json(c, MHD_HTTP_OK, queue_list_json(s->queue));
+        if (get) {
+            /* ?technique=&status=&label.KEY=VALUE&since= (daemon/api/job_filter.h) */
+            struct list_args a = {.ok = true};
+            job_filter_init(&a.filter);
+            MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, list_arg, &a);
+            if (!a.ok)
+                return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&a.err));
+            return respond_json(c, MHD_HTTP_OK,
+                                queue_list_json_with(s->queue, job_filter_visit, &a.filter));
+        }
         return respond_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "method",
                              "use GET to list jobs or POST to submit one");
     }

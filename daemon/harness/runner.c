@@ -169,22 +169,29 @@ static bool setup_targets(struct run *run)
     return true;
 }
 
-/* The per-frame block for frame k: camera, viewport and counts. */
+/* The per-frame block for frame k: camera, viewport and counts. A still
+ * camera's block is the same every frame, so only a moving one is rebuilt. */
 static void frame_data(const struct run *run, int64_t k, struct gpu_frame_data *d)
 {
     const struct scene *s = run->env.scene;
-    memcpy(d->view, s->view, sizeof(d->view));
-    memcpy(d->proj, s->proj, sizeof(d->proj));
-    memcpy(d->view_proj, s->view_proj, sizeof(d->view_proj));
-    mat4_invert(d->view, d->inv_view);
-    mat4_invert(d->proj, d->inv_proj);
+    if (d->viewport[0] != 0 && !scene_camera_moves(s)) {
+        d->counts[0] = (int32_t)(k & 0x7fffffff);
+        return;
+    }
+    struct scene_camera cam;
+    scene_camera_at(s, k, &cam);
+    memcpy(d->view, cam.view, sizeof(d->view));
+    memcpy(d->proj, cam.proj, sizeof(d->proj));
+    memcpy(d->view_proj, cam.view_proj, sizeof(d->view_proj));
+    memcpy(d->inv_view, cam.inv_view, sizeof(d->inv_view));
+    memcpy(d->inv_proj, cam.inv_proj, sizeof(d->inv_proj));
     mat4_invert(d->view_proj, d->inv_view_proj);
-    d->eye[0] = s->eye[0], d->eye[1] = s->eye[1], d->eye[2] = s->eye[2], d->eye[3] = 1.0f;
+    d->eye[0] = cam.eye[0], d->eye[1] = cam.eye[1], d->eye[2] = cam.eye[2], d->eye[3] = 1.0f;
     d->viewport[0] = (float)run->env.width;
     d->viewport[1] = (float)run->env.height;
     d->viewport[2] = 1.0f / (float)run->env.width;
     d->viewport[3] = 1.0f / (float)run->env.height;
-    d->clip[0] = s->near_z, d->clip[1] = s->far_z, d->clip[2] = d->clip[3] = 0.0f;
+    d->clip[0] = cam.near_z, d->clip[1] = cam.far_z, d->clip[2] = d->clip[3] = 0.0f;
     d->counts[0] = (int32_t)(k & 0x7fffffff);
     d->counts[1] = s->light_count;
     d->counts[2] = s->instance_count;
@@ -403,6 +410,7 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
     json_object_set_new(result, "look", look_spec_to_json(&run->spec->look));
     json_object_set_new(result, "nonfinite", nonfinite_summary(run)); /* post hook */
     json_object_set_new(result, "targets_bytes", json_real(gpu_targets_bytes(run->runner->targets)));
+    json_object_set_new(result, "scene", scene_describe(&run->scene));
     /* Store hook: what could have disturbed the timed region. */
     json_object_set_new(result, "interference",
                         interference_json(&run->interference[0], &run->interference[1]));
@@ -472,7 +480,7 @@ static bool render_reference(struct run *run, enum job_status *status)
             ref->destroy(state);
             goto out;
         }
-        struct gpu_frame_data fd;
+        struct gpu_frame_data fd = {0};
         frame_data(&rr, k, &fd);
         gpu_frame_block_update(&run->runner->frame_block, &fd);
         gpu_timer_begin_frame(rr.timer);
@@ -512,7 +520,7 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
     struct job *job = run->job;
     int w0 = spec->warmup_frames, n = spec->frames;
     run->look = &spec->look; /* post hook */
-    run->scene_ok = scene_create(&run->scene, &spec->scene);
+    run->scene_ok = scene_init(&run->scene, &spec->scene);
     run->capture_count = capture ? job_spec_capture_count(spec) : 0;
     run->captures = calloc((size_t)run->capture_count + 1, sizeof(*run->captures));
     run->nonfinite = calloc((size_t)run->capture_count + 1, sizeof(*run->nonfinite));
@@ -539,7 +547,7 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
         }
 
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    struct gpu_frame_data fd;
+    struct gpu_frame_data fd = {0};
     double wall_start = 0, frame_begin = 0;
     int captured = 0;
     *capture_s = 0;

@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 
@@ -209,12 +210,60 @@ static bool parse_metrics(const json_t *v, struct metrics_options *m, struct job
     return true;
 }
 
+static int by_label_key(const void *a, const void *b)
+{
+    return strcmp(((const struct job_label *)a)->key, ((const struct job_label *)b)->key);
+}
+
+/* "labels": {"commit": "abc123", "branch": "main"}. Sorted by key, so that
+ * the spec as understood does not depend on the order they were sent in. */
+static bool parse_labels(const json_t *v, struct job_spec *out, struct job_error *err)
+{
+    if (!json_is_object(v))
+        return job_error_set(err, "labels", "must be an object of strings, like "
+                             "{\"commit\": \"abc123\", \"branch\": \"main\"}");
+    if (json_object_size(v) > JOB_MAX_LABELS)
+        return job_error_set(err, "labels", "at most %d labels", JOB_MAX_LABELS);
+    const char *key;
+    json_t *value;
+    out->nlabels = 0;
+    json_object_foreach((json_t *)v, key, value) {
+        char field[64];
+        snprintf(field, sizeof(field), "labels.%s", key);
+        size_t klen = strlen(key);
+        bool key_ok = klen >= 1 && klen <= JOB_LABEL_KEY_MAX;
+        for (size_t i = 0; key_ok && i < klen; i++)
+            key_ok = (key[i] >= 'a' && key[i] <= 'z') || (key[i] >= 'A' && key[i] <= 'Z') ||
+                     (key[i] >= '0' && key[i] <= '9') || key[i] == '_' || key[i] == '-' ||
+                     key[i] == '.';
+        if (!key_ok)
+            return job_error_set(err, field, "label names are 1 to %d characters of A-Z, a-z, "
+                                 "0-9, '_', '-' and '.'", JOB_LABEL_KEY_MAX);
+        if (!json_is_string(value))
+            return job_error_set(err, field, "must be a string");
+        const char *s = json_string_value(value);
+        size_t vlen = json_string_length(value);
+        if (vlen > JOB_LABEL_VALUE_MAX)
+            return job_error_set(err, field, "must be at most %d bytes (got %zu)",
+                                 JOB_LABEL_VALUE_MAX, vlen);
+        for (size_t i = 0; i < vlen; i++)
+            if ((unsigned char)s[i] < 0x20 || s[i] == 0x7f)
+                return job_error_set(err, field, "must not contain control characters");
+        struct job_label *l = &out->labels[out->nlabels++];
+        snprintf(l->key, sizeof(l->key), "%s", key);
+        snprintf(l->value, sizeof(l->value), "%s", s);
+    }
+    qsort(out->labels, (size_t)out->nlabels, sizeof(out->labels[0]), by_label_key);
+    return true;
+}
+
 bool job_spec_parse(const json_t *body, const struct technique_catalog *techniques,
                     struct job_spec *out, struct job_error *err)
 {
     static const char *const fixed[] = {"technique", "frames", "warmup_frames",
                                         "capture_interval", "async_distance", "scene", "look",
-                                        "reference", "reference_look", "metrics", "repeat"};
+                                        "reference", "reference_look", "metrics", "repeat",
+                                        "labels"};
     enum { NFIXED = sizeof(fixed) / sizeof(fixed[0]) };
     /* Every technique's options live under its own name. */
     const char *keys[NFIXED + TECHNIQUE_MAX + 1];
@@ -251,6 +300,11 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
             return false;
         out->options_given |= 1u << i;
     }
+    /* What runs is always written back; the bit records only the rest, so
+     * that the spec is the same after a round trip. */
+    out->options_given &= ~(1u << out->technique_index);
+    if (out->reference_index >= 0)
+        out->options_given &= ~(1u << out->reference_index);
     json_t *look;
     if (!jf_get_object(body, "look", "look", &look, err) ||
         (look && !parse_look(look, "look", &out->look, err)))
@@ -272,6 +326,9 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
         return false;
     json_t *repeat = json_object_get(body, "repeat");
     if (repeat && !parse_repeat(repeat, out, err))
+        return false;
+    json_t *labels = json_object_get(body, "labels");
+    if (labels && !parse_labels(labels, out, err))
         return false;
     if (!jf_get_int(body, "frames", "frames", 1, 1000000, &out->frames, err) ||
         !jf_get_int(body, "warmup_frames", "warmup_frames", 0, 10000,
@@ -391,6 +448,10 @@ json_t *job_spec_to_json(const struct job_spec *spec)
         json_object_set_new(out, "metrics", metrics_to_json(&spec->metrics));
     if (spec->reference_look_given)
         json_object_set_new(out, "reference_look", look_spec_to_json(&spec->reference_look));
+    json_t *labels = json_object();
+    for (int i = 0; i < spec->nlabels; i++)
+        json_object_set_new(labels, spec->labels[i].key, json_string(spec->labels[i].value));
+    json_object_set_new(out, "labels", labels);
     return out;
 }
 

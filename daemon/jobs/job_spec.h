@@ -33,6 +33,19 @@ struct look_spec {
     struct post_spec post; /* effects the harness runs on the HDR output, in order */
 };
 
+/* labels: free-form tags for history (commit, branch, driver version). Keys
+ * are 1 to 32 characters of [A-Za-z0-9_.-] so that they fit a query
+ * (?label.KEY=VALUE); values are strings of at most 128 bytes without
+ * control characters. They never change what is measured. */
+#define JOB_MAX_LABELS 16
+#define JOB_LABEL_KEY_MAX 32
+#define JOB_LABEL_VALUE_MAX 128
+
+struct job_label {
+    char key[JOB_LABEL_KEY_MAX + 1];
+    char value[JOB_LABEL_VALUE_MAX + 1];
+};
+
 struct job_spec {
     char technique[32];
     int frames;
@@ -53,8 +66,11 @@ struct job_spec {
      * sweep over techniques keeps each one's settings. */
     const struct technique_catalog *catalog;
     int technique_index, reference_index; /* reference_index -1 without one */
-    unsigned options_given;               /* bit i: the body gave technique i's object */
+    unsigned options_given;               /* bit i: the body gave technique i's object,
+                                           * and i is neither technique nor reference */
     struct technique_options options[TECHNIQUE_MAX];
+    int nlabels;                   /* sorted by key */
+    struct job_label labels[JOB_MAX_LABELS];
 };
 
 

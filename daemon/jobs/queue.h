@@ -82,8 +82,8 @@ int queue_max_queued(const struct queue *q);
 /* Accepts a job only once its spec.json and job.json are on disk. */
 enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *spec,
                                       const char *dir_override, char id_out[24]);
-/* Why the calling thread's last queue_submit returned QUEUE_IO_ERROR: names
- * the file or directory and the errno text. */
+/* Why the calling thread's last queue_submit (or sweeps_submit) returned
+ * QUEUE_IO_ERROR: names the state directory, the file and the errno text. */
 const char *queue_submit_error(void);
 
 /* Render thread: blocks until a job is queued (marks it running) or the
@@ -109,6 +109,14 @@ enum queue_cancel_result queue_cancel(struct queue *q, const char *id);
  * or wait_s pass. NULL when there is no such job. */
 json_t *queue_job_json(struct queue *q, const char *id, double wait_s);
 json_t *queue_list_json(struct queue *q);
+
+/* The list with a say per job, for filters and figures: fn gets the job's
+ * list entry with its "labels" (its own reference) and its result
+ * (borrowed, NULL until done), under the store's lock, so it must be quick
+ * and must not keep result. It returns the entry to list (it may add to it)
+ * or NULL to leave the job out (releasing the entry). */
+typedef json_t *(*queue_list_fn)(json_t *entry, const json_t *result, void *ctx);
+json_t *queue_list_json_with(struct queue *q, queue_list_fn fn, void *ctx);
 
 /* Copies the job's directory; false when there is no such job. */
 bool queue_job_dir(struct queue *q, const char *id, char *dir, size_t cap,

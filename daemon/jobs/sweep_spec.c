@@ -23,6 +23,12 @@ static const struct {
     {"scene.sphere_segments", PARAM_INT}, {"scene.light_speed", PARAM_NUMBER},
     {"look.lighting", PARAM_CHOICE},    {"look.hdr", PARAM_CHOICE},
     {"look.exposure", PARAM_NUMBER},    {"look.tonemap", PARAM_CHOICE},
+    {"scene.preset", PARAM_CHOICE},     {"scene.light_layout", PARAM_CHOICE},
+    {"scene.light_radius", PARAM_NUMBER}, {"scene.light_intensity", PARAM_NUMBER},
+    {"scene.tessellation_error_px", PARAM_NUMBER}, {"scene.camera", PARAM_CHOICE},
+    {"scene.materials", PARAM_CHOICE},  {"scene.specular", PARAM_NUMBER},
+    {"scene.shininess", PARAM_NUMBER},  {"scene.metallic", PARAM_NUMBER},
+    {"scene.roughness", PARAM_NUMBER},
 };
 enum { NPARAMS = sizeof(PARAMS) / sizeof(PARAMS[0]) };
 
@@ -68,14 +74,10 @@ static bool param_type(const struct technique_catalog *techniques, const char *p
 static bool unknown_param(const struct technique_catalog *techniques, struct job_error *err,
                           const char *field)
 {
-    char list[200] = "";
-    for (int i = 0; i < (int)NPARAMS; i++) {
-        size_t used = strlen(list);
-        snprintf(list + used, sizeof(list) - used, "%s%s", i ? ", " : "", PARAMS[i].path);
-    }
     (void)techniques;
-    return job_error_set(err, field, "not a parameter a sweep can vary; one of: %s, "
-                         "TECHNIQUE.OPTION or look.post.EFFECT.OPTION (see /v1/info)", list);
+    return job_error_set(err, field, "not a parameter a sweep can vary: scene, look and "
+                         "top-level job fields, TECHNIQUE.OPTION or look.post.EFFECT.OPTION; "
+                         "GET /v1/info lists them under \"sweepable\"");
 }
 
 /* Sets a post effect's option in every entry of that effect in look.post;
@@ -98,6 +100,34 @@ static bool set_post_option(json_t *job, const char *effect, const char *option,
         }
     }
     return any;
+}
+
+json_t *sweep_params_json(const struct technique_catalog *techniques)
+{
+    static const char *const types[] = {"integer", "number", "boolean", "choice"};
+    json_t *o = json_object();
+    for (int i = 0; i < (int)NPARAMS; i++)
+        json_object_set_new(o, PARAMS[i].path, json_string(types[PARAMS[i].type]));
+    for (int t = 0; t < techniques->count; t++) {
+        const struct technique_info *info = techniques->infos[t];
+        for (const struct technique_option *opt = info->options; opt && opt->name; opt++) {
+            char path[128];
+            enum param_type type;
+            snprintf(path, sizeof(path), "%s.%s", info->name, opt->name);
+            if (param_type(techniques, path, &type))
+                json_object_set_new(o, path, json_string(types[type]));
+        }
+    }
+    /* Post hook: every effect's options, set in each entry of that effect. */
+    for (int e = 0; effect_infos[e]; e++)
+        for (const struct technique_option *opt = effect_infos[e]->options; opt && opt->name; opt++) {
+            char path[128];
+            enum param_type type;
+            snprintf(path, sizeof(path), POST_PARAM "%s.%s", effect_infos[e]->name, opt->name);
+            if (param_type(techniques, path, &type))
+                json_object_set_new(o, path, json_string(types[type]));
+        }
+    return o;
 }
 
 /* A copy of job with the field at a dotted path set to value, creating the
@@ -165,6 +195,33 @@ static bool check_point(const json_t *job, const struct technique_catalog *techn
     if (job_spec_parse(job, techniques, &spec, &inner))
         return true;
     return job_error_set(err, field, "%s: %s", inner.field, inner.message);
+}
+
+/* Point p of a grid, exactly as it will be submitted; the error names the
+ * combination ("vary", point 3: frames=2, capture_interval=5) and the job
+ * field and rule it breaks. */
+static bool check_combination(const struct sweep_spec *s, size_t p, const struct technique_catalog *techniques,
+                              struct job_error *err)
+{
+    json_t *values, *job = sweep_point_job(s, p, &values);
+    struct job_spec spec;
+    struct job_error inner;
+    bool ok = job_spec_parse(job, techniques, &spec, &inner);
+    if (!ok) {
+        char combo[160] = "";
+        size_t used = 0;
+        for (int i = 0; i < s->nparams && used < sizeof(combo); i++) {
+            char *v = json_dumps(json_object_get(values, s->params[i]), JSON_ENCODE_ANY | JSON_COMPACT);
+            used += (size_t)snprintf(combo + used, sizeof(combo) - used, "%s%s=%.40s",
+                                     i ? ", " : "", s->params[i], v ? v : "?");
+            free(v);
+        }
+        job_error_set(err, "vary", "point %zu (%s) is not a valid job: %s: %s", p + 1, combo,
+                      inner.field, inner.message);
+    }
+    json_decref(values);
+    json_decref(job);
+    return ok;
 }
 
 static bool parse_criterion(const char *text, struct sweep_spec *s)
@@ -265,7 +322,7 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
         out->npoints = 1;
         json_object_foreach(vary, key, v) {
             char field[96];
-            snprintf(field, sizeof(field), "vary.%.40s", key);
+            snprintf(field, sizeof(field), "vary.%.*s", (int)jf_utf8_prefix(key, 40), key);
             enum param_type unused;
             if (!param_type(techniques, key, &unused))
                 return unknown_param(techniques, err, field);
@@ -281,7 +338,8 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
             size_t i;
             json_t *value;
             json_array_foreach(v, i, value) {
-                snprintf(field, sizeof(field), "vary.%.40s[%zu]", key, i);
+                snprintf(field, sizeof(field), "vary.%.*s[%zu]", (int)jf_utf8_prefix(key, 40),
+                         key, i);
                 json_t *job = with_field(base, key, value);
                 bool ok = check_point(job, techniques, field, err);
                 json_decref(job);
@@ -289,6 +347,12 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
                     return false;
             }
         }
+        /* Each value may be fine alone and a combination still refused
+         * (frames 2 with capture_interval 5): every point is parsed as the
+         * job it will run, so that no sweep fails after earlier points ran. */
+        for (size_t p = 0; p < out->npoints; p++)
+            if (!check_combination(out, p, techniques, err))
+                return false;
         return true;
     }
 
@@ -299,7 +363,7 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
                                           strcmp(key, "to") && strcmp(key, "while") &&
                                           strcmp(key, "steps")) {
         char field[64];
-        snprintf(field, sizeof(field), "find.%.40s", key);
+        snprintf(field, sizeof(field), "find.%.*s", (int)jf_utf8_prefix(key, 40), key);
         return job_error_set(err, field, "unknown field (param, from, to, while, steps)");
     }
     const char *param = json_string_value(json_object_get(find, "param"));

@@ -40,6 +40,10 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
                       struct job_error *err);
 void sweep_spec_finish(struct sweep_spec *s);
 
+/* Every path a sweep may vary, with its kind ("integer", "number", "boolean",
+ * "choice"), for /v1/info. New reference. */
+json_t *sweep_params_json(const struct technique_catalog *techniques);
+
 /* The job of grid point index (row-major over the parameters); *values gets
  * {"path": value, ...}. New references. */
 json_t *sweep_point_job(const struct sweep_spec *s, size_t index, json_t **values);

@@ -11,8 +11,6 @@
 #endif
 
 const float AMBIENT = 0.15;
-const float SPECULAR = 0.5;
-const float SHININESS = 32.0;
 
 vec3 light_ambient(vec3 albedo)
 {
@@ -51,13 +49,13 @@ vec3 light_contribution(int i, vec3 Lpos, vec3 P, vec3 N, vec3 V, vec3 albedo,
     return lights[i].color_radius.rgb * att * (albedo * nl + specular * s);
 }
 
-// Every light, for forward and OSL.
-vec3 shade_all_lights(vec3 P, vec3 N, vec3 albedo, int row)
+// Every light, for forward and OSL; m from instance_material().
+vec3 shade_all_lights(vec3 P, vec3 N, Material m, int row)
 {
     vec3 V = normalize(u_frame.eye.xyz - P);
-    vec3 color = light_ambient(albedo);
+    vec3 color = light_ambient(m.albedo);
     for (int i = 0; i < u_frame.counts.y; i++)
-        color += light_contribution(i, light_position(i, row), P, N, V, albedo, SPECULAR,
-                                    SHININESS);
+        color += light_contribution(i, light_position(i, row), P, N, V, m.albedo, m.specular,
+                                    m.shininess);
     return color;
 }

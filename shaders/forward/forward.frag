@@ -7,6 +7,6 @@ layout(location = 0) out vec4 out_color;
 
 void main()
 {
-    vec3 albedo = instances[v_instance].albedo_mesh.rgb;
-    out_color = vec4(shade_all_lights(v_world, normalize(v_normal), albedo, 0), 1.0);
+    out_color = vec4(shade_all_lights(v_world, normalize(v_normal), instance_material(v_instance), 0),
+                     1.0);
 }

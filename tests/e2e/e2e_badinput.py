@@ -36,7 +36,7 @@ try:
     rejected(d, {"scene": {"width": 15}}, "scene.width")
     rejected(d, {"scene": {"width": 8193}}, "scene.width")
     rejected(d, {"scene": {"height": "720"}}, "scene.height")
-    rejected(d, {"scene": {"lights": 5000}}, "scene.lights")
+    rejected(d, {"scene": {"lights": 70000}}, "scene.lights")
     rejected(d, {"scene": {"dynamic": 1}}, "scene.dynamic")
     rejected(d, {"scene": {"preset": "sponza"}}, "scene.preset")
     rejected(d, {"osl": {"resolution": 300}}, "osl.resolution")

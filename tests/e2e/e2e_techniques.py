@@ -1,7 +1,8 @@
 """The technique contract, over the registry as /v1/info describes it, so a
 technique added later is tested without new test code:
 - conformance: every technique but unlit, at default options, agrees with
-  forward under the same look (SSIM bound), runs every pass it declares plus
+  forward under the same look (SSIM bound), on the grid and on the lights
+  preset with an orbiting camera, runs every pass it declares plus
   the harness's resolve, and reports them in the result and timings.csv;
 - options: /v1/info documents each option (type, default, rule); the defaults
   are accepted and come back in the spec unchanged; a bad value of each
@@ -53,8 +54,14 @@ try:
     names = [t.get("name") for t in techs]
     check(status == 200 and {"forward", "unlit", "osl"} <= set(names), "info lists techniques: %s" % names)
 
+    sweepable = info.get("sweepable", {})
+    check(sweepable.get("scene.lights") == "integer" and sweepable.get("osl.resolution") == "choice",
+          "info lists what sweeps may vary: %s" % sorted(sweepable)[:8])
+
     for t in techs:
         name = t["name"]
+        for oname in t.get("options", {}):
+            check("%s.%s" % (name, oname) in sweepable, "%s.%s is sweepable" % (name, oname))
         check(t.get("summary") and t.get("passes"), "%s: summary and passes documented" % name)
         for oname, opt in t.get("options", {}).items():
             check(all(k in opt for k in ("type", "default", "rule", "summary")),
@@ -86,6 +93,15 @@ try:
         if name != "unlit":
             ssim = result.get("quality", {}).get("worst_ssim", {}).get("value", 0)
             check(ssim >= SSIM_BOUND, "%s agrees with forward: SSIM %.5f >= %s" % (name, ssim, SSIM_BOUND))
+            # The many-lights scene under a moving camera: the frame block's
+            # camera reaches every pass of the technique.
+            moving = dict(JOB, technique=name, reference="forward",
+                          scene=dict(SCENE, preset="lights", lights=64, camera="orbit"))
+            done = d.run(moving)
+            ssim = done.get("result", {}).get("quality", {}).get("worst_ssim", {}).get("value", 0)
+            check(done.get("status") == "done" and ssim >= SSIM_BOUND,
+                  "%s agrees with forward on lights with an orbiting camera: SSIM %.5f (%s)"
+                  % (name, ssim, done.get("error")))
 
         # A bad value of each option is refused, naming it.
         for oname, opt in t.get("options", {}).items():

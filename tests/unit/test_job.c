@@ -1,3 +1,4 @@
+#include <stdlib.h>
 #include <string.h>
 
 #include "daemon/jobs/job_spec.h"
@@ -145,10 +146,84 @@ int main(void)
     rejects("{\"look\":{\"hdr\":\"rgb8\"}}", "look.hdr");
     rejects("{\"look\":{\"tonemap\":\"hable\"}}", "look.tonemap");
 
+    /* Labels: sorted by key, kept in the spec as understood, and round-tripped. */
+    CHECK(parse("{\"labels\":{\"commit\":\"abc123\",\"branch\":\"main\",\"ci.run\":\"\"}}",
+                &spec, &err));
+    CHECK(spec.nlabels == 3 && strcmp(spec.labels[0].key, "branch") == 0 &&
+          strcmp(spec.labels[1].key, "ci.run") == 0 && strcmp(spec.labels[2].value, "abc123") == 0);
+    j = job_spec_to_json(&spec);
+    CHECK(strcmp(json_string_value(json_object_get(json_object_get(j, "labels"), "commit")),
+                 "abc123") == 0);
+    text = json_dumps(j, 0);
+    CHECK(parse(text, &again, &err) && memcmp(&again, &spec, sizeof(spec)) == 0);
+    free(text);
+    json_decref(j);
+    CHECK(parse("{}", &spec, &err) && spec.nlabels == 0);
+    j = job_spec_to_json(&spec);
+    CHECK(json_object_size(json_object_get(j, "labels")) == 0);
+    json_decref(j);
+    rejects("{\"labels\":[\"main\"]}", "labels");
+    rejects("{\"labels\":{\"commit\":5}}", "labels.commit");
+    rejects("{\"labels\":{\"bad key\":\"x\"}}", "labels.bad key");
+    rejects("{\"labels\":{\"\":\"x\"}}", "labels.");
+    rejects("{\"labels\":{\"k\":\"a\\nb\"}}", "labels.k");
+    {
+        char big[400];
+        snprintf(big, sizeof(big), "{\"labels\":{\"v\":\"%0200d\"}}", 0);
+        rejects(big, "labels.v");
+        char many[600] = "{\"labels\":{";
+        for (int i = 0; i < JOB_MAX_LABELS + 1; i++)
+            snprintf(many + strlen(many), sizeof(many) - strlen(many), "%s\"k%d\":\"v\"",
+                     i ? "," : "", i);
+        strcat(many, "}}");
+        rejects(many, "labels");
+    }
+
     /* A typo gets a suggestion. */
     parse("{\"frame\":10}", &spec, &err);
     CHECK(strstr(err.message, "'frames'") != NULL);
     parse("{\"scene\":{\"widht\":300}}", &spec, &err);
     CHECK(strstr(err.message, "'scene.width'") != NULL);
+    /* Error texts are cut to their buffers at a UTF-8 boundary, and bytes
+     * that are not UTF-8 are escaped: the error JSON is always built. */
+    char key[128];
+    for (int at = 36; at <= 42; at++) {
+        /* "é" (2 bytes) straddling byte 40 of an unknown key. */
+        memset(key, 'k', sizeof(key));
+        memcpy(key + at, "\xc3\xa9", 2);
+        key[60] = '\0';
+        char text[256];
+        snprintf(text, sizeof(text), "{\"%s\": 1}", key);
+        CHECK(!parse(text, &spec, &err));
+        json_t *e = job_error_to_json(&err);
+        CHECK(e != NULL);
+        CHECK(json_string_value(json_object_get(json_object_get(e, "error"), "field")) != NULL);
+        json_decref(e);
+    }
+    /* A syntax error whose quoted token is cut inside a 3-byte character. */
+    char bad[600] = "{\"frames\": ";
+    for (int i = 0; i < 150; i++)
+        strcat(bad, "\xe2\x82\xac");
+    CHECK(!parse(bad, &spec, &err));
+    json_t *e = job_error_to_json(&err);
+    CHECK(e != NULL);
+    char *dump = e ? json_dumps(e, 0) : NULL;
+    CHECK(dump != NULL);
+    free(dump);
+    json_decref(e);
+    /* Invalid bytes are escaped, a cut character is dropped. */
+    char msg[32] = "a\xff b \xe2\x82";
+    jf_utf8_sanitize(msg, sizeof(msg));
+    CHECK(strcmp(msg, "a\\xff b ") == 0);
+    char fits[8] = "abcdef";
+    jf_utf8_sanitize(fits, 6); /* room for 5 bytes */
+    CHECK(strcmp(fits, "abcde") == 0);
+    CHECK(jf_utf8_prefix("ab\xc3\xa9", 3) == 2 && jf_utf8_prefix("ab\xc3\xa9", 4) == 4);
+    struct job_error raw;
+    snprintf(raw.field, sizeof(raw.field), "x\xc3");
+    snprintf(raw.message, sizeof(raw.message), "\x80\x80");
+    e = job_error_to_json(&raw);
+    CHECK(e != NULL);
+    json_decref(e);
     return check_finish("test_job");
 }

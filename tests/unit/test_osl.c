@@ -104,7 +104,7 @@ static void test_plan(void)
     } spec;
     scene_spec_defaults(&spec.scene);
     struct scene scene;
-    CHECK(scene_create(&scene, &spec.scene));
+    CHECK(scene_init(&scene, &spec.scene));
     int n = scene.instance_count;
     double *dist = malloc((size_t)n * sizeof(double));
     struct osl_work *plan = malloc((size_t)n * sizeof(*plan));
@@ -121,7 +121,7 @@ static void test_plan(void)
     scene_finish(&scene);
 
     spec.scene.dynamic = true;
-    CHECK(scene_create(&scene, &spec.scene));
+    CHECK(scene_init(&scene, &spec.scene));
     long touched0 = 0, all0 = 0, touched20 = 0;
     for (int k = 1; k <= 60; k++) {
         int t0 = osl_schedule_plan(&s0, &scene, k, false, OSL_RESHADE_TOUCHED, plan);

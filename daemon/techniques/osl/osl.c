@@ -23,6 +23,10 @@
 /* The passes of osl_info, in order. */
 enum { PASS_LIGHTING, PASS_RASTER };
 
+/* shaders/osl/osl_light.comp has one position and one normal sampler per
+ * mesh and selects them by branch: keep both in step. */
+_Static_assert(SCENE_MESH_COUNT == 3, "osl_light.comp samples exactly three meshes");
+
 /* Atlas memory ceiling; the device's texture size limit applies as well. */
 static const double OSL_MAX_ATLAS_BYTES = 1024.0 * 1024.0 * 1024.0;
 

@@ -1,0 +1,226 @@
+/* ab: two jobs (or one job on two daemons) run alternately, paired, and
+ * compared as the ratio B/A with its confidence interval. Alternating keeps
+ * the ratio meaningful when the machine's speed drifts: each pair sees the
+ * same conditions, and the order within a pair flips every time (A B, B A,
+ * A B, ...) so that a steady drift favours neither side. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "client/client.h"
+#include "client/gate.h"
+#include "client/junit.h"
+#include "client/verdicts.h"
+#include "common/fsutil.h"
+
+/* A pair is noisy when its two runs saw different conditions: their
+ * other-process CPU shares differ by more than the tolerance (or, without
+ * figures, the daemon flagged either). */
+static void mark_pairs(struct run_set *sa, struct run_set *sb, double tolerance)
+{
+    for (size_t i = 0; i < sa->n && i < sb->n; i++) {
+        struct gate_run *a = &sa->runs[i], *b = &sb->runs[i];
+        a->noisy = b->noisy = false;
+        a->why[0] = b->why[0] = '\0';
+        if (a->has_share && b->has_share && fabs(a->other_share - b->other_share) > tolerance) {
+            snprintf(a->why, sizeof(a->why), "other processes used %.0f%% of the CPU during A "
+                     "and %.0f%% during B", 100 * a->other_share, 100 * b->other_share);
+            a->noisy = b->noisy = true;
+        } else if ((!a->has_share || !b->has_share) && (a->daemon_noisy || b->daemon_noisy)) {
+            snprintf(a->why, sizeof(a->why), "the daemon marked the %s run noisy",
+                     a->daemon_noisy ? "A" : "B");
+            a->noisy = b->noisy = true;
+        }
+        if (b->noisy)
+            snprintf(b->why, sizeof(b->why), "%s", a->why);
+    }
+}
+
+static size_t clean_pairs(const struct run_set *sa, const struct run_set *sb, double *a, double *b)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < sa->n && i < sb->n; i++)
+        if (!sa->runs[i].noisy) {
+            a[k] = sa->runs[i].ms;
+            b[k++] = sb->runs[i].ms;
+        }
+    return k;
+}
+
+int cmd_ab(struct conn *ca, struct conn *cb, const struct options *o, const char *file_a,
+           const char *file_b)
+{
+    double t0 = now_s();
+    char err[600];
+    int rc = EXIT_ERROR;
+    if (o->baseline) {
+        fprintf(stderr, "shadebench: ab compares A with B; --baseline belongs to submit\n");
+        return EXIT_ERROR;
+    }
+    if (o->out_dir && !out_dir_claim(o->out_dir, "ab.json", NULL, err, sizeof(err))) {
+        fprintf(stderr, "shadebench: %s\n", err);
+        return EXIT_ERROR;
+    }
+    struct run_set sa, sb;
+    run_set_init(&sa, ca, "A");
+    run_set_init(&sb, cb, "B");
+    struct junit j;
+    junit_init(&j);
+    char *ta = job_text_for_submit(file_a, o, 1, err, sizeof(err));
+    char *tb = ta ? job_text_for_submit(file_b, o, 1, err, sizeof(err)) : NULL;
+    json_t *info_a = NULL, *info_b = NULL, *summary = NULL;
+    double *va = NULL, *vb = NULL;
+    if (!ta || !tb) {
+        fprintf(stderr, "shadebench: %s\n", err);
+        goto out;
+    }
+    if (!(info_a = conn_json(ca, "GET", "/v1/info", NULL, NULL)) ||
+        !(info_b = conn_json(cb, "GET", "/v1/info", NULL, NULL)))
+        goto out;
+    json_t *dev_a = json_object_get(info_a, "device"), *dev_b = json_object_get(info_b, "device");
+    const char *series = o->series ? o->series : gate_default_series(dev_a);
+    if (strcmp(gate_default_series(dev_a), gate_default_series(dev_b)) != 0 && !o->series)
+        fprintf(stderr, "shadebench: warning: A and B run on different kinds of device; "
+                "comparing %s\n", series);
+    size_t planned = (size_t)(o->runs ? o->runs : 5), target = planned;
+    int budget = o->max_reruns;
+    bool confirmed = false;
+    struct gate_verdict v;
+    memset(&v, 0, sizeof(v));
+    size_t nclean = 0;
+    if (!o->quiet)
+        fprintf(stderr, "A: %s on %s\nB: %s on %s\n%zu pairs, alternating, judged on %s\n", file_a,
+                ca->server, file_b, cb->server, planned, series);
+    for (;;) {
+        while (sa.n < target && !sa.failed && !sb.failed) {
+            /* A B, then B A: the order flips each pair. */
+            bool a_first = sa.n % 2 == 0;
+            struct run_set *first = a_first ? &sa : &sb, *second = a_first ? &sb : &sa;
+            if (!run_set_add(first, o, a_first ? ta : tb, series, NULL, NULL) || first->failed ||
+                !run_set_add(second, o, a_first ? tb : ta, series, NULL, NULL))
+                goto out;
+        }
+        if (sa.failed || sb.failed)
+            break;
+        mark_pairs(&sa, &sb, o->noise_tolerance);
+        free(va);
+        free(vb);
+        va = malloc(sa.n * sizeof(double));
+        vb = malloc(sb.n * sizeof(double));
+        if (!va || !vb)
+            goto out;
+        nclean = clean_pairs(&sa, &sb, va, vb);
+        struct ratio_interval r;
+        if (nclean >= 2 && paired_log_ratio(va, vb, nclean, o->confidence, &r)) {
+            gate_decide(&r, o->max_slowdown, &v);
+        } else {
+            memset(&v, 0, sizeof(v));
+            v.outcome = GATE_INCONCLUSIVE;
+            snprintf(v.why, sizeof(v.why), "too few clean pairs (%zu)", nclean);
+        }
+        if (budget <= 0)
+            break;
+        size_t batch = planned < (size_t)budget ? planned : (size_t)budget;
+        if (nclean < planned) {
+            size_t need = planned - nclean < (size_t)budget ? planned - nclean : (size_t)budget;
+            if (!o->quiet)
+                fprintf(stderr, "%zu noisy pair(s) left out: running %zu more\n", sa.n - nclean,
+                        need);
+            target += need;
+            budget -= (int)need;
+            continue;
+        }
+        if ((v.outcome == GATE_REGRESSION && !confirmed) || v.outcome == GATE_INCONCLUSIVE) {
+            if (!o->quiet)
+                fprintf(stderr, "%s (%s): running %zu more pairs\n",
+                        v.outcome == GATE_REGRESSION ? "B looks slower" : "inconclusive", v.why,
+                        batch);
+            confirmed = confirmed || v.outcome == GATE_REGRESSION;
+            target += batch;
+            budget -= (int)batch;
+            continue;
+        }
+        break;
+    }
+
+    json_t *ja = sa.n ? json_array_get(sa.jobs, 0) : sa.failed;
+    json_t *jb = sb.n ? json_array_get(sb.jobs, 0) : sb.failed;
+    char name_a[320], name_b[320], cls[96], name[700];
+    junit_job_name(json_object_get(ja, "spec"), name_a, sizeof(name_a));
+    junit_job_name(json_object_get(jb, "spec"), name_b, sizeof(name_b));
+    if (ca != cb) {
+        snprintf(name_a + strlen(name_a), sizeof(name_a) - strlen(name_a), " on A");
+        snprintf(name_b + strlen(name_b), sizeof(name_b) - strlen(name_b), " on B");
+    }
+    job_classname(json_object_get(ja, "spec"), cls, sizeof(cls));
+    job_case(&j, cls, name_a, sa.failed ? sa.failed : ja, sa.elapsed_s);
+    job_classname(json_object_get(jb, "spec"), cls, sizeof(cls));
+    job_case(&j, cls, name_b, sb.failed ? sb.failed : jb, sb.elapsed_s);
+    snprintf(name, sizeof(name), "%s against %s: %s B/A", name_b, name_a, series);
+    if (!sa.failed && !sb.failed) {
+        if (!o->quiet) {
+            run_set_print(&sa, series, stderr);
+            run_set_print(&sb, series, stderr);
+            fprintf(stderr, "B/A = %.4f, %.0f%% interval [%.4f, %.4f] over %zu pairs: %s (%s)\n",
+                    v.r.ratio, 100 * o->confidence, v.r.lo, v.r.hi, nclean,
+                    v.outcome == GATE_REGRESSION ? "B SLOWER"
+                    : v.outcome == GATE_PASS ? "pass" : "INCONCLUSIVE", v.why);
+        }
+        struct junit_case *t = junit_add(&j, "shadebench.ab", name);
+        if (t) {
+            t->time_s = sa.elapsed_s + sb.elapsed_s;
+            junit_prop_str(t, "outcome", gate_outcome_name(v.outcome));
+            junit_prop_str(t, "series", series);
+            junit_prop_num(t, "ratio", v.r.ratio);
+            junit_prop_num(t, "ci_low", v.r.lo);
+            junit_prop_num(t, "ci_high", v.r.hi);
+            junit_prop_num(t, "confidence", o->confidence);
+            junit_prop_num(t, "pairs", (double)nclean);
+            junit_prop_num(t, "noisy_pairs", (double)(sa.n - nclean));
+            junit_out(t, "%s: %s", gate_outcome_name(v.outcome), v.why);
+            if (v.outcome == GATE_REGRESSION)
+                junit_fail(t, "B is slower than A: %s", v.why);
+            else if (v.outcome == GATE_INCONCLUSIVE && o->fail_inconclusive)
+                junit_fail(t, "inconclusive (--fail-inconclusive): %s", v.why);
+        }
+        json_t *pairs = json_array();
+        for (size_t i = 0; i < sa.n; i++)
+            json_array_append_new(pairs, json_pack("{s:s, s:s, s:f, s:f, s:b, s:s}", "a",
+                                                   sa.runs[i].job, "b", sb.runs[i].job, "a_ms",
+                                                   sa.runs[i].ms, "b_ms", sb.runs[i].ms, "noisy",
+                                                   sa.runs[i].noisy, "why", sa.runs[i].why));
+        summary = json_pack("{s:s, s:s, s:s, s:s, s:s, s:f, s:f, s:f, s:f, s:I, s:s, s:o}", "a",
+                            file_a, "b", file_b, "series", series, "outcome",
+                            gate_outcome_name(v.outcome), "why", v.why, "ratio", v.r.ratio,
+                            "ci_low", v.r.lo, "ci_high", v.r.hi, "confidence", o->confidence,
+                            "pairs", (json_int_t)nclean, "server_b", cb->server, "runs", pairs);
+    }
+    rc = junit_conclude(o, &j, name, now_s() - t0);
+    if (o->out_dir && summary) {
+        char path[4096];
+        snprintf(path, sizeof(path), "%s/A", o->out_dir);
+        bool ok = run_set_write(&sa, path);
+        snprintf(path, sizeof(path), "%s/B", o->out_dir);
+        ok = run_set_write(&sb, path) && ok;
+        snprintf(path, sizeof(path), "%s/ab.json", o->out_dir);
+        ok = ok && fs_write_json_atomic(path, summary);
+        if (!ok)
+            rc = EXIT_ERROR;
+        else if (!o->quiet)
+            fprintf(stderr, "files in %s\n", o->out_dir);
+    }
+out:
+    free(va);
+    free(vb);
+    free(ta);
+    free(tb);
+    json_decref(info_a);
+    json_decref(info_b);
+    json_decref(summary);
+    run_set_finish(&sa);
+    run_set_finish(&sb);
+    junit_finish(&j);
+    return rc;
+}

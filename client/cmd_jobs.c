@@ -1,0 +1,493 @@
+/* submit (with the timing gate), fetch, status, list, cancel and info. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "client/client.h"
+#include "client/gate.h"
+#include "client/junit.h"
+#include "client/verdicts.h"
+#include "common/fsutil.h"
+
+/* ---- the baseline ---- */
+
+struct baseline {
+    json_t *root;   /* the file */
+    json_t *beside; /* job.json beside a result.json without a spec */
+    const json_t *result, *spec, *device;
+};
+
+static void baseline_finish(struct baseline *b)
+{
+    json_decref(b->root);
+    json_decref(b->beside);
+    memset(b, 0, sizeof(*b));
+}
+
+/* A result.json written by this client (with its spec, and gate_runs for
+ * several runs), or a job.json with the result inside. Read before any job
+ * runs, so that a wrong path fails at once. */
+static bool baseline_load(const char *path, struct baseline *b)
+{
+    memset(b, 0, sizeof(*b));
+    json_error_t jerr;
+    b->root = json_load_file(path, 0, &jerr);
+    if (!b->root) {
+        fprintf(stderr, "shadebench: --baseline %s: %s\n", path, jerr.text);
+        return false;
+    }
+    json_t *inner = json_object_get(b->root, "result");
+    b->result = inner ? inner : b->root;
+    b->spec = json_object_get(inner ? b->root : b->result, "spec");
+    if (!b->spec) {
+        /* An older result.json: the spec is in job.json beside it. */
+        char beside[4096];
+        snprintf(beside, sizeof(beside), "%s", path);
+        char *slash = strrchr(beside, '/');
+        snprintf(slash ? slash + 1 : beside,
+                 sizeof(beside) - (size_t)(slash ? slash + 1 - beside : 0), "job.json");
+        b->beside = json_load_file(beside, 0, NULL);
+        b->spec = json_object_get(b->beside, "spec");
+    }
+    b->device = json_object_get(b->result, "device");
+    if (!json_is_object(b->result) || !json_object_get(b->result, "frame_ms")) {
+        fprintf(stderr, "shadebench: --baseline %s: not a finished job's result (no frame_ms)\n",
+                path);
+        baseline_finish(b);
+        return false;
+    }
+    return true;
+}
+
+/* ---- the gate ---- */
+
+struct spec_check {
+    const struct baseline *base;
+    const struct options *o;
+    bool mismatch;
+};
+
+static bool check_spec(const json_t *spec, void *ctx)
+{
+    struct spec_check *sc = ctx;
+    char what[512];
+    if (!sc->base->spec) {
+        if (sc->o->allow_mismatch)
+            return true;
+        fprintf(stderr, "shadebench: the baseline has no job spec to check the job against "
+                "(neither in it nor in job.json beside it); --allow-mismatch compares anyway\n");
+        sc->mismatch = true;
+        return false;
+    }
+    if (!gate_spec_differs(sc->base->spec, spec, what, sizeof(what)))
+        return true;
+    if (sc->o->allow_mismatch) {
+        fprintf(stderr, "shadebench: warning: not the baseline's job (%s); compared anyway "
+                "(--allow-mismatch)\n", what);
+        return true;
+    }
+    fprintf(stderr, "shadebench: not the baseline's job: %s. Labels, repeat, captures, the "
+            "reference and metrics may differ; nothing else (--allow-mismatch to compare "
+            "anyway)\n", what);
+    sc->mismatch = true;
+    return false;
+}
+
+/* Job-file repeat as the number of runs, else 5. */
+static int default_runs(const char *file)
+{
+    json_t *job = json_load_file(file, 0, NULL);
+    json_t *rep = json_object_get(job, "repeat");
+    int n = json_is_integer(rep) ? (int)json_integer_value(rep)
+            : json_is_object(rep) ? (int)json_integer_value(json_object_get(rep, "max")) : 0;
+    json_decref(job);
+    return n > 1 ? (n > 100 ? 100 : n) : 5;
+}
+
+/* Marks noise on both sides and compares. The candidate runs are judged
+ * against the baseline's typical other-process CPU share when it has one,
+ * else against their own. */
+static void evaluate(const struct options *o, struct gate_run *base, size_t nb, struct run_set *s,
+                     struct gate_verdict *v, size_t *nb_clean, size_t *nc_clean)
+{
+    double ref;
+    bool have = gate_typical_share(base, nb, &ref);
+    gate_mark_noisy(base, nb, have, ref, o->noise_tolerance);
+    for (size_t i = 0; i < s->n; i++) {
+        s->runs[i].noisy = false;
+        s->runs[i].why[0] = '\0';
+    }
+    if (!have)
+        have = gate_typical_share(s->runs, s->n, &ref);
+    gate_mark_noisy(s->runs, s->n, have, ref, o->noise_tolerance);
+    double *bv = malloc((nb + 1) * sizeof(double)), *cv = malloc((s->n + 1) * sizeof(double));
+    *nb_clean = bv ? gate_clean_values(base, nb, bv) : 0;
+    *nc_clean = cv ? gate_clean_values(s->runs, s->n, cv) : 0;
+    gate_compare(bv, *nb_clean, cv, *nc_clean, o->confidence, o->max_slowdown, v);
+    free(bv);
+    free(cv);
+}
+
+/* Consecutive noisy runs at the end: when a whole batch was disturbed, the
+ * machine's conditions differ from the baseline's and more runs will not
+ * help. */
+static size_t trailing_noisy(const struct run_set *s)
+{
+    size_t k = 0;
+    while (k < s->n && s->runs[s->n - 1 - k].noisy)
+        k++;
+    return k;
+}
+
+static int gate_or_runs(struct conn *c, const struct options *o, const char *file,
+                        const struct baseline *base, int planned)
+{
+    double t0 = now_s();
+    int rc = EXIT_ERROR;
+    char err[512];
+    struct run_set s;
+    run_set_init(&s, c, "run");
+    struct gate_run *brun = NULL;
+    size_t nb = 0;
+    struct junit j;
+    junit_init(&j);
+    char *text = job_text_for_submit(file, o, 1, err, sizeof(err));
+    json_t *info = NULL, *gate_json = NULL;
+    if (!text) {
+        fprintf(stderr, "shadebench: %s\n", err);
+        goto out;
+    }
+    /* The device first: a baseline from another device is refused before
+     * anything runs. */
+    if (!(info = conn_json(c, "GET", "/v1/info", NULL, NULL)))
+        goto out;
+    json_t *device = json_object_get(info, "device");
+    if (base && gate_device_differs(base->device, device, err, sizeof(err))) {
+        if (!o->allow_mismatch) {
+            fprintf(stderr, "shadebench: the baseline was measured on another device: %s "
+                    "(--allow-mismatch to compare anyway)\n", err);
+            goto out;
+        }
+        fprintf(stderr, "shadebench: warning: another device than the baseline's: %s\n", err);
+    }
+    const char *series = o->series ? o->series : gate_default_series(base ? base->device : device);
+    if (base && !(nb = gate_runs_from_result(base->result, series, &brun))) {
+        fprintf(stderr, "shadebench: the baseline has no %s figures\n", series);
+        goto out;
+    }
+    struct spec_check sc = {base, o, false};
+    struct gate_verdict v;
+    memset(&v, 0, sizeof(v));
+    size_t nb_clean = 0, nc_clean = 0, target = (size_t)planned;
+    int budget = o->max_reruns;
+    bool confirmed = false;
+    if (!o->quiet)
+        fprintf(stderr, "%d runs of %s, each a job of its own, judged on %s\n", planned, file,
+                series);
+    for (;;) {
+        while (s.n < target && !s.failed) {
+            if (!run_set_add(&s, o, text, series, base && s.n == 0 ? check_spec : NULL, &sc))
+                goto out;
+        }
+        if (s.failed)
+            break;
+        evaluate(o, brun, nb, &s, &v, &nb_clean, &nc_clean);
+        if (!base) {
+            /* Runs for a later baseline: replace disturbed ones. */
+            if (nc_clean < (size_t)planned && budget > 0 &&
+                trailing_noisy(&s) < (size_t)(planned > 3 ? planned : 3)) {
+                target += 1;
+                budget--;
+                continue;
+            }
+            break;
+        }
+        size_t batch = (size_t)planned < (size_t)budget ? (size_t)planned : (size_t)budget;
+        if (budget <= 0 || trailing_noisy(&s) >= (size_t)(planned > 3 ? planned : 3))
+            break;
+        if (nc_clean < (size_t)planned) {
+            size_t need = (size_t)planned - nc_clean;
+            need = need < (size_t)budget ? need : (size_t)budget;
+            if (!o->quiet)
+                fprintf(stderr, "%zu noisy run(s) left out: running %zu more\n", s.n - nc_clean,
+                        need);
+            target += need;
+            budget -= (int)need;
+            continue;
+        }
+        if (v.outcome == GATE_REGRESSION && !confirmed) {
+            /* A regression must hold on fresh runs too before it fails a
+             * build: one unlucky batch is not enough. */
+            if (!o->quiet)
+                fprintf(stderr, "possible regression (%s): confirming on %zu more runs\n", v.why,
+                        batch);
+            confirmed = true;
+            target += batch;
+            budget -= (int)batch;
+            continue;
+        }
+        if (v.outcome == GATE_INCONCLUSIVE) {
+            if (!o->quiet)
+                fprintf(stderr, "inconclusive (%s): running %zu more\n", v.why, batch);
+            target += batch;
+            budget -= (int)batch;
+            continue;
+        }
+        break;
+    }
+
+    /* The verdicts. */
+    json_t *first = s.n ? json_array_get(s.jobs, 0) : s.failed;
+    json_t *spec = json_object_get(first, "spec");
+    char name[320], classname[96];
+    junit_job_name(spec, name, sizeof(name));
+    job_classname(spec, classname, sizeof(classname));
+    struct junit_case *jc = job_case(&j, classname, name, s.failed ? s.failed : first, s.elapsed_s);
+    if (jc && s.n > 1) {
+        junit_prop_num(jc, "runs", (double)s.n);
+        junit_out(jc, "%zu runs, each a job of its own", s.n);
+    }
+    if (s.n)
+        quality_cases(o, json_object_get(first, "result"), classname, name, &j);
+    if (!o->quiet && s.n) {
+        fprintf(stderr, "runs (%s):\n", series);
+        run_set_print(&s, series, stderr);
+    }
+    if (base && !s.failed) {
+        if (!o->quiet) {
+            struct run_set bs = {.what = "baseline run", .runs = brun, .n = nb};
+            fprintf(stderr, "baseline runs:\n");
+            run_set_print(&bs, series, stderr);
+        }
+        char cname[400];
+        snprintf(cname, sizeof(cname), "%s: median %s against the baseline", name, series);
+        struct junit_case *t = junit_add(&j, classname, cname);
+        if (t) {
+            t->time_s = s.elapsed_s;
+            junit_prop_str(t, "outcome", gate_outcome_name(v.outcome));
+            junit_prop_str(t, "series", series);
+            junit_prop_num(t, "ratio", v.r.ratio);
+            junit_prop_num(t, "ci_low", v.r.lo);
+            junit_prop_num(t, "ci_high", v.r.hi);
+            junit_prop_num(t, "confidence", o->confidence);
+            junit_prop_num(t, "allowed_slowdown", o->max_slowdown);
+            junit_prop_num(t, "baseline_runs", (double)nb_clean);
+            junit_prop_num(t, "runs", (double)nc_clean);
+            junit_prop_num(t, "noisy_runs", (double)(s.n - nc_clean + nb - nb_clean));
+            junit_out(t, "%s: %s", gate_outcome_name(v.outcome), v.why);
+            junit_out(t, "%zu baseline runs and %zu runs here compared (%zu and %zu left out as "
+                      "noisy)", nb_clean, nc_clean, nb - nb_clean, s.n - nc_clean);
+            for (size_t i = 0; i < s.n; i++)
+                if (s.runs[i].noisy)
+                    junit_out(t, "run %s left out: %s", s.runs[i].job, s.runs[i].why);
+            if (v.outcome == GATE_REGRESSION)
+                junit_fail(t, "%s", v.why);
+            else if (v.outcome == GATE_INCONCLUSIVE && o->fail_inconclusive)
+                junit_fail(t, "inconclusive (--fail-inconclusive): %s", v.why);
+        }
+        if (!o->quiet) {
+            fprintf(stderr, "gate: %s: %s\n", v.outcome == GATE_REGRESSION ? "REGRESSION"
+                                              : v.outcome == GATE_PASS ? "PASS" : "INCONCLUSIVE",
+                    v.why);
+            if (v.outcome == GATE_INCONCLUSIVE)
+                fprintf(stderr, "shadebench: warning: the timing gate could not decide within "
+                        "%d reruns; %s\n", o->max_reruns,
+                        o->fail_inconclusive ? "failing (--fail-inconclusive)"
+                                             : "passing (--fail-inconclusive fails instead)");
+        }
+        gate_json = json_pack("{s:s, s:s, s:f, s:f, s:f, s:f, s:f, s:I, s:I, s:s}", "outcome",
+                              gate_outcome_name(v.outcome), "series", series, "ratio", v.r.ratio,
+                              "ci_low", v.r.lo, "ci_high", v.r.hi, "confidence", o->confidence,
+                              "allowed_slowdown", o->max_slowdown, "baseline_runs",
+                              (json_int_t)nb_clean, "runs", (json_int_t)nc_clean, "why", v.why);
+    }
+    rc = junit_conclude(o, &j, name, now_s() - t0);
+    if (o->out_dir && s.n) {
+        json_t *extra = json_pack("{s:o}", "gate_runs", run_set_json(&s));
+        if (gate_json)
+            json_object_set(extra, "gate", gate_json);
+        json_t *written = fetch_job_files(c, first, o->out_dir, true, extra);
+        bool ok = written && run_set_write(&s, o->out_dir);
+        if (ok && gate_json) {
+            char path[4096];
+            snprintf(path, sizeof(path), "%s/gate.json", o->out_dir);
+            ok = fs_write_json_atomic(path, gate_json);
+        }
+        json_decref(written);
+        json_decref(extra);
+        if (!ok)
+            rc = EXIT_ERROR;
+        else if (!o->quiet)
+            fprintf(stderr, "files in %s\n", o->out_dir);
+    }
+out:
+    json_decref(gate_json);
+    json_decref(info);
+    free(text);
+    free(brun);
+    run_set_finish(&s);
+    junit_finish(&j);
+    return rc;
+}
+
+/* One job, as submitted: the files, the quality verdicts, JUnit. */
+static int finish_single(struct conn *c, const struct options *o, json_t *job, double time_s)
+{
+    int rc = EXIT_PASS;
+    if (o->out_dir) {
+        json_t *written = fetch_job_files(c, job, o->out_dir, true, NULL);
+        if (!written)
+            rc = EXIT_ERROR;
+        else if (!o->quiet)
+            fprintf(stderr, "files in %s\n", o->out_dir);
+        json_decref(written);
+    }
+    struct junit j;
+    junit_init(&j);
+    json_t *spec = json_object_get(job, "spec");
+    char name[320], classname[96];
+    junit_job_name(spec, name, sizeof(name));
+    job_classname(spec, classname, sizeof(classname));
+    job_case(&j, classname, name, job, time_s);
+    json_t *result = json_object_get(job, "result");
+    if (result)
+        quality_cases(o, result, classname, name, &j);
+    int verdict = junit_conclude(o, &j, name, time_s);
+    junit_finish(&j);
+    return rc == EXIT_ERROR ? rc : verdict;
+}
+
+int cmd_submit(struct conn *c, const struct options *o, const char *file)
+{
+    char err[600];
+    if (o->baseline && !o->wait) {
+        fprintf(stderr, "shadebench: --baseline needs --wait: the gate judges finished runs\n");
+        return EXIT_ERROR;
+    }
+    if (o->runs > 1 && !o->wait) {
+        fprintf(stderr, "shadebench: --runs needs --wait\n");
+        return EXIT_ERROR;
+    }
+    if (o->out_dir && !o->wait) {
+        fprintf(stderr, "shadebench: --out needs --wait: files exist once the job is done\n");
+        return EXIT_ERROR;
+    }
+    if (o->out_dir && !out_dir_claim(o->out_dir, "job.json", NULL, err, sizeof(err))) {
+        fprintf(stderr, "shadebench: %s\n", err);
+        return EXIT_ERROR;
+    }
+    struct baseline base;
+    if (o->baseline && !baseline_load(o->baseline, &base))
+        return EXIT_ERROR;
+    int runs = o->runs ? o->runs : o->baseline ? default_runs(file) : 1;
+    if (o->baseline || runs > 1) {
+        int rc = gate_or_runs(c, o, file, o->baseline ? &base : NULL, runs);
+        if (o->baseline)
+            baseline_finish(&base);
+        return rc;
+    }
+    char *text = job_text_for_submit(file, o, 0, err, sizeof(err));
+    if (!text) {
+        fprintf(stderr, "shadebench: %s\n", err);
+        return EXIT_ERROR;
+    }
+    double t0 = now_s();
+    json_t *reply = conn_json(c, "POST", "/v1/jobs", text, NULL);
+    free(text);
+    if (!reply)
+        return EXIT_ERROR;
+    char id[64];
+    snprintf(id, sizeof(id), "%s", json_string_value(json_object_get(reply, "id")));
+    json_decref(reply);
+    printf("%s\n", id);
+    fflush(stdout);
+    if (!o->wait)
+        return EXIT_PASS;
+    json_t *job = conn_follow_job(c, id, NULL, o->quiet, o->timeout_s);
+    if (!job)
+        return EXIT_ERROR;
+    int rc = finish_single(c, o, job, now_s() - t0);
+    json_decref(job);
+    return rc;
+}
+
+int cmd_fetch(struct conn *c, const struct options *o, const char *id)
+{
+    char path[256], err[600];
+    if (o->baseline) {
+        fprintf(stderr, "shadebench: fetch judges one finished job; compare with a baseline "
+                "through submit --wait --baseline\n");
+        return EXIT_ERROR;
+    }
+    if (!out_dir_claim(o->out_dir, "job.json", id, err, sizeof(err))) {
+        fprintf(stderr, "shadebench: %s\n", err);
+        return EXIT_ERROR;
+    }
+    snprintf(path, sizeof(path), "/v1/jobs/%s", id);
+    json_t *job = conn_json(c, "GET", path, NULL, NULL);
+    if (!job)
+        return EXIT_ERROR;
+    const char *status = json_string_value(json_object_get(job, "status"));
+    if (status && (strcmp(status, "queued") == 0 || strcmp(status, "running") == 0)) {
+        json_decref(job);
+        if (!o->wait) {
+            fprintf(stderr, "shadebench: job %s is %s; use --wait to wait for it\n", id, status);
+            return EXIT_ERROR;
+        }
+        if (!(job = conn_follow_job(c, id, NULL, o->quiet, o->timeout_s)))
+            return EXIT_ERROR;
+    }
+    int rc = finish_single(c, o, job, 0);
+    json_decref(job);
+    return rc;
+}
+
+int cmd_print(struct conn *c, const char *method, const char *path)
+{
+    json_t *j = conn_json(c, method, path, NULL, NULL);
+    if (!j)
+        return EXIT_ERROR;
+    json_dumpf(j, stdout, JSON_INDENT(2));
+    putchar('\n');
+    json_decref(j);
+    return EXIT_PASS;
+}
+
+int cmd_status(struct conn *c, const char *id)
+{
+    char path[256];
+    snprintf(path, sizeof(path), "/v1/jobs/%s", id);
+    json_t *job = conn_json(c, "GET", path, NULL, NULL);
+    if (!job)
+        return EXIT_ERROR;
+    json_t *p = json_object_get(job, "progress");
+    const char *error = json_string_value(json_object_get(job, "error"));
+    printf("%s %s %s %lld/%lld frames%s%s\n", id, json_string_value(json_object_get(job, "status")),
+           json_string_value(json_object_get(job, "technique")),
+           (long long)json_integer_value(json_object_get(p, "frames_done")),
+           (long long)json_integer_value(json_object_get(p, "frames_total")), error ? "  " : "",
+           error ? error : "");
+    json_decref(job);
+    return EXIT_PASS;
+}
+
+int cmd_list(struct conn *c)
+{
+    json_t *list = conn_json(c, "GET", "/v1/jobs", NULL, NULL);
+    if (!list)
+        return EXIT_ERROR;
+    size_t i;
+    json_t *job;
+    json_array_foreach(json_object_get(list, "jobs"), i, job) {
+        json_t *p = json_object_get(job, "progress");
+        printf("%-22s %-11s %-8s %lld/%lld\n", json_string_value(json_object_get(job, "id")),
+               json_string_value(json_object_get(job, "status")),
+               json_string_value(json_object_get(job, "technique")),
+               (long long)json_integer_value(json_object_get(p, "frames_done")),
+               (long long)json_integer_value(json_object_get(p, "frames_total")));
+    }
+    json_decref(list);
+    return EXIT_PASS;
+}

@@ -1,0 +1,302 @@
+/* sweep: starts a sweep, follows it by points, downloads its table (JSON
+ * and CSV), charts and report, and turns its criteria into test cases. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "client/client.h"
+#include "client/junit.h"
+#include "client/verdicts.h"
+#include "common/fsutil.h"
+
+static void csv_cell(FILE *f, const json_t *v)
+{
+    if (json_is_number(v))
+        fprintf(f, "%.10g", json_number_value(v));
+    else if (json_is_string(v))
+        fprintf(f, "\"%s\"", json_string_value(v)); /* values never hold quotes here */
+    else if (json_is_boolean(v))
+        fputs(json_is_true(v) ? "true" : "false", f);
+}
+
+/* One row per point: the swept values, then the figures. */
+static bool write_csv(const json_t *sweep, const char *path)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return false;
+    json_t *points = json_object_get(sweep, "points");
+    json_t *keys = json_array(); /* swept fields, in order of first appearance */
+    size_t i, k;
+    json_t *row, *key;
+    json_array_foreach(points, i, row) {
+        const char *name;
+        json_t *v;
+        json_object_foreach(json_object_get(row, "values"), name, v) {
+            bool seen = false;
+            json_array_foreach(keys, k, key) seen = seen || !strcmp(json_string_value(key), name);
+            if (!seen)
+                json_array_append_new(keys, json_string(name));
+        }
+    }
+    json_array_foreach(keys, k, key) fprintf(f, "%s,", json_string_value(key));
+    static const char *const series[] = {"frame_ms", "gpu_ms", "cpu_ms"};
+    fprintf(f, "technique,job,status");
+    for (int s = 0; s < 3; s++)
+        fprintf(f, ",%s_median,%s_ci95_low,%s_ci95_high,%s_over", series[s], series[s], series[s],
+                series[s]);
+    fprintf(f, ",worst_ssim,worst_ssim_min,worst_flip,pdiff_failed_captures,criterion_holds\n");
+    json_array_foreach(points, i, row) {
+        json_t *values = json_object_get(row, "values");
+        json_array_foreach(keys, k, key) {
+            csv_cell(f, json_object_get(values, json_string_value(key)));
+            fputc(',', f);
+        }
+        csv_cell(f, json_object_get(row, "technique"));
+        fputc(',', f);
+        csv_cell(f, json_object_get(row, "job"));
+        fputc(',', f);
+        csv_cell(f, json_object_get(row, "status"));
+        for (int s = 0; s < 3; s++) {
+            json_t *cell = json_object_get(row, series[s]);
+            json_t *ci = json_object_get(cell, "ci95");
+            fputc(',', f);
+            csv_cell(f, json_object_get(cell, "median"));
+            fputc(',', f);
+            csv_cell(f, json_array_get(ci, 0));
+            fputc(',', f);
+            csv_cell(f, json_array_get(ci, 1));
+            fputc(',', f);
+            csv_cell(f, json_object_get(cell, "over"));
+        }
+        static const char *const tail[] = {"worst_ssim", "worst_ssim_min", "worst_flip",
+                                           "pdiff_failed_captures", "criterion_holds"};
+        for (size_t t = 0; t < sizeof(tail) / sizeof(tail[0]); t++) {
+            fputc(',', f);
+            csv_cell(f, json_object_get(row, tail[t]));
+        }
+        fputc('\n', f);
+    }
+    json_decref(keys);
+    return fclose(f) == 0;
+}
+
+/* "osl async_distance=5 scene.lights=8": the point's content, stable from
+ * build to build. */
+static void point_name(const json_t *row, char *out, size_t cap)
+{
+    const char *tech = json_string_value(json_object_get(row, "technique"));
+    snprintf(out, cap, "%s", tech ? tech : "?");
+    const char *key;
+    json_t *v;
+    json_object_foreach(json_object_get(row, "values"), key, v) {
+        if (!strcmp(key, "technique"))
+            continue;
+        char *text = json_dumps(v, JSON_ENCODE_ANY | JSON_COMPACT);
+        size_t used = strlen(out);
+        snprintf(out + used, cap - used, " %s=%s", key, text ? text : "?");
+        free(text);
+    }
+}
+
+static void point_cases(const struct options *o, const json_t *sweep, struct junit *j)
+{
+    bool find = !strcmp(json_string_value(json_object_get(sweep, "kind")) ?
+                        json_string_value(json_object_get(sweep, "kind")) : "", "find");
+    size_t i;
+    json_t *row;
+    char name[400], cname[440];
+    json_array_foreach(json_object_get(sweep, "points"), i, row) {
+        point_name(row, name, sizeof(name));
+        snprintf(cname, sizeof(cname), "%s: job", name);
+        struct junit_case *t = junit_add(j, "shadebench.sweep", cname);
+        if (!t)
+            return;
+        const char *status = json_string_value(json_object_get(row, "status"));
+        junit_prop_str(t, "job", json_string_value(json_object_get(row, "job")));
+        if (!status || strcmp(status, "done") != 0) {
+            const char *error = json_string_value(json_object_get(row, "error"));
+            junit_fail(t, "point job %s: %s", status ? status : "?", error ? error : "");
+            continue;
+        }
+        static const char *const series[] = {"frame_ms", "gpu_ms", "cpu_ms"};
+        char prop[48];
+        for (int s = 0; s < 3; s++) {
+            json_t *cell = json_object_get(row, series[s]);
+            snprintf(prop, sizeof(prop), "%s_median", series[s]);
+            junit_prop_num(t, prop, json_number_value(json_object_get(cell, "median")));
+        }
+        junit_prop_num(t, "wall_s", json_number_value(json_object_get(json_object_get(row, "wall_s"),
+                                                                      "mean")));
+        t->time_s = json_number_value(json_object_get(json_object_get(row, "wall_s"), "mean")) *
+                    (double)json_integer_value(json_object_get(json_object_get(row, "wall_s"),
+                                                               "runs"));
+        junit_out(t, "frame_ms median %.4f ms",
+                  json_number_value(json_object_get(json_object_get(row, "frame_ms"), "median")));
+        json_t *pf = json_object_get(row, "pdiff_failed_captures");
+        json_t *ssim = json_object_get(row, "worst_ssim");
+        json_t *flip = json_object_get(row, "worst_flip");
+        if (!pf && !json_is_number(ssim))
+            continue; /* no reference: nothing judged */
+        snprintf(cname, sizeof(cname), "%s: quality", name);
+        struct junit_case *q = junit_add(j, "shadebench.sweep", cname);
+        if (!q)
+            return;
+        junit_prop_num(q, "worst_ssim", json_number_value(ssim));
+        junit_prop_num(q, "worst_flip", json_number_value(flip));
+        junit_prop_num(q, "pdiff_failed_captures", (double)json_integer_value(pf));
+        json_t *holds = json_object_get(row, "criterion_holds");
+        if (find) {
+            /* Probes of a bisection fail above the boundary by design: their
+             * verdicts are output, the breaking point is the case. */
+            junit_out(q, "criterion %s", json_is_true(holds) ? "holds" : "fails");
+        } else if (json_integer_value(pf) > 0) {
+            junit_fail(q, "PerceptualDiff failed on %lld captures",
+                       (long long)json_integer_value(pf));
+        }
+        if (!find && !isnan(o->min_ssim) && json_is_number(ssim) &&
+            json_number_value(ssim) < o->min_ssim)
+            junit_fail(q, "worst SSIM %.6f below %.6f", json_number_value(ssim), o->min_ssim);
+        if (!find && !isnan(o->max_flip) && json_is_number(flip) &&
+            json_number_value(flip) > o->max_flip)
+            junit_fail(q, "worst FLIP mean %.6f above %.6f", json_number_value(flip), o->max_flip);
+    }
+    json_t *result = json_object_get(sweep, "result");
+    json_t *bp = json_object_get(result, "breaking_point");
+    if (bp) {
+        snprintf(cname, sizeof(cname), "breaking point of %s while %s",
+                 json_string_value(json_object_get(bp, "param")),
+                 json_string_value(json_object_get(bp, "criterion")));
+        struct junit_case *t = junit_add(j, "shadebench.sweep", cname);
+        if (!t)
+            return;
+        const char *outcome = json_string_value(json_object_get(bp, "outcome"));
+        junit_prop_str(t, "outcome", outcome);
+        junit_prop_num(t, "value", json_number_value(json_object_get(bp, "value")));
+        junit_prop_num(t, "first_failing", json_number_value(json_object_get(bp, "first_failing")));
+        junit_prop_num(t, "probes", (double)json_integer_value(json_object_get(bp, "probes")));
+        char *v = json_dumps(json_object_get(bp, "value"), JSON_ENCODE_ANY);
+        junit_out(t, "%s: largest value at which it holds %s", outcome ? outcome : "?",
+                  v ? v : "?");
+        free(v);
+        if (!outcome || !strcmp(outcome, "fails everywhere") || !strcmp(outcome, "aborted"))
+            junit_fail(t, "no value holds the criterion (%s)", outcome ? outcome : "no outcome");
+    }
+    json_t *largest = json_object_get(result, "largest_pdiff_pass");
+    if (largest) {
+        snprintf(cname, sizeof(cname), "largest %s passing PerceptualDiff",
+                 json_string_value(json_object_get(largest, "param")));
+        struct junit_case *t = junit_add(j, "shadebench.sweep", cname);
+        if (!t)
+            return;
+        char *v = json_dumps(json_object_get(largest, "value"), JSON_ENCODE_ANY);
+        junit_prop_str(t, "value", v);
+        junit_out(t, "%s", v ? v : "null");
+        free(v);
+    }
+}
+
+static bool download_all(struct conn *c, const json_t *sweep, const char *dir)
+{
+    const char *id = json_string_value(json_object_get(sweep, "id"));
+    char path[4096], url[512];
+    bool ok = fs_mkdir_p(dir);
+    snprintf(path, sizeof(path), "%s/charts", dir);
+    ok = ok && fs_mkdir_p(path);
+    snprintf(path, sizeof(path), "%s/sweep.json", dir);
+    ok = ok && fs_write_json_atomic(path, sweep);
+    snprintf(path, sizeof(path), "%s/table.csv", dir);
+    ok = ok && write_csv(sweep, path);
+    /* file name, chart name, query */
+    static const char *const charts[][3] = {
+        {"speed_accuracy", "speed_accuracy", ""},
+        {"speed_accuracy_flip", "speed_accuracy", "?y=flip"},
+        {"time_vs_param", "time_vs_param", ""},
+        {"distribution", "distribution", ""},
+    };
+    static const char *const formats[] = {"svg", "png"};
+    for (size_t k = 0; ok && k < sizeof(charts) / sizeof(charts[0]); k++)
+        for (int f = 0; f < 2; f++) {
+            snprintf(url, sizeof(url), "/v1/sweeps/%s/charts/%s.%s%s", id, charts[k][1],
+                     formats[f], charts[k][2]);
+            snprintf(path, sizeof(path), "%s/charts/%s.%s", dir, charts[k][0], formats[f]);
+            ok = conn_download(c, url, path) && ok;
+        }
+    snprintf(url, sizeof(url), "/v1/sweeps/%s/report.html", id);
+    snprintf(path, sizeof(path), "%s/report.html", dir);
+    return conn_download(c, url, path) && ok;
+}
+
+int cmd_sweep(struct conn *c, const struct options *o, const char *file)
+{
+    char err[600];
+    if (o->baseline) {
+        fprintf(stderr, "shadebench: --baseline belongs to submit\n");
+        return EXIT_ERROR;
+    }
+    if (o->out_dir && !out_dir_claim(o->out_dir, "sweep.json", NULL, err, sizeof(err))) {
+        fprintf(stderr, "shadebench: %s\n", err);
+        return EXIT_ERROR;
+    }
+    json_error_t jerr;
+    json_t *body = json_load_file(file, JSON_REJECT_DUPLICATES, &jerr);
+    if (!json_is_object(body)) {
+        fprintf(stderr, "shadebench: %s: %s\n", file, body ? "a sweep is a JSON object" : jerr.text);
+        json_decref(body);
+        return EXIT_ERROR;
+    }
+    json_t *base = json_object_get(body, "base");
+    if (json_object_size(o->labels) && json_is_object(base)) {
+        /* Labels reach the point jobs through the base job. */
+        json_t *labels = json_object_get(base, "labels");
+        if (!json_is_object(labels)) {
+            labels = json_object();
+            json_object_set_new(base, "labels", labels);
+        }
+        json_object_update(labels, o->labels);
+    }
+    char *text = json_dumps(body, JSON_COMPACT);
+    json_decref(body);
+    double t0 = now_s();
+    json_t *reply = text ? conn_json(c, "POST", "/v1/sweeps", text, NULL) : NULL;
+    free(text);
+    if (!reply)
+        return EXIT_ERROR;
+    char id[64];
+    snprintf(id, sizeof(id), "%s", json_string_value(json_object_get(reply, "id")));
+    json_decref(reply);
+    printf("%s\n", id);
+    fflush(stdout);
+    if (!o->wait)
+        return EXIT_PASS;
+    json_t *sweep = conn_follow_sweep(c, id, o->quiet, o->timeout_s);
+    if (!sweep)
+        return EXIT_ERROR;
+    struct junit j;
+    junit_init(&j);
+    const char *status = json_string_value(json_object_get(sweep, "status"));
+    struct junit_case *t = junit_add(&j, "shadebench.sweep", "sweep");
+    if (t) {
+        t->time_s = now_s() - t0;
+        junit_prop_str(t, "sweep", id);
+        junit_prop_num(t, "points",
+                       (double)json_array_size(json_object_get(sweep, "points")));
+        if (!status || strcmp(status, "done") != 0) {
+            const char *error = json_string_value(json_object_get(sweep, "error"));
+            junit_fail(t, "sweep %s: %s", status ? status : "?", error ? error : "");
+        }
+    }
+    point_cases(o, sweep, &j);
+    int rc = junit_conclude(o, &j, "sweep", now_s() - t0);
+    if (o->out_dir) {
+        if (!download_all(c, sweep, o->out_dir))
+            rc = EXIT_ERROR;
+        else if (!o->quiet)
+            fprintf(stderr, "files in %s\n", o->out_dir);
+    }
+    junit_finish(&j);
+    json_decref(sweep);
+    return rc;
+}

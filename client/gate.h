@@ -1,0 +1,106 @@
+#ifndef SHADEBENCH_GATE_H
+#define SHADEBENCH_GATE_H
+
+/* The timing gate: is this build slower than its baseline? Decided on runs,
+ * not frames: each side is a set of run medians (frames within one run are
+ * not independent, and whole runs move far more than frames within a run on
+ * a shared machine), compared as a ratio with its confidence interval
+ * (client/stats_test.h), against a minimum effect. Three outcomes:
+ *   regression:   slower by more than the minimum effect, and the interval
+ *                 lies wholly above no change;
+ *   pass:         the interval lies wholly below 1 + minimum effect (a
+ *                 slowdown that large is ruled out);
+ *   inconclusive: neither; too noisy to tell, so the caller reruns.
+ * Also the checks that make a comparison meaningful: the same job (spec
+ * minus the fields that do not change what is timed) on the same device,
+ * and runs disturbed by other processes marked noisy from the daemon's
+ * interference figures.
+ * GL-free and free of I/O; pure functions on JSON, any thread; unit-tested
+ * in tests/unit/test_gate.c. */
+
+#include <jansson.h>
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "client/stats_test.h"
+
+enum gate_outcome { GATE_PASS, GATE_REGRESSION, GATE_INCONCLUSIVE };
+
+struct gate_verdict {
+    enum gate_outcome outcome;
+    struct ratio_interval r;
+    double min_effect; /* 0.05: slower by more than 5% counts */
+    char why[512];     /* one sentence: why this outcome */
+};
+
+const char *gate_outcome_name(enum gate_outcome o);
+
+/* Decides from an interval (ratio = new / baseline, or B / A). */
+void gate_decide(const struct ratio_interval *r, double min_effect, struct gate_verdict *out);
+
+/* Welch on log run medians, then gate_decide. With too few runs (fewer than
+ * 2 on the new side, or 3 in all) the outcome is inconclusive, and why says
+ * so. */
+void gate_compare(const double *baseline, size_t nb, const double *current, size_t nc,
+                  double confidence, double min_effect, struct gate_verdict *out);
+
+/* One run as the gate sees it. */
+struct gate_run {
+    char job[24];
+    double ms;           /* the run's median of the chosen series */
+    bool has_share;      /* the result carried interference figures */
+    double other_share;  /* other processes' share of the machine's CPU, 0..1 */
+    double load_start, load_end; /* 1-minute load average, NAN when absent */
+    bool daemon_noisy;   /* the daemon's own flag */
+    bool noisy;          /* excluded from the comparison */
+    char why[160];       /* why it is noisy */
+};
+
+/* The runs a result holds, for series ("frame_ms", "gpu_ms", "cpu_ms"):
+ * "gate_runs" (a result written by this client for several runs), else
+ * "runs" of a repeated job, else the result itself as one run. Interference
+ * comes from each run's "interference" when it has one, else the result's.
+ * Runs recorded as noisy in gate_runs stay noisy. Returns the count (0 when
+ * the series is absent) and a malloc'ed array in *out. */
+size_t gate_runs_from_result(const json_t *result, const char *series, struct gate_run **out);
+
+/* Fills one run from a single-run result (a job run by the gate). */
+bool gate_run_from_result(const json_t *result, const char *job_id, const char *series,
+                          struct gate_run *out);
+
+/* The median other-process CPU share of the runs not already noisy; false
+ * when none has interference figures. */
+bool gate_typical_share(const struct gate_run *runs, size_t n, double *share);
+
+/* Marks runs noisy whose other-process CPU share differs from reference by
+ * more than tolerance (0.10 = ten points of the machine's CPU): such a run
+ * was measured under other conditions than the runs it is compared with.
+ * Without a reference share, a run the daemon flagged noisy is marked.
+ * Runs without figures are kept (older results). Returns the noisy count. */
+size_t gate_mark_noisy(struct gate_run *runs, size_t n, bool have_reference, double reference,
+                       double tolerance);
+
+/* Copies the ms of the runs not marked noisy into values (capacity n);
+ * returns how many. */
+size_t gate_clean_values(const struct gate_run *runs, size_t n, double *values);
+
+/* Fields of a job spec that never change what is timed: labels (tags),
+ * repeat (how many runs, the gate chooses), capture_interval (captures are
+ * read back outside the timed figures), reference and metrics (rendered and
+ * scored after the timed run). Every other field must match. */
+bool gate_nonsemantic_field(const char *top_level_key);
+
+/* True when the specs differ in a field that matters; field gets its dotted
+ * path and the two values ("scene.lights: 10 in the baseline, 80 here"). */
+bool gate_spec_differs(const json_t *baseline_spec, const json_t *spec, char *what, size_t cap);
+
+/* True when the devices differ: GL_RENDERER and GL_VERSION must match. */
+bool gate_device_differs(const json_t *baseline_device, const json_t *device, char *what,
+                         size_t cap);
+
+/* The series that means something on this device: frame_ms on software
+ * renderers (llvmpipe's GL_TIME_ELAPSED covers rasterization only), gpu_ms
+ * on GPUs. */
+const char *gate_default_series(const json_t *device);
+
+#endif

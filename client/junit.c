@@ -1,0 +1,289 @@
+#define _POSIX_C_SOURCE 200809L
+#include "client/junit.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "client/gate.h"
+
+void junit_init(struct junit *j) { memset(j, 0, sizeof(*j)); }
+
+void junit_finish(struct junit *j)
+{
+    if (!j)
+        return;
+    for (size_t i = 0; i < j->count; i++)
+        json_decref(j->cases[i].properties);
+    free(j->cases);
+    memset(j, 0, sizeof(*j));
+}
+
+struct junit_case *junit_add(struct junit *j, const char *classname, const char *name)
+{
+    if (j->count == j->cap) {
+        size_t cap = j->cap ? j->cap * 2 : 16;
+        struct junit_case *grown = realloc(j->cases, cap * sizeof(*grown));
+        if (!grown)
+            return NULL;
+        j->cases = grown;
+        j->cap = cap;
+    }
+    struct junit_case *c = &j->cases[j->count++];
+    memset(c, 0, sizeof(*c));
+    snprintf(c->classname, sizeof(c->classname), "%s", classname);
+    snprintf(c->name, sizeof(c->name), "%s", name);
+    c->properties = json_object();
+    return c;
+}
+
+static void vappend(char *dst, size_t cap, const char *fmt, va_list ap)
+{
+    size_t used = strlen(dst);
+    if (used + 1 < cap)
+        vsnprintf(dst + used, cap - used, fmt, ap);
+}
+
+void junit_fail(struct junit_case *c, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    if (c->failure[0] && strlen(c->failure) + 3 < sizeof(c->failure))
+        strcat(c->failure, "; ");
+    vappend(c->failure, sizeof(c->failure), fmt, ap);
+    va_end(ap);
+}
+
+void junit_out(struct junit_case *c, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    if (c->output[0] && strlen(c->output) + 2 < sizeof(c->output))
+        strcat(c->output, "\n");
+    vappend(c->output, sizeof(c->output), fmt, ap);
+    va_end(ap);
+}
+
+void junit_prop_num(struct junit_case *c, const char *name, double value)
+{
+    if (c->properties && isfinite(value))
+        json_object_set_new(c->properties, name, json_real(value));
+}
+
+void junit_prop_str(struct junit_case *c, const char *name, const char *value)
+{
+    if (c->properties && value)
+        json_object_set_new(c->properties, name, json_string(value));
+}
+
+size_t junit_failures(const struct junit *j)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < j->count; i++)
+        n += j->cases[i].failure[0] != '\0';
+    return n;
+}
+
+static void xml_escaped(FILE *f, const char *s)
+{
+    for (; s && *s; s++)
+        switch (*s) {
+        case '<': fputs("&lt;", f); break;
+        case '>': fputs("&gt;", f); break;
+        case '&': fputs("&amp;", f); break;
+        case '"': fputs("&quot;", f); break;
+        default:
+            if ((unsigned char)*s >= 0x20 || *s == '\n' || *s == '\t')
+                fputc(*s, f);
+        }
+}
+
+static void prop_text(const json_t *v, char *out, size_t cap)
+{
+    if (json_is_string(v))
+        snprintf(out, cap, "%s", json_string_value(v));
+    else if (json_is_number(v))
+        snprintf(out, cap, "%.6g", json_number_value(v));
+    else
+        snprintf(out, cap, "?");
+}
+
+bool junit_write(const struct junit *j, const char *path, const char *suite, double time_s)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return false;
+    size_t failures = junit_failures(j);
+    fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    fprintf(f, "<testsuites name=\"shadebench\" tests=\"%zu\" failures=\"%zu\" time=\"%.3f\">\n",
+            j->count, failures, time_s);
+    fprintf(f, "  <testsuite name=\"");
+    xml_escaped(f, suite);
+    fprintf(f, "\" tests=\"%zu\" failures=\"%zu\" errors=\"0\" skipped=\"0\" time=\"%.3f\">\n",
+            j->count, failures, time_s);
+    char text[256];
+    for (size_t i = 0; i < j->count; i++) {
+        const struct junit_case *c = &j->cases[i];
+        fprintf(f, "    <testcase classname=\"");
+        xml_escaped(f, c->classname);
+        fprintf(f, "\" name=\"");
+        xml_escaped(f, c->name);
+        fprintf(f, "\" time=\"%.3f\">\n", c->time_s > 0 ? c->time_s : 0.0);
+        if (json_object_size(c->properties)) {
+            fprintf(f, "      <properties>\n");
+            const char *key;
+            json_t *v;
+            json_object_foreach(c->properties, key, v) {
+                prop_text(v, text, sizeof(text));
+                fprintf(f, "        <property name=\"");
+                xml_escaped(f, key);
+                fprintf(f, "\" value=\"");
+                xml_escaped(f, text);
+                fprintf(f, "\"/>\n");
+            }
+            fprintf(f, "      </properties>\n");
+        }
+        if (c->failure[0]) {
+            fprintf(f, "      <failure type=\"");
+            xml_escaped(f, c->classname);
+            fprintf(f, "\" message=\"");
+            xml_escaped(f, c->failure);
+            fprintf(f, "\"/>\n");
+        }
+        if (c->output[0]) {
+            fprintf(f, "      <system-out>");
+            xml_escaped(f, c->output);
+            fprintf(f, "</system-out>\n");
+        }
+        fprintf(f, "    </testcase>\n");
+    }
+    fprintf(f, "  </testsuite>\n</testsuites>\n");
+    return fclose(f) == 0;
+}
+
+void junit_print(const struct junit *j, FILE *f)
+{
+    char text[256];
+    for (size_t i = 0; i < j->count; i++) {
+        const struct junit_case *c = &j->cases[i];
+        fprintf(f, "%s %s (%.2f s)", c->failure[0] ? "FAIL" : "PASS", c->name, c->time_s);
+        const char *key;
+        json_t *v;
+        const char *sep = ": ";
+        json_object_foreach(c->properties, key, v) {
+            prop_text(v, text, sizeof(text));
+            fprintf(f, "%s%s=%s", sep, key, text);
+            sep = ", ";
+        }
+        fputc('\n', f);
+        if (c->failure[0])
+            fprintf(f, "    failure: %s\n", c->failure);
+        if (c->output[0])
+            fprintf(f, "    %s\n", c->output);
+    }
+}
+
+static void scalar_text(const json_t *v, char *out, size_t cap)
+{
+    if (json_is_string(v))
+        snprintf(out, cap, "%s", json_string_value(v));
+    else if (json_is_number(v))
+        snprintf(out, cap, "%g", json_number_value(v));
+    else if (json_is_boolean(v))
+        snprintf(out, cap, "%s", json_is_true(v) ? "true" : "false");
+    else {
+        char *t = json_dumps(v, JSON_ENCODE_ANY | JSON_COMPACT | JSON_SORT_KEYS);
+        snprintf(out, cap, "%s", t ? t : "?");
+        free(t);
+    }
+}
+
+static int by_string(const void *a, const void *b)
+{
+    return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+/* Keys of an object in sorted order (the names must not depend on the
+ * order the daemon writes them in). Returns a malloc'ed array. */
+static const char **sorted_keys(const json_t *o, size_t *n)
+{
+    *n = json_object_size(o);
+    const char **keys = malloc((*n ? *n : 1) * sizeof(*keys));
+    size_t k = 0;
+    const char *key;
+    json_t *v;
+    json_object_foreach((json_t *)o, key, v) if (keys) keys[k++] = key;
+    if (keys)
+        qsort(keys, k, sizeof(*keys), by_string);
+    return keys;
+}
+
+static void put(char *out, size_t cap, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+static void put(char *out, size_t cap, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vappend(out, cap, fmt, ap);
+    va_end(ap);
+}
+
+void junit_job_name(const json_t *spec, char *out, size_t cap)
+{
+    out[0] = '\0';
+    const char *tech = json_string_value(json_object_get(spec, "technique"));
+    put(out, cap, "%s", tech ? tech : "job");
+    size_t n;
+    const char **keys = sorted_keys(spec, &n);
+    char text[128];
+    /* Technique options: top-level scalars that are set, and the object
+     * named after this technique. */
+    for (size_t i = 0; keys && i < n; i++) {
+        const char *k = keys[i];
+        json_t *v = json_object_get(spec, k);
+        if (gate_nonsemantic_field(k) || !strcmp(k, "technique") || !strcmp(k, "scene") ||
+            !strcmp(k, "frames") || !strcmp(k, "warmup_frames"))
+            continue;
+        if (json_is_object(v)) {
+            if (!tech || strcmp(k, tech) != 0)
+                continue; /* another technique's options */
+            size_t m;
+            const char **sub = sorted_keys(v, &m);
+            put(out, cap, " %s(", k);
+            for (size_t s = 0; sub && s < m; s++) {
+                scalar_text(json_object_get(v, sub[s]), text, sizeof(text));
+                put(out, cap, "%s%s=%s", s ? " " : "", sub[s], text);
+            }
+            put(out, cap, ")");
+            free(sub);
+            continue;
+        }
+        if ((json_is_number(v) && json_number_value(v) == 0) || json_is_false(v) ||
+            json_is_null(v))
+            continue;
+        scalar_text(v, text, sizeof(text));
+        put(out, cap, " %s=%s", k, text);
+    }
+    free(keys);
+    json_t *scene = json_object_get(spec, "scene");
+    if (scene) {
+        const char *preset = json_string_value(json_object_get(scene, "preset"));
+        put(out, cap, " %s %lldx%lld %lld lights %s", preset ? preset : "scene",
+            (long long)json_integer_value(json_object_get(scene, "width")),
+            (long long)json_integer_value(json_object_get(scene, "height")),
+            (long long)json_integer_value(json_object_get(scene, "lights")),
+            json_is_true(json_object_get(scene, "dynamic")) ? "moving" : "still");
+        const char **sk = sorted_keys(scene, &n);
+        for (size_t i = 0; sk && i < n; i++) {
+            if (!strcmp(sk[i], "preset") || !strcmp(sk[i], "width") || !strcmp(sk[i], "height") ||
+                !strcmp(sk[i], "lights") || !strcmp(sk[i], "dynamic"))
+                continue;
+            scalar_text(json_object_get(scene, sk[i]), text, sizeof(text));
+            put(out, cap, " %s=%s", sk[i], text);
+        }
+        free(sk);
+    }
+    json_t *frames = json_object_get(spec, "frames");
+    if (json_is_integer(frames))
+        put(out, cap, ", %lld frames", (long long)json_integer_value(frames));
+}

@@ -1,0 +1,57 @@
+#ifndef SHADEBENCH_JUNIT_H
+#define SHADEBENCH_JUNIT_H
+
+/* Verdicts as test cases, written as JUnit XML that CI systems track from
+ * build to build: names come from what a job measures (technique, scene,
+ * technique options, frame), never from its id, so the same check keeps its
+ * name across builds; every case has its real duration, and its figures as
+ * properties and as output, which is also printed to the CI log.
+ * GL-free, no network; single-threaded (one collection per command). */
+
+#include <jansson.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdio.h>
+
+struct junit_case {
+    char classname[96];
+    char name[320];
+    char failure[1024]; /* empty: passed */
+    char output[2048];
+    double time_s;
+    json_t *properties; /* name -> string or number, in insertion order */
+};
+
+struct junit {
+    struct junit_case *cases;
+    size_t count, cap;
+};
+
+void junit_init(struct junit *j);
+void junit_finish(struct junit *j);
+
+/* A new case; NULL when out of memory. */
+struct junit_case *junit_add(struct junit *j, const char *classname, const char *name);
+
+void junit_fail(struct junit_case *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+void junit_out(struct junit_case *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+void junit_prop_num(struct junit_case *c, const char *name, double value);
+void junit_prop_str(struct junit_case *c, const char *name, const char *value);
+
+size_t junit_failures(const struct junit *j);
+
+/* Writes the XML; false when the file cannot be written. */
+bool junit_write(const struct junit *j, const char *path, const char *suite, double time_s);
+
+/* The CI log: one line a case, PASS or FAIL, its properties and output. */
+void junit_print(const struct junit *j, FILE *f);
+
+/* A stable name for a job from its spec as the daemon understood it:
+ * "osl async_distance=20 osl(reshade=touched resolution=auto texel_density=1)
+ *  grid 160x120 10 lights moving, 20 frames". Options of other techniques,
+ * and the fields that do not change what is measured (labels, repeat,
+ * captures, reference, metrics), are left out; so are top-level numbers that
+ * are 0 and flags that are false. */
+void junit_job_name(const json_t *spec, char *out, size_t cap);
+
+#endif

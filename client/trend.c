@@ -1,0 +1,215 @@
+#define _POSIX_C_SOURCE 200809L
+#include "client/trend.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+enum { W = 900, H = 520, MAX_SERIES = 8 };
+static const double L = 80, R = 180, T = 50, B = 70;
+static const char *const COLOURS[MAX_SERIES] = {"#0072b2", "#e69f00", "#009e73", "#cc79a7",
+                                                "#56b4e9", "#d55e00", "#f0e442", "#595959"};
+
+struct out {
+    char *data;
+    size_t len, cap;
+    bool failed;
+};
+
+static void add(struct out *o, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void add(struct out *o, const char *fmt, ...)
+{
+    if (o->failed)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    char buf[1024];
+    int n = vsnprintf(buf, sizeof(buf), fmt, ap);
+    va_end(ap);
+    if (n < 0)
+        return;
+    size_t len = (size_t)n < sizeof(buf) ? (size_t)n : sizeof(buf) - 1;
+    if (o->len + len + 1 > o->cap) {
+        size_t cap = (o->len + len + 1) * 2;
+        char *grown = realloc(o->data, cap);
+        if (!grown) {
+            o->failed = true;
+            return;
+        }
+        o->data = grown;
+        o->cap = cap;
+    }
+    memcpy(o->data + o->len, buf, len);
+    o->len += len;
+    o->data[o->len] = '\0';
+}
+
+static void escaped(struct out *o, const char *s)
+{
+    for (; s && *s; s++)
+        switch (*s) {
+        case '<': add(o, "&lt;"); break;
+        case '>': add(o, "&gt;"); break;
+        case '&': add(o, "&amp;"); break;
+        case '"': add(o, "&quot;"); break;
+        default:
+            if ((unsigned char)*s >= 0x20)
+                add(o, "%c", *s);
+        }
+}
+
+bool trend_log_axis(double lo, double hi) { return lo > 0 && hi / lo > 10.0; }
+
+static double tick_step(double span)
+{
+    double raw = span / 6.0, mag = pow(10.0, floor(log10(raw))), f = raw / mag;
+    return (f < 1.5 ? 1 : f < 3 ? 2 : f < 7 ? 5 : 10) * mag;
+}
+
+char *trend_svg(const struct trend_point *pts, size_t n, const char *title, const char *ylabel)
+{
+    struct out o = {0};
+    double x0 = L, x1 = W - R, y0 = H - B, y1 = T;
+    double tmin = INFINITY, tmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+    char series[MAX_SERIES][48];
+    int nseries = 0;
+    for (size_t i = 0; i < n; i++) {
+        tmin = fmin(tmin, pts[i].t);
+        tmax = fmax(tmax, pts[i].t);
+        /* Intervals never cross zero: figures here are times and scores. */
+        double lo = isnan(pts[i].lo) ? pts[i].y : fmax(pts[i].lo, 0.0);
+        double hi = isnan(pts[i].hi) ? pts[i].y : pts[i].hi;
+        ymin = fmin(ymin, fmin(pts[i].y, lo));
+        ymax = fmax(ymax, fmax(pts[i].y, hi));
+        int s = 0;
+        while (s < nseries && strcmp(series[s], pts[i].series) != 0)
+            s++;
+        if (s == nseries && nseries < MAX_SERIES)
+            snprintf(series[nseries++], sizeof(series[0]), "%s", pts[i].series);
+    }
+    bool logy = trend_log_axis(ymin, ymax);
+    if (!(tmax > tmin)) {
+        tmin -= 60;
+        tmax += 60;
+    }
+    double pad = (tmax - tmin) * 0.05;
+    tmin -= pad;
+    tmax += pad;
+    double ylo, yhi;
+    if (logy) {
+        ylo = log10(ymin) - 0.05;
+        yhi = log10(ymax) + 0.05;
+    } else {
+        if (!(ymax > ymin)) {
+            ymin = ymin > 0 ? ymin * 0.9 : ymin - 1;
+            ymax = ymax > 0 ? ymax * 1.1 : ymax + 1;
+        }
+        double p = (ymax - ymin) * 0.08;
+        ylo = ymin - p < 0 && ymin >= 0 ? 0 : ymin - p;
+        yhi = ymax + p;
+    }
+#define MAPX(t) (x0 + ((t) - tmin) / (tmax - tmin) * (x1 - x0))
+#define YV(v) (logy ? log10(v) : (v))
+#define MAPY(v) (y0 + (YV(v) - ylo) / (yhi - ylo) * (y1 - y0))
+    add(&o, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" "
+            "width=\"%d\" height=\"%d\" viewBox=\"0 0 %d %d\" font-family=\"sans-serif\">\n",
+        W, H, W, H);
+    add(&o, "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n<text x=\"%g\" y=\"30\" "
+            "font-size=\"16\" font-weight=\"bold\">", x0);
+    escaped(&o, title);
+    add(&o, "</text>\n");
+    /* Y grid and ticks. */
+    if (logy) {
+        for (int e = (int)floor(ylo); e <= (int)ceil(yhi); e++)
+            for (int m = 1; m < 10; m++) {
+                double v = m * pow(10.0, e);
+                if (YV(v) < ylo || YV(v) > yhi || (m != 1 && m != 2 && m != 5))
+                    continue;
+                add(&o, "<line x1=\"%g\" x2=\"%g\" y1=\"%.1f\" y2=\"%.1f\" stroke=\"#e0e0e0\"/>"
+                        "<text x=\"%g\" y=\"%.1f\" font-size=\"12\" text-anchor=\"end\">%g</text>\n",
+                    x0, x1, MAPY(v), MAPY(v), x0 - 8, MAPY(v) + 4, v);
+            }
+    } else {
+        double step = tick_step(yhi - ylo);
+        for (double v = ceil(ylo / step) * step; v <= yhi; v += step)
+            add(&o, "<line x1=\"%g\" x2=\"%g\" y1=\"%.1f\" y2=\"%.1f\" stroke=\"#e0e0e0\"/>"
+                    "<text x=\"%g\" y=\"%.1f\" font-size=\"12\" text-anchor=\"end\">%g</text>\n",
+                x0, x1, MAPY(v), MAPY(v), x0 - 8, MAPY(v) + 4, fabs(v) < step * 1e-6 ? 0.0 : v);
+    }
+    /* X ticks: dates, or times of day within a day. */
+    double tstep = tick_step(tmax - tmin);
+    bool same_day = tmax - tmin < 86400 * 2;
+    for (double t = ceil(tmin / tstep) * tstep; t <= tmax; t += tstep) {
+        time_t tt = (time_t)t;
+        struct tm tm;
+        gmtime_r(&tt, &tm);
+        char buf[32];
+        strftime(buf, sizeof(buf), same_day ? "%H:%M" : "%Y-%m-%d", &tm);
+        add(&o, "<line x1=\"%.1f\" x2=\"%.1f\" y1=\"%g\" y2=\"%g\" stroke=\"#e0e0e0\"/>"
+                "<text x=\"%.1f\" y=\"%g\" font-size=\"12\" text-anchor=\"middle\">%s</text>\n",
+            MAPX(t), MAPX(t), y0, y1, MAPX(t), y0 + 18, buf);
+    }
+    add(&o, "<rect x=\"%g\" y=\"%g\" width=\"%g\" height=\"%g\" fill=\"none\" stroke=\"#222\"/>\n",
+        x0, y1, x1 - x0, y0 - y1);
+    add(&o, "<text x=\"%g\" y=\"%d\" font-size=\"14\" text-anchor=\"middle\">job created (UTC)%s"
+            "</text>\n", (x0 + x1) / 2, H - 22, logy ? "" : "");
+    add(&o, "<text transform=\"translate(24 %g) rotate(-90)\" font-size=\"14\" "
+            "text-anchor=\"middle\">", (y0 + y1) / 2);
+    escaped(&o, ylabel);
+    add(&o, "%s</text>\n", logy ? " (log scale)" : "");
+    /* One line per series, in time order, then the points. */
+    for (int s = 0; s < nseries; s++) {
+        add(&o, "<g class=\"series\" data-series=\"");
+        escaped(&o, series[s]);
+        add(&o, "\" stroke=\"%s\" fill=\"%s\">\n<polyline fill=\"none\" stroke-width=\"2\" points=\"",
+            COLOURS[s], COLOURS[s]);
+        double last = -INFINITY;
+        for (;;) {
+            size_t best = n;
+            for (size_t i = 0; i < n; i++)
+                if (!strcmp(pts[i].series, series[s]) && pts[i].t > last &&
+                    (best == n || pts[i].t < pts[best].t))
+                    best = i;
+            if (best == n)
+                break;
+            add(&o, "%.1f,%.1f ", MAPX(pts[best].t), MAPY(pts[best].y));
+            last = pts[best].t;
+        }
+        add(&o, "\"/>\n");
+        for (size_t i = 0; i < n; i++) {
+            const struct trend_point *p = &pts[i];
+            if (strcmp(p->series, series[s]) != 0)
+                continue;
+            if (!isnan(p->lo) && !isnan(p->hi)) {
+                double lo = fmax(p->lo, logy ? ymin : 0.0);
+                add(&o, "<line class=\"interval\" x1=\"%.1f\" x2=\"%.1f\" y1=\"%.1f\" y2=\"%.1f\" "
+                        "data-low=\"%g\" data-high=\"%g\"/>\n",
+                    MAPX(p->t), MAPX(p->t), MAPY(lo), MAPY(p->hi), lo, p->hi);
+            }
+            add(&o, "<circle class=\"point\" cx=\"%.1f\" cy=\"%.1f\" r=\"4\" data-value=\"%g\">"
+                    "<title>", MAPX(p->t), MAPY(p->y), p->y);
+            escaped(&o, p->label);
+            add(&o, ": %g</title></circle>\n", p->y);
+        }
+        add(&o, "</g>\n<circle cx=\"%g\" cy=\"%d\" r=\"5\" fill=\"%s\"/><text x=\"%g\" y=\"%d\" "
+                "font-size=\"12\">", x1 + 20, (int)T + 10 + 22 * s, COLOURS[s], x1 + 32,
+            (int)T + 14 + 22 * s);
+        escaped(&o, series[s]);
+        add(&o, "</text>\n");
+    }
+    if (n == 0)
+        add(&o, "<text x=\"%g\" y=\"%g\" font-size=\"14\" text-anchor=\"middle\">no matching "
+                "jobs</text>\n", (x0 + x1) / 2, (y0 + y1) / 2);
+    add(&o, "</svg>\n");
+#undef MAPX
+#undef YV
+#undef MAPY
+    if (o.failed) {
+        free(o.data);
+        return NULL;
+    }
+    return o.data;
+}

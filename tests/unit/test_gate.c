@@ -1,0 +1,206 @@
+#define _DEFAULT_SOURCE /* M_PI */
+/* The gate on synthetic run samples: no change with noise passes, a 10%
+ * slowdown with low noise is a regression, high noise is inconclusive; the
+ * t distribution against published tables; paired ratios; spec and device
+ * matching; runs and interference read from results; noisy runs marked. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "client/gate.h"
+#include "tests/unit/check.h"
+
+/* A deterministic normal generator (xorshift + Box-Muller), so that the
+ * rates below are the same on every machine. */
+static unsigned long long rng_state = 88172645463325252ULL;
+static double uniform(void)
+{
+    rng_state ^= rng_state << 13;
+    rng_state ^= rng_state >> 7;
+    rng_state ^= rng_state << 17;
+    return ((double)(rng_state >> 11) + 0.5) / 9007199254740992.0;
+}
+static double normal(void)
+{
+    return sqrt(-2.0 * log(uniform())) * cos(2.0 * M_PI * uniform());
+}
+
+/* n run medians around ms with multiplicative noise of relative size cv. */
+static void runs(double *v, size_t n, double ms, double cv)
+{
+    for (size_t i = 0; i < n; i++)
+        v[i] = ms * exp(cv * normal());
+}
+
+/* Outcome counts over many synthetic gates of 5 runs a side. */
+static void rates(double slowdown, double cv, int trials, int counts[3])
+{
+    counts[0] = counts[1] = counts[2] = 0;
+    for (int t = 0; t < trials; t++) {
+        double b[5], c[5];
+        runs(b, 5, 20.0, cv);
+        runs(c, 5, 20.0 * (1 + slowdown), cv);
+        struct gate_verdict v;
+        gate_compare(b, 5, c, 5, 0.95, 0.05, &v);
+        counts[v.outcome]++;
+    }
+}
+
+int main(void)
+{
+    /* Student's t against the tables. */
+    CHECK_NEAR(student_t_quantile(0.975, 1), 12.706, 1e-3);
+    CHECK_NEAR(student_t_quantile(0.975, 4), 2.776, 1e-3);
+    CHECK_NEAR(student_t_quantile(0.975, 8), 2.306, 1e-3);
+    CHECK_NEAR(student_t_quantile(0.95, 10), 1.812, 1e-3);
+    CHECK_NEAR(student_t_quantile(0.975, 1000), 1.962, 1e-3);
+    CHECK_NEAR(student_t_quantile(0.025, 8), -2.306, 1e-3);
+    CHECK_NEAR(student_t_cdf(0.0, 3.7), 0.5, 1e-12);
+    CHECK_NEAR(student_t_cdf(2.306, 8), 0.975, 1e-4);
+    /* Fractional degrees of freedom (Welch) sit between their neighbours. */
+    double q75 = student_t_quantile(0.975, 7.5);
+    CHECK(q75 < student_t_quantile(0.975, 7) && q75 > student_t_quantile(0.975, 8));
+
+    /* Welch on logs, by hand: a = {10, 10.2, 9.8}, b = 1.1 * a exactly,
+     * so the ratio is 1.1 with the spread of a on both sides. */
+    double a[3] = {10, 10.2, 9.8}, b[3] = {11, 11.22, 10.78};
+    struct ratio_interval r;
+    CHECK(welch_log_ratio(a, 3, b, 3, 0.95, &r));
+    CHECK_NEAR(r.ratio, 1.1, 1e-9);
+    CHECK(r.lo > 1.0 && r.hi > 1.1 && r.lo < 1.1);
+    CHECK_NEAR(r.df, 4.0, 1e-9); /* equal variances and sizes: df = 2n - 2 */
+    CHECK(r.p_greater < 0.01);
+    /* One baseline run: its spread is taken from the other side. */
+    CHECK(welch_log_ratio(a, 1, b, 3, 0.95, &r) && r.df == 2.0 && r.lo < r.ratio);
+    CHECK(!welch_log_ratio(a, 1, b, 1, 0.95, &r));
+    double bad[2] = {10, 0};
+    CHECK(!welch_log_ratio(bad, 2, b, 3, 0.95, &r));
+
+    struct gate_verdict v;
+    /* The three outcomes on fixed samples. */
+    double base[5] = {20.0, 20.3, 19.8, 20.1, 19.9};
+    double same[5] = {20.1, 19.9, 20.2, 19.8, 20.0};
+    double slow[5] = {22.0, 22.3, 21.8, 22.1, 21.9};
+    double wild[5] = {16.0, 25.0, 19.0, 28.0, 21.0};
+    gate_compare(base, 5, same, 5, 0.95, 0.05, &v);
+    CHECK(v.outcome == GATE_PASS && strstr(v.why, "ruled out"));
+    gate_compare(base, 5, slow, 5, 0.95, 0.05, &v);
+    CHECK(v.outcome == GATE_REGRESSION && v.r.ratio > 1.09 && strstr(v.why, "slower by"));
+    gate_compare(base, 5, wild, 5, 0.95, 0.05, &v);
+    CHECK(v.outcome == GATE_INCONCLUSIVE && strstr(v.why, "spread"));
+    gate_compare(base, 5, slow, 1, 0.95, 0.05, &v);
+    CHECK(v.outcome == GATE_INCONCLUSIVE && strstr(v.why, "too few"));
+    /* A slowdown below the minimum effect is never a regression, however
+     * certain. */
+    double slight[5] = {20.6, 20.9, 20.4, 20.7, 20.5};
+    gate_compare(base, 5, slight, 5, 0.95, 0.05, &v);
+    CHECK(v.outcome != GATE_REGRESSION && v.r.lo > 1.0);
+
+    /* Rates over 2000 synthetic gates of 5 runs a side. */
+    int c[3];
+    rates(0.0, 0.02, 2000, c); /* no change, 2% run-to-run noise */
+    printf("no change, 2%% noise: pass %d, regression %d, inconclusive %d\n", c[0], c[1], c[2]);
+    CHECK(c[GATE_REGRESSION] <= 20 && c[GATE_PASS] >= 1200);
+    rates(0.10, 0.01, 2000, c); /* a 10% slowdown, 1% noise */
+    printf("10%% slower, 1%% noise: pass %d, regression %d, inconclusive %d\n", c[0], c[1], c[2]);
+    CHECK(c[GATE_REGRESSION] >= 1980 && c[GATE_PASS] == 0);
+    /* No change under 20% noise: too noisy to tell, nearly always. A false
+     * regression needs the interval wholly above no change, which happens
+     * at most at the one-sided level of a 95% interval (2.5%); the caller
+     * confirms a regression on fresh runs before it fails a build. */
+    rates(0.0, 0.20, 2000, c);
+    printf("no change, 20%% noise: pass %d, regression %d, inconclusive %d\n", c[0], c[1], c[2]);
+    CHECK(c[GATE_INCONCLUSIVE] >= 1800 && c[GATE_REGRESSION] <= 60);
+
+    /* Paired ratios: B is half of A on every pair, whatever A's drift. */
+    double pa[6] = {10, 14, 9, 20, 12, 11}, pb[6];
+    for (int i = 0; i < 6; i++)
+        pb[i] = pa[i] * 0.5 * (i % 2 ? 1.01 : 0.99);
+    CHECK(paired_log_ratio(pa, pb, 6, 0.95, &r));
+    CHECK(r.lo < 0.5 && r.hi > 0.5 && r.hi - r.lo < 0.03);
+    /* The same drift with independent samples gives a far wider interval. */
+    struct ratio_interval w;
+    CHECK(welch_log_ratio(pa, 6, pb, 6, 0.95, &w) && w.hi - w.lo > 5 * (r.hi - r.lo));
+    CHECK(!paired_log_ratio(pa, pb, 1, 0.95, &r));
+
+    /* Specs: labels, repeat, captures and the reference do not matter;
+     * scene.lights does, and the difference is named. */
+    json_t *s1 = json_loads("{\"technique\":\"forward\",\"frames\":20,\"scene\":{\"lights\":10,"
+                            "\"width\":160},\"repeat\":1,\"labels\":{\"commit\":\"a\"},"
+                            "\"reference\":null,\"async_distance\":0}", 0, NULL);
+    json_t *s2 = json_loads("{\"technique\":\"forward\",\"frames\":20,\"scene\":{\"lights\":10,"
+                            "\"width\":160},\"repeat\":5,\"labels\":{\"commit\":\"b\"},"
+                            "\"reference\":\"forward\",\"capture_interval\":5,"
+                            "\"async_distance\":0.0}", 0, NULL);
+    json_t *s3 = json_loads("{\"technique\":\"forward\",\"frames\":20,\"scene\":{\"lights\":80,"
+                            "\"width\":160},\"async_distance\":0}", 0, NULL);
+    json_t *s4 = json_loads("{\"technique\":\"forward\",\"frames\":20,\"scene\":{\"lights\":10,"
+                            "\"width\":160,\"depth\":1},\"async_distance\":0}", 0, NULL);
+    char what[256];
+    CHECK(!gate_spec_differs(s1, s2, what, sizeof(what)));
+    CHECK(gate_spec_differs(s1, s3, what, sizeof(what)) &&
+          strcmp(what, "scene.lights: 10 in the baseline, 80 here") == 0);
+    CHECK(gate_spec_differs(s1, s4, what, sizeof(what)) && strstr(what, "scene.depth: absent"));
+    json_decref(s1);
+    json_decref(s2);
+    json_decref(s3);
+    json_decref(s4);
+
+    json_t *d1 = json_pack("{s:s, s:s}", "gl_renderer", "llvmpipe (LLVM 15.0.6, 256 bits)",
+                           "gl_version", "4.5 (Core Profile) Mesa 22.3.6");
+    json_t *d2 = json_pack("{s:s, s:s}", "gl_renderer", "NVIDIA GeForce RTX 3070/PCIe/SSE2",
+                           "gl_version", "4.6.0 NVIDIA 535.54.03");
+    CHECK(!gate_device_differs(d1, d1, what, sizeof(what)));
+    CHECK(gate_device_differs(d1, d2, what, sizeof(what)) && strstr(what, "gl_renderer"));
+    CHECK(strcmp(gate_default_series(d1), "frame_ms") == 0);
+    CHECK(strcmp(gate_default_series(d2), "gpu_ms") == 0);
+    json_decref(d1);
+    json_decref(d2);
+
+    /* Runs from results: a single run with interference, a repeated job,
+     * and a client-written result with gate_runs. */
+    json_t *single = json_loads("{\"job_id\":\"j1\",\"frame_ms\":{\"median\":12.5},"
+                                "\"interference\":{\"loadavg_start\":[0.5,0.4,0.3],"
+                                "\"loadavg_end\":[0.7,0.4,0.3],\"other_cpu_share\":0.03,"
+                                "\"noisy\":false}}", 0, NULL);
+    struct gate_run *gr = NULL;
+    CHECK(gate_runs_from_result(single, "frame_ms", &gr) == 1 && gr[0].ms == 12.5 &&
+          gr[0].has_share && gr[0].other_share == 0.03 && gr[0].load_end == 0.7 &&
+          strcmp(gr[0].job, "j1") == 0);
+    free(gr);
+    CHECK(gate_runs_from_result(single, "gpu_ms", &gr) == 0 && gr == NULL);
+    json_decref(single);
+    json_t *repeated = json_loads("{\"frame_ms\":{\"median\":12.5},\"runs\":[{\"run\":1,"
+                                  "\"frame_ms\":{\"median\":12.5}},{\"run\":2,\"frame_ms\":"
+                                  "{\"median\":13.0}}]}", 0, NULL);
+    CHECK(gate_runs_from_result(repeated, "frame_ms", &gr) == 2 && gr[1].ms == 13.0 &&
+          !gr[1].has_share);
+    free(gr);
+    json_decref(repeated);
+    json_t *client = json_loads("{\"gate_runs\":[{\"job\":\"a\",\"frame_ms\":10.0,"
+                                "\"interference\":{\"other_cpu_share\":0.02}},{\"job\":\"b\","
+                                "\"frame_ms\":11.0,\"noisy\":true,\"why\":\"busy\"},{\"job\":\"c\","
+                                "\"frame_ms\":10.2,\"interference\":{\"other_cpu_share\":0.04}}]}",
+                                0, NULL);
+    size_t n = gate_runs_from_result(client, "frame_ms", &gr);
+    CHECK(n == 3 && gr[1].noisy && strcmp(gr[1].why, "busy") == 0 && strcmp(gr[2].job, "c") == 0);
+    double share;
+    CHECK(gate_typical_share(gr, n, &share) && fabs(share - 0.03) < 1e-12);
+    double values[3];
+    CHECK(gate_clean_values(gr, n, values) == 2 && values[1] == 10.2);
+    free(gr);
+    json_decref(client);
+
+    /* Noise: runs measured under other load than the baseline's are marked. */
+    struct gate_run nr[4] = {
+        {.ms = 10, .has_share = true, .other_share = 0.05},
+        {.ms = 10, .has_share = true, .other_share = 0.45},
+        {.ms = 10, .has_share = false, .daemon_noisy = true},
+        {.ms = 10, .has_share = true, .other_share = 0.12},
+    };
+    CHECK(gate_mark_noisy(nr, 4, true, 0.04, 0.10) == 1 && nr[1].noisy &&
+          strstr(nr[1].why, "45%") && !nr[3].noisy && !nr[2].noisy);
+    struct gate_run nr2[2] = {{.ms = 10, .daemon_noisy = true}, {.ms = 10}};
+    CHECK(gate_mark_noisy(nr2, 2, false, 0, 0.10) == 1 && nr2[0].noisy);
+    return check_finish("test_gate");
+}

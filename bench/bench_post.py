@@ -9,7 +9,8 @@
 3. the whole chain (bloom, toon with Sobel outlines, SSAO, ACES) as a share
    of each technique's frame.
 
-  bench/bench_post.py [--frames N] [--warmup N] [--repeat R] [--width W --height H] [--json FILE]
+  bench/bench_post.py [--frames N] [--warmup N] [--repeat R] [--width W --height H]
+                      [--only bloom,ssao,chain] [--json FILE]
 
 Effect costs are the medians of the effect passes' GL_TIME_ELAPSED
 (gpu_sections_ms): on llvmpipe that covers rasterization, which is all a
@@ -32,6 +33,8 @@ ap.add_argument("--warmup", type=int, default=2)
 ap.add_argument("--repeat", type=int, default=2)
 ap.add_argument("--width", type=int, default=480)
 ap.add_argument("--height", type=int, default=320)
+ap.add_argument("--only", default="bloom,ssao,chain",
+                help="comma-separated parts to run: bloom, ssao, chain")
 ap.add_argument("--json", help="write every result here")
 args = ap.parse_args()
 
@@ -50,17 +53,18 @@ def base_job(**kw):
     return job
 
 
+PARTS = set(args.only.split(","))
 CONFIGS = []
-for r in RADII:
+for r in RADII if "bloom" in PARTS else ():
     for kernel in ("separable", "2d"):
         CONFIGS.append(("bloom-%s-r%d" % (kernel, r),
                         base_job(look={"post": [{"bloom": {"kernel": kernel, "radius": r, "threshold": 0}}]})))
-for n in SAMPLES:
+for n in SAMPLES if "ssao" in PARTS else ():
     CONFIGS.append(("ssao-%d" % n,
                     base_job(look={"post": [{"ssao": {"samples": n}}]}, capture_interval=args.frames,
                              reference="forward", metrics=["ssim"],
                              reference_look={"post": [{"ssao": {"samples": 64}}]})))
-for name, extra in TECHNIQUES:
+for name, extra in TECHNIQUES if "chain" in PARTS else ():
     CONFIGS.append(("%s-plain" % name, base_job(**extra)))
     CONFIGS.append(("%s-chain" % name, base_job(look=CHAIN, **extra)))
 
@@ -72,6 +76,66 @@ def med(values):
 def section(r, prefix):
     """Sum of the median GPU ms of the passes whose names start with prefix."""
     return sum(v["median"] for k, v in r["gpu_sections_ms"].items() if k.startswith(prefix))
+
+
+def m(name, f):
+    """Median over repeats of f(result)."""
+    return med([f(r) for r in results[name]])
+
+
+def paired(a, b, f):
+    """Median over repeats of f(b) / f(a), each pair run side by side."""
+    return med([f(y) / f(x) for x, y in zip(results[a], results[b]) if f(x) > 0])
+
+
+def frame_ms(x):
+    return x["frame_ms"]["median"]
+
+
+def post_ms(x):
+    return section(x, "bloom.") + section(x, "toon.") + section(x, "ssao.")
+
+
+def bloom_table():
+    print("## Bloom: separable against 2d (medians over repeats of job medians, ms; ratios "
+          "paired within each repeat)\n")
+    print("| radius | taps 2d / separable | sep. blur | 2d blur | blur ratio 2d/sep. | "
+          "arithmetic limit (2r+1)/2 | whole bloom ratio | frame_ms sep. | frame_ms 2d | frame ratio |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for r in RADII:
+        sep, two = "bloom-separable-r%d" % r, "bloom-2d-r%d" % r
+        taps = 2 * r + 1
+        print("| %d (%dx%d) | %d / %d | %.2f | %.2f | %.2f | %.1f | %.2f | %.2f | %.2f | %.2f |"
+              % (r, taps, taps, taps * taps, 2 * taps,
+                 m(sep, lambda x: section(x, "bloom.blur")), m(two, lambda x: section(x, "bloom.blur")),
+                 paired(sep, two, lambda x: section(x, "bloom.blur")), taps / 2.0,
+                 paired(sep, two, lambda x: section(x, "bloom.")), m(sep, frame_ms), m(two, frame_ms),
+                 paired(sep, two, frame_ms)))
+
+
+def ssao_table():
+    print("\n## SSAO: cost and quality against samples\n")
+    print("| samples | ssao.ao ms | ssao.blur ms | both | frame_ms | SSIM against 64 samples |")
+    print("|---|---|---|---|---|---|")
+    for n in SAMPLES:
+        name = "ssao-%d" % n
+        ao, bl = m(name, lambda x: section(x, "ssao.ao")), m(name, lambda x: section(x, "ssao.blur"))
+        ssim = m(name, lambda x: x.get("quality", {}).get("worst_ssim", {}).get("value", float("nan")))
+        print("| %d | %.2f | %.2f | %.2f | %.2f | %.5f |" % (n, ao, bl, ao + bl, m(name, frame_ms), ssim))
+
+
+def chain_table():
+    print("\n## The whole chain (bloom r4, toon Sobel, SSAO 16, ACES) against each technique's frame\n")
+    print("| technique | frame_ms plain | frame_ms chain | chain share of frame_ms (paired) | "
+          "post passes gpu ms | post share of gpu_ms | per effect gpu ms (bloom, toon, ssao) |")
+    print("|---|---|---|---|---|---|---|")
+    for name, _ in TECHNIQUES:
+        plain, chain = name + "-plain", name + "-chain"
+        share = 1.0 - paired(chain, plain, frame_ms)  # (chain - plain) / chain
+        per = [m(chain, lambda x, p=p: section(x, p)) for p in ("bloom.", "toon.", "ssao.")]
+        print("| %s | %.2f | %.2f | %.1f %% | %.2f | %.1f %% | %.2f, %.2f, %.2f |"
+              % (name, m(plain, frame_ms), m(chain, frame_ms), 100.0 * share, m(chain, post_ms),
+                 100.0 * m(chain, lambda x: post_ms(x) / x["gpu_ms"]["median"]), *per))
 
 
 d = testlib.Daemon()
@@ -95,56 +159,12 @@ try:
                      time.time() - t0), flush=True)
     print("\n(%.0f s in all; load average %.2f before, %.2f after, on %d cores)\n"
           % (time.time() - t_start, load0, os.getloadavg()[0], os.cpu_count()))
-
-    def m(name, f):
-        return med([f(r) for r in results[name]])
-
-    def paired(a, b, f):
-        """Median over repeats of f(b) / f(a), each pair run side by side."""
-        return med([f(y) / f(x) for x, y in zip(results[a], results[b]) if f(x) > 0])
-
-    print("## Bloom: separable against 2d (medians over repeats of job medians, ms; ratios "
-          "paired within each repeat)\n")
-    print("| radius | taps 2d / separable | sep. blur | 2d blur | blur ratio 2d/sep. | "
-          "arithmetic limit (2r+1)/2 | whole bloom ratio | frame_ms sep. | frame_ms 2d | frame ratio |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
-    for r in RADII:
-        sep, two = "bloom-separable-r%d" % r, "bloom-2d-r%d" % r
-        bs, b2 = m(sep, lambda x: section(x, "bloom.blur")), m(two, lambda x: section(x, "bloom.blur"))
-        ws, w2 = m(sep, lambda x: section(x, "bloom.")), m(two, lambda x: section(x, "bloom."))
-        fs, f2 = m(sep, lambda x: x["frame_ms"]["median"]), m(two, lambda x: x["frame_ms"]["median"])
-        taps = (2 * r + 1)
-        ratio = paired(sep, two, lambda x: section(x, "bloom.blur"))
-        whole = paired(sep, two, lambda x: section(x, "bloom."))
-        frame = paired(sep, two, lambda x: x["frame_ms"]["median"])
-        print("| %d (%dx%d) | %d / %d | %.2f | %.2f | %.2f | %.1f | %.2f | %.2f | %.2f | %.2f |"
-              % (r, taps, taps, taps * taps, 2 * taps, bs, b2, ratio, taps / 2.0, whole, fs, f2,
-                 frame))
-
-    print("\n## SSAO: cost and quality against samples\n")
-    print("| samples | ssao.ao ms | ssao.blur ms | both | frame_ms | SSIM against 64 samples |")
-    print("|---|---|---|---|---|---|")
-    for n in SAMPLES:
-        name = "ssao-%d" % n
-        ao, bl = m(name, lambda x: section(x, "ssao.ao")), m(name, lambda x: section(x, "ssao.blur"))
-        fr = m(name, lambda x: x["frame_ms"]["median"])
-        ssim = m(name, lambda x: x["quality"]["worst_ssim"]["value"]) if "quality" in results[name][0] else float("nan")
-        print("| %d | %.2f | %.2f | %.2f | %.2f | %.5f |" % (n, ao, bl, ao + bl, fr, ssim))
-
-    print("\n## The whole chain (bloom r4, toon Sobel, SSAO 16, ACES) against each technique's frame\n")
-    print("| technique | frame_ms plain | frame_ms chain | chain share of frame_ms | technique gpu ms | "
-          "post passes gpu ms | post share of gpu_ms | per effect gpu ms (bloom, toon, ssao) |")
-    print("|---|---|---|---|---|---|---|---|")
-    for name, _ in TECHNIQUES:
-        plain, chain = name + "-plain", name + "-chain"
-        fp, fc = m(plain, lambda x: x["frame_ms"]["median"]), m(chain, lambda x: x["frame_ms"]["median"])
-        post = m(chain, lambda x: section(x, "bloom.") + section(x, "toon.") + section(x, "ssao."))
-        gpu = m(chain, lambda x: x["gpu_ms"]["median"])
-        tech = m(chain, lambda x: x["gpu_ms"]["median"] - section(x, "bloom.") - section(x, "toon.")
-                 - section(x, "ssao.") - section(x, "resolve"))
-        per = [m(chain, lambda x, p=p: section(x, p)) for p in ("bloom.", "toon.", "ssao.")]
-        print("| %s | %.2f | %.2f | %.1f %% | %.2f | %.2f | %.1f %% | %.2f, %.2f, %.2f |"
-              % (name, fp, fc, 100.0 * (fc - fp) / fc, tech, post, 100.0 * post / gpu, *per))
+    if "bloom" in PARTS:
+        bloom_table()
+    if "ssao" in PARTS:
+        ssao_table()
+    if "chain" in PARTS:
+        chain_table()
     if args.json:
         with open(args.json, "w") as f:
             json.dump(results, f, indent=1)

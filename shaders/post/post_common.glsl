@@ -57,20 +57,26 @@ vec3 post_view_normal(ivec2 p)
 #else
 // Rebuilt from depth: on each axis the one-sided difference with the smaller
 // depth step, so that a silhouette does not bend the normal of the surface
-// in front of it.
-vec3 post_view_normal(ivec2 p)
+// in front of it. c is the pixel's view position, l r b t its neighbours'.
+vec3 post_normal_from(vec3 c, vec3 l, vec3 r, vec3 b, vec3 t)
 {
-    float d = post_depth(p);
-    if (d >= 1.0)
-        return vec3(0.0, 0.0, 1.0);
-    vec3 c = post_view_pos(p, d);
-    ivec2 ex = ivec2(1, 0), ey = ivec2(0, 1);
-    vec3 l = post_view_pos(p - ex, post_depth(p - ex)), r = post_view_pos(p + ex, post_depth(p + ex));
-    vec3 b = post_view_pos(p - ey, post_depth(p - ey)), t = post_view_pos(p + ey, post_depth(p + ey));
     vec3 dx = abs(r.z - c.z) < abs(c.z - l.z) ? r - c : c - l;
     vec3 dy = abs(t.z - c.z) < abs(c.z - b.z) ? t - c : c - b;
     vec3 n = cross(dx, dy);
     float len = length(n);
     return len > 1e-12 ? n / len : vec3(0.0, 0.0, 1.0);
+}
+
+vec3 post_view_normal(ivec2 p)
+{
+    float d = post_depth(p);
+    if (d >= 1.0)
+        return vec3(0.0, 0.0, 1.0);
+    ivec2 ex = ivec2(1, 0), ey = ivec2(0, 1);
+    return post_normal_from(post_view_pos(p, d),
+                            post_view_pos(p - ex, post_depth(p - ex)),
+                            post_view_pos(p + ex, post_depth(p + ex)),
+                            post_view_pos(p - ey, post_depth(p - ey)),
+                            post_view_pos(p + ey, post_depth(p + ey)));
 }
 #endif

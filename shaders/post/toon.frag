@@ -24,15 +24,35 @@ void main()
 
     float edge = 0.0;
 #if defined(EDGES_SOBEL)
-    float zc = post_view_depth(p);
     float z[9];
     vec3 n[9];
+#if THICKNESS == 1 && !defined(HAVE_NORMAL_TEX)
+    // One-pixel taps rebuilding normals from depth: read the 5x5 block once
+    // (21 of its depths are used) instead of 5 depths for each of 9 taps.
+    vec3 v[25];
+    float d[25];
+    for (int j = 0; j < 5; j++)
+        for (int i = 0; i < 5; i++) {
+            d[j * 5 + i] = post_depth(p + ivec2(i - 2, j - 2));
+            v[j * 5 + i] = post_view_pos(p + ivec2(i - 2, j - 2), d[j * 5 + i]);
+        }
+    float zc = -v[12].z;
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < 3; i++) {
+            int k = (j + 1) * 5 + (i + 1);
+            z[j * 3 + i] = -v[k].z / zc;
+            n[j * 3 + i] = d[k] >= 1.0 ? vec3(0.0, 0.0, 1.0)
+                                       : post_normal_from(v[k], v[k - 1], v[k + 1], v[k - 5], v[k + 5]);
+        }
+#else
+    float zc = post_view_depth(p);
     for (int j = 0; j < 3; j++)
         for (int i = 0; i < 3; i++) {
             ivec2 q = p + ivec2(i - 1, j - 1) * THICKNESS;
             z[j * 3 + i] = post_view_depth(q) / zc;
             n[j * 3 + i] = post_view_normal(q);
         }
+#endif
     float gx = (z[2] + 2.0 * z[5] + z[8]) - (z[0] + 2.0 * z[3] + z[6]);
     float gy = (z[6] + 2.0 * z[7] + z[8]) - (z[0] + 2.0 * z[1] + z[2]);
     vec3 nx = (n[2] + 2.0 * n[5] + n[8]) - (n[0] + 2.0 * n[3] + n[6]);

@@ -28,6 +28,8 @@ struct queue {
     double keep_days;
     struct record_kind kind; /* STATE_DIR/jobs/ID/job.json */
     const struct technique_catalog *techniques; /* for queue_load */
+    void (*listener)(void *ctx);
+    void *listener_ctx;
 };
 
 /* A job's state as taken under the store lock, written after it is
@@ -37,6 +39,14 @@ struct snapshot {
     uint64_t seq;
     json_t *json;
 };
+
+void queue_set_listener(struct queue *q, void (*fn)(void *ctx), void *ctx)
+{
+    q->listener = fn;
+    q->listener_ctx = ctx;
+}
+
+#define NOTIFY_LISTENER(q) ((q)->listener ? (q)->listener((q)->listener_ctx) : (void)0)
 
 const char *job_status_name(enum job_status s)
 {
@@ -395,6 +405,7 @@ void queue_finish(struct queue *q, struct job *job, enum job_status status,
     if (again)
         snapshot_locked(job, &snap);
     pthread_cond_broadcast(&q->changed);
+    NOTIFY_LISTENER(q);
     pthread_mutex_unlock(&q->lock);
     if (again)
         write_snapshot(q, &snap, NULL, 0);
@@ -416,6 +427,7 @@ void queue_stop(struct queue *q)
             atomic_store(&q->jobs[i]->cancel, true);
         }
     pthread_cond_broadcast(&q->changed);
+    NOTIFY_LISTENER(q);
     pthread_mutex_unlock(&q->lock);
 }
 
@@ -436,6 +448,7 @@ enum queue_cancel_result queue_cancel(struct queue *q, const char *id)
         snapshot_locked(job, &snap);
         res = CANCEL_DONE;
         pthread_cond_broadcast(&q->changed);
+        NOTIFY_LISTENER(q);
         break;
     case JOB_RUNNING:
         job->user_cancel = true;

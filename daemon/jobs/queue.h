@@ -124,4 +124,9 @@ bool queue_job_dir(struct queue *q, const char *id, char *dir, size_t cap,
 
 const char *job_status_name(enum job_status s);
 
+/* fn(ctx) is called whenever a job finishes or is cancelled, and when the
+ * queue stops, with the queue's lock held: it must return at once and take
+ * no lock (the HTTP layer writes to an eventfd). Set once, before serving. */
+void queue_set_listener(struct queue *q, void (*fn)(void *ctx), void *ctx);
+
 #endif

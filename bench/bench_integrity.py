@@ -30,16 +30,10 @@ ap.add_argument("--pairs", type=int, default=6, help="rounds of (B alone, A then
 ap.add_argument("--frames", type=int, default=40, help="B's timed frames")
 ap.add_argument("--warmup", type=int, default=10)
 ap.add_argument("--heavy-frames", type=int, default=40, help="A's timed frames (8 of them captured)")
-ap.add_argument("--nice", type=int, default=0,
-                help="run the daemon at this niceness (negative needs root): on a machine shared "
-                     "with other users' work, -10 keeps their load from swamping a 2%% effect; the "
-                     "daemon's own threads (metrics included) share it, so the effect measured stays")
 ap.add_argument("--json", help="write every measurement here")
 args = ap.parse_args()
 if args.pairs < 4:
     sys.exit("--pairs must be at least 4")
-if args.nice:
-    os.nice(args.nice)  # inherited by the daemon and all its threads
 
 HEAVY = {"technique": "forward", "frames": args.heavy_frames, "warmup_frames": 2,
          "capture_interval": args.heavy_frames // 8, "reference": "forward",
@@ -64,7 +58,7 @@ d = testlib.Daemon()
 alone, behind, rounds = [], [], []
 try:
     info = d.json("GET", "/v1/info")[1]["device"]
-    print("device: %s | %s | niceness %d" % (info["gl_renderer"], info["gl_version"], os.nice(0)))
+    print("device: %s | %s" % (info["gl_renderer"], info["gl_version"]))
     print("A: 1080x720, %d frames, %d captures against forward, all metrics; B: 480x320 forward, %d+%d frames\n"
           % (HEAVY["frames"], HEAVY["frames"] // HEAVY["capture_interval"], args.warmup, args.frames))
     print("round  case     B frame_ms  B started after A finished  other_cpu  load1  noisy")

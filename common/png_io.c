@@ -1,6 +1,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "common/png_io.h"
 
+#include <errno.h>
 #include <png.h>
 #include <setjmp.h>
 #include <stdio.h>
@@ -14,7 +15,7 @@ static bool write_rows(const char *path, png_bytep *rows, int width, int height,
     snprintf(tmp, sizeof(tmp), "%s.tmp", path);
     FILE *f = fopen(tmp, "wb");
     if (!f) {
-        snprintf(err, errlen, "cannot write %s", tmp);
+        snprintf(err, errlen, "cannot write %s: %s", tmp, strerror(errno));
         return false;
     }
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
@@ -36,7 +37,7 @@ static bool write_rows(const char *path, png_bytep *rows, int width, int height,
     png_write_end(png, NULL);
     png_destroy_write_struct(&png, &info);
     if (fclose(f) != 0 || rename(tmp, path) != 0) {
-        snprintf(err, errlen, "cannot finish %s", path);
+        snprintf(err, errlen, "cannot finish %s: %s", path, strerror(errno));
         remove(tmp);
         return false;
     }

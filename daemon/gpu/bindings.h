@@ -19,6 +19,7 @@
 #define SB_SSBO_CULL_STATS 7    /* overflow and evaluation counters */
 #define SB_SSBO_LIGHT_BITS 8    /* per cell, one bit per light while binning */
 #define SB_SSBO_TILE_DEPTH 9    /* per tile: nearest and farthest view depth */
+#define SB_SSBO_LIGHT_SUMMARY 10 /* per cell, one bit per non-zero word of light bits */
 
 /* Texture units. */
 #define SB_TEX_HDR 0

@@ -157,10 +157,18 @@ try:
     testlib.rejects(d, dict(base, technique="clustered_deferred", clustered_deferred={"overflow": "drop"}),
                     "clustered_deferred.overflow")
     # Grids only the device (or the image) refuses: the job fails at create,
-    # naming the field and the limit.
-    for grid, why in (([200, 9, 24], "image"), ([160, 120, 48], "MiB")):
-        done = d.run(dict(base, technique="clustered_deferred", scene={"width": 160, "height": 120,
-                                                                        "lights": 1024},
+    # naming the field and the limit. The bit buffer takes cells x lights / 8
+    # bytes: pick a grid just past this device's storage-buffer limit.
+    caps = d.json("GET", "/v1/info")[1].get("device", {}).get("caps", {})
+    lights = 65536
+    cells = caps.get("max_ssbo_bytes", 1 << 27) // (lights // 8) + 1
+    z = -(-cells // (160 * 120))
+    refusals = [([200, 9, 24], "image", 1024)]
+    if 160 * 120 * z <= 1 << 20:
+        refusals.append(([160, 120, z], "GL_MAX_SHADER_STORAGE_BLOCK_SIZE", lights))
+    for grid, why, n in refusals:
+        done = d.run(dict(base, technique="clustered_deferred",
+                          scene={"preset": "lights", "width": 160, "height": 120, "lights": n},
                           clustered_deferred={"grid": grid}))
         err = done.get("error") or ""
         check(done.get("status") == "failed" and "clustered_deferred.grid" in err and why in err,

@@ -12,10 +12,11 @@
 #include "daemon/gpu/bindings.h"
 #include "daemon/gpu/glutil.h"
 
-/* Index entries the lists may take at most (128 MiB), whatever the device
- * allows: past it a scene is better served by larger cells. */
-static const long long INDEX_BUDGET = 32LL * 1024 * 1024;
-/* The CPU path keeps three grids in flight; a smaller budget each. */
+/* Index entries a frame's lists may take at most (64 MiB, times the ring),
+ * whatever the device allows: past it a scene is better served by larger
+ * cells. */
+static const long long INDEX_BUDGET = 16LL * 1024 * 1024;
+/* The CPU path also fills a host copy: a smaller budget. */
 static const long long CPU_INDEX_BUDGET = 8LL * 1024 * 1024;
 enum { GROUP = 64 }; /* local size of the scatter and compaction passes */
 
@@ -206,12 +207,13 @@ bool light_grid_init(struct light_grid *g, const struct technique_env *env,
     if (!check_device(g, env, bits_bytes, err, errlen))
         return false;
 
-    g->ring_size = cpu ? 3 : 1;
-    glGenBuffers(1, &g->ubo);
-    glBindBuffer(GL_UNIFORM_BUFFER, g->ubo);
-    glBufferData(GL_UNIFORM_BUFFER, sizeof(g->block), &g->block, GL_DYNAMIC_DRAW);
+    glGenBuffers(LIGHT_GRID_RING, g->ubo);
+    for (int r = 0; r < LIGHT_GRID_RING; r++) {
+        glBindBuffer(GL_UNIFORM_BUFFER, g->ubo[r]);
+        glBufferData(GL_UNIFORM_BUFFER, sizeof(g->block), &g->block, GL_DYNAMIC_DRAW);
+    }
     glBindBuffer(GL_UNIFORM_BUFFER, 0);
-    for (int r = 0; r < g->ring_size; r++) {
+    for (int r = 0; r < LIGHT_GRID_RING; r++) {
         g->cells_buf[r] = make_buffer((double)g->cells * 8.0, &g->buffer_bytes);
         g->index_buf[r] = make_buffer((double)g->capacity * 4.0, &g->buffer_bytes);
     }
@@ -264,9 +266,9 @@ void light_grid_finish(struct light_grid *g)
     glDeleteProgram(g->depth_prog);
     glDeleteProgram(g->scatter_prog);
     glDeleteProgram(g->compact_prog);
-    glDeleteBuffers(1, &g->ubo);
-    glDeleteBuffers(3, g->cells_buf);
-    glDeleteBuffers(3, g->index_buf);
+    glDeleteBuffers(LIGHT_GRID_RING, g->ubo);
+    glDeleteBuffers(LIGHT_GRID_RING, g->cells_buf);
+    glDeleteBuffers(LIGHT_GRID_RING, g->index_buf);
     glDeleteBuffers(1, &g->tile_depth_buf);
     glDeleteBuffers(1, &g->bits_buf);
     glDeleteBuffers(1, &g->summary_buf);
@@ -341,7 +343,6 @@ static void build_cpu(struct light_grid *g, const struct technique_env *env, int
             }
     }
     g->stats[slot] = st;
-    g->ring = (g->ring + 1) % g->ring_size;
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->cells_buf[g->ring]);
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)((size_t)g->cells * 8),
                     g->cells_host);
@@ -364,10 +365,11 @@ void light_grid_build(struct light_grid *g, const struct technique_env *env, int
     if (g->camera_moves && g->cfg.kind == LIGHT_GRID_CLUSTERS)
         set_slices(g, env->scene, &cam);
     g->block.counts[1] = slot;
-    glBindBuffer(GL_UNIFORM_BUFFER, g->ubo);
+    g->ring = (g->ring + 1) % LIGHT_GRID_RING;
+    glBindBuffer(GL_UNIFORM_BUFFER, g->ubo[g->ring]);
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof(g->block), &g->block);
     glBindBuffer(GL_UNIFORM_BUFFER, 0);
-    glBindBufferBase(GL_UNIFORM_BUFFER, SB_UBO_LIGHT_GRID, g->ubo);
+    glBindBufferBase(GL_UNIFORM_BUFFER, SB_UBO_LIGHT_GRID, g->ubo[g->ring]);
     if (cpu) {
         build_cpu(g, env, frame, slot, &cam);
     } else {
@@ -383,8 +385,8 @@ void light_grid_build(struct light_grid *g, const struct technique_env *env, int
                          env->gpu->position_buffer);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_BITS, g->bits_buf);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_SUMMARY, g->summary_buf);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_GRID, g->cells_buf[0]);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_INDICES, g->index_buf[0]);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_GRID, g->cells_buf[g->ring]);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_INDICES, g->index_buf[g->ring]);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_CULL_STATS, g->stats_buf);
         if (g->cfg.kind == LIGHT_GRID_TILES) {
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_TILE_DEPTH, g->tile_depth_buf);
@@ -411,7 +413,7 @@ void light_grid_build(struct light_grid *g, const struct technique_env *env, int
 
 void light_grid_bind(const struct light_grid *g)
 {
-    glBindBufferBase(GL_UNIFORM_BUFFER, SB_UBO_LIGHT_GRID, g->ubo);
+    glBindBufferBase(GL_UNIFORM_BUFFER, SB_UBO_LIGHT_GRID, g->ubo[g->ring]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_GRID, g->cells_buf[g->ring]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_INDICES, g->index_buf[g->ring]);
 }

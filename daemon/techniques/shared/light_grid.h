@@ -34,6 +34,9 @@
 
 enum light_grid_kind { LIGHT_GRID_TILES, LIGHT_GRID_CLUSTERS };
 
+/* Frames whose grids exist at once: more than the harness keeps in flight. */
+#define LIGHT_GRID_RING 3
+
 struct light_grid_config {
     int kind;          /* enum light_grid_kind */
     int tile_size;     /* tiles: edge in pixels */
@@ -66,11 +69,13 @@ struct light_grid {
     bool camera_moves; /* slices follow the camera's depth range every frame */
     float mesh_box[SCENE_MESH_COUNT][2][3]; /* object-space min and max of each mesh */
     long long capacity; /* index entries */
-    GLuint ubo, tile_depth_buf, bits_buf, summary_buf, stats_buf;
-    /* CPU binning cycles through a ring of grids so that an upload never
-     * waits for a frame still in flight; GPU binning uses slot 0. */
-    GLuint cells_buf[3], index_buf[3];
-    int ring, ring_size;
+    GLuint tile_depth_buf, bits_buf, summary_buf, stats_buf;
+    /* Each frame writes the next of a ring of blocks and lists, so that
+     * neither an upload nor a compute pass waits for a frame still in
+     * flight that reads the previous ones (on llvmpipe such a write
+     * hazard stalls the CPU until that frame is rasterised). */
+    GLuint ubo[LIGHT_GRID_RING], cells_buf[LIGHT_GRID_RING], index_buf[LIGHT_GRID_RING];
+    int ring;
     int scatter_groups[2]; /* the scatter pass's dispatch: an invocation per light */
     GLuint depth_prog, scatter_prog, compact_prog;
     double buffer_bytes;

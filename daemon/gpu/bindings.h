@@ -20,6 +20,7 @@
 #define SB_SSBO_LIGHT_BITS 8    /* per cell, one bit per light while binning */
 #define SB_SSBO_TILE_DEPTH 9    /* per tile: nearest and farthest view depth */
 #define SB_SSBO_NONFINITE 10    /* the harness's NaN and infinity pixel counters */
+#define SB_SSBO_LIGHT_SUMMARY 11 /* per cell, one bit per non-zero word of light bits */
 
 /* Texture units. */
 #define SB_TEX_HDR 0

@@ -3,7 +3,8 @@
 // sharply. EDGES_SOBEL: the Sobel operator on relative view depth and on
 // view normals (seed 001); EDGES_DEPTH_DIFF: the largest relative depth
 // difference to the 4 neighbours (seed 003). Samples sit THICKNESS pixels
-// from the centre, so thicker lines need no extra taps.
+// from the centre, so thicker lines need no extra taps. Normals are rebuilt
+// from depth on every technique (daemon/effects/toon.c says why).
 #include "post_common.glsl"
 
 layout(binding = SB_TEX_POST_SRC) uniform sampler2D u_src;
@@ -26,7 +27,7 @@ void main()
 #if defined(EDGES_SOBEL)
     float z[9];
     vec3 n[9];
-#if THICKNESS == 1 && !defined(HAVE_NORMAL_TEX)
+#if THICKNESS == 1
     // One-pixel taps rebuilding normals from depth: read the 5x5 block once
     // (21 of its depths are used) instead of 5 depths for each of 9 taps.
     vec3 v[25];

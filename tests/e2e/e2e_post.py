@@ -5,7 +5,8 @@ non-finite count, on small frames:
   the background; toon outlines lie on depth edges and its ramp leaves the
   background alone; SSAO only darkens, more at contacts than in the open;
 - every effect pass is timed in the result and timings.csv;
-- separable and 2D bloom agree; the same look on forward and OSL agrees;
+- separable and 2D bloom agree; the same look on forward, OSL and deferred
+  (g-buffer normals) agrees;
 - exposure and the tone maps brighten monotonically; the default look is
   today's image;
 - reference_look scores an effect against none;
@@ -242,14 +243,19 @@ try:
         check(all(p == (0, 0, 0) for p, b in zip(images[2], black) if b),
               "%s keeps black black" % tonemap)
 
-    # The same look on two techniques agrees (OSL against forward).
+    # The same look on other techniques agrees with forward: OSL, and
+    # deferred, whose g-buffer normals (octahedral and float3) SSAO and toon
+    # read instead of rebuilding them from depth.
     chain = {"post": [{"bloom": {"threshold": 0.5}}, {"toon": {"edges": "sobel"}}, "ssao"],
              "tonemap": "aces"}
-    same = d.run(job(chain, technique="osl", osl={"resolution": "auto"}, reference="forward"))
-    q = same.get("result", {}).get("quality", {})
-    ssim = q.get("worst_ssim", {}).get("value", 0)
-    check(same.get("status") == "done" and ssim >= 0.99,
-          "osl and forward agree under the same post chain: SSIM %.5f" % ssim)
+    for name, extra in (("osl", {"osl": {"resolution": "auto"}}), ("deferred", {}),
+                        ("deferred", {"deferred": {"gbuffer": {"normal": "float3"}}})):
+        same = d.run(job(chain, technique=name, reference="forward", **extra))
+        q = same.get("result", {}).get("quality", {})
+        ssim = q.get("worst_ssim", {}).get("value", 0)
+        check(same.get("status") == "done" and ssim >= 0.99,
+              "%s %s and forward agree under the same post chain: SSIM %.5f (%s)"
+              % (name, extra, ssim, same.get("error")))
 
     # reference_look: the reference renders without the effect, so the
     # score is the effect's; by default it renders with it (identical here).

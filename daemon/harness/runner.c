@@ -24,6 +24,7 @@
 #include "common/log.h"
 #include "daemon/harness/interference.h"
 #include "daemon/harness/metrics_stage.h"
+#include "daemon/lighting/pbr_math.h"
 #include "common/png_io.h"
 #include "daemon/service.h"
 #include "common/stats.h"
@@ -97,7 +98,7 @@ struct run {
     GLuint ldr_fbo;
     struct technique_env env;
     struct technique_products products;
-    char defines[128];
+    char defines[512];
     void *state;
     uint8_t **captures;
     int capture_count;
@@ -109,6 +110,15 @@ struct run {
 };
 
 static const char *hdr_name(int hdr) { return hdr == LOOK_HDR_RGBA16F ? "rgba16f" : "rgba32f"; }
+
+/* The #define lines of the look, for every program that lights: the model,
+ * and the constants C owns (pbr_math.h) so that GLSL cannot disagree. */
+static void look_defines(const struct look_spec *look, char *out, size_t cap)
+{
+    static const char *const models[] = {"PHONG", "BLINN_PHONG", "PBR"};
+    snprintf(out, cap, "#define LIGHTING_%s 1\n#define PBR_MIN_ROUGHNESS %.9g\n",
+             models[look->lighting], PBR_MIN_ROUGHNESS);
+}
 
 /* The output every technique draws into (HDR colour and a depth texture
  * later passes may sample) and the 8-bit image the resolve writes, from the
@@ -142,8 +152,7 @@ static bool setup_targets(struct run *run)
                        : 0;
     if (!run->ldr_fbo)
         return false;
-    snprintf(run->defines, sizeof(run->defines), "#define LIGHTING_%s 1\n",
-             run->spec->look.lighting == LOOK_BLINN_PHONG ? "BLINN_PHONG" : "PHONG");
+    look_defines(&run->spec->look, run->defines, sizeof(run->defines));
     run->env = (struct technique_env){
         .spec = run->spec,
         .scene = &run->scene,

@@ -61,12 +61,12 @@ const void *job_spec_reference_options(const struct job_spec *spec)
     return spec->reference_index >= 0 ? spec->options[spec->reference_index].bytes : NULL;
 }
 
-static const char *const LIGHTING_NAMES[] = {"phong", "blinn_phong", NULL};
+static const char *const LIGHTING_NAMES[] = {"phong", "blinn_phong", "pbr", NULL};
 static const char *const HDR_NAMES[] = {"rgba32f", "rgba16f", NULL};
 
 const char *look_lighting_name(int lighting) { return LIGHTING_NAMES[lighting]; }
 
-/* "look": {"lighting": "phong" | "blinn_phong", "hdr": "rgba32f" | "rgba16f"}. */
+/* "look": {"lighting": "phong" | "blinn_phong" | "pbr", "hdr": "rgba32f" | "rgba16f"}. */
 static bool parse_look(const json_t *v, struct look_spec *look, struct job_error *err)
 {
     static const char *const keys[] = {"lighting", "hdr", NULL};

@@ -19,7 +19,7 @@
 
 /* The job's "look": what the image should look like, independent of the
  * technique that renders it; the reference renders with the same look. */
-enum look_lighting { LOOK_PHONG, LOOK_BLINN_PHONG };
+enum look_lighting { LOOK_PHONG, LOOK_BLINN_PHONG, LOOK_PBR };
 enum look_hdr { LOOK_HDR_RGBA32F, LOOK_HDR_RGBA16F };
 
 struct look_spec {

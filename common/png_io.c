@@ -115,6 +115,15 @@ bool png_read_rgb_limit(const char *path, long long max_pixels, struct image *ou
         snprintf(err, errlen, "%s: cannot open", path);
         return false;
     }
+    bool ok = png_read_rgb_stream(f, path, max_pixels, out, err, errlen);
+    fclose(f);
+    return ok;
+}
+
+bool png_read_rgb_stream(FILE *f, const char *path, long long max_pixels, struct image *out,
+                         char *err, size_t errlen)
+{
+    memset(out, 0, sizeof(*out));
     struct png_errors perr = {""};
     png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &perr, on_png_error,
                                              on_png_warning);
@@ -161,13 +170,11 @@ bool png_read_rgb_limit(const char *path, long long max_pixels, struct image *ou
     out->height = (int)h;
     png_destroy_read_struct(&png, &info, NULL);
     free(rows);
-    fclose(f);
     return true;
 fail:
     png_destroy_read_struct(&png, &info, NULL);
     free(rows);
     image_finish(out);
-    fclose(f);
     return false;
 }
 

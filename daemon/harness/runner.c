@@ -23,6 +23,8 @@
 #include "daemon/gpu/targets.h"
 #include "common/log.h"
 #include "daemon/harness/interference.h"
+#include "daemon/harness/deadline.h"
+#include "daemon/harness/telemetry.h"
 #include "daemon/harness/metrics_stage.h"
 #include "daemon/lighting/pbr_math.h"
 #include "common/png_io.h"
@@ -409,6 +411,10 @@ static bool render_reference(struct run *run, enum job_status *status)
             snprintf(run->err, sizeof(run->err), "cancelled while rendering the reference");
             goto out;
         }
+        if (job_timed_out(run->job)) {
+            job_timeout_message(run->job, "reference", run->err, sizeof(run->err));
+            goto out;
+        }
         void *state = NULL;
         char why[900] = "";
         if (!ref->create(&rr.env, &state, why, sizeof(why))) {
@@ -490,6 +496,10 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
                      run_index + 1);
             return false;
         }
+        if (job_timed_out(job)) {
+            job_timeout_message(job, "rendering", run->err, sizeof(run->err));
+            return false;
+        }
         if (k == 1) {
             /* Warm-up work still queued must not be billed to the timed frames. */
             glFinish();
@@ -533,6 +543,7 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
         if ((seq & 15) == 15 && gl_error_take("rendering", run->err, sizeof(run->err)))
             return false;
         queue_progress(r->queue, job, run_index * n + (k > 0 ? (int)k : 0));
+        telemetry_frames(1);
     }
     glFinish();
     double wall_end = clock_mono_s();
@@ -746,8 +757,11 @@ static void *runner_main(void *arg)
 
     struct job *job;
     /* Store hook: the metrics and files of earlier jobs finish before the next job is timed. */
-    while ((metrics_worker_wait_idle(r->metrics), job = queue_next(r->queue)))
+    while ((metrics_worker_wait_idle(r->metrics), job = queue_next(r->queue))) {
+        double busy_from = telemetry_now();
         run_job(r, job);
+        telemetry_render_busy(telemetry_now() - busy_from);
+    }
     atomic_store(&r->alive, false);
     harness_gl_finish(r);
     egl_context_destroy(egl);

@@ -29,6 +29,11 @@ static bool get_technique(const json_t *v, const char *field,
     return job_error_set(err, field, "must be one of: %s%s", list, nullable ? ", or null" : "");
 }
 
+static double default_timeout_s;
+
+void job_spec_set_default_timeout(double seconds) { default_timeout_s = seconds; }
+double job_spec_default_timeout(void) { return default_timeout_s; }
+
 void job_spec_defaults(struct job_spec *out, const struct technique_catalog *techniques)
 {
     memset(out, 0, sizeof(*out));
@@ -49,6 +54,7 @@ void job_spec_defaults(struct job_spec *out, const struct technique_catalog *tec
     out->repeat_auto = false;
     out->reference[0] = '\0';
     metrics_options_defaults(&out->metrics);
+    out->timeout_s = default_timeout_s;
 }
 
 const void *job_spec_technique_options(const struct job_spec *spec)
@@ -237,7 +243,7 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
 {
     static const char *const fixed[] = {"technique", "frames", "warmup_frames",
                                         "capture_interval", "async_distance", "scene", "look",
-                                        "reference", "metrics", "repeat", "labels"};
+                                        "reference", "metrics", "repeat", "labels", "timeout_s"};
     enum { NFIXED = sizeof(fixed) / sizeof(fixed[0]) };
     /* Every technique's options live under its own name. */
     const char *keys[NFIXED + TECHNIQUE_MAX + 1];
@@ -298,7 +304,8 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
         !jf_get_int(body, "capture_interval", "capture_interval", 0, 1000000,
                  &out->capture_interval, err) ||
         !jf_get_number(body, "async_distance", "async_distance", 0.0, 1e6,
-                    &out->async_distance, err))
+                    &out->async_distance, err) ||
+        !jf_get_number(body, "timeout_s", "timeout_s", 0.0, 1e7, &out->timeout_s, err))
         return false;
 
     json_t *scene;
@@ -317,6 +324,9 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
     if (out->capture_interval > out->frames)
         return job_error_set(err, "capture_interval",
                     "must be 0 (no captures) or at most frames (%d)", out->frames);
+    if (job_spec_capture_count(out) > JOB_MAX_CAPTURES)
+        return job_error_set(err, "capture_interval", "would capture %d frames; at most %d a job",
+                             job_spec_capture_count(out), JOB_MAX_CAPTURES);
     /* Captured frames are kept in memory until the timed run ends, so that
      * encoding never lands inside the measurement: bound that memory. */
     double bytes = (double)job_spec_capture_count(out) * out->scene.width *
@@ -403,6 +413,7 @@ json_t *job_spec_to_json(const struct job_spec *spec)
                                           : json_integer(spec->repeat));
     json_object_set_new(out, "reference",
                         spec->reference[0] ? json_string(spec->reference) : json_null());
+    json_object_set_new(out, "timeout_s", json_real(spec->timeout_s));
     if (spec->reference[0])
         json_object_set_new(out, "metrics", metrics_to_json(&spec->metrics));
     json_t *labels = json_object();

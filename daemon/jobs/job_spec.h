@@ -16,6 +16,7 @@
 
 #define JOB_MAX_BODY_BYTES (64 * 1024)
 #define JOB_MAX_CAPTURE_BYTES (1024.0 * 1024.0 * 1024.0)
+#define JOB_MAX_CAPTURES 1000
 
 /* The job's "look": what the image should look like, independent of the
  * technique that renders it; the reference renders with the same look. */
@@ -61,7 +62,13 @@ struct job_spec {
     struct technique_options options[TECHNIQUE_MAX];
     int nlabels;                   /* sorted by key */
     struct job_label labels[JOB_MAX_LABELS];
+    double timeout_s;              /* running time allowed, all phases; 0: no limit */
 };
+
+/* The timeout_s a job gets when it names none (--job-timeout). Set once at
+ * start-up, before any thread parses jobs. */
+void job_spec_set_default_timeout(double seconds);
+double job_spec_default_timeout(void);
 
 
 /* Fills defaults, then applies and validates the body. techniques is the

@@ -14,20 +14,21 @@ enum param_type { PARAM_INT, PARAM_NUMBER, PARAM_BOOL, PARAM_CHOICE };
 static const struct {
     const char *path;
     enum param_type type;
+    int step; /* integers: valid values are from + k step (sphere segments are even) */
 } PARAMS[] = {
-    {"technique", PARAM_CHOICE},        {"reference", PARAM_CHOICE},
-    {"frames", PARAM_INT},              {"warmup_frames", PARAM_INT},
-    {"capture_interval", PARAM_INT},    {"async_distance", PARAM_NUMBER},
-    {"scene.lights", PARAM_INT},        {"scene.dynamic", PARAM_BOOL},
-    {"scene.width", PARAM_INT},         {"scene.height", PARAM_INT},
-    {"scene.sphere_segments", PARAM_INT}, {"scene.light_speed", PARAM_NUMBER},
-    {"look.lighting", PARAM_CHOICE},    {"look.hdr", PARAM_CHOICE},
-    {"scene.preset", PARAM_CHOICE},     {"scene.light_layout", PARAM_CHOICE},
-    {"scene.light_radius", PARAM_NUMBER}, {"scene.light_intensity", PARAM_NUMBER},
-    {"scene.tessellation_error_px", PARAM_NUMBER}, {"scene.camera", PARAM_CHOICE},
-    {"scene.materials", PARAM_CHOICE},  {"scene.specular", PARAM_NUMBER},
-    {"scene.shininess", PARAM_NUMBER},  {"scene.metallic", PARAM_NUMBER},
-    {"scene.roughness", PARAM_NUMBER},
+    {"technique", PARAM_CHOICE, 0},        {"reference", PARAM_CHOICE, 0},
+    {"frames", PARAM_INT, 1},              {"warmup_frames", PARAM_INT, 1},
+    {"capture_interval", PARAM_INT, 1},    {"async_distance", PARAM_NUMBER, 0},
+    {"scene.lights", PARAM_INT, 1},        {"scene.dynamic", PARAM_BOOL, 0},
+    {"scene.width", PARAM_INT, 1},         {"scene.height", PARAM_INT, 1},
+    {"scene.sphere_segments", PARAM_INT, 2}, {"scene.light_speed", PARAM_NUMBER, 0},
+    {"look.lighting", PARAM_CHOICE, 0},    {"look.hdr", PARAM_CHOICE, 0},
+    {"scene.preset", PARAM_CHOICE, 0},     {"scene.light_layout", PARAM_CHOICE, 0},
+    {"scene.light_radius", PARAM_NUMBER, 0}, {"scene.light_intensity", PARAM_NUMBER, 0},
+    {"scene.tessellation_error_px", PARAM_NUMBER, 0}, {"scene.camera", PARAM_CHOICE, 0},
+    {"scene.materials", PARAM_CHOICE, 0},  {"scene.specular", PARAM_NUMBER, 0},
+    {"scene.shininess", PARAM_NUMBER, 0},  {"scene.metallic", PARAM_NUMBER, 0},
+    {"scene.roughness", PARAM_NUMBER, 0},
 };
 enum { NPARAMS = sizeof(PARAMS) / sizeof(PARAMS[0]) };
 
@@ -46,6 +47,16 @@ static bool param_type(const struct technique_catalog *techniques, const char *p
     *type = opt->type == TOPT_INT ? PARAM_INT : opt->type == TOPT_NUMBER ? PARAM_NUMBER
                                               : PARAM_CHOICE;
     return true;
+}
+
+/* The grid an integer parameter's values lie on (sphere segments are even);
+ * 1 for technique options, which take any integer in their range. */
+static int param_step(const char *path)
+{
+    for (int i = 0; i < (int)NPARAMS; i++)
+        if (strcmp(PARAMS[i].path, path) == 0)
+            return PARAMS[i].step > 0 ? PARAMS[i].step : 1;
+    return 1;
 }
 
 static bool unknown_param(const struct technique_catalog *techniques, struct job_error *err,
@@ -300,6 +311,7 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
     snprintf(out->params[0], sizeof(out->params[0]), "%s", param);
     out->nparams = 1;
     out->integer = type == PARAM_INT;
+    out->step = type == PARAM_INT ? param_step(param) : 0;
     json_t *from = json_object_get(find, "from"), *to = json_object_get(find, "to");
     if (!json_is_number(from))
         return job_error_set(err, "find.from", "must be a number");
@@ -361,6 +373,11 @@ json_t *sweep_point_job(const struct sweep_spec *s, size_t index, json_t **value
 
 json_t *sweep_probe_job(const struct sweep_spec *s, double v)
 {
+    /* Bisection halves the range; on a field with a step (sphere segments
+     * are even) a probe goes down to the step's grid, so that it is valid
+     * whenever both ends are. */
+    if (s->integer && s->step > 1)
+        v = s->from + floor((llround(v) - s->from) / s->step) * s->step;
     json_t *value = s->integer ? json_integer((json_int_t)llround(v)) : json_real(v);
     json_t *job = with_field(s->base, s->params[0], value);
     json_decref(value);

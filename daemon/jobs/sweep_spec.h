@@ -28,6 +28,7 @@ struct sweep_spec {
     /* SWEEP_FIND */
     double from, to;
     bool integer;
+    int step;               /* integer fields: probes are from + k step */
     int max_probes;
     enum sweep_criterion criterion;
     double threshold;

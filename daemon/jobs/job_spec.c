@@ -48,6 +48,8 @@ void job_spec_defaults(struct job_spec *out, const struct technique_catalog *tec
     scene_spec_defaults(&out->scene);
     out->look.lighting = LOOK_PHONG;
     out->look.hdr = LOOK_HDR_RGBA32F;
+    ibl_spec_defaults(&out->look.ibl);
+    shadow_spec_defaults(&out->look.shadows);
     for (int i = 0; i < techniques->count; i++)
         technique_options_defaults(techniques->infos[i], &out->options[i]);
     out->repeat = 1;
@@ -75,16 +77,25 @@ const char *look_lighting_name(int lighting) { return LIGHTING_NAMES[lighting]; 
 /* "look": {"lighting": "phong" | "blinn_phong" | "pbr", "hdr": "rgba32f" | "rgba16f"}. */
 static bool parse_look(const json_t *v, struct look_spec *look, struct job_error *err)
 {
-    static const char *const keys[] = {"lighting", "hdr", NULL};
-    return jf_check_keys(v, "look.", keys, err) &&
-           jf_get_choice(v, "lighting", "look.lighting", LIGHTING_NAMES, &look->lighting, err) &&
-           jf_get_choice(v, "hdr", "look.hdr", HDR_NAMES, &look->hdr, err);
+    static const char *const keys[] = {"lighting", "hdr", "ibl", "shadows", NULL};
+    json_t *ibl = json_object_get(v, "ibl"), *shadows = json_object_get(v, "shadows");
+    if (!(jf_check_keys(v, "look.", keys, err) &&
+          jf_get_choice(v, "lighting", "look.lighting", LIGHTING_NAMES, &look->lighting, err) &&
+          jf_get_choice(v, "hdr", "look.hdr", HDR_NAMES, &look->hdr, err) &&
+          (!ibl || ibl_spec_parse(ibl, "look.ibl", &look->ibl, err)) &&
+          (!shadows || shadow_spec_parse(shadows, "look.shadows", &look->shadows, err))))
+        return false;
+    /* The split sum lights a metallic-roughness material: nothing else. */
+    if (look->ibl.enabled && look->lighting != LOOK_PBR)
+        return job_error_set(err, "look.ibl", "needs look.lighting \"pbr\"");
+    return true;
 }
 
 static json_t *look_to_json(const struct look_spec *look)
 {
-    return json_pack("{s:s, s:s}", "lighting", LIGHTING_NAMES[look->lighting], "hdr",
-                     HDR_NAMES[look->hdr]);
+    return json_pack("{s:s, s:s, s:o, s:o}", "lighting", LIGHTING_NAMES[look->lighting], "hdr",
+                     HDR_NAMES[look->hdr], "ibl", ibl_spec_to_json(&look->ibl), "shadows",
+                     shadow_spec_to_json(&look->shadows));
 }
 
 /* "repeat": N, or {"auto": true, "max": M}. */

@@ -10,6 +10,7 @@
 #include <stddef.h>
 
 #include "common/json_fields.h"
+#include "daemon/lighting/look_lighting.h"
 #include "daemon/quality/metrics.h"
 #include "daemon/scene/scene_spec.h"
 #include "daemon/techniques/technique_info.h"
@@ -26,6 +27,8 @@ enum look_hdr { LOOK_HDR_RGBA32F, LOOK_HDR_RGBA16F };
 struct look_spec {
     int lighting; /* enum look_lighting */
     int hdr;      /* enum look_hdr: the format of the HDR target techniques draw into */
+    struct ibl_spec ibl;         /* image-based lighting (needs lighting pbr) */
+    struct shadow_spec shadows;  /* omni shadow maps for the point lights */
 };
 
 /* labels: free-form tags for history (commit, branch, driver version). Keys

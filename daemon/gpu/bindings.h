@@ -6,6 +6,7 @@
 
 /* Uniform blocks. */
 #define SB_UBO_FRAME 0
+#define SB_UBO_IBL 1 /* the probes lighting this frame (shaders/common/ibl.glsl) */
 
 /* Shader storage blocks. */
 #define SB_SSBO_INSTANCES 0
@@ -16,6 +17,7 @@
 #define SB_SSBO_LIGHT_GRID 5    /* per tile or cluster: offset, count */
 #define SB_SSBO_LIGHT_INDICES 6 /* the lists the grid points into */
 #define SB_SSBO_CULL_STATS 7    /* overflow and evaluation counters */
+#define SB_SSBO_SHADOW_LIGHTS 9 /* per light: where its shadow map's faces lie */
 
 /* Texture units. */
 #define SB_TEX_HDR 0
@@ -23,6 +25,22 @@
 #define SB_TEX_GBUFFER0 2 /* 2..5: g-buffer planes */
 #define SB_TEX_OSL_ATLAS 0
 #define SB_TEX_OSL_MESH 1 /* 1 + 2m: position of mesh m, 2 + 2m: normal */
+
+/* Harness-owned units, bound before every frame's passes for the lighting
+ * library (look.ibl, look.shadows): techniques leave 10 and up alone. */
+#define SB_TEX_IBL_SOURCE 10      /* setup only: the cube map being filtered */
+#define SB_TEX_IBL_IRRADIANCE 12  /* cube map array: environment, then each probe */
+#define SB_TEX_IBL_PREFILTERED 13 /* cube map array, roughness picks the level */
+#define SB_TEX_IBL_BRDF 14        /* the split sum's (A, B) table */
+#define SB_TEX_SHADOW_ATLAS 15    /* depth atlas of every light's six faces */
+#define SB_TEX_SHADOW_CUBES 16    /* or a depth cube map array, a layer a light */
+
+/* Uniform locations of the harness's own programs, explicit so that timed
+ * code never looks a name up. */
+#define SB_LOC_SHADOW_VIEW_PROJ 0 /* mat4, locations 0..3 */
+#define SB_LOC_SHADOW_INSTANCE 4  /* int */
+#define SB_LOC_IBL_FACE 0         /* filters: int, the cube face written */
+#define SB_LOC_IBL_PARAMS 1       /* filters: vec4 (roughness or lod, 1 / size, samples, source size) */
 
 /* Image units. */
 #define SB_IMG_OSL_ATLAS 0

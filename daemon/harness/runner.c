@@ -25,8 +25,8 @@
 #include "daemon/harness/interference.h"
 #include "daemon/harness/deadline.h"
 #include "daemon/harness/telemetry.h"
+#include "daemon/harness/look.h"
 #include "daemon/harness/metrics_stage.h"
-#include "daemon/lighting/pbr_math.h"
 #include "common/png_io.h"
 #include "daemon/service.h"
 #include "common/stats.h"
@@ -97,6 +97,12 @@ struct run {
     struct gpu_timer *timer;
     struct gpu_passes passes;
     int resolve_pass;
+    /* The look's harness work (probes, shadow maps, sky): owned by the run
+     * that measures; the reference borrows it. */
+    struct harness_look look;
+    int shadow_pass, sky_pass; /* -1 when the look has none */
+    struct hdr_stats *hdr;     /* per capture, when the look is physically based */
+    float *hdr_scratch;
     GLuint ldr_fbo;
     struct technique_env env;
     struct technique_products products;
@@ -112,15 +118,6 @@ struct run {
 };
 
 static const char *hdr_name(int hdr) { return hdr == LOOK_HDR_RGBA16F ? "rgba16f" : "rgba32f"; }
-
-/* The #define lines of the look, for every program that lights: the model,
- * and the constants C owns (pbr_math.h) so that GLSL cannot disagree. */
-static void look_defines(const struct look_spec *look, char *out, size_t cap)
-{
-    static const char *const models[] = {"PHONG", "BLINN_PHONG", "PBR"};
-    snprintf(out, cap, "#define LIGHTING_%s 1\n#define PBR_MIN_ROUGHNESS %.9g\n",
-             models[look->lighting], PBR_MIN_ROUGHNESS);
-}
 
 /* The output every technique draws into (HDR colour and a depth texture
  * later passes may sample) and the 8-bit image the resolve writes, from the
@@ -154,7 +151,7 @@ static bool setup_targets(struct run *run)
                        : 0;
     if (!run->ldr_fbo)
         return false;
-    look_defines(&run->spec->look, run->defines, sizeof(run->defines));
+    harness_look_defines(&run->spec->look, run->defines, sizeof(run->defines));
     run->env = (struct technique_env){
         .spec = run->spec,
         .scene = &run->scene,
@@ -220,18 +217,20 @@ static void resolve(const struct run *run)
     gpu_pass_end(&run->passes);
 }
 
-/* Builds the technique for a run: its options, passes (its own, then the
- * harness's resolve) and timer. */
+/* Builds the technique for a run: its options, passes (its own, the look's
+ * shadows and sky, then the harness's resolve) and timer. */
 static bool setup_technique(struct run *run, const struct technique *tech, const void *options,
                             int64_t timed_frames)
 {
-    run->timer = gpu_timer_create(technique_pass_count(tech) + 1, timed_frames);
+    int look_passes = (run->look.shadows != NULL) + run->look.sky_on;
+    run->timer = gpu_timer_create(technique_pass_count(tech) + look_passes + 1, timed_frames);
     if (!run->timer) {
         snprintf(run->err, sizeof(run->err), "cannot create GPU timer queries");
         return false;
     }
     if (!gpu_passes_init(&run->passes, run->timer, tech->info->passes,
                          run->runner->caps.debug_groups) ||
+        !harness_look_add_passes(&run->look, &run->passes, &run->shadow_pass, &run->sky_pass) ||
         (run->resolve_pass = gpu_passes_add(&run->passes, "resolve")) < 0) {
         snprintf(run->err, sizeof(run->err), "%s declares more passes than the harness times",
                  tech->info->name);
@@ -241,10 +240,26 @@ static bool setup_technique(struct run *run, const struct technique *tech, const
     return true;
 }
 
+/* Passes in the order a frame runs them: the shadow pass before the
+ * technique's, then the rest as declared. Returns the count. */
+static int pass_order(const struct run *run, int *order)
+{
+    int n = 0;
+    if (run->shadow_pass >= 0)
+        order[n++] = run->shadow_pass;
+    for (int s = 0; s < run->passes.count; s++)
+        if (s != run->shadow_pass)
+            order[n++] = s;
+    return n;
+}
+
 static void teardown(struct run *run)
 {
     if (run->tech && run->state)
         run->tech->destroy(run->state);
+    harness_look_finish(&run->look);
+    free(run->hdr);
+    free(run->hdr_scratch);
     gpu_timer_destroy(run->timer);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     gpu_scene_finish(&run->gpu);
@@ -270,7 +285,8 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
     const struct job_spec *spec = run->spec;
     const struct job *job = run->job;
     int n = spec->frames, w0 = spec->warmup_frames;
-    int sections = run->passes.count;
+    int sections = run->passes.count, order[GPU_MAX_PASSES];
+    pass_order(run, order);
     double *gpu = malloc((size_t)n * sizeof(double));
     double *sec = malloc((size_t)n * sizeof(double));
     json_t *captures = json_array(), *result = NULL;
@@ -295,8 +311,10 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
             goto out;
         free(run->captures[c]);
         run->captures[c++] = NULL;
-        json_array_append_new(captures, json_pack("{s:i, s:s, s:s}", "frame", k, "url",
-                                                  url, "file", name));
+        json_t *entry = json_pack("{s:i, s:s, s:s}", "frame", k, "url", url, "file", name);
+        if (run->hdr)
+            json_object_set_new(entry, "hdr", hdr_stats_json(&run->hdr[c - 1]));
+        json_array_append_new(captures, entry);
     }
 
     /* timings.csv: one row per timed frame. */
@@ -307,15 +325,16 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
         goto out;
     }
     used += (size_t)snprintf(csv + used, cap - used, "frame,gpu_ms,cpu_ms,frame_ms");
-    for (int s = 0; s < sections; s++)
-        used += (size_t)snprintf(csv + used, cap - used, ",gpu_%s_ms", run->passes.names[s]);
+    for (int o = 0; o < sections; o++)
+        used += (size_t)snprintf(csv + used, cap - used, ",gpu_%s_ms",
+                                 run->passes.names[order[o]]);
     used += (size_t)snprintf(csv + used, cap - used, "\n");
     for (int i = 0; i < n; i++) {
         used += (size_t)snprintf(csv + used, cap - used, "%d,%.6f,%.6f,%.6f", i + 1, gpu[i],
                                  run->cpu_ms[i], run->frame_ms[i]);
-        for (int s = 0; s < sections; s++)
+        for (int o = 0; o < sections; o++)
             used += (size_t)snprintf(csv + used, cap - used, ",%.6f",
-                                     gpu_timer_ms(run->timer, w0 + i, s));
+                                     gpu_timer_ms(run->timer, w0 + i, order[o]));
         used += (size_t)snprintf(csv + used, cap - used, "\n");
     }
     snprintf(path, sizeof(path), "%s/timings.csv", job->dir);
@@ -350,15 +369,19 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
     captures = NULL;
     /* Every pass, the harness's resolve included, in frame order. */
     json_t *by_section = json_object();
-    for (int s = 0; s < sections; s++) {
+    for (int o = 0; o < sections; o++) {
         for (int i = 0; i < n; i++)
-            sec[i] = gpu_timer_ms(run->timer, w0 + i, s);
-        json_object_set_new(by_section, run->passes.names[s], stats_json(sec, (size_t)n));
+            sec[i] = gpu_timer_ms(run->timer, w0 + i, order[o]);
+        json_object_set_new(by_section, run->passes.names[order[o]], stats_json(sec, (size_t)n));
     }
     json_object_set_new(result, "gpu_sections_ms", by_section);
-    json_object_set_new(result, "look", json_pack("{s:s, s:s}", "lighting",
-                                                  look_lighting_name(run->spec->look.lighting),
-                                                  "hdr", hdr_name(run->spec->look.hdr)));
+    json_object_set_new(result, "look",
+                        json_pack("{s:s, s:s, s:o, s:o}", "lighting",
+                                  look_lighting_name(run->spec->look.lighting), "hdr",
+                                  hdr_name(run->spec->look.hdr), "ibl",
+                                  ibl_spec_to_json(&run->spec->look.ibl), "shadows",
+                                  shadow_spec_to_json(&run->spec->look.shadows)));
+    harness_look_describe(&run->look, result);
     json_object_set_new(result, "targets_bytes", json_real(gpu_targets_bytes(run->runner->targets)));
     json_object_set_new(result, "scene", scene_describe(&run->scene));
     /* Store hook: what could have disturbed the timed region. */
@@ -394,7 +417,7 @@ static bool render_reference(struct run *run, enum job_status *status)
     uint8_t *pixels = malloc((size_t)w * (size_t)h * 4);
     /* The reference gets a run of its own over the same scene and targets. */
     struct run rr = {.runner = run->runner, .job = run->job, .spec = spec, .tech = ref,
-                     .env = run->env, .ldr_fbo = run->ldr_fbo};
+                     .env = run->env, .ldr_fbo = run->ldr_fbo, .look = run->look};
     memcpy(rr.defines, run->defines, sizeof(rr.defines));
     rr.env.defines = rr.defines;
     rr.env.passes = &rr.passes;
@@ -426,7 +449,10 @@ static bool render_reference(struct run *run, enum job_status *status)
         frame_data(&rr, k, &fd);
         gpu_frame_block_update(&run->runner->frame_block, &fd);
         gpu_timer_begin_frame(rr.timer);
-        bool drawn = ref->render(state, &rr.env, k, why, sizeof(why));
+        bool drawn = harness_look_before(&rr.look, &rr.passes, rr.shadow_pass, k, false, why,
+                                         sizeof(why)) &&
+                     ref->render(state, &rr.env, k, why, sizeof(why));
+        harness_look_after(&rr.look, &rr.passes, rr.sky_pass, rr.env.output_fbo, w, h);
         resolve(&rr);
         gpu_timer_end_frame(rr.timer);
         if (drawn) {
@@ -459,6 +485,7 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
     const struct job_spec *spec = run->spec;
     struct job *job = run->job;
     int w0 = spec->warmup_frames, n = spec->frames;
+    run->shadow_pass = run->sky_pass = -1;
     run->scene_ok = scene_init(&run->scene, &spec->scene);
     run->capture_count = capture ? job_spec_capture_count(spec) : 0;
     run->captures = calloc((size_t)run->capture_count + 1, sizeof(*run->captures));
@@ -470,8 +497,21 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
     }
     if (!gpu_scene_init(&run->gpu, &run->scene, run->err, sizeof(run->err)) ||
         !setup_targets(run) ||
+        !harness_look_init(&run->look, &spec->look, &run->scene, &run->gpu, &r->frame_block,
+                           &r->caps, run->defines, run->err, sizeof(run->err)) ||
         !setup_technique(run, run->tech, job_spec_technique_options(spec), (int64_t)w0 + n))
         return false;
+    /* Physically based looks report each capture's HDR figures: non-finite
+     * pixels (what the roughness clamp keeps out), mean and peak. */
+    if (run->capture_count && spec->look.lighting == LOOK_PBR) {
+        run->hdr = calloc((size_t)run->capture_count, sizeof(*run->hdr));
+        run->hdr_scratch = malloc((size_t)spec->scene.width * (size_t)spec->scene.height * 4 *
+                                  sizeof(float));
+        if (!run->hdr || !run->hdr_scratch) {
+            snprintf(run->err, sizeof(run->err), "out of memory for HDR statistics");
+            return false;
+        }
+    }
     if (!run->tech->create(&run->env, &run->state, run->err, sizeof(run->err)) ||
         gl_error_take("setup", run->err, sizeof(run->err)))
         return false;
@@ -521,7 +561,11 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
         frame_data(run, k, &fd);
         gpu_frame_block_update(&r->frame_block, &fd);
         gpu_timer_begin_frame(run->timer);
-        bool ok = run->tech->render(run->state, &run->env, k, run->err, sizeof(run->err));
+        bool ok = harness_look_before(&run->look, &run->passes, run->shadow_pass, k, k >= 1,
+                                      run->err, sizeof(run->err)) &&
+                  run->tech->render(run->state, &run->env, k, run->err, sizeof(run->err));
+        harness_look_after(&run->look, &run->passes, run->sky_pass, run->env.output_fbo,
+                           run->env.width, run->env.height);
         resolve(run);
         gpu_timer_end_frame(run->timer);
         glFlush(); /* where a swap would hand the frame to the GPU */
@@ -536,6 +580,9 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
             glBindFramebuffer(GL_READ_FRAMEBUFFER, run->ldr_fbo);
             glReadPixels(0, 0, spec->scene.width, spec->scene.height, GL_RGBA,
                          GL_UNSIGNED_BYTE, run->captures[captured++]);
+            if (run->hdr)
+                harness_hdr_stats(run->env.output_fbo, spec->scene.width, spec->scene.height,
+                                  run->hdr_scratch, &run->hdr[captured - 1]);
             double c = clock_mono_s() - c0;
             *capture_s += c;
             run->frame_ms[k - 1] -= c * 1e3;

@@ -14,6 +14,8 @@ void ibl_place_probes(const struct scene *s, const struct ibl_spec *spec, struct
     }
     const struct scene_box *b = &s->objects;
     int n = spec->probes;
+    if (n <= 0)
+        return;
     int cols = (int)ceil(sqrt((double)n)), rows = (n + cols - 1) / cols;
     float size[3] = {b->max[0] - b->min[0], b->max[1] - b->min[1], b->max[2] - b->min[2]};
     float diag = sqrtf(size[0] * size[0] + size[1] * size[1] + size[2] * size[2]);

@@ -10,8 +10,9 @@
  *  - chart: spheres by metallic (rows, 0 at the bottom to 1 at the top)
  *    and roughness (columns, 0 on the left to 1 on the right), the usual
  *    check of a physically based model, lit from above the camera;
- *  - sphere: one white sphere in the spec's material, filling the middle
- *    of the frame: the white furnace test's scene. */
+ *  - sphere: one white sphere on a white ground, both in the spec's
+ *    material, a light straight above: the white furnace's and the shadow
+ *    test's scene. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -203,7 +204,7 @@ static bool build_teapots(struct scene *s)
     s->light_volume = (struct scene_box){{-5.0f, 0.3f, -5.0f}, {5.0f, 2.8f, 5.0f}};
     s->light_orbit_plane = SCENE_ORBIT_XZ;
     s->sky = true;
-    set_pose(s, 0.0f, 4.5f, 8.0f, 0.0f, 0.4f, 0.0f, 50.0f);
+    set_pose(s, 0.0f, 3.4f, 8.5f, 0.0f, 0.5f, 0.0f, 50.0f);
     if (!scene_place_lights(s, 1.0f))
         return false;
     /* Many overlapping lights: each at half the other presets' brightness. */
@@ -244,16 +245,24 @@ static bool build_chart(struct scene *s)
 
 static bool build_sphere(struct scene *s)
 {
-    if (!alloc_instances(s, 1))
+    /* By mesh: the sphere, then the ground it rests on; both white, both in
+     * the spec's material. */
+    if (!alloc_instances(s, 2))
         return false;
-    struct scene_instance *in = &s->instances[0];
+    struct scene_instance *in = &s->instances[0], *ground = &s->instances[1];
     in->mesh = SCENE_MESH_SPHERE;
     in->scale = 1.0f;
-    in->albedo[0] = in->albedo[1] = in->albedo[2] = 1.0f;
-    s->light_volume = (struct scene_box){{2.0f, 3.0f, 4.0f}, {2.0f, 3.0f, 4.0f}};
+    ground->mesh = SCENE_MESH_PLANE;
+    ground->scale = 6.0f / SCENE_PLANE_HALF;
+    ground->pos[1] = -SCENE_SPHERE_RADIUS;
+    for (int k = 0; k < 3; k++)
+        in->albedo[k] = ground->albedo[k] = 1.0f;
+    /* The light straight above the sphere: its shadow falls around the
+     * point where the sphere touches the ground. */
+    s->light_volume = (struct scene_box){{0.0f, 3.0f, 0.0f}, {0.0f, 3.0f, 0.0f}};
     s->light_orbit_plane = SCENE_ORBIT_XZ;
     s->sky = true;
-    set_pose(s, 0.0f, 0.0f, 3.2f, 0.0f, 0.0f, 0.0f, 40.0f);
+    set_pose(s, 0.0f, 2.6f, 4.2f, 0.0f, -0.3f, 0.0f, 40.0f);
     if (!scene_place_lights(s, 0.5f))
         return false;
     white_lights(s, 1.0f);

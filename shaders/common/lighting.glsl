@@ -25,6 +25,12 @@ const float AMBIENT = 0.15;
 #if defined(LIGHTING_PBR)
 #include "pbr.glsl"
 #endif
+#if defined(LOOK_IBL)
+#include "ibl.glsl"
+#endif
+#if defined(LOOK_SHADOWS)
+#include "shadows.glsl"
+#endif
 
 vec3 light_ambient(vec3 albedo)
 {

@@ -202,6 +202,9 @@ static void test_probes(void)
     CHECK(ibl_probe_weight(&probes[0], edge) == 0.0f);
     float mid[3] = {probes[0].pos[0] + 0.5f * probes[0].radius, probes[0].pos[1], probes[0].pos[2]};
     CHECK_NEAR(ibl_probe_weight(&probes[0], mid), 0.5, 1e-6);
+    /* None placed: nothing written. */
+    spec.probes = 0;
+    ibl_place_probes(&s, &spec, probes);
     /* A placed list is taken as given. */
     spec.placed = true;
     spec.probes = 1;

@@ -926,7 +926,7 @@ static void test_teapots_preset(void)
     scene_spec_preset_defaults(&spec, SCENE_PRESET_SPHERE);
     spec.roughness = 1.0;
     CHECK(scene_init(&s, &spec));
-    CHECK(s.instance_count == 1 && s.instances[0].albedo[0] == 1.0f &&
+    CHECK(s.instance_count == 2 && s.instances[0].albedo[0] == 1.0f &&
           s.instances[0].material.roughness == 1.0f);
     scene_finish(&s);
 

@@ -395,10 +395,10 @@ static bool parse_wait(struct MHD_Connection *c, double *wait)
 }
 
 static enum MHD_Result respond_chart(struct MHD_Connection *c, const json_t *subject,
-                                     const struct route *r, bool is_sweep)
+                                     const struct route *r, bool is_sweep, const json_t *device)
 {
     enum chart_format format = r->chart_png ? CHART_PNG : CHART_SVG;
-    struct chart_options o = {0};
+    struct chart_options o = {.device = device};
     o.series = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "series");
     if (o.series && strcmp(o.series, "frame_ms") && strcmp(o.series, "gpu_ms") && strcmp(o.series, "cpu_ms"))
         return respond_error(c, MHD_HTTP_BAD_REQUEST, "series", "must be frame_ms, gpu_ms or cpu_ms");
@@ -570,7 +570,7 @@ static enum MHD_Result job_resource(struct http_server *s, struct MHD_Connection
             return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
         enum MHD_Result ret =
             json_object_get(job, "result")
-                ? respond_chart(c, job, r, false)
+                ? respond_chart(c, job, r, false, NULL)
                 : respond_error(c, MHD_HTTP_CONFLICT, "id", "the job has no result yet");
         json_decref(job);
         return ret;
@@ -663,7 +663,9 @@ static enum MHD_Result sweep_resource(struct http_server *s, struct MHD_Connecti
         return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such sweep");
     enum MHD_Result ret;
     if (r->kind == ROUTE_SWEEP_CHART) {
-        ret = respond_chart(c, sw, r, true);
+        json_t *device = runner_device_json(s->runner);
+        ret = respond_chart(c, sw, r, true, device);
+        json_decref(device);
     } else {
         json_t *device = runner_device_json(s->runner);
         size_t len = 0;

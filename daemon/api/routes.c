@@ -28,6 +28,7 @@ static const char *const IMAGE_DIRS[][2] = {
     [IMAGE_REFERENCE] = {"reference/", "reference"},
     [IMAGE_SSIM] = {"ssim/", "ssim"},
     [IMAGE_FLIP] = {"flip/", "flip"},
+    [IMAGE_HEATMAP] = {"heatmap/", "heatmap"}, /* light evaluations per pixel */
 };
 
 static bool none(struct route *r, const char *field, const char *message)

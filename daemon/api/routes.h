@@ -27,7 +27,7 @@ enum route_kind {
 };
 
 /* Per-capture images of a job: URL folder and file prefix. */
-enum route_image { IMAGE_FRAME, IMAGE_REFERENCE, IMAGE_SSIM, IMAGE_FLIP };
+enum route_image { IMAGE_FRAME, IMAGE_REFERENCE, IMAGE_SSIM, IMAGE_FLIP, IMAGE_HEATMAP };
 
 struct route {
     enum route_kind kind;

@@ -6,7 +6,8 @@
 
 /* Uniform blocks. */
 #define SB_UBO_FRAME 0
-#define SB_UBO_IBL 1 /* the probes lighting this frame (shaders/common/ibl.glsl) */
+#define SB_UBO_LIGHT_GRID 1 /* light grid dimensions, slices, list bounds */
+#define SB_UBO_IBL 2 /* the probes lighting this frame (shaders/common/ibl.glsl) */
 
 /* Shader storage blocks. */
 #define SB_SSBO_INSTANCES 0
@@ -17,12 +18,16 @@
 #define SB_SSBO_LIGHT_GRID 5    /* per tile or cluster: offset, count */
 #define SB_SSBO_LIGHT_INDICES 6 /* the lists the grid points into */
 #define SB_SSBO_CULL_STATS 7    /* overflow and evaluation counters */
-#define SB_SSBO_SHADOW_LIGHTS 9 /* per light: where its shadow map's faces lie */
+#define SB_SSBO_LIGHT_BITS 8    /* per cell, one bit per light while binning */
+#define SB_SSBO_TILE_DEPTH 9    /* per tile: nearest and farthest view depth */
+#define SB_SSBO_SHADOW_LIGHTS 10 /* per light: where its shadow map's faces lie */
 
 /* Texture units. */
 #define SB_TEX_HDR 0
 #define SB_TEX_DEPTH 1
 #define SB_TEX_GBUFFER0 2 /* 2..5: g-buffer planes */
+#define SB_TEX_GBUFFER1 3
+#define SB_TEX_GBUFFER2 4
 #define SB_TEX_OSL_ATLAS 0
 #define SB_TEX_OSL_MESH 1 /* 1 + 2m: position of mesh m, 2 + 2m: normal */
 
@@ -44,5 +49,6 @@
 
 /* Image units. */
 #define SB_IMG_OSL_ATLAS 0
+#define SB_IMG_HEAT 1 /* light evaluations per pixel (r32ui) */
 
 #endif

@@ -110,6 +110,7 @@ struct run {
     void *state;
     uint8_t **captures;
     int capture_count;
+    json_t *heatmap; /* result.heatmap: captured heat maps, when the technique publishes one */
     double *cpu_ms;
     double *frame_ms;
     GLsync fences[FRAMES_IN_FLIGHT];
@@ -265,6 +266,7 @@ static void teardown(struct run *run)
     gpu_scene_finish(&run->gpu);
     if (run->scene_ok)
         scene_finish(&run->scene);
+    json_decref(run->heatmap);
     for (int i = 0; run->captures && i < run->capture_count; i++)
         free(run->captures[i]);
     free(run->captures);
@@ -383,6 +385,8 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
                                   shadow_spec_to_json(&run->spec->look.shadows)));
     harness_look_describe(&run->look, result);
     json_object_set_new(result, "targets_bytes", json_real(gpu_targets_bytes(run->runner->targets)));
+    if (run->heatmap)
+        json_object_set(result, "heatmap", run->heatmap);
     json_object_set_new(result, "scene", scene_describe(&run->scene));
     /* Store hook: what could have disturbed the timed region. */
     json_object_set_new(result, "interference",
@@ -473,6 +477,56 @@ static bool render_reference(struct run *run, enum job_status *status)
 out:
     gpu_timer_destroy(rr.timer);
     free(pixels);
+    return ok;
+}
+
+/* The light-count heat map a technique publishes (products.heat_tex: light
+ * evaluations per pixel), read back at captured frame k inside the capture
+ * bracket (so outside every timed figure) and written as heatmap-NNNNNN.png
+ * on a colour ramp from 0 (black) to the frame's largest count (white),
+ * with the frame's mean and max in result.heatmap. */
+static bool capture_heatmap(struct run *run, int k)
+{
+    static const float ramp[6][3] = {{0, 0, 0}, {0, 0, 1}, {0, 1, 1}, {0, 1, 0}, {1, 1, 0}, {1, 1, 1}};
+    size_t n = (size_t)run->env.width * (size_t)run->env.height;
+    uint32_t *count = malloc(n * sizeof(uint32_t));
+    uint8_t *rgba = malloc(n * 4);
+    bool ok = count && rgba;
+    if (ok) {
+        glBindTexture(GL_TEXTURE_2D, run->products.heat_tex);
+        glGetTexImage(GL_TEXTURE_2D, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, count);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        double sum = 0;
+        uint32_t max = 0;
+        for (size_t i = 0; i < n; i++)
+            sum += count[i], max = count[i] > max ? count[i] : max;
+        for (size_t i = 0; i < n; i++) {
+            float t = max ? 5.0f * (float)count[i] / (float)max : 0.0f;
+            int seg = t >= 5.0f ? 4 : (int)t;
+            float f = t - (float)seg;
+            for (int ch = 0; ch < 3; ch++)
+                rgba[i * 4 + ch] = (uint8_t)(255.0f * (ramp[seg][ch] + f * (ramp[seg + 1][ch] - ramp[seg][ch])) + 0.5f);
+            rgba[i * 4 + 3] = 255;
+        }
+        char name[64], url[128], path[PATH_MAX + 64];
+        snprintf(name, sizeof(name), "heatmap-%06d.png", k);
+        snprintf(url, sizeof(url), "/v1/jobs/%s/heatmap/%d.png", run->job->id, k);
+        snprintf(path, sizeof(path), "%s/%s", run->job->dir, name);
+        ok = png_write_gl_rgba(path, rgba, run->env.width, run->env.height, run->err, sizeof(run->err));
+        if (ok && !run->heatmap)
+            run->heatmap = json_pack("{s:s, s:s, s:[]}", "unit", "light evaluations per pixel",
+                                     "ramp", "black (0), blue, cyan, green, yellow, white (scale_max)",
+                                     "captures");
+        if (ok)
+            json_array_append_new(json_object_get(run->heatmap, "captures"),
+                                  json_pack("{s:i, s:s, s:s, s:f, s:i, s:i}", "frame", k, "url", url,
+                                            "file", name, "mean", sum / (double)n, "max", (int)max,
+                                            "scale_max", (int)max));
+    } else {
+        snprintf(run->err, sizeof(run->err), "out of memory for the heat map");
+    }
+    free(count);
+    free(rgba);
     return ok;
 }
 
@@ -583,6 +637,8 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
             if (run->hdr)
                 harness_hdr_stats(run->env.output_fbo, spec->scene.width, spec->scene.height,
                                   run->hdr_scratch, &run->hdr[captured - 1]);
+            if (run->products.heat_tex && !capture_heatmap(run, (int)k))
+                return false;
             double c = clock_mono_s() - c0;
             *capture_s += c;
             run->frame_ms[k - 1] -= c * 1e3;
@@ -598,6 +654,8 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
     run->frame_ms[n - 1] += (wall_end - frame_begin) * 1e3;
     *wall_s = wall_end - wall_start;
     gpu_timer_drain(run->timer);
+    if (run->tech->verify && !run->tech->verify(run->state, run->err, sizeof(run->err)))
+        return false;
     return !gl_error_take("rendering", run->err, sizeof(run->err));
 }
 

@@ -167,6 +167,61 @@ static bool check_combination(const struct sweep_spec *s, size_t p, const struct
     return ok;
 }
 
+static bool workload_param(const char *path)
+{
+    return strncmp(path, "scene.", 6) == 0 || strcmp(path, "frames") == 0 ||
+           strcmp(path, "warmup_frames") == 0;
+}
+
+/* One timed point of the reference technique per workload of the grid (see
+ * sweep_point_job), unless the reference is among the sweep's techniques. */
+static bool add_reference_points(struct sweep_spec *out, const json_t *body,
+                                 struct job_error *err)
+{
+    out->ngrid = out->npoints;
+    json_t *flag = json_object_get(body, "time_reference");
+    if (flag && !json_is_boolean(flag))
+        return job_error_set(err, "time_reference", "must be true or false");
+    if (json_is_false(flag))
+        return true;
+    json_t *r = json_object_get(out->base, "reference");
+    const char *ref = json_is_string(r) ? json_string_value(r) : "forward";
+    json_t *t = json_object_get(out->base, "technique");
+    bool varied = false;
+    for (int p = 0; p < out->nparams; p++) {
+        if (strcmp(out->params[p], "technique") != 0)
+            continue;
+        varied = true;
+        size_t i;
+        json_t *v;
+        json_array_foreach(out->values[p], i, v) if (json_is_string(v) &&
+                                                     !strcmp(json_string_value(v), ref)) return true;
+    }
+    if (!varied && !strcmp(json_is_string(t) ? json_string_value(t) : "forward", ref))
+        return true;
+    /* Every combination of the workload parameters' values, first parameter
+     * slowest (as in the grid). */
+    out->reference_values = json_array();
+    size_t combos = 1;
+    for (int p = 0; p < out->nparams; p++)
+        if (workload_param(out->params[p]))
+            combos *= json_array_size(out->values[p]);
+    for (size_t c = 0; c < combos; c++) {
+        json_t *values = json_pack("{s:s}", "technique", ref);
+        size_t rest = c;
+        for (int p = out->nparams - 1; p >= 0; p--) {
+            if (!workload_param(out->params[p]))
+                continue;
+            size_t n = json_array_size(out->values[p]);
+            json_object_set(values, out->params[p], json_array_get(out->values[p], rest % n));
+            rest /= n;
+        }
+        json_array_append_new(out->reference_values, values);
+    }
+    out->npoints += combos;
+    return true;
+}
+
 static bool parse_criterion(const char *text, struct sweep_spec *s)
 {
     double x;
@@ -244,8 +299,10 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
     const char *key;
     json_t *v;
     json_object_foreach((json_t *)body, key, v) if (strcmp(key, "base") && strcmp(key, "vary") &&
-                                                  strcmp(key, "find"))
-        return job_error_set(err, key, "unknown field (a sweep has base and vary, or base and find)");
+                                                  strcmp(key, "find") &&
+                                                  strcmp(key, "time_reference"))
+        return job_error_set(err, key, "unknown field (a sweep has base and vary, or base and "
+                             "find, and time_reference)");
     json_t *base = json_object_get(body, "base");
     if (!json_is_object(base))
         return job_error_set(err, "base", "must be a job object");
@@ -289,10 +346,11 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
         /* Each value may be fine alone and a combination still refused
          * (frames 2 with capture_interval 5): every point is parsed as the
          * job it will run, so that no sweep fails after earlier points ran. */
+        out->ngrid = out->npoints;
         for (size_t p = 0; p < out->npoints; p++)
             if (!check_combination(out, p, techniques, err))
                 return false;
-        return true;
+        return add_reference_points(out, body, err);
     }
 
     out->kind = SWEEP_FIND;
@@ -354,6 +412,7 @@ void sweep_spec_finish(struct sweep_spec *s)
     if (!s)
         return;
     json_decref(s->base);
+    json_decref(s->reference_values);
     for (int i = 0; i < 2; i++)
         json_decref(s->values[i]);
     memset(s, 0, sizeof(*s));
@@ -361,6 +420,23 @@ void sweep_spec_finish(struct sweep_spec *s)
 
 json_t *sweep_point_job(const struct sweep_spec *s, size_t index, json_t **values)
 {
+    if (s->kind == SWEEP_VARY && index >= s->ngrid) {
+        /* A timed reference point: timed like the others, nothing to judge. */
+        json_t *v = json_array_get(s->reference_values, index - s->ngrid);
+        *values = json_deep_copy(v);
+        json_t *job = json_deep_copy(s->base);
+        const char *key;
+        json_t *value;
+        json_object_foreach(v, key, value) {
+            json_t *next = with_field(job, key, value);
+            json_decref(job);
+            job = next;
+        }
+        json_object_del(job, "reference");
+        json_object_del(job, "metrics");
+        json_object_set_new(job, "capture_interval", json_integer(0));
+        return job;
+    }
     json_t *job = json_deep_copy(s->base);
     *values = json_object();
     /* Row-major: the last parameter varies fastest. */

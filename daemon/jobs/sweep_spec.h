@@ -24,7 +24,9 @@ struct sweep_spec {
     int nparams;
     char params[2][64];     /* dotted paths */
     json_t *values[2];      /* arrays, for SWEEP_VARY */
-    size_t npoints;
+    size_t npoints;         /* the grid, then the timed reference points */
+    size_t ngrid;           /* SWEEP_VARY: points of the grid itself */
+    json_t *reference_values; /* SWEEP_VARY: values of each timed reference point */
     /* SWEEP_FIND */
     double from, to;
     bool integer;
@@ -45,7 +47,13 @@ void sweep_spec_finish(struct sweep_spec *s);
 json_t *sweep_params_json(const struct technique_catalog *techniques);
 
 /* The job of grid point index (row-major over the parameters); *values gets
- * {"path": value, ...}. New references. */
+ * {"path": value, ...}. Indices from ngrid on are the timed reference
+ * points: the reference technique (forward unless the base names another)
+ * on each workload of the grid (each combination of swept scene.*, frames
+ * and warmup_frames values), timed like the others and not judged, so that
+ * charts and reports place it beside them. A sweep adds none when the
+ * reference is already among its techniques, or with "time_reference":
+ * false. New references. */
 json_t *sweep_point_job(const struct sweep_spec *s, size_t index, json_t **values);
 
 /* The job of a find probe at value v. New reference. */

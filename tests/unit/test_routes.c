@@ -23,6 +23,7 @@ int main(void)
     CHECK(kind_of("/v1/jobs/1/frames/100.png", &r) == ROUTE_JOB_IMAGE && r.frame == 100 &&
           r.image == IMAGE_FRAME && strcmp(route_image_prefix(r.image), "frame") == 0);
     CHECK(kind_of("/v1/jobs/1/flip/7.png", &r) == ROUTE_JOB_IMAGE && r.image == IMAGE_FLIP);
+    CHECK(kind_of("/v1/jobs/1/heatmap/7.png", &r) == ROUTE_JOB_IMAGE && r.image == IMAGE_HEATMAP);
     CHECK(kind_of("/v1/jobs/1/timings.csv", &r) == ROUTE_JOB_TIMINGS);
     CHECK(kind_of("/v1/jobs/1/report.html", &r) == ROUTE_JOB_REPORT);
     CHECK(kind_of("/v1/jobs/1/charts/distribution.svg", &r) == ROUTE_JOB_CHART &&

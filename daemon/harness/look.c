@@ -143,6 +143,7 @@ void harness_hdr_stats(GLuint fbo, int w, int h, float *scratch, struct hdr_stat
     glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, scratch);
     long long finite = 0;
     double sum[3] = {0, 0, 0};
+    out->min = INFINITY;
     for (long long p = 0; p < (long long)w * h; p++) {
         const float *c = &scratch[p * 4];
         if (!isfinite(c[0]) || !isfinite(c[1]) || !isfinite(c[2])) {
@@ -153,14 +154,17 @@ void harness_hdr_stats(GLuint fbo, int w, int h, float *scratch, struct hdr_stat
         for (int k = 0; k < 3; k++) {
             sum[k] += c[k];
             out->max = c[k] > out->max ? c[k] : out->max;
+            out->min = c[k] < out->min ? c[k] : out->min;
         }
     }
     for (int k = 0; k < 3; k++)
         out->mean[k] = finite ? sum[k] / (double)finite : 0.0;
+    if (!finite)
+        out->min = 0.0;
 }
 
 json_t *hdr_stats_json(const struct hdr_stats *s)
 {
-    return json_pack("{s:I, s:[f, f, f], s:f}", "nonfinite", (json_int_t)s->nonfinite, "mean",
-                     s->mean[0], s->mean[1], s->mean[2], "max", s->max);
+    return json_pack("{s:I, s:[f, f, f], s:f, s:f}", "nonfinite", (json_int_t)s->nonfinite,
+                     "mean", s->mean[0], s->mean[1], s->mean[2], "min", s->min, "max", s->max);
 }

@@ -73,7 +73,7 @@ void harness_look_describe(const struct harness_look *l, json_t *result);
 struct hdr_stats {
     long long nonfinite; /* pixels with a NaN or infinite R, G or B */
     double mean[3];      /* of the finite pixels */
-    double max;          /* largest finite channel */
+    double min, max;     /* smallest and largest finite channel */
 };
 
 /* Reads the HDR colour attachment of fbo (w x h, RGBA float) into scratch

@@ -263,7 +263,7 @@ static bool build_sphere(struct scene *s)
     s->light_orbit_plane = SCENE_ORBIT_XZ;
     s->sky = true;
     set_pose(s, 0.0f, 2.6f, 4.2f, 0.0f, -0.3f, 0.0f, 40.0f);
-    if (!scene_place_lights(s, 0.5f))
+    if (!scene_place_lights(s, 0.0f))
         return false;
     white_lights(s, 1.0f);
     return true;

@@ -167,6 +167,17 @@ def png_info(path):
     return json.loads(out.stdout) if out.returncode == 0 else None
 
 
+def png_pixels(path):
+    """(width, height, rgb bytes, top row first) of a PNG, or None."""
+    out = subprocess.run([PNG_TOOL, "ppm", path], capture_output=True)
+    if out.returncode != 0:
+        return None
+    data = out.stdout
+    parts = data.split(b"\n", 3)
+    width, height = map(int, parts[1].split())
+    return width, height, parts[3]
+
+
 def png_diff(a, b):
     out = subprocess.run([PNG_TOOL, "diff", a, b], capture_output=True, text=True)
     return json.loads(out.stdout) if out.returncode == 0 else None

@@ -1,6 +1,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "common/png_io.h"
 
+#include <errno.h>
 #include <png.h>
 #include <setjmp.h>
 #include <stdio.h>
@@ -35,7 +36,10 @@ bool png_write_by_rows(const char *path, int width, int height, png_row_fn row, 
     uint8_t *line = malloc((size_t)width * 3);
     FILE *f = line ? fopen(tmp, "wb") : NULL;
     if (!f) {
-        snprintf(err, errlen, line ? "cannot write %s" : "out of memory encoding %s", tmp);
+        if (line)
+            snprintf(err, errlen, "cannot write %s: %s", tmp, strerror(errno));
+        else
+            snprintf(err, errlen, "out of memory encoding %s", tmp);
         free(line);
         return false;
     }
@@ -65,7 +69,7 @@ bool png_write_by_rows(const char *path, int width, int height, png_row_fn row, 
     png_destroy_write_struct(&png, &info);
     free(line);
     if (fclose(f) != 0 || rename(tmp, path) != 0) {
-        snprintf(err, errlen, "cannot finish %s", path);
+        snprintf(err, errlen, "cannot finish %s: %s", path, strerror(errno));
         remove(tmp);
         return false;
     }

@@ -1,6 +1,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include <getopt.h>
 #include <limits.h>
+#include <malloc.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -445,6 +446,13 @@ int main(int argc, char **argv)
         fprintf(stderr, "shadebenchd: %s\n", technique_catalog_error());
         return 1;
     }
+    /* Measurement integrity: glibc raises its mmap and trim thresholds as it
+     * frees large blocks, and the first job after a larger one then ran its
+     * frames up to 3 times slower (the heap top trimmed and faulted back in
+     * every frame). Fixed thresholds keep a job's timings independent of the
+     * jobs before it, for at most 128 MiB of free heap kept. */
+    mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
+    mallopt(M_TRIM_THRESHOLD, 128 * 1024 * 1024);
     struct options o = {.device = -1, .queue_size = 64, .job_timeout = 86400};
     snprintf(o.listen, sizeof(o.listen), "127.0.0.1:8460");
     enum { OPT_LISTEN = 256, OPT_STATE, OPT_DEVICE, OPT_QUEUE, OPT_TOKEN, OPT_KEEP_JOBS,

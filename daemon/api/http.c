@@ -248,12 +248,13 @@ static json_t *info_json(struct http_server *s)
     /* From the GL-free catalogue: HTTP threads never touch GL. */
     json_t *techs = technique_catalog_json(technique_catalog());
     const struct http_limits *l = &s->limits;
-    return json_pack("{s:s, s:s, s:s, s:o, s:o, s:o, s:o, s:{s:i, s:i, s:i, s:I, s:I, s:f, s:f, "
-                     "s:I, s:f, s:I, s:I}}",
+    return json_pack("{s:s, s:s, s:s, s:o, s:o, s:o, s:o, s:o, s:{s:i, s:i, s:i, s:I, s:I, s:f, "
+                     "s:f, s:I, s:f, s:I, s:I}}",
                      "name", "shadebenchd", "version", PACKAGE_VERSION, "api", "v1", "memory",
                      memory, "device",
-                     runner_device_json(s->runner), "techniques", techs, "sweepable",
-                     sweep_params_json(technique_catalog()), "limits",
+                     runner_device_json(s->runner), "techniques", techs,
+                     "effects", effect_catalog_json(), /* post hook: look.post's effects */
+                     "sweepable", sweep_params_json(technique_catalog()), "limits",
                      "max_body_bytes", JOB_MAX_BODY_BYTES, "max_queued_jobs",
                      queue_max_queued(s->queue), "max_wait_s", MAX_WAIT_S, "max_connections",
                      (json_int_t)l->max_connections, "max_connections_per_ip",

@@ -23,6 +23,7 @@ static const struct {
     {"scene.width", PARAM_INT, 1},         {"scene.height", PARAM_INT, 1},
     {"scene.sphere_segments", PARAM_INT, 2}, {"scene.light_speed", PARAM_NUMBER, 0},
     {"look.lighting", PARAM_CHOICE, 0},    {"look.hdr", PARAM_CHOICE, 0},
+    {"look.exposure", PARAM_NUMBER, 0},    {"look.tonemap", PARAM_CHOICE, 0},
     {"scene.preset", PARAM_CHOICE, 0},     {"scene.light_layout", PARAM_CHOICE, 0},
     {"scene.light_radius", PARAM_NUMBER, 0}, {"scene.light_intensity", PARAM_NUMBER, 0},
     {"scene.tessellation_error_px", PARAM_NUMBER, 0}, {"scene.camera", PARAM_CHOICE, 0},
@@ -37,6 +38,25 @@ static const struct {
 };
 enum { NPARAMS = sizeof(PARAMS) / sizeof(PARAMS[0]) };
 
+/* "look.post.<effect>.<option>": the option of every <effect> in the
+ * base job's look.post (post hook: an effect's breaking point, e.g.
+ * look.post.bloom.intensity against the finite criterion). */
+#define POST_PARAM "look.post."
+static const struct technique_option *post_param(const char *path, char *effect, size_t cap)
+{
+    if (strncmp(path, POST_PARAM, strlen(POST_PARAM)) != 0)
+        return NULL;
+    const char *name = path + strlen(POST_PARAM), *dot = strchr(name, '.');
+    if (!dot || (size_t)(dot - name) >= cap)
+        return NULL;
+    snprintf(effect, cap, "%.*s", (int)(dot - name), name);
+    int e = effect_find(effect);
+    for (const struct technique_option *o = e >= 0 ? effect_infos[e]->options : NULL; o && o->name; o++)
+        if (strcmp(o->name, dot + 1) == 0)
+            return o;
+    return NULL;
+}
+
 /* The type of a sweepable path; false when a sweep cannot vary it. */
 static bool param_type(const struct technique_catalog *techniques, const char *path,
                        enum param_type *type)
@@ -46,7 +66,10 @@ static bool param_type(const struct technique_catalog *techniques, const char *p
             *type = PARAMS[i].type;
             return true;
         }
+    char effect[32];
     const struct technique_option *opt = technique_catalog_option(techniques, path);
+    if (!opt)
+        opt = post_param(path, effect, sizeof(effect));
     if (!opt)
         return false;
     *type = opt->type == TOPT_INT ? PARAM_INT : opt->type == TOPT_NUMBER ? PARAM_NUMBER
@@ -69,8 +92,30 @@ static bool unknown_param(const struct technique_catalog *techniques, struct job
 {
     (void)techniques;
     return job_error_set(err, field, "not a parameter a sweep can vary: scene, look and "
-                         "top-level job fields, or TECHNIQUE.OPTION; GET /v1/info lists "
-                         "them under \"sweepable\"");
+                         "top-level job fields, TECHNIQUE.OPTION or look.post.EFFECT.OPTION; "
+                         "GET /v1/info lists them under \"sweepable\"");
+}
+
+/* Sets a post effect's option in every entry of that effect in look.post;
+ * false when the list has none. */
+static bool set_post_option(json_t *job, const char *effect, const char *option, json_t *value)
+{
+    json_t *list = json_object_get(json_object_get(job, "look"), "post");
+    bool any = false;
+    for (size_t i = 0; i < json_array_size(list); i++) {
+        json_t *entry = json_array_get(list, i), *opts = NULL;
+        if (json_is_string(entry) && strcmp(json_string_value(entry), effect) == 0) {
+            opts = json_object();
+            json_array_set_new(list, i, json_pack("{s:o}", effect, opts));
+        } else if (json_is_object(entry)) {
+            opts = json_object_get(entry, effect);
+        }
+        if (json_is_object(opts)) {
+            json_object_set(opts, option, value);
+            any = true;
+        }
+    }
+    return any;
 }
 
 json_t *sweep_params_json(const struct technique_catalog *techniques)
@@ -89,6 +134,15 @@ json_t *sweep_params_json(const struct technique_catalog *techniques)
                 json_object_set_new(o, path, json_string(types[type]));
         }
     }
+    /* Post hook: every effect's options, set in each entry of that effect. */
+    for (int e = 0; effect_infos[e]; e++)
+        for (const struct technique_option *opt = effect_infos[e]->options; opt && opt->name; opt++) {
+            char path[128];
+            enum param_type type;
+            snprintf(path, sizeof(path), POST_PARAM "%s.%s", effect_infos[e]->name, opt->name);
+            if (param_type(techniques, path, &type))
+                json_object_set_new(o, path, json_string(types[type]));
+        }
     return o;
 }
 
@@ -97,6 +151,12 @@ json_t *sweep_params_json(const struct technique_catalog *techniques)
 static json_t *with_field(const json_t *job, const char *path, json_t *value)
 {
     json_t *copy = json_deep_copy(job), *obj = copy;
+    char effect[32];
+    const struct technique_option *post = post_param(path, effect, sizeof(effect));
+    if (post) {
+        set_post_option(copy, effect, post->name, value);
+        return copy;
+    }
     const char *dot;
     while ((dot = strchr(path, '.'))) {
         char head[64];
@@ -128,6 +188,19 @@ static json_t *point_defaults(const struct sweep_spec *s, json_t *job)
     if (s->kind == SWEEP_FIND && s->criterion == CRITERION_STABLE && !json_object_get(job, "repeat"))
         json_object_set_new(job, "repeat", json_pack("{s:b, s:i}", "auto", 1, "max", 10));
     return job;
+}
+
+/* A post effect's option can only vary where the base job runs the effect. */
+static bool post_param_in_base(const json_t *base, const char *path, const char *field,
+                               struct job_error *err)
+{
+    char effect[32];
+    if (!post_param(path, effect, sizeof(effect)))
+        return true;
+    json_t *copy = json_deep_copy(base);
+    bool any = set_post_option(copy, effect, "unused", json_null());
+    json_decref(copy);
+    return any || job_error_set(err, field, "the base job's look.post has no %s to vary", effect);
 }
 
 static bool check_point(const json_t *job, const struct technique_catalog *techniques, const char *field,
@@ -231,6 +304,8 @@ static bool parse_criterion(const char *text, struct sweep_spec *s)
         s->criterion = CRITERION_PDIFF_PASS;
     else if (strcmp(text, "stable") == 0)
         s->criterion = CRITERION_STABLE;
+    else if (strcmp(text, "finite") == 0)
+        s->criterion = CRITERION_FINITE;
     else if (sscanf(text, "ssim_min >= %lf%1s", &x, tail) == 1 && x >= -1 && x <= 1)
         s->criterion = CRITERION_SSIM_MIN, s->threshold = x;
     else if (sscanf(text, "flip_max <= %lf%1s", &x, tail) == 1 && x >= 0 && x <= 1)
@@ -324,6 +399,8 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
             enum param_type unused;
             if (!param_type(techniques, key, &unused))
                 return unknown_param(techniques, err, field);
+            if (!post_param_in_base(base, key, field, err))
+                return false;
             if (!json_is_array(v) || json_array_size(v) == 0)
                 return job_error_set(err, field, "must be a non-empty list of values");
             snprintf(out->params[out->nparams], sizeof(out->params[0]), "%s", key);
@@ -369,6 +446,8 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
         return job_error_set(err, "find.param", "must name a parameter");
     if (!param_type(techniques, param, &type))
         return unknown_param(techniques, err, "find.param");
+    if (!post_param_in_base(base, param, "find.param", err))
+        return false;
     if (type != PARAM_INT && type != PARAM_NUMBER)
         return job_error_set(err, "find.param", "%s is not numeric: find bisects a numeric parameter", param);
     snprintf(out->params[0], sizeof(out->params[0]), "%s", param);
@@ -388,7 +467,7 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
     const char *crit = json_string_value(json_object_get(find, "while"));
     if (!crit || !parse_criterion(crit, out))
         return job_error_set(err, "find.while", "must be one of \"pdiff_pass\", \"stable\", "
-                    "\"ssim_min >= X\", \"flip_max <= X\"");
+                    "\"finite\", \"ssim_min >= X\", \"flip_max <= X\"");
     out->max_probes = 10;
     json_t *steps = json_object_get(find, "steps");
     if (steps) {
@@ -481,6 +560,8 @@ bool sweep_criterion_holds(const struct sweep_spec *s, const json_t *result)
     }
     case CRITERION_STABLE:
         return json_is_true(json_object_get(json_object_get(result, "repeat"), "stable"));
+    case CRITERION_FINITE:
+        return json_is_true(json_object_get(json_object_get(result, "nonfinite"), "finite"));
     }
     return false;
 }

@@ -16,7 +16,8 @@
 
 enum sweep_kind { SWEEP_VARY, SWEEP_FIND };
 
-enum sweep_criterion { CRITERION_PDIFF_PASS, CRITERION_SSIM_MIN, CRITERION_FLIP_MAX, CRITERION_STABLE };
+enum sweep_criterion { CRITERION_PDIFF_PASS, CRITERION_SSIM_MIN, CRITERION_FLIP_MAX, CRITERION_STABLE,
+                       CRITERION_FINITE /* no capture had NaN or infinite HDR pixels */ };
 
 struct sweep_spec {
     enum sweep_kind kind;

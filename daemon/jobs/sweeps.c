@@ -210,6 +210,10 @@ static json_t *point_row(const json_t *job, json_t *values)
         json_object_set(row, "worst_flip", json_object_get(json_object_get(q, "worst_flip"), "mean"));
         json_object_set(row, "pdiff_failed_captures", json_object_get(q, "pdiff_failed_captures"));
     }
+    /* Post hook: the worst capture's non-finite pixels, for breaking points. */
+    json_t *nonfinite = json_object_get(r, "nonfinite");
+    if (nonfinite)
+        json_object_set(row, "nonfinite_pixels", json_object_get(nonfinite, "pixels_max"));
     return row;
 }
 

@@ -12,7 +12,8 @@ layout(std140, binding = SB_UBO_LIGHT_GRID) uniform LightGridBlock {
                   // (linear) or per unit of log depth (exponential), 1 = exponential
     ivec4 lists;  // most lights a cell keeps (0: lists placed by offset), index
                   // capacity, 32-bit words of light bits per cell, 1 = overflow falls back
-    ivec4 counts; // lights, statistics record of this frame
+    ivec4 counts; // lights, statistics record of this frame, 32-bit summary
+                  // words per cell (one bit per word of light bits)
 } u_grid;
 
 const uint CELL_OVERFLOW = 0x80000000u;

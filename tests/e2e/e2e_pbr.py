@@ -139,9 +139,8 @@ try:
             dvec = [f + sx * r + sy * u for f, r, u in zip(fwd, right, up)]
             n = math.sqrt(sum(c * c for c in dvec))
             dvec = [c / n for c in dvec]
-            i = (y * w + x) * 3
-            a = sum(off[i:i + 3]) / 3.0
-            b = sum(on[i:i + 3]) / 3.0
+            a = sum(off[y * w + x]) / 3.0
+            b = sum(on[y * w + x]) / 3.0
             t = ray_sphere(eye, dvec, 0.8)
             if t is not None and t > 0:
                 p = [e + t * c for e, c in zip(eye, dvec)]

@@ -215,71 +215,74 @@ base = tempfile.mkdtemp(prefix="shadebench-fs-")
 mnt = os.path.join(base, "state")
 os.mkdir(mnt)
 mounted = try_mount_tmpfs(mnt)
-if not mounted and os.geteuid() == 0:
-    check(False, "the full-disk test needs a tmpfs mount (root with CAP_SYS_ADMIN)")
-else:
-    full = testlib.Daemon("--state-dir", mnt)
-    try:
-        kept = full.run(SMALL)
-        check(kept["status"] == "done", "a job on the small state directory")
-        listed = full.json("GET", "/v1/jobs")[1]["jobs"]
-        if mounted:
-            # Fill it up.
-            filler = os.path.join(mnt, "filler")
-            try:
-                with open(filler, "wb") as f:
-                    while True:
-                        f.write(b"\0" * 65536)
-                        f.flush()
-            except OSError:
-                pass
-            reason = "No space left on device"
-        else:
-            os.chmod(os.path.join(mnt, "jobs"), 0o555)
-            os.makedirs(os.path.join(mnt, "sweeps"), exist_ok=True)
-            os.chmod(os.path.join(mnt, "sweeps"), 0o555)
-            reason = "Permission denied"
-        entries = sorted(os.listdir(os.path.join(mnt, "jobs")))
-        status, reply = full.json("POST", "/v1/jobs", SMALL)
-        err = reply.get("error", {})
-        check(status == 507 and err.get("field") == "state_dir" and mnt in err.get("message", "")
-              and reason in err.get("message", ""),
-              "a job that cannot be persisted gets 507 naming the state directory and why: %d %s" % (status, reply))
-        status, reply = full.json("POST", "/v1/sweeps", {"base": SMALL, "vary": {"scene.lights": [1, 2]}})
-        check(status == 507 and mnt in reply.get("error", {}).get("message", ""),
-              "so does a sweep: %d %s" % (status, reply))
-        check(sorted(os.listdir(os.path.join(mnt, "jobs"))) == entries, "nothing of the refused job is left behind")
-        check(full.json("GET", "/v1/jobs")[1]["jobs"] == listed, "the job list is unchanged")
-        check(full.json("GET", "/v1/jobs/" + kept["id"])[1].get("result") == kept["result"],
-              "the earlier job is still served")
-        check("cannot be persisted" in log_text(full), "the refusal is logged")
-        if mounted:
-            os.remove(filler)
-            # Read-only: the same answer, with the errno saying so.
-            ro = subprocess.run(["mount", "-o", "remount,ro", mnt], capture_output=True).returncode == 0
-            if check(ro, "remount read-only"):
-                status, reply = full.json("POST", "/v1/jobs", SMALL)
-                check(status == 507 and "Read-only file system" in reply.get("error", {}).get("message", ""),
-                      "a read-only state directory gets 507 too: %d %s" % (status, reply))
-                subprocess.run(["mount", "-o", "remount,rw", mnt], capture_output=True)
-        else:
-            os.chmod(os.path.join(mnt, "jobs"), 0o755)
-            os.chmod(os.path.join(mnt, "sweeps"), 0o755)
-        later = full.run(SMALL)
-        check(later["status"] == "done", "with room again, jobs are accepted and run")
-    finally:
-        code = full.stop()
-    check(code == 0, "daemon exits 0")
-    again = testlib.Daemon("--state-dir", mnt)
-    try:
-        ids_now = [j["id"] for j in again.json("GET", "/v1/jobs")[1]["jobs"]]
-        check(ids_now == [kept["id"], later["id"]], "after a restart every accepted job is there: %s" % ids_now)
-        check(not os.path.exists(os.path.join(mnt, "quarantine")), "and nothing needed quarantine")
-    finally:
-        testlib.stop_and_check(again)
-    full.cleanup()
-if mounted:
-    subprocess.run(["umount", mnt], capture_output=True)
-os.rmdir(mnt) if os.path.isdir(mnt) and not os.listdir(mnt) else None
-os.rmdir(base) if os.path.isdir(base) and not os.listdir(base) else None
+try:
+    if not mounted and os.geteuid() == 0:
+        check(False, "the full-disk test needs a tmpfs mount (root with CAP_SYS_ADMIN)")
+    else:
+        full = testlib.Daemon("--state-dir", mnt)
+        try:
+            kept = full.run(SMALL)
+            check(kept["status"] == "done", "a job on the small state directory")
+            listed = full.json("GET", "/v1/jobs")[1]["jobs"]
+            if mounted:
+                # Fill it up.
+                filler = os.path.join(mnt, "filler")
+                try:
+                    with open(filler, "wb") as f:
+                        while True:
+                            f.write(b"\0" * 65536)
+                            f.flush()
+                except OSError:
+                    pass
+                reason = "No space left on device"
+            else:
+                os.chmod(os.path.join(mnt, "jobs"), 0o555)
+                os.makedirs(os.path.join(mnt, "sweeps"), exist_ok=True)
+                os.chmod(os.path.join(mnt, "sweeps"), 0o555)
+                reason = "Permission denied"
+            entries = sorted(os.listdir(os.path.join(mnt, "jobs")))
+            status, reply = full.json("POST", "/v1/jobs", SMALL)
+            err = reply.get("error", {})
+            check(status == 507 and err.get("field") == "state_dir" and mnt in err.get("message", "")
+                  and reason in err.get("message", ""),
+                  "a job that cannot be persisted gets 507 naming the state directory and why: %d %s" % (status, reply))
+            status, reply = full.json("POST", "/v1/sweeps", {"base": SMALL, "vary": {"scene.lights": [1, 2]}})
+            check(status == 507 and mnt in reply.get("error", {}).get("message", ""),
+                  "so does a sweep: %d %s" % (status, reply))
+            check(sorted(os.listdir(os.path.join(mnt, "jobs"))) == entries, "nothing of the refused job is left behind")
+            check(full.json("GET", "/v1/jobs")[1]["jobs"] == listed, "the job list is unchanged")
+            check(full.json("GET", "/v1/jobs/" + kept["id"])[1].get("result") == kept["result"],
+                  "the earlier job is still served")
+            check("cannot be persisted" in log_text(full), "the refusal is logged")
+            if mounted:
+                os.remove(filler)
+                # Read-only: the same answer, with the errno saying so.
+                ro = subprocess.run(["mount", "-o", "remount,ro", mnt], capture_output=True).returncode == 0
+                if check(ro, "remount read-only"):
+                    status, reply = full.json("POST", "/v1/jobs", SMALL)
+                    check(status == 507 and "Read-only file system" in reply.get("error", {}).get("message", ""),
+                          "a read-only state directory gets 507 too: %d %s" % (status, reply))
+                    subprocess.run(["mount", "-o", "remount,rw", mnt], capture_output=True)
+            else:
+                os.chmod(os.path.join(mnt, "jobs"), 0o755)
+                os.chmod(os.path.join(mnt, "sweeps"), 0o755)
+            later = full.run(SMALL)
+            check(later["status"] == "done", "with room again, jobs are accepted and run")
+        finally:
+            code = full.stop()
+        check(code == 0, "daemon exits 0")
+        again = testlib.Daemon("--state-dir", mnt)
+        try:
+            ids_now = [j["id"] for j in again.json("GET", "/v1/jobs")[1]["jobs"]]
+            check(ids_now == [kept["id"], later["id"]], "after a restart every accepted job is there: %s" % ids_now)
+            check(not os.path.exists(os.path.join(mnt, "quarantine")), "and nothing needed quarantine")
+        finally:
+            testlib.stop_and_check(again)
+        full.cleanup()
+finally:
+    if mounted:  # never leave a mount behind, whatever failed
+        subprocess.run(["umount", mnt], capture_output=True)
+for leftover in (mnt, base):
+    if os.path.isdir(leftover) and not os.listdir(leftover):
+        os.rmdir(leftover)
 testlib.finish("e2e_records")

@@ -1,9 +1,7 @@
 /* Test helper: "png-tool info FILE" prints width, height and how many
  * distinct colours and non-black pixels it has; "png-tool diff A B" prints
  * per-channel mean absolute difference, the largest difference and the
- * count of differing pixels, as JSON; "png-tool ppm FILE" writes the pixels
- * as a binary PPM (P6, top row first) to stdout, for tests that look at
- * single pixels with the standard library only. */
+ * count of differing pixels, as JSON. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -68,28 +66,12 @@ static int diff(const char *a_path, const char *b_path)
     return 0;
 }
 
-static int ppm(const char *path)
-{
-    struct image img;
-    char err[256];
-    if (!png_read_rgb(path, &img, err, sizeof(err))) {
-        fprintf(stderr, "%s\n", err);
-        return 2;
-    }
-    printf("P6\n%d %d\n255\n", img.width, img.height);
-    fwrite(img.rgb, 3, (size_t)img.width * (size_t)img.height, stdout);
-    image_finish(&img);
-    return 0;
-}
-
 int main(int argc, char **argv)
 {
     if (argc == 3 && strcmp(argv[1], "info") == 0)
         return info(argv[2]);
     if (argc == 4 && strcmp(argv[1], "diff") == 0)
         return diff(argv[2], argv[3]);
-    if (argc == 3 && strcmp(argv[1], "ppm") == 0)
-        return ppm(argv[2]);
-    fprintf(stderr, "usage: png-tool info FILE | png-tool diff A B | png-tool ppm FILE\n");
+    fprintf(stderr, "usage: png-tool info FILE | png-tool diff A B\n");
     return 2;
 }

@@ -9,7 +9,7 @@ const char *const light_bounds_choices[] = {"scissor_tight", "scissor_loose", "v
 const char *const light_binning_choices[] = {"gpu", "cpu", NULL};
 const char *const cluster_slices_choices[] = {"linear", "exponential", NULL};
 const char *const cluster_overflow_choices[] = {"fallback", "fail", NULL};
-const int cluster_grid_default[3] = {16, 9, 24};
+const int cluster_grid_default[3] = {32, 18, 32};
 
 bool cluster_grid_check(const int grid[3], const char *field, struct job_error *err)
 {

@@ -86,7 +86,7 @@ extern const int cluster_grid_default[3];
      .summary = "depth slices even in view depth (linear) or in its logarithm (exponential), " \
                 "between the nearest and farthest object",                                    \
      .offset = offsetof(opts_type, member.slices)},                                                 \
-    {.name = "max_lights_per_cluster", .type = TOPT_INT, .def = 256, .min = 1, .max = 65536,   \
+    {.name = "max_lights_per_cluster", .type = TOPT_INT, .def = 1024, .min = 1, .max = 65536, \
      .summary = "lights a cluster's list keeps; more overflow (counted in the result)",       \
      .offset = offsetof(opts_type, member.max_lights_per_cluster)},                                 \
     {.name = "overflow", .type = TOPT_CHOICE, .def = CLUSTER_OVERFLOW_FALLBACK,                \

@@ -80,7 +80,7 @@ bool gbuffer_init(struct gbuffer *g, const struct technique_env *env,
                                                         env->height, err, errlen)
                                   : 0;
     /* Metallic and roughness ride along only where the look reads them. */
-    g->material_format = env->spec->look.lighting == LOOK_PBR ? GL_RGBA32F : GL_RG32F;
+    g->material_format = env->look->lighting == LOOK_PBR ? GL_RGBA32F : GL_RG32F;
     g->material_tex = g->normal_tex ? gpu_targets_texture(env->targets, "gbuffer.material",
                                                           g->material_format, env->width,
                                                           env->height, err, errlen)

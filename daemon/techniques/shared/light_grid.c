@@ -12,10 +12,11 @@
 #include "daemon/gpu/bindings.h"
 #include "daemon/gpu/glutil.h"
 
-/* Index entries tiles may take at most (128 MiB), whatever the device
- * allows: past it a scene is better served by larger tiles. */
-static const long long TILE_INDEX_BUDGET = 32LL * 1024 * 1024;
-/* The CPU path keeps three grids in flight; a smaller budget each. */
+/* Index entries a frame's lists may take at most (64 MiB, times the ring),
+ * whatever the device allows: past it a scene is better served by larger
+ * cells. */
+static const long long INDEX_BUDGET = 16LL * 1024 * 1024;
+/* The CPU path also fills a host copy: a smaller budget. */
 static const long long CPU_INDEX_BUDGET = 8LL * 1024 * 1024;
 enum { GROUP = 64 }; /* local size of the scatter and compaction passes */
 
@@ -29,20 +30,28 @@ static const char *field_name(const struct light_grid_config *cfg, char *buf, si
 }
 
 /* The depth range the slices span: the nearest and farthest view depth of
- * any object's bounding sphere, within the clip planes. Slices spent on
- * empty space in front of the scene would only make the occupied ones
- * coarser (Filament's froxelizer starts its slices at a "light near" for
- * the same reason); the first and last slices still reach the clip planes,
- * so every pixel has a cell. */
-static void slice_range(const struct scene *s, const struct scene_camera *cam, float out[2])
+ * any object's box, within the clip planes. Slices spent on empty space in
+ * front of the scene would only make the occupied ones coarser (Filament's
+ * froxelizer starts its slices at a "light near" for the same reason); the
+ * first and last slices still reach the clip planes, so every pixel has a
+ * cell. Boxes rather than bounding spheres: a ground plane's sphere would
+ * stretch the range far beyond the plane. */
+static void slice_range(const struct light_grid *g, const struct scene *s,
+                        const struct scene_camera *cam, float out[2])
 {
     float lo = cam->far_z, hi = cam->near_z;
+    const float *v = cam->view;
     for (int i = 0; i < s->instance_count; i++) {
-        const float *p = s->instances[i].pos, *v = cam->view;
-        float z = -(v[2] * p[0] + v[6] * p[1] + v[10] * p[2] + v[14]);
-        float r = scene_instance_bound(s, i);
-        lo = fminf(lo, z - r);
-        hi = fmaxf(hi, z + r);
+        const struct scene_instance *in = &s->instances[i];
+        for (int corner = 0; corner < 8; corner++) {
+            float p[3];
+            for (int k = 0; k < 3; k++)
+                p[k] = in->pos[k] + in->scale * (corner >> k & 1 ? g->mesh_box[in->mesh][1][k]
+                                                                 : g->mesh_box[in->mesh][0][k]);
+            float z = -(v[2] * p[0] + v[6] * p[1] + v[10] * p[2] + v[14]);
+            lo = fminf(lo, z);
+            hi = fmaxf(hi, z);
+        }
     }
     lo = fmaxf(lo, cam->near_z);
     hi = fminf(hi, cam->far_z);
@@ -55,7 +64,7 @@ static void slice_range(const struct scene *s, const struct scene_camera *cam, f
 static void set_slices(struct light_grid *g, const struct scene *s, const struct scene_camera *cam)
 {
     float range[2];
-    slice_range(s, cam, range);
+    slice_range(g, s, cam, range);
     bool exponential = g->cfg.slices == CLUSTER_SLICES_EXPONENTIAL;
     double span = exponential ? log(range[1] / range[0]) : range[1] - range[0];
     g->block.slices[0] = range[0];
@@ -83,15 +92,16 @@ static GLuint build_compute(const char *label, const char *file, const char *def
     return gl_program_build(label, stage, 1, defines, err, errlen);
 }
 
-/* Every buffer within GL_MAX_SHADER_STORAGE_BLOCK_SIZE and every dispatch
- * within the work-group counts, or a message naming the option to change. */
+/* The bit buffer within GL_MAX_SHADER_STORAGE_BLOCK_SIZE (the index buffer
+ * is cut to fit) and every dispatch within the work-group counts, or a
+ * message naming the option to change. */
 static bool check_device(const struct light_grid *g, const struct technique_env *env,
-                         double bits_bytes, double index_bytes, char *err, size_t errlen)
+                         double bits_bytes, char *err, size_t errlen)
 {
     const struct gpu_caps *caps = env->caps;
     const struct light_grid_config *cfg = &g->cfg;
     bool tiles = cfg->kind == LIGHT_GRID_TILES;
-    char field[96], field2[96];
+    char field[96];
     const char *grid_field = field_name(cfg, field, sizeof(field), tiles ? "tile_size" : "grid");
     double max = (double)caps->max_ssbo_bytes;
     if (max > 0 && bits_bytes > max) {
@@ -102,23 +112,14 @@ static bool check_device(const struct light_grid *g, const struct technique_env 
                  grid_field, g->lights, g->cells, mib(bits_bytes), mib(max));
         return false;
     }
-    if (max > 0 && index_bytes > max) {
-        snprintf(err, errlen,
-                 "%s: %d cells x %d lights each need a %.1f MiB index buffer; this device "
-                 "allows %.1f MiB per storage buffer (GL_MAX_SHADER_STORAGE_BLOCK_SIZE): use "
-                 "fewer cells or a smaller %s",
-                 grid_field, g->cells, cfg->max_per_cell, mib(index_bytes), mib(max),
-                 field_name(cfg, field2, sizeof(field2), "max_lights_per_cluster"));
-        return false;
-    }
     long long groups_cells = (g->cells + GROUP - 1) / GROUP;
-    long long groups_lights = (g->lights + GROUP - 1) / GROUP;
     const int *count = caps->max_compute_work_group_count;
-    if (groups_cells > count[0] || groups_lights > count[0] ||
+    if (groups_cells > count[0] || (long long)g->scatter_groups[1] > count[1] ||
         (tiles && (g->block.dims[0] > count[0] || g->block.dims[1] > count[1]))) {
         snprintf(err, errlen,
-                 "%s: %d cells (%lld work groups of %d) or %d lights exceed this device's "
-                 "compute work-group counts (GL_MAX_COMPUTE_WORK_GROUP_COUNT %d x %d)",
+                 "%s: %d cells (%lld work groups of %d) or %d lights "
+                 "exceed this device's compute work-group counts "
+                 "(GL_MAX_COMPUTE_WORK_GROUP_COUNT %d x %d)",
                  grid_field, g->cells, groups_cells, GROUP, g->lights, count[0], count[1]);
         return false;
     }
@@ -139,6 +140,17 @@ bool light_grid_init(struct light_grid *g, const struct technique_env *env,
     g->lights = env->scene->light_count;
     g->frames = env->spec->frames;
     g->camera_moves = scene_camera_moves(env->scene);
+    for (int m = 0; m < SCENE_MESH_COUNT; m++) {
+        const struct mesh *mesh = &env->scene->meshes[m];
+        for (int k = 0; k < 3; k++)
+            g->mesh_box[m][0][k] = mesh->vertex_count ? INFINITY : 0.0f,
+            g->mesh_box[m][1][k] = mesh->vertex_count ? -INFINITY : 0.0f;
+        for (uint32_t i = 0; i < mesh->vertex_count; i++)
+            for (int k = 0; k < 3; k++) {
+                g->mesh_box[m][0][k] = fminf(g->mesh_box[m][0][k], mesh->vertices[i].pos[k]);
+                g->mesh_box[m][1][k] = fmaxf(g->mesh_box[m][1][k], mesh->vertices[i].pos[k]);
+            }
+    }
     bool tiles = cfg->kind == LIGHT_GRID_TILES;
     bool cpu = tiles && cfg->binning == LIGHT_BINNING_CPU;
     char field[96];
@@ -163,36 +175,45 @@ bool light_grid_init(struct light_grid *g, const struct technique_env *env,
     g->words = (g->lights + 31) / 32;
     if (g->words < 1)
         g->words = 1;
-    if (tiles) {
-        long long budget = cpu ? CPU_INDEX_BUDGET : TILE_INDEX_BUDGET;
-        g->capacity = (long long)g->cells * (g->lights > 0 ? g->lights : 1);
-        if (g->capacity > budget)
-            g->capacity = budget;
-        if (env->caps->max_ssbo_bytes > 0 && g->capacity * 4 > env->caps->max_ssbo_bytes)
-            g->capacity = env->caps->max_ssbo_bytes / 4;
-    } else {
-        g->capacity = (long long)g->cells * cfg->max_per_cell;
-    }
+    /* Lists are packed one after another, so the index buffer needs what
+     * the frame's lists take, not cells x the bound: its capacity is the
+     * worst case, cut to a budget and the device's limit; a list that finds
+     * it full overflows like one over the bound (counted, never silent). */
+    long long budget = cpu ? CPU_INDEX_BUDGET : INDEX_BUDGET;
+    long long per_cell = g->lights > 0 ? g->lights : 1;
+    if (!tiles && cfg->max_per_cell < per_cell)
+        per_cell = cfg->max_per_cell;
+    g->capacity = (long long)g->cells * per_cell;
+    if (g->capacity > budget)
+        g->capacity = budget;
+    if (env->caps->max_ssbo_bytes > 0 && g->capacity * 4 > env->caps->max_ssbo_bytes)
+        g->capacity = env->caps->max_ssbo_bytes / 4;
     g->block = (struct light_grid_block){
         .dims = {dims[0], dims[1], dims[2], g->cells},
         .tile = {(float)tw, (float)th, 1.0f / (float)tw, 1.0f / (float)th},
         .lists = {tiles ? 0 : cfg->max_per_cell, (int32_t)g->capacity, g->words,
                   tiles || cfg->overflow == CLUSTER_OVERFLOW_FALLBACK},
-        .counts = {g->lights, 0, 0, 0},
+        .counts = {g->lights, 0, (g->words + 31) / 32, 0},
     };
     struct scene_camera cam;
     scene_camera_at(env->scene, 0, &cam);
     set_slices(g, env->scene, &cam);
     double bits_bytes = cpu ? 0 : (double)g->cells * g->words * 4.0;
-    if (!check_device(g, env, bits_bytes, (double)g->capacity * 4.0, err, errlen))
+    int row = env->caps->max_compute_work_group_count[0] > 0
+                  ? env->caps->max_compute_work_group_count[0] : 65535;
+    int groups = (g->lights + GROUP - 1) / GROUP;
+    g->scatter_groups[0] = groups < row ? groups : row;
+    g->scatter_groups[1] = groups ? (groups + row - 1) / row : 0;
+    if (!check_device(g, env, bits_bytes, err, errlen))
         return false;
 
-    g->ring_size = cpu ? 3 : 1;
-    glGenBuffers(1, &g->ubo);
-    glBindBuffer(GL_UNIFORM_BUFFER, g->ubo);
-    glBufferData(GL_UNIFORM_BUFFER, sizeof(g->block), &g->block, GL_DYNAMIC_DRAW);
+    glGenBuffers(LIGHT_GRID_RING, g->ubo);
+    for (int r = 0; r < LIGHT_GRID_RING; r++) {
+        glBindBuffer(GL_UNIFORM_BUFFER, g->ubo[r]);
+        glBufferData(GL_UNIFORM_BUFFER, sizeof(g->block), &g->block, GL_DYNAMIC_DRAW);
+    }
     glBindBuffer(GL_UNIFORM_BUFFER, 0);
-    for (int r = 0; r < g->ring_size; r++) {
+    for (int r = 0; r < LIGHT_GRID_RING; r++) {
         g->cells_buf[r] = make_buffer((double)g->cells * 8.0, &g->buffer_bytes);
         g->index_buf[r] = make_buffer((double)g->capacity * 4.0, &g->buffer_bytes);
     }
@@ -215,7 +236,16 @@ bool light_grid_init(struct light_grid *g, const struct technique_env *env,
         }
         return true;
     }
+    /* Zero once: compaction leaves them zero for the next frame. */
     g->bits_buf = make_buffer(bits_bytes, &g->buffer_bytes);
+    g->summary_buf = make_buffer((double)g->cells * g->block.counts[2] * 4.0, &g->buffer_bytes);
+    GLuint zeroed[2] = {g->bits_buf, g->summary_buf};
+    for (int i = 0; i < 2; i++) {
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, zeroed[i]);
+        glClearBufferData(GL_SHADER_STORAGE_BUFFER, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT,
+                          NULL);
+    }
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
     const char *defines = tiles ? "#define GRID_TILES 1\n" : "";
     if (tiles) {
         g->tile_depth_buf = make_buffer((double)g->cells * 8.0, &g->buffer_bytes);
@@ -236,11 +266,12 @@ void light_grid_finish(struct light_grid *g)
     glDeleteProgram(g->depth_prog);
     glDeleteProgram(g->scatter_prog);
     glDeleteProgram(g->compact_prog);
-    glDeleteBuffers(1, &g->ubo);
-    glDeleteBuffers(3, g->cells_buf);
-    glDeleteBuffers(3, g->index_buf);
+    glDeleteBuffers(LIGHT_GRID_RING, g->ubo);
+    glDeleteBuffers(LIGHT_GRID_RING, g->cells_buf);
+    glDeleteBuffers(LIGHT_GRID_RING, g->index_buf);
     glDeleteBuffers(1, &g->tile_depth_buf);
     glDeleteBuffers(1, &g->bits_buf);
+    glDeleteBuffers(1, &g->summary_buf);
     glDeleteBuffers(1, &g->stats_buf);
     free(g->stats);
     free(g->bin_ms);
@@ -312,7 +343,6 @@ static void build_cpu(struct light_grid *g, const struct technique_env *env, int
             }
     }
     g->stats[slot] = st;
-    g->ring = (g->ring + 1) % g->ring_size;
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->cells_buf[g->ring]);
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)((size_t)g->cells * 8),
                     g->cells_host);
@@ -335,29 +365,28 @@ void light_grid_build(struct light_grid *g, const struct technique_env *env, int
     if (g->camera_moves && g->cfg.kind == LIGHT_GRID_CLUSTERS)
         set_slices(g, env->scene, &cam);
     g->block.counts[1] = slot;
-    glBindBuffer(GL_UNIFORM_BUFFER, g->ubo);
+    g->ring = (g->ring + 1) % LIGHT_GRID_RING;
+    glBindBuffer(GL_UNIFORM_BUFFER, g->ubo[g->ring]);
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof(g->block), &g->block);
     glBindBuffer(GL_UNIFORM_BUFFER, 0);
-    glBindBufferBase(GL_UNIFORM_BUFFER, SB_UBO_LIGHT_GRID, g->ubo);
+    glBindBufferBase(GL_UNIFORM_BUFFER, SB_UBO_LIGHT_GRID, g->ubo[g->ring]);
     if (cpu) {
         build_cpu(g, env, frame, slot, &cam);
     } else {
-        /* Zero this frame's record and the bits. */
+        /* Zero this frame's record (the bits are zero already). */
         glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->stats_buf);
         glClearBufferSubData(GL_SHADER_STORAGE_BUFFER, GL_R32UI,
                              (GLintptr)((size_t)slot * sizeof(struct light_grid_stats)),
                              sizeof(struct light_grid_stats), GL_RED_INTEGER, GL_UNSIGNED_INT,
                              NULL);
-        glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->bits_buf);
-        glClearBufferData(GL_SHADER_STORAGE_BUFFER, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT,
-                          NULL);
         glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHTS, env->gpu->light_buffer);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_POSITIONS,
                          env->gpu->position_buffer);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_BITS, g->bits_buf);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_GRID, g->cells_buf[0]);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_INDICES, g->index_buf[0]);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_SUMMARY, g->summary_buf);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_GRID, g->cells_buf[g->ring]);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_INDICES, g->index_buf[g->ring]);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_CULL_STATS, g->stats_buf);
         if (g->cfg.kind == LIGHT_GRID_TILES) {
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_TILE_DEPTH, g->tile_depth_buf);
@@ -369,8 +398,9 @@ void light_grid_build(struct light_grid *g, const struct technique_env *env, int
             glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         }
         if (g->lights > 0) {
+            /* An invocation per light, in rows of at most the device's count. */
             glUseProgram(g->scatter_prog);
-            glDispatchCompute((GLuint)((g->lights + GROUP - 1) / GROUP), 1, 1);
+            glDispatchCompute((GLuint)g->scatter_groups[0], (GLuint)g->scatter_groups[1], 1);
             glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         }
         glUseProgram(g->compact_prog);
@@ -383,7 +413,7 @@ void light_grid_build(struct light_grid *g, const struct technique_env *env, int
 
 void light_grid_bind(const struct light_grid *g)
 {
-    glBindBufferBase(GL_UNIFORM_BUFFER, SB_UBO_LIGHT_GRID, g->ubo);
+    glBindBufferBase(GL_UNIFORM_BUFFER, SB_UBO_LIGHT_GRID, g->ubo[g->ring]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_GRID, g->cells_buf[g->ring]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_INDICES, g->index_buf[g->ring]);
 }

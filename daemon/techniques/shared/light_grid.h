@@ -9,13 +9,16 @@
  *
  * GPU binning (shaders/culling/): a bit per light and cell set by one
  * invocation per light over the cells its screen rectangle and depth range
- * cover, then one invocation per cell compacting its bits into a list. CPU
+ * cover, then one invocation per cell compacting its bits into a list; a
+ * summary bit per word of bits lets compaction visit (and zero for the next
+ * frame) only the words that hold lights, so no pass touches every cell's
+ * every word. CPU
  * binning (tiles only, seed 003): the lists built from each light's screen
  * rectangle on the CPU every frame and uploaded, inside the timed region.
  *
- * Cells keep at most max_per_cell lights (clusters), or take what they need
- * from an index buffer of bounded capacity (tiles). A cell that does not fit
- * is flagged: under the fallback policy it shades with every light (correct,
+ * Lists are packed into one index buffer of bounded capacity; clusters keep
+ * at most max_per_cell lights. A cell over the bound, or that finds the
+ * buffer full, is flagged: under the fallback policy it shades with every light (correct,
  * slower); under fail, light_grid_verify fails the job. Either way every
  * frame's overflowed cells and dropped lights are counted on the GPU into a
  * per-frame record read back once after the run (never in the timed
@@ -30,6 +33,9 @@
 #include "daemon/techniques/technique.h"
 
 enum light_grid_kind { LIGHT_GRID_TILES, LIGHT_GRID_CLUSTERS };
+
+/* Frames whose grids exist at once: more than the harness keeps in flight. */
+#define LIGHT_GRID_RING 3
 
 struct light_grid_config {
     int kind;          /* enum light_grid_kind */
@@ -48,7 +54,7 @@ struct light_grid_block {
     float tile[4];    /* tile width, height (pixels); reciprocals */
     float slices[4];  /* depth where slicing starts, ends; slices per unit; 1 = exponential */
     int32_t lists[4]; /* max per cell (0: by offset), capacity, bit words per cell, fallback */
-    int32_t counts[4]; /* lights, statistics record of this frame */
+    int32_t counts[4]; /* lights, statistics record of this frame, summary words per cell */
 };
 
 /* One frame's record, written by light_compact.comp (or the CPU binning). */
@@ -61,12 +67,16 @@ struct light_grid {
     struct light_grid_block block;
     int cells, words, lights, width, height, frames;
     bool camera_moves; /* slices follow the camera's depth range every frame */
+    float mesh_box[SCENE_MESH_COUNT][2][3]; /* object-space min and max of each mesh */
     long long capacity; /* index entries */
-    GLuint ubo, tile_depth_buf, bits_buf, stats_buf;
-    /* CPU binning cycles through a ring of grids so that an upload never
-     * waits for a frame still in flight; GPU binning uses slot 0. */
-    GLuint cells_buf[3], index_buf[3];
-    int ring, ring_size;
+    GLuint tile_depth_buf, bits_buf, summary_buf, stats_buf;
+    /* Each frame writes the next of a ring of blocks and lists, so that
+     * neither an upload nor a compute pass waits for a frame still in
+     * flight that reads the previous ones (on llvmpipe such a write
+     * hazard stalls the CPU until that frame is rasterised). */
+    GLuint ubo[LIGHT_GRID_RING], cells_buf[LIGHT_GRID_RING], index_buf[LIGHT_GRID_RING];
+    int ring;
+    int scatter_groups[2]; /* the scatter pass's dispatch: an invocation per light */
     GLuint depth_prog, scatter_prog, compact_prog;
     double buffer_bytes;
     double *bin_ms; /* CPU time of each timed frame's binning */

@@ -7,6 +7,7 @@
 /* Uniform blocks. */
 #define SB_UBO_FRAME 0
 #define SB_UBO_LIGHT_GRID 1 /* light grid dimensions, slices, list bounds */
+#define SB_UBO_IBL 2 /* the probes lighting this frame (shaders/common/ibl.glsl) */
 
 /* Shader storage blocks. */
 #define SB_SSBO_INSTANCES 0
@@ -21,6 +22,7 @@
 #define SB_SSBO_TILE_DEPTH 9    /* per tile: nearest and farthest view depth */
 #define SB_SSBO_NONFINITE 10    /* the harness's NaN and infinity pixel counters */
 #define SB_SSBO_LIGHT_SUMMARY 11 /* per cell, one bit per non-zero word of light bits */
+#define SB_SSBO_SHADOW_LIGHTS 12 /* per light: where its shadow map's faces lie */
 
 /* Texture units. */
 #define SB_TEX_HDR 0
@@ -42,6 +44,22 @@
 #define SB_LOC_POST_WEIGHTS 1 /* bloom: float[33] Gaussian weights */
 #define SB_LOC_SSAO_NOISE 1   /* ssao: float[16] rotation angles */
 #define SB_LOC_SSAO_KERNEL 17 /* ssao: vec4[64] hemisphere samples */
+
+/* Harness-owned units, bound before every frame's passes for the lighting
+ * library (look.ibl, look.shadows): techniques leave 10 and up alone. */
+#define SB_TEX_IBL_SOURCE 10      /* setup only: the cube map being filtered */
+#define SB_TEX_IBL_IRRADIANCE 12  /* cube map array: environment, then each probe */
+#define SB_TEX_IBL_PREFILTERED 13 /* cube map array, roughness picks the level */
+#define SB_TEX_IBL_BRDF 14        /* the split sum's (A, B) table */
+#define SB_TEX_SHADOW_ATLAS 15    /* depth atlas of every light's six faces */
+#define SB_TEX_SHADOW_CUBES 16    /* or a depth cube map array, a layer a light */
+
+/* Uniform locations of the harness's own programs, explicit so that timed
+ * code never looks a name up. */
+#define SB_LOC_SHADOW_VIEW_PROJ 0 /* mat4, locations 0..3 */
+#define SB_LOC_SHADOW_INSTANCE 4  /* int */
+#define SB_LOC_IBL_FACE 0         /* filters: int, the cube face written */
+#define SB_LOC_IBL_PARAMS 1       /* filters: vec4 (roughness or lod, 1 / size, samples, source size) */
 
 /* Image units. */
 #define SB_IMG_OSL_ATLAS 0

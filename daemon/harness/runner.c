@@ -27,6 +27,7 @@
 #include "daemon/harness/interference.h"
 #include "daemon/harness/deadline.h"
 #include "daemon/harness/telemetry.h"
+#include "daemon/harness/look.h"
 #include "daemon/harness/metrics_stage.h"
 #include "common/png_io.h"
 #include "daemon/service.h"
@@ -99,10 +100,16 @@ struct run {
     struct gpu_timer *timer;
     struct gpu_passes passes;
     int resolve_pass;
+    /* The look's harness work (probes, shadow maps, sky): owned by the run
+     * that measures; the reference borrows it. */
+    struct harness_look hlook;
+    int shadow_pass, sky_pass; /* -1 when the look has none */
+    struct hdr_stats *hdr;     /* per capture, when the look is physically based */
+    float *hdr_scratch;
     GLuint ldr_fbo;
     struct technique_env env;
     struct technique_products products;
-    char defines[128];
+    char defines[512];
     void *state;
     uint8_t **captures;
     int capture_count;
@@ -153,10 +160,10 @@ static bool setup_targets(struct run *run)
                        : 0;
     if (!run->ldr_fbo)
         return false;
-    snprintf(run->defines, sizeof(run->defines), "#define LIGHTING_%s 1\n",
-             run->look->lighting == LOOK_BLINN_PHONG ? "BLINN_PHONG" : "PHONG");
+    harness_look_defines(run->look, run->defines, sizeof(run->defines));
     run->env = (struct technique_env){
         .spec = run->spec,
+        .look = run->look,
         .scene = &run->scene,
         .gpu = &run->gpu,
         .caps = caps,
@@ -266,19 +273,23 @@ static json_t *nonfinite_summary(const struct run *run)
                      "clamps an overflowing write leaves it");
 }
 
-/* Builds the technique for a run: its options, passes (its own, the post
- * chain's, then the harness's resolve) and timer. */
+/* Builds the technique for a run: its options, passes (its own, the look's
+ * shadows and sky, the post chain's, then the harness's resolve) and timer. */
 static bool setup_technique(struct run *run, const struct technique *tech, const void *options,
                             int64_t timed_frames)
 {
     int post_passes = post_spec_pass_names(&run->look->post, NULL, 0); /* post hook */
-    run->timer = gpu_timer_create(technique_pass_count(tech) + post_passes + 1, timed_frames);
+    int look_passes = (run->hlook.shadows != NULL) + run->hlook.sky_on;
+    run->timer = gpu_timer_create(technique_pass_count(tech) + look_passes + post_passes + 1,
+                                  timed_frames);
     if (!run->timer) {
         snprintf(run->err, sizeof(run->err), "cannot create GPU timer queries");
         return false;
     }
     bool fits = gpu_passes_init(&run->passes, run->timer, tech->info->passes,
-                                run->runner->caps.debug_groups);
+                                run->runner->caps.debug_groups) &&
+                harness_look_add_passes(&run->hlook, &run->passes, &run->shadow_pass,
+                                        &run->sky_pass);
     /* Post hook: the chain's passes; its effects are built once the technique exists. */
     if (fits && !(run->post = post_chain_create(&run->env, run->look, &run->passes, run->err,
                                                 sizeof(run->err))))
@@ -292,10 +303,26 @@ static bool setup_technique(struct run *run, const struct technique *tech, const
     return true;
 }
 
+/* Passes in the order a frame runs them: the shadow pass before the
+ * technique's, then the rest as declared. Returns the count. */
+static int pass_order(const struct run *run, int *order)
+{
+    int n = 0;
+    if (run->shadow_pass >= 0)
+        order[n++] = run->shadow_pass;
+    for (int s = 0; s < run->passes.count; s++)
+        if (s != run->shadow_pass)
+            order[n++] = s;
+    return n;
+}
+
 static void teardown(struct run *run)
 {
     if (run->tech && run->state)
         run->tech->destroy(run->state);
+    harness_look_finish(&run->hlook);
+    free(run->hdr);
+    free(run->hdr_scratch);
     post_chain_destroy(run->post); /* post hook */
     free(run->nonfinite);
     gpu_timer_destroy(run->timer);
@@ -324,7 +351,8 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
     const struct job_spec *spec = run->spec;
     const struct job *job = run->job;
     int n = spec->frames, w0 = spec->warmup_frames;
-    int sections = run->passes.count;
+    int sections = run->passes.count, order[GPU_MAX_PASSES];
+    pass_order(run, order);
     double *gpu = malloc((size_t)n * sizeof(double));
     double *sec = malloc((size_t)n * sizeof(double));
     json_t *captures = json_array(), *result = NULL;
@@ -349,9 +377,12 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
             goto out;
         free(run->captures[c]);
         run->captures[c] = NULL;
-        json_array_append_new(captures, json_pack("{s:i, s:s, s:s, s:o}", "frame", k, "url",
-                                                  url, "file", name, "nonfinite", /* post hook */
-                                                  nonfinite_json(&run->nonfinite[c])));
+        json_t *entry = json_pack("{s:i, s:s, s:s, s:o}", "frame", k, "url", url, "file", name,
+                                  "nonfinite", /* post hook */
+                                  nonfinite_json(&run->nonfinite[c]));
+        if (run->hdr)
+            json_object_set_new(entry, "hdr", hdr_stats_json(&run->hdr[c]));
+        json_array_append_new(captures, entry);
         c++;
     }
 
@@ -363,15 +394,16 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
         goto out;
     }
     used += (size_t)snprintf(csv + used, cap - used, "frame,gpu_ms,cpu_ms,frame_ms");
-    for (int s = 0; s < sections; s++)
-        used += (size_t)snprintf(csv + used, cap - used, ",gpu_%s_ms", run->passes.names[s]);
+    for (int o = 0; o < sections; o++)
+        used += (size_t)snprintf(csv + used, cap - used, ",gpu_%s_ms",
+                                 run->passes.names[order[o]]);
     used += (size_t)snprintf(csv + used, cap - used, "\n");
     for (int i = 0; i < n; i++) {
         used += (size_t)snprintf(csv + used, cap - used, "%d,%.6f,%.6f,%.6f", i + 1, gpu[i],
                                  run->cpu_ms[i], run->frame_ms[i]);
-        for (int s = 0; s < sections; s++)
+        for (int o = 0; o < sections; o++)
             used += (size_t)snprintf(csv + used, cap - used, ",%.6f",
-                                     gpu_timer_ms(run->timer, w0 + i, s));
+                                     gpu_timer_ms(run->timer, w0 + i, order[o]));
         used += (size_t)snprintf(csv + used, cap - used, "\n");
     }
     snprintf(path, sizeof(path), "%s/timings.csv", job->dir);
@@ -406,14 +438,15 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
     captures = NULL;
     /* Every pass, the harness's resolve included, in frame order. */
     json_t *by_section = json_object();
-    for (int s = 0; s < sections; s++) {
+    for (int o = 0; o < sections; o++) {
         for (int i = 0; i < n; i++)
-            sec[i] = gpu_timer_ms(run->timer, w0 + i, s);
-        json_object_set_new(by_section, run->passes.names[s], stats_json(sec, (size_t)n));
+            sec[i] = gpu_timer_ms(run->timer, w0 + i, order[o]);
+        json_object_set_new(by_section, run->passes.names[order[o]], stats_json(sec, (size_t)n));
     }
     json_object_set_new(result, "gpu_sections_ms", by_section);
     json_object_set_new(result, "look", look_spec_to_json(&run->spec->look));
     json_object_set_new(result, "nonfinite", nonfinite_summary(run)); /* post hook */
+    harness_look_describe(&run->hlook, result);
     json_object_set_new(result, "targets_bytes", json_real(gpu_targets_bytes(run->runner->targets)));
     if (run->heatmap)
         json_object_set(result, "heatmap", run->heatmap);
@@ -464,7 +497,7 @@ static bool render_reference(struct run *run, enum job_status *status)
     uint8_t *pixels = malloc((size_t)w * (size_t)h * 4);
     /* The reference gets a run of its own over the same scene and targets. */
     struct run rr = {.runner = run->runner, .job = run->job, .spec = spec, .tech = ref,
-                     .look = &spec->reference_look};
+                     .look = &spec->reference_look, .hlook = run->hlook};
     bool ok = false;
     if (!ref || !pixels || !reference_targets(&rr, run) ||
         !setup_technique(&rr, ref, job_spec_reference_options(spec), 1)) {
@@ -495,7 +528,10 @@ static bool render_reference(struct run *run, enum job_status *status)
         frame_data(&rr, k, &fd);
         gpu_frame_block_update(&run->runner->frame_block, &fd);
         gpu_timer_begin_frame(rr.timer);
-        bool drawn = ref->render(state, &rr.env, k, why, sizeof(why));
+        bool drawn = harness_look_before(&rr.hlook, &rr.passes, rr.shadow_pass, k, false, why,
+                                         sizeof(why)) &&
+                     ref->render(state, &rr.env, k, why, sizeof(why));
+        harness_look_after(&rr.hlook, &rr.passes, rr.sky_pass, rr.env.output_fbo, w, h);
         post_chain_run_frame(&rr);
         resolve(&rr);
         gpu_timer_end_frame(rr.timer);
@@ -581,6 +617,7 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
     struct job *job = run->job;
     int w0 = spec->warmup_frames, n = spec->frames;
     run->look = &spec->look; /* post hook */
+    run->shadow_pass = run->sky_pass = -1;
     run->scene_ok = scene_init(&run->scene, &spec->scene);
     run->capture_count = capture ? job_spec_capture_count(spec) : 0;
     run->captures = calloc((size_t)run->capture_count + 1, sizeof(*run->captures));
@@ -593,8 +630,21 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
     }
     if (!gpu_scene_init(&run->gpu, &run->scene, run->err, sizeof(run->err)) ||
         !setup_targets(run) ||
+        !harness_look_init(&run->hlook, &spec->look, &run->scene, &run->gpu, &r->frame_block,
+                           &r->caps, run->defines, run->err, sizeof(run->err)) ||
         !setup_technique(run, run->tech, job_spec_technique_options(spec), (int64_t)w0 + n))
         return false;
+    /* Physically based looks report each capture's HDR figures: non-finite
+     * pixels (what the roughness clamp keeps out), mean and peak. */
+    if (run->capture_count && spec->look.lighting == LOOK_PBR) {
+        run->hdr = calloc((size_t)run->capture_count, sizeof(*run->hdr));
+        run->hdr_scratch = malloc((size_t)spec->scene.width * (size_t)spec->scene.height * 4 *
+                                  sizeof(float));
+        if (!run->hdr || !run->hdr_scratch) {
+            snprintf(run->err, sizeof(run->err), "out of memory for HDR statistics");
+            return false;
+        }
+    }
     if (!run->tech->create(&run->env, &run->state, run->err, sizeof(run->err)) ||
         !post_chain_build(run->post, run->err, sizeof(run->err)) || /* post hook */
         gl_error_take("setup", run->err, sizeof(run->err)))
@@ -645,7 +695,11 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
         frame_data(run, k, &fd);
         gpu_frame_block_update(&r->frame_block, &fd);
         gpu_timer_begin_frame(run->timer);
-        bool ok = run->tech->render(run->state, &run->env, k, run->err, sizeof(run->err));
+        bool ok = harness_look_before(&run->hlook, &run->passes, run->shadow_pass, k, k >= 1,
+                                      run->err, sizeof(run->err)) &&
+                  run->tech->render(run->state, &run->env, k, run->err, sizeof(run->err));
+        harness_look_after(&run->hlook, &run->passes, run->sky_pass, run->env.output_fbo,
+                           run->env.width, run->env.height);
         post_chain_run_frame(run);
         resolve(run);
         gpu_timer_end_frame(run->timer);
@@ -661,6 +715,9 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
             glBindFramebuffer(GL_READ_FRAMEBUFFER, run->ldr_fbo);
             glReadPixels(0, 0, spec->scene.width, spec->scene.height, GL_RGBA,
                          GL_UNSIGNED_BYTE, run->captures[captured]);
+            if (run->hdr)
+                harness_hdr_stats(run->env.output_fbo, spec->scene.width, spec->scene.height,
+                                  run->hdr_scratch, &run->hdr[captured]);
             if (!count_nonfinite(run, captured++)) /* post hook, billed to the capture */
                 return false;
             if (run->products.heat_tex && !capture_heatmap(run, (int)k))

@@ -37,6 +37,8 @@ static void look_defaults(struct look_spec *look)
     look->hdr = LOOK_HDR_RGBA32F;
     look->exposure = 1.0;
     look->tonemap = LOOK_TONEMAP_NONE;
+    ibl_spec_defaults(&look->ibl);
+    shadow_spec_defaults(&look->shadows);
 }
 
 static double default_timeout_s;
@@ -77,39 +79,52 @@ const void *job_spec_reference_options(const struct job_spec *spec)
     return spec->reference_index >= 0 ? spec->options[spec->reference_index].bytes : NULL;
 }
 
-static const char *const LIGHTING_NAMES[] = {"phong", "blinn_phong", NULL};
+static const char *const LIGHTING_NAMES[] = {"phong", "blinn_phong", "pbr", NULL};
 static const char *const HDR_NAMES[] = {"rgba32f", "rgba16f", NULL};
 static const char *const TONEMAP_NAMES[] = {"none", "reinhard", "aces", NULL};
 
 const char *look_lighting_name(int lighting) { return LIGHTING_NAMES[lighting]; }
 const char *look_tonemap_name(int tonemap) { return TONEMAP_NAMES[tonemap]; }
 
-/* "look": {"lighting": "phong" | "blinn_phong", "hdr": "rgba32f" | "rgba16f",
- * "exposure": x, "tonemap": "none" | "reinhard" | "aces", "post": [...]};
- * name is "look" or "reference_look", for the errors. */
+/* "look": {"lighting": "phong" | "blinn_phong" | "pbr", "hdr": "rgba32f" | "rgba16f",
+ * "exposure": x, "tonemap": "none" | "reinhard" | "aces", "post": [...], "ibl": ...,
+ * "shadows": ...}; name is "look" or "reference_look", for the errors. */
 static bool parse_look(const json_t *v, const char *name, struct look_spec *look,
                        struct job_error *err)
 {
-    static const char *const keys[] = {"lighting", "hdr", "exposure", "tonemap", "post", NULL};
-    char prefix[32], field[5][48];
-    static const char *const fields[] = {"lighting", "hdr", "exposure", "tonemap", "post"};
+    static const char *const keys[] = {"lighting", "hdr", "exposure", "tonemap", "post",
+                                       "ibl", "shadows", NULL};
+    char prefix[32], field[7][48];
+    static const char *const fields[] = {"lighting", "hdr", "exposure", "tonemap", "post",
+                                         "ibl", "shadows"};
     snprintf(prefix, sizeof(prefix), "%s.", name);
-    for (int i = 0; i < 5; i++)
+    for (int i = 0; i < 7; i++)
         snprintf(field[i], sizeof(field[i]), "%s.%s", name, fields[i]);
     json_t *post = json_object_get(v, "post");
-    return jf_check_keys(v, prefix, keys, err) &&
-           jf_get_choice(v, "lighting", field[0], LIGHTING_NAMES, &look->lighting, err) &&
-           jf_get_choice(v, "hdr", field[1], HDR_NAMES, &look->hdr, err) &&
-           jf_get_number(v, "exposure", field[2], 1.0 / 1024.0, 1024.0, &look->exposure, err) &&
-           jf_get_choice(v, "tonemap", field[3], TONEMAP_NAMES, &look->tonemap, err) &&
-           (!post || post_spec_parse(post, field[4], &look->post, err));
+    json_t *ibl = json_object_get(v, "ibl"), *shadows = json_object_get(v, "shadows");
+    if (!(jf_check_keys(v, prefix, keys, err) &&
+          jf_get_choice(v, "lighting", field[0], LIGHTING_NAMES, &look->lighting, err) &&
+          jf_get_choice(v, "hdr", field[1], HDR_NAMES, &look->hdr, err) &&
+          jf_get_number(v, "exposure", field[2], 1.0 / 1024.0, 1024.0, &look->exposure, err) &&
+          jf_get_choice(v, "tonemap", field[3], TONEMAP_NAMES, &look->tonemap, err) &&
+          (!post || post_spec_parse(post, field[4], &look->post, err)) &&
+          (!ibl || ibl_spec_parse(ibl, field[5], &look->ibl, err)) &&
+          (!shadows || shadow_spec_parse(shadows, field[6], &look->shadows, err))))
+        return false;
+    /* The split sum lights a metallic-roughness material: nothing else. */
+    if (look->ibl.enabled && look->lighting != LOOK_PBR)
+        return job_error_set(err, field[5], "needs %s \"pbr\"", field[0]);
+    return true;
 }
 
 json_t *look_spec_to_json(const struct look_spec *look)
 {
-    return json_pack("{s:s, s:s, s:f, s:s, s:o}", "lighting", LIGHTING_NAMES[look->lighting],
-                     "hdr", HDR_NAMES[look->hdr], "exposure", look->exposure, "tonemap",
-                     TONEMAP_NAMES[look->tonemap], "post", post_spec_to_json(&look->post));
+    json_t *o = json_pack("{s:s, s:s, s:f, s:s, s:o}", "lighting", LIGHTING_NAMES[look->lighting],
+                          "hdr", HDR_NAMES[look->hdr], "exposure", look->exposure, "tonemap",
+                          TONEMAP_NAMES[look->tonemap], "post", post_spec_to_json(&look->post));
+    json_object_set_new(o, "ibl", ibl_spec_to_json(&look->ibl));
+    json_object_set_new(o, "shadows", shadow_spec_to_json(&look->shadows));
+    return o;
 }
 
 /* "repeat": N, or {"auto": true, "max": M}. */
@@ -324,8 +339,21 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
     if (ref_look) {
         look_defaults(&out->reference_look);
         out->reference_look_given = true;
+        /* Probes and shadow maps are made once a run, for both: a
+         * reference_look takes the look's, or states them the same. */
+        if (!json_object_get(ref_look, "ibl"))
+            out->reference_look.ibl = out->look.ibl;
+        if (!json_object_get(ref_look, "shadows"))
+            out->reference_look.shadows = out->look.shadows;
         if (!parse_look(ref_look, "reference_look", &out->reference_look, err))
             return false;
+        if (memcmp(&out->reference_look.ibl, &out->look.ibl, sizeof(out->look.ibl)) != 0)
+            return job_error_set(err, "reference_look.ibl", "must equal look.ibl (leave it out): "
+                                 "the probes are captured once for the job and its reference");
+        if (memcmp(&out->reference_look.shadows, &out->look.shadows,
+                   sizeof(out->look.shadows)) != 0)
+            return job_error_set(err, "reference_look.shadows", "must equal look.shadows (leave "
+                                 "it out): the shadow maps are rendered once a frame for both");
     }
     json_t *metrics = json_object_get(body, "metrics");
     if (metrics && !parse_metrics(metrics, &out->metrics, err))

@@ -10,6 +10,7 @@
 #include <stddef.h>
 
 #include "common/json_fields.h"
+#include "daemon/lighting/look_lighting.h"
 #include "daemon/effects/effect_info.h"
 #include "daemon/quality/metrics.h"
 #include "daemon/scene/scene_spec.h"
@@ -21,7 +22,7 @@
 
 /* The job's "look": what the image should look like, independent of the
  * technique that renders it; the reference renders with the same look. */
-enum look_lighting { LOOK_PHONG, LOOK_BLINN_PHONG };
+enum look_lighting { LOOK_PHONG, LOOK_BLINN_PHONG, LOOK_PBR };
 enum look_hdr { LOOK_HDR_RGBA32F, LOOK_HDR_RGBA16F };
 /* none: today's clamp, no encoding; the curves write 8-bit sRGB. */
 enum look_tonemap { LOOK_TONEMAP_NONE, LOOK_TONEMAP_REINHARD, LOOK_TONEMAP_ACES };
@@ -32,6 +33,8 @@ struct look_spec {
     double exposure; /* scales the HDR colour in the resolve, before the tone curve */
     int tonemap;     /* enum look_tonemap */
     struct post_spec post; /* effects the harness runs on the HDR output, in order */
+    struct ibl_spec ibl;         /* image-based lighting (needs lighting pbr) */
+    struct shadow_spec shadows;  /* omni shadow maps for the point lights */
 };
 
 /* labels: free-form tags for history (commit, branch, driver version). Keys

@@ -29,7 +29,12 @@ static const struct {
     {"scene.tessellation_error_px", PARAM_NUMBER, 0}, {"scene.camera", PARAM_CHOICE, 0},
     {"scene.materials", PARAM_CHOICE, 0},  {"scene.specular", PARAM_NUMBER, 0},
     {"scene.shininess", PARAM_NUMBER, 0},  {"scene.metallic", PARAM_NUMBER, 0},
-    {"scene.roughness", PARAM_NUMBER, 0},
+    {"scene.roughness", PARAM_NUMBER, 0},  {"scene.teapot_segments", PARAM_INT, 1},
+    {"look.ibl.probes", PARAM_INT, 1},     {"look.ibl.resolution", PARAM_INT, 1},
+    {"look.ibl.samples", PARAM_INT, 1},    {"look.ibl.blend", PARAM_INT, 1},
+    {"look.shadows.atlas", PARAM_INT, 1},  {"look.shadows.tile", PARAM_INT, 1},
+    {"look.shadows.bias", PARAM_NUMBER, 0}, {"look.shadows.normal_offset", PARAM_NUMBER, 0},
+    {"look.shadows.pcf", PARAM_INT, 1},    {"look.shadows.layout", PARAM_CHOICE, 0},
 };
 enum { NPARAMS = sizeof(PARAMS) / sizeof(PARAMS[0]) };
 

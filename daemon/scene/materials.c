@@ -6,9 +6,11 @@
 
 #include "daemon/scene/scene_build.h"
 
-void scene_assign_materials(struct scene *s)
+void scene_assign_materials(struct scene *s, bool preset_set)
 {
     const struct scene_spec *spec = &s->spec;
+    if (spec->materials == SCENE_MATERIALS_PRESET && preset_set)
+        return;
     for (int i = 0; i < s->instance_count; i++) {
         struct scene_material *m = &s->instances[i].material;
         m->specular = (float)spec->specular;

@@ -7,10 +7,11 @@
 #include <string.h>
 
 #include "daemon/scene/scene_build.h"
+#include "daemon/scene/teapot.h"
 
 static const double PI = 3.14159265358979323846;
 
-const char *const scene_mesh_names[] = {"sphere", "cube", "plane", NULL};
+const char *const scene_mesh_names[] = {"sphere", "cube", "plane", "teapot", NULL};
 
 double scene_hash01(uint32_t index, uint32_t salt)
 {
@@ -60,6 +61,10 @@ static void instance_half_extent(const struct scene_instance *in, float out[3])
     case SCENE_MESH_CUBE:
         out[0] = out[1] = out[2] = SCENE_CUBE_HALF * in->scale;
         return;
+    case SCENE_MESH_TEAPOT:
+        for (int k = 0; k < 3; k++)
+            out[k] = SCENE_TEAPOT_HALF[k] * in->scale;
+        return;
     default:
         out[0] = out[2] = SCENE_PLANE_HALF * in->scale;
         out[1] = 0.0f;
@@ -100,7 +105,8 @@ bool scene_init(struct scene *out, const struct scene_spec *spec)
 {
     memset(out, 0, sizeof(*out));
     out->spec = *spec;
-    if (!scene_build_preset(out))
+    bool materials_set = false;
+    if (!scene_build_preset(out, &materials_set))
         goto fail;
     for (int i = 0; i < out->instance_count; i++) {
         /* Each mesh is one instanced draw over a contiguous range. */
@@ -108,14 +114,16 @@ bool scene_init(struct scene *out, const struct scene_spec *spec)
             goto fail;
         out->mesh_instance_count[out->instances[i].mesh]++;
     }
-    scene_assign_materials(out);
+    scene_assign_materials(out, materials_set);
     compute_bounds(out);
     scene_rig_derive(out);
     scene_choose_segments(out);
     if (!mesh_create_sphere(&out->meshes[SCENE_MESH_SPHERE], SCENE_SPHERE_RADIUS,
                             out->sphere_segments) ||
         !mesh_create_cube(&out->meshes[SCENE_MESH_CUBE], SCENE_CUBE_HALF) ||
-        !mesh_create_plane(&out->meshes[SCENE_MESH_PLANE], SCENE_PLANE_HALF))
+        !mesh_create_plane(&out->meshes[SCENE_MESH_PLANE], SCENE_PLANE_HALF) ||
+        (out->mesh_instance_count[SCENE_MESH_TEAPOT] &&
+         !mesh_create_teapot(&out->meshes[SCENE_MESH_TEAPOT], out->teapot_segments, 1.0f)))
         goto fail;
 
     struct scene_camera cam;
@@ -352,10 +360,20 @@ json_t *scene_describe(const struct scene *s)
                                  "silhouette_error_px", (double)s->sphere_error_px);
     if (automatic)
         json_object_set_new(segments, "error_bound_px", json_real(s->spec.tessellation_error_px));
-    return json_pack("{s:s, s:i, s:o, s:I, s:o, s:o, s:s, s:o, s:o}", "preset",
-                     scene_preset_names[s->spec.preset], "instances", s->instance_count,
-                     "instances_by_mesh", by_mesh, "triangles_per_frame",
-                     (json_int_t)scene_triangles(s), "sphere_tessellation", segments, "lights",
-                     lights, "materials", scene_materials_names[s->spec.materials], "camera",
-                     describe_camera(s), "bounds", box_json(&s->bounds));
+    json_t *out = json_pack("{s:s, s:i, s:o, s:I, s:o, s:o, s:s, s:o, s:o, s:b}", "preset",
+                            scene_preset_names[s->spec.preset], "instances", s->instance_count,
+                            "instances_by_mesh", by_mesh, "triangles_per_frame",
+                            (json_int_t)scene_triangles(s), "sphere_tessellation", segments,
+                            "lights", lights, "materials",
+                            scene_materials_names[s->spec.materials], "camera",
+                            describe_camera(s), "bounds", box_json(&s->bounds), "sky", s->sky);
+    if (out && s->mesh_instance_count[SCENE_MESH_TEAPOT])
+        json_object_set_new(
+            out, "teapot_tessellation",
+            json_pack("{s:s, s:i, s:i, s:f, s:f}", "mode",
+                      s->spec.teapot_segments == SCENE_TEAPOT_SEGMENTS_AUTO ? "auto" : "fixed",
+                      "segments", s->teapot_segments, "triangles_per_teapot",
+                      (int)(s->meshes[SCENE_MESH_TEAPOT].index_count / 3), "largest_px_per_unit",
+                      (double)s->teapot_px_per_unit, "error_px", (double)s->teapot_error_px));
+    return out;
 }

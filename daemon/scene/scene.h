@@ -14,8 +14,10 @@
 #include "daemon/scene/mesh.h"
 
 /* Instances are grouped by mesh in this order, one instanced draw each. */
-enum scene_mesh { SCENE_MESH_SPHERE, SCENE_MESH_CUBE, SCENE_MESH_PLANE, SCENE_MESH_COUNT };
-extern const char *const scene_mesh_names[]; /* "sphere", "cube", "plane" */
+enum scene_mesh {
+    SCENE_MESH_SPHERE, SCENE_MESH_CUBE, SCENE_MESH_PLANE, SCENE_MESH_TEAPOT, SCENE_MESH_COUNT
+};
+extern const char *const scene_mesh_names[]; /* "sphere", "cube", "plane", "teapot" */
 
 /* Per-instance material, uploaded beside the albedo (shaders/common/
  * scene_data.glsl: instance_material()). metallic and roughness are carried
@@ -83,6 +85,12 @@ struct scene {
     struct scene_box light_volume; /* where the layout puts light centres */
     struct scene_rig rig;
     int sphere_segments;           /* in use: the spec's, or the one "auto" chose */
+    int teapot_segments;           /* per patch edge, likewise (0 without teapots) */
+    float teapot_px_per_unit;      /* largest teapot scale on screen, pixels per unit */
+    float teapot_error_px;         /* the chosen tessellation's error there */
+    /* The preset draws a sky behind its objects (the harness's sky pass,
+     * which shows the look's environment: seed 002's skybox). */
+    bool sky;
     float sphere_radius_px;        /* largest sphere radius on screen over the camera path */
     float sphere_error_px;         /* the chosen tessellation's silhouette error there */
     /* The frame-0 camera, flat, for the code that reads one fixed camera. */
@@ -125,6 +133,9 @@ bool scene_sphere_in_frustum(const float view_proj[16], const float centre[3], f
  * the eye counts as. */
 float scene_sphere_radius_px(const struct scene_camera *c, int width, int height,
                              const float centre[3], float radius);
+
+/* "auto" teapot tessellation (tessellation.c): s->teapot_segments from the
+ * largest teapot on screen over the camera path. */
 
 /* Silhouette error of a sphere tessellated with segments (lat-long, rings
  * = segments / 2), as a fraction of its radius: see tessellation.c. */

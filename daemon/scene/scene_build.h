@@ -19,11 +19,13 @@ void scene_hsv_to_rgb(double h, double s, double v, float out[3]);
 /* Object-space sizes of the meshes (presets.c), known before the meshes
  * are built (the sphere's tessellation depends on where objects stand). */
 extern const float SCENE_SPHERE_RADIUS, SCENE_CUBE_HALF, SCENE_PLANE_HALF;
+/* The teapot mesh's half extents at scale 1 (x towards the spout, y up). */
+extern const float SCENE_TEAPOT_HALF[3];
 
 /* presets.c: instances (grouped by mesh, materials unset), the light
  * volume, the lights (through scene_place_lights) and the static pose.
  * Returns false when out of memory. */
-bool scene_build_preset(struct scene *s);
+bool scene_build_preset(struct scene *s, bool *materials_set);
 
 /* lights.c: allocates and places spec.lights lights in s->light_volume
  * with spec.light_layout, each circling its centre at radius orbit when the
@@ -31,8 +33,9 @@ bool scene_build_preset(struct scene *s);
 bool scene_place_lights(struct scene *s, float orbit);
 
 /* materials.c: each instance's material from spec.materials and the
- * spec's material values. */
-void scene_assign_materials(struct scene *s);
+ * spec's material values; "preset" keeps what the preset set when it set
+ * materials (materials_set), else it is "uniform". */
+void scene_assign_materials(struct scene *s, bool preset_set);
 
 /* camera.c: the orbit and flythrough parameters from the bounds and the
  * static pose (needs instances, bounds and rig.eye/target/fovy/near/far). */

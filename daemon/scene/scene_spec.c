@@ -4,9 +4,9 @@
 #include <stdio.h>
 #include <string.h>
 
-const char *const scene_preset_names[] = {"grid", "lights", NULL};
+const char *const scene_preset_names[] = {"grid", "lights", "teapots", "chart", "sphere", NULL};
 const char *const scene_layout_names[] = {"halton", "uniform", "grid", "clustered", NULL};
-const char *const scene_materials_names[] = {"uniform", "varied", NULL};
+const char *const scene_materials_names[] = {"uniform", "varied", "preset", NULL};
 const char *const scene_camera_names[] = {"static", "orbit", "flythrough", NULL};
 
 /* What each preset chooses for itself. grid's values are the thesis's
@@ -21,6 +21,12 @@ static const struct {
 } PRESETS[] = {
     [SCENE_PRESET_GRID] = {10, SCENE_LAYOUT_HALTON, 5.0, SCENE_MATERIALS_UNIFORM},
     [SCENE_PRESET_LIGHTS] = {256, SCENE_LAYOUT_UNIFORM, 4.0, SCENE_MATERIALS_VARIED},
+    /* Seed 002's 80 lights through the air around the teapots, each
+     * reaching two or three of them. */
+    [SCENE_PRESET_TEAPOTS] = {80, SCENE_LAYOUT_UNIFORM, 2.5, SCENE_MATERIALS_PRESET},
+    /* A row of lights in front of the chart, above the camera. */
+    [SCENE_PRESET_CHART] = {4, SCENE_LAYOUT_GRID, 30.0, SCENE_MATERIALS_PRESET},
+    [SCENE_PRESET_SPHERE] = {1, SCENE_LAYOUT_GRID, 10.0, SCENE_MATERIALS_UNIFORM},
 };
 
 void scene_spec_preset_defaults(struct scene_spec *s, enum scene_preset preset)
@@ -41,6 +47,7 @@ void scene_spec_defaults(struct scene_spec *s)
     s->height = 720;
     s->sphere_segments = 32;
     s->tessellation_error_px = 0.5;
+    s->teapot_segments = 12;
     s->light_speed = 1.0;
     s->light_intensity = 1.0;
     /* The constants of the thesis's Phong (shaders/common/lighting.glsl);
@@ -75,6 +82,26 @@ static bool parse_segments(const json_t *scene, struct scene_spec *s, struct job
     return true;
 }
 
+static bool parse_teapot_segments(const json_t *scene, struct scene_spec *s,
+                                  struct job_error *err)
+{
+    static const char rule[] = "must be \"auto\" or an integer from 1 to 64 (segments per "
+                               "Bezier patch edge)";
+    json_t *v = json_object_get(scene, "teapot_segments");
+    if (!v)
+        return true;
+    if (json_is_string(v)) {
+        if (strcmp(json_string_value(v), "auto") != 0)
+            return job_error_set(err, "scene.teapot_segments", rule);
+        s->teapot_segments = SCENE_TEAPOT_SEGMENTS_AUTO;
+        return true;
+    }
+    if (!jf_get_int(scene, "teapot_segments", "scene.teapot_segments", 1, 64,
+                    &s->teapot_segments, err))
+        return job_error_set(err, "scene.teapot_segments", rule);
+    return true;
+}
+
 /* "camera": "orbit" or {"path": "orbit", "period": 240}. */
 static bool parse_camera(const json_t *scene, struct scene_spec *s, struct job_error *err)
 {
@@ -106,7 +133,7 @@ bool scene_spec_parse(const json_t *scene, struct scene_spec *s, struct job_erro
 {
     static const char *const keys[] = {
         "preset", "lights", "dynamic", "width", "height", "sphere_segments",
-        "tessellation_error_px", "light_speed", "light_radius", "light_intensity",
+        "teapot_segments", "tessellation_error_px", "light_speed", "light_radius", "light_intensity",
         "light_layout", "materials", "specular", "shininess", "metallic", "roughness",
         "camera", NULL};
     if (!jf_check_keys(scene, "scene.", keys, err))
@@ -122,7 +149,7 @@ bool scene_spec_parse(const json_t *scene, struct scene_spec *s, struct job_erro
         !jf_get_bool(scene, "dynamic", "scene.dynamic", &s->dynamic, err) ||
         !jf_get_int(scene, "width", "scene.width", 16, 8192, &s->width, err) ||
         !jf_get_int(scene, "height", "scene.height", 16, 8192, &s->height, err) ||
-        !parse_segments(scene, s, err) ||
+        !parse_segments(scene, s, err) || !parse_teapot_segments(scene, s, err) ||
         !jf_get_number(scene, "tessellation_error_px", "scene.tessellation_error_px", 0.01,
                        100.0, &s->tessellation_error_px, err) ||
         !jf_get_number(scene, "light_speed", "scene.light_speed", 0.0, 100.0, &s->light_speed,
@@ -157,6 +184,9 @@ json_t *scene_spec_to_json(const struct scene_spec *s)
     json_object_set_new(o, "sphere_segments", s->sphere_segments == SCENE_SEGMENTS_AUTO
                                                   ? json_string("auto")
                                                   : json_integer(s->sphere_segments));
+    json_object_set_new(o, "teapot_segments", s->teapot_segments == SCENE_TEAPOT_SEGMENTS_AUTO
+                                                  ? json_string("auto")
+                                                  : json_integer(s->teapot_segments));
     json_object_set_new(o, "tessellation_error_px", json_real(s->tessellation_error_px));
     json_object_set_new(o, "light_speed", json_real(s->light_speed));
     json_object_set_new(o, "light_radius", json_real(s->light_radius));

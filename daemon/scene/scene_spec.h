@@ -10,7 +10,12 @@
 
 #include "common/json_fields.h"
 
-enum scene_preset { SCENE_PRESET_GRID, SCENE_PRESET_LIGHTS };
+enum scene_preset {
+    SCENE_PRESET_GRID, SCENE_PRESET_LIGHTS,
+    SCENE_PRESET_TEAPOTS, /* seed 002: eight teapots, a container, ground and sky */
+    SCENE_PRESET_CHART,   /* spheres by metallic (rows) and roughness (columns) */
+    SCENE_PRESET_SPHERE,  /* one sphere in the spec's material: the furnace test's */
+};
 enum scene_light_layout {
     SCENE_LAYOUT_HALTON,    /* the thesis's low-discrepancy spread (Halton 2, 3, 5) */
     SCENE_LAYOUT_UNIFORM,   /* independent hashed positions, uniform in the volume */
@@ -20,6 +25,7 @@ enum scene_light_layout {
 enum scene_materials {
     SCENE_MATERIALS_UNIFORM, /* every object gets scene.specular, .shininess, ... */
     SCENE_MATERIALS_VARIED,  /* a deterministic per-object spread around them */
+    SCENE_MATERIALS_PRESET,  /* the preset's own (teapots, chart); uniform elsewhere */
 };
 enum scene_camera_path { SCENE_CAMERA_STATIC, SCENE_CAMERA_ORBIT, SCENE_CAMERA_FLYTHROUGH };
 
@@ -33,6 +39,7 @@ enum {
     SCENE_MAX_LIGHTS = 65536,
     SCENE_SEGMENTS_AUTO = 0, /* sphere_segments "auto" */
     SCENE_MAX_CAMERA_PERIOD = 1000000,
+    SCENE_TEAPOT_SEGMENTS_AUTO = 0, /* teapot_segments "auto" */
 };
 
 struct scene_spec {
@@ -42,6 +49,7 @@ struct scene_spec {
     int width, height;
     int sphere_segments;          /* even 8..256 (rings = segments / 2), or SCENE_SEGMENTS_AUTO */
     double tessellation_error_px; /* silhouette error "auto" keeps under, in pixels */
+    int teapot_segments;          /* per Bezier patch edge, 1..64, or SCENE_TEAPOT_SEGMENTS_AUTO */
     double light_speed;           /* scales how fast dynamic lights circle (1 = default) */
     double light_radius;          /* influence radius of every light */
     double light_intensity;       /* scales every light's colour */

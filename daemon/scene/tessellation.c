@@ -9,10 +9,15 @@
  * latitude and longitude, so a face centre sits r cos^2(pi/n) from the
  * centre, and a silhouette that crosses a face there (a view from above
  * the face's diagonal) is r sin^2(pi/n) inside the true one: about twice
- * the n-gon's sagitta. The bound below holds from every direction. */
+ * the n-gon's sagitta. The bound below holds from every direction.
+ *
+ * teapot_segments "auto" likewise: the coarsest patch tessellation whose
+ * distance to the true surface (teapot_tessellation_error) stays within the
+ * bound at the largest scale a teapot reaches on screen. */
 #include <math.h>
 
 #include "daemon/scene/scene_build.h"
+#include "daemon/scene/teapot.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -57,12 +62,26 @@ void scene_choose_segments(struct scene *s)
      * evenly spaced frames of its period (every frame for shorter loops). */
     int64_t period = scene_camera_moves(s) ? spec->camera_period : 1;
     int64_t samples = period < 720 ? period : 720;
-    double largest = 0.0;
+    double largest = 0.0, teapot_ppu = 0.0;
+    bool teapots = false;
     for (int64_t j = 0; j < samples; j++) {
         struct scene_camera cam;
         scene_camera_at(s, j * period / samples, &cam);
         for (int i = 0; i < s->instance_count; i++) {
             const struct scene_instance *in = &s->instances[i];
+            if (in->mesh == SCENE_MESH_TEAPOT) {
+                /* Object-space units per pixel from the teapot's bounding
+                 * sphere: the error is measured in object space. */
+                float h[3] = {SCENE_TEAPOT_HALF[0] * in->scale, SCENE_TEAPOT_HALF[1] * in->scale,
+                              SCENE_TEAPOT_HALF[2] * in->scale};
+                float r = sqrtf(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
+                teapots = true;
+                if (!scene_sphere_in_frustum(cam.view_proj, in->pos, r, false))
+                    continue;
+                double px = scene_sphere_radius_px(&cam, spec->width, spec->height, in->pos, r);
+                teapot_ppu = fmax(teapot_ppu, px / r * in->scale);
+                continue;
+            }
             if (in->mesh != SCENE_MESH_SPHERE)
                 continue;
             float r = SCENE_SPHERE_RADIUS * in->scale;
@@ -77,5 +96,13 @@ void scene_choose_segments(struct scene *s)
                              ? scene_auto_segments(largest, spec->tessellation_error_px)
                              : spec->sphere_segments;
     s->sphere_radius_px = (float)largest;
+    s->teapot_segments = 0;
+    if (teapots)
+        s->teapot_segments = spec->teapot_segments == SCENE_TEAPOT_SEGMENTS_AUTO
+                                 ? teapot_auto_segments(teapot_ppu, spec->tessellation_error_px)
+                                 : spec->teapot_segments;
+    s->teapot_px_per_unit = (float)teapot_ppu;
+    s->teapot_error_px = teapots ? (float)(teapot_ppu * teapot_tessellation_error(s->teapot_segments))
+                                 : 0.0f;
     s->sphere_error_px = (float)(largest * scene_sphere_error(s->sphere_segments));
 }

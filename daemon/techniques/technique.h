@@ -40,6 +40,9 @@ struct technique_products {
 /* What the harness hands a technique; valid from create to destroy. */
 struct technique_env {
     const struct job_spec *spec;
+    /* The look this run renders with: the job's, or the reference's
+     * reference_look (lighting model, materials a g-buffer must carry). */
+    const struct look_spec *look;
     const void *options; /* the technique's own options struct (its info's layout) */
     const struct scene *scene;
     struct gpu_scene *gpu;

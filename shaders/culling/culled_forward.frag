@@ -17,8 +17,7 @@ void main()
     int cell = grid_cell(gl_FragCoord.xy, 1.0 / gl_FragCoord.w);
     uint evaluations;
     Material m = instance_material(v_instance);
-    vec3 color = shade_cell(cell, v_world, normalize(v_normal), m.albedo, m.specular, m.shininess,
-                            evaluations);
+    vec3 color = shade_cell(cell, v_world, normalize(v_normal), m, evaluations);
     heat_add(ivec2(gl_FragCoord.xy), evaluations);
     out_color = vec4(color, 1.0);
 }

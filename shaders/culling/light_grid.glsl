@@ -55,24 +55,21 @@ int grid_cell(vec2 frag, float d)
 // forward sums them (lights left out contribute exactly 0 there, so the
 // sums agree). An overflowed cell under the fallback policy loops over
 // every light: slower, never wrong. evaluations: lights evaluated.
-vec3 shade_cell(int cell, vec3 P, vec3 N, vec3 albedo, float specular, float shininess,
-                out uint evaluations)
+vec3 shade_cell(int cell, vec3 P, vec3 N, Material m, out uint evaluations)
 {
     vec3 V = normalize(u_frame.eye.xyz - P);
-    vec3 color = light_ambient(albedo);
+    vec3 color = light_ambient(m, P, N, V);
     uvec2 c = light_cells[cell];
     if ((c.y & CELL_OVERFLOW) != 0u && u_grid.lists.w != 0) {
         for (int i = 0; i < u_frame.counts.y; i++)
-            color += light_contribution(i, light_position(i, 0), P, N, V, albedo, specular,
-                                        shininess);
+            color += light_contribution(i, light_position(i, 0), P, N, V, m);
         evaluations = uint(u_frame.counts.y);
         return color;
     }
     uint count = c.y & ~CELL_OVERFLOW;
     for (uint j = 0u; j < count; j++) {
         int i = int(light_index[c.x + j]);
-        color += light_contribution(i, light_position(i, 0), P, N, V, albedo, specular,
-                                    shininess);
+        color += light_contribution(i, light_position(i, 0), P, N, V, m);
     }
     evaluations = count;
     return color;

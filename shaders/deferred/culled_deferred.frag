@@ -13,8 +13,8 @@ void main()
     vec3 color = vec3(0.0);
     if (gbuffer_surface(pixel, s)) {
         float d = -(u_frame.view * vec4(s.P, 1.0)).z;
-        color = shade_cell(grid_cell(gl_FragCoord.xy, d), s.P, s.N, s.albedo, s.specular,
-                           s.shininess, evaluations);
+        color = shade_cell(grid_cell(gl_FragCoord.xy, d), s.P, s.N, surface_material(s),
+                           evaluations);
     }
     heat_set(pixel, evaluations);
     out_color = vec4(color, 1.0);

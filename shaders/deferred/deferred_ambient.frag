@@ -10,6 +10,9 @@ void main()
 {
     ivec2 pixel = ivec2(gl_FragCoord.xy);
     Surface s;
-    out_color = gbuffer_surface(pixel, s) ? vec4(light_ambient(s.albedo), 1.0) : vec4(0.0, 0.0, 0.0, 1.0);
+    out_color = gbuffer_surface(pixel, s)
+                    ? vec4(light_ambient(surface_material(s), s.P, s.N,
+                                         normalize(u_frame.eye.xyz - s.P)), 1.0)
+                    : vec4(0.0, 0.0, 0.0, 1.0);
     heat_set(pixel, 0u);
 }

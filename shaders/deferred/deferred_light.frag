@@ -14,6 +14,6 @@ void main()
         discard;
     vec3 V = normalize(u_frame.eye.xyz - s.P);
     out_color = vec4(light_contribution(v_light, light_position(v_light, 0), s.P, s.N, V,
-                                        s.albedo, s.specular, s.shininess), 0.0);
+                                        surface_material(s)), 0.0);
     heat_add(pixel, 1u);
 }

@@ -15,5 +15,5 @@ void main()
     Material m = instance_material(v_instance);
     g_albedo = gbuffer_encode_albedo(m.albedo);
     g_normal = gbuffer_encode_normal(normalize(v_normal));
-    g_material = vec4(m.specular, m.shininess, 0.0, 0.0);
+    g_material = vec4(m.specular, m.shininess, m.metallic, m.roughness);
 }

@@ -9,10 +9,11 @@
 //     float, channels scaled by powers of 1/255 and unpacked with fract),
 //   GBUFFER_ALBEDO_PACK_BASE10 (r: seed 001's second, three decimal digits a
 //     channel in one float).
-// A third plane holds the material's specular weight and exponent (rg,
-// 32-bit floats: exact). Position is never stored: it is rebuilt from the
+// A third plane holds the material: specular weight and exponent (rg), and
+// under LIGHTING_PBR metallic and roughness (ba), 32-bit floats: exact. Position is never stored: it is rebuilt from the
 // depth texture with the frame block's inverse view-projection.
 #include "frame.glsl"
+#include "scene_data.glsl"
 
 vec2 gbuffer_sign_not_zero(vec2 v)
 {
@@ -96,7 +97,7 @@ layout(binding = SB_TEX_GBUFFER2) uniform sampler2D u_gbuffer_material;
 
 struct Surface {
     vec3 P, N, albedo;
-    float specular, shininess;
+    float specular, shininess, metallic, roughness;
 };
 
 // False for background pixels (nothing drawn: depth 1).
@@ -108,8 +109,17 @@ bool gbuffer_surface(ivec2 pixel, out Surface s)
     s.P = gbuffer_position(vec2(pixel) + 0.5, depth);
     s.N = gbuffer_decode_normal(texelFetch(u_gbuffer_normal, pixel, 0));
     s.albedo = gbuffer_decode_albedo(texelFetch(u_gbuffer_albedo, pixel, 0));
-    vec2 m = texelFetch(u_gbuffer_material, pixel, 0).rg;
+    vec4 m = texelFetch(u_gbuffer_material, pixel, 0);
     s.specular = m.r;
     s.shininess = m.g;
+    s.metallic = m.b;
+    s.roughness = m.a;
     return true;
+}
+
+// The surface's material, as the lighting library's Material forms take it
+// (scene_data.glsl declares the struct).
+Material surface_material(Surface s)
+{
+    return Material(s.albedo, s.specular, s.shininess, s.metallic, s.roughness);
 }

@@ -9,10 +9,10 @@ layout(std430, binding = SB_SSBO_OSL_TILES) readonly buffer TileBuffer { ivec4 t
 layout(std430, binding = SB_SSBO_OSL_WORK) readonly buffer WorkBuffer { uvec4 work[]; };
 layout(rgba8, binding = SB_IMG_OSL_ATLAS) writeonly uniform image2D u_atlas;
 
-// Per mesh (SCENE_MESH_COUNT: sphere, cube, plane); mip level l holds tiles
-// of size base >> l.
-uniform sampler2D u_position[3];
-uniform sampler2D u_normal[3];
+// Per mesh (SCENE_MESH_COUNT: sphere, cube, plane, teapot); mip level l
+// holds tiles of size base >> l.
+uniform sampler2D u_position[4];
+uniform sampler2D u_normal[4];
 uniform int u_work_count;
 uniform int u_groups_x;
 
@@ -45,9 +45,12 @@ void main()
     } else if (mesh == 1) {
         p = texelFetch(u_position[1], texel, tile.w);
         n = texelFetch(u_normal[1], texel, tile.w);
-    } else {
+    } else if (mesh == 2) {
         p = texelFetch(u_position[2], texel, tile.w);
         n = texelFetch(u_normal[2], texel, tile.w);
+    } else {
+        p = texelFetch(u_position[3], texel, tile.w);
+        n = texelFetch(u_normal[3], texel, tile.w);
     }
     vec3 color = vec3(0.0);
     if (p.w > 0.0) {

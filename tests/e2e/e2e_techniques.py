@@ -7,8 +7,9 @@ technique added later is tested without new test code:
 - options: /v1/info documents each option (type, default, rule); the defaults
   are accepted and come back in the spec unchanged; a bad value of each
   option answers 400 naming "<technique>.<option>";
-- the look: Blinn-Phong changes the image against Phong, and a technique
-  with it still agrees with forward under the same look; a 16-bit HDR target
+- the look: Blinn-Phong and PBR change the image against Phong, a technique
+  with Blinn-Phong still agrees with forward under the same look, every
+  technique with PBR agrees with forward with PBR; a 16-bit HDR target
   runs."""
 
 import os
@@ -112,7 +113,7 @@ try:
     # The look: the lighting model changes the image, and every technique is
     # scored against forward under the same look.
     paths = {}
-    for lighting in ("phong", "blinn_phong"):
+    for lighting in ("phong", "blinn_phong", "pbr"):
         done = d.run(dict(JOB, technique="forward", look={"lighting": lighting}))
         check(done.get("spec", {}).get("look", {}).get("lighting") == lighting, "look in the spec")
         paths[lighting] = os.path.join(d.tmp, lighting + ".png")
@@ -122,6 +123,19 @@ try:
     done = d.run(dict(JOB, technique="osl", reference="forward", look={"lighting": "blinn_phong"}))
     ssim = done.get("result", {}).get("quality", {}).get("worst_ssim", {}).get("value", 0)
     check(ssim >= SSIM_BOUND, "osl with Blinn-Phong agrees with forward with Blinn-Phong: %.5f" % ssim)
+    diff = testlib.png_diff(paths["phong"], paths["pbr"])
+    check(diff and diff["max_abs"] > 0, "PBR differs from Phong: %s" % diff)
+    # Every technique but unlit, with PBR, agrees with forward with PBR, on
+    # the many-lights scene (varied materials: a quarter of them metallic).
+    for name in names:
+        if name in ("forward", "unlit"):
+            continue
+        done = d.run(dict(JOB, technique=name, reference="forward", look={"lighting": "pbr"},
+                          scene=dict(SCENE, preset="lights", lights=64)))
+        ssim = done.get("result", {}).get("quality", {}).get("worst_ssim", {}).get("value", 0)
+        check(done.get("status") == "done" and ssim >= SSIM_BOUND,
+              "%s with PBR agrees with forward with PBR: SSIM %.5f (%s)"
+              % (name, ssim, done.get("error")))
     done = d.run(dict(JOB, technique="forward", look={"hdr": "rgba16f"}))
     check(done.get("status") == "done" and done["result"].get("look", {}).get("hdr") == "rgba16f",
           "a 16-bit HDR target runs: %s" % done.get("error"))

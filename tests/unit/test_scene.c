@@ -745,7 +745,7 @@ static bool round_trips(const char *json)
     json_t *again = scene_spec_to_json(&b);
     ok = ok && json_equal(out, again) && memcmp(&a, &b, sizeof(a)) == 0;
     /* Every option is written back. */
-    ok = ok && json_object_size(out) == 17;
+    ok = ok && json_object_size(out) == 18;
     json_decref(in);
     json_decref(out);
     json_decref(again);
@@ -775,6 +775,8 @@ static void test_spec(void)
                       "\"light_speed\":3,\"camera\":{\"path\":\"flythrough\",\"period\":99},"
                       "\"width\":160,\"height\":120}"));
     CHECK(round_trips("{\"camera\":\"orbit\"}"));
+    CHECK(round_trips("{\"preset\":\"teapots\",\"teapot_segments\":\"auto\"}"));
+    CHECK(round_trips("{\"preset\":\"chart\",\"teapot_segments\":3,\"materials\":\"preset\"}"));
 
     /* The preset's defaults come first, whatever the key order. */
     struct job_error err;
@@ -849,6 +851,95 @@ static void test_describe(void)
     scene_finish(&s);
 }
 
+/* The teapots preset (seed 002): eight teapots on the ground around a
+ * container, each its own material, a sky, 80 lights by default; the chart
+ * spans metallic by roughness; "preset" materials can be overridden. */
+static void test_teapots_preset(void)
+{
+    struct scene_spec spec;
+    struct job_error err;
+    scene_spec_defaults(&spec);
+    json_t *j = json_loads("{\"preset\":\"teapots\",\"width\":320,\"height\":240}", 0, NULL);
+    CHECK(scene_spec_parse(j, &spec, &err));
+    json_decref(j);
+    CHECK(spec.lights == 80 && spec.materials == SCENE_MATERIALS_PRESET && spec.teapot_segments == 12);
+    struct scene s;
+    CHECK(scene_init(&s, &spec));
+    CHECK(s.mesh_instance_count[SCENE_MESH_TEAPOT] == 8 && s.mesh_instance_count[SCENE_MESH_CUBE] == 1 &&
+          s.mesh_instance_count[SCENE_MESH_PLANE] == 1 && s.sky && s.light_count == 80);
+    CHECK(s.teapot_segments == 12 && s.meshes[SCENE_MESH_TEAPOT].index_count == 32 * 12 * 12 * 6);
+    int metals = 0, distinct = 0;
+    for (int i = 0; i < s.instance_count; i++) {
+        const struct scene_instance *in = &s.instances[i];
+        if (in->mesh != SCENE_MESH_TEAPOT)
+            continue;
+        metals += in->material.metallic == 1.0f;
+        /* Resting on the ground: the mesh is centred, its half height up. */
+        CHECK(fabsf(in->pos[1] - 1.575f * in->scale) < 1e-5f);
+        bool seen = false;
+        for (int k = 0; k < i; k++)
+            seen |= s.instances[k].mesh == SCENE_MESH_TEAPOT &&
+                    s.instances[k].material.roughness == in->material.roughness &&
+                    s.instances[k].material.metallic == in->material.metallic;
+        distinct += !seen;
+        /* Every teapot is on screen from the preset's camera. */
+        struct scene_camera cam;
+        scene_camera_at(&s, 0, &cam);
+        CHECK(scene_instance_in_view(&s, i, &cam));
+    }
+    CHECK(metals == 4 && distinct == 8);
+    json_t *d = scene_describe(&s);
+    CHECK(d && json_integer_value(json_object_get(json_object_get(d, "teapot_tessellation"),
+                                                  "segments")) == 12);
+    CHECK(json_is_true(json_object_get(d, "sky")));
+    json_decref(d);
+    scene_finish(&s);
+
+    /* "auto" picks from the teapots' size on screen, finer for a larger image. */
+    spec.teapot_segments = SCENE_TEAPOT_SEGMENTS_AUTO;
+    CHECK(scene_init(&s, &spec));
+    int small = s.teapot_segments;
+    CHECK(small >= 1 && s.teapot_error_px <= spec.tessellation_error_px + 1e-6);
+    scene_finish(&s);
+    spec.width = 1280, spec.height = 960;
+    CHECK(scene_init(&s, &spec));
+    CHECK(s.teapot_segments > small);
+    scene_finish(&s);
+
+    /* Uniform materials override the preset's. */
+    spec.materials = SCENE_MATERIALS_UNIFORM;
+    CHECK(scene_init(&s, &spec));
+    CHECK(s.instances[2].material.roughness == (float)spec.roughness);
+    scene_finish(&s);
+
+    /* The chart: metallic by row, roughness by column, corners 0 and 1. */
+    scene_spec_defaults(&spec);
+    scene_spec_preset_defaults(&spec, SCENE_PRESET_CHART);
+    CHECK(scene_init(&s, &spec));
+    CHECK(s.instance_count == 35 && s.mesh_instance_count[SCENE_MESH_SPHERE] == 35);
+    CHECK(s.instances[0].material.metallic == 0.0f && s.instances[0].material.roughness == 0.0f);
+    CHECK(s.instances[34].material.metallic == 1.0f && s.instances[34].material.roughness == 1.0f);
+    CHECK(s.teapot_segments == 0 && s.meshes[SCENE_MESH_TEAPOT].index_count == 0);
+    scene_finish(&s);
+
+    /* One white sphere in the spec's material. */
+    scene_spec_preset_defaults(&spec, SCENE_PRESET_SPHERE);
+    spec.roughness = 1.0;
+    CHECK(scene_init(&s, &spec));
+    CHECK(s.instance_count == 2 && s.instances[0].albedo[0] == 1.0f &&
+          s.instances[0].material.roughness == 1.0f);
+    scene_finish(&s);
+
+    /* Bad tessellations are named. */
+    scene_spec_defaults(&spec);
+    j = json_loads("{\"teapot_segments\":65}", 0, NULL);
+    CHECK(!scene_spec_parse(j, &spec, &err) && strcmp(err.field, "scene.teapot_segments") == 0);
+    json_decref(j);
+    j = json_loads("{\"teapot_segments\":\"fine\"}", 0, NULL);
+    CHECK(!scene_spec_parse(j, &spec, &err) && strcmp(err.field, "scene.teapot_segments") == 0);
+    json_decref(j);
+}
+
 int main(void)
 {
     test_grid_unchanged();
@@ -858,5 +949,6 @@ int main(void)
     test_tessellation();
     test_spec();
     test_describe();
+    test_teapots_preset();
     return check_finish("test_scene");
 }

@@ -57,7 +57,7 @@ static bool deferred_create(const struct technique_env *env, void **state, char 
                                    err, errlen);
     if (!d->light_fbo)
         goto fail;
-    char defines[512];
+    char defines[1024];
     snprintf(defines, sizeof(defines), "%s%s", bounds_defines[d->bounds], d->gbuffer.defines);
     const struct gl_stage ambient[] = {
         {GL_VERTEX_SHADER, {"fullscreen.vert"}},

@@ -25,7 +25,7 @@ enum { PASS_LIGHTING, PASS_RASTER };
 
 /* shaders/osl/osl_light.comp has one position and one normal sampler per
  * mesh and selects them by branch: keep both in step. */
-_Static_assert(SCENE_MESH_COUNT == 3, "osl_light.comp samples exactly three meshes");
+_Static_assert(SCENE_MESH_COUNT == 4, "osl_light.comp samples exactly four meshes");
 
 /* Atlas memory ceiling; the device's texture size limit applies as well. */
 static const double OSL_MAX_ATLAS_BYTES = 1024.0 * 1024.0 * 1024.0;

@@ -4,14 +4,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-static const int *sort_sizes;
-
-static int by_size_desc(const void *a, const void *b)
+static int log2_of(int v)
 {
-    int ia = *(const int *)a, ib = *(const int *)b;
-    if (sort_sizes[ia] != sort_sizes[ib])
-        return sort_sizes[ib] - sort_sizes[ia];
-    return ia - ib; /* stable: equal tiles keep instance order */
+    int l = 0;
+    while ((1 << (l + 1)) <= v && l < 30)
+        l++;
+    return l;
 }
 
 /* Morton (Z-order) index to cell coordinates. */
@@ -64,13 +62,33 @@ bool osl_atlas_pack(const int *sizes, int count, int max_size, double max_bytes,
         snprintf(err, errlen, "out of memory packing the atlas");
         return false;
     }
+    osl_atlas_place(sizes, count, w, h, order, tiles);
+    free(order);
+    *width = w;
+    *height = h;
+    return true;
+}
+
+void osl_atlas_place(const int *sizes, int count, int w, int h, int *order,
+                     struct osl_tile *tiles)
+{
+    /* Largest first, equal sizes in index order: a counting sort over the
+     * powers of two, so no allocation and the same order a stable sort
+     * gives. */
+    int per_log[32] = {0};
     for (int i = 0; i < count; i++)
-        order[i] = i;
-    sort_sizes = sizes;
-    qsort(order, (size_t)count, sizeof(int), by_size_desc);
+        per_log[log2_of(sizes[i])]++;
+    int start[32], next = 0;
+    for (int l = 31; l >= 0; l--) {
+        start[l] = next;
+        next += per_log[l];
+    }
+    for (int i = 0; i < count; i++)
+        order[start[log2_of(sizes[i])]++] = i;
     /* The atlas is w/h squares of h x h side by side. Largest tiles first,
      * each at the next Z-order position of its own size: with sizes falling,
      * the cursor is always aligned, so nothing overlaps and no space is lost. */
+    (void)w;
     double cursor = 0;
     for (int k = 0; k < count; k++) {
         int i = order[k], s = sizes[i];
@@ -84,10 +102,6 @@ bool osl_atlas_pack(const int *sizes, int count, int max_size, double max_bytes,
         tiles[i].size = s;
         cursor += (double)s * s;
     }
-    free(order);
-    *width = w;
-    *height = h;
-    return true;
 }
 
 int osl_auto_tile_size(double pixels_per_unit, double uv_per_unit, double texel_density)

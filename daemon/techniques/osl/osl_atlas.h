@@ -26,6 +26,15 @@ bool osl_atlas_pack(const int *sizes, int count, int max_size, double max_bytes,
                     struct osl_tile *tiles, int *width, int *height, char *err,
                     size_t errlen);
 
+/* Places tiles of power-of-two sizes, largest first (equal sizes in index
+ * order), each at the next Z-order position of its size, in an atlas of
+ * w x h texels (h a power of two at least the largest size, w a multiple
+ * of h) whose area holds them all; order is scratch for count ints. Never
+ * allocates, so the shadow atlas (daemon/lighting/shadow_plan.c) packs with
+ * it every frame. */
+void osl_atlas_place(const int *sizes, int count, int w, int h, int *order,
+                     struct osl_tile *tiles);
+
 /* Tile edge that gives about texel_density texels per covered pixel for an
  * object covering pixels_per_unit pixels per world unit whose UV layout has
  * uv_per_unit UV units per world unit: the nearest power of two in log

@@ -79,9 +79,11 @@ bool gbuffer_init(struct gbuffer *g, const struct technique_env *env,
                                                         g->normal_format, env->width,
                                                         env->height, err, errlen)
                                   : 0;
+    /* Metallic and roughness ride along only where the look reads them. */
+    g->material_format = env->look->lighting == LOOK_PBR ? GL_RGBA32F : GL_RG32F;
     g->material_tex = g->normal_tex ? gpu_targets_texture(env->targets, "gbuffer.material",
-                                                          GL_RG32F, env->width, env->height,
-                                                          err, errlen)
+                                                          g->material_format, env->width,
+                                                          env->height, err, errlen)
                                     : 0;
     GLuint planes[3] = {g->albedo_tex, g->normal_tex, g->material_tex};
     g->fbo = g->material_tex ? gpu_targets_fbo(env->targets, "gbuffer", planes, 3,
@@ -148,7 +150,11 @@ json_t *gbuffer_describe(const struct gbuffer *g)
                      format_name(g->normal_format), "albedo",
                      gbuffer_albedo_choices[g->opt.albedo], "albedo_format",
                      format_name(g->albedo_format), "material_format",
-                     "rg32f (specular, shininess)", "bytes_per_pixel",
-                     format_bytes(g->albedo_format) + format_bytes(g->normal_format) + 8.0 + 4.0,
+                     g->material_format == GL_RGBA32F
+                         ? "rgba32f (specular, shininess, metallic, roughness)"
+                         : "rg32f (specular, shininess)",
+                     "bytes_per_pixel",
+                     format_bytes(g->albedo_format) + format_bytes(g->normal_format) +
+                         format_bytes(g->material_format) + 4.0,
                      "position", "rebuilt from the 24-bit depth texture with inv_view_proj");
 }

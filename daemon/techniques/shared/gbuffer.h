@@ -19,11 +19,11 @@
 struct gbuffer {
     struct gbuffer_options opt;
     GLuint albedo_tex, normal_tex, material_tex, fbo;
-    GLenum albedo_format, normal_format;
+    GLenum albedo_format, normal_format, material_format;
     struct scene_program program;
     /* The layout's #defines and the look's, for every program that reads the
      * g-buffer (pass to gl_program_build). */
-    char defines[384];
+    char defines[768];
 };
 
 /* Allocates the planes from the pool and builds the g-buffer program. On

@@ -1,0 +1,170 @@
+#define _POSIX_C_SOURCE 200809L
+#include "daemon/harness/look.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "common/clock.h"
+#include "daemon/lighting/pbr_math.h"
+#include "daemon/lighting/shadow_plan.h"
+
+/* A GLSL float literal (always with a point or exponent). */
+static void glsl_float(char *out, size_t cap, double v)
+{
+    snprintf(out, cap, "%.9g", v);
+    if (!strpbrk(out, ".eE") && strlen(out) + 2 < cap)
+        strcat(out, ".0");
+}
+
+void harness_look_defines(const struct look_spec *look, char *out, size_t cap)
+{
+    static const char *const models[] = {"PHONG", "BLINN_PHONG", "PBR"};
+    char rough[32], intensity[32], bias[32], offset[32];
+    glsl_float(rough, sizeof(rough), PBR_MIN_ROUGHNESS);
+    glsl_float(intensity, sizeof(intensity), look->ibl.intensity);
+    int used = snprintf(out, cap,
+                        "#define LIGHTING_%s 1\n#define PBR_MIN_ROUGHNESS %s\n#define ENV_%s 1\n"
+                        "#define ENV_INTENSITY %s\n",
+                        models[look->lighting], rough,
+                        look->ibl.environment == IBL_ENV_UNIFORM ? "UNIFORM" : "SKY", intensity);
+    if (look->ibl.enabled && used > 0 && (size_t)used < cap)
+        used += snprintf(out + used, cap - (size_t)used,
+                         "#define LOOK_IBL 1\n#define IBL_MAX_BLEND %d\n", IBL_MAX_BLEND);
+    if (look->shadows.enabled && used > 0 && (size_t)used < cap) {
+        const struct shadow_spec *s = &look->shadows;
+        glsl_float(bias, sizeof(bias), s->bias);
+        glsl_float(offset, sizeof(offset), s->normal_offset);
+        snprintf(out + used, cap - (size_t)used,
+                 "#define LOOK_SHADOWS 1\n#define SHADOW_PCF %d\n#define SHADOW_BIAS %s\n"
+                 "#define SHADOW_NORMAL_OFFSET %s\n#define SHADOW_ATLAS_SIZE %d.0\n%s",
+                 s->pcf, bias, offset, s->atlas,
+                 s->layout == SHADOW_LAYOUT_CUBES ? "#define SHADOW_CUBES 1\n" : "");
+    }
+}
+
+bool harness_look_init(struct harness_look *l, const struct look_spec *look,
+                       const struct scene *scene, struct gpu_scene *gpu,
+                       struct gpu_frame_block *frame_block, const struct gpu_caps *caps,
+                       const char *defines, char *err, size_t errlen)
+{
+    memset(l, 0, sizeof(*l));
+    l->look = look;
+    l->scene = scene;
+    double t0 = clock_mono_s();
+    l->sky_on = scene->sky;
+    if ((l->sky_on || look->ibl.enabled) && !harness_sky_init(&l->sky, defines, err, errlen))
+        goto fail;
+    if (look->ibl.enabled) {
+        struct harness_ibl_env env = {&look->ibl, scene, gpu, frame_block, &l->sky};
+        if (!(l->ibl = harness_ibl_create(&env, err, errlen)))
+            goto fail;
+    }
+    if (look->shadows.enabled &&
+        !(l->shadows = harness_shadows_create(&look->shadows, scene, gpu, caps, err, errlen)))
+        goto fail;
+    l->setup_ms = (clock_mono_s() - t0) * 1e3;
+    return true;
+fail:
+    harness_look_finish(l);
+    return false;
+}
+
+void harness_look_finish(struct harness_look *l)
+{
+    if (!l)
+        return;
+    harness_shadows_destroy(l->shadows);
+    harness_ibl_destroy(l->ibl);
+    harness_sky_finish(&l->sky);
+    memset(l, 0, sizeof(*l));
+}
+
+bool harness_look_add_passes(const struct harness_look *l, struct gpu_passes *passes,
+                             int *shadow_pass, int *sky_pass)
+{
+    *shadow_pass = *sky_pass = -1;
+    if (l->shadows && (*shadow_pass = gpu_passes_add(passes, "shadows")) < 0)
+        return false;
+    if (l->sky_on && (*sky_pass = gpu_passes_add(passes, "sky")) < 0)
+        return false;
+    return true;
+}
+
+bool harness_look_before(struct harness_look *l, const struct gpu_passes *passes, int shadow_pass,
+                         int64_t frame, bool timed, char *err, size_t errlen)
+{
+    if (l->ibl)
+        harness_ibl_frame(l->ibl, frame);
+    if (l->shadows && shadow_pass >= 0)
+        return harness_shadows_render(l->shadows, passes, shadow_pass, frame, timed, err, errlen);
+    return true;
+}
+
+void harness_look_after(struct harness_look *l, const struct gpu_passes *passes, int sky_pass,
+                        GLuint output_fbo, int width, int height)
+{
+    if (!l->sky_on || sky_pass < 0)
+        return;
+    gpu_pass_begin(passes, sky_pass, output_fbo, width, height);
+    harness_sky_draw(&l->sky);
+    gpu_pass_end(passes);
+}
+
+void harness_look_describe(const struct harness_look *l, json_t *result)
+{
+    if (l->ibl)
+        json_object_set_new(result, "ibl", harness_ibl_describe(l->ibl));
+    if (l->shadows)
+        json_object_set_new(result, "shadows", harness_shadows_describe(l->shadows));
+    if (l->ibl || l->shadows || l->sky_on)
+        json_object_set_new(result, "setup_ms",
+                            json_pack("{s:f, s:s}", "look", l->setup_ms, "includes",
+                                      "the sky, image-based lighting's captures and filtering, "
+                                      "and the shadow maps' allocation, before the warm-up "
+                                      "frames"));
+    if (l->look->lighting == LOOK_PBR) {
+        int clamped = 0;
+        for (int i = 0; i < l->scene->instance_count; i++)
+            clamped += l->scene->instances[i].material.roughness < PBR_MIN_ROUGHNESS;
+        json_object_set_new(result, "pbr",
+                            json_pack("{s:f, s:i, s:s}", "min_roughness", PBR_MIN_ROUGHNESS,
+                                      "materials_clamped", clamped, "rule",
+                                      "roughness below min_roughness is shaded at it: GGX at "
+                                      "roughness 0 divides 0 by 0 where N = H"));
+    }
+}
+
+void harness_hdr_stats(GLuint fbo, int w, int h, float *scratch, struct hdr_stats *out)
+{
+    memset(out, 0, sizeof(*out));
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, scratch);
+    long long finite = 0;
+    double sum[3] = {0, 0, 0};
+    out->min = INFINITY;
+    for (long long p = 0; p < (long long)w * h; p++) {
+        const float *c = &scratch[p * 4];
+        if (!isfinite(c[0]) || !isfinite(c[1]) || !isfinite(c[2])) {
+            out->nonfinite++;
+            continue;
+        }
+        finite++;
+        for (int k = 0; k < 3; k++) {
+            sum[k] += c[k];
+            out->max = c[k] > out->max ? c[k] : out->max;
+            out->min = c[k] < out->min ? c[k] : out->min;
+        }
+    }
+    for (int k = 0; k < 3; k++)
+        out->mean[k] = finite ? sum[k] / (double)finite : 0.0;
+    if (!finite)
+        out->min = 0.0;
+}
+
+json_t *hdr_stats_json(const struct hdr_stats *s)
+{
+    return json_pack("{s:I, s:[f, f, f], s:f, s:f}", "nonfinite", (json_int_t)s->nonfinite,
+                     "mean", s->mean[0], s->mean[1], s->mean[2], "min", s->min, "max", s->max);
+}

@@ -1,0 +1,324 @@
+/* Omni shadow maps: see shadows.h. Casters are drawn one instance at a time
+ * (an explicit uniform per draw), culled against the light's sphere and
+ * each face's frustum on the CPU as seed 002 culls by bounding boxes; back
+ * faces go into the maps (front faces culled), so that lit surfaces are
+ * compared against the far side of their own object and the bias only has
+ * to cover contact. */
+#define _POSIX_C_SOURCE 200809L
+#include "daemon/harness/shadows.h"
+
+#include <epoxy/gl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "daemon/gpu/bindings.h"
+#include "daemon/gpu/glutil.h"
+#include "daemon/lighting/cube_faces.h"
+#include "daemon/lighting/shadow_plan.h"
+
+static const float SHADOW_NEAR = 0.02f;
+
+/* shaders/common/shadows.glsl, ShadowLight (std430). */
+struct shadow_light_gpu {
+    float pos_far[4];
+    float params[4]; /* size, widen, near, layer */
+    int32_t faces[12];
+};
+
+enum { MAX_DROPPED_LISTED = 64 };
+
+struct harness_shadows {
+    struct shadow_spec spec;
+    const struct scene *scene;
+    struct gpu_scene *gpu;
+    struct shadow_plan plan;
+    GLuint prog, fbo, depth, ssbo;
+    struct shadow_light_gpu *rows;
+    int *casters; /* scratch: instances within the light */
+    int border;
+    double bytes;
+    /* Timed frames. */
+    int frames;
+    double mapped_sum, texels_sum, faces_sum, draws_sum, dropped_sum;
+    int mapped_min, mapped_max, dropped_max, culled_last, no_casters_last;
+    double texels_max;
+    int frames_with_drops;
+    int dropped_lights[MAX_DROPPED_LISTED], ndropped_lights, dropped_distinct;
+    unsigned char *ever_dropped;
+    int tile_hist[16]; /* faces by log2 size at the first timed frame */
+};
+
+struct harness_shadows *harness_shadows_create(const struct shadow_spec *spec,
+                                               const struct scene *s, struct gpu_scene *gpu,
+                                               const struct gpu_caps *caps, char *err,
+                                               size_t errlen)
+{
+    struct harness_shadows *sh = calloc(1, sizeof(*sh));
+    if (!sh) {
+        snprintf(err, errlen, "look.shadows: out of memory");
+        return NULL;
+    }
+    sh->spec = *spec;
+    sh->scene = s;
+    sh->gpu = gpu;
+    sh->border = spec->layout == SHADOW_LAYOUT_ATLAS ? shadow_border(spec->pcf) : 0;
+    sh->mapped_min = s->light_count;
+    size_t n = (size_t)(s->light_count ? s->light_count : 1);
+    sh->rows = calloc(n, sizeof(*sh->rows));
+    sh->casters = calloc((size_t)(s->instance_count ? s->instance_count : 1), sizeof(int));
+    sh->ever_dropped = calloc(n, 1);
+    if (!sh->rows || !sh->casters || !sh->ever_dropped ||
+        !shadow_plan_init(&sh->plan, s->light_count, spec)) {
+        snprintf(err, errlen, "look.shadows: out of memory for %d lights", s->light_count);
+        goto fail;
+    }
+    int limit = spec->layout == SHADOW_LAYOUT_ATLAS ? caps->max_texture_size : caps->max_texture_size;
+    if (spec->atlas > limit || spec->tile > limit) {
+        snprintf(err, errlen, "look.shadows.atlas %d exceeds this device's GL_MAX_TEXTURE_SIZE %d",
+                 spec->atlas, limit);
+        goto fail;
+    }
+    const struct gl_stage stages[] = {{GL_VERTEX_SHADER, {"shadow.vert"}},
+                                      {GL_FRAGMENT_SHADER, {"shadow.frag"}}};
+    if (!(sh->prog = gl_program_build("shadows", stages, 2, NULL, err, errlen)))
+        goto fail;
+    glGenTextures(1, &sh->depth);
+    GLenum target = spec->layout == SHADOW_LAYOUT_ATLAS ? GL_TEXTURE_2D : GL_TEXTURE_CUBE_MAP_ARRAY;
+    glBindTexture(target, sh->depth);
+    if (spec->layout == SHADOW_LAYOUT_ATLAS) {
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_DEPTH_COMPONENT32F, spec->atlas, spec->atlas);
+        sh->bytes = 4.0 * spec->atlas * spec->atlas;
+    } else {
+        int layers = sh->plan.layers > 0 ? sh->plan.layers : 1;
+        glTexStorage3D(GL_TEXTURE_CUBE_MAP_ARRAY, 1, GL_DEPTH_COMPONENT32F, spec->tile, spec->tile,
+                       6 * layers);
+        sh->bytes = 4.0 * 6.0 * layers * spec->tile * spec->tile;
+    }
+    glTexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexParameteri(target, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTexParameteri(target, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    glGenFramebuffers(1, &sh->fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, sh->fbo);
+    glDrawBuffer(GL_NONE);
+    glReadBuffer(GL_NONE);
+    if (spec->layout == SHADOW_LAYOUT_ATLAS) {
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, sh->depth, 0);
+        if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+            snprintf(err, errlen, "look.shadows: the atlas framebuffer is incomplete");
+            glBindFramebuffer(GL_FRAMEBUFFER, 0);
+            goto fail;
+        }
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glGenBuffers(1, &sh->ssbo);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, sh->ssbo);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(n * sizeof(*sh->rows)), NULL,
+                 GL_DYNAMIC_DRAW);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    return sh;
+fail:
+    harness_shadows_destroy(sh);
+    return NULL;
+}
+
+/* Whether a sphere (centre relative to the light d, radius r) reaches the
+ * face's frustum (widened by w): inside all four side planes, or nearly. */
+static bool sphere_meets_face(const float d[3], float r, const float fw[3], const float sa[3],
+                              const float ta[3], float w)
+{
+    float f = d[0] * fw[0] + d[1] * fw[1] + d[2] * fw[2];
+    if (f < -r)
+        return false;
+    float s = d[0] * sa[0] + d[1] * sa[1] + d[2] * sa[2];
+    float t = d[0] * ta[0] + d[1] * ta[1] + d[2] * ta[2];
+    float norm = sqrtf(w * w + 1.0f);
+    /* Planes f w -+ s >= 0 and f w -+ t >= 0, normalised. */
+    return (f * w - s) / norm >= -r && (f * w + s) / norm >= -r && (f * w - t) / norm >= -r &&
+           (f * w + t) / norm >= -r;
+}
+
+static void draw_casters(struct harness_shadows *sh, int ncasters, const float light[3], int face,
+                         float widen)
+{
+    const struct scene *s = sh->scene;
+    float fw[3], sa[3], ta[3];
+    cube_face_axes(face, fw, sa, ta);
+    int bound_mesh = -1;
+    for (int c = 0; c < ncasters; c++) {
+        int i = sh->casters[c];
+        const struct scene_instance *in = &s->instances[i];
+        float d[3] = {in->pos[0] - light[0], in->pos[1] - light[1], in->pos[2] - light[2]};
+        if (!sphere_meets_face(d, scene_instance_bound(s, i), fw, sa, ta, widen))
+            continue;
+        if ((int)in->mesh != bound_mesh) {
+            bound_mesh = (int)in->mesh;
+            glBindVertexArray(sh->gpu->vao[bound_mesh]);
+        }
+        glUniform1i(SB_LOC_SHADOW_INSTANCE, i);
+        glDrawElements(GL_TRIANGLES, (GLsizei)s->meshes[in->mesh].index_count, GL_UNSIGNED_INT,
+                       NULL);
+        sh->draws_sum += 1;
+    }
+}
+
+bool harness_shadows_render(struct harness_shadows *sh, const struct gpu_passes *passes, int pass,
+                            int64_t frame, bool timed, char *err, size_t errlen)
+{
+    const struct scene *s = sh->scene;
+    const struct shadow_spec *spec = &sh->spec;
+    struct shadow_plan *p = &sh->plan;
+    if (!shadow_plan_frame(p, s, spec, frame, err, errlen))
+        return false;
+    bool atlas = spec->layout == SHADOW_LAYOUT_ATLAS;
+    gpu_pass_begin(passes, pass, sh->fbo, atlas ? spec->atlas : spec->tile,
+                   atlas ? spec->atlas : spec->tile);
+    glCullFace(GL_FRONT);
+    glUseProgram(sh->prog);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_INSTANCES, sh->gpu->instance_buffer);
+    if (atlas)
+        glEnable(GL_SCISSOR_TEST);
+    double draws_before = sh->draws_sum;
+    for (int i = 0; i < p->lights; i++) {
+        const struct shadow_light_plan *l = &p->light[i];
+        struct shadow_light_gpu *row = &sh->rows[i];
+        memset(row, 0, sizeof(*row));
+        if (l->status != SHADOW_MAPPED)
+            continue;
+        float radius = s->lights[i].radius;
+        float widen = shadow_face_widen(l->size, sh->border);
+        memcpy(row->pos_far, l->pos, sizeof(l->pos));
+        row->pos_far[3] = radius;
+        row->params[0] = (float)l->size;
+        row->params[1] = widen;
+        row->params[2] = SHADOW_NEAR;
+        row->params[3] = (float)l->x[0];
+        for (int f = 0; f < 6; f++)
+            row->faces[f * 2] = l->x[f], row->faces[f * 2 + 1] = l->y[f];
+        /* Casters within the light's reach (the ground never casts). */
+        int ncasters = 0;
+        for (int k = 0; k < s->instance_count; k++) {
+            const struct scene_instance *in = &s->instances[k];
+            if (in->mesh == SCENE_MESH_PLANE)
+                continue;
+            float r = radius + scene_instance_bound(s, k);
+            float d[3] = {in->pos[0] - l->pos[0], in->pos[1] - l->pos[1], in->pos[2] - l->pos[2]};
+            if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < r * r)
+                sh->casters[ncasters++] = k;
+        }
+        for (int f = 0; f < 6; f++) {
+            float vp[16];
+            cube_face_view_proj(f, l->pos, widen, SHADOW_NEAR, radius, vp);
+            if (atlas) {
+                glViewport(l->x[f], l->y[f], l->size, l->size);
+                glScissor(l->x[f], l->y[f], l->size, l->size);
+            } else {
+                glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, sh->depth, 0,
+                                          l->x[0] * 6 + f);
+            }
+            glClear(GL_DEPTH_BUFFER_BIT);
+            glUniformMatrix4fv(SB_LOC_SHADOW_VIEW_PROJ, 1, GL_FALSE, vp);
+            draw_casters(sh, ncasters, l->pos, f, widen);
+        }
+    }
+    glBindVertexArray(0);
+    glDisable(GL_SCISSOR_TEST);
+    glCullFace(GL_BACK);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, sh->ssbo);
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0,
+                    (GLsizeiptr)((size_t)p->lights * sizeof(*sh->rows)), sh->rows);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    gpu_pass_end(passes);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_SHADOW_LIGHTS, sh->ssbo);
+    glActiveTexture(GL_TEXTURE0 + (atlas ? SB_TEX_SHADOW_ATLAS : SB_TEX_SHADOW_CUBES));
+    glBindTexture(atlas ? GL_TEXTURE_2D : GL_TEXTURE_CUBE_MAP_ARRAY, sh->depth);
+    glActiveTexture(GL_TEXTURE0);
+
+    if (!timed) {
+        sh->draws_sum = draws_before;
+        return true;
+    }
+    if (sh->frames == 0)
+        for (int i = 0; i < p->lights; i++)
+            if (p->light[i].status == SHADOW_MAPPED) {
+                int lg = 0;
+                while ((1 << (lg + 1)) <= p->light[i].size && lg < 15)
+                    lg++;
+                sh->tile_hist[lg] += 6;
+            }
+    sh->frames++;
+    sh->mapped_sum += p->mapped;
+    sh->texels_sum += p->texels;
+    sh->faces_sum += 6.0 * p->mapped;
+    sh->dropped_sum += p->dropped;
+    sh->mapped_min = p->mapped < sh->mapped_min ? p->mapped : sh->mapped_min;
+    sh->mapped_max = p->mapped > sh->mapped_max ? p->mapped : sh->mapped_max;
+    sh->dropped_max = p->dropped > sh->dropped_max ? p->dropped : sh->dropped_max;
+    sh->texels_max = p->texels > sh->texels_max ? p->texels : sh->texels_max;
+    sh->culled_last = p->culled;
+    sh->no_casters_last = p->no_casters;
+    if (p->dropped) {
+        sh->frames_with_drops++;
+        for (int i = 0; i < p->lights; i++)
+            if (p->light[i].status == SHADOW_DROPPED && !sh->ever_dropped[i]) {
+                sh->ever_dropped[i] = 1;
+                sh->dropped_distinct++;
+                if (sh->ndropped_lights < MAX_DROPPED_LISTED)
+                    sh->dropped_lights[sh->ndropped_lights++] = i;
+            }
+    }
+    return true;
+}
+
+json_t *harness_shadows_describe(const struct harness_shadows *sh)
+{
+    const struct shadow_spec *spec = &sh->spec;
+    double n = sh->frames > 0 ? sh->frames : 1;
+    double capacity = (double)spec->atlas * spec->atlas;
+    json_t *dropped = json_array(), *tiles = json_object();
+    for (int i = 0; i < sh->ndropped_lights; i++)
+        json_array_append_new(dropped, json_integer(sh->dropped_lights[i]));
+    for (int lg = 0; lg < 16; lg++)
+        if (sh->tile_hist[lg]) {
+            char key[16];
+            snprintf(key, sizeof(key), "%d", 1 << lg);
+            json_object_set_new(tiles, key, json_integer(sh->tile_hist[lg]));
+        }
+    return json_pack(
+        "{s:s, s:i, s:o, s:f, s:i, s:i, s:{s:f, s:i, s:i}, s:{s:f, s:f, s:f, s:f}, s:f, s:f, "
+        "s:o, s:{s:s, s:i, s:f, s:i, s:i, s:o, s:s}, s:i, s:i}",
+        "layout", shadow_layout_names[spec->layout], "atlas", spec->atlas, "tile",
+        spec->tile ? json_integer(spec->tile) : json_string("auto"), "bytes", sh->bytes, "pcf",
+        spec->pcf, "border_texels", sh->border, "lights_mapped", "mean", sh->mapped_sum / n, "min",
+        sh->frames ? sh->mapped_min : 0, "max", sh->mapped_max, "atlas_use", "texels_mean",
+        sh->texels_sum / n, "texels_max", sh->texels_max, "fraction_mean",
+        sh->texels_sum / n / capacity, "fraction_max", sh->texels_max / capacity, "faces_per_frame",
+        sh->faces_sum / n, "caster_draws_per_frame", sh->draws_sum / n, "faces_by_size_at_frame_1",
+        tiles, "overflow", "policy", shadow_overflow_names[spec->overflow], "frames_with_drops",
+        sh->frames_with_drops, "dropped_mean", sh->dropped_sum / n, "dropped_max",
+        sh->dropped_max, "lights_dropped", sh->dropped_distinct, "lights", dropped, "rule",
+        "lights that needed a map but did not fit the atlas at min_tile, least important "
+        "first; 'lights' lists the first 64 of them by index",
+        "lights_culled_last_frame", sh->culled_last, "lights_without_casters_last_frame",
+        sh->no_casters_last);
+}
+
+void harness_shadows_destroy(struct harness_shadows *sh)
+{
+    if (!sh)
+        return;
+    if (sh->prog)
+        glDeleteProgram(sh->prog);
+    glDeleteTextures(1, &sh->depth);
+    glDeleteFramebuffers(1, &sh->fbo);
+    glDeleteBuffers(1, &sh->ssbo);
+    shadow_plan_finish(&sh->plan);
+    free(sh->rows);
+    free(sh->casters);
+    free(sh->ever_dropped);
+    free(sh);
+}

@@ -1,0 +1,213 @@
+#define _POSIX_C_SOURCE 200809L
+#include "daemon/lighting/shadow_plan.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+int shadow_cube_layers(const struct shadow_spec *spec, int lights)
+{
+    double texels = (double)spec->atlas * spec->atlas;
+    int fit = (int)(texels / (6.0 * spec->tile * spec->tile));
+    return fit < lights ? fit : lights;
+}
+
+int shadow_border(int pcf) { return pcf + 1; }
+
+float shadow_face_widen(int size, int border)
+{
+    int inner = size - 2 * border;
+    return inner > 0 ? (float)size / (float)inner : 1.0f;
+}
+
+bool shadow_plan_init(struct shadow_plan *p, int lights, const struct shadow_spec *spec)
+{
+    memset(p, 0, sizeof(*p));
+    size_t n = (size_t)(lights ? lights : 1);
+    p->lights = lights;
+    p->light = calloc(n, sizeof(*p->light));
+    p->order = calloc(n * 6, sizeof(int));
+    p->sizes = calloc(n * 6, sizeof(int));
+    p->slots = calloc(n * 6, sizeof(int));
+    p->tiles = calloc(n * 6, sizeof(*p->tiles));
+    if (!p->light || !p->order || !p->sizes || !p->slots || !p->tiles) {
+        shadow_plan_finish(p);
+        return false;
+    }
+    if (spec->layout == SHADOW_LAYOUT_CUBES)
+        p->layers = shadow_cube_layers(spec, lights);
+    return true;
+}
+
+void shadow_plan_finish(struct shadow_plan *p)
+{
+    if (!p)
+        return;
+    free(p->light);
+    free(p->order);
+    free(p->sizes);
+    free(p->slots);
+    free(p->tiles);
+    memset(p, 0, sizeof(*p));
+}
+
+static int nearest_pow2(double v)
+{
+    if (!(v > 1.0))
+        return 1;
+    double l = round(log2(v));
+    return l > 30 ? 1 << 30 : 1 << (int)l;
+}
+
+/* Whether a caster (any object but the ground) lies within the light. */
+static bool has_caster(const struct scene *s, const float pos[3], float radius)
+{
+    for (int i = 0; i < s->instance_count; i++) {
+        const struct scene_instance *in = &s->instances[i];
+        if (in->mesh == SCENE_MESH_PLANE)
+            continue;
+        float r = radius + scene_instance_bound(s, i);
+        float d[3] = {in->pos[0] - pos[0], in->pos[1] - pos[1], in->pos[2] - pos[2]};
+        if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < r * r)
+            return true;
+    }
+    return false;
+}
+
+/* Indices of lights needing maps, most important first (ties by index):
+ * an insertion into a sorted run would be quadratic for 16,384 lights, so
+ * a heap sort, which needs no scratch. */
+static bool before(const struct shadow_plan *p, int a, int b)
+{
+    float ia = p->light[a].importance, ib = p->light[b].importance;
+    return ia > ib || (ia == ib && a < b);
+}
+
+static void sift(const struct shadow_plan *p, int *h, int n, int i)
+{
+    for (;;) {
+        int l = 2 * i + 1, r = l + 1, last = i;
+        /* A max-heap on "after": the root is the least important. */
+        if (l < n && before(p, h[last], h[l]))
+            last = l;
+        if (r < n && before(p, h[last], h[r]))
+            last = r;
+        if (last == i)
+            return;
+        int t = h[i];
+        h[i] = h[last];
+        h[last] = t;
+        i = last;
+    }
+}
+
+static void sort_by_importance(const struct shadow_plan *p, int *h, int n)
+{
+    for (int i = n / 2 - 1; i >= 0; i--)
+        sift(p, h, n, i);
+    for (int end = n - 1; end > 0; end--) {
+        int t = h[0];
+        h[0] = h[end];
+        h[end] = t;
+        sift(p, h, end, 0);
+    }
+}
+
+bool shadow_plan_frame(struct shadow_plan *p, const struct scene *s, const struct shadow_spec *spec,
+                       int64_t frame, char *err, size_t errlen)
+{
+    struct scene_camera cam;
+    scene_camera_at(s, frame, &cam);
+    p->mapped = p->culled = p->no_casters = p->dropped = 0;
+    p->texels = 0;
+    int need = 0;
+    for (int i = 0; i < p->lights; i++) {
+        struct shadow_light_plan *l = &p->light[i];
+        float radius = s->lights[i].radius;
+        scene_light_position(s, i, frame, l->pos);
+        l->size = 0;
+        l->importance = 0;
+        if (!scene_sphere_in_frustum(cam.view_proj, l->pos, radius, false)) {
+            l->status = SHADOW_CULLED;
+            p->culled++;
+            continue;
+        }
+        if (!has_caster(s, l->pos, radius)) {
+            l->status = SHADOW_NO_CASTERS;
+            p->no_casters++;
+            continue;
+        }
+        l->status = SHADOW_MAPPED;
+        l->importance = scene_sphere_radius_px(&cam, s->spec.width, s->spec.height, l->pos, radius);
+        int size = spec->tile ? spec->tile : nearest_pow2(l->importance);
+        if (!spec->tile)
+            size = size < spec->min_tile ? spec->min_tile : size > spec->max_tile ? spec->max_tile : size;
+        l->size = size;
+        p->order[need++] = i;
+    }
+    sort_by_importance(p, p->order, need);
+
+    int kept = need;
+    if (spec->layout == SHADOW_LAYOUT_CUBES) {
+        kept = need < p->layers ? need : p->layers;
+    } else {
+        double cap = (double)spec->atlas * spec->atlas, total = 0;
+        for (int k = 0; k < need; k++)
+            total += 6.0 * p->light[p->order[k]].size * p->light[p->order[k]].size;
+        /* Shrink the least important first, each down to min_tile. */
+        for (int k = need - 1; k >= 0 && total > cap && !spec->tile; k--) {
+            struct shadow_light_plan *l = &p->light[p->order[k]];
+            while (l->size > spec->min_tile && total > cap) {
+                total -= 6.0 * l->size * l->size * 0.75;
+                l->size /= 2;
+            }
+        }
+        /* Then drop, least important first. */
+        while (kept > 0 && total > cap) {
+            struct shadow_light_plan *l = &p->light[p->order[--kept]];
+            total -= 6.0 * l->size * l->size;
+        }
+    }
+    for (int k = kept; k < need; k++) {
+        struct shadow_light_plan *l = &p->light[p->order[k]];
+        l->status = SHADOW_DROPPED;
+        l->size = 0;
+        p->dropped++;
+    }
+    if (p->dropped && spec->overflow == SHADOW_OVERFLOW_FAIL) {
+        int used = snprintf(err, errlen, "frame %lld: look.shadows.atlas %d cannot hold the maps "
+                            "of %d lights at their smallest size; lights without shadows:",
+                            (long long)frame, spec->atlas, need);
+        for (int k = kept; k < need && used > 0 && (size_t)used < errlen; k++)
+            used += snprintf(err + used, errlen - (size_t)used, "%s %d", k > kept ? "," : "",
+                             p->order[k]);
+        if (used > 0 && (size_t)used < errlen)
+            snprintf(err + used, errlen - (size_t)used, " (raise look.shadows.atlas, lower "
+                     "min_tile, or set overflow \"drop_report\")");
+        return false;
+    }
+    p->mapped = kept;
+    if (spec->layout == SHADOW_LAYOUT_CUBES) {
+        for (int k = 0; k < kept; k++) {
+            struct shadow_light_plan *l = &p->light[p->order[k]];
+            l->x[0] = k;
+            p->texels += 6.0 * l->size * l->size;
+        }
+        return true;
+    }
+    /* Six faces a light, in importance order, into one atlas square. */
+    for (int k = 0; k < kept; k++)
+        for (int f = 0; f < 6; f++)
+            p->sizes[k * 6 + f] = p->light[p->order[k]].size;
+    osl_atlas_place(p->sizes, kept * 6, spec->atlas, spec->atlas, p->slots, p->tiles);
+    for (int k = 0; k < kept; k++) {
+        struct shadow_light_plan *l = &p->light[p->order[k]];
+        for (int f = 0; f < 6; f++) {
+            l->x[f] = p->tiles[k * 6 + f].x;
+            l->y[f] = p->tiles[k * 6 + f].y;
+        }
+        p->texels += 6.0 * l->size * l->size;
+    }
+    return true;
+}

@@ -10,6 +10,8 @@ void main()
 {
     ivec2 pixel = ivec2(gl_FragCoord.xy);
     Surface s;
-    out_color = gbuffer_surface(pixel, s) ? vec4(light_ambient(s.albedo), 1.0) : vec4(0.0, 0.0, 0.0, 1.0);
+    out_color = vec4(0.0, 0.0, 0.0, 1.0);
+    if (gbuffer_surface(pixel, s))
+        out_color.rgb = light_ambient(s.albedo);
     heat_set(pixel, 0u);
 }

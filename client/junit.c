@@ -2,6 +2,7 @@
 #include "client/junit.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -244,9 +245,9 @@ void junit_job_name(const json_t *spec, char *out, size_t cap)
         if (gate_nonsemantic_field(k) || !strcmp(k, "technique") || !strcmp(k, "scene") ||
             !strcmp(k, "frames") || !strcmp(k, "warmup_frames"))
             continue;
-        if (json_is_object(v)) {
+        if (json_is_object(v) || !strcmp(k, "look")) {
             if (!tech || strcmp(k, tech) != 0)
-                continue; /* another technique's options */
+                continue; /* another technique's options, or the look (hashed below) */
             size_t m;
             const char **sub = sorted_keys(v, &m);
             put(out, cap, " %s(", k);
@@ -273,16 +274,27 @@ void junit_job_name(const json_t *spec, char *out, size_t cap)
             (long long)json_integer_value(json_object_get(scene, "height")),
             (long long)json_integer_value(json_object_get(scene, "lights")),
             json_is_true(json_object_get(scene, "dynamic")) ? "moving" : "still");
-        const char **sk = sorted_keys(scene, &n);
-        for (size_t i = 0; sk && i < n; i++) {
-            if (!strcmp(sk[i], "preset") || !strcmp(sk[i], "width") || !strcmp(sk[i], "height") ||
-                !strcmp(sk[i], "lights") || !strcmp(sk[i], "dynamic"))
-                continue;
-            scalar_text(json_object_get(scene, sk[i]), text, sizeof(text));
-            put(out, cap, " %s=%s", sk[i], text);
-        }
-        free(sk);
     }
+    /* The rest of the scene (layout, camera, materials, ...) and the look
+     * change the workload too, but spelled out they would bury the name:
+     * they go in as a short hash of their sorted JSON, stable across runs. */
+    json_t *rest = json_object();
+    if (json_is_object(scene)) {
+        json_t *s2 = json_deep_copy(scene);
+        static const char *const shown[] = {"preset", "width", "height", "lights", "dynamic"};
+        for (size_t i = 0; i < sizeof(shown) / sizeof(shown[0]); i++)
+            json_object_del(s2, shown[i]);
+        json_object_set_new(rest, "scene", s2);
+    }
+    if (json_object_get(spec, "look"))
+        json_object_set(rest, "look", json_object_get(spec, "look"));
+    char *text_rest = json_dumps(rest, JSON_SORT_KEYS | JSON_COMPACT);
+    uint32_t h = 2166136261u; /* FNV-1a */
+    for (const char *p = text_rest; p && *p; p++)
+        h = (h ^ (unsigned char)*p) * 16777619u;
+    put(out, cap, " #%08x", h);
+    free(text_rest);
+    json_decref(rest);
     json_t *frames = json_object_get(spec, "frames");
     if (json_is_integer(frames))
         put(out, cap, ", %lld frames", (long long)json_integer_value(frames));

@@ -9,8 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { WIDTH = 900, HEIGHT = 560, MAX_SERIES = 8 };
-static const double LEFT = 90, RIGHT = 200, TOP = 50, BOTTOM = 70;
+enum { WIDTH = 900, HEIGHT = 560, MAX_SERIES = 8, MAX_WORKLOADS = 32, MAX_LEVELS = 16 };
+static const double LEFT = 90, RIGHT = 200, TOP = 62, BOTTOM = 70;
 
 /* Colour-blind-safe (Okabe-Ito). */
 static const double PALETTE[MAX_SERIES][3] = {
@@ -20,48 +20,140 @@ static const double PALETTE[MAX_SERIES][3] = {
 
 struct point {
     double x, y, x_lo, x_hi, y_lo, y_hi;
+    bool lo_clamped;   /* the interval reached below zero and was cut at the axis */
     char label[64];
     int series;
-    bool pareto;
-    /* distribution charts */
-    double box[6]; /* min, p5, median, p95, p99, max */
+    int workload;      /* index into chart.workloads; fronts never cross them */
+    bool pareto, reference;
+    double box[6];     /* distribution charts: min, p5, median, p95, p99, max */
+    bool runs_median;  /* box[2] is the median of run medians, the box the first run's */
+    bool placed;       /* label drawn at lx, ly (top-left) with size lw, lh */
+    double lx, ly, lw, lh;
+};
+
+/* A horizontal level: the reference where it has no x of its own. */
+struct level {
+    double y, lo, hi;
+    char label[64];
+};
+
+struct axis {
+    double lo, hi; /* in log10 units when log */
+    bool log;
 };
 
 struct chart {
-    char title[160], xlabel[96], ylabel[96];
-    char series[MAX_SERIES][48];
+    const char *name;
+    char title[160], subtitle[200], xlabel[128], ylabel[128];
+    char series[MAX_SERIES][64];
     int nseries;
     struct point *pts;
     int n;
-    bool lines, boxes, categorical_x;
+    bool lines, boxes, categorical_x, no_markers, x_log_ok;
     char categories[64][112];
     int ncategories;
+    char workloads[MAX_WORKLOADS][128];
+    int nworkloads;
+    struct level levels[MAX_LEVELS];
+    int nlevels;
+    int labels_left_out;
+    struct axis ax, ay;
 };
 
-struct range {
-    double lo, hi;
-};
-
-static struct range nice_range(double lo, double hi)
+const char *charts_default_series(const json_t *device)
 {
+    const char *r = json_string_value(json_object_get(device, "gl_renderer"));
+    if (!r)
+        return "frame_ms";
+    static const char *const software[] = {"llvmpipe", "softpipe", "SwiftShader", NULL};
+    for (const char *const *s = software; *s; s++)
+        if (strstr(r, *s))
+            return "frame_ms";
+    return "gpu_ms";
+}
+
+static bool software_device(const json_t *device)
+{
+    return device && json_string_value(json_object_get(device, "gl_renderer")) &&
+           strcmp(charts_default_series(device), "frame_ms") == 0;
+}
+
+/* What the series measures here, for the chart's subtitle. */
+static void series_note(const char *series, const json_t *device, bool chosen, char *out,
+                        size_t cap)
+{
+    bool sw = software_device(device);
+    if (!strcmp(series, "frame_ms"))
+        snprintf(out, cap, "frame_ms: present-to-present time%s", chosen && sw
+                 ? ", the default on llvmpipe, whose gpu_ms covers rasterization only" : "");
+    else if (!strcmp(series, "gpu_ms"))
+        snprintf(out, cap, "gpu_ms: GPU time from timer queries%s",
+                 sw ? "; on llvmpipe it covers rasterization only, frame_ms compares techniques"
+                    : chosen ? ", the default on GPUs" : "");
+    else
+        snprintf(out, cap, "cpu_ms: CPU time to submit a frame");
+}
+
+/* ---- axes ---- */
+
+/* On a log axis, zero and below sit at the axis' lower end. */
+static double to_axis(const struct axis *a, double v)
+{
+    return a->log ? (v > 0 ? fmax(log10(v), a->lo) : a->lo) : v;
+}
+
+static double map(const struct axis *a, double v, double p0, double p1)
+{
+    return p0 + (to_axis(a, v) - a->lo) / (a->hi - a->lo) * (p1 - p0);
+}
+
+/* A padded range over [lo, hi] (data units). Log when asked and the values
+ * span more than a decade; a linear range over positive values never pads
+ * below zero. */
+static struct axis make_axis(double lo, double hi, bool log_ok, bool nonneg)
+{
+    struct axis a = {lo, hi, false};
+    if (log_ok && lo > 0 && hi / lo > 10.0) {
+        a.log = true;
+        a.lo = log10(lo) - 0.06 * (log10(hi) - log10(lo));
+        a.hi = log10(hi) + 0.06 * (log10(hi) - log10(lo));
+        return a;
+    }
     if (!(hi > lo)) {
         double pad = fabs(lo) > 0 ? fabs(lo) * 0.1 : 1.0;
         lo -= pad;
         hi += pad;
     }
     double pad = (hi - lo) * 0.08;
-    return (struct range){lo - pad, hi + pad};
+    a.lo = nonneg && lo - pad < 0 && lo >= 0 ? 0 : lo - pad;
+    a.hi = hi + pad;
+    return a;
 }
 
-static double tick_step(struct range r)
+static double tick_step(double span)
 {
-    double raw = (r.hi - r.lo) / 6.0, mag = pow(10.0, floor(log10(raw))), f = raw / mag;
+    double raw = span / 6.0, mag = pow(10.0, floor(log10(raw))), f = raw / mag;
     return (f < 1.5 ? 1 : f < 3 ? 2 : f < 7 ? 5 : 10) * mag;
 }
 
-static double map(double v, struct range r, double a, double b)
+/* Calls fn for each tick value of the axis: 1, 2, 5 per decade on log
+ * axes, round steps on linear ones. */
+static int ticks(const struct axis *a, double *out, int cap)
 {
-    return a + (v - r.lo) / (r.hi - r.lo) * (b - a);
+    int n = 0;
+    if (a->log) {
+        for (int e = (int)floor(a->lo); e <= (int)ceil(a->hi) && n < cap; e++)
+            for (int m = 1; m <= 5 && n < cap; m += m == 1 ? 1 : 3) {
+                double v = m * pow(10.0, e);
+                if (log10(v) >= a->lo && log10(v) <= a->hi)
+                    out[n++] = v;
+            }
+        return n;
+    }
+    double step = tick_step(a->hi - a->lo);
+    for (double v = ceil(a->lo / step) * step; v <= a->hi + step * 1e-9 && n < cap; v += step)
+        out[n++] = fabs(v) < step * 1e-6 ? 0.0 : v;
+    return n;
 }
 
 static void text(cairo_t *cr, double x, double y, const char *s, double size, double align)
@@ -74,13 +166,23 @@ static void text(cairo_t *cr, double x, double y, const char *s, double size, do
 }
 
 struct frame {
-    struct range rx, ry;
     double x0, x1, y0, y1;
 };
 
-/* Joins the points of one series (or, with series < 0, the Pareto points)
- * in order of x. */
-static void polyline_by_x(cairo_t *cr, const struct chart *c, int series, const struct frame *f)
+static double px(const struct chart *c, const struct frame *f, double x)
+{
+    return map(&c->ax, x, f->x0, f->x1);
+}
+
+static double py(const struct chart *c, const struct frame *f, double y)
+{
+    return map(&c->ay, y, f->y0, f->y1);
+}
+
+/* Joins the points of one series (series >= 0) or of one workload's Pareto
+ * front (series < 0, workload w) in order of x. */
+static void polyline_by_x(cairo_t *cr, const struct chart *c, int series, int w,
+                          const struct frame *f)
 {
     bool first = true;
     double last_x = -INFINITY;
@@ -88,188 +190,317 @@ static void polyline_by_x(cairo_t *cr, const struct chart *c, int series, const 
         int best = -1;
         for (int i = 0; i < c->n; i++) {
             const struct point *p = &c->pts[i];
-            bool member = series < 0 ? p->pareto : p->series == series;
+            bool member = series < 0 ? p->pareto && p->workload == w : p->series == series;
             if (member && p->x > last_x && (best < 0 || p->x < c->pts[best].x))
                 best = i;
         }
         if (best < 0)
             break;
-        double px = map(c->pts[best].x, f->rx, f->x0, f->x1), py = map(c->pts[best].y, f->ry, f->y0, f->y1);
+        double x = px(c, f, c->pts[best].x), y = py(c, f, c->pts[best].y);
         if (first)
-            cairo_move_to(cr, px, py);
+            cairo_move_to(cr, x, y);
         else
-            cairo_line_to(cr, px, py);
+            cairo_line_to(cr, x, y);
         first = false;
         last_x = c->pts[best].x;
     }
     cairo_stroke(cr);
 }
 
-static void draw(cairo_t *cr, const struct chart *c)
+/* ---- label placement: greedy, first free spot among eight around the
+ * point; a label that fits nowhere is left out (and counted). ---- */
+
+struct rect {
+    double x, y, w, h;
+};
+
+static bool overlaps(struct rect a, struct rect b)
+{
+    return a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h && b.y < a.y + a.h;
+}
+
+static void place_labels(cairo_t *cr, struct chart *c, const struct frame *f)
+{
+    cairo_set_font_size(cr, 11);
+    struct rect *taken = calloc((size_t)c->n * 4 + 1, sizeof(*taken));
+    if (!taken)
+        return;
+    int nt = 0;
+    for (int i = 0; i < c->n; i++) {
+        /* Every marker and interval bar is an obstacle. */
+        const struct point *p = &c->pts[i];
+        double x = px(c, f, p->x), y = py(c, f, p->y);
+        taken[nt++] = (struct rect){x - 6, y - 6, 12, 12};
+        if (p->x_hi > p->x_lo) {
+            double a = px(c, f, p->x_lo), b = px(c, f, p->x_hi);
+            taken[nt++] = (struct rect){a, y - 4, b - a, 8};
+        }
+        if (p->y_hi > p->y_lo) {
+            double a = py(c, f, p->y_hi), b = py(c, f, p->y_lo);
+            taken[nt++] = (struct rect){x - 4, a, 8, b - a};
+        }
+    }
+    for (int i = 0; i < c->n; i++) {
+        struct point *p = &c->pts[i];
+        if (!p->label[0])
+            continue;
+        cairo_text_extents_t e;
+        cairo_text_extents(cr, p->label, &e);
+        double w = e.x_advance + 2, h = 13, x = px(c, f, p->x), y = py(c, f, p->y);
+        const double cand[8][2] = {
+            {x + 9, y - 7 - h},      {x + 9, y + 7},      {x - 9 - w, y - 7 - h}, {x - 9 - w, y + 7},
+            {x - w / 2, y - 9 - h},  {x - w / 2, y + 9},  {x + 9, y - h / 2},     {x - 9 - w, y - h / 2},
+        };
+        for (int k = 0; k < 8 && !p->placed; k++) {
+            struct rect r = {cand[k][0], cand[k][1], w, h};
+            bool ok = r.x >= f->x0 + 1 && r.x + r.w <= f->x1 - 1 && r.y >= f->y1 + 1 &&
+                      r.y + r.h <= f->y0 - 1;
+            for (int t = 0; ok && t < nt; t++)
+                ok = !overlaps(r, taken[t]);
+            if (ok) {
+                p->placed = true;
+                p->lx = r.x, p->ly = r.y, p->lw = r.w, p->lh = r.h;
+                taken[nt++] = r;
+            }
+        }
+        c->labels_left_out += !p->placed;
+    }
+    free(taken);
+}
+
+static void diamond(cairo_t *cr, double x, double y, double r)
+{
+    cairo_move_to(cr, x, y - r);
+    cairo_line_to(cr, x + r, y);
+    cairo_line_to(cr, x, y + r);
+    cairo_line_to(cr, x - r, y);
+    cairo_close_path(cr);
+}
+
+static void draw(cairo_t *cr, struct chart *c)
 {
     cairo_set_source_rgb(cr, 1, 1, 1);
     cairo_paint(cr);
     cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
-    double x0 = LEFT, x1 = WIDTH - RIGHT, y0 = HEIGHT - BOTTOM, y1 = TOP;
-
-    struct range rx = {0, 1}, ry = {0, 1};
-    if (c->n > 0) {
-        double xl = INFINITY, xh = -INFINITY, yl = INFINITY, yh = -INFINITY;
-        for (int i = 0; i < c->n; i++) {
-            const struct point *p = &c->pts[i];
-            xl = fmin(xl, fmin(p->x, p->x_lo));
-            xh = fmax(xh, fmax(p->x, p->x_hi));
-            double lo = c->boxes ? p->box[0] : fmin(p->y, p->y_lo);
-            double hi = c->boxes ? p->box[5] : fmax(p->y, p->y_hi);
-            yl = fmin(yl, lo);
-            yh = fmax(yh, hi);
+    /* Many categories: labels slanted, with room made for them below and
+     * to the left, so that they overlap neither each other nor the axis
+     * title nor the edge. */
+    double left = LEFT, bottom = BOTTOM, angle = 0;
+    if (c->categorical_x && c->ncategories > 4) {
+        angle = 0.6;
+        cairo_set_font_size(cr, 10);
+        double span = WIDTH - RIGHT - LEFT;
+        for (int i = 0; i < c->ncategories; i++) {
+            cairo_text_extents_t e;
+            cairo_text_extents(cr, c->categories[i], &e);
+            left = fmax(left, 5 + e.x_advance * cos(angle) - (i + 0.5) * span / c->ncategories);
+            bottom = fmax(bottom, e.x_advance * sin(angle) + 48);
         }
-        rx = c->categorical_x ? (struct range){-0.5, c->ncategories - 0.5} : nice_range(xl, xh);
-        ry = nice_range(yl, yh);
+        left = fmin(left, WIDTH / 3.0);
+        bottom = fmin(bottom, HEIGHT / 2.0);
     }
+    const struct frame f = {left, WIDTH - RIGHT, HEIGHT - bottom, TOP};
 
-    /* Grid, ticks and axis labels. */
-    cairo_set_line_width(cr, 1);
-    cairo_set_source_rgb(cr, 0.88, 0.88, 0.88);
     char buf[64];
-    double sy = tick_step(ry);
-    for (double v = ceil(ry.lo / sy) * sy; v <= ry.hi; v += sy) {
-        double py = map(v, ry, y0, y1);
+    double tv[64];
+    int nt = ticks(&c->ay, tv, 64);
+    cairo_set_line_width(cr, 1);
+    for (int i = 0; i < nt; i++) {
+        double y = py(c, &f, tv[i]);
         cairo_set_source_rgb(cr, 0.88, 0.88, 0.88);
-        cairo_move_to(cr, x0, py);
-        cairo_line_to(cr, x1, py);
+        cairo_move_to(cr, f.x0, y);
+        cairo_line_to(cr, f.x1, y);
         cairo_stroke(cr);
         cairo_set_source_rgb(cr, 0.2, 0.2, 0.2);
-        snprintf(buf, sizeof(buf), "%.6g", fabs(v) < sy * 1e-6 ? 0.0 : v);
-        text(cr, x0 - 8, py + 4, buf, 12, 1.0);
+        snprintf(buf, sizeof(buf), "%.6g", tv[i]);
+        text(cr, f.x0 - 8, y + 4, buf, 12, 1.0);
     }
     if (c->categorical_x) {
-        /* Many categories: slanted labels, so that they never overlap. */
-        bool slant = c->ncategories > 4;
         for (int i = 0; i < c->ncategories; i++) {
             cairo_set_source_rgb(cr, 0.2, 0.2, 0.2);
-            if (!slant) {
-                text(cr, map(i, rx, x0, x1), y0 + 18, c->categories[i], 11, 0.5);
+            if (angle == 0) {
+                text(cr, px(c, &f, i), f.y0 + 18, c->categories[i], 11, 0.5);
                 continue;
             }
             cairo_save(cr);
-            cairo_translate(cr, map(i, rx, x0, x1), y0 + 12);
-            cairo_rotate(cr, -0.35);
+            cairo_translate(cr, px(c, &f, i) + 3, f.y0 + 10);
+            cairo_rotate(cr, -angle);
             text(cr, 0, 0, c->categories[i], 10, 1.0);
             cairo_restore(cr);
         }
     } else {
-        double sx = tick_step(rx);
-        for (double v = ceil(rx.lo / sx) * sx; v <= rx.hi; v += sx) {
-            double px = map(v, rx, x0, x1);
+        nt = ticks(&c->ax, tv, 64);
+        for (int i = 0; i < nt; i++) {
+            double x = px(c, &f, tv[i]);
             cairo_set_source_rgb(cr, 0.88, 0.88, 0.88);
-            cairo_move_to(cr, px, y0);
-            cairo_line_to(cr, px, y1);
+            cairo_move_to(cr, x, f.y0);
+            cairo_line_to(cr, x, f.y1);
             cairo_stroke(cr);
             cairo_set_source_rgb(cr, 0.2, 0.2, 0.2);
-            snprintf(buf, sizeof(buf), "%.6g", fabs(v) < sx * 1e-6 ? 0.0 : v);
-            text(cr, px, y0 + 18, buf, 12, 0.5);
+            snprintf(buf, sizeof(buf), "%.6g", tv[i]);
+            text(cr, x, f.y0 + 18, buf, 12, 0.5);
         }
     }
     cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
-    cairo_rectangle(cr, x0, y1, x1 - x0, y0 - y1);
+    cairo_rectangle(cr, f.x0, f.y1, f.x1 - f.x0, f.y0 - f.y1);
     cairo_stroke(cr);
-    text(cr, (x0 + x1) / 2, HEIGHT - 22, c->xlabel, 14, 0.5);
+    char axis_label[160];
+    snprintf(axis_label, sizeof(axis_label), "%s%s", c->xlabel, c->ax.log ? " (log scale)" : "");
+    text(cr, (f.x0 + f.x1) / 2, angle > 0 ? HEIGHT - 10 : HEIGHT - 22, axis_label, 14, 0.5);
     cairo_save(cr);
-    cairo_translate(cr, 24, (y0 + y1) / 2);
+    cairo_translate(cr, f.x0 - 66, (f.y0 + f.y1) / 2);
     cairo_rotate(cr, -M_PI / 2);
-    text(cr, 0, 0, c->ylabel, 14, 0.5);
+    snprintf(axis_label, sizeof(axis_label), "%s%s", c->ylabel, c->ay.log ? " (log scale)" : "");
+    text(cr, 0, 0, axis_label, 14, 0.5);
     cairo_restore(cr);
     cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
-    text(cr, x0, 30, c->title, 16, 0.0);
+    text(cr, f.x0, 26, c->title, 16, 0.0);
     cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+    cairo_set_source_rgb(cr, 0.3, 0.3, 0.3);
+    text(cr, f.x0, 46, c->subtitle, 11, 0.0);
 
-    if (c->n == 0) {
-        text(cr, (x0 + x1) / 2, (y0 + y1) / 2, "no finished points yet", 14, 0.5);
+    if (c->n == 0 && c->nlevels == 0) {
+        text(cr, (f.x0 + f.x1) / 2, (f.y0 + f.y1) / 2, "no finished points yet", 14, 0.5);
         return;
     }
 
-    const struct frame frame = {rx, ry, x0, x1, y0, y1};
-    /* The Pareto front first, under the points. */
-    int npareto = 0;
-    for (int i = 0; i < c->n; i++)
-        npareto += c->pts[i].pareto;
-    if (npareto > 1) {
-        cairo_set_source_rgba(cr, 0.2, 0.2, 0.2, 0.6);
-        cairo_set_line_width(cr, 1.5);
-        double dash[] = {6, 4};
+    /* Reference levels: a dashed line with its interval as a band. */
+    for (int i = 0; i < c->nlevels; i++) {
+        const struct level *l = &c->levels[i];
+        double y = py(c, &f, l->y);
+        cairo_set_source_rgba(cr, 0.1, 0.1, 0.1, 0.05);
+        if (l->hi > l->lo) {
+            double a = py(c, &f, l->lo), b = py(c, &f, l->hi);
+            cairo_rectangle(cr, f.x0, b, f.x1 - f.x0, a - b);
+            cairo_fill(cr);
+        }
+        cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
+        double dash[] = {8, 4};
         cairo_set_dash(cr, dash, 2, 0);
-        polyline_by_x(cr, c, -1, &frame);
+        cairo_set_line_width(cr, 1.5);
+        cairo_move_to(cr, f.x0, y);
+        cairo_line_to(cr, f.x1, y);
+        cairo_stroke(cr);
+        cairo_set_dash(cr, NULL, 0, 0);
+        text(cr, f.x1 - 4, y - 4, l->label, 11, 1.0);
+    }
+
+    /* Pareto fronts first, under the points: one per workload, each with
+     * a dash pattern of its own (named in the legend). */
+    static const double DASHES[4][2] = {{6, 4}, {2, 3}, {10, 3}, {4, 2}};
+    bool any_front = false;
+    for (int w = 0; w < c->nworkloads; w++) {
+        int members = 0;
+        for (int i = 0; i < c->n; i++)
+            members += c->pts[i].pareto && c->pts[i].workload == w;
+        if (members < 1)
+            continue;
+        any_front = true;
+        if (members < 2)
+            continue;
+        cairo_set_source_rgba(cr, 0.2, 0.2, 0.2, 0.7);
+        cairo_set_line_width(cr, 1.5);
+        cairo_set_dash(cr, DASHES[w % 4], 2, 0);
+        polyline_by_x(cr, c, -1, w, &f);
         cairo_set_dash(cr, NULL, 0, 0);
     }
 
+    if (!c->boxes && !c->no_markers)
+        place_labels(cr, c, &f);
     for (int s = 0; s < c->nseries; s++) {
         const double *col = PALETTE[s % MAX_SERIES];
         if (c->lines) {
             cairo_set_source_rgb(cr, col[0], col[1], col[2]);
-            cairo_set_line_width(cr, 2);
-            polyline_by_x(cr, c, s, &frame);
+            cairo_set_line_width(cr, c->no_markers ? 1.2 : 2);
+            polyline_by_x(cr, c, s, 0, &f);
         }
+        if (c->no_markers)
+            continue;
         for (int i = 0; i < c->n; i++) {
-            const struct point *p = &c->pts[i];
+            struct point *p = &c->pts[i];
             if (p->series != s)
                 continue;
-            double px = map(p->x, rx, x0, x1), py = map(p->y, ry, y0, y1);
+            double x = px(c, &f, p->x), y = py(c, &f, p->y);
             cairo_set_source_rgb(cr, col[0], col[1], col[2]);
             cairo_set_line_width(cr, 1.5);
             if (c->boxes) {
                 /* Whiskers min-max, box p5-p95, median line, p99 tick. */
-                double w = fmin(40.0, (x1 - x0) / (c->ncategories * 2.5));
+                double w = fmin(40.0, (f.x1 - f.x0) / (c->ncategories * 2.5));
                 double b[6];
                 for (int k = 0; k < 6; k++)
-                    b[k] = map(p->box[k], ry, y0, y1);
-                cairo_move_to(cr, px, b[0]);
-                cairo_line_to(cr, px, b[5]);
+                    b[k] = py(c, &f, p->box[k]);
+                cairo_move_to(cr, x, b[0]);
+                cairo_line_to(cr, x, b[5]);
                 cairo_stroke(cr);
-                cairo_rectangle(cr, px - w / 2, b[3], w, b[1] - b[3]);
+                cairo_rectangle(cr, x - w / 2, b[3], w, b[1] - b[3]);
                 cairo_set_source_rgba(cr, col[0], col[1], col[2], 0.3);
                 cairo_fill_preserve(cr);
                 cairo_set_source_rgb(cr, col[0], col[1], col[2]);
                 cairo_stroke(cr);
                 cairo_set_line_width(cr, 3);
-                cairo_move_to(cr, px - w / 2, b[2]);
-                cairo_line_to(cr, px + w / 2, b[2]);
-                cairo_stroke(cr);
+                if (p->runs_median) {
+                    /* Not this run's median: a mark of its own. */
+                    cairo_set_line_width(cr, 2);
+                    diamond(cr, x, b[2], 6);
+                    cairo_stroke(cr);
+                } else {
+                    cairo_move_to(cr, x - w / 2, b[2]);
+                    cairo_line_to(cr, x + w / 2, b[2]);
+                    cairo_stroke(cr);
+                }
                 cairo_set_line_width(cr, 1.5);
-                cairo_move_to(cr, px - w / 4, b[4]);
-                cairo_line_to(cr, px + w / 4, b[4]);
+                cairo_move_to(cr, x - w / 4, b[4]);
+                cairo_line_to(cr, x + w / 4, b[4]);
                 cairo_stroke(cr);
                 continue;
             }
-            /* Error bars from the intervals. */
+            /* Error bars from the intervals; a bar cut at zero ends in an
+             * arrow head instead of a cap. */
             if (p->x_hi > p->x_lo) {
-                double a = map(p->x_lo, rx, x0, x1), bx = map(p->x_hi, rx, x0, x1);
-                cairo_move_to(cr, a, py);
-                cairo_line_to(cr, bx, py);
-                cairo_move_to(cr, a, py - 4);
-                cairo_line_to(cr, a, py + 4);
-                cairo_move_to(cr, bx, py - 4);
-                cairo_line_to(cr, bx, py + 4);
+                double a = px(c, &f, p->x_lo), b = px(c, &f, p->x_hi);
+                cairo_move_to(cr, a, y);
+                cairo_line_to(cr, b, y);
+                cairo_move_to(cr, b, y - 4);
+                cairo_line_to(cr, b, y + 4);
+                if (p->lo_clamped) {
+                    cairo_move_to(cr, a + 5, y - 4);
+                    cairo_line_to(cr, a, y);
+                    cairo_line_to(cr, a + 5, y + 4);
+                } else {
+                    cairo_move_to(cr, a, y - 4);
+                    cairo_line_to(cr, a, y + 4);
+                }
                 cairo_stroke(cr);
             }
             if (p->y_hi > p->y_lo) {
-                double a = map(p->y_lo, ry, y0, y1), by = map(p->y_hi, ry, y0, y1);
-                cairo_move_to(cr, px, a);
-                cairo_line_to(cr, px, by);
+                double a = py(c, &f, p->y_lo), b = py(c, &f, p->y_hi);
+                cairo_move_to(cr, x - 4, a);
+                cairo_line_to(cr, x + 4, a);
+                cairo_move_to(cr, x, a);
+                cairo_line_to(cr, x, b);
+                cairo_move_to(cr, x - 4, b);
+                cairo_line_to(cr, x + 4, b);
                 cairo_stroke(cr);
             }
-            cairo_new_sub_path(cr);
-            cairo_arc(cr, px, py, 4.5, 0, 2 * M_PI);
-            cairo_fill(cr);
+            if (p->reference) {
+                diamond(cr, x, y, 6.5);
+                cairo_fill(cr);
+            } else {
+                cairo_new_sub_path(cr);
+                cairo_arc(cr, x, y, 4.5, 0, 2 * M_PI);
+                cairo_fill(cr);
+            }
             if (p->pareto) {
                 cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
                 cairo_new_sub_path(cr);
-            cairo_arc(cr, px, py, 8, 0, 2 * M_PI);
+                cairo_arc(cr, x, y, 9, 0, 2 * M_PI);
                 cairo_stroke(cr);
             }
-            if (p->label[0]) {
+            if (p->placed) {
                 cairo_set_source_rgb(cr, 0.15, 0.15, 0.15);
-                text(cr, px + 9, py - 7, p->label, 11, 0.0);
+                cairo_set_font_size(cr, 11);
+                cairo_move_to(cr, p->lx + 1, p->ly + p->lh - 3);
+                cairo_show_text(cr, p->label);
             }
         }
     }
@@ -279,20 +510,50 @@ static void draw(cairo_t *cr, const struct chart *c)
     for (int s = 0; s < c->nseries; s++, ly += 22) {
         const double *col = PALETTE[s % MAX_SERIES];
         cairo_set_source_rgb(cr, col[0], col[1], col[2]);
-        cairo_new_sub_path(cr);
-            cairo_arc(cr, x1 + 20, ly, 5, 0, 2 * M_PI);
+        bool ref = false;
+        for (int i = 0; i < c->n && !ref; i++)
+            ref = c->pts[i].series == s && c->pts[i].reference;
+        if (ref) {
+            diamond(cr, f.x1 + 20, ly, 6);
+        } else {
+            cairo_new_sub_path(cr);
+            cairo_arc(cr, f.x1 + 20, ly, 5, 0, 2 * M_PI);
+        }
         cairo_fill(cr);
         cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
-        text(cr, x1 + 32, ly + 4, c->series[s], 12, 0.0);
+        text(cr, f.x1 + 32, ly + 4, c->series[s], 12, 0.0);
     }
-    if (npareto > 0) {
-        cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
+    cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
+    if (any_front) {
         cairo_new_sub_path(cr);
-            cairo_arc(cr, x1 + 20, ly, 8, 0, 2 * M_PI);
+        cairo_arc(cr, f.x1 + 20, ly, 8, 0, 2 * M_PI);
         cairo_stroke(cr);
-        text(cr, x1 + 32, ly + 4, "Pareto front", 12, 0.0);
+        text(cr, f.x1 + 32, ly + 4, c->nworkloads > 1 ? "Pareto front, per workload:"
+                                                      : "Pareto front", 12, 0.0);
+        ly += 20;
+        for (int w = 0; c->nworkloads > 1 && w < c->nworkloads && w < 8; w++, ly += 18) {
+            cairo_set_line_width(cr, 1.5);
+            cairo_set_dash(cr, DASHES[w % 4], 2, 0);
+            cairo_move_to(cr, f.x1 + 12, ly);
+            cairo_line_to(cr, f.x1 + 30, ly);
+            cairo_stroke(cr);
+            cairo_set_dash(cr, NULL, 0, 0);
+            char wl[40];
+            const char *dot = strrchr(c->workloads[w], '.');
+            snprintf(wl, sizeof(wl), "%.38s", dot ? dot + 1 : c->workloads[w]);
+            text(cr, f.x1 + 34, ly + 4, wl, 11, 0.0);
+        }
+        ly += 4;
+    }
+    if (c->labels_left_out) {
+        snprintf(buf, sizeof(buf), "%d label%s left out", c->labels_left_out,
+                 c->labels_left_out > 1 ? "s" : "");
+        text(cr, f.x1 + 12, ly + 4, buf, 11, 0.0);
+        text(cr, f.x1 + 12, ly + 18, "(no room without overlap)", 11, 0.0);
     }
 }
+
+/* ---- output ---- */
 
 struct sink {
     char *data;
@@ -302,8 +563,8 @@ struct sink {
 static cairo_status_t collect(void *closure, const unsigned char *data, unsigned int length)
 {
     struct sink *s = closure;
-    if (s->len + length > s->cap) {
-        size_t cap = (s->len + length) * 2;
+    if (s->len + length + 1 > s->cap) {
+        size_t cap = (s->len + length + 1) * 2;
         char *grown = realloc(s->data, cap);
         if (!grown)
             return CAIRO_STATUS_NO_MEMORY;
@@ -315,8 +576,127 @@ static cairo_status_t collect(void *closure, const unsigned char *data, unsigned
     return CAIRO_STATUS_SUCCESS;
 }
 
-static char *render(const struct chart *c, enum chart_format format, size_t *len)
+static json_t *layout_json(const struct chart *c)
 {
+    json_t *pts = json_array(), *fronts = json_array(), *workloads = json_array();
+    for (int i = 0; i < c->n; i++) {
+        const struct point *p = &c->pts[i];
+        json_t *o = json_pack("{s:f, s:f, s:f, s:f, s:f, s:f, s:b, s:s, s:s, s:i, s:b, s:b}", "x",
+                              p->x, "y", p->y, "x_lo", p->x_lo, "x_hi", p->x_hi, "y_lo", p->y_lo,
+                              "y_hi", p->y_hi, "lo_clamped", p->lo_clamped, "label", p->label,
+                              "series", c->series[p->series], "workload", p->workload, "pareto",
+                              p->pareto, "reference", p->reference);
+        json_object_set_new(o, "label_box", p->placed ? json_pack("[f, f, f, f]", p->lx, p->ly,
+                                                                  p->lw, p->lh)
+                                                      : json_null());
+        json_array_append_new(pts, o);
+    }
+    for (int w = 0; w < c->nworkloads; w++) {
+        json_array_append_new(workloads, json_string(c->workloads[w]));
+        json_t *members = json_array();
+        for (int i = 0; i < c->n; i++)
+            if (c->pts[i].pareto && c->pts[i].workload == w)
+                json_array_append_new(members, json_integer(i));
+        json_array_append_new(fronts, members);
+    }
+    json_t *levels = json_array();
+    for (int i = 0; i < c->nlevels; i++)
+        json_array_append_new(levels, json_pack("{s:s, s:f, s:f, s:f}", "label", c->levels[i].label,
+                                                "y", c->levels[i].y, "lo", c->levels[i].lo, "hi",
+                                                c->levels[i].hi));
+    return json_pack("{s:s, s:s, s:s, s:s, s:b, s:b, s:o, s:o, s:o, s:o, s:i}", "chart", c->name,
+                     "subtitle", c->subtitle, "xlabel", c->xlabel, "ylabel", c->ylabel, "x_log",
+                     c->ax.log, "y_log", c->ay.log, "points", pts, "workloads", workloads,
+                     "fronts", fronts, "levels", levels, "labels_left_out", c->labels_left_out);
+}
+
+/* The layout as JSON inside <metadata>, before the closing </svg>. */
+static bool add_metadata(struct sink *s, const struct chart *c)
+{
+    json_t *layout = layout_json(c);
+    char *text = json_dumps(layout, JSON_COMPACT);
+    json_decref(layout);
+    if (!text)
+        return false;
+    size_t esc = 0;
+    for (const char *p = text; *p; p++)
+        esc += *p == '<' || *p == '>' ? 3 : *p == '&' ? 4 : 0;
+    static const char open[] = "<metadata id=\"shadebench-chart\">", close[] = "</metadata>\n";
+    size_t add = strlen(open) + strlen(text) + esc + strlen(close);
+    char *end = NULL;
+    for (size_t i = s->len; i >= 6 && !end; i--)
+        if (!strncmp(s->data + i - 6, "</svg>", 6))
+            end = s->data + i - 6;
+    char *grown = end ? realloc(s->data, s->len + add + 1) : NULL;
+    if (!grown) {
+        free(text);
+        return false;
+    }
+    end = grown + (end - s->data);
+    s->data = grown;
+    size_t tail = (size_t)(s->data + s->len - end);
+    memmove(end + add, end, tail);
+    char *w = end;
+    memcpy(w, open, strlen(open));
+    w += strlen(open);
+    for (const char *p = text; *p; p++) {
+        const char *rep = *p == '<' ? "&lt;" : *p == '>' ? "&gt;" : *p == '&' ? "&amp;" : NULL;
+        if (rep) {
+            memcpy(w, rep, strlen(rep));
+            w += strlen(rep);
+        } else {
+            *w++ = *p;
+        }
+    }
+    memcpy(w, close, strlen(close));
+    s->len += add;
+    s->data[s->len] = '\0';
+    free(text);
+    return true;
+}
+
+/* Axes from the points (and levels). The log decision looks at the
+ * positive values only: an interval cut at zero runs to the axis' end on a
+ * log axis (drawn with the arrow head that marks the cut). */
+static void fit_axes(struct chart *c)
+{
+    double xl = INFINITY, xh = -INFINITY, yl = INFINITY, yh = -INFINITY;
+    double xpos = INFINITY, ypos = INFINITY;
+    for (int i = 0; i < c->n; i++) {
+        const struct point *p = &c->pts[i];
+        double ylo = c->boxes ? p->box[0] : fmin(p->y, p->y_lo);
+        double yhi = c->boxes ? p->box[5] : fmax(p->y, p->y_hi);
+        xl = fmin(xl, fmin(p->x, p->x_lo));
+        xh = fmax(xh, fmax(p->x, p->x_hi));
+        yl = fmin(yl, ylo);
+        yh = fmax(yh, yhi);
+        xpos = fmin(xpos, p->x > 0 ? p->x : INFINITY);
+        xpos = fmin(xpos, p->x_lo > 0 ? p->x_lo : INFINITY);
+        ypos = fmin(ypos, p->y > 0 ? p->y : INFINITY);
+        ypos = fmin(ypos, ylo > 0 ? ylo : INFINITY);
+    }
+    for (int i = 0; i < c->nlevels; i++) {
+        yl = fmin(yl, fmin(c->levels[i].y, c->levels[i].lo));
+        yh = fmax(yh, fmax(c->levels[i].y, c->levels[i].hi));
+        ypos = fmin(ypos, c->levels[i].y > 0 ? c->levels[i].y : INFINITY);
+    }
+    if (c->n == 0 && c->nlevels == 0)
+        xl = yl = xpos = ypos = 0, xh = yh = 1;
+    if (c->n == 0)
+        xl = xpos = 0, xh = 1;
+    bool x_log_ok = c->x_log_ok && xpos > 0 && xh / xpos > 10.0;
+    bool y_log_ok = !c->x_log_ok && strcmp(c->name, "speed_accuracy") != 0 && ypos > 0 &&
+                    yh / ypos > 10.0;
+    /* Times never go below zero; a swept parameter or SSIM may. */
+    bool sa = strcmp(c->name, "speed_accuracy") == 0;
+    c->ax = c->categorical_x ? (struct axis){-0.5, c->ncategories - 0.5, false}
+                             : make_axis(x_log_ok ? xpos : xl, xh, x_log_ok, sa);
+    c->ay = make_axis(y_log_ok ? ypos : yl, yh, y_log_ok, !sa);
+}
+
+static char *render(struct chart *c, enum chart_format format, size_t *len)
+{
+    fit_axes(c);
     struct sink sink = {0};
     cairo_surface_t *surface =
         format == CHART_SVG ? cairo_svg_surface_create_for_stream(collect, &sink, WIDTH, HEIGHT)
@@ -327,8 +707,10 @@ static char *render(const struct chart *c, enum chart_format format, size_t *len
     if (format == CHART_PNG)
         cairo_surface_write_to_png_stream(surface, collect, &sink);
     cairo_surface_finish(surface);
-    bool ok = cairo_surface_status(surface) == CAIRO_STATUS_SUCCESS;
+    bool ok = cairo_surface_status(surface) == CAIRO_STATUS_SUCCESS && sink.data;
     cairo_surface_destroy(surface);
+    if (ok && format == CHART_SVG)
+        ok = add_metadata(&sink, c);
     if (!ok) {
         free(sink.data);
         return NULL;
@@ -348,7 +730,36 @@ static int series_of(struct chart *c, const char *name)
     return c->nseries++;
 }
 
-/* "async_distance=5, scene.lights=8" without the technique (it is the series). */
+static bool workload_key(const char *path)
+{
+    return !strncmp(path, "scene.", 6) || !strcmp(path, "frames") || !strcmp(path, "warmup_frames");
+}
+
+/* The workload a row measures: its swept scene.*, frames and warmup_frames
+ * values ("" when none is swept). Points are comparable only within one. */
+static int workload_of(struct chart *c, const json_t *values)
+{
+    char key[128] = "";
+    const char *k;
+    json_t *v;
+    json_object_foreach((json_t *)values, k, v) {
+        if (!workload_key(k))
+            continue;
+        char *t = json_dumps(v, JSON_ENCODE_ANY);
+        size_t used = strlen(key);
+        snprintf(key + used, sizeof(key) - used, "%s%s=%s", used ? ", " : "", k, t ? t : "?");
+        free(t);
+    }
+    for (int w = 0; w < c->nworkloads; w++)
+        if (!strcmp(c->workloads[w], key))
+            return w;
+    if (c->nworkloads == MAX_WORKLOADS)
+        return MAX_WORKLOADS - 1;
+    snprintf(c->workloads[c->nworkloads], sizeof(c->workloads[0]), "%s", key);
+    return c->nworkloads++;
+}
+
+/* "async_distance=5, lights=8" without the technique (it is the series). */
 static void values_label(const json_t *values, char *out, size_t cap)
 {
     out[0] = '\0';
@@ -357,11 +768,11 @@ static void values_label(const json_t *values, char *out, size_t cap)
     json_object_foreach((json_t *)values, key, v) {
         if (strcmp(key, "technique") == 0)
             continue;
-        char *text = json_dumps(v, JSON_ENCODE_ANY);
+        char *t = json_dumps(v, JSON_ENCODE_ANY);
         size_t used = strlen(out);
         const char *short_key = strrchr(key, '.') ? strrchr(key, '.') + 1 : key;
-        snprintf(out + used, cap - used, "%s%s=%s", used ? ", " : "", short_key, text ? text : "?");
-        free(text);
+        snprintf(out + used, cap - used, "%s%s=%s", used ? ", " : "", short_key, t ? t : "?");
+        free(t);
     }
 }
 
@@ -370,44 +781,118 @@ static double num(const json_t *v, double fallback)
     return json_is_number(v) ? json_number_value(v) : fallback;
 }
 
+/* The sweep's reference technique: the base job's, else forward. */
+static const char *sweep_reference(const json_t *sweep)
+{
+    const json_t *base = json_object_get(json_object_get(sweep, "spec"), "base");
+    const char *r = json_string_value(json_object_get(base, "reference"));
+    return r ? r : "forward";
+}
+
+/* A time with its interval, cut at zero: times are never negative, and an
+ * interval below zero (few runs, Student's t) says only "very uncertain". */
+static void time_interval(const json_t *cell, double *v, double *lo, double *hi, bool *clamped)
+{
+    *v = num(json_object_get(cell, "median"), NAN);
+    json_t *ci = json_object_get(cell, "ci95");
+    *lo = num(json_array_get(ci, 0), *v);
+    *hi = num(json_array_get(ci, 1), *v);
+    *clamped = *lo < 0;
+    if (*clamped)
+        *lo = 0;
+}
+
 char *charts_sweep(const json_t *sweep, const char *name, enum chart_format format,
                    const struct chart_options *o, size_t *len, char *err, size_t errlen)
 {
-    const char *series = o->series ? o->series : "frame_ms";
+    bool sa = !strcmp(name, "speed_accuracy"), tvp = !strcmp(name, "time_vs_param"),
+         dist = !strcmp(name, "distribution");
+    if (!sa && !tvp && !dist) {
+        snprintf(err, errlen, "no chart named %s (speed_accuracy, time_vs_param, distribution)", name);
+        return NULL;
+    }
+    const char *series = o->series ? o->series : charts_default_series(o->device);
+    const char *ref = sweep_reference(sweep);
     json_t *points = json_object_get(sweep, "points");
     struct chart c;
     memset(&c, 0, sizeof(c));
+    c.name = name;
     c.pts = calloc(json_array_size(points) + 1, sizeof(*c.pts));
     if (!c.pts) {
         snprintf(err, errlen, "out of memory");
         return NULL;
     }
+    /* The first swept parameter: the first key of a grid point's values
+     * other than a timed reference point's technique. */
     const char *param = NULL;
-    json_t *first_values = json_object_get(json_array_get(points, 0), "values");
-    const char *key;
-    json_t *v;
-    json_object_foreach(first_values, key, v) if (!param) param = key;
     size_t i;
     json_t *row;
+    json_array_foreach(points, i, row) {
+        const char *key;
+        json_t *v;
+        json_object_foreach(json_object_get(row, "values"), key, v) {
+            if (!param && !(strcmp(key, "technique") == 0 &&
+                            json_object_size(json_object_get(row, "values")) == 1))
+                param = key;
+        }
+        if (param)
+            break;
+    }
+    c.x_log_ok = sa;
+    bool any_runs = false;
     json_array_foreach(points, i, row) {
         json_t *t = json_object_get(row, series);
         if (!t || !json_is_number(json_object_get(t, "median")))
             continue; /* a failed or cancelled point */
         struct point *p = &c.pts[c.n];
         const char *tech = json_string_value(json_object_get(row, "technique"));
-        p->series = series_of(&c, tech ? tech : "?");
-        values_label(json_object_get(row, "values"), p->label, sizeof(p->label));
-        double median = json_number_value(json_object_get(t, "median"));
-        json_t *ci = json_object_get(t, "ci95");
-        double lo = num(json_array_get(ci, 0), median), hi = num(json_array_get(ci, 1), median);
-        if (strcmp(name, "speed_accuracy") == 0) {
+        json_t *values = json_object_get(row, "values");
+        p->reference = tech && !strcmp(tech, ref);
+        char sname[96], others[64] = "";
+        if (tvp) {
+            /* A line per technique and per value of the other swept
+             * parameters: lines never join points of two workloads. */
+            json_t *rest = json_deep_copy(values);
+            if (param)
+                json_object_del(rest, param);
+            values_label(rest, others, sizeof(others));
+            json_decref(rest);
+        }
+        snprintf(sname, sizeof(sname), "%.20s%s%s%.24s", tech ? tech : "?",
+                 p->reference ? " (reference)" : "", others[0] ? " " : "", others);
+        p->workload = workload_of(&c, values);
+        double median, lo, hi;
+        time_interval(t, &median, &lo, &hi, &p->lo_clamped);
+        if (!(tvp && p->reference && !(param && json_object_get(values, param))))
+            p->series = series_of(&c, sname);
+        if (sa) {
             json_t *q = json_object_get(row, o->flip ? "worst_flip" : "worst_ssim");
-            if (!json_is_number(q))
+            if (!json_is_number(q) && !p->reference)
                 continue;
+            /* The reference against itself: SSIM 1, FLIP 0, exactly. */
+            double qv = json_is_number(q) ? json_number_value(q) : (o->flip ? 0.0 : 1.0);
             p->x = median, p->x_lo = lo, p->x_hi = hi;
-            p->y = p->y_lo = p->y_hi = json_number_value(q);
-        } else if (strcmp(name, "time_vs_param") == 0) {
-            json_t *pv = json_object_get(json_object_get(row, "values"), param);
+            p->y = p->y_lo = p->y_hi = qv;
+            values_label(values, p->label, sizeof(p->label));
+            if (p->reference) {
+                char wl[64];
+                snprintf(wl, sizeof(wl), "%s", p->label);
+                snprintf(p->label, sizeof(p->label), "%.20s%s%.40s", tech, wl[0] ? ", " : "", wl);
+            }
+        } else if (tvp) {
+            json_t *pv = param ? json_object_get(values, param) : NULL;
+            if (!pv && p->reference) {
+                /* Timed on the same workload but not swept: a level. */
+                if (c.nlevels < MAX_LEVELS) {
+                    struct level *l = &c.levels[c.nlevels++];
+                    l->y = median, l->lo = lo, l->hi = hi;
+                    char wl[64];
+                    values_label(values, wl, sizeof(wl));
+                    snprintf(l->label, sizeof(l->label), "%.20s (reference)%s%.30s", tech,
+                             wl[0] ? " " : "", wl);
+                }
+                continue;
+            }
             if (json_is_number(pv)) {
                 p->x = p->x_lo = p->x_hi = json_number_value(pv);
             } else {
@@ -422,38 +907,39 @@ char *charts_sweep(const json_t *sweep, const char *name, enum chart_format form
                 p->x = p->x_lo = p->x_hi = k;
             }
             p->y = median, p->y_lo = lo, p->y_hi = hi;
-            p->label[0] = '\0';
-        } else if (strcmp(name, "distribution") == 0) {
+        } else {
             c.boxes = c.categorical_x = true;
             static const char *const keys[6] = {"min", "p5", "median", "p95", "p99", "max"};
             for (int k = 0; k < 6; k++)
                 p->box[k] = num(json_object_get(t, keys[k]), median);
+            const char *over = json_string_value(json_object_get(t, "over"));
+            p->runs_median = over && !strcmp(over, "runs");
+            any_runs = any_runs || p->runs_median;
             if (c.ncategories < 64) {
                 char label[64];
-                values_label(json_object_get(row, "values"), label, sizeof(label));
-                snprintf(c.categories[c.ncategories], sizeof(c.categories[0]), "%s %s",
-                         tech ? tech : "", label);
+                values_label(values, label, sizeof(label));
+                snprintf(c.categories[c.ncategories], sizeof(c.categories[0]), "%.48s %.60s",
+                         sname, label);
                 p->x = c.ncategories++;
             }
             p->y = median;
-            p->label[0] = '\0';
-        } else {
-            free(c.pts);
-            snprintf(err, errlen, "no chart named %s (speed_accuracy, time_vs_param, distribution)", name);
-            return NULL;
         }
         c.n++;
     }
-    if (strcmp(name, "speed_accuracy") == 0) {
+    char note[200];
+    series_note(series, o->device, !o->series, note, sizeof(note));
+    snprintf(c.subtitle, sizeof(c.subtitle), "%s", note);
+    if (sa) {
         snprintf(c.title, sizeof(c.title), "Speed against accuracy");
-        snprintf(c.xlabel, sizeof(c.xlabel), "median %s (95%% interval)", series);
+        snprintf(c.xlabel, sizeof(c.xlabel), "median %s, ms (95%% interval)", series);
         snprintf(c.ylabel, sizeof(c.ylabel), o->flip ? "worst mean FLIP (lower is better)"
                                                      : "worst SSIM (higher is better)");
-        /* Pareto: nothing both faster and at least as accurate. */
+        /* Pareto within each workload only: nothing of the same workload
+         * both faster and at least as accurate. */
         for (int a = 0; a < c.n; a++) {
             c.pts[a].pareto = true;
             for (int b = 0; b < c.n && c.pts[a].pareto; b++) {
-                if (a == b)
+                if (a == b || c.pts[b].workload != c.pts[a].workload)
                     continue;
                 bool better_q = o->flip ? c.pts[b].y <= c.pts[a].y : c.pts[b].y >= c.pts[a].y;
                 bool strictly = c.pts[b].x < c.pts[a].x ||
@@ -462,15 +948,22 @@ char *charts_sweep(const json_t *sweep, const char *name, enum chart_format form
                     c.pts[a].pareto = false;
             }
         }
-    } else if (strcmp(name, "time_vs_param") == 0) {
+        if (c.nworkloads > 1) {
+            size_t used = strlen(c.subtitle);
+            snprintf(c.subtitle + used, sizeof(c.subtitle) - used, "; a front per workload (%d)",
+                     c.nworkloads);
+        }
+    } else if (tvp) {
         c.lines = !c.categorical_x;
         snprintf(c.title, sizeof(c.title), "Frame time against %s", param ? param : "the parameter");
         snprintf(c.xlabel, sizeof(c.xlabel), "%s", param ? param : "");
-        snprintf(c.ylabel, sizeof(c.ylabel), "median %s (95%% interval)", series);
+        snprintf(c.ylabel, sizeof(c.ylabel), "median %s, ms (95%% interval)", series);
     } else {
         snprintf(c.title, sizeof(c.title), "Frame-time distribution per point");
-        snprintf(c.xlabel, sizeof(c.xlabel), "box p5-p95, line median, tick p99, whiskers min-max");
-        snprintf(c.ylabel, sizeof(c.ylabel), "%s", series);
+        snprintf(c.xlabel, sizeof(c.xlabel), any_runs
+                 ? "box p5-p95 of the first run, line median, diamond median over runs, tick p99"
+                 : "box p5-p95, line median, tick p99, whiskers min-max");
+        snprintf(c.ylabel, sizeof(c.ylabel), "%s, ms", series);
     }
     char *out = render(&c, format, len);
     free(c.pts);
@@ -490,6 +983,7 @@ char *charts_job(const json_t *job, const char *name, enum chart_format format,
     /* One box per series. */
     struct chart c;
     memset(&c, 0, sizeof(c));
+    c.name = name;
     struct point pts[3];
     memset(pts, 0, sizeof(pts));
     c.pts = pts;
@@ -510,12 +1004,62 @@ char *charts_job(const json_t *job, const char *name, enum chart_format format,
         p->series = series_of(&c, all[s]);
         snprintf(c.categories[c.ncategories++], sizeof(c.categories[0]), "%s", all[s]);
     }
+    const json_t *device = json_object_get(result, "device");
     snprintf(c.title, sizeof(c.title), "Frame times of job %s (%s)",
              json_string_value(json_object_get(job, "id")) ? json_string_value(json_object_get(job, "id")) : "",
              json_string_value(json_object_get(job, "technique")) ? json_string_value(json_object_get(job, "technique")) : "");
+    if (software_device(device))
+        snprintf(c.subtitle, sizeof(c.subtitle), "on llvmpipe gpu_ms covers rasterization only: "
+                 "frame_ms compares techniques");
     snprintf(c.xlabel, sizeof(c.xlabel), "box p5-p95, line median, tick p99, whiskers min-max");
     snprintf(c.ylabel, sizeof(c.ylabel), "milliseconds");
     char *out = render(&c, format, len);
+    if (!out)
+        snprintf(err, errlen, "cairo could not draw the chart");
+    return out;
+}
+
+char *charts_job_timeline(const json_t *job, const json_t *samples, enum chart_format format,
+                          const struct chart_options *o, size_t *len, char *err, size_t errlen)
+{
+    const json_t *device = json_object_get(json_object_get(job, "result"), "device");
+    const char *series = o->series ? o->series : charts_default_series(device);
+    json_t *main = json_object_get(samples, series);
+    size_t n = json_array_size(main);
+    if (!n) {
+        snprintf(err, errlen, "no per-frame %s samples", series);
+        return NULL;
+    }
+    struct chart c;
+    memset(&c, 0, sizeof(c));
+    c.name = "timeline";
+    c.pts = calloc(n, sizeof(*c.pts));
+    if (!c.pts) {
+        snprintf(err, errlen, "out of memory");
+        return NULL;
+    }
+    c.lines = c.no_markers = true;
+    int s = series_of(&c, series);
+    for (size_t i = 0; i < n; i++) {
+        struct point *p = &c.pts[c.n++];
+        p->x = p->x_lo = p->x_hi = (double)(i + 1);
+        p->y = p->y_lo = p->y_hi = num(json_array_get(main, i), 0);
+        p->series = s;
+    }
+    /* The median as a level, so that drift over the run stands out. */
+    json_t *st = json_object_get(json_object_get(job, "result"), series);
+    if (json_is_number(json_object_get(st, "median"))) {
+        struct level *l = &c.levels[c.nlevels++];
+        l->y = l->lo = l->hi = json_number_value(json_object_get(st, "median"));
+        snprintf(l->label, sizeof(l->label), "median %.3f ms", l->y);
+    }
+    snprintf(c.title, sizeof(c.title), "%s over the run of job %s", series,
+             json_string_value(json_object_get(job, "id")) ? json_string_value(json_object_get(job, "id")) : "");
+    series_note(series, device, !o->series, c.subtitle, sizeof(c.subtitle));
+    snprintf(c.xlabel, sizeof(c.xlabel), "timed frame");
+    snprintf(c.ylabel, sizeof(c.ylabel), "%s, ms", series);
+    char *out = render(&c, format, len);
+    free(c.pts);
     if (!out)
         snprintf(err, errlen, "cairo could not draw the chart");
     return out;

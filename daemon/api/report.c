@@ -2,6 +2,7 @@
 #include "daemon/api/report.h"
 
 #include <limits.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -180,7 +181,8 @@ static void ms_cell(struct html *h, const json_t *cell)
     }
     if (json_array_size(ci) == 2)
         add(h, "<td>%.3f [%.3f, %.3f]</td>", json_number_value(json_object_get(cell, "median")),
-            json_number_value(json_array_get(ci, 0)), json_number_value(json_array_get(ci, 1)));
+            fmax(0.0, json_number_value(json_array_get(ci, 0))),
+            json_number_value(json_array_get(ci, 1)));
     else
         add(h, "<td>%.3f</td>", json_number_value(json_object_get(cell, "median")));
 }
@@ -191,6 +193,289 @@ static void num_cell(struct html *h, const json_t *v, const char *fmt)
         add(h, fmt, json_number_value(v));
     else
         add(h, "<td>-</td>");
+}
+
+/* ---- the verdict of a sweep ---- */
+
+static bool workload_key(const char *k)
+{
+    return !strncmp(k, "scene.", 6) || !strcmp(k, "frames") || !strcmp(k, "warmup_frames");
+}
+
+/* "key=value, ..." of the values that pass keep(key), in their order. */
+static void values_text(const json_t *values, bool (*keep)(const char *key, const char *skip),
+                        const char *skip, char *out, size_t cap)
+{
+    out[0] = '\0';
+    const char *k;
+    json_t *v;
+    json_object_foreach((json_t *)values, k, v) {
+        if (!keep(k, skip))
+            continue;
+        char *t = json_dumps(v, JSON_ENCODE_ANY);
+        size_t used = strlen(out);
+        snprintf(out + used, cap - used, "%s%s=%s", used ? ", " : "", k, t ? t : "?");
+        free(t);
+    }
+}
+
+static bool keep_workload(const char *k, const char *skip)
+{
+    return workload_key(k) && (!skip || strcmp(k, skip) != 0);
+}
+
+static bool keep_variant(const char *k, const char *skip)
+{
+    return !workload_key(k) && strcmp(k, "technique") != 0 && (!skip || strcmp(k, skip) != 0);
+}
+
+static double row_ms(const json_t *row, const char *series)
+{
+    json_t *m = json_object_get(json_object_get(row, series), "median");
+    return json_is_number(m) ? json_number_value(m) : NAN;
+}
+
+/* Adds crossovers between two curves {"name", "workload", "flat", "xs",
+ * "ys"} to list. A flat curve (the reference, timed once per workload)
+ * holds its value at every x of the other. */
+static void cross(const json_t *a, const json_t *b, const char *param, json_t *list)
+{
+    json_t *xa = json_object_get(a, "xs"), *ya = json_object_get(a, "ys");
+    json_t *xb = json_object_get(b, "xs"), *yb = json_object_get(b, "ys");
+    bool fa = json_is_true(json_object_get(a, "flat")), fb = json_is_true(json_object_get(b, "flat"));
+    if (fa && fb)
+        return;
+    const json_t *xs = fa ? xb : xa;
+    size_t n = json_array_size(xs);
+    double *x = malloc((n + 1) * sizeof(double)), *d = malloc((n + 1) * sizeof(double));
+    size_t k = 0;
+    for (size_t i = 0; x && d && i < n; i++) {
+        double xv = json_number_value(json_array_get(xs, i));
+        double va = NAN, vb = NAN;
+        for (size_t j = 0; j < json_array_size(xa); j++)
+            if (fa || json_number_value(json_array_get(xa, j)) == xv)
+                va = json_number_value(json_array_get(ya, j));
+        for (size_t j = 0; j < json_array_size(xb); j++)
+            if (fb || json_number_value(json_array_get(xb, j)) == xv)
+                vb = json_number_value(json_array_get(yb, j));
+        if (isnan(va) || isnan(vb))
+            continue;
+        /* Insert sorted by x. */
+        size_t at = k;
+        while (at > 0 && x[at - 1] > xv) {
+            x[at] = x[at - 1];
+            d[at] = d[at - 1];
+            at--;
+        }
+        x[at] = xv;
+        d[at] = va - vb;
+        k++;
+    }
+    for (size_t i = 0; i + 1 < k; i++) {
+        if (!(d[i] * d[i + 1] < 0))
+            continue;
+        double at = x[i] + (x[i + 1] - x[i]) * d[i] / (d[i] - d[i + 1]);
+        /* Below the crossing, the curve with the smaller time is faster. */
+        const json_t *below = d[i] < 0 ? a : b, *above = d[i] < 0 ? b : a;
+        json_array_append_new(list, json_pack("{s:O, s:O, s:s, s:[f, f], s:f, s:O}", "faster_below",
+                                              json_object_get(below, "name"), "faster_above",
+                                              json_object_get(above, "name"), "param", param,
+                                              "between", x[i], x[i + 1], "at", at, "workload",
+                                              json_object_get(a, "workload")));
+    }
+    free(x);
+    free(d);
+}
+
+json_t *report_sweep_verdict(const json_t *sweep, const char *series)
+{
+    json_t *v = json_pack("{s:s}", "series", series);
+    json_t *result = json_object_get(sweep, "result");
+    static const char *const copied[] = {"largest_pdiff_pass", "breaking_point"};
+    for (int i = 0; i < 2; i++)
+        if (json_object_get(result, copied[i]))
+            json_object_set(v, copied[i], json_object_get(result, copied[i]));
+    const json_t *base = json_object_get(json_object_get(sweep, "spec"), "base");
+    const char *ref = json_string_value(json_object_get(base, "reference"));
+    ref = ref ? ref : "forward";
+    json_t *points = json_object_get(sweep, "points");
+    /* The first numeric parameter of the grid. */
+    const char *param = NULL;
+    size_t i;
+    json_t *row;
+    json_array_foreach(points, i, row) {
+        const char *k;
+        json_t *val;
+        json_object_foreach(json_object_get(row, "values"), k, val) if (!param && json_is_number(val))
+            param = k;
+    }
+    /* Curves: one per technique and per value of the other parameters. */
+    json_t *curves = json_object();
+    json_t *by_workload = json_object();
+    char name[160], wl[160], key[400];
+    json_array_foreach(points, i, row) {
+        double ms = row_ms(row, series);
+        const char *tech = json_string_value(json_object_get(row, "technique"));
+        json_t *values = json_object_get(row, "values");
+        if (isnan(ms) || !tech)
+            continue;
+        bool is_ref = !strcmp(tech, ref);
+        /* Per workload: the reference against the fastest points. */
+        values_text(values, keep_workload, NULL, wl, sizeof(wl));
+        json_t *w = json_object_get(by_workload, wl);
+        if (!w) {
+            w = json_pack("{s:s, s:s}", "workload", wl, "reference", ref);
+            json_object_set_new(by_workload, wl, w);
+        }
+        if (is_ref) {
+            json_object_set_new(w, "reference_ms", json_real(ms));
+        } else {
+            json_t *pt = json_pack("{s:s, s:O, s:f}", "technique", tech, "values", values, "ms", ms);
+            json_t *fastest = json_object_get(w, "fastest");
+            if (!fastest || ms < json_number_value(json_object_get(fastest, "ms")))
+                json_object_set(w, "fastest", pt);
+            json_t *pf = json_object_get(row, "pdiff_failed_captures");
+            json_t *fp = json_object_get(w, "fastest_passing");
+            if (json_is_integer(pf) && json_integer_value(pf) == 0 &&
+                (!fp || ms < json_number_value(json_object_get(fp, "ms"))))
+                json_object_set(w, "fastest_passing", pt);
+            json_decref(pt);
+        }
+        if (!param)
+            continue;
+        json_t *pv = json_object_get(values, param);
+        if (pv && !json_is_number(pv))
+            continue;
+        values_text(values, keep_workload, param, wl, sizeof(wl));
+        values_text(values, keep_variant, param, name, sizeof(name));
+        char full[200];
+        snprintf(full, sizeof(full), "%s%s%s%s", tech, is_ref ? " (reference)" : "",
+                 name[0] ? " " : "", name);
+        snprintf(key, sizeof(key), "%s|%s", full, wl);
+        json_t *c = json_object_get(curves, key);
+        if (!c) {
+            c = json_pack("{s:s, s:s, s:b, s:[], s:[]}", "name", full, "workload", wl, "flat",
+                          pv == NULL, "xs", "ys");
+            json_object_set_new(curves, key, c);
+        }
+        json_array_append_new(json_object_get(c, "xs"), json_real(pv ? json_number_value(pv) : 0));
+        json_array_append_new(json_object_get(c, "ys"), json_real(ms));
+    }
+    json_t *crossovers = json_array();
+    const char *ka, *kb;
+    json_t *a, *b;
+    json_object_foreach(curves, ka, a) {
+        bool after = false;
+        json_object_foreach(curves, kb, b) {
+            if (!strcmp(ka, kb)) {
+                after = true;
+                continue;
+            }
+            if (after && !strcmp(json_string_value(json_object_get(a, "workload")),
+                                 json_string_value(json_object_get(b, "workload"))))
+                cross(a, b, param, crossovers);
+        }
+    }
+    json_object_set_new(v, "crossovers", crossovers);
+    json_t *against = json_array();
+    const char *k;
+    json_t *w;
+    json_object_foreach(by_workload, k, w) {
+        json_t *rm = json_object_get(w, "reference_ms");
+        static const char *const which[] = {"fastest", "fastest_passing"};
+        for (int j = 0; j < 2 && rm; j++) {
+            json_t *pt = json_object_get(w, which[j]);
+            if (pt)
+                json_object_set_new(pt, "ratio", json_real(json_number_value(json_object_get(pt, "ms")) /
+                                                           json_number_value(rm)));
+        }
+        json_array_append(against, w);
+    }
+    json_object_set_new(v, "against_reference", against);
+    json_decref(curves);
+    json_decref(by_workload);
+    return v;
+}
+
+static void verdict_html(struct html *h, const json_t *v)
+{
+    add(h, "<h2>Verdict</h2><ul class=\"verdict\">");
+    json_t *lp = json_object_get(v, "largest_pdiff_pass");
+    if (lp) {
+        char *val = json_dumps(json_object_get(lp, "value"), JSON_ENCODE_ANY);
+        add(h, "<li>Largest <b>");
+        escaped(h, str(lp, "param"));
+        add(h, "</b> whose captures all pass PerceptualDiff: <b>%s</b>.</li>",
+            json_is_null(json_object_get(lp, "value")) ? "none passes" : (val ? val : "?"));
+        free(val);
+    }
+    json_t *bp = json_object_get(v, "breaking_point");
+    if (bp) {
+        char *val = json_dumps(json_object_get(bp, "value"), JSON_ENCODE_ANY);
+        add(h, "<li>Breaking point: the largest <b>");
+        escaped(h, str(bp, "param"));
+        add(h, "</b> at which <b>");
+        escaped(h, str(bp, "criterion"));
+        add(h, "</b> still holds: <b>%s</b> (%s, after %lld probes).</li>", val ? val : "?",
+            str(bp, "outcome"), (long long)json_integer_value(json_object_get(bp, "probes")));
+        free(val);
+    }
+    size_t i;
+    json_t *c;
+    json_array_foreach(json_object_get(v, "crossovers"), i, c) {
+        add(h, "<li>Crossover on %s: <b>", str(v, "series"));
+        escaped(h, str(c, "faster_below"));
+        add(h, "</b> is faster below <b>");
+        escaped(h, str(c, "param"));
+        json_t *bt = json_object_get(c, "between");
+        add(h, " &asymp; %.4g</b> (between %.4g and %.4g), <b>",
+            json_number_value(json_object_get(c, "at")), json_number_value(json_array_get(bt, 0)),
+            json_number_value(json_array_get(bt, 1)));
+        escaped(h, str(c, "faster_above"));
+        add(h, "</b> above it");
+        if (str(c, "workload")[0]) {
+            add(h, " (");
+            escaped(h, str(c, "workload"));
+            add(h, ")");
+        }
+        add(h, ".</li>");
+    }
+    if (!json_array_size(json_object_get(v, "crossovers")))
+        add(h, "<li>No crossover: along the first swept parameter no technique overtakes "
+               "another on the same workload.</li>");
+    json_t *w;
+    json_array_foreach(json_object_get(v, "against_reference"), i, w) {
+        json_t *rm = json_object_get(w, "reference_ms");
+        if (!rm)
+            continue;
+        add(h, "<li>");
+        if (str(w, "workload")[0]) {
+            escaped(h, str(w, "workload"));
+            add(h, ": ");
+        }
+        escaped(h, str(w, "reference"));
+        add(h, " (the reference) takes %.3f ms", json_number_value(rm));
+        static const char *const which[][2] = {{"fastest", "the fastest point"},
+                                               {"fastest_passing", "the fastest passing PerceptualDiff"}};
+        for (int k = 0; k < 2; k++) {
+            json_t *pt = json_object_get(w, which[k][0]);
+            if (!pt)
+                continue;
+            char *vals = json_dumps(json_object_get(pt, "values"), JSON_COMPACT);
+            add(h, "; %s is ", which[k][1]);
+            escaped(h, str(pt, "technique"));
+            add(h, " ");
+            escaped(h, vals);
+            add(h, " at %.3f ms (<b>%.2f&times;</b> the reference)",
+                json_number_value(json_object_get(pt, "ms")),
+                json_number_value(json_object_get(pt, "ratio")));
+            free(vals);
+        }
+        if (!json_object_get(w, "fastest_passing"))
+            add(h, "; no point passes PerceptualDiff");
+        add(h, ".</li>");
+    }
+    add(h, "</ul>");
 }
 
 /* The thesis's chapter 4 for this device: execution time of the timed
@@ -257,20 +542,16 @@ char *report_sweep_html(const json_t *sweep, const json_t *device, report_job_di
         escaped(&h, str(sweep, "error"));
     }
     add(&h, "</p>");
-    json_t *bp = json_object_get(json_object_get(sweep, "result"), "breaking_point");
-    if (bp) {
-        char *v = json_dumps(json_object_get(bp, "value"), JSON_ENCODE_ANY);
-        add(&h, "<h2>Breaking point</h2><p>The largest <b>");
-        escaped(&h, str(bp, "param"));
-        add(&h, "</b> at which <b>");
-        escaped(&h, str(bp, "criterion"));
-        add(&h, "</b> still holds: <b>%s</b> (%s, after %lld probes).</p>", v ? v : "?",
-            str(bp, "outcome"), (long long)json_integer_value(json_object_get(bp, "probes")));
-        free(v);
-    }
+    const char *series = charts_default_series(device);
+    json_t *verdict = report_sweep_verdict(sweep, series);
+    verdict_html(&h, verdict);
+    json_decref(verdict);
     json_t *points = json_object_get(sweep, "points");
     if (strcmp(str(sweep, "preset"), "thesis") == 0)
         thesis_tables(&h, points);
+    const char *reference = json_string_value(
+        json_object_get(json_object_get(json_object_get(sweep, "spec"), "base"), "reference"));
+    reference = reference ? reference : "forward";
     add(&h, "<h2>Table</h2><table><tr><th class=\"l\">parameters</th><th class=\"l\">technique</th>"
             "<th class=\"l\">job</th><th>frame_ms median [95%%]</th><th>gpu_ms median [95%%]</th>"
             "<th>worst SSIM</th><th>worst FLIP</th><th>PerceptualDiff failures</th></tr>");
@@ -284,7 +565,8 @@ char *report_sweep_html(const json_t *sweep, const json_t *device, report_job_di
         escaped(&h, str(row, "technique"));
         add(&h, "</td><td class=\"l\">");
         escaped(&h, str(row, "job"));
-        add(&h, " (%s)</td>", str(row, "status"));
+        add(&h, " (%s)%s</td>", str(row, "status"),
+            !strcmp(str(row, "technique"), reference) ? " reference, timed" : "");
         free(values);
         ms_cell(&h, json_object_get(row, "frame_ms"));
         ms_cell(&h, json_object_get(row, "gpu_ms"));
@@ -298,8 +580,9 @@ char *report_sweep_html(const json_t *sweep, const json_t *device, report_job_di
             add(&h, "<td>-</td>");
         add(&h, "</tr>");
     }
-    add(&h, "</table><h2>Charts</h2>");
-    struct chart_options o = {0};
+    add(&h, "</table><p>Intervals are 95%%; a lower end below zero is shown as 0 (times are "
+            "never negative).</p><h2>Charts</h2>");
+    struct chart_options o = {.device = device};
     chart(&h, sweep, "speed_accuracy", true, &o, "speed against accuracy (SSIM)");
     o.flip = true;
     chart(&h, sweep, "speed_accuracy", true, &o, "speed against accuracy (FLIP)");
@@ -350,6 +633,99 @@ static void stats_row(struct html *h, const char *name, const json_t *s)
     add(h, "</tr>");
 }
 
+/* Per-frame samples from a job's timings.csv: {"frame_ms": [...], ...}. */
+static json_t *read_timings(const char *dir)
+{
+    char path[PATH_MAX + 16];
+    snprintf(path, sizeof(path), "%s/timings.csv", dir ? dir : "");
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return NULL;
+    char line[1024];
+    json_t *out = json_object(), *cols = json_array();
+    if (fgets(line, sizeof(line), f)) {
+        line[strcspn(line, "\r\n")] = '\0';
+        for (char *save = NULL, *t = strtok_r(line, ",", &save); t; t = strtok_r(NULL, ",", &save)) {
+            json_t *arr = json_array();
+            json_array_append(cols, arr);
+            json_object_set_new(out, t, arr);
+        }
+    }
+    while (fgets(line, sizeof(line), f)) {
+        char *p = line;
+        for (size_t c = 0; c < json_array_size(cols); c++) {
+            double v = strtod(p, &p);
+            json_array_append_new(json_array_get(cols, c), json_real(v));
+            if (*p == ',')
+                p++;
+        }
+    }
+    fclose(f);
+    json_decref(cols);
+    return out;
+}
+
+/* The technique's own figures (result.<technique>, as its describe hook
+ * wrote them) and its per-pass GPU times. */
+static void technique_figures(struct html *h, const json_t *r, const char *technique)
+{
+    json_t *own = json_object_get(r, technique);
+    json_t *sections = json_object_get(r, "gpu_sections_ms");
+    add(h, "<h2>Technique figures (%s)</h2><table><tr><th class=\"l\">figure</th>"
+           "<th class=\"l\">value</th></tr>", technique);
+    add(h, "<tr><td class=\"l\">triangles a frame, instances, lights</td><td class=\"l\">%lld, "
+           "%lld, %lld</td></tr>",
+        (long long)json_integer_value(json_object_get(r, "triangles_per_frame")),
+        (long long)json_integer_value(json_object_get(r, "instances")),
+        (long long)json_integer_value(json_object_get(r, "lights")));
+    add(h, "<tr><td class=\"l\">timer query stalls</td><td class=\"l\">%lld</td></tr>",
+        (long long)json_integer_value(json_object_get(r, "timer_query_stalls")));
+    const char *key;
+    json_t *v;
+    json_object_foreach(own, key, v) {
+        char *text = json_is_string(v) ? NULL : json_dumps(v, JSON_ENCODE_ANY | JSON_COMPACT);
+        add(h, "<tr><td class=\"l\">");
+        escaped(h, key);
+        add(h, "</td><td class=\"l\">");
+        escaped(h, json_is_string(v) ? json_string_value(v) : text);
+        add(h, "</td></tr>");
+        free(text);
+    }
+    json_object_foreach(sections, key, v) {
+        add(h, "<tr><td class=\"l\">gpu_ms of pass ");
+        escaped(h, key);
+        add(h, "</td><td class=\"l\">median %.4f, p95 %.4f</td></tr>",
+            json_number_value(json_object_get(v, "median")),
+            json_number_value(json_object_get(v, "p95")));
+    }
+    add(h, "</table>");
+}
+
+static void runs_table(struct html *h, const json_t *r)
+{
+    json_t *runs = json_object_get(r, "runs");
+    if (!json_array_size(runs))
+        return;
+    json_t *rep = json_object_get(r, "repeat");
+    add(h, "<h2>Runs</h2><p>%lld runs (%s); across runs, the median frame_ms of the run "
+           "medians is %.4f ms.</p><table><tr><th>run</th><th>frame_ms median</th>"
+           "<th>gpu_ms median</th><th>cpu_ms median</th><th>wall s</th></tr>",
+        (long long)json_integer_value(json_object_get(rep, "runs")),
+        json_is_true(json_object_get(rep, "stable")) ? "stable" : "not stable to 2.5%",
+        json_number_value(json_object_get(json_object_get(rep, "frame_ms"), "median")));
+    size_t i;
+    json_t *run;
+    json_array_foreach(runs, i, run) {
+        add(h, "<tr><td>%lld</td>", (long long)json_integer_value(json_object_get(run, "run")));
+        num_cell(h, json_object_get(json_object_get(run, "frame_ms"), "median"), "<td>%.4f</td>");
+        num_cell(h, json_object_get(json_object_get(run, "gpu_ms"), "median"), "<td>%.4f</td>");
+        num_cell(h, json_object_get(json_object_get(run, "cpu_ms"), "median"), "<td>%.4f</td>");
+        num_cell(h, json_object_get(run, "wall_s"), "<td>%.3f</td>");
+        add(h, "</tr>");
+    }
+    add(h, "</table>");
+}
+
 char *report_job_html(const json_t *job, const char *dir, const json_t *device, size_t *len)
 {
     struct html h = {0};
@@ -376,8 +752,20 @@ char *report_job_html(const json_t *job, const char *dir, const json_t *device, 
         stats_row(&h, "gpu_ms", json_object_get(r, "gpu_ms"));
         stats_row(&h, "cpu_ms", json_object_get(r, "cpu_ms"));
         add(&h, "</table>");
-        struct chart_options o = {0};
+        struct chart_options o = {.device = device};
+        json_t *samples = read_timings(dir);
+        char err[256];
+        size_t tlen = 0;
+        char *png = samples ? charts_job_timeline(job, samples, CHART_PNG, &o, &tlen, err,
+                                                  sizeof(err))
+                            : NULL;
+        if (png)
+            png_img(&h, (unsigned char *)png, tlen, "frame times over the run", "chart");
+        free(png);
+        json_decref(samples);
         chart(&h, job, "distribution", false, &o, "frame-time distribution");
+        runs_table(&h, r);
+        technique_figures(&h, r, str(job, "technique"));
         json_t *q = json_object_get(r, "quality");
         if (q) {
             add(&h, "<h2>Quality against %s</h2><p>Worst SSIM %.6f, worst FLIP mean %.5f, "

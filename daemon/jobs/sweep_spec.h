@@ -16,7 +16,8 @@
 
 enum sweep_kind { SWEEP_VARY, SWEEP_FIND };
 
-enum sweep_criterion { CRITERION_PDIFF_PASS, CRITERION_SSIM_MIN, CRITERION_FLIP_MAX, CRITERION_STABLE };
+enum sweep_criterion { CRITERION_PDIFF_PASS, CRITERION_SSIM_MIN, CRITERION_FLIP_MAX, CRITERION_STABLE,
+                       CRITERION_FINITE /* no capture had NaN or infinite HDR pixels */ };
 
 struct sweep_spec {
     enum sweep_kind kind;
@@ -24,10 +25,13 @@ struct sweep_spec {
     int nparams;
     char params[2][64];     /* dotted paths */
     json_t *values[2];      /* arrays, for SWEEP_VARY */
-    size_t npoints;
+    size_t npoints;         /* the grid, then the timed reference points */
+    size_t ngrid;           /* SWEEP_VARY: points of the grid itself */
+    json_t *reference_values; /* SWEEP_VARY: values of each timed reference point */
     /* SWEEP_FIND */
     double from, to;
     bool integer;
+    int step;               /* integer fields: probes are from + k step */
     int max_probes;
     enum sweep_criterion criterion;
     double threshold;
@@ -44,7 +48,13 @@ void sweep_spec_finish(struct sweep_spec *s);
 json_t *sweep_params_json(const struct technique_catalog *techniques);
 
 /* The job of grid point index (row-major over the parameters); *values gets
- * {"path": value, ...}. New references. */
+ * {"path": value, ...}. Indices from ngrid on are the timed reference
+ * points: the reference technique (forward unless the base names another)
+ * on each workload of the grid (each combination of swept scene.*, frames
+ * and warmup_frames values), timed like the others and not judged, so that
+ * charts and reports place it beside them. A sweep adds none when the
+ * reference is already among its techniques, or with "time_reference":
+ * false. New references. */
 json_t *sweep_point_job(const struct sweep_spec *s, size_t index, json_t **values);
 
 /* The job of a find probe at value v. New reference. */

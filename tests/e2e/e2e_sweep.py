@@ -33,8 +33,12 @@ try:
     # 11 frames: the table must show exactly that.
     sw = wait(d, post(d, {"base": BASE, "vary": {"async_distance": [0, 5, 80]}}))
     check(sw["status"] == "done", "grid sweep done: %s" % sw.get("error"))
-    rows = sw["points"]
+    rows = [r for r in sw["points"] if r["technique"] == "osl"]
     check(len(rows) == 3 and [r["values"]["async_distance"] for r in rows] == [0, 5, 80], "one row per value")
+    ref = [r for r in sw["points"] if r["technique"] == "forward"]
+    check(len(sw["points"]) == 4 and len(ref) == 1 and ref[0]["values"] == {"technique": "forward"} and
+          ref[0]["frame_ms"]["median"] > 0 and "worst_ssim" not in ref[0],
+          "the reference technique is timed once beside the grid, not judged: %s" % ref)
     for r in rows:
         check(r["status"] == "done" and r["frame_ms"]["median"] > 0 and len(r["frame_ms"]["ci95"]) == 2,
               "row has a median frame time with its interval: %s" % r.get("frame_ms"))

@@ -76,7 +76,8 @@ int main(void)
     struct job_error err;
     CHECK(parse("{\"base\":{\"technique\":\"osl\",\"frames\":20},"
                 "\"vary\":{\"async_distance\":[0,5,10],\"scene.lights\":[4,8]}}", &s, &err));
-    CHECK(s.kind == SWEEP_VARY && s.npoints == 6 && s.nparams == 2);
+    /* 6 grid points, then forward timed once per light count. */
+    CHECK(s.kind == SWEEP_VARY && s.ngrid == 6 && s.npoints == 8 && s.nparams == 2);
     json_t *values, *job = sweep_point_job(&s, 3, &values);
     CHECK(json_integer_value(json_object_get(values, "async_distance")) == 5);
     CHECK(json_integer_value(json_object_get(values, "scene.lights")) == 8);
@@ -85,7 +86,37 @@ int main(void)
     CHECK(json_integer_value(json_object_get(job, "capture_interval")) == 20);
     json_decref(values);
     json_decref(job);
+    job = sweep_point_job(&s, 7, &values);
+    CHECK(!strcmp(json_string_value(json_object_get(values, "technique")), "forward") &&
+          json_integer_value(json_object_get(values, "scene.lights")) == 8 &&
+          json_object_size(values) == 2);
+    CHECK(!strcmp(json_string_value(json_object_get(job, "technique")), "forward") &&
+          !json_object_get(job, "reference") &&
+          json_integer_value(json_object_get(job, "capture_interval")) == 0 &&
+          json_integer_value(json_object_get(json_object_get(job, "scene"), "lights")) == 8);
+    json_decref(values);
+    json_decref(job);
     sweep_spec_finish(&s);
+    /* No workload varied: one reference point. The reference among the
+     * techniques, or time_reference false: none. */
+    CHECK(parse("{\"base\":{\"technique\":\"osl\"},\"vary\":{\"async_distance\":[0,5]}}",
+                &s, &err) && s.npoints == 3);
+    sweep_spec_finish(&s);
+    CHECK(parse("{\"base\":{},\"vary\":{\"technique\":[\"osl\",\"forward\"],"
+                "\"scene.lights\":[1,2]}}", &s, &err) && s.npoints == 4);
+    sweep_spec_finish(&s);
+    CHECK(parse("{\"base\":{\"technique\":\"osl\"},\"vary\":{\"async_distance\":[0,5]},"
+                "\"time_reference\":false}", &s, &err) && s.npoints == 2);
+    sweep_spec_finish(&s);
+    CHECK(parse("{\"base\":{\"technique\":\"osl\",\"reference\":\"unlit\","
+                "\"capture_interval\":5},\"vary\":{\"async_distance\":[0]}}", &s, &err) &&
+          s.npoints == 2);
+    job = sweep_point_job(&s, 1, &values);
+    CHECK(!strcmp(json_string_value(json_object_get(job, "technique")), "unlit"));
+    json_decref(values);
+    json_decref(job);
+    sweep_spec_finish(&s);
+    rejects("{\"base\":{},\"vary\":{\"frames\":[1]},\"time_reference\":1}", "time_reference");
 
     /* find: numeric parameter, criterion parsed, probes built. */
     CHECK(parse("{\"base\":{\"technique\":\"osl\"},\"find\":{\"param\":\"async_distance\","

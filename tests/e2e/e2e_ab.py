@@ -1,0 +1,96 @@
+"""shadebench ab end to end: forward against unlit on one daemon, run in
+alternating pairs, gives B/A with an interval that contains the ratio of
+separate runs of the same jobs; the same job on two daemons (--server-b)
+pairs across them; JUnit and exit codes as for the gate.
+
+The forward/unlit ratio itself moves with the machine's load on llvmpipe
+(forward's rasterization is spread over threads that compete with the
+neighbours; unlit's vertex work is not), so the separate runs bracket the
+ab run in time (half before, half after, in A B B A order) and the
+interval is taken at 99%: the check is that ab's interval is honest, not
+that the load stands still."""
+
+import json
+import os
+import statistics
+
+import testlib
+from testlib import check
+from clientlib import Client, junit_cases
+
+testlib.skip_without_egl()
+SCENE = {"width": 160, "height": 120, "dynamic": True}
+FORWARD = {"technique": "forward", "frames": 60, "warmup_frames": 5, "scene": SCENE}
+UNLIT = dict(FORWARD, technique="unlit")
+
+d = testlib.Daemon()
+d2 = None
+cl = Client(d)
+try:
+    fa, fb = cl.write("forward", FORWARD), cl.write("unlit", UNLIT)
+    separate = {"forward": [], "unlit": []}
+
+    def separate_runs(order):
+        for name in order:
+            r = d.run(FORWARD if name == "forward" else UNLIT)
+            check(r["status"] == "done", "%s run done" % name)
+            separate[name].append(r["result"]["frame_ms"]["median"])
+
+    separate_runs(("forward", "unlit", "unlit", "forward"))
+    outdir, junit = cl.path("ab"), cl.path("ab.xml")
+    out = cl.run("ab", fa, fb, "--runs", "6", "--max-reruns", "4", "--confidence", "99%",
+                 "--out", outdir, "--junit", junit)
+    check(out.returncode == 0, "unlit is not slower than forward: exit 0: %s" % out.stderr[-600:])
+    with open(os.path.join(outdir, "ab.json")) as f:
+        ab = json.load(f)
+    pairs = [p for p in ab["runs"] if not p["noisy"]]
+    check(ab["pairs"] >= 6 and len(pairs) == ab["pairs"], "at least 6 clean pairs: %s" % ab["pairs"])
+    # Alternation: A before B in even pairs, B before A in odd ones (ids
+    # sort in submission order).
+    order = [(p["a"] < p["b"]) for p in ab["runs"]]
+    check(order == [i % 2 == 0 for i in range(len(order))], "pairs alternate A B, B A, ...: %s" % order)
+    lo, ratio, hi = ab["ci_low"], ab["ratio"], ab["ci_high"]
+    check(0 < lo < ratio < hi < 1, "B/A = %.3f in [%.3f, %.3f], below 1: unlit is cheaper" % (ratio, lo, hi))
+    gm = statistics.geometric_mean([p["b_ms"] / p["a_ms"] for p in pairs])
+    check(abs(gm - ratio) < 1e-6 * ratio, "the ratio is the geometric mean of the pairs' ratios")
+    _, cases = junit_cases(junit)
+    abcase = [c for n, c in cases.items() if "B/A" in n]
+    check(len(abcase) == 1 and abs(float(abcase[0][2]["ratio"]) - ratio) < 1e-5 * ratio and
+          abcase[0][0] is None and abcase[0][2]["confidence"] == "0.99",
+          "JUnit has the ratio with its interval: %s" % abcase)
+    check(len(cases) == 3 and all(not n.startswith("2026") for n in cases), "a job case per side, named by content")
+    for side in ("A", "B"):
+        check(len(os.listdir(os.path.join(outdir, side, "runs"))) == len(ab["runs"]), "%s's runs are kept" % side)
+
+    # Separate runs, each a job, four before ab and four after: the ratio of
+    # their medians lies inside ab's interval.
+    separate_runs(("unlit", "forward", "forward", "unlit"))
+    sep = statistics.median(separate["unlit"]) / statistics.median(separate["forward"])
+    check(lo <= sep <= hi, "separate runs' ratio %.3f lies in ab's interval [%.3f, %.3f]" % (sep, lo, hi))
+
+    # B slower than A beyond the allowance: exit 1, like a regression.
+    out = cl.run("ab", cl.write("unlit20", dict(UNLIT, frames=20)),
+                 cl.write("forward20", dict(FORWARD, frames=20, scene=dict(SCENE, lights=200))),
+                 "--runs", "3", "--max-reruns", "3", "--max-slowdown", "5%")
+    check(out.returncode == 1 and "B SLOWER" in out.stderr,
+          "forward with 200 lights as B is slower: exit 1: %s" % out.stderr[-400:])
+
+    # The same job on two daemons.
+    d2 = testlib.Daemon()
+    out = cl.run("ab", cl.write("small", dict(FORWARD, frames=20)), "--server-b", d2.base, "--runs", "3",
+                 "--max-reruns", "0",
+                 "--max-slowdown", "400%", "--out", cl.path("two"))
+    check(out.returncode == 0, "one job on two daemons: %s" % out.stderr[-400:])
+    with open(cl.path("two", "ab.json")) as f:
+        two = json.load(f)
+    b_ids = {p["b"] for p in two["runs"]}
+    on_b = {j["id"] for j in d2.json("GET", "/v1/jobs")[1]["jobs"]}
+    check(two["server_b"] == d2.base and b_ids <= on_b and len(b_ids) == 3, "B's runs ran on the second daemon")
+    check(0.2 < two["ratio"] < 5, "the same job gives a ratio near 1: %.3f" % two["ratio"])
+    check(cl.run("ab", fa).returncode == 2, "ab with one job file needs --server-b")
+    check(cl.run("ab", fa, fb, "--server-b", d2.base).returncode == 2, "two files and --server-b is refused")
+finally:
+    if d2:
+        testlib.stop_and_check(d2)
+    testlib.stop_and_check(d)
+testlib.finish("e2e_ab")

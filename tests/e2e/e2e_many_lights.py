@@ -12,6 +12,8 @@ e2e_techniques.py:
   "fail" the job fails naming the option and the overflow;
 - the heat map: served as a PNG per capture, with a mean and max that grow
   with the light count;
+- frame k is a pure function of k (the same capture after 1 or 3 warm-up
+  frames);
 - bad options answer 400 naming the field; a grid only the device refuses
   fails the job at create, naming the field.
 Small frames (160x120), few frames, so the suite stays short on 2 cores."""
@@ -146,6 +148,22 @@ try:
     check(len(means) == 2 and means[1] > 2 * means[0], "heat grows with the lights: %s" % means)
     done = d.run(job("forward", 16, frames=2, capture=1, reference=None))
     check("heatmap" not in done.get("result", {}), "forward publishes no heat map")
+
+    # Frame k is a pure function of k: the same capture after 1 or 3 warm-up
+    # frames (lists, rings and records carry nothing into the image).
+    for tech, opts in (("clustered_deferred", {}), ("tiled_deferred", {"binning": "cpu"}),
+                       ("deferred", {"light_bounds": "volume"})):
+        paths = []
+        for warmup in (1, 3):
+            done = d.run(job(tech, 256, opts, frames=3, capture=3, preset="lights", reference=None,
+                             warmup_frames=warmup))
+            paths.append(os.path.join(d.tmp, "%s-w%d.png" % (tech, warmup)))
+            check(done.get("status") == "done" and
+                  d.download(done["result"]["captures"][-1]["url"], paths[-1]) == 200,
+                  "%s renders: %s" % (tech, done.get("error")))
+        diff = testlib.png_diff(*paths)
+        check(diff and diff["max_abs"] == 0, "%s %s: frame 3 the same after 1 or 3 warm-up frames: %s"
+              % (tech, opts, diff))
 
     # Bad options: 400 naming the field.
     base = {"frames": 2, "scene": {"width": 160, "height": 120}}

@@ -101,6 +101,10 @@ try:
     pid = d.proc.pid
     running = d.submit(LONG)
     check(wait_running(d, running), "a long job runs")
+    deadline = time.time() + 60 * S
+    while (d.json("GET", "/v1/jobs/" + running)[1]["progress"]["frames_done"] == 0 and
+           time.time() < deadline):
+        time.sleep(0.1)
     time.sleep(0.5)
     base_threads, base_fds = threads(pid), fds(pid)
 

@@ -1,5 +1,7 @@
-#define _POSIX_C_SOURCE 200809L
+#define _GNU_SOURCE /* dl_iterate_phdr, RTLD_NODELETE */
+#include <dlfcn.h>
 #include <getopt.h>
+#include <link.h>
 #include <limits.h>
 #include <malloc.h>
 #include <signal.h>
@@ -251,6 +253,28 @@ static rlim_t raise_fd_limit(void)
     return rl.rlim_cur;
 }
 
+#ifdef SHADEBENCH_SANITIZERS
+static int pin_module(struct dl_phdr_info *info, size_t size, void *data)
+{
+    (void)size, (void)data;
+    if (info->dlpi_name && info->dlpi_name[0])
+        dlopen(info->dlpi_name, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
+    return 0;
+}
+#endif
+
+/* Sanitizer builds only: Mesa unloads its driver when the GL context goes,
+ * and memory that only the driver's globals pointed to then looks leaked,
+ * with no module to name in a suppression. Marking every library loaded by
+ * now (the driver and LLVM included) as never to be unloaded keeps it
+ * reachable, so LeakSanitizer reports the daemon's own leaks only. */
+static void pin_loaded_modules(void)
+{
+#ifdef SHADEBENCH_SANITIZERS
+    dl_iterate_phdr(pin_module, NULL);
+#endif
+}
+
 static int list_devices(void)
 {
     struct egl_device_info devs[16];
@@ -266,6 +290,7 @@ static int list_devices(void)
         char gl_renderer[256] = "";
         /* The GL renderer string is what users recognise: open each device briefly. */
         struct egl_context *ctx = egl_context_create(i, false, why, sizeof(why));
+        pin_loaded_modules();
         if (ctx) {
             snprintf(gl_renderer, sizeof(gl_renderer), "%s", (const char *)glGetString(GL_RENDERER));
             renderer = gl_renderer;
@@ -315,6 +340,7 @@ static int run_once(const struct options *o)
         queue_destroy(q);
         return 1;
     }
+    pin_loaded_modules();
     char id[24];
     int rc = 1;
     if (queue_submit(q, &spec, o->out, id) == QUEUE_OK) {
@@ -395,6 +421,7 @@ static int serve(const struct options *o)
         queue_destroy(q);
         return 1;
     }
+    pin_loaded_modules();
     struct sweeps *sweeps = sweeps_create(q, technique_catalog());
     struct http_server *http =
         sweeps ? http_server_create(o->listen, &limits, q, r, sweeps, err, sizeof(err)) : NULL;

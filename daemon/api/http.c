@@ -183,7 +183,9 @@ static enum MHD_Result respond_405(struct MHD_Connection *c, const char *allow, 
     struct job_error e;
     snprintf(e.field, sizeof(e.field), "method");
     snprintf(e.message, sizeof(e.message), "%s", rule);
-    char *text = json_dumps(job_error_to_json(&e), JSON_COMPACT);
+    json_t *body = job_error_to_json(&e);
+    char *text = body ? json_dumps(body, JSON_COMPACT) : NULL;
+    json_decref(body);
     struct MHD_Response *resp =
         text ? MHD_create_response_from_buffer(strlen(text), text, MHD_RESPMEM_MUST_FREE) : NULL;
     if (!resp) {

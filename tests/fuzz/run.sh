@@ -25,10 +25,13 @@ fi
 flags="-g -O1 -std=c11 -I. -fno-omit-frame-pointer -fsanitize=address,undefined
   -fno-sanitize-recover=undefined $(pkg-config --cflags jansson libpng)"
 libs="$(pkg-config --libs jansson libpng) -lm -pthread"
-sources="common/json_fields.c common/png_io.c common/log.c common/clock.c
-  daemon/quality/ssim.c daemon/quality/psnr.c daemon/quality/pdiff.c daemon/quality/flip.c
-  daemon/quality/diffmap.c daemon/quality/compare.c daemon/scene/scene_spec.c
-  daemon/jobs/job_spec.c daemon/jobs/sweep_spec.c daemon/api/routes.c"
+# The GL-free libraries, read from Makefile.am so that this list cannot
+# fall behind the build.
+sources=$(awk '/^libsb_[a-z]*_a_SOURCES *=/ { on = 1 }
+    on { for (i = 1; i <= NF; i++) if ($i ~ /\.c$/) print $i }
+    on && !/\\$/ { on = 0 }' Makefile.am)
+[ -n "$sources" ] || { echo "FAIL: fuzz: no library sources found in Makefile.am"; exit 1; }
+sources="$sources daemon/api/routes.c" # the route target's only GL-free part of the API layer
 objs=""
 for src in $sources; do
     obj="$out/obj/$(echo "$src" | tr / _ | sed 's/\.c$/.o/')"

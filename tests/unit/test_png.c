@@ -1,3 +1,4 @@
+#define _POSIX_C_SOURCE 200809L /* mkdtemp */
 /* The PNG reader on damaged and oversized files: every one is refused with
  * a message and nothing leaks (the sanitizer build checks the leaks, clang's
  * included, where a non-volatile local would lose its buffer after libpng's

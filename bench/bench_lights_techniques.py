@@ -52,6 +52,7 @@ ap.add_argument("--height", type=int, default=720)
 ap.add_argument("--forward-max", type=int, default=1024, help="largest count forward runs at")
 ap.add_argument("--svg", default="bench-lights-techniques.svg", help="chart file ('' for none)")
 ap.add_argument("--json", help="write every result here")
+ap.add_argument("--from-json", help="report on the results a --json run wrote, without running")
 args = ap.parse_args()
 
 counts = [int(c) for c in args.counts.split(",")]
@@ -76,15 +77,23 @@ def runs(name, n):
 
 
 results = {(t, n): [] for t in names for n in counts}
-d = testlib.Daemon()
+if args.from_json:
+    with open(args.from_json) as f:
+        for key, rs in json.load(f).items():
+            t, n = key.rsplit("@", 1)
+            if (t, int(n)) in results:
+                results[(t, int(n))] = rs
 started = time.time()
+d = None if args.from_json else testlib.Daemon()
 try:
-    info = d.json("GET", "/v1/info")[1]["device"]
+    info = d.json("GET", "/v1/info")[1]["device"] if d else \
+        next(iter(rs[0] for rs in results.values() if rs))["device"]
     print("device: %s | %s | %s" % (info["gl_renderer"], info["gl_version"], info["egl_device"]))
-    print("scene: lights preset %dx%d, %d timed frames after %d warm-up, %d repeat(s); "
-          "forward up to %d lights\n" % (args.width, args.height, args.frames, args.warmup,
-                                        args.repeat, args.forward_max))
-    for rep in range(args.repeat):
+    print("scene: lights preset %dx%d, %d (%d above 1,024 lights) timed frames after %d warm-up, "
+          "%d repeat(s); "
+          "forward up to %d lights\n" % (args.width, args.height, args.frames, args.frames_high,
+                                        args.warmup, args.repeat, args.forward_max))
+    for rep in range(0 if args.from_json else args.repeat):
         for n in counts:
             for t in names:
                 if not runs(t, n):
@@ -99,9 +108,11 @@ try:
                       % (rep + 1, args.repeat, t, n, r["frame_ms"]["median"], time.time() - t0),
                       flush=True)
 finally:
-    d.stop()
-    d.cleanup()
-print("\nran in %.0f s" % (time.time() - started))
+    if d:
+        d.stop()
+        d.cleanup()
+if d:
+    print("\nran in %.0f s" % (time.time() - started))
 
 
 def work_ms(r):
@@ -253,7 +264,8 @@ for series in ("frame_ms", "work"):
     report(series)
 
 if args.svg:
-    # A log-log chart, standard library only.
+    # A log-log chart of frame_ms, standard library only.
+    SERIES = "frame_ms"
     W, H, L, R, T, B = 760, 480, 70, 190, 20, 50
     xs = [math.log10(n) for n in counts]
     ys = [math.log10(frame(t, n)[0]) for t in names for n in counts if frame(t, n)[0]]
@@ -294,6 +306,6 @@ if args.svg:
         f.write("\n".join(out))
     print("\nchart: %s" % args.svg)
 
-if args.json:
+if args.json and not args.from_json:
     with open(args.json, "w") as f:
         json.dump({"%s@%d" % k: v for k, v in results.items()}, f)

@@ -2,6 +2,7 @@
 #include "daemon/harness/runner.h"
 
 #include <epoxy/gl.h>
+#include <errno.h>
 #include <inttypes.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -409,7 +410,7 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
     bool csv_ok = fs_write_atomic(path, csv, used);
     free(csv);
     if (!csv_ok) {
-        snprintf(run->err, sizeof(run->err), "cannot write %.900s", path);
+        snprintf(run->err, sizeof(run->err), "cannot write %.900s: %s", path, strerror(errno));
         goto out;
     }
 
@@ -460,7 +461,7 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
     }
     snprintf(path, sizeof(path), "%s/result.json", job->dir);
     if (!fs_write_json_atomic(path, result)) {
-        snprintf(run->err, sizeof(run->err), "cannot write %.900s", path);
+        snprintf(run->err, sizeof(run->err), "cannot write %.900s: %s", path, strerror(errno));
         json_decref(result);
         result = NULL;
     }
@@ -823,7 +824,7 @@ static bool repeat_runs(struct runner *r, struct run *first, json_t *result,
         char path[PATH_MAX + 16];
         snprintf(path, sizeof(path), "%s/result.json", first->job->dir);
         if (!fs_write_json_atomic(path, result)) {
-            snprintf(first->err, sizeof(first->err), "cannot write %.900s", path);
+            snprintf(first->err, sizeof(first->err), "cannot write %.900s: %s", path, strerror(errno));
             ok = false;
         }
     }

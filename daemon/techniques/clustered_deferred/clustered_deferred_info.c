@@ -18,7 +18,8 @@ static bool check(const void *opts, struct job_error *err)
 
 const struct technique_info clustered_deferred_info = {
     .name = "clustered_deferred",
-    .summary = "froxel light lists (compute), g-buffer, one lighting pass over each cluster's lights (seed 004)",
+    .summary = "froxel light lists (compute), g-buffer, one lighting pass over each "
+               "cluster's lights (seed 004)",
     .passes = passes,
     .options = options,
     .options_size = sizeof(struct clustered_deferred_options),

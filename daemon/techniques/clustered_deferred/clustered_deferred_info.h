@@ -2,7 +2,8 @@
 #define SHADEBENCH_CLUSTERED_DEFERRED_INFO_H
 
 /* Clustered deferred shading's GL-free half (seed 004): its options
- * ("clustered_deferred": {"grid", "slices", "max_lights_per_cluster", "overflow", "gbuffer": {...}}) and passes. Any thread. */
+ * ("clustered_deferred": {"grid", "slices", "max_lights_per_cluster",
+ * "overflow", "gbuffer": {...}}) and passes. Any thread. */
 
 #include "daemon/techniques/shared/culling_info.h"
 

@@ -17,7 +17,8 @@ static bool check(const void *opts, struct job_error *err)
 
 const struct technique_info clustered_forward_info = {
     .name = "clustered_forward",
-    .summary = "froxel light lists (compute), depth pre-pass, forward shading over each cluster's lights (seed 004)",
+    .summary = "froxel light lists (compute), depth pre-pass, forward shading over each "
+               "cluster's lights (seed 004)",
     .passes = passes,
     .options = options,
     .options_size = sizeof(struct clustered_forward_options),

@@ -2,7 +2,8 @@
 #define SHADEBENCH_CLUSTERED_FORWARD_INFO_H
 
 /* Clustered forward shading's GL-free half (seed 004): its options
- * ("clustered_forward": {"grid", "slices", "max_lights_per_cluster", "overflow"}) and passes. Any thread. */
+ * ("clustered_forward": {"grid", "slices", "max_lights_per_cluster",
+ * "overflow"}) and passes. Any thread. */
 
 #include "daemon/techniques/shared/culling_info.h"
 

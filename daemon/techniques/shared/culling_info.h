@@ -18,11 +18,11 @@
 enum gbuffer_normal {
     GBUFFER_NORMAL_OCTAHEDRAL,       /* two channels, world space (default) */
     GBUFFER_NORMAL_FLOAT3,           /* three floats, world space */
-    GBUFFER_NORMAL_XY_RECONSTRUCT_Z, /* view-space x, y; z = sqrt(1 - x² - y²) loses its sign (seed 004) */
+    GBUFFER_NORMAL_XY_RECONSTRUCT_Z, /* view-space x, y; z rebuilt without its sign (seed 004) */
 };
 enum gbuffer_albedo {
     GBUFFER_ALBEDO_RGBA8,       /* 8 bits a channel (default) */
-    GBUFFER_ALBEDO_PACK_SHIFT,  /* seed 001: channels packed into one float by multiplied "shifts" */
+    GBUFFER_ALBEDO_PACK_SHIFT,  /* seed 001: channels in one float by multiplied "shifts" */
     GBUFFER_ALBEDO_PACK_BASE10, /* seed 001's fix: three decimal digits a channel in one float */
 };
 extern const char *const gbuffer_normal_choices[];
@@ -35,16 +35,16 @@ struct gbuffer_options {
 
 /* The two option rows of a technique whose options struct opts_type holds a
  * struct gbuffer_options named `member`. */
-#define GBUFFER_OPTION_ROWS(opts_type, member)                                                      \
-    {.name = "gbuffer.normal", .type = TOPT_CHOICE, .def = GBUFFER_NORMAL_OCTAHEDRAL,          \
-     .choices = gbuffer_normal_choices,                                                        \
-     .summary = "normal layout: octahedral (two channels, default), float3, or "               \
-                "xy_reconstruct_z (seed 004: view-space x and y, z rebuilt without its sign)", \
-     .offset = offsetof(opts_type, member.normal)},                                                 \
-    {.name = "gbuffer.albedo", .type = TOPT_CHOICE, .def = GBUFFER_ALBEDO_RGBA8,               \
-     .choices = gbuffer_albedo_choices,                                                        \
-     .summary = "albedo layout: rgba8 (default), pack_shift (seed 001: channels in one "       \
-                "float by multiplied shifts) or pack_base10 (three decimal digits a channel)", \
+#define GBUFFER_OPTION_ROWS(opts_type, member)                                                    \
+    {.name = "gbuffer.normal", .type = TOPT_CHOICE, .def = GBUFFER_NORMAL_OCTAHEDRAL,             \
+     .choices = gbuffer_normal_choices,                                                           \
+     .summary = "normal layout: octahedral (two channels, default), float3, or "                  \
+                "xy_reconstruct_z (seed 004: view-space x and y, z rebuilt without its sign)",    \
+     .offset = offsetof(opts_type, member.normal)},                                               \
+    {.name = "gbuffer.albedo", .type = TOPT_CHOICE, .def = GBUFFER_ALBEDO_RGBA8,                  \
+     .choices = gbuffer_albedo_choices,                                                           \
+     .summary = "albedo layout: rgba8 (default), pack_shift (seed 001: channels in one "          \
+                "float by multiplied shifts) or pack_base10 (three decimal digits a channel)",    \
      .offset = offsetof(opts_type, member.albedo)}
 
 /* How the deferred technique bounds the pixels each light shades. */
@@ -75,24 +75,24 @@ struct cluster_options {
 };
 extern const int cluster_grid_default[3];
 
-#define CLUSTER_OPTION_ROWS(opts_type, member)                                                      \
-    {.name = "grid", .type = TOPT_INT_LIST, .def_list = cluster_grid_default, .count = 3,      \
-     .min = 1, .max = 1024,                                                                    \
-     .summary = "froxel grid [x, y, z]: tiles across and down the screen, slices in depth "   \
-                "(at most 1,048,576 clusters, and within the device's buffers)",              \
-     .offset = offsetof(opts_type, member.grid)},                                                   \
-    {.name = "slices", .type = TOPT_CHOICE, .def = CLUSTER_SLICES_EXPONENTIAL,                 \
-     .choices = cluster_slices_choices,                                                        \
-     .summary = "depth slices even in view depth (linear) or in its logarithm (exponential), " \
-                "between the nearest and farthest object",                                    \
-     .offset = offsetof(opts_type, member.slices)},                                                 \
-    {.name = "max_lights_per_cluster", .type = TOPT_INT, .def = 1024, .min = 1, .max = 65536, \
-     .summary = "lights a cluster's list keeps; more overflow (counted in the result)",       \
-     .offset = offsetof(opts_type, member.max_lights_per_cluster)},                                 \
-    {.name = "overflow", .type = TOPT_CHOICE, .def = CLUSTER_OVERFLOW_FALLBACK,                \
-     .choices = cluster_overflow_choices,                                                      \
-     .summary = "an overflowing cluster shades with every light (fallback: correct, slower) " \
-                "or fails the job (fail)",                                                     \
+#define CLUSTER_OPTION_ROWS(opts_type, member)                                                    \
+    {.name = "grid", .type = TOPT_INT_LIST, .def_list = cluster_grid_default, .count = 3,         \
+     .min = 1, .max = 1024,                                                                       \
+     .summary = "froxel grid [x, y, z]: tiles across and down the screen, slices in depth "       \
+                "(at most 1,048,576 clusters, and within the device's buffers)",                  \
+     .offset = offsetof(opts_type, member.grid)},                                                 \
+    {.name = "slices", .type = TOPT_CHOICE, .def = CLUSTER_SLICES_EXPONENTIAL,                    \
+     .choices = cluster_slices_choices,                                                           \
+     .summary = "depth slices even in view depth (linear) or in its logarithm (exponential), "    \
+                "between the nearest and farthest object",                                        \
+     .offset = offsetof(opts_type, member.slices)},                                               \
+    {.name = "max_lights_per_cluster", .type = TOPT_INT, .def = 1024, .min = 1, .max = 65536,     \
+     .summary = "lights a cluster's list keeps; more overflow (counted in the result)",           \
+     .offset = offsetof(opts_type, member.max_lights_per_cluster)},                               \
+    {.name = "overflow", .type = TOPT_CHOICE, .def = CLUSTER_OVERFLOW_FALLBACK,                   \
+     .choices = cluster_overflow_choices,                                                         \
+     .summary = "an overflowing cluster shades with every light (fallback: correct, slower) "     \
+                "or fails the job (fail)",                                                        \
      .offset = offsetof(opts_type, member.overflow)}
 
 /* The most clusters a grid may have whatever the device: past it the light

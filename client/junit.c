@@ -230,9 +230,11 @@ static void put(char *out, size_t cap, const char *fmt, ...)
 
 void junit_job_name(const json_t *spec, char *out, size_t cap)
 {
-    out[0] = '\0';
+    /* At most 240 characters, so that a check's suffix always fits. */
+    char name[241] = "";
+    size_t ncap = sizeof(name) < cap ? sizeof(name) : cap;
     const char *tech = json_string_value(json_object_get(spec, "technique"));
-    put(out, cap, "%s", tech ? tech : "job");
+    put(name, ncap, "%s", tech ? tech : "job");
     size_t n;
     const char **keys = sorted_keys(spec, &n);
     char text[128];
@@ -245,16 +247,16 @@ void junit_job_name(const json_t *spec, char *out, size_t cap)
             !strcmp(k, "frames") || !strcmp(k, "warmup_frames"))
             continue;
         if (json_is_object(v)) {
-            if (!tech || strcmp(k, tech) != 0)
-                continue; /* another technique's options */
+            if (!tech || strcmp(k, tech) != 0 || json_object_size(v) == 0)
+                continue; /* another technique's options, the look, or none */
             size_t m;
             const char **sub = sorted_keys(v, &m);
-            put(out, cap, " %s(", k);
+            put(name, ncap, " %s(", k);
             for (size_t s = 0; sub && s < m; s++) {
                 scalar_text(json_object_get(v, sub[s]), text, sizeof(text));
-                put(out, cap, "%s%s=%s", s ? " " : "", sub[s], text);
+                put(name, ncap, "%s%s=%s", s ? " " : "", sub[s], text);
             }
-            put(out, cap, ")");
+            put(name, ncap, ")");
             free(sub);
             continue;
         }
@@ -262,28 +264,27 @@ void junit_job_name(const json_t *spec, char *out, size_t cap)
             json_is_null(v))
             continue;
         scalar_text(v, text, sizeof(text));
-        put(out, cap, " %s=%s", k, text);
+        put(name, ncap, " %s=%s", k, text);
     }
     free(keys);
+    /* The scene by what shapes the work most: preset, size, lights, their
+     * motion and the camera's. */
     json_t *scene = json_object_get(spec, "scene");
     if (scene) {
         const char *preset = json_string_value(json_object_get(scene, "preset"));
-        put(out, cap, " %s %lldx%lld %lld lights %s", preset ? preset : "scene",
+        put(name, ncap, " %s %lldx%lld %lld lights %s", preset ? preset : "scene",
             (long long)json_integer_value(json_object_get(scene, "width")),
             (long long)json_integer_value(json_object_get(scene, "height")),
             (long long)json_integer_value(json_object_get(scene, "lights")),
             json_is_true(json_object_get(scene, "dynamic")) ? "moving" : "still");
-        const char **sk = sorted_keys(scene, &n);
-        for (size_t i = 0; sk && i < n; i++) {
-            if (!strcmp(sk[i], "preset") || !strcmp(sk[i], "width") || !strcmp(sk[i], "height") ||
-                !strcmp(sk[i], "lights") || !strcmp(sk[i], "dynamic"))
-                continue;
-            scalar_text(json_object_get(scene, sk[i]), text, sizeof(text));
-            put(out, cap, " %s=%s", sk[i], text);
-        }
-        free(sk);
+        json_t *cam = json_object_get(scene, "camera");
+        const char *path = json_is_string(cam) ? json_string_value(cam)
+                                               : json_string_value(json_object_get(cam, "path"));
+        if (path && strcmp(path, "static") != 0)
+            put(name, ncap, " camera %s", path);
     }
     json_t *frames = json_object_get(spec, "frames");
     if (json_is_integer(frames))
-        put(out, cap, ", %lld frames", (long long)json_integer_value(frames));
+        put(name, ncap, ", %lld frames", (long long)json_integer_value(frames));
+    snprintf(out, cap, "%s", name);
 }

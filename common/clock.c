@@ -8,6 +8,13 @@ double clock_unix_s(void)
     return (double)ts.tv_sec + ts.tv_nsec / 1e9;
 }
 
+double clock_mono_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec / 1e9;
+}
+
 struct timespec clock_deadline(double wait_s)
 {
     double at = clock_unix_s() + wait_s;

@@ -23,15 +23,26 @@ bool fs_write_atomic(const char *path, const void *data, size_t len)
         if (n < 0 && errno == EINTR)
             continue;
         if (n <= 0) {
+            int saved = n < 0 ? errno : ENOSPC; /* a zero-byte write: no room */
             close(fd);
             unlink(tmp);
+            errno = saved;
             return false;
         }
         p += n;
         len -= (size_t)n;
     }
-    if (fsync(fd) != 0 || close(fd) != 0 || rename(tmp, path) != 0) {
+    if (fsync(fd) != 0) {
+        int saved = errno;
+        close(fd);
         unlink(tmp);
+        errno = saved;
+        return false;
+    }
+    if (close(fd) != 0 || rename(tmp, path) != 0) {
+        int saved = errno;
+        unlink(tmp);
+        errno = saved;
         return false;
     }
     return true;
@@ -40,8 +51,10 @@ bool fs_write_atomic(const char *path, const void *data, size_t len)
 bool fs_write_json_atomic(const char *path, const json_t *value)
 {
     char *text = json_dumps(value, JSON_INDENT(2) | JSON_SORT_KEYS);
-    if (!text)
+    if (!text) {
+        errno = ENOMEM;
         return false;
+    }
     size_t len = strlen(text);
     text[len] = '\0';
     bool ok = fs_write_atomic(path, text, len);
@@ -71,9 +84,13 @@ char *fs_read_file(const char *path, size_t max, size_t *len)
         return NULL;
     char *buf = malloc(max + 1);
     size_t n = buf ? fread(buf, 1, max, f) : 0;
+    int saved = buf ? (ferror(f) ? errno : 0) : ENOMEM;
     fclose(f);
-    if (!buf)
+    if (!buf || saved) {
+        free(buf);
+        errno = saved;
         return NULL;
+    }
     buf[n] = '\0';
     *len = n;
     return buf;

@@ -1,6 +1,10 @@
 #ifndef SHADEBENCH_FSUTIL_H
 #define SHADEBENCH_FSUTIL_H
 
+/* File helpers shared by the daemon and the client. Any thread. On failure
+ * every function leaves errno saying why (cleanup after a failed step never
+ * clobbers it), so callers can name the file and the cause. */
+
 #include <jansson.h>
 #include <stdbool.h>
 #include <stddef.h>

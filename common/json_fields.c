@@ -6,6 +6,86 @@
 #include <stdio.h>
 #include <string.h>
 
+/* Length of the valid UTF-8 sequence at s (at most avail bytes), or 0 when
+ * the bytes there are not one: a stray continuation byte, an overlong form,
+ * a surrogate, a code point above U+10FFFF, or a sequence cut short. */
+static size_t utf8_sequence(const unsigned char *s, size_t avail)
+{
+    unsigned char c = s[0];
+    size_t len;
+    unsigned cp;
+    if (c < 0x80)
+        return 1;
+    if (c >= 0xc2 && c <= 0xdf)
+        len = 2, cp = c & 0x1fu;
+    else if (c >= 0xe0 && c <= 0xef)
+        len = 3, cp = c & 0x0fu;
+    else if (c >= 0xf0 && c <= 0xf4)
+        len = 4, cp = c & 0x07u;
+    else
+        return 0;
+    if (len > avail)
+        return 0;
+    for (size_t i = 1; i < len; i++) {
+        if ((s[i] & 0xc0) != 0x80)
+            return 0;
+        cp = (cp << 6) | (s[i] & 0x3fu);
+    }
+    if ((len == 3 && cp < 0x800) || (len == 4 && (cp < 0x10000 || cp > 0x10ffff)) ||
+        (cp >= 0xd800 && cp <= 0xdfff))
+        return 0;
+    return len;
+}
+
+size_t jf_utf8_prefix(const char *s, size_t max)
+{
+    size_t total = strlen(s), used = 0;
+    while (used < total) {
+        size_t len = utf8_sequence((const unsigned char *)s + used, total - used);
+        if (len == 0)
+            len = 1; /* a stray byte stands alone: cutting after it splits nothing */
+        if (used + len > max)
+            break;
+        used += len;
+    }
+    return used;
+}
+
+void jf_utf8_sanitize(char *s, size_t cap)
+{
+    char out[1024];
+    size_t in_len = strlen(s), o = 0, limit = (cap < sizeof(out) ? cap : sizeof(out)) - 1;
+    /* A character cut short by an earlier truncation goes entirely. */
+    size_t lead = in_len;
+    while (lead > 0 && in_len - lead < 3 && ((unsigned char)s[lead - 1] & 0xc0) == 0x80)
+        lead--;
+    if (lead > 0 && (unsigned char)s[lead - 1] >= 0xc2 && (unsigned char)s[lead - 1] <= 0xf4) {
+        unsigned char c = (unsigned char)s[lead - 1];
+        size_t want = c >= 0xf0 ? 4 : (c >= 0xe0 ? 3 : 2);
+        if (in_len - (lead - 1) < want)
+            in_len = lead - 1;
+    }
+    for (size_t i = 0; i < in_len && o < limit;) {
+        size_t len = utf8_sequence((const unsigned char *)s + i, in_len - i);
+        if (len == 0) {
+            /* Escaped, so the reader still sees which byte was there. */
+            if (o + 4 > limit)
+                break;
+            snprintf(out + o, 5, "\\x%02x", (unsigned char)s[i]);
+            o += 4;
+            i++;
+            continue;
+        }
+        if (o + len > limit)
+            break;
+        memcpy(out + o, s + i, len);
+        o += len;
+        i += len;
+    }
+    out[o] = '\0';
+    memcpy(s, out, o + 1);
+}
+
 bool job_error_set(struct job_error *err, const char *field, const char *fmt, ...)
 {
     snprintf(err->field, sizeof(err->field), "%s", field);
@@ -13,6 +93,10 @@ bool job_error_set(struct job_error *err, const char *field, const char *fmt, ..
     va_start(ap, fmt);
     vsnprintf(err->message, sizeof(err->message), fmt, ap);
     va_end(ap);
+    /* A cut may land inside a multi-byte character, and quoted input may hold
+     * bytes that are not UTF-8 at all: JSON cannot carry either. */
+    jf_utf8_sanitize(err->field, sizeof(err->field));
+    jf_utf8_sanitize(err->message, sizeof(err->message));
     return false;
 }
 
@@ -65,7 +149,7 @@ bool jf_check_keys(const json_t *obj, const char *prefix, const char *const *kno
         }
         if (!found) {
             char field[64];
-            snprintf(field, sizeof(field), "%s%.40s", prefix, key);
+            snprintf(field, sizeof(field), "%s%.*s", prefix, (int)jf_utf8_prefix(key, 40), key);
             if (closest)
                 return job_error_set(err, field, "unknown field (did you mean '%s%s'?)",
                             prefix, closest);
@@ -156,6 +240,12 @@ void jf_list_choices(const char *const *choices, char *buf, size_t cap)
 
 json_t *job_error_to_json(const struct job_error *err)
 {
-    return json_pack("{s:{s:s, s:s}}", "error", "field", err->field, "message",
-                     err->message);
+    /* Callers may fill err by hand: sanitize a copy so that the answer is
+     * always built. */
+    struct job_error e = *err;
+    e.field[sizeof(e.field) - 1] = '\0';
+    e.message[sizeof(e.message) - 1] = '\0';
+    jf_utf8_sanitize(e.field, sizeof(e.field));
+    jf_utf8_sanitize(e.message, sizeof(e.message));
+    return json_pack("{s:{s:s, s:s}}", "error", "field", e.field, "message", e.message);
 }

@@ -16,12 +16,22 @@ struct job_error {
     char message[256];
 };
 
-/* Fills err (field and formatted message); returns false, for "return
- * job_error_set(...)". */
+/* Fills err (field and formatted message, each cut to its buffer at a
+ * UTF-8 boundary, bytes that are not UTF-8 escaped); returns false, for
+ * "return job_error_set(...)". */
 bool job_error_set(struct job_error *err, const char *field, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
-/* {"error": {"field": ..., "message": ...}}. New reference. */
+/* The longest prefix of s of at most max bytes that cuts no UTF-8 sequence. */
+size_t jf_utf8_prefix(const char *s, size_t max);
+
+/* Makes s (a string in a buffer of cap bytes) valid UTF-8: a byte that
+ * starts no valid sequence becomes the text \xNN, and a sequence cut short
+ * at the end is dropped. Stays within cap. */
+void jf_utf8_sanitize(char *s, size_t cap);
+
+/* {"error": {"field": ..., "message": ...}}, sanitized as above so that it
+ * is always built. New reference. */
 json_t *job_error_to_json(const struct job_error *err);
 
 /* Rejects keys of obj not in known (NULL-terminated), suggesting the closest

@@ -7,23 +7,48 @@
 #include <stdlib.h>
 #include <string.h>
 
-static bool write_rows(const char *path, png_bytep *rows, int width, int height,
-                       char *err, size_t errlen)
+/* libpng reports errors through a callback that must not return: keep the
+ * message for the caller and jump back to the setjmp of the current call. */
+struct png_errors {
+    char message[200];
+};
+
+static void on_png_error(png_structp png, png_const_charp msg)
+{
+    struct png_errors *e = png_get_error_ptr(png);
+    if (e)
+        snprintf(e->message, sizeof(e->message), "%s", msg);
+    png_longjmp(png, 1);
+}
+
+static void on_png_warning(png_structp png, png_const_charp msg)
+{
+    (void)png, (void)msg; /* warnings never stop a read or a write */
+}
+
+bool png_write_by_rows(const char *path, int width, int height, png_row_fn row, void *ctx,
+                    char *err, size_t errlen)
 {
     char tmp[4096];
     snprintf(tmp, sizeof(tmp), "%s.tmp", path);
-    FILE *f = fopen(tmp, "wb");
+    struct png_errors perr = {""};
+    uint8_t *line = malloc((size_t)width * 3);
+    FILE *f = line ? fopen(tmp, "wb") : NULL;
     if (!f) {
-        snprintf(err, errlen, "cannot write %s", tmp);
+        snprintf(err, errlen, line ? "cannot write %s" : "out of memory encoding %s", tmp);
+        free(line);
         return false;
     }
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &perr, on_png_error,
+                                              on_png_warning);
     png_infop info = png ? png_create_info_struct(png) : NULL;
     if (!info || setjmp(png_jmpbuf(png))) {
-        snprintf(err, errlen, "libpng failed writing %s", path);
+        snprintf(err, errlen, "libpng failed writing %s%s%s", path, perr.message[0] ? ": " : "",
+                 perr.message);
         png_destroy_write_struct(&png, &info);
         fclose(f);
         remove(tmp);
+        free(line);
         return false;
     }
     png_init_io(png, f);
@@ -32,9 +57,13 @@ static bool write_rows(const char *path, png_bytep *rows, int width, int height,
     png_set_IHDR(png, info, (png_uint_32)width, (png_uint_32)height, 8, PNG_COLOR_TYPE_RGB,
                  PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_write_info(png, info);
-    png_write_image(png, rows);
+    for (int y = 0; y < height; y++) {
+        row(ctx, y, line);
+        png_write_row(png, line);
+    }
     png_write_end(png, NULL);
     png_destroy_write_struct(&png, &info);
+    free(line);
     if (fclose(f) != 0 || rename(tmp, path) != 0) {
         snprintf(err, errlen, "cannot finish %s", path);
         remove(tmp);
@@ -43,48 +72,42 @@ static bool write_rows(const char *path, png_bytep *rows, int width, int height,
     return true;
 }
 
+struct gl_rows {
+    const uint8_t *rgba;
+    int width, height;
+};
+
+static void gl_row(void *ctx, int y, uint8_t *rgb)
+{
+    const struct gl_rows *g = ctx;
+    const uint8_t *src = g->rgba + (size_t)(g->height - 1 - y) * (size_t)g->width * 4;
+    for (int x = 0; x < g->width; x++) {
+        rgb[x * 3 + 0] = src[x * 4 + 0];
+        rgb[x * 3 + 1] = src[x * 4 + 1];
+        rgb[x * 3 + 2] = src[x * 4 + 2];
+    }
+}
+
 bool png_write_gl_rgba(const char *path, const uint8_t *rgba, int width,
                        int height, char *err, size_t errlen)
 {
-    uint8_t *rgb = malloc((size_t)width * (size_t)height * 3);
-    png_bytep *rows = malloc((size_t)height * sizeof(*rows));
-    bool ok = false;
-    if (!rgb || !rows) {
-        snprintf(err, errlen, "out of memory encoding %s", path);
-        goto out;
-    }
-    for (int y = 0; y < height; y++) {
-        const uint8_t *src = rgba + (size_t)(height - 1 - y) * (size_t)width * 4;
-        uint8_t *dst = rgb + (size_t)y * (size_t)width * 3;
-        for (int x = 0; x < width; x++) {
-            dst[x * 3 + 0] = src[x * 4 + 0];
-            dst[x * 3 + 1] = src[x * 4 + 1];
-            dst[x * 3 + 2] = src[x * 4 + 2];
-        }
-        rows[y] = dst;
-    }
-    ok = write_rows(path, rows, width, height, err, errlen);
-out:
-    free(rows);
-    free(rgb);
-    return ok;
+    struct gl_rows g = {rgba, width, height};
+    return png_write_by_rows(path, width, height, gl_row, &g, err, errlen);
+}
+
+static void rgb_row(void *ctx, int y, uint8_t *rgb)
+{
+    const struct image *img = ctx;
+    memcpy(rgb, img->rgb + (size_t)y * (size_t)img->width * 3, (size_t)img->width * 3);
 }
 
 bool png_write_rgb(const char *path, const struct image *img, char *err, size_t errlen)
 {
-    png_bytep *rows = malloc((size_t)img->height * sizeof(*rows));
-    if (!rows) {
-        snprintf(err, errlen, "out of memory encoding %s", path);
-        return false;
-    }
-    for (int y = 0; y < img->height; y++)
-        rows[y] = img->rgb + (size_t)y * (size_t)img->width * 3;
-    bool ok = write_rows(path, rows, img->width, img->height, err, errlen);
-    free(rows);
-    return ok;
+    return png_write_by_rows(path, img->width, img->height, rgb_row, (void *)img, err, errlen);
 }
 
-bool png_read_rgb(const char *path, struct image *out, char *err, size_t errlen)
+bool png_read_rgb_limit(const char *path, long long max_pixels, struct image *out, char *err,
+                        size_t errlen)
 {
     memset(out, 0, sizeof(*out));
     FILE *f = fopen(path, "rb");
@@ -92,12 +115,17 @@ bool png_read_rgb(const char *path, struct image *out, char *err, size_t errlen)
         snprintf(err, errlen, "%s: cannot open", path);
         return false;
     }
-    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+    struct png_errors perr = {""};
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &perr, on_png_error,
+                                             on_png_warning);
     png_infop info = png ? png_create_info_struct(png) : NULL;
-    png_bytep *rows = NULL;
-    uint8_t *rgba = NULL;
+    /* Assigned after setjmp and read after a longjmp back to it: volatile,
+     * or an optimising compiler may hand the error path a stale copy (NULL)
+     * and leak the buffer. */
+    png_bytep *volatile rows = NULL;
     if (!info || setjmp(png_jmpbuf(png))) {
-        snprintf(err, errlen, "%s: not a readable PNG", path);
+        snprintf(err, errlen, "%s: not a readable PNG%s%s", path, perr.message[0] ? ": " : "",
+                 perr.message);
         goto fail;
     }
     png_init_io(png, f);
@@ -108,34 +136,44 @@ bool png_read_rgb(const char *path, struct image *out, char *err, size_t errlen)
                  path, depth, type);
         goto fail;
     }
-    int w = (int)png_get_image_width(png, info), h = (int)png_get_image_height(png, info);
-    int channels = type == PNG_COLOR_TYPE_RGBA ? 4 : 3;
-    rgba = malloc((size_t)w * (size_t)h * (size_t)channels);
+    png_uint_32 w = png_get_image_width(png, info), h = png_get_image_height(png, info);
+    /* Before any allocation: a small file can declare a huge image. */
+    if ((long long)w * (long long)h > max_pixels) {
+        snprintf(err, errlen, "%s: %ux%u is %lld pixels, over the limit of %lld", path,
+                 (unsigned)w, (unsigned)h, (long long)w * (long long)h, max_pixels);
+        goto fail;
+    }
+    if (type == PNG_COLOR_TYPE_RGBA)
+        png_set_strip_alpha(png);
+    png_set_interlace_handling(png);
+    png_read_update_info(png, info);
     rows = malloc((size_t)h * sizeof(*rows));
     out->rgb = malloc((size_t)w * (size_t)h * 3);
-    if (!rgba || !rows || !out->rgb) {
+    if (!rows || !out->rgb) {
         snprintf(err, errlen, "%s: out of memory", path);
         goto fail;
     }
-    for (int y = 0; y < h; y++)
-        rows[y] = rgba + (size_t)y * (size_t)w * (size_t)channels;
+    for (png_uint_32 y = 0; y < h; y++)
+        rows[y] = out->rgb + (size_t)y * (size_t)w * 3;
     png_read_image(png, rows);
-    for (size_t i = 0; i < (size_t)w * (size_t)h; i++)
-        memcpy(out->rgb + i * 3, rgba + i * (size_t)channels, 3);
-    out->width = w;
-    out->height = h;
+    png_read_end(png, NULL);
+    out->width = (int)w;
+    out->height = (int)h;
     png_destroy_read_struct(&png, &info, NULL);
     free(rows);
-    free(rgba);
     fclose(f);
     return true;
 fail:
     png_destroy_read_struct(&png, &info, NULL);
     free(rows);
-    free(rgba);
     image_finish(out);
     fclose(f);
     return false;
+}
+
+bool png_read_rgb(const char *path, struct image *out, char *err, size_t errlen)
+{
+    return png_read_rgb_limit(path, IMAGE_MAX_PIXELS, out, err, errlen);
 }
 
 void image_finish(struct image *img)
@@ -199,7 +237,7 @@ unsigned char *png_encode_thumbnail(const struct image *img, int max_width, size
             }
         rows[y] = small + (size_t)y * (size_t)w * 3;
     }
-    png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+    png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, on_png_error, on_png_warning);
     info = png ? png_create_info_struct(png) : NULL;
     if (!info || setjmp(png_jmpbuf(png)))
         goto fail;

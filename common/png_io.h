@@ -1,6 +1,8 @@
 #ifndef SHADEBENCH_PNG_IO_H
 #define SHADEBENCH_PNG_IO_H
 
+/* PNG files in and out, 8-bit RGB in memory. GL-free; any thread. */
+
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -19,8 +21,21 @@ bool png_write_gl_rgba(const char *path, const uint8_t *rgba, int width,
 /* Writes RGB pixels, top row first. */
 bool png_write_rgb(const char *path, const struct image *img, char *err, size_t errlen);
 
-/* Reads an 8-bit RGB or RGBA PNG (alpha dropped). Other formats are
- * rejected with a message. */
+/* Writes an RGB PNG whose rows come from row(ctx, y, rgb) (width * 3 bytes,
+ * top row first), so that an image never has to exist whole in memory. */
+typedef void (*png_row_fn)(void *ctx, int y, uint8_t *rgb);
+bool png_write_by_rows(const char *path, int width, int height, png_row_fn row, void *ctx,
+                    char *err, size_t errlen);
+
+/* The largest image read or compared: 8192x8192, the largest frame a job can
+ * render. Its RGB copy is 192 MiB. */
+#define IMAGE_MAX_PIXELS (8192LL * 8192LL)
+
+/* Reads an 8-bit RGB or RGBA PNG (alpha dropped). Other formats, and images
+ * of more than max_pixels pixels (checked before anything is allocated), are
+ * rejected with a message. png_read_rgb uses IMAGE_MAX_PIXELS. */
+bool png_read_rgb_limit(const char *path, long long max_pixels, struct image *out, char *err,
+                        size_t errlen);
 bool png_read_rgb(const char *path, struct image *out, char *err, size_t errlen);
 void image_finish(struct image *img);
 

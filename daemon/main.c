@@ -19,7 +19,7 @@
 #include "daemon/harness/runner.h"
 #include "daemon/service.h"
 #include "daemon/jobs/sweeps.h"
-#include "daemon/techniques/technique.h"
+#include "daemon/techniques/catalog.h"
 
 struct options {
     char listen[256];
@@ -238,7 +238,7 @@ static int run_once(const struct options *o)
     struct job_spec spec;
     struct job_error jerr;
     bool ok = len <= JOB_MAX_BODY_BYTES &&
-              job_spec_parse_text(text, len, technique_names(), &spec, &jerr);
+              job_spec_parse_text(text, len, technique_catalog(), &spec, &jerr);
     free(text);
     if (!ok) {
         if (len > JOB_MAX_BODY_BYTES)
@@ -314,7 +314,7 @@ static int serve(const struct options *o)
     }
     queue_set_retention(q, o->keep_jobs, o->keep_days);
     /* Earlier jobs first: finished ones are served again, queued ones run. */
-    int loaded = queue_load(q, technique_names(), err, sizeof(err));
+    int loaded = queue_load(q, technique_catalog(), err, sizeof(err));
     if (loaded < 0) {
         LOG(LOG_ERROR, "%s", err);
         queue_destroy(q);
@@ -328,7 +328,7 @@ static int serve(const struct options *o)
         queue_destroy(q);
         return 1;
     }
-    struct sweeps *sweeps = sweeps_create(q, technique_names());
+    struct sweeps *sweeps = sweeps_create(q, technique_catalog());
     struct http_server *http =
         sweeps ? http_server_create(o->listen, q, r, sweeps, err, sizeof(err)) : NULL;
     if (!http) {
@@ -372,6 +372,12 @@ static int serve(const struct options *o)
 
 int main(int argc, char **argv)
 {
+    /* Built before any thread starts, then read-only: every registered
+     * technique checked once. */
+    if (!technique_catalog()) {
+        fprintf(stderr, "shadebenchd: %s\n", technique_catalog_error());
+        return 1;
+    }
     struct options o = {.device = -1, .queue_size = 64};
     snprintf(o.listen, sizeof(o.listen), "127.0.0.1:8460");
     enum { OPT_LISTEN = 256, OPT_STATE, OPT_DEVICE, OPT_QUEUE, OPT_TOKEN, OPT_KEEP_JOBS,

@@ -19,7 +19,7 @@
 #include "daemon/jobs/job_spec.h"
 #include "daemon/api/report.h"
 #include "common/log.h"
-#include "daemon/techniques/technique.h"
+#include "daemon/techniques/catalog.h"
 
 #ifndef MHD_HTTP_CONTENT_TOO_LARGE
 #define MHD_HTTP_CONTENT_TOO_LARGE 413
@@ -153,18 +153,12 @@ static bool valid_id(const char *id, size_t len)
 
 static json_t *info_json(struct http_server *s)
 {
-    json_t *techs = json_array();
-    for (const struct technique *const *t = technique_registry; *t; t++) {
-        json_t *sections = json_array();
-        for (int i = 0; (*t)->sections[i]; i++)
-            json_array_append_new(sections, json_string((*t)->sections[i]));
-        json_array_append_new(techs, json_pack("{s:s, s:s, s:o}", "name", (*t)->name,
-                                               "summary", (*t)->summary,
-                                               "gpu_sections", sections));
-    }
-    return json_pack("{s:s, s:s, s:s, s:o, s:o, s:{s:i, s:i, s:i}}", "name", "shadebenchd",
+    /* From the GL-free catalogue: HTTP threads never touch GL. */
+    json_t *techs = technique_catalog_json(technique_catalog());
+    return json_pack("{s:s, s:s, s:s, s:o, s:o, s:o, s:{s:i, s:i, s:i}}", "name", "shadebenchd",
                      "version", PACKAGE_VERSION, "api", "v1", "device",
-                     runner_device_json(s->runner), "techniques", techs, "limits",
+                     runner_device_json(s->runner), "techniques", techs, "sweepable",
+                     sweep_params_json(technique_catalog()), "limits",
                      "max_body_bytes", JOB_MAX_BODY_BYTES, "max_queued_jobs",
                      queue_max_queued(s->queue), "max_wait_s", MAX_WAIT_S);
 }
@@ -174,7 +168,7 @@ static enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *
 {
     struct job_spec spec;
     struct job_error err;
-    if (!job_spec_parse_text(req->body ? req->body : "", req->len, technique_names(),
+    if (!job_spec_parse_text(req->body ? req->body : "", req->len, technique_catalog(),
                              &spec, &err))
         return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
     char id[24];
@@ -408,7 +402,7 @@ static enum MHD_Result sweep_routes(struct http_server *s, struct MHD_Connection
             }
             struct sweep_spec spec;
             struct job_error err;
-            if (!sweep_spec_parse(body, technique_names(), &spec, &err)) {
+            if (!sweep_spec_parse(body, technique_catalog(), &spec, &err)) {
                 sweep_spec_finish(&spec);
                 json_decref(body);
                 return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));

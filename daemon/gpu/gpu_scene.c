@@ -1,5 +1,7 @@
 #include "daemon/gpu/gpu_scene.h"
 
+#include "daemon/gpu/bindings.h"
+
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -37,8 +39,10 @@ bool gpu_scene_init(struct gpu_scene *g, const struct scene *s, char *err, size_
     }
     glBindVertexArray(0);
 
+    /* std430 Instance (shaders/common/scene_data.glsl): three vec4s. */
+    enum { INSTANCE_FLOATS = 12 };
     size_t n = (size_t)s->instance_count;
-    float *inst = calloc(n * 8, sizeof(float));
+    float *inst = calloc(n * INSTANCE_FLOATS, sizeof(float));
     size_t lights = (size_t)(s->light_count ? s->light_count : 1);
     float *light = calloc(lights * 4, sizeof(float));
     g->position_scratch = calloc(lights * 4, sizeof(float));
@@ -51,10 +55,15 @@ bool gpu_scene_init(struct gpu_scene *g, const struct scene *s, char *err, size_
     }
     for (size_t i = 0; i < n; i++) {
         const struct scene_instance *in = &s->instances[i];
-        memcpy(&inst[i * 8], in->pos, sizeof(in->pos));
-        inst[i * 8 + 3] = in->scale;
-        memcpy(&inst[i * 8 + 4], in->albedo, sizeof(in->albedo));
-        inst[i * 8 + 7] = (float)in->mesh;
+        float *o = &inst[i * INSTANCE_FLOATS];
+        memcpy(&o[0], in->pos, sizeof(in->pos));
+        o[3] = in->scale;
+        memcpy(&o[4], in->albedo, sizeof(in->albedo));
+        o[7] = (float)in->mesh;
+        o[8] = in->material.specular;
+        o[9] = in->material.shininess;
+        o[10] = in->material.metallic;
+        o[11] = in->material.roughness;
     }
     for (int i = 0; i < s->light_count; i++) {
         memcpy(&light[i * 4], s->lights[i].color, sizeof(s->lights[i].color));
@@ -62,7 +71,8 @@ bool gpu_scene_init(struct gpu_scene *g, const struct scene *s, char *err, size_
     }
     glGenBuffers(1, &g->instance_buffer);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->instance_buffer);
-    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(n * 8 * sizeof(float)), inst, GL_STATIC_DRAW);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(n * INSTANCE_FLOATS * sizeof(float)), inst,
+                 GL_STATIC_DRAW);
     glGenBuffers(1, &g->light_buffer);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->light_buffer);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(lights * 4 * sizeof(float)), light, GL_STATIC_DRAW);
@@ -114,20 +124,17 @@ void gpu_scene_set_light_rows(struct gpu_scene *g, const int64_t *frames, int ro
 
 struct scene_program gpu_scene_program(const struct gpu_scene *g, GLuint prog)
 {
-    const struct scene *s = g->scene;
-    glProgramUniformMatrix4fv(prog, glGetUniformLocation(prog, "u_view_proj"), 1, GL_FALSE,
-                              s->view_proj);
-    glProgramUniform3fv(prog, glGetUniformLocation(prog, "u_eye"), 1, s->eye);
-    glProgramUniform1i(prog, glGetUniformLocation(prog, "u_light_count"), s->light_count);
-    return (struct scene_program){prog, glGetUniformLocation(prog, "u_instance_base")};
+    (void)g;
+    struct scene_program p = {prog, glGetUniformLocation(prog, "u_instance_base")};
+    return p;
 }
 
 void gpu_scene_bind(const struct gpu_scene *g, const struct scene_program *p)
 {
     glUseProgram(p->prog);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, g->instance_buffer);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, g->light_buffer);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, g->position_buffer);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_INSTANCES, g->instance_buffer);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHTS, g->light_buffer);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_POSITIONS, g->position_buffer);
 }
 
 void gpu_scene_draw(const struct gpu_scene *g, const struct scene_program *p)

@@ -11,7 +11,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#define GPU_TIMER_MAX_SECTIONS 4
+#define GPU_TIMER_MAX_SECTIONS 32
 #define GPU_TIMER_RING 8
 
 struct gpu_timer;

@@ -1,6 +1,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "daemon/harness/metrics_stage.h"
 
+#include <errno.h>
 #include <limits.h>
 #include <math.h>
 #include <pthread.h>
@@ -9,6 +10,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "common/clock.h"
 #include "common/fsutil.h"
 #include "common/log.h"
 #include "daemon/quality/metrics.h"
@@ -25,7 +27,9 @@ struct metrics_worker {
     pthread_t thread;
     pthread_mutex_t lock;
     pthread_cond_t wake;
+    pthread_cond_t idle; /* signalled when a task has ended */
     struct task *head, *tail;
+    bool busy; /* a task is running: out of the list, not yet finished */
     bool stopping;
 };
 
@@ -102,8 +106,7 @@ static void run_task(struct metrics_worker *w, struct task *t)
 {
     struct job *job = t->job;
     char err[512] = "";
-    struct timespec t0, t1;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
+    double t0 = clock_mono_s();
     json_t *summary = json_pack("{s:s, s:i, s:[]}", "reference", job->spec.reference,
                                 "captures_compared", 0, "pdiff_failed_frames");
     json_t *captures = json_object_get(t->result, "captures");
@@ -115,21 +118,19 @@ static void run_task(struct metrics_worker *w, struct task *t)
             break;
         json_object_set_new(summary, "captures_compared", json_integer((json_int_t)i + 1));
     }
-    clock_gettime(CLOCK_MONOTONIC, &t1);
+    double t1 = clock_mono_s();
     if (ok) {
         json_t *failed = json_object_get(summary, "pdiff_failed_frames");
         json_object_set_new(summary, "pdiff_failed_captures",
                             json_integer((json_int_t)json_array_size(failed)));
-        json_object_set_new(summary, "metrics_s",
-                            json_real((double)(t1.tv_sec - t0.tv_sec) +
-                                      (double)(t1.tv_nsec - t0.tv_nsec) / 1e9));
+        json_object_set_new(summary, "metrics_s", json_real(t1 - t0));
         json_object_set_new(t->result, "quality", summary);
         summary = NULL;
         char path[PATH_MAX + 16];
         snprintf(path, sizeof(path), "%s/result.json", job->dir);
         if (!fs_write_json_atomic(path, t->result)) {
             ok = false;
-            snprintf(err, sizeof(err), "cannot write %.400s", path);
+            snprintf(err, sizeof(err), "cannot write %.400s: %s", path, strerror(errno));
         }
     }
     json_decref(summary);
@@ -158,10 +159,13 @@ static void *worker_main(void *arg)
         w->head = t->next;
         if (!w->head)
             w->tail = NULL;
+        w->busy = true;
         pthread_mutex_unlock(&w->lock);
         run_task(w, t);
         free(t);
         pthread_mutex_lock(&w->lock);
+        w->busy = false;
+        pthread_cond_broadcast(&w->idle);
     }
     pthread_mutex_unlock(&w->lock);
     return NULL;
@@ -175,7 +179,9 @@ struct metrics_worker *metrics_worker_create(struct queue *q)
     w->queue = q;
     pthread_mutex_init(&w->lock, NULL);
     pthread_cond_init(&w->wake, NULL);
+    pthread_cond_init(&w->idle, NULL);
     if (pthread_create(&w->thread, NULL, worker_main, w) != 0) {
+        pthread_cond_destroy(&w->idle);
         pthread_cond_destroy(&w->wake);
         pthread_mutex_destroy(&w->lock);
         free(w);
@@ -193,6 +199,7 @@ void metrics_worker_destroy(struct metrics_worker *w)
     pthread_cond_broadcast(&w->wake);
     pthread_mutex_unlock(&w->lock);
     pthread_join(w->thread, NULL);
+    pthread_cond_destroy(&w->idle);
     pthread_cond_destroy(&w->wake);
     pthread_mutex_destroy(&w->lock);
     free(w);
@@ -215,5 +222,13 @@ void metrics_worker_submit(struct metrics_worker *w, struct job *job, json_t *re
         w->head = t;
     w->tail = t;
     pthread_cond_signal(&w->wake);
+    pthread_mutex_unlock(&w->lock);
+}
+
+void metrics_worker_wait_idle(struct metrics_worker *w)
+{
+    pthread_mutex_lock(&w->lock);
+    while (w->head || w->busy)
+        pthread_cond_wait(&w->idle, &w->lock);
     pthread_mutex_unlock(&w->lock);
 }

@@ -11,12 +11,18 @@
 #include <time.h>
 
 #include "config.h"
+#include "common/clock.h"
 #include "daemon/gpu/egl.h"
 #include "common/fsutil.h"
+#include "daemon/gpu/bindings.h"
+#include "daemon/gpu/caps.h"
 #include "daemon/gpu/glutil.h"
 #include "daemon/gpu/gpu_scene.h"
 #include "daemon/gpu/gpu_timer.h"
+#include "daemon/gpu/pass.h"
+#include "daemon/gpu/targets.h"
 #include "common/log.h"
+#include "daemon/harness/interference.h"
 #include "daemon/harness/metrics_stage.h"
 #include "common/png_io.h"
 #include "daemon/service.h"
@@ -35,14 +41,14 @@ struct runner {
     atomic_bool alive;
     char error[512];
     json_t *device_json; /* immutable once ready */
+    /* Render-thread state shared by every job: limits, the target pool
+     * (re-created only when a size or format changes), the frame block and
+     * the resolve program. */
+    struct gpu_caps caps;
+    struct gpu_targets *targets;
+    struct gpu_frame_block frame_block;
+    GLuint empty_vao, resolve_prog;
 };
-
-static double mono_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec / 1e9;
-}
 
 static json_t *stats_json(const double *v, size_t n)
 {
@@ -60,18 +66,18 @@ static const char *gl_str(GLenum name)
     return s ? s : "";
 }
 
-static json_t *collect_device(struct egl_context *egl)
+static json_t *collect_device(struct egl_context *egl, const struct gpu_caps *caps)
 {
-    GLint max_tex = 0, max_rb = 0;
-    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
-    glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_rb);
-    return json_pack("{s:s, s:s, s:s, s:s, s:s, s:s, s:s, s:s, s:i, s:i}",
-                     "egl_platform", egl_context_platform(egl), "egl_device",
-                     egl_context_device(egl), "egl_vendor", egl_context_egl_vendor(egl),
-                     "egl_version", egl_context_egl_version(egl), "gl_vendor",
-                     gl_str(GL_VENDOR), "gl_renderer", gl_str(GL_RENDERER), "gl_version",
-                     gl_str(GL_VERSION), "glsl_version", gl_str(GL_SHADING_LANGUAGE_VERSION),
-                     "max_texture_size", max_tex, "max_renderbuffer_size", max_rb);
+    json_t *d = json_pack("{s:s, s:s, s:s, s:s, s:s, s:s, s:s, s:s, s:i, s:i}",
+                          "egl_platform", egl_context_platform(egl), "egl_device",
+                          egl_context_device(egl), "egl_vendor", egl_context_egl_vendor(egl),
+                          "egl_version", egl_context_egl_version(egl), "gl_vendor",
+                          gl_str(GL_VENDOR), "gl_renderer", gl_str(GL_RENDERER), "gl_version",
+                          gl_str(GL_VERSION), "glsl_version", gl_str(GL_SHADING_LANGUAGE_VERSION),
+                          "max_texture_size", caps->max_texture_size, "max_renderbuffer_size",
+                          caps->max_renderbuffer_size);
+    json_object_set_new(d, "caps", gpu_caps_json(caps));
+    return d;
 }
 
 /* Frames the GPU may run behind the CPU, as a double-buffered swap chain allows. */
@@ -85,45 +91,142 @@ struct run {
     struct scene scene;
     bool scene_ok;
     struct gpu_scene gpu;
-    GLuint fbo, color_rb, depth_rb;
     struct gpu_timer *timer;
+    struct gpu_passes passes;
+    int resolve_pass;
+    GLuint ldr_fbo;
+    struct technique_env env;
+    struct technique_products products;
+    char defines[128];
     void *state;
     uint8_t **captures;
     int capture_count;
     double *cpu_ms;
     double *frame_ms;
     GLsync fences[FRAMES_IN_FLIGHT];
+    struct interference_sample interference[2]; /* store hook: start and end of the timed region */
     char err[1024];
 };
 
-static bool setup_framebuffer(struct run *run)
+static const char *hdr_name(int hdr) { return hdr == LOOK_HDR_RGBA16F ? "rgba16f" : "rgba32f"; }
+
+/* The output every technique draws into (HDR colour and a depth texture
+ * later passes may sample) and the 8-bit image the resolve writes, from the
+ * runner's pool: allocated once per size and format, not per job. */
+static bool setup_targets(struct run *run)
 {
+    const struct gpu_caps *caps = &run->runner->caps;
+    struct gpu_targets *pool = run->runner->targets;
     int w = run->spec->scene.width, h = run->spec->scene.height;
-    GLint max_rb = 0, dims[2] = {0, 0};
-    glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_rb);
-    glGetIntegerv(GL_MAX_VIEWPORT_DIMS, dims);
-    if (w > max_rb || h > max_rb || w > dims[0] || h > dims[1]) {
+    if (w > caps->max_texture_size || h > caps->max_texture_size ||
+        w > caps->max_viewport[0] || h > caps->max_viewport[1]) {
         snprintf(run->err, sizeof(run->err),
                  "scene.width/height %dx%d exceed this device's limits "
-                 "(GL_MAX_RENDERBUFFER_SIZE %d, GL_MAX_VIEWPORT_DIMS %dx%d)",
-                 w, h, max_rb, dims[0], dims[1]);
+                 "(GL_MAX_TEXTURE_SIZE %d, GL_MAX_VIEWPORT_DIMS %dx%d)",
+                 w, h, caps->max_texture_size, caps->max_viewport[0], caps->max_viewport[1]);
         return false;
     }
-    glGenFramebuffers(1, &run->fbo);
-    glGenRenderbuffers(1, &run->color_rb);
-    glGenRenderbuffers(1, &run->depth_rb);
-    glBindRenderbuffer(GL_RENDERBUFFER, run->color_rb);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
-    glBindRenderbuffer(GL_RENDERBUFFER, run->depth_rb);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
-    glBindFramebuffer(GL_FRAMEBUFFER, run->fbo);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, run->color_rb);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, run->depth_rb);
-    GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-    if (status != GL_FRAMEBUFFER_COMPLETE) {
-        snprintf(run->err, sizeof(run->err), "framebuffer %dx%d incomplete (0x%04x)", w, h, status);
+    GLenum hdr_format = run->spec->look.hdr == LOOK_HDR_RGBA16F ? GL_RGBA16F : GL_RGBA32F;
+    GLuint color = gpu_targets_texture(pool, "output.hdr", hdr_format, w, h, run->err,
+                                       sizeof(run->err));
+    GLuint depth = color ? gpu_targets_texture(pool, "output.depth", GL_DEPTH_COMPONENT24, w, h,
+                                               run->err, sizeof(run->err))
+                         : 0;
+    GLuint ldr = depth ? gpu_targets_texture(pool, "output.ldr", GL_RGBA8, w, h, run->err,
+                                             sizeof(run->err))
+                       : 0;
+    if (!ldr)
+        return false;
+    GLuint out = gpu_targets_fbo(pool, "output", &color, 1, depth, run->err, sizeof(run->err));
+    run->ldr_fbo = out ? gpu_targets_fbo(pool, "resolve", &ldr, 1, 0, run->err, sizeof(run->err))
+                       : 0;
+    if (!run->ldr_fbo)
+        return false;
+    snprintf(run->defines, sizeof(run->defines), "#define LIGHTING_%s 1\n",
+             run->spec->look.lighting == LOOK_BLINN_PHONG ? "BLINN_PHONG" : "PHONG");
+    run->env = (struct technique_env){
+        .spec = run->spec,
+        .scene = &run->scene,
+        .gpu = &run->gpu,
+        .caps = caps,
+        .targets = pool,
+        .passes = &run->passes,
+        .output_fbo = out,
+        .output_color = color,
+        .output_depth = depth,
+        .width = w,
+        .height = h,
+        .defines = run->defines,
+        .products = &run->products,
+    };
+    return true;
+}
+
+/* The per-frame block for frame k: camera, viewport and counts. A still
+ * camera's block is the same every frame, so only a moving one is rebuilt. */
+static void frame_data(const struct run *run, int64_t k, struct gpu_frame_data *d)
+{
+    const struct scene *s = run->env.scene;
+    if (d->viewport[0] != 0 && !scene_camera_moves(s)) {
+        d->counts[0] = (int32_t)(k & 0x7fffffff);
+        return;
+    }
+    struct scene_camera cam;
+    scene_camera_at(s, k, &cam);
+    memcpy(d->view, cam.view, sizeof(d->view));
+    memcpy(d->proj, cam.proj, sizeof(d->proj));
+    memcpy(d->view_proj, cam.view_proj, sizeof(d->view_proj));
+    memcpy(d->inv_view, cam.inv_view, sizeof(d->inv_view));
+    memcpy(d->inv_proj, cam.inv_proj, sizeof(d->inv_proj));
+    mat4_invert(d->view_proj, d->inv_view_proj);
+    d->eye[0] = cam.eye[0], d->eye[1] = cam.eye[1], d->eye[2] = cam.eye[2], d->eye[3] = 1.0f;
+    d->viewport[0] = (float)run->env.width;
+    d->viewport[1] = (float)run->env.height;
+    d->viewport[2] = 1.0f / (float)run->env.width;
+    d->viewport[3] = 1.0f / (float)run->env.height;
+    d->clip[0] = cam.near_z, d->clip[1] = cam.far_z, d->clip[2] = d->clip[3] = 0.0f;
+    d->counts[0] = (int32_t)(k & 0x7fffffff);
+    d->counts[1] = s->light_count;
+    d->counts[2] = s->instance_count;
+    d->counts[3] = 0;
+}
+
+/* The harness's resolve pass: HDR output to the 8-bit image, timed as a pass
+ * of every frame so that every technique pays it alike. */
+static void resolve(const struct run *run)
+{
+    struct runner *r = run->runner;
+    gpu_pass_begin(&run->passes, run->resolve_pass, run->ldr_fbo, run->env.width,
+                   run->env.height);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glUseProgram(r->resolve_prog);
+    glActiveTexture(GL_TEXTURE0 + SB_TEX_HDR);
+    glBindTexture(GL_TEXTURE_2D, run->env.output_color);
+    glBindVertexArray(r->empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindVertexArray(0);
+    gpu_pass_end(&run->passes);
+}
+
+/* Builds the technique for a run: its options, passes (its own, then the
+ * harness's resolve) and timer. */
+static bool setup_technique(struct run *run, const struct technique *tech, const void *options,
+                            int64_t timed_frames)
+{
+    run->timer = gpu_timer_create(technique_pass_count(tech) + 1, timed_frames);
+    if (!run->timer) {
+        snprintf(run->err, sizeof(run->err), "cannot create GPU timer queries");
         return false;
     }
+    if (!gpu_passes_init(&run->passes, run->timer, tech->info->passes,
+                         run->runner->caps.debug_groups) ||
+        (run->resolve_pass = gpu_passes_add(&run->passes, "resolve")) < 0) {
+        snprintf(run->err, sizeof(run->err), "%s declares more passes than the harness times",
+                 tech->info->name);
+        return false;
+    }
+    run->env.options = options;
     return true;
 }
 
@@ -133,12 +236,6 @@ static void teardown(struct run *run)
         run->tech->destroy(run->state);
     gpu_timer_destroy(run->timer);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    if (run->fbo)
-        glDeleteFramebuffers(1, &run->fbo);
-    if (run->color_rb)
-        glDeleteRenderbuffers(1, &run->color_rb);
-    if (run->depth_rb)
-        glDeleteRenderbuffers(1, &run->depth_rb);
     gpu_scene_finish(&run->gpu);
     if (run->scene_ok)
         scene_finish(&run->scene);
@@ -162,7 +259,7 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
     const struct job_spec *spec = run->spec;
     const struct job *job = run->job;
     int n = spec->frames, w0 = spec->warmup_frames;
-    int sections = technique_section_count(run->tech);
+    int sections = run->passes.count;
     double *gpu = malloc((size_t)n * sizeof(double));
     double *sec = malloc((size_t)n * sizeof(double));
     json_t *captures = json_array(), *result = NULL;
@@ -199,13 +296,13 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
         goto out;
     }
     used += (size_t)snprintf(csv + used, cap - used, "frame,gpu_ms,cpu_ms,frame_ms");
-    for (int s = 0; sections > 1 && s < sections; s++)
-        used += (size_t)snprintf(csv + used, cap - used, ",gpu_%s_ms", run->tech->sections[s]);
+    for (int s = 0; s < sections; s++)
+        used += (size_t)snprintf(csv + used, cap - used, ",gpu_%s_ms", run->passes.names[s]);
     used += (size_t)snprintf(csv + used, cap - used, "\n");
     for (int i = 0; i < n; i++) {
         used += (size_t)snprintf(csv + used, cap - used, "%d,%.6f,%.6f,%.6f", i + 1, gpu[i],
                                  run->cpu_ms[i], run->frame_ms[i]);
-        for (int s = 0; sections > 1 && s < sections; s++)
+        for (int s = 0; s < sections; s++)
             used += (size_t)snprintf(csv + used, cap - used, ",%.6f",
                                      gpu_timer_ms(run->timer, w0 + i, s));
         used += (size_t)snprintf(csv + used, cap - used, "\n");
@@ -221,7 +318,7 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
     double timed_wall = wall_s - capture_s;
     result = json_pack(
         "{s:s, s:i, s:i, s:f, s:f, s:f, s:o, s:o, s:o, s:I, s:i, s:i, s:o, s:s, s:s, s:I, s:O}",
-        "technique", run->tech->name, "frames", n, "warmup_frames", w0, "wall_s",
+        "technique", run->tech->info->name, "frames", n, "warmup_frames", w0, "wall_s",
         timed_wall, "wall_s_including_captures", wall_s, "fps",
         timed_wall > 0 ? n / timed_wall : 0.0, "gpu_ms", stats_json(gpu, (size_t)n),
         "cpu_ms", stats_json(run->cpu_ms, (size_t)n), "frame_ms",
@@ -240,19 +337,26 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
         "timer_query_stalls", (json_int_t)gpu_timer_stalls(run->timer), "device",
         run->runner->device_json);
     captures = NULL;
-    if (sections > 1) {
-        json_t *by_section = json_object();
-        for (int s = 0; s < sections; s++) {
-            for (int i = 0; i < n; i++)
-                sec[i] = gpu_timer_ms(run->timer, w0 + i, s);
-            json_object_set_new(by_section, run->tech->sections[s], stats_json(sec, (size_t)n));
-        }
-        json_object_set_new(result, "gpu_sections_ms", by_section);
+    /* Every pass, the harness's resolve included, in frame order. */
+    json_t *by_section = json_object();
+    for (int s = 0; s < sections; s++) {
+        for (int i = 0; i < n; i++)
+            sec[i] = gpu_timer_ms(run->timer, w0 + i, s);
+        json_object_set_new(by_section, run->passes.names[s], stats_json(sec, (size_t)n));
     }
+    json_object_set_new(result, "gpu_sections_ms", by_section);
+    json_object_set_new(result, "look", json_pack("{s:s, s:s}", "lighting",
+                                                  look_lighting_name(run->spec->look.lighting),
+                                                  "hdr", hdr_name(run->spec->look.hdr)));
+    json_object_set_new(result, "targets_bytes", json_real(gpu_targets_bytes(run->runner->targets)));
+    json_object_set_new(result, "scene", scene_describe(&run->scene));
+    /* Store hook: what could have disturbed the timed region. */
+    json_object_set_new(result, "interference",
+                        interference_json(&run->interference[0], &run->interference[1]));
     if (run->tech->describe) {
         json_t *d = run->tech->describe(run->state);
         if (d)
-            json_object_set_new(result, run->tech->name, d);
+            json_object_set_new(result, run->tech->info->name, d);
     }
     snprintf(path, sizeof(path), "%s/result.json", job->dir);
     if (!fs_write_json_atomic(path, result)) {
@@ -277,13 +381,19 @@ static bool render_reference(struct run *run, enum job_status *status)
     const struct technique *ref = technique_find(spec->reference);
     int w = spec->scene.width, h = spec->scene.height;
     uint8_t *pixels = malloc((size_t)w * (size_t)h * 4);
-    struct gpu_timer *timer = ref ? gpu_timer_create(technique_section_count(ref), 1) : NULL;
+    /* The reference gets a run of its own over the same scene and targets. */
+    struct run rr = {.runner = run->runner, .job = run->job, .spec = spec, .tech = ref,
+                     .env = run->env, .ldr_fbo = run->ldr_fbo};
+    memcpy(rr.defines, run->defines, sizeof(rr.defines));
+    rr.env.defines = rr.defines;
+    rr.env.passes = &rr.passes;
+    rr.env.products = &rr.products;
     bool ok = false;
-    if (!ref || !pixels || !timer) {
-        snprintf(run->err, sizeof(run->err), "reference %s: cannot prepare it", spec->reference);
+    if (!ref || !pixels || !setup_technique(&rr, ref, job_spec_reference_options(spec), 1)) {
+        snprintf(run->err, sizeof(run->err), "reference %s: cannot prepare it: %.900s",
+                 spec->reference, rr.err);
         goto out;
     }
-    struct technique_ctx ctx = {spec, &run->scene, &run->gpu, timer};
     for (int k = spec->capture_interval; k <= spec->frames; k += spec->capture_interval) {
         if (atomic_load(&run->job->cancel)) {
             *status = JOB_CANCELLED;
@@ -292,20 +402,25 @@ static bool render_reference(struct run *run, enum job_status *status)
         }
         void *state = NULL;
         char why[900] = "";
-        if (!ref->create(&ctx, &state, why, sizeof(why))) {
-            snprintf(run->err, sizeof(run->err), "reference %s cannot run: %s", ref->name, why);
+        if (!ref->create(&rr.env, &state, why, sizeof(why))) {
+            snprintf(run->err, sizeof(run->err), "reference %s cannot run: %s", ref->info->name,
+                     why);
             goto out;
         }
-        glBindFramebuffer(GL_FRAMEBUFFER, run->fbo);
-        glViewport(0, 0, w, h);
-        gpu_timer_begin_frame(timer);
-        bool drawn = ref->render(state, &ctx, k, why, sizeof(why));
-        gpu_timer_end_frame(timer);
-        if (drawn)
+        struct gpu_frame_data fd = {0};
+        frame_data(&rr, k, &fd);
+        gpu_frame_block_update(&run->runner->frame_block, &fd);
+        gpu_timer_begin_frame(rr.timer);
+        bool drawn = ref->render(state, &rr.env, k, why, sizeof(why));
+        resolve(&rr);
+        gpu_timer_end_frame(rr.timer);
+        if (drawn) {
+            glBindFramebuffer(GL_READ_FRAMEBUFFER, rr.ldr_fbo);
             glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, pixels);
+        }
         ref->destroy(state);
         if (!drawn || gl_error_take("reference rendering", why, sizeof(why))) {
-            snprintf(run->err, sizeof(run->err), "reference %s failed: %s", ref->name, why);
+            snprintf(run->err, sizeof(run->err), "reference %s failed: %s", ref->info->name, why);
             goto out;
         }
         char path[PATH_MAX + 32];
@@ -315,7 +430,7 @@ static bool render_reference(struct run *run, enum job_status *status)
     }
     ok = true;
 out:
-    gpu_timer_destroy(timer);
+    gpu_timer_destroy(rr.timer);
     free(pixels);
     return ok;
 }
@@ -329,7 +444,7 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
     const struct job_spec *spec = run->spec;
     struct job *job = run->job;
     int w0 = spec->warmup_frames, n = spec->frames;
-    run->scene_ok = scene_create(&run->scene, &spec->scene);
+    run->scene_ok = scene_init(&run->scene, &spec->scene);
     run->capture_count = capture ? job_spec_capture_count(spec) : 0;
     run->captures = calloc((size_t)run->capture_count + 1, sizeof(*run->captures));
     run->cpu_ms = calloc((size_t)n, sizeof(double));
@@ -339,15 +454,10 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
         return false;
     }
     if (!gpu_scene_init(&run->gpu, &run->scene, run->err, sizeof(run->err)) ||
-        !setup_framebuffer(run))
+        !setup_targets(run) ||
+        !setup_technique(run, run->tech, job_spec_technique_options(spec), (int64_t)w0 + n))
         return false;
-    run->timer = gpu_timer_create(technique_section_count(run->tech), (int64_t)w0 + n);
-    if (!run->timer) {
-        snprintf(run->err, sizeof(run->err), "cannot create GPU timer queries");
-        return false;
-    }
-    struct technique_ctx ctx = {spec, &run->scene, &run->gpu, run->timer};
-    if (!run->tech->create(&ctx, &run->state, run->err, sizeof(run->err)) ||
+    if (!run->tech->create(&run->env, &run->state, run->err, sizeof(run->err)) ||
         gl_error_take("setup", run->err, sizeof(run->err)))
         return false;
 
@@ -358,9 +468,8 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
             return false;
         }
 
-    glBindFramebuffer(GL_FRAMEBUFFER, run->fbo);
-    glViewport(0, 0, spec->scene.width, spec->scene.height);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    struct gpu_frame_data fd = {0};
     double wall_start = 0, frame_begin = 0;
     int captured = 0;
     *capture_s = 0;
@@ -375,7 +484,8 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
         if (k == 1) {
             /* Warm-up work still queued must not be billed to the timed frames. */
             glFinish();
-            wall_start = mono_s();
+            interference_sample(&run->interference[0]); /* store hook, outside the timing */
+            wall_start = clock_mono_s();
         }
         /* Bound the frames in flight like a swap chain would; the wait is part
          * of the frame interval, never of the CPU submit time. */
@@ -385,25 +495,29 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
             glDeleteSync(*fence);
             *fence = NULL;
         }
-        double t0 = mono_s();
+        double t0 = clock_mono_s();
         if (k >= 2)
             run->frame_ms[k - 2] += (t0 - frame_begin) * 1e3;
         frame_begin = t0;
+        frame_data(run, k, &fd);
+        gpu_frame_block_update(&r->frame_block, &fd);
         gpu_timer_begin_frame(run->timer);
-        bool ok = run->tech->render(run->state, &ctx, k, run->err, sizeof(run->err));
+        bool ok = run->tech->render(run->state, &run->env, k, run->err, sizeof(run->err));
+        resolve(run);
         gpu_timer_end_frame(run->timer);
         glFlush(); /* where a swap would hand the frame to the GPU */
-        double t1 = mono_s();
+        double t1 = clock_mono_s();
         *fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
         if (!ok)
             return false;
         if (k >= 1)
             run->cpu_ms[k - 1] = (t1 - t0) * 1e3;
         if (run->capture_count && job_spec_is_capture_frame(spec, (int)k)) {
-            double c0 = mono_s();
+            double c0 = clock_mono_s();
+            glBindFramebuffer(GL_READ_FRAMEBUFFER, run->ldr_fbo);
             glReadPixels(0, 0, spec->scene.width, spec->scene.height, GL_RGBA,
                          GL_UNSIGNED_BYTE, run->captures[captured++]);
-            double c = mono_s() - c0;
+            double c = clock_mono_s() - c0;
             *capture_s += c;
             run->frame_ms[k - 1] -= c * 1e3;
         }
@@ -412,7 +526,8 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
         queue_progress(r->queue, job, run_index * n + (k > 0 ? (int)k : 0));
     }
     glFinish();
-    double wall_end = mono_s();
+    double wall_end = clock_mono_s();
+    interference_sample(&run->interference[1]); /* store hook, outside the timing */
     run->frame_ms[n - 1] += (wall_end - frame_begin) * 1e3;
     *wall_s = wall_end - wall_start;
     gpu_timer_drain(run->timer);
@@ -458,6 +573,9 @@ static bool repeat_runs(struct runner *r, struct run *first, json_t *result,
                                                 json_deep_copy(json_object_get(result, "frame_ms")),
                                                 json_deep_copy(json_object_get(result, "gpu_ms")),
                                                 json_deep_copy(json_object_get(result, "cpu_ms"))));
+    if (ok) /* store hook: each run's interference */
+        json_object_set_new(json_array_get(runs, 0), "interference",
+                            json_deep_copy(json_object_get(result, "interference")));
     int done = 1;
     while (ok && done < planned && !(spec->repeat_auto && stats_is_stable(med, (size_t)done, 0.025))) {
         struct run extra = {.runner = r, .job = first->job, .spec = spec, .tech = first->tech};
@@ -472,6 +590,8 @@ static bool repeat_runs(struct runner *r, struct run *first, json_t *result,
             med[planned + done] = json_real_value(json_object_get(g, "median"));
             med[2 * planned + done] = json_real_value(json_object_get(c, "median"));
             json_array_append_new(runs, run_summary(done + 1, wall_s, f, g, c));
+            json_object_set_new(json_array_get(runs, done), "interference", /* store hook */
+                                interference_json(&extra.interference[0], &extra.interference[1]));
             done++;
         } else {
             char why[900];
@@ -561,15 +681,47 @@ done:
     queue_finish(r->queue, job, status, status == JOB_DONE ? NULL : run.err, result);
 }
 
+/* What every job shares on the render thread; made once the context is up. */
+static bool harness_gl_init(struct runner *r, char *err, size_t errlen)
+{
+    gl_debug_install();
+    gpu_caps_query(&r->caps);
+    const struct gl_stage stages[] = {
+        {GL_VERTEX_SHADER, {"fullscreen.vert"}},
+        {GL_FRAGMENT_SHADER, {"resolve.frag"}},
+    };
+    r->targets = gpu_targets_create();
+    if (!r->targets || !gpu_frame_block_init(&r->frame_block) ||
+        !(r->resolve_prog = gl_program_build("resolve", stages, 2, NULL, err, errlen))) {
+        if (!err[0])
+            snprintf(err, errlen, "cannot set up the harness's GL objects");
+        return false;
+    }
+    glGenVertexArrays(1, &r->empty_vao);
+    return !gl_error_take("harness setup", err, errlen);
+}
+
+static void harness_gl_finish(struct runner *r)
+{
+    gpu_targets_destroy(r->targets);
+    r->targets = NULL;
+    gpu_frame_block_finish(&r->frame_block);
+    glDeleteProgram(r->resolve_prog);
+    glDeleteVertexArrays(1, &r->empty_vao);
+}
+
 static void *runner_main(void *arg)
 {
     struct runner *r = arg;
     char err[512] = "";
     struct egl_context *egl = egl_context_create(r->device, r->gl_debug, err, sizeof(err));
     pthread_mutex_lock(&r->lock);
+    if (egl && !harness_gl_init(r, err, sizeof(err))) {
+        egl_context_destroy(egl);
+        egl = NULL;
+    }
     if (egl) {
-        gl_debug_install();
-        r->device_json = collect_device(egl);
+        r->device_json = collect_device(egl, &r->caps);
         r->ready = 1;
         atomic_store(&r->alive, true);
     } else {
@@ -584,9 +736,11 @@ static void *runner_main(void *arg)
         egl_context_platform(egl), gl_str(GL_RENDERER), gl_str(GL_VERSION));
 
     struct job *job;
-    while ((job = queue_next(r->queue)))
+    /* Store hook: the metrics and files of earlier jobs finish before the next job is timed. */
+    while ((metrics_worker_wait_idle(r->metrics), job = queue_next(r->queue)))
         run_job(r, job);
     atomic_store(&r->alive, false);
+    harness_gl_finish(r);
     egl_context_destroy(egl);
     return NULL;
 }

@@ -8,42 +8,77 @@
 #include <string.h>
 
 
-/* A technique name from the registry; null gives "" where allowed. */
-static bool get_technique(const json_t *v, const char *field, const char *const *techniques,
-                          bool nullable, char *out, size_t cap, struct job_error *err)
+/* A technique name from the catalogue; null gives "" (index -1) where allowed. */
+static bool get_technique(const json_t *v, const char *field,
+                          const struct technique_catalog *techniques, bool nullable, char *out,
+                          size_t cap, int *index, struct job_error *err)
 {
     if (nullable && json_is_null(v)) {
         out[0] = '\0';
+        *index = -1;
         return true;
     }
-    char list[200] = "";
-    for (const char *const *t = techniques; *t; t++) {
-        if (json_is_string(v) && strcmp(*t, json_string_value(v)) == 0) {
-            snprintf(out, cap, "%s", *t);
-            return true;
-        }
-        size_t used = strlen(list);
-        snprintf(list + used, sizeof(list) - used, "%s\"%s\"", used ? ", " : "", *t);
+    int i = json_is_string(v) ? technique_catalog_find(techniques, json_string_value(v)) : -1;
+    if (i >= 0) {
+        snprintf(out, cap, "%s", techniques->infos[i]->name);
+        *index = i;
+        return true;
     }
+    char list[400];
+    technique_catalog_list(techniques, list, sizeof(list));
     return job_error_set(err, field, "must be one of: %s%s", list, nullable ? ", or null" : "");
 }
 
-void job_spec_defaults(struct job_spec *out)
+void job_spec_defaults(struct job_spec *out, const struct technique_catalog *techniques)
 {
     memset(out, 0, sizeof(*out));
+    out->catalog = techniques;
+    out->technique_index = technique_catalog_find(techniques, "forward");
     snprintf(out->technique, sizeof(out->technique), "forward");
+    out->reference_index = -1;
     out->frames = 300;
     out->warmup_frames = 10;
     out->capture_interval = 0;
     out->async_distance = 0.0;
     scene_spec_defaults(&out->scene);
-    out->osl.resolution = 256;
-    out->osl.texel_density = 1.0;
-    out->osl.reshade = OSL_RESHADE_TOUCHED;
+    out->look.lighting = LOOK_PHONG;
+    out->look.hdr = LOOK_HDR_RGBA32F;
+    for (int i = 0; i < techniques->count; i++)
+        technique_options_defaults(techniques->infos[i], &out->options[i]);
     out->repeat = 1;
     out->repeat_auto = false;
     out->reference[0] = '\0';
     metrics_options_defaults(&out->metrics);
+}
+
+const void *job_spec_technique_options(const struct job_spec *spec)
+{
+    return spec->technique_index >= 0 ? spec->options[spec->technique_index].bytes : NULL;
+}
+
+const void *job_spec_reference_options(const struct job_spec *spec)
+{
+    return spec->reference_index >= 0 ? spec->options[spec->reference_index].bytes : NULL;
+}
+
+static const char *const LIGHTING_NAMES[] = {"phong", "blinn_phong", NULL};
+static const char *const HDR_NAMES[] = {"rgba32f", "rgba16f", NULL};
+
+const char *look_lighting_name(int lighting) { return LIGHTING_NAMES[lighting]; }
+
+/* "look": {"lighting": "phong" | "blinn_phong", "hdr": "rgba32f" | "rgba16f"}. */
+static bool parse_look(const json_t *v, struct look_spec *look, struct job_error *err)
+{
+    static const char *const keys[] = {"lighting", "hdr", NULL};
+    return jf_check_keys(v, "look.", keys, err) &&
+           jf_get_choice(v, "lighting", "look.lighting", LIGHTING_NAMES, &look->lighting, err) &&
+           jf_get_choice(v, "hdr", "look.hdr", HDR_NAMES, &look->hdr, err);
+}
+
+static json_t *look_to_json(const struct look_spec *look)
+{
+    return json_pack("{s:s, s:s}", "lighting", LIGHTING_NAMES[look->lighting], "hdr",
+                     HDR_NAMES[look->hdr]);
 }
 
 /* "repeat": N, or {"auto": true, "max": M}. */
@@ -197,52 +232,23 @@ static bool parse_labels(const json_t *v, struct job_spec *out, struct job_error
     return true;
 }
 
-static bool parse_osl(const json_t *osl, struct osl_spec *o, struct job_error *err)
-{
-    static const char *const keys[] = {"resolution", "texel_density", "reshade", NULL};
-    if (!jf_check_keys(osl, "osl.", keys, err))
-        return false;
-    json_t *res = json_object_get(osl, "resolution");
-    if (res) {
-        static const char rule[] =
-            "must be \"auto\" or a power of two from 8 to 1024";
-        if (json_is_string(res)) {
-            if (strcmp(json_string_value(res), "auto") != 0)
-                return job_error_set(err, "osl.resolution", rule);
-            o->resolution = 0;
-        } else if (json_is_integer(res)) {
-            json_int_t r = json_integer_value(res);
-            if (r < 8 || r > 1024 || (r & (r - 1)) != 0)
-                return job_error_set(err, "osl.resolution", rule);
-            o->resolution = (int)r;
-        } else {
-            return job_error_set(err, "osl.resolution", rule);
-        }
-    }
-    if (!jf_get_number(osl, "texel_density", "osl.texel_density", 0.0625, 16.0,
-                    &o->texel_density, err))
-        return false;
-    json_t *reshade = json_object_get(osl, "reshade");
-    if (reshade) {
-        const char *v = json_is_string(reshade) ? json_string_value(reshade) : "";
-        if (strcmp(v, "touched") == 0)
-            o->reshade = OSL_RESHADE_TOUCHED;
-        else if (strcmp(v, "all") == 0)
-            o->reshade = OSL_RESHADE_ALL;
-        else
-            return job_error_set(err, "osl.reshade", "must be one of: \"touched\", \"all\"");
-    }
-    return true;
-}
-
-bool job_spec_parse(const json_t *body, const char *const *techniques,
+bool job_spec_parse(const json_t *body, const struct technique_catalog *techniques,
                     struct job_spec *out, struct job_error *err)
 {
-    static const char *const keys[] = {"technique", "frames", "warmup_frames",
-                                       "capture_interval", "async_distance",
-                                       "scene", "osl", "reference", "metrics", "repeat",
-                                       "labels", NULL};
-    job_spec_defaults(out);
+    static const char *const fixed[] = {"technique", "frames", "warmup_frames",
+                                        "capture_interval", "async_distance", "scene", "look",
+                                        "reference", "metrics", "repeat", "labels"};
+    enum { NFIXED = sizeof(fixed) / sizeof(fixed[0]) };
+    /* Every technique's options live under its own name. */
+    const char *keys[NFIXED + TECHNIQUE_MAX + 1];
+    int nkeys = 0;
+    for (int i = 0; i < NFIXED; i++)
+        keys[nkeys++] = fixed[i];
+    for (int i = 0; i < techniques->count; i++)
+        keys[nkeys++] = techniques->infos[i]->name;
+    keys[nkeys] = NULL;
+
+    job_spec_defaults(out, techniques);
     memset(err, 0, sizeof(*err));
     if (!json_is_object(body))
         return job_error_set(err, "body", "the job must be a JSON object");
@@ -251,11 +257,31 @@ bool job_spec_parse(const json_t *body, const char *const *techniques,
 
     json_t *tech = json_object_get(body, "technique");
     if (tech && !get_technique(tech, "technique", techniques, false, out->technique,
-                               sizeof(out->technique), err))
+                               sizeof(out->technique), &out->technique_index, err))
         return false;
+    if (out->technique_index < 0)
+        return job_error_set(err, "technique", "no technique named \"forward\" is available: "
+                             "name one");
     json_t *ref = json_object_get(body, "reference");
     if (ref && !get_technique(ref, "reference", techniques, true, out->reference,
-                              sizeof(out->reference), err))
+                              sizeof(out->reference), &out->reference_index, err))
+        return false;
+    for (int i = 0; i < techniques->count; i++) {
+        json_t *opts = json_object_get(body, techniques->infos[i]->name);
+        if (!opts)
+            continue;
+        if (!technique_options_parse(techniques->infos[i], opts, &out->options[i], err))
+            return false;
+        out->options_given |= 1u << i;
+    }
+    /* What runs is always written back; the bit records only the rest, so
+     * that the spec is the same after a round trip. */
+    out->options_given &= ~(1u << out->technique_index);
+    if (out->reference_index >= 0)
+        out->options_given &= ~(1u << out->reference_index);
+    json_t *look;
+    if (!jf_get_object(body, "look", "look", &look, err) ||
+        (look && !parse_look(look, &out->look, err)))
         return false;
     json_t *metrics = json_object_get(body, "metrics");
     if (metrics && !parse_metrics(metrics, &out->metrics, err))
@@ -275,11 +301,9 @@ bool job_spec_parse(const json_t *body, const char *const *techniques,
                     &out->async_distance, err))
         return false;
 
-    json_t *scene, *osl;
+    json_t *scene;
     if (!jf_get_object(body, "scene", "scene", &scene, err) ||
-        (scene && !scene_spec_parse(scene, &out->scene, err)) ||
-        !jf_get_object(body, "osl", "osl", &osl, err) ||
-        (osl && !parse_osl(osl, &out->osl, err)))
+        (scene && !scene_spec_parse(scene, &out->scene, err)))
         return false;
 
     if (out->reference[0] && out->capture_interval == 0)
@@ -308,13 +332,13 @@ bool job_spec_parse(const json_t *body, const char *const *techniques,
 }
 
 bool job_spec_parse_text(const char *text, size_t len,
-                         const char *const *techniques, struct job_spec *out,
+                         const struct technique_catalog *techniques, struct job_spec *out,
                          struct job_error *err)
 {
     json_error_t jerr;
     json_t *body = json_loadb(text, len, JSON_REJECT_DUPLICATES, &jerr);
     if (!body) {
-        job_spec_defaults(out);
+        job_spec_defaults(out, techniques);
         return job_error_set(err, "body", "malformed JSON at line %d, column %d: %s",
                     jerr.line, jerr.column, jerr.text);
     }
@@ -361,15 +385,19 @@ static json_t *metrics_to_json(const struct metrics_options *m)
 
 json_t *job_spec_to_json(const struct job_spec *spec)
 {
-    json_t *res = spec->osl.resolution ? json_integer(spec->osl.resolution)
-                                       : json_string("auto");
-    json_t *out = json_pack(
-        "{s:s, s:i, s:i, s:i, s:f, s:o, s:{s:o, s:f, s:s}}",
-        "technique", spec->technique, "frames", spec->frames, "warmup_frames",
-        spec->warmup_frames, "capture_interval", spec->capture_interval,
-        "async_distance", spec->async_distance, "scene", scene_spec_to_json(&spec->scene),
-        "osl", "resolution", res, "texel_density", spec->osl.texel_density,
-        "reshade", spec->osl.reshade == OSL_RESHADE_ALL ? "all" : "touched");
+    json_t *out = json_pack("{s:s, s:i, s:i, s:i, s:f, s:o, s:o}", "technique", spec->technique,
+                            "frames", spec->frames, "warmup_frames", spec->warmup_frames,
+                            "capture_interval", spec->capture_interval, "async_distance",
+                            spec->async_distance, "scene", scene_spec_to_json(&spec->scene),
+                            "look", look_to_json(&spec->look));
+    /* The options of what runs (technique and reference) and of whatever the
+     * body set, so that the spec round-trips. */
+    const struct technique_catalog *c = spec->catalog;
+    for (int i = 0; c && i < c->count; i++)
+        if (i == spec->technique_index || i == spec->reference_index ||
+            (spec->options_given & (1u << i)))
+            json_object_set_new(out, c->infos[i]->name,
+                                technique_options_to_json(c->infos[i], &spec->options[i]));
     json_object_set_new(out, "repeat",
                         spec->repeat_auto ? json_pack("{s:b, s:i}", "auto", 1, "max", spec->repeat)
                                           : json_integer(spec->repeat));

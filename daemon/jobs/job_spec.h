@@ -2,7 +2,8 @@
 #define SHADEBENCH_JOB_H
 
 /* Job specifications: parsing, validation and defaults. GL-free so that it is
- * unit-tested plainly; the technique names come from the caller. */
+ * unit-tested plainly; the techniques and their options come from the
+ * catalogue the caller hands in. Any thread. */
 
 #include <jansson.h>
 #include <stdbool.h>
@@ -11,20 +12,19 @@
 #include "common/json_fields.h"
 #include "daemon/quality/metrics.h"
 #include "daemon/scene/scene_spec.h"
+#include "daemon/techniques/technique_info.h"
 
 #define JOB_MAX_BODY_BYTES (64 * 1024)
 #define JOB_MAX_CAPTURE_BYTES (1024.0 * 1024.0 * 1024.0)
 
-enum osl_reshade {
-    OSL_RESHADE_TOUCHED, /* only objects a moving light reaches */
-    OSL_RESHADE_ALL,     /* every due object, as the thesis measured */
-};
+/* The job's "look": what the image should look like, independent of the
+ * technique that renders it; the reference renders with the same look. */
+enum look_lighting { LOOK_PHONG, LOOK_BLINN_PHONG };
+enum look_hdr { LOOK_HDR_RGBA32F, LOOK_HDR_RGBA16F };
 
-
-struct osl_spec {
-    int resolution; /* tile edge in texels; 0 means "auto" */
-    double texel_density;
-    enum osl_reshade reshade;
+struct look_spec {
+    int lighting; /* enum look_lighting */
+    int hdr;      /* enum look_hdr: the format of the HDR target techniques draw into */
 };
 
 /* labels: free-form tags for history (commit, branch, driver version). Keys
@@ -47,27 +47,41 @@ struct job_spec {
     int capture_interval;
     double async_distance;
     struct scene_spec scene;
-    struct osl_spec osl;
+    struct look_spec look;
     int repeat;                    /* runs of the job; with repeat_auto, the most */
     bool repeat_auto;              /* stop once the 95% interval is within 2.5% */
     char reference[32];            /* technique to compare captures with; "" for none */
     struct metrics_options metrics; /* used when reference is set */
+    /* Every catalogued technique's options, by catalogue index, so that a
+     * sweep over techniques keeps each one's settings. */
+    const struct technique_catalog *catalog;
+    int technique_index, reference_index; /* reference_index -1 without one */
+    unsigned options_given;               /* bit i: the body gave technique i's object,
+                                           * and i is neither technique nor reference */
+    struct technique_options options[TECHNIQUE_MAX];
     int nlabels;                   /* sorted by key */
     struct job_label labels[JOB_MAX_LABELS];
 };
 
 
-/* Fills defaults, then applies and validates the body. techniques is a
- * NULL-terminated list of accepted technique names. */
-bool job_spec_parse(const json_t *body, const char *const *techniques,
+/* Fills defaults, then applies and validates the body. techniques is the
+ * catalogue of accepted techniques; it must outlive the spec. */
+bool job_spec_parse(const json_t *body, const struct technique_catalog *techniques,
                     struct job_spec *out, struct job_error *err);
 
 /* Same, from raw request text (reports JSON syntax errors with position). */
 bool job_spec_parse_text(const char *text, size_t len,
-                         const char *const *techniques, struct job_spec *out,
+                         const struct technique_catalog *techniques, struct job_spec *out,
                          struct job_error *err);
 
-void job_spec_defaults(struct job_spec *out);
+void job_spec_defaults(struct job_spec *out, const struct technique_catalog *techniques);
+
+/* The options of the job's technique and of its reference (NULL without one). */
+const void *job_spec_technique_options(const struct job_spec *spec);
+const void *job_spec_reference_options(const struct job_spec *spec);
+
+/* The look's names, for shaders and results. */
+const char *look_lighting_name(int lighting);
 
 /* The job as understood, defaults filled in. New reference. */
 json_t *job_spec_to_json(const struct job_spec *spec);

@@ -16,17 +16,29 @@
 #include <unistd.h>
 
 struct queue {
+    /* Guards everything below and the jobs' store-owned fields. Never held
+     * across file I/O: see struct snapshot. */
     pthread_mutex_t lock;
     pthread_cond_t changed;
-    struct job **jobs;
+    struct job **jobs; /* sorted by id: submission order */
     size_t count, cap;
-    int queued, max_queued;
-    unsigned serial;
+    int queued, max_queued; /* queued counts submissions in progress too */
     bool stopping;
     int keep_jobs;
     double keep_days;
-    char state_dir[PATH_MAX];
+    struct record_kind kind; /* STATE_DIR/jobs/ID/job.json */
+    const struct technique_catalog *techniques; /* for queue_load */
 };
+
+/* A job's state as taken under the store lock, written after it is
+ * released. The job stays alive until then (pending). */
+struct snapshot {
+    struct job *job;
+    uint64_t seq;
+    json_t *json;
+};
+
+static _Thread_local char submit_error[PATH_MAX + 200];
 
 const char *job_status_name(enum job_status s)
 {
@@ -35,9 +47,62 @@ const char *job_status_name(enum job_status s)
     return names[s];
 }
 
+/* The parts of a job's state that its JSON shows and that change. */
+struct job_state {
+    enum job_status status;
+    const char *phase;
+    double started, finished;
+    const char *error;
+    int frames_done;
+};
+
+static struct job_state state_of(const struct job *job);
+static json_t *state_json(const struct job *job, const struct job_state *st, bool full);
+static json_t *state_record(const struct job *job, const struct job_state *st);
 static json_t *job_json_locked(const struct job *job, bool full);
-static void persist_locked(const struct job *job);
+static json_t *job_record_locked(const struct job *job);
 static void apply_retention(struct queue *q);
+
+static bool finished(const struct job *job)
+{
+    return job->status != JOB_QUEUED && job->status != JOB_RUNNING;
+}
+
+/* Under the lock: the job's state changed; number it and copy it. */
+static void snapshot_locked(struct job *job, struct snapshot *snap)
+{
+    snap->job = job;
+    snap->seq = ++job->seq;
+    snap->json = job_record_locked(job);
+    job->pending++;
+}
+
+/* Without the lock: writes the snapshot unless a newer one is on disk, and
+ * releases the job. Failures are logged with the file and errno. */
+static bool write_snapshot(struct queue *q, struct snapshot *snap, char *err, size_t errlen)
+{
+    struct job *job = snap->job;
+    char path[PATH_MAX + 16], why[PATH_MAX + 128] = "";
+    bool ok = true;
+    snprintf(path, sizeof(path), "%s/job.json", job->dir);
+    if (!snap->json) {
+        ok = false;
+        snprintf(why, sizeof(why), "cannot write %s: out of memory", path);
+    } else {
+        ok = record_writer_write(&job->writer, snap->seq, path, snap->json, why, sizeof(why));
+    }
+    if (!ok)
+        LOG(LOG_ERROR, "job %s: %s (its state in memory stays right; written again at exit)",
+            job->id, why);
+    if (err)
+        snprintf(err, errlen, "%s", why);
+    json_decref(snap->json);
+    snap->json = NULL;
+    pthread_mutex_lock(&q->lock);
+    job->pending--;
+    pthread_mutex_unlock(&q->lock);
+    return ok;
+}
 
 struct queue *queue_create(const char *state_dir, int max_queued)
 {
@@ -47,19 +112,40 @@ struct queue *queue_create(const char *state_dir, int max_queued)
     pthread_mutex_init(&q->lock, NULL);
     pthread_cond_init(&q->changed, NULL);
     q->max_queued = max_queued;
-    if (state_dir)
-        snprintf(q->state_dir, sizeof(q->state_dir), "%s", state_dir);
+    record_kind_init(&q->kind, state_dir, "jobs", "job.json");
     return q;
+}
+
+static void job_free(struct job *job)
+{
+    if (!job)
+        return;
+    json_decref(job->result);
+    record_writer_finish(&job->writer);
+    free(job);
 }
 
 void queue_destroy(struct queue *q)
 {
     if (!q)
         return;
+    /* Every other thread is gone: state a full disk held back gets one more
+     * try, so that a restart does not find it stale. */
     for (size_t i = 0; i < q->count; i++) {
-        json_decref(q->jobs[i]->result);
-        free(q->jobs[i]);
+        struct job *job = q->jobs[i];
+        if (job->writer.written < job->seq) {
+            struct snapshot snap;
+            pthread_mutex_lock(&q->lock);
+            snap.job = job;
+            snap.seq = job->seq;
+            snap.json = job_record_locked(job);
+            job->pending++;
+            pthread_mutex_unlock(&q->lock);
+            write_snapshot(q, &snap, NULL, 0);
+        }
     }
+    for (size_t i = 0; i < q->count; i++)
+        job_free(q->jobs[i]);
     free(q->jobs);
     pthread_cond_destroy(&q->changed);
     pthread_mutex_destroy(&q->lock);
@@ -67,6 +153,18 @@ void queue_destroy(struct queue *q)
 }
 
 int queue_max_queued(const struct queue *q) { return q->max_queued; }
+
+const char *queue_state_dir(const struct queue *q) { return q->kind.state_dir; }
+
+void queue_retention(struct queue *q, int *keep_jobs, double *keep_days)
+{
+    pthread_mutex_lock(&q->lock);
+    *keep_jobs = q->keep_jobs;
+    *keep_days = q->keep_days;
+    pthread_mutex_unlock(&q->lock);
+}
+
+const char *queue_submit_error(void) { return submit_error; }
 
 static struct job *find_locked(struct queue *q, const char *id)
 {
@@ -76,83 +174,133 @@ static struct job *find_locked(struct queue *q, const char *id)
     return NULL;
 }
 
-enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *spec,
-                                      const char *dir_override, char id_out[24])
+/* Keeps the array in id order, which is submission order. */
+static bool insert_locked(struct queue *q, struct job *job)
 {
-    enum queue_submit_result res = QUEUE_OK;
-    pthread_mutex_lock(&q->lock);
-    if (q->stopping) {
-        res = QUEUE_STOPPING;
-        goto out;
-    }
-    if (q->queued >= q->max_queued) {
-        res = QUEUE_FULL;
-        goto out;
-    }
     if (q->count == q->cap) {
         size_t cap = q->cap ? q->cap * 2 : 64;
         struct job **jobs = realloc(q->jobs, cap * sizeof(*jobs));
-        if (!jobs) {
-            res = QUEUE_IO_ERROR;
-            goto out;
-        }
+        if (!jobs)
+            return false;
         q->jobs = jobs;
         q->cap = cap;
     }
+    size_t at = q->count;
+    while (at > 0 && strcmp(q->jobs[at - 1]->id, job->id) > 0)
+        at--;
+    memmove(q->jobs + at + 1, q->jobs + at, (q->count - at) * sizeof(*q->jobs));
+    q->jobs[at] = job;
+    q->count++;
+    return true;
+}
+
+static struct job *job_new(void)
+{
     struct job *job = calloc(1, sizeof(*job));
+    if (!job)
+        return NULL;
+    atomic_init(&job->cancel, false);
+    atomic_init(&job->frames_done, 0);
+    record_writer_init(&job->writer);
+    return job;
+}
+
+/* spec.json: the job as accepted, written once. A damaged job.json is
+ * rebuilt from it and result.json. */
+static bool write_spec_record(const struct job *job, char *err, size_t errlen)
+{
+    char path[PATH_MAX + 16];
+    snprintf(path, sizeof(path), "%s/spec.json", job->dir);
+    json_t *o = json_pack("{s:s, s:f, s:o}", "id", job->id, "created_unix", job->created, "spec",
+                          job_spec_to_json(&job->spec));
+    bool ok = o && fs_write_json_atomic(path, o);
+    if (!ok)
+        snprintf(err, errlen, "cannot write %s: %s", path, o ? strerror(errno) : "out of memory");
+    json_decref(o);
+    return ok;
+}
+
+enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *spec,
+                                      const char *dir_override, char id_out[24])
+{
+    submit_error[0] = '\0';
+    pthread_mutex_lock(&q->lock);
+    enum queue_submit_result res = q->stopping                  ? QUEUE_STOPPING
+                                   : q->queued >= q->max_queued ? QUEUE_FULL
+                                                                : QUEUE_OK;
+    if (res == QUEUE_OK)
+        q->queued++; /* the place is taken while the files are written */
+    pthread_mutex_unlock(&q->lock);
+    if (res != QUEUE_OK)
+        return res;
+
+    /* The directory and both records are written with no lock held; the job
+     * joins the store only once they are on disk, so a job that cannot be
+     * persisted is refused and nothing of it is left behind. */
+    struct job *job = job_new();
+    bool made_dir = false;
     if (!job) {
-        res = QUEUE_IO_ERROR;
-        goto out;
+        snprintf(submit_error, sizeof(submit_error), "out of memory");
+        goto fail;
     }
-    /* Time-ordered ids: they sort by submission and stay unique across restarts. */
-    time_t t = time(NULL);
-    struct tm tm;
-    gmtime_r(&t, &tm);
-    char stamp[16];
-    strftime(stamp, sizeof(stamp), "%Y%m%d-%H%M%S", &tm);
-    /* A fresh directory per job: an id that is taken (after a restart in the
-     * same second) just moves on to the next serial number. */
-    bool made = false;
-    for (int attempt = 0; attempt < 10000 && !made; attempt++) {
-        snprintf(job->id, sizeof(job->id), "%.15s-%04u", stamp, ++q->serial % 10000u);
-        if (dir_override) {
-            snprintf(job->dir, sizeof(job->dir), "%s", dir_override);
-            made = fs_mkdir_p(job->dir);
-            break;
-        }
-        snprintf(job->dir, sizeof(job->dir), "%.*s/jobs/%s",
-                 (int)(sizeof(job->dir) - sizeof(job->id) - 8), q->state_dir, job->id);
-        char parent[PATH_MAX];
-        snprintf(parent, sizeof(parent), "%.*s/jobs", (int)(sizeof(parent) - 8), q->state_dir);
-        if (!fs_mkdir_p(parent))
-            break;
-        made = mkdir(job->dir, 0755) == 0;
-        if (!made && errno != EEXIST)
-            break;
-    }
-    if (!made) {
-        free(job);
-        res = QUEUE_IO_ERROR;
-        goto out;
-    }
+    if (!record_create_dir(&q->kind, dir_override, job->id, job->dir, sizeof(job->dir),
+                           submit_error, sizeof(submit_error)))
+        goto fail;
+    made_dir = !dir_override;
     job->spec = *spec;
     job->status = JOB_QUEUED;
     job->frames_total = spec->frames * job_spec_runs(spec);
     job->created = clock_unix_s();
-    atomic_init(&job->cancel, false);
-    q->jobs[q->count++] = job;
-    q->queued++;
-    persist_locked(job);
-    snprintf(id_out, 24, "%s", job->id);
-    pthread_cond_broadcast(&q->changed);
-out:
+    if (!dir_override && !write_spec_record(job, submit_error, sizeof(submit_error)))
+        goto fail;
+    json_t *first = job_record_locked(job); /* not shared yet: no lock needed */
+    char path[PATH_MAX + 16];
+    snprintf(path, sizeof(path), "%s/job.json", job->dir);
+    job->seq = 1;
+    bool written = first && record_writer_write(&job->writer, 1, path, first, submit_error,
+                                                sizeof(submit_error));
+    if (!first)
+        snprintf(submit_error, sizeof(submit_error), "out of memory");
+    json_decref(first);
+    if (!written)
+        goto fail;
+    pthread_mutex_lock(&q->lock);
+    bool inserted = insert_locked(q, job);
+    if (inserted)
+        pthread_cond_broadcast(&q->changed);
     pthread_mutex_unlock(&q->lock);
-    return res;
+    if (!inserted) {
+        snprintf(submit_error, sizeof(submit_error), "out of memory");
+        goto fail;
+    }
+    snprintf(id_out, 24, "%s", job->id);
+    return QUEUE_OK;
+
+fail:
+    LOG(LOG_ERROR, "job refused, it cannot be persisted: %s", submit_error);
+    if (made_dir) {
+        /* Never accepted, so not a record: remove what was made of it. */
+        static const char *const files[] = {"job.json", "job.json.tmp", "spec.json",
+                                            "spec.json.tmp"};
+        char path2[PATH_MAX + 32];
+        for (size_t i = 0; i < sizeof(files) / sizeof(files[0]); i++) {
+            snprintf(path2, sizeof(path2), "%s/%s", job->dir, files[i]);
+            unlink(path2);
+        }
+        if (rmdir(job->dir) != 0)
+            LOG(LOG_WARN, "cannot remove %s: %s", job->dir, strerror(errno));
+    }
+    job_free(job);
+    pthread_mutex_lock(&q->lock);
+    q->queued--;
+    pthread_mutex_unlock(&q->lock);
+    return QUEUE_IO_ERROR;
 }
 
 struct job *queue_next(struct queue *q)
 {
     struct job *job = NULL;
+    struct snapshot snap;
     pthread_mutex_lock(&q->lock);
     while (!q->stopping) {
         for (size_t i = 0; i < q->count && !job; i++)
@@ -167,18 +315,19 @@ struct job *queue_next(struct queue *q)
         job->phase = "rendering";
         job->started = clock_unix_s();
         q->queued--;
-        persist_locked(job);
+        snapshot_locked(job, &snap);
         pthread_cond_broadcast(&q->changed);
     }
     pthread_mutex_unlock(&q->lock);
+    if (job)
+        write_snapshot(q, &snap, NULL, 0);
     return job;
 }
 
 void queue_progress(struct queue *q, struct job *job, int frames_done)
 {
-    pthread_mutex_lock(&q->lock);
-    job->frames_done = frames_done;
-    pthread_mutex_unlock(&q->lock);
+    (void)q;
+    atomic_store_explicit(&job->frames_done, frames_done, memory_order_relaxed);
 }
 
 void queue_set_phase(struct queue *q, struct job *job, const char *phase)
@@ -191,16 +340,63 @@ void queue_set_phase(struct queue *q, struct job *job, const char *phase)
 void queue_finish(struct queue *q, struct job *job, enum job_status status,
                   const char *error, json_t *result)
 {
+    struct snapshot snap;
     pthread_mutex_lock(&q->lock);
-    job->status = status;
-    job->finished = clock_unix_s();
-    if (error)
-        snprintf(job->error, sizeof(job->error), "%s", error);
-    json_decref(job->result);
-    job->result = result;
-    persist_locked(job);
+    /* Stopped by SIGTERM, not by anyone's wish: it runs again, first, on the
+     * next start. */
+    bool requeue = status == JOB_CANCELLED && job->requeue_on_stop;
+    struct job_state next = state_of(job);
+    if (requeue) {
+        next.status = JOB_QUEUED;
+        next.phase = NULL;
+        next.started = 0;
+        next.error = "";
+        next.frames_done = 0;
+    } else {
+        next.status = status;
+        next.finished = clock_unix_s();
+        if (error)
+            next.error = error;
+    }
+    snap.job = job;
+    snap.seq = ++job->seq;
+    snap.json = state_record(job, &next);
+    job->pending++;
+    pthread_mutex_unlock(&q->lock);
+    /* Written before anyone can see it (the job is running, so only this
+     * thread changes its state): a job shown finished is finished on disk,
+     * unless the write failed, which is logged. */
+    write_snapshot(q, &snap, NULL, 0);
+
+    pthread_mutex_lock(&q->lock);
+    if (requeue) {
+        LOG(LOG_INFO, "job %s: stopped by the daemon's exit; back to the head of the queue",
+            job->id);
+        job->status = JOB_QUEUED;
+        job->phase = NULL;
+        job->started = 0;
+        job->error[0] = '\0';
+        atomic_store(&job->frames_done, 0);
+        atomic_store(&job->cancel, false);
+        job->requeue_on_stop = false;
+        json_decref(result);
+        q->queued++;
+    } else {
+        job->status = status;
+        job->finished = next.finished;
+        if (error)
+            snprintf(job->error, sizeof(job->error), "%s", error);
+        json_decref(job->result);
+        job->result = result;
+    }
+    /* Had anyone written an older view meanwhile, the newest goes last. */
+    bool again = job->seq != snap.seq;
+    if (again)
+        snapshot_locked(job, &snap);
     pthread_cond_broadcast(&q->changed);
     pthread_mutex_unlock(&q->lock);
+    if (again)
+        write_snapshot(q, &snap, NULL, 0);
     apply_retention(q);
 }
 
@@ -208,10 +404,13 @@ void queue_stop(struct queue *q)
 {
     pthread_mutex_lock(&q->lock);
     q->stopping = true;
-    /* A running job stops at its next frame rather than holding up the exit. */
+    /* A running job stops at its next frame rather than holding up the exit,
+     * and goes back to the queue: the stop is not its fault. */
     for (size_t i = 0; i < q->count; i++)
-        if (q->jobs[i]->status == JOB_RUNNING)
+        if (q->jobs[i]->status == JOB_RUNNING) {
+            q->jobs[i]->requeue_on_stop = !q->jobs[i]->user_cancel;
             atomic_store(&q->jobs[i]->cancel, true);
+        }
     pthread_cond_broadcast(&q->changed);
     pthread_mutex_unlock(&q->lock);
 }
@@ -219,6 +418,7 @@ void queue_stop(struct queue *q)
 enum queue_cancel_result queue_cancel(struct queue *q, const char *id)
 {
     enum queue_cancel_result res = CANCEL_NOT_FOUND;
+    struct snapshot snap = {0};
     pthread_mutex_lock(&q->lock);
     struct job *job = find_locked(q, id);
     if (!job)
@@ -229,11 +429,13 @@ enum queue_cancel_result queue_cancel(struct queue *q, const char *id)
         job->finished = clock_unix_s();
         snprintf(job->error, sizeof(job->error), "cancelled before it started");
         q->queued--;
-        persist_locked(job);
+        snapshot_locked(job, &snap);
         res = CANCEL_DONE;
         pthread_cond_broadcast(&q->changed);
         break;
     case JOB_RUNNING:
+        job->user_cancel = true;
+        job->requeue_on_stop = false;
         atomic_store(&job->cancel, true);
         res = CANCEL_REQUESTED;
         break;
@@ -242,6 +444,8 @@ enum queue_cancel_result queue_cancel(struct queue *q, const char *id)
     }
 out:
     pthread_mutex_unlock(&q->lock);
+    if (snap.job)
+        write_snapshot(q, &snap, NULL, 0);
     return res;
 }
 
@@ -259,20 +463,28 @@ static json_t *iso_time(double t)
     return json_string(buf);
 }
 
-static json_t *job_json_locked(const struct job *job, bool full)
+static struct job_state state_of(const struct job *job)
+{
+    return (struct job_state){job->status, job->phase, job->started, job->finished, job->error,
+                              atomic_load_explicit(&job->frames_done, memory_order_relaxed)};
+}
+
+static json_t *state_json(const struct job *job, const struct job_state *st, bool full)
 {
     char url[64];
     snprintf(url, sizeof(url), "/v1/jobs/%s", job->id);
     json_t *o = json_pack("{s:s, s:s, s:s, s:s, s:{s:i, s:i}, s:o, s:o, s:o}",
-                          "id", job->id, "url", url, "status", job_status_name(job->status),
+                          "id", job->id, "url", url, "status", job_status_name(st->status),
                           "technique", job->spec.technique, "progress", "frames_done",
-                          job->frames_done, "frames_total", job->frames_total, "created",
-                          iso_time(job->created), "started", iso_time(job->started),
-                          "finished", iso_time(job->finished));
-    if (job->status == JOB_RUNNING && job->phase)
-        json_object_set_new(o, "phase", json_string(job->phase));
-    if (job->error[0])
-        json_object_set_new(o, "error", json_string(job->error));
+                          st->frames_done, "frames_total", job->frames_total, "created",
+                          iso_time(job->created), "started", iso_time(st->started),
+                          "finished", iso_time(st->finished));
+    if (!o)
+        return NULL;
+    if (st->status == JOB_RUNNING && st->phase)
+        json_object_set_new(o, "phase", json_string(st->phase));
+    if (st->error && st->error[0])
+        json_object_set_new(o, "error", json_string(st->error));
     if (full) {
         json_object_set_new(o, "spec", job_spec_to_json(&job->spec));
         if (job->result)
@@ -281,146 +493,231 @@ static json_t *job_json_locked(const struct job *job, bool full)
     return o;
 }
 
-static bool finished(const struct job *job)
-{
-    return job->status != JOB_QUEUED && job->status != JOB_RUNNING;
-}
-
 /* job.json: the job's state, written whenever it changes (the result lives
  * in result.json beside it, written before the job is marked done). */
-static void persist_locked(const struct job *job)
+static json_t *state_record(const struct job *job, const struct job_state *st)
 {
-    json_t *o = job_json_locked(job, false);
+    json_t *o = state_json(job, st, false);
+    if (!o)
+        return NULL;
     json_object_set_new(o, "spec", job_spec_to_json(&job->spec));
     json_object_set_new(o, "times_unix",
-                        json_pack("[f, f, f]", job->created, job->started, job->finished));
-    char path[PATH_MAX + 16];
-    snprintf(path, sizeof(path), "%s/job.json", job->dir);
-    if (!fs_write_json_atomic(path, o))
-        LOG(LOG_ERROR, "job %s: cannot write %s", job->id, path);
-    json_decref(o);
+                        json_pack("[f, f, f]", job->created, st->started, st->finished));
+    return o;
 }
 
-static enum job_status status_from_name(const char *name)
+static json_t *job_json_locked(const struct job *job, bool full)
+{
+    struct job_state st = state_of(job);
+    return state_json(job, &st, full);
+}
+
+static json_t *job_record_locked(const struct job *job)
+{
+    struct job_state st = state_of(job);
+    return state_record(job, &st);
+}
+
+static bool status_from_name(const char *name, enum job_status *out)
 {
     for (int s = JOB_QUEUED; s <= JOB_INTERRUPTED; s++)
-        if (name && strcmp(name, job_status_name((enum job_status)s)) == 0)
-            return (enum job_status)s;
-    return JOB_INTERRUPTED;
-}
-
-static int by_id(const void *a, const void *b)
-{
-    return strcmp((*(struct job *const *)a)->id, (*(struct job *const *)b)->id);
-}
-
-static bool load_job(struct queue *q, const char *id, const char *const *techniques)
-{
-    char dir[PATH_MAX], path[PATH_MAX + 16];
-    if (strlen(id) >= sizeof(((struct job *)0)->id))
-        return false;
-    snprintf(dir, sizeof(dir), "%.*s/jobs/%.23s", (int)(sizeof(dir) - 40), q->state_dir, id);
-    snprintf(path, sizeof(path), "%s/job.json", dir);
-    json_error_t jerr;
-    json_t *o = json_load_file(path, 0, &jerr);
-    if (!o)
-        return false;
-    struct job_spec spec;
-    struct job_error err;
-    struct job *job = NULL;
-    const char *jid = json_string_value(json_object_get(o, "id"));
-    if (!jid || strcmp(jid, id) != 0 || strlen(id) >= sizeof(job->id) ||
-        !job_spec_parse(json_object_get(o, "spec"), techniques, &spec, &err)) {
-        LOG(LOG_WARN, "skipping %s: not a job this daemon can read (%s %s)", path, err.field,
-            err.message);
-        json_decref(o);
-        return false;
-    }
-    if (q->count == q->cap) {
-        size_t cap = q->cap ? q->cap * 2 : 64;
-        struct job **jobs = realloc(q->jobs, cap * sizeof(*jobs));
-        if (!jobs) {
-            json_decref(o);
-            return false;
+        if (name && strcmp(name, job_status_name((enum job_status)s)) == 0) {
+            *out = (enum job_status)s;
+            return true;
         }
-        q->jobs = jobs;
-        q->cap = cap;
-    }
-    job = calloc(1, sizeof(*job));
-    if (!job) {
-        json_decref(o);
+    return false;
+}
+
+/* A result.json is complete once nothing more would have been added to it:
+ * the metrics stage adds "quality" for jobs with a reference, the repeats
+ * add "repeat". An earlier version means the job never finished. */
+static bool result_complete(const struct job_spec *spec, const json_t *result)
+{
+    if (spec->reference[0] && !json_object_get(result, "quality"))
         return false;
+    if (job_spec_runs(spec) > 1 && !json_object_get(result, "repeat"))
+        return false;
+    return true;
+}
+
+static double file_mtime(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 ? (double)st.st_mtim.tv_sec + st.st_mtim.tv_nsec / 1e9 : 0;
+}
+
+/* Rebuilds a job whose job.json cannot be read from spec.json (written once
+ * at submission) and result.json. NULL, with why, when they do not allow it. */
+static struct job *rebuild_job(struct queue *q, const char *id, const char *dir, char *why,
+                               size_t whylen)
+{
+    char path[PATH_MAX + 16], rwhy[300] = "", swhy[700] = "";
+    snprintf(path, sizeof(path), "%s/spec.json", dir);
+    json_t *rec = record_read(path, swhy, sizeof(swhy));
+    struct job_spec spec;
+    struct job_error jerr;
+    const char *rid = json_string_value(json_object_get(rec, "id"));
+    if (rec && (!rid || strcmp(rid, id) != 0))
+        snprintf(swhy, sizeof(swhy), "its id does not match its directory");
+    else if (rec && !job_spec_parse(json_object_get(rec, "spec"), q->techniques, &spec, &jerr))
+        snprintf(swhy, sizeof(swhy), "not a job this daemon can run (%s: %s)", jerr.field,
+                 jerr.message);
+    if (swhy[0]) {
+        snprintf(why, whylen, "spec.json: %s", swhy);
+        json_decref(rec);
+        return NULL;
+    }
+    struct job *job = job_new();
+    if (!job) {
+        snprintf(why, whylen, "out of memory");
+        json_decref(rec);
+        return NULL;
     }
     snprintf(job->id, sizeof(job->id), "%s", id);
     snprintf(job->dir, sizeof(job->dir), "%s", dir);
     job->spec = spec;
-    job->status = status_from_name(json_string_value(json_object_get(o, "status")));
-    json_t *progress = json_object_get(o, "progress");
     job->frames_total = spec.frames * job_spec_runs(&spec);
-    job->frames_done = (int)json_integer_value(json_object_get(progress, "frames_done"));
-    json_t *times = json_object_get(o, "times_unix");
-    job->created = json_real_value(json_array_get(times, 0));
-    job->started = json_real_value(json_array_get(times, 1));
-    job->finished = json_real_value(json_array_get(times, 2));
-    const char *error = json_string_value(json_object_get(o, "error"));
-    if (error)
-        snprintf(job->error, sizeof(job->error), "%s", error);
-    atomic_init(&job->cancel, false);
-    json_decref(o);
-
-    bool changed = false;
-    if (job->status == JOB_RUNNING) {
+    job->created = json_number_value(json_object_get(rec, "created_unix"));
+    json_decref(rec);
+    snprintf(path, sizeof(path), "%s/result.json", dir);
+    json_t *result = record_read(path, rwhy, sizeof(rwhy));
+    if (result && result_complete(&job->spec, result)) {
+        job->status = JOB_DONE;
+        job->result = result;
+        job->finished = file_mtime(path);
+        atomic_store(&job->frames_done, job->frames_total);
+        snprintf(why, whylen, "rebuilt as done from spec.json and result.json");
+    } else {
+        /* Its state is unknown: it may have been queued, running or failed.
+         * Interrupted says so, and nothing is run twice behind anyone's back. */
+        json_decref(result);
         job->status = JOB_INTERRUPTED;
         job->finished = clock_unix_s();
         snprintf(job->error, sizeof(job->error),
-                 "interrupted: the daemon stopped (killed or crashed) while this job ran; "
-                 "its files may be incomplete, submit it again to measure it");
-        changed = true;
-    } else if (job->status == JOB_DONE) {
-        snprintf(path, sizeof(path), "%s/result.json", dir);
-        job->result = json_load_file(path, 0, &jerr);
-        if (!job->result) {
-            job->status = JOB_FAILED;
-            snprintf(job->error, sizeof(job->error), "result.json is missing or damaged: %s",
-                     jerr.text);
-            changed = true;
-        }
-    } else if (job->status == JOB_QUEUED) {
-        q->queued++;
+                 "interrupted: its job.json was damaged and its result.json is %s; "
+                 "submit it again to measure it", result ? "incomplete" : "missing or damaged");
+        snprintf(why, whylen, "rebuilt as interrupted from spec.json (result.json %s)",
+                 result ? "incomplete" : rwhy);
     }
-    if (changed)
-        persist_locked(job);
-    q->jobs[q->count++] = job;
-    return true;
+    return job;
 }
 
-int queue_load(struct queue *q, const char *const *techniques, char *err, size_t errlen)
+/* Reads one job's directory (startup: no lock is needed to read files, and
+ * none is held). Whatever cannot be read is quarantined, never skipped
+ * silently. */
+static void load_job(void *ctx, const char *id, const char *dir)
 {
-    char jobs_dir[PATH_MAX];
-    snprintf(jobs_dir, sizeof(jobs_dir), "%.*s/jobs", (int)(sizeof(jobs_dir) - 8), q->state_dir);
-    DIR *d = opendir(jobs_dir);
-    if (!d) {
-        if (errno == ENOENT)
-            return 0;
-        snprintf(err, errlen, "cannot read %s: %s", jobs_dir, strerror(errno));
-        return -1;
+    struct queue *q = ctx;
+    char path[PATH_MAX + 16], why[600] = "", quarantined[PATH_MAX] = "";
+    snprintf(path, sizeof(path), "%s/job.json", dir);
+    json_t *o = record_read(path, why, sizeof(why));
+    struct job_spec spec;
+    struct job_error jerr;
+    enum job_status status = JOB_INTERRUPTED;
+    if (o) {
+        const char *jid = json_string_value(json_object_get(o, "id"));
+        if (!jid || strcmp(jid, id) != 0)
+            snprintf(why, sizeof(why), "its id %.40s does not match its directory",
+                     jid ? jid : "(none)");
+        else if (!status_from_name(json_string_value(json_object_get(o, "status")), &status))
+            snprintf(why, sizeof(why), "no valid status");
+        else if (!job_spec_parse(json_object_get(o, "spec"), q->techniques, &spec, &jerr))
+            snprintf(why, sizeof(why), "not a job this daemon can read (%s: %s)", jerr.field,
+                     jerr.message);
     }
-    int loaded = 0;
+    struct job *job = NULL;
+    bool changed = false;
+    if (why[0]) {
+        json_decref(o);
+        char rebuilt[800];
+        job = rebuild_job(q, id, dir, rebuilt, sizeof(rebuilt));
+        if (!job) {
+            char reason[1600];
+            snprintf(reason, sizeof(reason), "job.json: %s; cannot be rebuilt: %s", why, rebuilt);
+            record_quarantine(&q->kind, id, dir, reason, NULL, 0);
+            return;
+        }
+        char reason[1600];
+        snprintf(reason, sizeof(reason), "job.json: %s; job %s", why, rebuilt);
+        if (access(path, F_OK) == 0)
+            record_quarantine(&q->kind, id, path, reason, quarantined, sizeof(quarantined));
+        LOG(LOG_WARN, "job %s: %s", id, reason);
+        changed = true;
+    } else {
+        if (!(job = job_new())) {
+            LOG(LOG_ERROR, "job %s: out of memory loading it", id);
+            json_decref(o);
+            return;
+        }
+        snprintf(job->id, sizeof(job->id), "%s", id);
+        snprintf(job->dir, sizeof(job->dir), "%s", dir);
+        job->spec = spec;
+        job->status = status;
+        json_t *progress = json_object_get(o, "progress");
+        job->frames_total = spec.frames * job_spec_runs(&spec);
+        atomic_store(&job->frames_done,
+                     (int)json_integer_value(json_object_get(progress, "frames_done")));
+        json_t *times = json_object_get(o, "times_unix");
+        job->created = json_number_value(json_array_get(times, 0));
+        job->started = json_number_value(json_array_get(times, 1));
+        job->finished = json_number_value(json_array_get(times, 2));
+        const char *error = json_string_value(json_object_get(o, "error"));
+        if (error)
+            snprintf(job->error, sizeof(job->error), "%s", error);
+        json_decref(o);
+
+        if (job->status == JOB_RUNNING) {
+            job->status = JOB_INTERRUPTED;
+            job->finished = clock_unix_s();
+            snprintf(job->error, sizeof(job->error),
+                     "interrupted: the daemon stopped (killed or crashed) while this job ran; "
+                     "its files may be incomplete, submit it again to measure it");
+            changed = true;
+        } else if (job->status == JOB_DONE) {
+            snprintf(path, sizeof(path), "%s/result.json", dir);
+            job->result = record_read(path, why, sizeof(why));
+            if (!job->result) {
+                bool present = access(path, F_OK) == 0;
+                char reason[800];
+                snprintf(reason, sizeof(reason), "result.json of a finished job: %s", why);
+                if (present)
+                    record_quarantine(&q->kind, id, path, reason, quarantined,
+                                      sizeof(quarantined));
+                else
+                    LOG(LOG_WARN, "job %s: %s", id, reason);
+                job->status = JOB_FAILED;
+                snprintf(job->error, sizeof(job->error), "result.json is missing or damaged: %s%s%s",
+                         why, quarantined[0] ? "; moved to " : "", quarantined);
+                changed = true;
+            }
+        }
+    }
+    record_note_id(&q->kind, id);
+    struct snapshot snap = {0};
     pthread_mutex_lock(&q->lock);
-    struct dirent *e;
-    while ((e = readdir(d)))
-        if (e->d_name[0] != '.' && load_job(q, e->d_name, techniques))
-            loaded++;
-    closedir(d);
-    qsort(q->jobs, q->count, sizeof(*q->jobs), by_id);
-    /* New ids continue after the loaded ones, so that ids keep sorting in
-     * submission order even within the second of a restart. */
-    for (size_t i = 0; i < q->count; i++) {
-        const char *dash = strrchr(q->jobs[i]->id, '-');
-        unsigned serial = dash ? (unsigned)strtoul(dash + 1, NULL, 10) : 0;
-        if (serial > q->serial)
-            q->serial = serial;
+    bool inserted = insert_locked(q, job);
+    if (inserted && job->status == JOB_QUEUED)
+        q->queued++;
+    if (inserted && changed)
+        snapshot_locked(job, &snap);
+    pthread_mutex_unlock(&q->lock);
+    if (!inserted) {
+        LOG(LOG_ERROR, "job %s: out of memory loading it", id);
+        job_free(job);
+        return;
     }
+    if (snap.job)
+        write_snapshot(q, &snap, NULL, 0);
+}
+
+int queue_load(struct queue *q, const struct technique_catalog *techniques, char *err, size_t errlen)
+{
+    q->techniques = techniques;
+    size_t before = q->count;
+    if (record_scan(&q->kind, load_job, q, err, errlen) < 0)
+        return -1;
+    pthread_mutex_lock(&q->lock);
+    int loaded = (int)(q->count - before);
     pthread_cond_broadcast(&q->changed);
     pthread_mutex_unlock(&q->lock);
     apply_retention(q);
@@ -435,82 +732,39 @@ void queue_set_retention(struct queue *q, int keep_jobs, double keep_days)
     pthread_mutex_unlock(&q->lock);
 }
 
-static int by_time(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* Removes a finished job's directory: the files in it, then the directory. */
-static void remove_job_dir(const char *dir)
-{
-    DIR *d = opendir(dir);
-    if (d) {
-        struct dirent *e;
-        char path[PATH_MAX + 300];
-        while ((e = readdir(d)))
-            if (e->d_name[0] != '.') {
-                snprintf(path, sizeof(path), "%s/%s", dir, e->d_name);
-                unlink(path);
-            }
-        closedir(d);
-    }
-    if (rmdir(dir) != 0)
-        LOG(LOG_WARN, "retention: cannot remove %s: %s", dir, strerror(errno));
-}
-
 static void apply_retention(struct queue *q)
 {
     pthread_mutex_lock(&q->lock);
-    if (!q->state_dir[0] || (q->keep_jobs <= 0 && q->keep_days <= 0)) {
+    if (!q->kind.state_dir[0] || (q->keep_jobs <= 0 && q->keep_days <= 0) || !q->count) {
         pthread_mutex_unlock(&q->lock);
         return;
     }
-    size_t finished_count = 0;
-    for (size_t i = 0; i < q->count; i++)
-        finished_count += finished(q->jobs[i]);
-    double cutoff = q->keep_days > 0 ? clock_unix_s() - q->keep_days * 86400.0 : -1.0;
-    struct job **victims = calloc(q->count ? q->count : 1, sizeof(*victims));
+    double *times = malloc(q->count * sizeof(double));
+    bool *victim = malloc(q->count * sizeof(bool));
+    struct job **victims = malloc(q->count * sizeof(*victims));
     size_t nv = 0, kept = 0;
-    if (!victims) {
-        pthread_mutex_unlock(&q->lock);
-        return;
-    }
-    /* Over the count limit: the jobs that finished earliest go first. The
-     * finish time of the newest one to go is the count cutoff. */
-    size_t excess = q->keep_jobs > 0 && finished_count > (size_t)q->keep_jobs
-                        ? finished_count - (size_t)q->keep_jobs
-                        : 0;
-    double count_cutoff = -1.0;
-    if (excess) {
-        double *times = malloc(finished_count * sizeof(double));
-        size_t nt = 0;
-        for (size_t i = 0; times && i < q->count; i++)
-            if (finished(q->jobs[i]))
-                times[nt++] = q->jobs[i]->finished;
-        if (times) {
-            qsort(times, nt, sizeof(double), by_time);
-            count_cutoff = times[excess - 1];
+    if (times && victim && victims) {
+        /* A job with a write in flight is not finished for retention yet. */
+        for (size_t i = 0; i < q->count; i++)
+            times[i] = finished(q->jobs[i]) && !q->jobs[i]->pending ? q->jobs[i]->finished : -1;
+        record_retention(times, q->count, q->keep_jobs, q->keep_days, clock_unix_s(), victim);
+        for (size_t i = 0; i < q->count; i++) {
+            if (victim[i])
+                victims[nv++] = q->jobs[i];
+            else
+                q->jobs[kept++] = q->jobs[i];
         }
-        free(times);
+        q->count = kept;
     }
-    for (size_t i = 0; i < q->count; i++) {
-        struct job *job = q->jobs[i];
-        bool old = finished(job) && ((job->finished <= count_cutoff && nv < excess) ||
-                                     (cutoff > 0 && job->finished < cutoff));
-        if (old)
-            victims[nv++] = job;
-        else
-            q->jobs[kept++] = job;
-    }
-    q->count = kept;
     pthread_mutex_unlock(&q->lock);
+    /* Files are removed with no lock held. */
     for (size_t i = 0; i < nv; i++) {
         LOG(LOG_INFO, "retention: removing job %s", victims[i]->id);
-        remove_job_dir(victims[i]->dir);
-        json_decref(victims[i]->result);
-        free(victims[i]);
+        record_remove_dir(victims[i]->dir);
+        job_free(victims[i]);
     }
+    free(times);
+    free(victim);
     free(victims);
 }
 

@@ -9,7 +9,8 @@
 
 enum param_type { PARAM_INT, PARAM_NUMBER, PARAM_BOOL, PARAM_CHOICE };
 
-/* Every job field a sweep may vary. */
+/* Every job field a sweep may vary, besides each technique's options
+ * ("<technique>.<option>", from the catalogue). */
 static const struct {
     const char *path;
     enum param_type type;
@@ -20,47 +21,79 @@ static const struct {
     {"scene.lights", PARAM_INT},        {"scene.dynamic", PARAM_BOOL},
     {"scene.width", PARAM_INT},         {"scene.height", PARAM_INT},
     {"scene.sphere_segments", PARAM_INT}, {"scene.light_speed", PARAM_NUMBER},
-    {"osl.resolution", PARAM_CHOICE},   {"osl.texel_density", PARAM_NUMBER},
-    {"osl.reshade", PARAM_CHOICE},
+    {"look.lighting", PARAM_CHOICE},    {"look.hdr", PARAM_CHOICE},
+    {"scene.preset", PARAM_CHOICE},     {"scene.light_layout", PARAM_CHOICE},
+    {"scene.light_radius", PARAM_NUMBER}, {"scene.light_intensity", PARAM_NUMBER},
+    {"scene.tessellation_error_px", PARAM_NUMBER}, {"scene.camera", PARAM_CHOICE},
+    {"scene.materials", PARAM_CHOICE},  {"scene.specular", PARAM_NUMBER},
+    {"scene.shininess", PARAM_NUMBER},  {"scene.metallic", PARAM_NUMBER},
+    {"scene.roughness", PARAM_NUMBER},
 };
 enum { NPARAMS = sizeof(PARAMS) / sizeof(PARAMS[0]) };
 
-
-static int param_index(const char *path)
+/* The type of a sweepable path; false when a sweep cannot vary it. */
+static bool param_type(const struct technique_catalog *techniques, const char *path,
+                       enum param_type *type)
 {
     for (int i = 0; i < (int)NPARAMS; i++)
-        if (strcmp(PARAMS[i].path, path) == 0)
-            return i;
-    return -1;
+        if (strcmp(PARAMS[i].path, path) == 0) {
+            *type = PARAMS[i].type;
+            return true;
+        }
+    const struct technique_option *opt = technique_catalog_option(techniques, path);
+    if (!opt)
+        return false;
+    *type = opt->type == TOPT_INT ? PARAM_INT : opt->type == TOPT_NUMBER ? PARAM_NUMBER
+                                              : PARAM_CHOICE;
+    return true;
 }
 
-static bool unknown_param(struct job_error *err, const char *field)
+static bool unknown_param(const struct technique_catalog *techniques, struct job_error *err,
+                          const char *field)
 {
-    char list[400] = "";
-    for (int i = 0; i < (int)NPARAMS; i++) {
-        size_t used = strlen(list);
-        snprintf(list + used, sizeof(list) - used, "%s%s", i ? ", " : "", PARAMS[i].path);
-    }
-    return job_error_set(err, field, "not a parameter a sweep can vary; one of: %s", list);
+    (void)techniques;
+    return job_error_set(err, field, "not a parameter a sweep can vary: scene, look and "
+                         "top-level job fields, or TECHNIQUE.OPTION; GET /v1/info lists "
+                         "them under \"sweepable\"");
 }
 
-/* A copy of job with the field at a dotted path set to value. */
+json_t *sweep_params_json(const struct technique_catalog *techniques)
+{
+    static const char *const types[] = {"integer", "number", "boolean", "choice"};
+    json_t *o = json_object();
+    for (int i = 0; i < (int)NPARAMS; i++)
+        json_object_set_new(o, PARAMS[i].path, json_string(types[PARAMS[i].type]));
+    for (int t = 0; t < techniques->count; t++) {
+        const struct technique_info *info = techniques->infos[t];
+        for (const struct technique_option *opt = info->options; opt && opt->name; opt++) {
+            char path[128];
+            enum param_type type;
+            snprintf(path, sizeof(path), "%s.%s", info->name, opt->name);
+            if (param_type(techniques, path, &type))
+                json_object_set_new(o, path, json_string(types[type]));
+        }
+    }
+    return o;
+}
+
+/* A copy of job with the field at a dotted path set to value, creating the
+ * objects between. */
 static json_t *with_field(const json_t *job, const char *path, json_t *value)
 {
-    json_t *copy = json_deep_copy(job);
-    const char *dot = strchr(path, '.');
-    if (!dot) {
-        json_object_set(copy, path, value);
-        return copy;
+    json_t *copy = json_deep_copy(job), *obj = copy;
+    const char *dot;
+    while ((dot = strchr(path, '.'))) {
+        char head[64];
+        snprintf(head, sizeof(head), "%.*s", (int)(dot - path), path);
+        json_t *inner = json_object_get(obj, head);
+        if (!json_is_object(inner)) {
+            inner = json_object();
+            json_object_set_new(obj, head, inner);
+        }
+        obj = inner;
+        path = dot + 1;
     }
-    char head[40];
-    snprintf(head, sizeof(head), "%.*s", (int)(dot - path), path);
-    json_t *inner = json_object_get(copy, head);
-    if (!json_is_object(inner)) {
-        inner = json_object();
-        json_object_set_new(copy, head, inner);
-    }
-    json_object_set(inner, dot + 1, value);
+    json_object_set(obj, path, value);
     return copy;
 }
 
@@ -81,7 +114,7 @@ static json_t *point_defaults(const struct sweep_spec *s, json_t *job)
     return job;
 }
 
-static bool check_point(const json_t *job, const char *const *techniques, const char *field,
+static bool check_point(const json_t *job, const struct technique_catalog *techniques, const char *field,
                         struct job_error *err)
 {
     struct job_spec spec;
@@ -146,6 +179,33 @@ static bool add_reference_points(struct sweep_spec *out, const json_t *body,
     return true;
 }
 
+/* Point p of a grid, exactly as it will be submitted; the error names the
+ * combination ("vary", point 3: frames=2, capture_interval=5) and the job
+ * field and rule it breaks. */
+static bool check_combination(const struct sweep_spec *s, size_t p, const struct technique_catalog *techniques,
+                              struct job_error *err)
+{
+    json_t *values, *job = sweep_point_job(s, p, &values);
+    struct job_spec spec;
+    struct job_error inner;
+    bool ok = job_spec_parse(job, techniques, &spec, &inner);
+    if (!ok) {
+        char combo[160] = "";
+        size_t used = 0;
+        for (int i = 0; i < s->nparams && used < sizeof(combo); i++) {
+            char *v = json_dumps(json_object_get(values, s->params[i]), JSON_ENCODE_ANY | JSON_COMPACT);
+            used += (size_t)snprintf(combo + used, sizeof(combo) - used, "%s%s=%.40s",
+                                     i ? ", " : "", s->params[i], v ? v : "?");
+            free(v);
+        }
+        job_error_set(err, "vary", "point %zu (%s) is not a valid job: %s: %s", p + 1, combo,
+                      inner.field, inner.message);
+    }
+    json_decref(values);
+    json_decref(job);
+    return ok;
+}
+
 static bool parse_criterion(const char *text, struct sweep_spec *s)
 {
     double x;
@@ -201,7 +261,7 @@ static json_t *thesis_sweep(const json_t *body, struct job_error *err)
                      "technique", "forward", "osl");
 }
 
-bool sweep_spec_parse(const json_t *body, const char *const *techniques, struct sweep_spec *out,
+bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techniques, struct sweep_spec *out,
                       struct job_error *err)
 {
     memset(out, 0, sizeof(*out));
@@ -244,9 +304,10 @@ bool sweep_spec_parse(const json_t *body, const char *const *techniques, struct 
         out->npoints = 1;
         json_object_foreach(vary, key, v) {
             char field[96];
-            snprintf(field, sizeof(field), "vary.%.40s", key);
-            if (param_index(key) < 0)
-                return unknown_param(err, field);
+            snprintf(field, sizeof(field), "vary.%.*s", (int)jf_utf8_prefix(key, 40), key);
+            enum param_type unused;
+            if (!param_type(techniques, key, &unused))
+                return unknown_param(techniques, err, field);
             if (!json_is_array(v) || json_array_size(v) == 0)
                 return job_error_set(err, field, "must be a non-empty list of values");
             snprintf(out->params[out->nparams], sizeof(out->params[0]), "%s", key);
@@ -257,7 +318,8 @@ bool sweep_spec_parse(const json_t *body, const char *const *techniques, struct 
             size_t i;
             json_t *value;
             json_array_foreach(v, i, value) {
-                snprintf(field, sizeof(field), "vary.%.40s[%zu]", key, i);
+                snprintf(field, sizeof(field), "vary.%.*s[%zu]", (int)jf_utf8_prefix(key, 40),
+                         key, i);
                 json_t *job = with_field(base, key, value);
                 bool ok = check_point(job, techniques, field, err);
                 json_decref(job);
@@ -265,7 +327,21 @@ bool sweep_spec_parse(const json_t *body, const char *const *techniques, struct 
                     return false;
             }
         }
-        return add_reference_points(out, body, err);
+        /* Each value may be fine alone and a combination still refused
+         * (frames 2 with capture_interval 5): every point is parsed as the
+         * job it will run, so that no sweep fails after earlier points ran;
+         * the timed reference points too. */
+        out->ngrid = out->npoints;
+        for (size_t p = 0; p < out->npoints; p++)
+            if (!check_combination(out, p, techniques, err))
+                return false;
+        size_t grid = out->npoints;
+        if (!add_reference_points(out, body, err))
+            return false;
+        for (size_t p = grid; p < out->npoints; p++)
+            if (!check_combination(out, p, techniques, err))
+                return false;
+        return true;
     }
 
     out->kind = SWEEP_FIND;
@@ -275,18 +351,20 @@ bool sweep_spec_parse(const json_t *body, const char *const *techniques, struct 
                                           strcmp(key, "to") && strcmp(key, "while") &&
                                           strcmp(key, "steps")) {
         char field[64];
-        snprintf(field, sizeof(field), "find.%.40s", key);
+        snprintf(field, sizeof(field), "find.%.*s", (int)jf_utf8_prefix(key, 40), key);
         return job_error_set(err, field, "unknown field (param, from, to, while, steps)");
     }
     const char *param = json_string_value(json_object_get(find, "param"));
-    int p = param ? param_index(param) : -1;
-    if (p < 0)
-        return param ? unknown_param(err, "find.param") : job_error_set(err, "find.param", "must name a parameter");
-    if (PARAMS[p].type != PARAM_INT && PARAMS[p].type != PARAM_NUMBER)
+    enum param_type type;
+    if (!param)
+        return job_error_set(err, "find.param", "must name a parameter");
+    if (!param_type(techniques, param, &type))
+        return unknown_param(techniques, err, "find.param");
+    if (type != PARAM_INT && type != PARAM_NUMBER)
         return job_error_set(err, "find.param", "%s is not numeric: find bisects a numeric parameter", param);
     snprintf(out->params[0], sizeof(out->params[0]), "%s", param);
     out->nparams = 1;
-    out->integer = PARAMS[p].type == PARAM_INT;
+    out->integer = type == PARAM_INT;
     json_t *from = json_object_get(find, "from"), *to = json_object_get(find, "to");
     if (!json_is_number(from))
         return job_error_set(err, "find.from", "must be a number");

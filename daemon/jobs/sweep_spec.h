@@ -22,7 +22,7 @@ struct sweep_spec {
     enum sweep_kind kind;
     json_t *base;           /* the base job, as given */
     int nparams;
-    char params[2][40];     /* dotted paths */
+    char params[2][64];     /* dotted paths */
     json_t *values[2];      /* arrays, for SWEEP_VARY */
     size_t npoints;         /* the grid, then the timed reference points */
     size_t ngrid;           /* SWEEP_VARY: points of the grid itself */
@@ -37,9 +37,13 @@ struct sweep_spec {
     bool thesis; /* {"preset": "thesis"}: the thesis's experiment */
 };
 
-bool sweep_spec_parse(const json_t *body, const char *const *techniques, struct sweep_spec *out,
+bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techniques, struct sweep_spec *out,
                       struct job_error *err);
 void sweep_spec_finish(struct sweep_spec *s);
+
+/* Every path a sweep may vary, with its kind ("integer", "number", "boolean",
+ * "choice"), for /v1/info. New reference. */
+json_t *sweep_params_json(const struct technique_catalog *techniques);
 
 /* The job of grid point index (row-major over the parameters); *values gets
  * {"path": value, ...}. Indices from ngrid on are the timed reference

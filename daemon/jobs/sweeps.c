@@ -29,7 +29,7 @@ struct sweep {
 
 struct sweeps {
     struct queue *queue;
-    const char *const *techniques;
+    const struct technique_catalog *techniques;
     pthread_t thread;
     pthread_mutex_t lock;
     pthread_cond_t changed;
@@ -270,7 +270,7 @@ static void *sweeps_main(void *arg)
     return NULL;
 }
 
-struct sweeps *sweeps_create(struct queue *q, const char *const *techniques)
+struct sweeps *sweeps_create(struct queue *q, const struct technique_catalog *techniques)
 {
     struct sweeps *s = calloc(1, sizeof(*s));
     if (!s)

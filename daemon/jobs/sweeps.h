@@ -15,7 +15,7 @@
 
 struct sweeps;
 
-struct sweeps *sweeps_create(struct queue *q, const char *const *techniques);
+struct sweeps *sweeps_create(struct queue *q, const struct technique_catalog *techniques);
 /* Cancels the running sweep and stops. Accepts NULL. */
 void sweeps_destroy(struct sweeps *s);
 

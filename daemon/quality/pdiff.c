@@ -89,12 +89,16 @@ static void xyz_to_ab(float x, float y, float z, float *a, float *b)
     *b = 200.0f * (f[1] - f[2]);
 }
 
+/* perceptualdiff's border rule (reflect about 0 on the left, about n - 0.5
+ * on the right), repeated until the index lands inside: one reflection is
+ * not enough when the image is narrower than the kernel (n < 3), and a
+ * 1-pixel image maps everything to its only pixel. */
 static int mirror(int v, int n)
 {
-    if (v < 0)
-        v = -v;
-    if (v >= n)
-        v = 2 * n - v - 1;
+    if (n <= 1)
+        return 0;
+    while (v < 0 || v >= n)
+        v = v < 0 ? -v : 2 * n - v - 1;
     return v;
 }
 

@@ -105,3 +105,28 @@ bool mesh_create_cube(struct mesh *out, float h)
     out->uv_per_unit = (1.0f / 3.0f) / (2.0f * h);
     return true;
 }
+
+bool mesh_create_plane(struct mesh *out, float h)
+{
+    /* Two triangles, counter-clockwise seen from above; u runs with x and v
+     * with z over one chart covering the tile. Lighting is per fragment (and
+     * per texel in OSL), so more vertices would add nothing. */
+    static const float corners[4][2] = {{-1, -1}, {-1, 1}, {1, 1}, {1, -1}};
+    static const uint32_t indices[6] = {0, 1, 2, 0, 2, 3};
+    if (!mesh_alloc(out, 4, 6))
+        return false;
+    for (int c = 0; c < 4; c++) {
+        struct mesh_vertex *vx = &out->vertices[c];
+        vx->pos[0] = h * corners[c][0];
+        vx->pos[2] = h * corners[c][1];
+        vx->normal[1] = 1.0f;
+        vx->uv[0] = (corners[c][0] + 1) * 0.5f;
+        vx->uv[1] = (corners[c][1] + 1) * 0.5f;
+        vx->chart[2] = 1.0f;
+        vx->chart[3] = 1.0f;
+    }
+    memcpy(out->indices, indices, sizeof(indices));
+    out->bound_radius = h * sqrtf(2.0f);
+    out->uv_per_unit = 1.0f / (2.0f * h);
+    return true;
+}

@@ -1,11 +1,13 @@
 #ifndef SHADEBENCH_MESH_H
 #define SHADEBENCH_MESH_H
 
-/* Procedural meshes with UV layouts for object-space shading. GL-free.
+/* Procedural meshes with UV layouts for object-space shading. GL-free; a
+ * mesh belongs to the thread that built it, and reading one is safe from
+ * any number of threads.
  * Every chart is an axis-aligned rectangle in UV space that the mesh's
  * triangles cover completely, so a texel whose centre lies inside a chart is
  * always written by the UV-space rasterization; samplers clamp to those
- * texel centres (see shaders/osl_draw.frag), which is what keeps bilinear
+ * texel centres (see shaders/osl/osl_draw.frag), which is what keeps bilinear
  * filtering from bleeding across chart edges at every tile size. */
 
 #include <stdbool.h>
@@ -30,6 +32,8 @@ struct mesh {
 
 bool mesh_create_sphere(struct mesh *out, float radius, int segments);
 bool mesh_create_cube(struct mesh *out, float half_extent);
+/* A square in the XZ plane facing +y, one chart over the whole tile. */
+bool mesh_create_plane(struct mesh *out, float half_extent);
 void mesh_finish(struct mesh *m);
 
 #endif

@@ -1,78 +1,35 @@
+/* Building a scene (preset, materials, bounds, camera rig, tessellation,
+ * meshes) and the queries every technique and the harness make of it. */
 #include "daemon/scene/scene.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "daemon/scene/scene_build.h"
+
 static const double PI = 3.14159265358979323846;
 
-/* Thesis layout (chapter 3.1.1): 16 columns, 8 rows, 4 layers; rows alternate
- * between spheres and cubes, giving 8x8x4 of each. */
-enum { GRID_COLS = 16, GRID_ROWS = 8, GRID_LAYERS = 4 };
-static const float GRID_SPACING_X = 2.5f, GRID_SPACING_Z = 3.0f,
-                   GRID_SPACING_Y = 2.5f;
-static const float SPHERE_RADIUS = 0.8f, CUBE_HALF = 0.65f;
+const char *const scene_mesh_names[] = {"sphere", "cube", "plane", NULL};
 
-static void mat4_mul(float out[16], const float a[16], const float b[16])
+double scene_hash01(uint32_t index, uint32_t salt)
 {
-    float r[16];
-    for (int c = 0; c < 4; c++)
-        for (int row = 0; row < 4; row++) {
-            float sum = 0.0f;
-            for (int k = 0; k < 4; k++)
-                sum += a[k * 4 + row] * b[c * 4 + k];
-            r[c * 4 + row] = sum;
-        }
-    memcpy(out, r, sizeof(r));
-}
-
-static void vec3_normalize(float v[3])
-{
-    float len = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    for (int i = 0; i < 3; i++)
-        v[i] /= len;
-}
-
-static void vec3_cross(float out[3], const float a[3], const float b[3])
-{
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static void look_at(float m[16], const float eye[3], const float target[3])
-{
-    float f[3] = {target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]};
-    float up[3] = {0, 1, 0}, s[3], u[3];
-    vec3_normalize(f);
-    vec3_cross(s, f, up);
-    vec3_normalize(s);
-    vec3_cross(u, s, f);
-    memset(m, 0, 16 * sizeof(float));
-    for (int i = 0; i < 3; i++) {
-        m[i * 4 + 0] = s[i];
-        m[i * 4 + 1] = u[i];
-        m[i * 4 + 2] = -f[i];
+    /* lowbias32 (Wellons) over the index mixed with a hashed salt: full
+     * avalanche, so neighbouring indices and streams are unrelated. */
+    uint32_t x = salt * 0x9e3779b9u;
+    x ^= x >> 16;
+    x = index ^ (x * 0x7feb352du);
+    for (int round = 0; round < 2; round++) {
+        x ^= x >> 16;
+        x *= 0x7feb352du;
+        x ^= x >> 15;
+        x *= 0x846ca68bu;
+        x ^= x >> 16;
     }
-    m[12] = -(s[0] * eye[0] + s[1] * eye[1] + s[2] * eye[2]);
-    m[13] = -(u[0] * eye[0] + u[1] * eye[1] + u[2] * eye[2]);
-    m[14] = f[0] * eye[0] + f[1] * eye[1] + f[2] * eye[2];
-    m[15] = 1.0f;
+    return x / 4294967296.0;
 }
 
-static void perspective(float m[16], float fovy_deg, float aspect, float n, float f)
-{
-    float t = 1.0f / tanf((float)(fovy_deg * PI / 360.0));
-    memset(m, 0, 16 * sizeof(float));
-    m[0] = t / aspect;
-    m[5] = t;
-    m[10] = (f + n) / (n - f);
-    m[11] = -1.0f;
-    m[14] = 2.0f * f * n / (n - f);
-}
-
-/* Van der Corput radical inverse: an even, deterministic spread of lights. */
-static double radical_inverse(unsigned i, unsigned base)
+double scene_radical_inverse(unsigned i, unsigned base)
 {
     double inv = 1.0 / base, f = inv, r = 0.0;
     for (; i; i /= base, f *= inv)
@@ -80,7 +37,7 @@ static double radical_inverse(unsigned i, unsigned base)
     return r;
 }
 
-static void hsv_to_rgb(double h, double s, double v, float out[3])
+void scene_hsv_to_rgb(double h, double s, double v, float out[3])
 {
     double c = v * s, hp = fmod(h, 1.0) * 6.0, x = c * (1 - fabs(fmod(hp, 2.0) - 1));
     double r = 0, g = 0, b = 0;
@@ -93,77 +50,90 @@ static void hsv_to_rgb(double h, double s, double v, float out[3])
     out[0] = (float)(r + v - c), out[1] = (float)(g + v - c), out[2] = (float)(b + v - c);
 }
 
-bool scene_create(struct scene *out, const struct scene_spec *spec)
+/* Object-space half extents of instance i's axis-aligned box. */
+static void instance_half_extent(const struct scene_instance *in, float out[3])
+{
+    switch (in->mesh) {
+    case SCENE_MESH_SPHERE:
+        out[0] = out[1] = out[2] = SCENE_SPHERE_RADIUS * in->scale;
+        return;
+    case SCENE_MESH_CUBE:
+        out[0] = out[1] = out[2] = SCENE_CUBE_HALF * in->scale;
+        return;
+    default:
+        out[0] = out[2] = SCENE_PLANE_HALF * in->scale;
+        out[1] = 0.0f;
+        return;
+    }
+}
+
+static void box_empty(struct scene_box *b)
+{
+    for (int k = 0; k < 3; k++) {
+        b->min[k] = INFINITY;
+        b->max[k] = -INFINITY;
+    }
+}
+
+static void compute_bounds(struct scene *s)
+{
+    box_empty(&s->bounds);
+    box_empty(&s->objects);
+    for (int i = 0; i < s->instance_count; i++) {
+        const struct scene_instance *in = &s->instances[i];
+        float half[3];
+        instance_half_extent(in, half);
+        for (int k = 0; k < 3; k++) {
+            s->bounds.min[k] = fminf(s->bounds.min[k], in->pos[k] - half[k]);
+            s->bounds.max[k] = fmaxf(s->bounds.max[k], in->pos[k] + half[k]);
+            if (in->mesh == SCENE_MESH_PLANE)
+                continue;
+            s->objects.min[k] = fminf(s->objects.min[k], in->pos[k] - half[k]);
+            s->objects.max[k] = fmaxf(s->objects.max[k], in->pos[k] + half[k]);
+        }
+    }
+    if (s->objects.min[0] > s->objects.max[0])
+        s->objects = s->bounds; /* a scene of ground only */
+}
+
+bool scene_init(struct scene *out, const struct scene_spec *spec)
 {
     memset(out, 0, sizeof(*out));
     out->spec = *spec;
-    if (!mesh_create_sphere(&out->meshes[SCENE_MESH_SPHERE], SPHERE_RADIUS,
-                            spec->sphere_segments) ||
-        !mesh_create_cube(&out->meshes[SCENE_MESH_CUBE], CUBE_HALF))
+    if (!scene_build_preset(out))
+        goto fail;
+    for (int i = 0; i < out->instance_count; i++) {
+        /* Each mesh is one instanced draw over a contiguous range. */
+        if (i && out->instances[i].mesh < out->instances[i - 1].mesh)
+            goto fail;
+        out->mesh_instance_count[out->instances[i].mesh]++;
+    }
+    scene_assign_materials(out);
+    compute_bounds(out);
+    scene_rig_derive(out);
+    scene_choose_segments(out);
+    if (!mesh_create_sphere(&out->meshes[SCENE_MESH_SPHERE], SCENE_SPHERE_RADIUS,
+                            out->sphere_segments) ||
+        !mesh_create_cube(&out->meshes[SCENE_MESH_CUBE], SCENE_CUBE_HALF) ||
+        !mesh_create_plane(&out->meshes[SCENE_MESH_PLANE], SCENE_PLANE_HALF))
         goto fail;
 
-    out->instance_count = GRID_COLS * GRID_ROWS * GRID_LAYERS;
-    out->instances = calloc((size_t)out->instance_count, sizeof(*out->instances));
-    out->light_count = spec->lights;
-    out->lights = calloc((size_t)(spec->lights ? spec->lights : 1), sizeof(*out->lights));
-    if (!out->instances || !out->lights)
-        goto fail;
-
-    /* Grouped by mesh (spheres first) so each mesh is one instanced draw. */
-    int next = 0;
-    for (int mesh = 0; mesh < SCENE_MESH_COUNT; mesh++) {
-        for (int layer = 0; layer < GRID_LAYERS; layer++)
-            for (int row = 0; row < GRID_ROWS; row++) {
-                if (row % 2 != mesh)
-                    continue;
-                for (int col = 0; col < GRID_COLS; col++) {
-                    struct scene_instance *in = &out->instances[next++];
-                    in->pos[0] = ((float)col - (GRID_COLS - 1) * 0.5f) * GRID_SPACING_X;
-                    in->pos[1] = (float)layer * GRID_SPACING_Y;
-                    in->pos[2] = -(float)row * GRID_SPACING_Z;
-                    in->scale = 1.0f;
-                    in->mesh = (enum scene_mesh)mesh;
-                    unsigned cell = (unsigned)((layer * GRID_ROWS + row) * GRID_COLS + col);
-                    hsv_to_rgb(radical_inverse(cell + 1, 2), 0.45, 0.85, in->albedo);
-                }
-            }
-        out->mesh_instance_count[mesh] = next - (mesh ? out->mesh_instance_count[0] : 0);
-    }
-
-    for (int i = 0; i < out->light_count; i++) {
-        struct scene_light *l = &out->lights[i];
-        unsigned k = (unsigned)i + 1;
-        l->centre[0] = (float)((radical_inverse(k, 2) - 0.5) * 40.0);
-        l->centre[1] = (float)(radical_inverse(k, 3) * 10.0 - 0.5);
-        l->centre[2] = (float)(1.5 - radical_inverse(k, 5) * 24.0);
-        l->orbit = 3.0f;
-        /* Radius 5 reaches about 100 objects a frame at async distance 20,
-         * close to the 90 the thesis reports (chapter 4.1). */
-        l->radius = 5.0f;
-        hsv_to_rgb(i * 0.618033988749895, 0.6, 1.6, l->color);
-        /* Whole frames per revolution keep positions exact for any frame
-         * index; light_speed divides the period (0 holds the lights still). */
-        int base_period = 180 + 40 * (i % 7);
-        l->period = spec->light_speed > 0
-                        ? (int)fmax(1.0, lround(base_period / spec->light_speed))
-                        : base_period;
-        l->phase = (i * 37) % base_period % l->period;
-    }
-
-    out->eye[0] = 0.0f, out->eye[1] = 28.0f, out->eye[2] = 22.0f;
-    out->target[0] = 0.0f, out->target[1] = 1.0f, out->target[2] = -10.0f;
-    out->fovy_deg = 55.0f;
-    out->near_z = 0.5f;
-    out->far_z = 200.0f;
-    look_at(out->view, out->eye, out->target);
-    perspective(out->proj, out->fovy_deg, (float)spec->width / (float)spec->height,
-                out->near_z, out->far_z);
-    mat4_mul(out->view_proj, out->proj, out->view);
+    struct scene_camera cam;
+    scene_camera_at(out, 0, &cam);
+    memcpy(out->eye, cam.eye, sizeof(out->eye));
+    memcpy(out->target, cam.target, sizeof(out->target));
+    out->fovy_deg = cam.fovy_deg;
+    out->near_z = cam.near_z;
+    out->far_z = cam.far_z;
+    memcpy(out->view, cam.view, sizeof(out->view));
+    memcpy(out->proj, cam.proj, sizeof(out->proj));
+    memcpy(out->view_proj, cam.view_proj, sizeof(out->view_proj));
     return true;
 fail:
     scene_finish(out);
     return false;
 }
+
 
 void scene_finish(struct scene *s)
 {
@@ -187,9 +157,15 @@ void scene_light_position(const struct scene *s, int light, int64_t frame,
     /* Integer frame arithmetic first, so the angle never loses precision
      * however long the run is. */
     double a = 2.0 * PI * (double)step / (double)l->period;
-    out[0] = l->centre[0] + l->orbit * (float)cos(a);
-    out[1] = l->centre[1] + l->orbit * (float)sin(a);
-    out[2] = l->centre[2];
+    if (s->light_orbit_plane == SCENE_ORBIT_XY) {
+        out[0] = l->centre[0] + l->orbit * (float)cos(a);
+        out[1] = l->centre[1] + l->orbit * (float)sin(a);
+        out[2] = l->centre[2];
+    } else {
+        out[0] = l->centre[0] + l->orbit * (float)cos(a);
+        out[1] = l->centre[1];
+        out[2] = l->centre[2] + l->orbit * (float)sin(a);
+    }
 }
 
 float scene_instance_bound(const struct scene *s, int i)
@@ -221,23 +197,165 @@ uint64_t scene_triangles(const struct scene *s)
     return total;
 }
 
-bool scene_all_in_view(const struct scene *s)
+bool scene_sphere_in_frustum(const float m[16], const float p[3], float r, bool fully)
 {
-    const float *m = s->view_proj;
-    for (int i = 0; i < s->instance_count; i++) {
-        const float *p = s->instances[i].pos;
-        float r = scene_instance_bound(s, i);
-        /* Gribb-Hartmann planes from the combined matrix. */
-        for (int plane = 0; plane < 6; plane++) {
-            int row = plane / 2;
-            float sign = plane % 2 ? -1.0f : 1.0f, eq[4];
-            for (int c = 0; c < 4; c++)
-                eq[c] = m[c * 4 + 3] + sign * m[c * 4 + row];
-            float len = sqrtf(eq[0] * eq[0] + eq[1] * eq[1] + eq[2] * eq[2]);
-            float dist = (eq[0] * p[0] + eq[1] * p[1] + eq[2] * p[2] + eq[3]) / len;
-            if (dist < r)
-                return false;
-        }
+    /* Gribb-Hartmann planes from the combined matrix. */
+    for (int plane = 0; plane < 6; plane++) {
+        int row = plane / 2;
+        float sign = plane % 2 ? -1.0f : 1.0f, eq[4];
+        for (int c = 0; c < 4; c++)
+            eq[c] = m[c * 4 + 3] + sign * m[c * 4 + row];
+        float len = sqrtf(eq[0] * eq[0] + eq[1] * eq[1] + eq[2] * eq[2]);
+        float dist = (eq[0] * p[0] + eq[1] * p[1] + eq[2] * p[2] + eq[3]) / len;
+        if (fully ? dist < r : dist < -r)
+            return false;
     }
     return true;
+}
+
+bool scene_all_in_view(const struct scene *s)
+{
+    for (int i = 0; i < s->instance_count; i++)
+        if (!scene_sphere_in_frustum(s->view_proj, s->instances[i].pos,
+                                     scene_instance_bound(s, i), true))
+            return false;
+    return true;
+}
+
+static bool point_in_clip(const float view_proj[16], const float p[3])
+{
+    float c[4];
+    scene_mat4_transform(view_proj, p, 1.0f, c);
+    return c[3] > 0 && fabsf(c[0]) <= c[3] && fabsf(c[1]) <= c[3] && fabsf(c[2]) <= c[3];
+}
+
+bool scene_instance_in_view(const struct scene *s, int i, const struct scene_camera *c)
+{
+    const struct scene_instance *in = &s->instances[i];
+    float half[3];
+    instance_half_extent(in, half);
+    for (int corner = 0; corner < 8; corner++) {
+        float p[3];
+        for (int k = 0; k < 3; k++)
+            p[k] = in->pos[k] + (corner >> k & 1 ? half[k] : -half[k]);
+        if (!point_in_clip(c->view_proj, p))
+            return false;
+    }
+    return true;
+}
+
+int scene_instances_in_view(const struct scene *s, const struct scene_camera *c)
+{
+    int n = 0;
+    for (int i = 0; i < s->instance_count; i++)
+        n += scene_instance_in_view(s, i, c);
+    return n;
+}
+
+static json_t *vec3_json(const float v[3])
+{
+    return json_pack("[f, f, f]", (double)v[0], (double)v[1], (double)v[2]);
+}
+
+static json_t *box_json(const struct scene_box *b)
+{
+    return json_pack("{s:o, s:o}", "min", vec3_json(b->min), "max", vec3_json(b->max));
+}
+
+static json_t *describe_lights(const struct scene *s)
+{
+    /* How many lights reach each object at frame 0 (a light's sphere meets
+     * the object's bounding sphere; the ground left out) and how many light
+     * centres are on screen: the overlap the light radius controls. */
+    struct scene_camera cam;
+    scene_camera_at(s, 0, &cam);
+    float *pos = malloc((size_t)(s->light_count ? s->light_count : 1) * 3 * sizeof(float));
+    if (!pos)
+        return NULL;
+    int on_screen = 0;
+    for (int l = 0; l < s->light_count; l++) {
+        scene_light_position(s, l, 0, &pos[l * 3]);
+        on_screen += point_in_clip(cam.view_proj, &pos[l * 3]);
+    }
+    double sum = 0;
+    int most = 0, objects = 0;
+    for (int i = 0; i < s->instance_count; i++) {
+        const struct scene_instance *in = &s->instances[i];
+        if (in->mesh == SCENE_MESH_PLANE)
+            continue;
+        float bound = scene_instance_bound(s, i);
+        int reach = 0;
+        for (int l = 0; l < s->light_count; l++) {
+            float d[3] = {pos[l * 3] - in->pos[0], pos[l * 3 + 1] - in->pos[1],
+                          pos[l * 3 + 2] - in->pos[2]};
+            float r = s->lights[l].radius + bound;
+            reach += d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < r * r;
+        }
+        sum += reach;
+        most = reach > most ? reach : most;
+        objects++;
+    }
+    free(pos);
+    return json_pack("{s:i, s:s, s:f, s:f, s:o, s:s, s:f, s:f, s:{s:f, s:i}}", "count",
+                     s->light_count, "layout", scene_layout_names[s->spec.light_layout],
+                     "radius", s->spec.light_radius, "intensity", s->spec.light_intensity,
+                     "volume", box_json(&s->light_volume), "orbit_plane",
+                     s->light_orbit_plane == SCENE_ORBIT_XY ? "xy" : "xz", "orbit",
+                     s->light_count ? (double)s->lights[0].orbit : 0.0,
+                     "on_screen_at_frame_0",
+                     s->light_count ? (double)on_screen / s->light_count : 0.0,
+                     "per_object_at_frame_0", "mean", objects ? sum / objects : 0.0, "max",
+                     most);
+}
+
+static json_t *describe_camera(const struct scene *s)
+{
+    const struct scene_rig *r = &s->rig;
+    struct scene_camera cam;
+    scene_camera_at(s, 0, &cam);
+    json_t *o = json_pack("{s:s, s:i, s:b, s:f, s:f, s:f, s:o, s:o}", "path",
+                          scene_camera_names[s->spec.camera], "period", s->spec.camera_period,
+                          "moves", scene_camera_moves(s), "fovy_deg", (double)cam.fovy_deg,
+                          "near", (double)cam.near_z, "far", (double)cam.far_z,
+                          "eye_at_frame_0", vec3_json(cam.eye), "target_at_frame_0",
+                          vec3_json(cam.target));
+    if (s->spec.camera == SCENE_CAMERA_ORBIT)
+        json_object_update_new(o, json_pack("{s:o, s:f, s:f}", "centre", vec3_json(r->centre),
+                                            "distance", (double)r->orbit_distance,
+                                            "elevation_deg",
+                                            r->orbit_elevation * 180.0 / PI));
+    else if (s->spec.camera == SCENE_CAMERA_FLYTHROUGH)
+        json_object_update_new(o, json_pack("{s:[f, f], s:[f, f], s:f}", "radius_xz",
+                                            (double)r->fly_radius[0], (double)r->fly_radius[1],
+                                            "height", (double)r->fly_height[0],
+                                            (double)r->fly_height[1], "look_at_height",
+                                            (double)r->fly_look_y));
+    return o;
+}
+
+json_t *scene_describe(const struct scene *s)
+{
+    json_t *by_mesh = json_object();
+    for (int m = 0; m < SCENE_MESH_COUNT; m++)
+        json_object_set_new(by_mesh, scene_mesh_names[m], json_integer(s->mesh_instance_count[m]));
+    json_t *lights = describe_lights(s);
+    if (!lights) {
+        json_decref(by_mesh);
+        return NULL;
+    }
+    bool automatic = s->spec.sphere_segments == SCENE_SEGMENTS_AUTO;
+    json_t *segments = json_pack("{s:s, s:i, s:i, s:f, s:f}", "mode",
+                                 automatic ? "auto" : "fixed", "segments", s->sphere_segments,
+                                 "triangles_per_sphere",
+                                 (int)(s->meshes[SCENE_MESH_SPHERE].index_count / 3),
+                                 "largest_radius_px", (double)s->sphere_radius_px,
+                                 "silhouette_error_px", (double)s->sphere_error_px);
+    if (automatic)
+        json_object_set_new(segments, "error_bound_px", json_real(s->spec.tessellation_error_px));
+    return json_pack("{s:s, s:i, s:o, s:I, s:o, s:o, s:s, s:o, s:o}", "preset",
+                     scene_preset_names[s->spec.preset], "instances", s->instance_count,
+                     "instances_by_mesh", by_mesh, "triangles_per_frame",
+                     (json_int_t)scene_triangles(s), "sphere_tessellation", segments, "lights",
+                     lights, "materials", scene_materials_names[s->spec.materials], "camera",
+                     describe_camera(s), "bounds", box_json(&s->bounds));
 }

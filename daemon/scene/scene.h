@@ -1,31 +1,72 @@
 #ifndef SHADEBENCH_SCENE_H
 #define SHADEBENCH_SCENE_H
 
-/* The procedural scene (GL-free): instances, lights and camera as pure
- * functions of the scene spec and the frame index. Never wall-clock time. */
+/* The procedural scene (GL-free): instances, materials, lights and camera
+ * as pure functions of the scene spec and the frame index, never of the
+ * clock. A built scene is read-only: any number of threads may query it at
+ * once; scene_init and scene_finish need the scene to themselves. */
 
+#include <jansson.h>
 #include <stdbool.h>
 #include <stdint.h>
 
 #include "daemon/scene/scene_spec.h"
 #include "daemon/scene/mesh.h"
 
-enum scene_mesh { SCENE_MESH_SPHERE, SCENE_MESH_CUBE, SCENE_MESH_COUNT };
+/* Instances are grouped by mesh in this order, one instanced draw each. */
+enum scene_mesh { SCENE_MESH_SPHERE, SCENE_MESH_CUBE, SCENE_MESH_PLANE, SCENE_MESH_COUNT };
+extern const char *const scene_mesh_names[]; /* "sphere", "cube", "plane" */
+
+/* Per-instance material, uploaded beside the albedo (shaders/common/
+ * scene_data.glsl: instance_material()). metallic and roughness are carried
+ * for the lighting models to come; Phong reads specular and shininess. */
+struct scene_material {
+    float specular, shininess, metallic, roughness;
+};
 
 struct scene_instance {
     float pos[3];
-    float scale;
+    float scale; /* uniform: object-space normals stay world-space normals */
     float albedo[3];
     enum scene_mesh mesh;
+    struct scene_material material;
 };
+
+/* The plane a dynamic light circles in around its centre. */
+enum scene_orbit_plane { SCENE_ORBIT_XY, SCENE_ORBIT_XZ };
 
 struct scene_light {
     float centre[3];
-    float orbit;  /* circle radius in the XY plane around centre */
+    float orbit;  /* circle radius around centre, in the scene's orbit plane */
     float radius; /* influence ends here: attenuation is exactly 0 beyond */
     float color[3];
     int period;   /* frames per revolution */
     int phase;    /* frames */
+};
+
+struct scene_box {
+    float min[3], max[3];
+};
+
+/* One frame's camera. Matrices are column-major with GL conventions (a
+ * right-handed view looking down -z, clip z in [-w, w]). */
+struct scene_camera {
+    float eye[3], target[3], up[3], fovy_deg, near_z, far_z;
+    float view[16], proj[16], view_proj[16], inv_view[16], inv_proj[16];
+};
+
+/* What the camera paths are derived from (scene_init fills it). */
+struct scene_rig {
+    float eye[3], target[3];   /* the static pose: the preset's own */
+    float fovy_deg, near_z, far_z;
+    float centre[3];           /* orbit: circles this, the bounds' centre... */
+    float orbit_distance;      /* ...at a distance that keeps the bounds in view, */
+    float orbit_elevation;     /* the static pose's elevation (radians), */
+    float orbit_azimuth;       /* starting from its azimuth (radians) */
+    float orbit_far;           /* far plane that reaches past the bounds */
+    float fly_radius[2];       /* flythrough: ellipse semi-axes in x and z, */
+    float fly_height[2];       /* eye height band above the objects, */
+    float fly_look_y;          /* and the height it looks down to */
 };
 
 struct scene {
@@ -33,31 +74,80 @@ struct scene {
     struct mesh meshes[SCENE_MESH_COUNT];
     struct scene_instance *instances;
     int instance_count;
-    int mesh_instance_count[SCENE_MESH_COUNT]; /* instances are grouped by mesh */
+    int mesh_instance_count[SCENE_MESH_COUNT];
     struct scene_light *lights;
     int light_count;
+    enum scene_orbit_plane light_orbit_plane;
+    struct scene_box bounds;       /* every instance's bounding sphere */
+    struct scene_box objects;      /* the same without the ground plane */
+    struct scene_box light_volume; /* where the layout puts light centres */
+    struct scene_rig rig;
+    int sphere_segments;           /* in use: the spec's, or the one "auto" chose */
+    float sphere_radius_px;        /* largest sphere radius on screen over the camera path */
+    float sphere_error_px;         /* the chosen tessellation's silhouette error there */
+    /* The frame-0 camera, flat, for the code that reads one fixed camera. */
     float eye[3], target[3], fovy_deg, near_z, far_z;
     float view[16], proj[16], view_proj[16]; /* column-major */
 };
 
-bool scene_create(struct scene *out, const struct scene_spec *spec);
+/* Builds the scene of spec into caller-owned memory. On failure (out of
+ * memory) the scene is left finished. */
+bool scene_init(struct scene *out, const struct scene_spec *spec);
+/* Frees what scene_init allocated; takes a zeroed or finished scene. */
 void scene_finish(struct scene *s);
 
 /* World-space light position at frame (any integer, negatives included). */
 void scene_light_position(const struct scene *s, int light, int64_t frame,
                           float out[3]);
 
+/* The camera at frame (any integer): a pure function of the frame index,
+ * periodic with spec.camera_period for moving paths. */
+void scene_camera_at(const struct scene *s, int64_t frame, struct scene_camera *out);
+/* True when the camera path moves (every frame needs its own camera). */
+bool scene_camera_moves(const struct scene *s);
+
 /* Bounding sphere of instance i in world space. */
 float scene_instance_bound(const struct scene *s, int i);
+/* Distance from the frame-0 eye to instance i's centre. */
 float scene_instance_distance(const struct scene *s, int i);
 
-/* Diameter in pixels of instance i's bounding sphere on screen. */
+/* Diameter in pixels of instance i's bounding sphere on screen (frame 0). */
 float scene_projected_diameter(const struct scene *s, int i);
+
+/* True when the sphere (centre, radius) lies at least partly inside the
+ * frustum of view_proj (inside: fully == false), or entirely inside it. */
+bool scene_sphere_in_frustum(const float view_proj[16], const float centre[3], float radius,
+                             bool fully);
+
+/* Semi-major axis in pixels of the sphere's projected silhouette (an
+ * ellipse) for camera c on a width x height image, exact for a perspective
+ * projection; capped at the image diagonal, which a sphere reaching behind
+ * the eye counts as. */
+float scene_sphere_radius_px(const struct scene_camera *c, int width, int height,
+                             const float centre[3], float radius);
+
+/* Silhouette error of a sphere tessellated with segments (lat-long, rings
+ * = segments / 2), as a fraction of its radius: see tessellation.c. */
+double scene_sphere_error(int segments);
+/* The coarsest even tessellation from 8 to 256 whose silhouette error at
+ * radius_px stays within bound_px (256 when none does). */
+int scene_auto_segments(double radius_px, double bound_px);
 
 /* Triangles submitted per drawn frame. */
 uint64_t scene_triangles(const struct scene *s);
 
-/* True when every instance's bounding sphere lies inside the view frustum. */
+/* True when instance i's axis-aligned box lies entirely inside camera c's
+ * frustum; scene_instances_in_view counts such instances. */
+bool scene_instance_in_view(const struct scene *s, int i, const struct scene_camera *c);
+int scene_instances_in_view(const struct scene *s, const struct scene_camera *c);
+/* True when every instance's bounding sphere lies inside the frame-0 frustum. */
 bool scene_all_in_view(const struct scene *s);
+
+/* The scene as built, for the job's result: instances (by mesh), lights
+ * (count, layout, radius, volume, how many reach each object, how many are
+ * on screen), triangles per frame, the sphere tessellation ("auto": its
+ * choice, radius and error), the camera path and the bounds. New reference,
+ * or NULL when out of memory. Costs instances x lights distance tests. */
+json_t *scene_describe(const struct scene *s);
 
 #endif

@@ -4,46 +4,171 @@
 #include <stdio.h>
 #include <string.h>
 
+const char *const scene_preset_names[] = {"grid", "lights", NULL};
+const char *const scene_layout_names[] = {"halton", "uniform", "grid", "clustered", NULL};
+const char *const scene_materials_names[] = {"uniform", "varied", NULL};
+const char *const scene_camera_names[] = {"static", "orbit", "flythrough", NULL};
+
+/* What each preset chooses for itself. grid's values are the thesis's
+ * (10 lights of radius 5 in a Halton spread, every object Phong with the
+ * same constants); lights' give about five lights over each point of the
+ * ground at 256 lights (see scene_describe's lights_per_object). */
+static const struct {
+    int lights;
+    enum scene_light_layout layout;
+    double light_radius;
+    enum scene_materials materials;
+} PRESETS[] = {
+    [SCENE_PRESET_GRID] = {10, SCENE_LAYOUT_HALTON, 5.0, SCENE_MATERIALS_UNIFORM},
+    [SCENE_PRESET_LIGHTS] = {256, SCENE_LAYOUT_UNIFORM, 4.0, SCENE_MATERIALS_VARIED},
+};
+
+void scene_spec_preset_defaults(struct scene_spec *s, enum scene_preset preset)
+{
+    s->preset = preset;
+    s->lights = PRESETS[preset].lights;
+    s->light_layout = PRESETS[preset].layout;
+    s->light_radius = PRESETS[preset].light_radius;
+    s->materials = PRESETS[preset].materials;
+}
+
 void scene_spec_defaults(struct scene_spec *s)
 {
     memset(s, 0, sizeof(*s));
-    snprintf(s->preset, sizeof(s->preset), "grid");
-    s->lights = 10;
+    scene_spec_preset_defaults(s, SCENE_PRESET_GRID);
     s->dynamic = false;
     s->width = 1080;
     s->height = 720;
     s->sphere_segments = 32;
+    s->tessellation_error_px = 0.5;
     s->light_speed = 1.0;
+    s->light_intensity = 1.0;
+    /* The constants of the thesis's Phong (shaders/common/lighting.glsl);
+     * roughness 0.25 is about the Beckmann roughness of Phong exponent 32,
+     * sqrt(2 / (32 + 2)), for the lighting models to come. */
+    s->specular = 0.5;
+    s->shininess = 32.0;
+    s->metallic = 0.0;
+    s->roughness = 0.25;
+    s->camera = SCENE_CAMERA_STATIC;
+    s->camera_period = 360;
+}
+
+static bool parse_segments(const json_t *scene, struct scene_spec *s, struct job_error *err)
+{
+    static const char rule[] = "must be \"auto\" or an even integer from 8 to 256";
+    json_t *v = json_object_get(scene, "sphere_segments");
+    if (!v)
+        return true;
+    if (json_is_string(v)) {
+        if (strcmp(json_string_value(v), "auto") != 0)
+            return job_error_set(err, "scene.sphere_segments", rule);
+        s->sphere_segments = SCENE_SEGMENTS_AUTO;
+        return true;
+    }
+    int segments = s->sphere_segments;
+    if (!jf_get_int(scene, "sphere_segments", "scene.sphere_segments", 8, 256, &segments, err))
+        return job_error_set(err, "scene.sphere_segments", rule);
+    if (segments % 2)
+        return job_error_set(err, "scene.sphere_segments", rule);
+    s->sphere_segments = segments;
+    return true;
+}
+
+/* "camera": "orbit" or {"path": "orbit", "period": 240}. */
+static bool parse_camera(const json_t *scene, struct scene_spec *s, struct job_error *err)
+{
+    static const char *const keys[] = {"path", "period", NULL};
+    json_t *v = json_object_get(scene, "camera");
+    int path = (int)s->camera;
+    if (!v)
+        return true;
+    if (json_is_object(v)) {
+        if (!jf_check_keys(v, "scene.camera.", keys, err) ||
+            !jf_get_choice(v, "path", "scene.camera.path", scene_camera_names, &path, err) ||
+            !jf_get_int(v, "period", "scene.camera.period", 1, SCENE_MAX_CAMERA_PERIOD,
+                        &s->camera_period, err))
+            return false;
+    } else if (json_is_string(v)) {
+        if (!jf_get_choice(scene, "camera", "scene.camera", scene_camera_names, &path, err))
+            return false;
+    } else {
+        char list[128];
+        jf_list_choices(scene_camera_names, list, sizeof(list));
+        return job_error_set(err, "scene.camera",
+                             "must be one of %s, or {\"path\": ..., \"period\": frames}", list);
+    }
+    s->camera = (enum scene_camera_path)path;
+    return true;
 }
 
 bool scene_spec_parse(const json_t *scene, struct scene_spec *s, struct job_error *err)
 {
-    static const char *const keys[] = {"preset", "lights", "dynamic", "width",
-                                       "height", "sphere_segments", "light_speed", NULL};
+    static const char *const keys[] = {
+        "preset", "lights", "dynamic", "width", "height", "sphere_segments",
+        "tessellation_error_px", "light_speed", "light_radius", "light_intensity",
+        "light_layout", "materials", "specular", "shininess", "metallic", "roughness",
+        "camera", NULL};
     if (!jf_check_keys(scene, "scene.", keys, err))
         return false;
-    json_t *preset = json_object_get(scene, "preset");
-    if (preset) {
-        if (!json_is_string(preset) || strcmp(json_string_value(preset), "grid") != 0)
-            return job_error_set(err, "scene.preset", "must be one of: \"grid\"");
-        snprintf(s->preset, sizeof(s->preset), "%s", json_string_value(preset));
-    }
-    if (!jf_get_int(scene, "lights", "scene.lights", 0, 1024, &s->lights, err) ||
+    int preset = (int)s->preset, layout, materials;
+    if (!jf_get_choice(scene, "preset", "scene.preset", scene_preset_names, &preset, err))
+        return false;
+    if (json_object_get(scene, "preset"))
+        scene_spec_preset_defaults(s, (enum scene_preset)preset);
+    layout = (int)s->light_layout;
+    materials = (int)s->materials;
+    if (!jf_get_int(scene, "lights", "scene.lights", 0, SCENE_MAX_LIGHTS, &s->lights, err) ||
         !jf_get_bool(scene, "dynamic", "scene.dynamic", &s->dynamic, err) ||
         !jf_get_int(scene, "width", "scene.width", 16, 8192, &s->width, err) ||
         !jf_get_int(scene, "height", "scene.height", 16, 8192, &s->height, err) ||
-        !jf_get_int(scene, "sphere_segments", "scene.sphere_segments", 8, 256,
-                 &s->sphere_segments, err) ||
-        !jf_get_number(scene, "light_speed", "scene.light_speed", 0.0, 100.0, &s->light_speed, err))
+        !parse_segments(scene, s, err) ||
+        !jf_get_number(scene, "tessellation_error_px", "scene.tessellation_error_px", 0.01,
+                       100.0, &s->tessellation_error_px, err) ||
+        !jf_get_number(scene, "light_speed", "scene.light_speed", 0.0, 100.0, &s->light_speed,
+                       err) ||
+        !jf_get_number(scene, "light_radius", "scene.light_radius", 0.01, 1000.0,
+                       &s->light_radius, err) ||
+        !jf_get_number(scene, "light_intensity", "scene.light_intensity", 0.0, 1000.0,
+                       &s->light_intensity, err) ||
+        !jf_get_choice(scene, "light_layout", "scene.light_layout", scene_layout_names, &layout,
+                       err) ||
+        !jf_get_choice(scene, "materials", "scene.materials", scene_materials_names,
+                       &materials, err) ||
+        !jf_get_number(scene, "specular", "scene.specular", 0.0, 16.0, &s->specular, err) ||
+        !jf_get_number(scene, "shininess", "scene.shininess", 1.0, 4096.0, &s->shininess, err) ||
+        !jf_get_number(scene, "metallic", "scene.metallic", 0.0, 1.0, &s->metallic, err) ||
+        !jf_get_number(scene, "roughness", "scene.roughness", 0.0, 1.0, &s->roughness, err) ||
+        !parse_camera(scene, s, err))
         return false;
-    if (s->sphere_segments % 2)
-        return job_error_set(err, "scene.sphere_segments", "must be an even integer from 8 to 256");
+    s->light_layout = (enum scene_light_layout)layout;
+    s->materials = (enum scene_materials)materials;
     return true;
 }
 
 json_t *scene_spec_to_json(const struct scene_spec *s)
 {
-    return json_pack("{s:s, s:i, s:b, s:i, s:i, s:i, s:f}", "preset", s->preset, "lights",
-                     s->lights, "dynamic", s->dynamic, "width", s->width, "height", s->height,
-                     "sphere_segments", s->sphere_segments, "light_speed", s->light_speed);
+    json_t *o = json_object();
+    json_object_set_new(o, "preset", json_string(scene_preset_names[s->preset]));
+    json_object_set_new(o, "lights", json_integer(s->lights));
+    json_object_set_new(o, "dynamic", json_boolean(s->dynamic));
+    json_object_set_new(o, "width", json_integer(s->width));
+    json_object_set_new(o, "height", json_integer(s->height));
+    json_object_set_new(o, "sphere_segments", s->sphere_segments == SCENE_SEGMENTS_AUTO
+                                                  ? json_string("auto")
+                                                  : json_integer(s->sphere_segments));
+    json_object_set_new(o, "tessellation_error_px", json_real(s->tessellation_error_px));
+    json_object_set_new(o, "light_speed", json_real(s->light_speed));
+    json_object_set_new(o, "light_radius", json_real(s->light_radius));
+    json_object_set_new(o, "light_intensity", json_real(s->light_intensity));
+    json_object_set_new(o, "light_layout", json_string(scene_layout_names[s->light_layout]));
+    json_object_set_new(o, "materials", json_string(scene_materials_names[s->materials]));
+    json_object_set_new(o, "specular", json_real(s->specular));
+    json_object_set_new(o, "shininess", json_real(s->shininess));
+    json_object_set_new(o, "metallic", json_real(s->metallic));
+    json_object_set_new(o, "roughness", json_real(s->roughness));
+    json_object_set_new(o, "camera", json_pack("{s:s, s:i}", "path",
+                                               scene_camera_names[s->camera], "period",
+                                               s->camera_period));
+    return o;
 }

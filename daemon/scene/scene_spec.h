@@ -2,28 +2,70 @@
 #define SHADEBENCH_SCENE_SPEC_H
 
 /* The job's "scene" object: presets and their options, defaults, parsing
- * with field-naming errors, and the JSON written back. GL-free; any thread. */
+ * with field-naming errors, and the JSON written back. GL-free; any thread
+ * (the name tables are constant). */
 
 #include <jansson.h>
 #include <stdbool.h>
 
 #include "common/json_fields.h"
 
+enum scene_preset { SCENE_PRESET_GRID, SCENE_PRESET_LIGHTS };
+enum scene_light_layout {
+    SCENE_LAYOUT_HALTON,    /* the thesis's low-discrepancy spread (Halton 2, 3, 5) */
+    SCENE_LAYOUT_UNIFORM,   /* independent hashed positions, uniform in the volume */
+    SCENE_LAYOUT_GRID,      /* a regular lattice filling the volume */
+    SCENE_LAYOUT_CLUSTERED, /* tight groups: hot spots where many lights overlap */
+};
+enum scene_materials {
+    SCENE_MATERIALS_UNIFORM, /* every object gets scene.specular, .shininess, ... */
+    SCENE_MATERIALS_VARIED,  /* a deterministic per-object spread around them */
+};
+enum scene_camera_path { SCENE_CAMERA_STATIC, SCENE_CAMERA_ORBIT, SCENE_CAMERA_FLYTHROUGH };
+
+/* NULL-terminated, indexed by the enums above; the JSON spelling. */
+extern const char *const scene_preset_names[];
+extern const char *const scene_layout_names[];
+extern const char *const scene_materials_names[];
+extern const char *const scene_camera_names[];
+
+enum {
+    SCENE_MAX_LIGHTS = 65536,
+    SCENE_SEGMENTS_AUTO = 0, /* sphere_segments "auto" */
+    SCENE_MAX_CAMERA_PERIOD = 1000000,
+};
+
 struct scene_spec {
-    char preset[16];
+    enum scene_preset preset;
     int lights;
     bool dynamic;
     int width, height;
-    int sphere_segments; /* longitudinal segments; rings = segments / 2 */
-    double light_speed;  /* scales how fast dynamic lights circle (1 = default) */
+    int sphere_segments;          /* even 8..256 (rings = segments / 2), or SCENE_SEGMENTS_AUTO */
+    double tessellation_error_px; /* silhouette error "auto" keeps under, in pixels */
+    double light_speed;           /* scales how fast dynamic lights circle (1 = default) */
+    double light_radius;          /* influence radius of every light */
+    double light_intensity;       /* scales every light's colour */
+    enum scene_light_layout light_layout;
+    enum scene_materials materials;
+    double specular, shininess, metallic, roughness;
+    enum scene_camera_path camera;
+    int camera_period; /* frames per loop of a moving camera */
 };
 
+/* The grid preset with every option at its default. */
 void scene_spec_defaults(struct scene_spec *s);
 
-/* Applies the "scene" object over the current values (defaults first). */
+/* Sets the options a preset chooses (lights, light_layout, light_radius,
+ * materials) to that preset's defaults; the rest are left alone. */
+void scene_spec_preset_defaults(struct scene_spec *s, enum scene_preset preset);
+
+/* Applies the "scene" object over the current values (defaults first). A
+ * "preset" key is applied first, with its defaults, so that the other keys
+ * override them whatever their order. */
 bool scene_spec_parse(const json_t *scene, struct scene_spec *s, struct job_error *err);
 
-/* The scene as understood, defaults filled in. New reference. */
+/* The scene as understood, every option filled in; parsing it gives the
+ * same spec back. New reference. */
 json_t *scene_spec_to_json(const struct scene_spec *s);
 
 #endif

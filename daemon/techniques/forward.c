@@ -1,20 +1,24 @@
-/* Forward shading, the thesis's ForwardProg: one pass, every light for every fragment. */
+/* Forward shading, the thesis's ForwardProg: one pass, every light for every
+ * fragment. The reference every other technique is scored against. */
 #include "daemon/techniques/technique.h"
 
-static const char *const sections[] = {"frame", NULL};
+static const char *const passes[] = {"shading", NULL};
 
-static bool forward_create(const struct technique_ctx *ctx, void **state,
-                           char *err, size_t errlen)
+static const struct technique_info forward_info = {
+    .name = "forward",
+    .summary = "one pass; every light evaluated per fragment (thesis ForwardProg)",
+    .passes = passes,
+};
+
+static bool forward_create(const struct technique_env *env, void **state, char *err,
+                           size_t errlen)
 {
-    return single_pass_create(ctx, "forward", "forward.frag", state, err, errlen);
+    return single_pass_create(env, "forward", "forward.frag", state, err, errlen);
 }
 
 const struct technique technique_forward = {
-    .name = "forward",
-    .summary = "one pass; every light evaluated per fragment (thesis ForwardProg)",
-    .sections = sections,
+    .info = &forward_info,
     .create = forward_create,
     .render = single_pass_render,
-    .describe = NULL,
     .destroy = single_pass_destroy,
 };

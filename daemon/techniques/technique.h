@@ -1,55 +1,96 @@
 #ifndef SHADEBENCH_TECHNIQUE_H
 #define SHADEBENCH_TECHNIQUE_H
 
-/* The interface every shading technique implements. The job runner owns
- * warm-up, timing, capture and statistics; a technique only draws. */
+/* The contract between the harness and a shading technique (GL side). The
+ * harness owns warm-up, timing, capture, the resolve to 8 bits and the
+ * statistics; a technique draws each frame into the HDR output it is handed,
+ * in the passes its info declares. Every hook runs on the render thread. */
 
+#include <epoxy/gl.h>
 #include <jansson.h>
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
+#include "daemon/gpu/caps.h"
 #include "daemon/gpu/gpu_scene.h"
-#include "daemon/gpu/gpu_timer.h"
+#include "daemon/gpu/pass.h"
+#include "daemon/gpu/targets.h"
 #include "daemon/jobs/job_spec.h"
 #include "daemon/scene/scene.h"
+#include "daemon/techniques/catalog.h"
+#include "daemon/techniques/technique_info.h"
 
-struct technique_ctx {
+/* What a technique may publish for the harness after create (0 = none):
+ * post effects read normals from a g-buffer when there is one (SSAO), else
+ * rebuild them from the depth texture; a light-culling technique publishes
+ * how many lights it evaluated per pixel, which the harness captures as a
+ * heat map beside the colour captures. */
+enum technique_normal_encoding {
+    TECHNIQUE_NORMAL_FLOAT3,     /* rgb = world-space unit normal */
+    TECHNIQUE_NORMAL_OCTAHEDRAL, /* rg = octahedral world-space normal in [-1, 1] */
+};
+
+struct technique_products {
+    GLuint normal_tex;
+    int normal_encoding; /* enum technique_normal_encoding */
+    GLuint heat_tex;     /* GL_R32UI, width x height: light evaluations this frame */
+};
+
+/* What the harness hands a technique; valid from create to destroy. */
+struct technique_env {
     const struct job_spec *spec;
+    const void *options; /* the technique's own options struct (its info's layout) */
     const struct scene *scene;
     struct gpu_scene *gpu;
-    struct gpu_timer *timer; /* switch sections with gpu_timer_section() */
+    const struct gpu_caps *caps;
+    struct gpu_targets *targets;    /* ask for extra planes by name */
+    const struct gpu_passes *passes; /* index i is info->passes[i] */
+    /* The output: HDR colour (spec->look.hdr format) and a depth texture that
+     * later passes may sample, both width x height, attached to output_fbo. */
+    GLuint output_fbo, output_color, output_depth;
+    int width, height;
+    /* #define lines for the look (lighting model), to pass to
+     * gl_program_build for every program that lights. */
+    const char *defines;
+    /* Zeroed by the harness before create; the technique fills what it has. */
+    struct technique_products *products;
 };
 
 struct technique {
-    const char *name;
-    const char *summary;
-    /* GPU timer sections in the order a frame enters them, NULL-terminated. */
-    const char *const *sections;
-    /* Builds programs and resources; checks GL limits against the job. */
-    bool (*create)(const struct technique_ctx *ctx, void **state, char *err, size_t errlen);
-    /* Draws frame (timed frames are 1..frames, warm-up frames are <= 0) into
-     * the bound framebuffer. */
-    bool (*render)(void *state, const struct technique_ctx *ctx, int64_t frame,
-                   char *err, size_t errlen);
-    /* Technique-specific figures for the result (timed frames only); may be NULL. */
+    const struct technique_info *info;
+    /* Builds programs and resources and checks the job against env->caps.
+     * Called once per run, outside the timed region; may take any GL state. */
+    bool (*create)(const struct technique_env *env, void **state, char *err, size_t errlen);
+    /* Draws frame (timed frames are 1..frames, warm-up frames <= 0) into
+     * env->output_fbo, one gpu_pass_begin/end per declared pass, in order.
+     * Timed (CPU and GPU): no allocation, no readback, no uniform lookups.
+     * May assume the baseline state of gpu_pass_begin and the frame block
+     * bound; must leave the output framebuffer's attachments as they are. */
+    bool (*render)(void *state, const struct technique_env *env, int64_t frame, char *err,
+                   size_t errlen);
+    /* Technique-specific figures for the result (timed frames only); NULL
+     * when it has none. Called after the last timed frame. */
     json_t *(*describe)(void *state);
+    /* Frees everything create made. Accepts NULL. */
     void (*destroy)(void *state);
 };
 
 extern const struct technique *const technique_registry[];
 
 const struct technique *technique_find(const char *name);
-/* NULL-terminated list of registered names, for job validation. */
-const char *const *technique_names(void);
-int technique_section_count(const struct technique *t);
+int technique_pass_count(const struct technique *t);
 
-/* Shared by the single-pass techniques (forward, unlit): scene.vert plus
- * one fragment shader. */
-bool single_pass_create(const struct technique_ctx *ctx, const char *label, const char *frag,
+/* Checks a technique's table at start-up: mandatory hooks present, passes
+ * within the limit, options fit their storage. */
+bool technique_check(const struct technique *t, char *err, size_t errlen);
+
+/* Shared by the single-pass techniques (forward, unlit): scene.vert plus one
+ * fragment shader, drawn in one pass. */
+bool single_pass_create(const struct technique_env *env, const char *label, const char *frag,
                         void **state, char *err, size_t errlen);
-bool single_pass_render(void *state, const struct technique_ctx *ctx,
-                        int64_t frame, char *err, size_t errlen);
+bool single_pass_render(void *state, const struct technique_env *env, int64_t frame, char *err,
+                        size_t errlen);
 void single_pass_destroy(void *state);
 
 #endif

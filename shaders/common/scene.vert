@@ -1,8 +1,9 @@
 // Instanced scene geometry in world space (forward and unlit).
+#include "frame.glsl"
+#include "scene_data.glsl"
 layout(location = 0) in vec3 a_pos;
 layout(location = 1) in vec3 a_normal;
 
-uniform mat4 u_view_proj;
 uniform int u_instance_base;
 
 out vec3 v_world;
@@ -17,5 +18,5 @@ void main()
     v_world = world;
     v_normal = a_normal; // uniform scale, no rotation: object normal is world normal
     v_instance = id;
-    gl_Position = u_view_proj * vec4(world, 1.0);
+    gl_Position = u_frame.view_proj * vec4(world, 1.0);
 }

@@ -1,21 +1,39 @@
-// Scene data shared by every technique: instances and lights.
-// Light positions are computed on the CPU per frame (daemon/scene.c) so that
-// every technique lights a frame with bit-identical light positions.
+// Scene data shared by every technique: instances, materials and lights.
+// Light positions are computed on the CPU per frame (daemon/scene/scene.c) so
+// that every technique lights a frame with bit-identical light positions.
 
+// std430, 48 bytes; written by daemon/gpu/gpu_scene.c in this order.
 struct Instance {
     vec4 pos_scale;   // world position, uniform scale
-    vec4 albedo_mesh; // albedo, mesh index
+    vec4 albedo_mesh; // albedo, mesh index (0 sphere, 1 cube, 2 plane)
+    vec4 material;    // specular, shininess, metallic, roughness
 };
-layout(std430, binding = 0) readonly buffer InstanceBuffer { Instance instances[]; };
+layout(std430, binding = SB_SSBO_INSTANCES) readonly buffer InstanceBuffer { Instance instances[]; };
+
+// One object's material. Phong reads albedo, specular and shininess;
+// metallic and roughness are there for the physically based models.
+struct Material {
+    vec3 albedo;
+    float specular;
+    float shininess;
+    float metallic;
+    float roughness;
+};
+
+Material instance_material(int id)
+{
+    Instance inst = instances[id];
+    return Material(inst.albedo_mesh.rgb, inst.material.x, inst.material.y, inst.material.z,
+                    inst.material.w);
+}
 
 struct Light {
-    vec4 color_radius; // colour, influence radius (attenuation is 0 beyond it)
+    vec4 color_radius; // colour (scaled by scene.light_intensity), influence radius
+                       // (attenuation is 0 beyond it)
 };
-layout(std430, binding = 1) readonly buffer LightBuffer { Light lights[]; };
+layout(std430, binding = SB_SSBO_LIGHTS) readonly buffer LightBuffer { Light lights[]; };
 
-// Rows of u_light_count positions; row 0 is the frame being drawn, OSL uses
+// Rows of u_frame.counts.y positions; row 0 is the frame being drawn, OSL uses
 // further rows for objects whose shading is from an earlier frame.
-layout(std430, binding = 2) readonly buffer LightPositionBuffer { vec4 light_positions[]; };
+layout(std430, binding = SB_SSBO_LIGHT_POSITIONS) readonly buffer LightPositionBuffer { vec4 light_positions[]; };
 
-uniform int u_light_count;
-uniform vec3 u_eye;

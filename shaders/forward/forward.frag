@@ -1,4 +1,5 @@
 // Thesis ForwardProg: every light evaluated for every fragment.
+#include "lighting.glsl"
 in vec3 v_world;
 in vec3 v_normal;
 flat in int v_instance;
@@ -6,6 +7,6 @@ layout(location = 0) out vec4 out_color;
 
 void main()
 {
-    vec3 albedo = instances[v_instance].albedo_mesh.rgb;
-    out_color = vec4(phong(v_world, normalize(v_normal), albedo, 0), 1.0);
+    out_color = vec4(shade_all_lights(v_world, normalize(v_normal), instance_material(v_instance), 0),
+                     1.0);
 }

@@ -1,4 +1,6 @@
 // The cost floor: same geometry and passes, flat per-object colour, no lights.
+#include "frame.glsl"
+#include "scene_data.glsl"
 in vec3 v_world;
 in vec3 v_normal;
 flat in int v_instance;

@@ -1,11 +1,12 @@
 // OSL rasterization pass: draw every object, shading comes from its atlas tile.
+#include "frame.glsl"
+#include "scene_data.glsl"
 layout(location = 0) in vec3 a_pos;
 layout(location = 2) in vec2 a_uv;
 layout(location = 3) in vec4 a_chart;
 
-layout(std430, binding = 3) readonly buffer TileBuffer { ivec4 tiles[]; };
+layout(std430, binding = SB_SSBO_OSL_TILES) readonly buffer TileBuffer { ivec4 tiles[]; };
 
-uniform mat4 u_view_proj;
 uniform int u_instance_base;
 
 out vec2 v_uv;
@@ -19,5 +20,5 @@ void main()
     v_uv = a_uv;
     v_chart = a_chart;
     v_tile = tiles[id];
-    gl_Position = u_view_proj * vec4(inst.pos_scale.xyz + inst.pos_scale.w * a_pos, 1.0);
+    gl_Position = u_frame.view_proj * vec4(inst.pos_scale.xyz + inst.pos_scale.w * a_pos, 1.0);
 }

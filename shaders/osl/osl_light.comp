@@ -1,14 +1,18 @@
 // OSL lighting pass: one 8x8 block of one object's tile per work group. The
 // work list holds one entry per object to shade: (instance, light row,
 // first block, blocks per tile row); a group finds its entry by binary search.
+#include "lighting.glsl"
+
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std430, binding = 3) readonly buffer TileBuffer { ivec4 tiles[]; };   // x, y, size, level
-layout(std430, binding = 4) readonly buffer WorkBuffer { uvec4 work[]; };
-layout(rgba8, binding = 0) writeonly uniform image2D u_atlas;
+layout(std430, binding = SB_SSBO_OSL_TILES) readonly buffer TileBuffer { ivec4 tiles[]; };   // x, y, size, level
+layout(std430, binding = SB_SSBO_OSL_WORK) readonly buffer WorkBuffer { uvec4 work[]; };
+layout(rgba8, binding = SB_IMG_OSL_ATLAS) writeonly uniform image2D u_atlas;
 
-uniform sampler2D u_position[2]; // per mesh, mip level l holds tiles of size base >> l
-uniform sampler2D u_normal[2];
+// Per mesh (SCENE_MESH_COUNT: sphere, cube, plane); mip level l holds tiles
+// of size base >> l.
+uniform sampler2D u_position[3];
+uniform sampler2D u_normal[3];
 uniform int u_work_count;
 uniform int u_groups_x;
 
@@ -34,17 +38,21 @@ void main()
     Instance inst = instances[instance];
     vec4 p, n;
     // The mesh differs between groups of one dispatch, so no dynamic indexing.
-    if (int(inst.albedo_mesh.w) == 0) {
+    int mesh = int(inst.albedo_mesh.w);
+    if (mesh == 0) {
         p = texelFetch(u_position[0], texel, tile.w);
         n = texelFetch(u_normal[0], texel, tile.w);
-    } else {
+    } else if (mesh == 1) {
         p = texelFetch(u_position[1], texel, tile.w);
         n = texelFetch(u_normal[1], texel, tile.w);
+    } else {
+        p = texelFetch(u_position[2], texel, tile.w);
+        n = texelFetch(u_normal[2], texel, tile.w);
     }
     vec3 color = vec3(0.0);
     if (p.w > 0.0) {
         vec3 world = inst.pos_scale.xyz + inst.pos_scale.w * p.xyz;
-        color = phong(world, normalize(n.xyz), inst.albedo_mesh.rgb, int(w.y));
+        color = shade_all_lights(world, normalize(n.xyz), instance_material(instance), int(w.y));
     }
     imageStore(u_atlas, tile.xy + texel, vec4(color, 1.0));
 }

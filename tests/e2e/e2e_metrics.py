@@ -90,7 +90,7 @@ try:
 
     # Bad metric options name the field.
     for body, field in (({"reference": "forward"}, "reference"),
-                        (dict(JOB, reference="deferred"), "reference"),
+                        (dict(JOB, reference="no_such_technique"), "reference"),
                         (dict(JOB, reference=None, metrics=["ssim"]), "metrics"),
                         (dict(JOB, metrics={"pdiff": {"fov": -1}}), "metrics.pdiff.fov"),
                         (dict(JOB, metrics={"pdiff": {"fvo": 20}}), "metrics.pdiff.fvo"),

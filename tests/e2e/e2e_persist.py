@@ -1,10 +1,12 @@
 """Results survive the daemon: kill -9 it mid-job, restart on the same state
 directory, and every finished job is served byte for byte as before, the
 killed job is "interrupted" with a message, a queued job runs; SIGTERM
-cancels the running job and exits 0; retention removes only the oldest
+puts the running job back at the head of the queue (persisted as queued,
+run again on the next start) and exits 0; retention removes only the oldest
 finished jobs' directories."""
 
 import hashlib
+import json
 import os
 import signal
 import time
@@ -54,8 +56,10 @@ try:
     status, again = second.json("GET", "/v1/jobs/" + done_id)
     check(status == 200 and again["status"] == "done", "the finished job is served after kill -9")
     check(again.get("result") == done_before.get("result"), "its result is unchanged")
-    check(digest_dir(os.path.join(state, "jobs", done_id)) == files_before,
-          "its files are byte-for-byte intact")
+    files_after = digest_dir(os.path.join(state, "jobs", done_id))
+    check(files_after == files_before, "its files are byte-for-byte intact: %s differ"
+          % sorted(k for k in set(files_before) | set(files_after)
+                   if files_before.get(k) != files_after.get(k)))
     png = os.path.join(second.tmp, "f.png")
     check(second.download("/v1/jobs/%s/flip/6.png" % done_id, png) == 200, "its images are served")
     status, killed = second.json("GET", "/v1/jobs/" + killed_id)
@@ -69,22 +73,40 @@ try:
     check(new_id not in (done_id, killed_id, queued_id), "new ids never clash with reloaded ones")
     check(second.wait(new_id)["status"] == "done", "and new jobs run")
 
-    # SIGTERM with a job running: it is cancelled, state written, exit 0.
+    # SIGTERM with a job running: it goes back to the queue, state written, exit 0.
     term_id = second.submit(LONG)
     wait_running(second, term_id)
+    after_id = second.submit(SMALL)  # queued behind it: must stay behind it
     t0 = time.time()
 finally:
     code = second.stop()
 check(code == 0 and time.time() - t0 < 30, "SIGTERM mid-job exits 0 quickly (%s)" % code)
+with open(os.path.join(state, "jobs", term_id, "job.json")) as f:
+    on_disk = json.load(f)
+check(on_disk["status"] == "queued" and "error" not in on_disk and on_disk["times_unix"][1] == 0,
+      "the SIGTERMed job is persisted as queued, not failed: %s" % on_disk.get("status"))
+with open(os.path.join(state, "jobs", after_id, "job.json")) as f:
+    check(json.load(f)["status"] == "queued", "the job behind it stays queued")
 
 third = testlib.Daemon("--state-dir", state, "--keep-jobs", "2")
 try:
+    wait_running(third, term_id)
     status, term = third.json("GET", "/v1/jobs/" + term_id)
-    check(status == 200 and term["status"] == "cancelled", "the SIGTERMed job is cancelled: %s" % term.get("status"))
+    check(status == 200 and term["status"] == "running",
+          "the SIGTERMed job runs again first on the next start: %s" % term.get("status"))
+    check(third.json("GET", "/v1/jobs/" + after_id)[1]["status"] == "queued",
+          "the job queued behind it waits its turn")
+    check(third.json("DELETE", "/v1/jobs/" + term_id)[0] in (200, 202), "it can be cancelled")
+    check(third.wait(term_id)["status"] == "cancelled", "a DELETE cancels it for good")
+    check(third.wait(after_id)["status"] == "done", "then the next job runs")
+    # Retention runs right after each job finishes; give it a moment.
+    deadline = time.time() + 10
+    while time.time() < deadline and len(os.listdir(os.path.join(state, "jobs"))) > 2:
+        time.sleep(0.1)
     remaining = sorted(os.listdir(os.path.join(state, "jobs")))
-    check(remaining == sorted([new_id, term_id]),
+    check(remaining == sorted([term_id, after_id]),
           "--keep-jobs 2 keeps the newest two finished (%s, %s): %s; statuses %s"
-          % (new_id, term_id, remaining,
+          % (term_id, after_id, remaining,
              [(j["id"], j["status"]) for j in third.json("GET", "/v1/jobs")[1]["jobs"]]))
     check(third.json("GET", "/v1/jobs/" + done_id)[0] == 404, "a removed job is gone from the API")
     check(os.path.isdir(state), "the state directory itself stays")

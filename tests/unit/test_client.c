@@ -32,8 +32,7 @@ int main(void)
     char name[320], other[320];
     junit_job_name(osl, name, sizeof(name));
     CHECK(strcmp(name, "osl async_distance=20 osl(reshade=touched resolution=auto "
-                       "texel_density=1) grid 160x120 10 lights moving light_speed=1 "
-                       "sphere_segments=32, 20 frames") == 0);
+                       "texel_density=1) grid 160x120 10 lights moving, 20 frames") == 0);
     printf("name: %s\n", name);
     /* Labels, repeat, captures and the reference leave the name alone. */
     json_object_set_new(osl, "labels", json_pack("{s:s}", "commit", "def"));
@@ -45,11 +44,26 @@ int main(void)
     json_object_set_new(json_object_get(osl, "scene"), "lights", json_integer(80));
     junit_job_name(osl, other, sizeof(other));
     CHECK(strcmp(name, other) != 0 && strstr(other, "80 lights"));
+    json_object_set_new(json_object_get(osl, "scene"), "camera",
+                        json_pack("{s:s, s:i}", "path", "orbit", "period", 240));
+    junit_job_name(osl, other, sizeof(other));
+    CHECK(strstr(other, "80 lights moving camera orbit, 20 frames") != NULL);
+    /* However long the options, the name stays within 240 characters. */
+    json_t *many = json_object();
+    for (int i = 0; i < 40; i++) {
+        char k[16];
+        snprintf(k, sizeof(k), "option%02d", i);
+        json_object_set_new(many, k, json_integer(i + 1000));
+    }
+    json_object_set_new(osl, "osl", many);
+    junit_job_name(osl, other, sizeof(other));
+    CHECK(strlen(other) <= 240);
     json_decref(osl);
     /* Forward leaves OSL's options and a zero async distance out. */
     json_t *fwd = json_loads("{\"technique\":\"forward\",\"frames\":40,\"async_distance\":0,"
                              "\"scene\":{\"preset\":\"grid\",\"lights\":10,\"dynamic\":false,"
-                             "\"width\":160,\"height\":120},\"osl\":{\"resolution\":256}}", 0,
+                             "\"width\":160,\"height\":120},\"osl\":{\"resolution\":256},"
+                             "\"forward\":{}}", 0,
                              NULL);
     junit_job_name(fwd, name, sizeof(name));
     CHECK(strcmp(name, "forward grid 160x120 10 lights still, 40 frames") == 0);

@@ -1,9 +1,11 @@
+#include <stdlib.h>
 #include <string.h>
 
 #include "daemon/jobs/job_spec.h"
+#include "tests/unit/catalog_fixture.h"
 #include "tests/unit/check.h"
 
-static const char *const techniques[] = {"forward", "unlit", "osl", NULL};
+#define techniques fixture_catalog()
 
 static bool parse(const char *text, struct job_spec *spec, struct job_error *err)
 {
@@ -32,7 +34,8 @@ int main(void)
     CHECK(strcmp(spec.technique, "forward") == 0);
     CHECK(spec.frames == 300 && spec.warmup_frames == 10 && spec.capture_interval == 0);
     CHECK(spec.scene.width == 1080 && spec.scene.height == 720 && spec.scene.lights == 10);
-    CHECK(!spec.scene.dynamic && spec.osl.resolution == 256);
+    CHECK(!spec.scene.dynamic);
+    CHECK(((const struct osl_options *)spec.options[2].bytes)->resolution == 256);
 
     CHECK(parse("{\"technique\":\"osl\",\"frames\":40,\"warmup_frames\":0,"
                 "\"capture_interval\":20,\"async_distance\":20,"
@@ -42,8 +45,9 @@ int main(void)
                 &spec, &err));
     CHECK(strcmp(spec.technique, "osl") == 0 && spec.frames == 40 && spec.warmup_frames == 0);
     CHECK(spec.async_distance == 20.0 && spec.scene.dynamic && spec.scene.lights == 3);
-    CHECK(spec.osl.resolution == 0 && spec.osl.texel_density == 2.0);
-    CHECK(spec.osl.reshade == OSL_RESHADE_ALL && spec.scene.sphere_segments == 16);
+    const struct osl_options *osl = job_spec_technique_options(&spec);
+    CHECK(osl->resolution == 0 && osl->texel_density == 2.0);
+    CHECK(osl->reshade == OSL_RESHADE_ALL && spec.scene.sphere_segments == 16);
     CHECK(job_spec_capture_count(&spec) == 2);
     CHECK(job_spec_is_capture_frame(&spec, 20) && job_spec_is_capture_frame(&spec, 40));
     CHECK(!job_spec_is_capture_frame(&spec, 10) && !job_spec_is_capture_frame(&spec, 0));
@@ -100,6 +104,48 @@ int main(void)
     rejects("{\"osl\":{\"reshade\":\"some\"}}", "osl.reshade");
     rejects("{\"osl\":{\"resolutoin\":256}}", "osl.resolutoin");
 
+    /* The generic option parser, on a technique with every kind of option. */
+    CHECK(parse("{\"technique\":\"demo\"}", &spec, &err));
+    const struct demo_options *demo = job_spec_technique_options(&spec);
+    CHECK(demo->tile == 16 && demo->radius == 0.5 && demo->fallback && demo->normal == 0 &&
+          demo->albedo == 1 && demo->size == 0 && demo->grid[0] == 16 && demo->grid[2] == 24);
+    CHECK(parse("{\"technique\":\"demo\",\"demo\":{\"tile\":32,\"radius\":1.5,"
+                "\"fallback\":false,\"gbuffer\":{\"normal\":\"xy_reconstruct_z\"},"
+                "\"size\":64,\"grid\":[8,8,32]}}", &spec, &err));
+    demo = job_spec_technique_options(&spec);
+    CHECK(demo->tile == 32 && demo->radius == 1.5 && !demo->fallback && demo->normal == 2 &&
+          demo->albedo == 1 && demo->size == 64 && demo->grid[0] == 8 && demo->grid[2] == 32);
+    j = job_spec_to_json(&spec);
+    CHECK(json_is_string(json_object_get(json_object_get(json_object_get(j, "demo"), "gbuffer"),
+                                         "normal")));
+    text = json_dumps(j, 0);
+    CHECK(parse(text, &again, &err));
+    CHECK(memcmp(&again, &spec, sizeof(spec)) == 0);
+    free(text);
+    json_decref(j);
+    rejects("{\"demo\":{\"tile\":4}}", "demo.tile");
+    rejects("{\"demo\":{\"radius\":\"big\"}}", "demo.radius");
+    rejects("{\"demo\":{\"fallback\":1}}", "demo.fallback");
+    rejects("{\"demo\":{\"gbuffer\":{\"normal\":\"packed\"}}}", "demo.gbuffer.normal");
+    rejects("{\"demo\":{\"gbuffer\":{\"normals\":\"float3\"}}}", "demo.gbuffer.normals");
+    rejects("{\"demo\":{\"gbuffer\":3}}", "demo.gbuffer");
+    rejects("{\"demo\":{\"size\":48}}", "demo.size");
+    rejects("{\"demo\":{\"grid\":[8,8]}}", "demo.grid");
+    rejects("{\"demo\":{\"grid\":[8,8,0]}}", "demo.grid");
+    rejects("{\"demo\":[]}", "demo");
+    rejects("{\"forward\":{\"x\":1}}", "forward.x");
+    rejects("{\"forward\":5}", "forward");
+    CHECK(parse("{\"forward\":{}}", &spec, &err));
+
+    /* The look. */
+    CHECK(parse("{}", &spec, &err) && spec.look.lighting == LOOK_PHONG &&
+          spec.look.hdr == LOOK_HDR_RGBA32F);
+    CHECK(parse("{\"look\":{\"lighting\":\"blinn_phong\",\"hdr\":\"rgba16f\"}}", &spec, &err) &&
+          spec.look.lighting == LOOK_BLINN_PHONG && spec.look.hdr == LOOK_HDR_RGBA16F);
+    rejects("{\"look\":{\"lighting\":\"pbr2\"}}", "look.lighting");
+    rejects("{\"look\":{\"hdr\":\"rgb8\"}}", "look.hdr");
+    rejects("{\"look\":{\"tonemap\":\"aces\"}}", "look.tonemap");
+
     /* Labels: sorted by key, kept in the spec as understood, and round-tripped. */
     CHECK(parse("{\"labels\":{\"commit\":\"abc123\",\"branch\":\"main\",\"ci.run\":\"\"}}",
                 &spec, &err));
@@ -138,5 +184,46 @@ int main(void)
     CHECK(strstr(err.message, "'frames'") != NULL);
     parse("{\"scene\":{\"widht\":300}}", &spec, &err);
     CHECK(strstr(err.message, "'scene.width'") != NULL);
+    /* Error texts are cut to their buffers at a UTF-8 boundary, and bytes
+     * that are not UTF-8 are escaped: the error JSON is always built. */
+    char key[128];
+    for (int at = 36; at <= 42; at++) {
+        /* "é" (2 bytes) straddling byte 40 of an unknown key. */
+        memset(key, 'k', sizeof(key));
+        memcpy(key + at, "\xc3\xa9", 2);
+        key[60] = '\0';
+        char text[256];
+        snprintf(text, sizeof(text), "{\"%s\": 1}", key);
+        CHECK(!parse(text, &spec, &err));
+        json_t *e = job_error_to_json(&err);
+        CHECK(e != NULL);
+        CHECK(json_string_value(json_object_get(json_object_get(e, "error"), "field")) != NULL);
+        json_decref(e);
+    }
+    /* A syntax error whose quoted token is cut inside a 3-byte character. */
+    char bad[600] = "{\"frames\": ";
+    for (int i = 0; i < 150; i++)
+        strcat(bad, "\xe2\x82\xac");
+    CHECK(!parse(bad, &spec, &err));
+    json_t *e = job_error_to_json(&err);
+    CHECK(e != NULL);
+    char *dump = e ? json_dumps(e, 0) : NULL;
+    CHECK(dump != NULL);
+    free(dump);
+    json_decref(e);
+    /* Invalid bytes are escaped, a cut character is dropped. */
+    char msg[32] = "a\xff b \xe2\x82";
+    jf_utf8_sanitize(msg, sizeof(msg));
+    CHECK(strcmp(msg, "a\\xff b ") == 0);
+    char fits[8] = "abcdef";
+    jf_utf8_sanitize(fits, 6); /* room for 5 bytes */
+    CHECK(strcmp(fits, "abcde") == 0);
+    CHECK(jf_utf8_prefix("ab\xc3\xa9", 3) == 2 && jf_utf8_prefix("ab\xc3\xa9", 4) == 4);
+    struct job_error raw;
+    snprintf(raw.field, sizeof(raw.field), "x\xc3");
+    snprintf(raw.message, sizeof(raw.message), "\x80\x80");
+    e = job_error_to_json(&raw);
+    CHECK(e != NULL);
+    json_decref(e);
     return check_finish("test_job");
 }

@@ -147,6 +147,40 @@ static void test_pdiff(void)
     free(a.rgb), free(b.rgb), free(c.rgb), free(n.rgb);
 }
 
+/* Images narrower or lower than the 5-tap pyramid kernel: perceptualdiff's
+ * mirror used to index -1 there, before the buffer on a 1-pixel-wide image
+ * (the --enable-sanitizers build of this test stops on that read). A 1-row
+ * image and the same row doubled blur to the same values, so every failing
+ * pixel is counted twice in the doubled one. */
+static void test_pdiff_tiny(void)
+{
+    char err[256];
+    struct pdiff_options o;
+    pdiff_defaults(&o);
+    o.threshold_pixels = 1;
+    struct pdiff_result r, r2;
+    for (int w = 1; w <= 4; w++)
+        for (int h = 1; h <= 4; h++) {
+            struct image a = pattern(w, h), b = noisy(&a, 90, (unsigned)(w * 7 + h));
+            CHECK(pdiff_compute(&a, &b, &o, &r, err, sizeof(err)));
+            CHECK(r.failing_pixels >= 0 && r.failing_pixels <= (long)w * h);
+            free(a.rgb), free(b.rgb);
+        }
+    for (int w = 1; w <= 64; w *= 4) {
+        struct image a = pattern(w, 1), b = noisy(&a, 90, (unsigned)w);
+        struct image a2 = make(w, 2, 0, 0, 0), b2 = make(w, 2, 0, 0, 0);
+        for (int y = 0; y < 2; y++) {
+            memcpy(a2.rgb + (size_t)y * (size_t)w * 3, a.rgb, (size_t)w * 3);
+            memcpy(b2.rgb + (size_t)y * (size_t)w * 3, b.rgb, (size_t)w * 3);
+        }
+        CHECK(pdiff_compute(&a, &b, &o, &r, err, sizeof(err)));
+        CHECK(pdiff_compute(&a2, &b2, &o, &r2, err, sizeof(err)));
+        CHECK(r2.failing_pixels == 2 * r.failing_pixels);
+        CHECK(w < 16 || r.failing_pixels > 0);
+        free(a.rgb), free(b.rgb), free(a2.rgb), free(b2.rgb);
+    }
+}
+
 static void test_flip(void)
 {
     char err[256];
@@ -181,6 +215,7 @@ int main(void)
     test_ssim();
     test_psnr();
     test_pdiff();
+    test_pdiff_tiny();
     test_flip();
     return check_finish("test_metrics");
 }

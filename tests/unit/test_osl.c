@@ -1,7 +1,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "daemon/jobs/job_spec.h"
 #include "daemon/techniques/osl/osl_atlas.h"
 #include "daemon/techniques/osl/osl_schedule.h"
 #include "daemon/scene/scene.h"
@@ -100,10 +99,12 @@ static void test_schedule(void)
 
 static void test_plan(void)
 {
-    struct job_spec spec;
-    job_spec_defaults(&spec);
+    struct {
+        struct scene_spec scene;
+    } spec;
+    scene_spec_defaults(&spec.scene);
     struct scene scene;
-    CHECK(scene_create(&scene, &spec.scene));
+    CHECK(scene_init(&scene, &spec.scene));
     int n = scene.instance_count;
     double *dist = malloc((size_t)n * sizeof(double));
     struct osl_work *plan = malloc((size_t)n * sizeof(*plan));
@@ -120,7 +121,7 @@ static void test_plan(void)
     scene_finish(&scene);
 
     spec.scene.dynamic = true;
-    CHECK(scene_create(&scene, &spec.scene));
+    CHECK(scene_init(&scene, &spec.scene));
     long touched0 = 0, all0 = 0, touched20 = 0;
     for (int k = 1; k <= 60; k++) {
         int t0 = osl_schedule_plan(&s0, &scene, k, false, OSL_RESHADE_TOUCHED, plan);

@@ -2,9 +2,10 @@
 #include <string.h>
 
 #include "daemon/jobs/sweep_spec.h"
+#include "tests/unit/catalog_fixture.h"
 #include "tests/unit/check.h"
 
-static const char *const techniques[] = {"forward", "unlit", "osl", NULL};
+#define techniques fixture_catalog()
 
 static int calls;
 static double boundary;
@@ -136,6 +137,23 @@ int main(void)
     sweep_spec_finish(&s);
 
     /* Bad input names the field. */
+    /* Values valid alone, refused together: 400 at submission, naming the
+     * first bad combination (point 2 of 4: frames=2, capture_interval=5). */
+    {
+        struct sweep_spec c;
+        struct job_error e;
+        CHECK(!parse("{\"base\":{},\"vary\":{\"frames\":[2,10],\"capture_interval\":[1,5]}}",
+                     &c, &e));
+        CHECK(strcmp(e.field, "vary") == 0);
+        CHECK(strstr(e.message, "point 2 (frames=2, capture_interval=5)") != NULL);
+        CHECK(strstr(e.message, "capture_interval") != NULL);
+        sweep_spec_finish(&c);
+        /* A key cut at 40 bytes inside a character still names the field. */
+        CHECK(!parse("{\"base\":{},\"vary\":{\"aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa\u00e9\":[1]}}",
+                     &c, &e));
+        CHECK(strncmp(e.field, "vary.", 5) == 0 && strlen(e.field) == 5 + 39);
+        sweep_spec_finish(&c);
+    }
     rejects("[]", "body");
     rejects("{\"base\":{},\"vary\":{\"async_distance\":[1]},\"find\":{}}", "find");
     rejects("{\"base\":{}}", "vary");
@@ -151,7 +169,7 @@ int main(void)
     rejects("{\"base\":{},\"find\":{\"param\":\"async_distance\",\"from\":5,\"to\":1,\"while\":\"pdiff_pass\"}}", "find.to");
     rejects("{\"base\":{},\"find\":{\"param\":\"scene.lights\",\"from\":0.5,\"to\":9,\"while\":\"pdiff_pass\"}}", "find.from");
     rejects("{\"base\":{},\"find\":{\"param\":\"async_distance\",\"from\":0,\"to\":9,\"while\":\"pretty\"}}", "find.while");
-    rejects("{\"base\":{},\"find\":{\"param\":\"scene.lights\",\"from\":0,\"to\":5000,\"while\":\"stable\"}}", "find.to");
+    rejects("{\"base\":{},\"find\":{\"param\":\"scene.lights\",\"from\":0,\"to\":70000,\"while\":\"stable\"}}", "find.to");
     rejects("{\"base\":{},\"vary\":{\"frames\":[1]},\"extra\":1}", "extra");
     return check_finish("test_sweep");
 }

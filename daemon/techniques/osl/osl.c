@@ -14,12 +14,18 @@
 
 #include "daemon/gpu/glutil.h"
 #include "common/log.h"
+#include "daemon/gpu/bindings.h"
 #include "daemon/techniques/osl/osl_atlas.h"
+#include "daemon/techniques/osl/osl_info.h"
 #include "daemon/techniques/osl/osl_schedule.h"
 #include "daemon/techniques/technique.h"
 
-enum { SECTION_LIGHTING, SECTION_RASTER };
-static const char *const sections[] = {"lighting", "raster", NULL};
+/* The passes of osl_info, in order. */
+enum { PASS_LIGHTING, PASS_RASTER };
+
+/* shaders/osl/osl_light.comp has one position and one normal sampler per
+ * mesh and selects them by branch: keep both in step. */
+_Static_assert(SCENE_MESH_COUNT == 3, "osl_light.comp samples exactly three meshes");
 
 /* Atlas memory ceiling; the device's texture size limit applies as well. */
 static const double OSL_MAX_ATLAS_BYTES = 1024.0 * 1024.0 * 1024.0;
@@ -58,7 +64,7 @@ static int log2i(int v)
     return l;
 }
 
-static bool check_limits(struct osl *o, const struct job_spec *spec, int *max_tex,
+static bool check_limits(struct osl *o, const struct technique_env *env, int *max_tex,
                          char *err, size_t errlen)
 {
     GLint size[2], count[2], invocations = 0, images = 0;
@@ -75,7 +81,8 @@ static bool check_limits(struct osl *o, const struct job_spec *spec, int *max_te
                  "image the lighting pass needs", size[0], size[1], invocations, images);
         return false;
     }
-    int largest = spec->osl.resolution ? spec->osl.resolution : OSL_TILE_MAX;
+    const struct osl_options *opt = env->options;
+    int largest = opt->resolution ? opt->resolution : OSL_TILE_MAX;
     if (largest > *max_tex) {
         snprintf(err, errlen, "osl.resolution %d exceeds GL_MAX_TEXTURE_SIZE %d",
                  largest, *max_tex);
@@ -94,10 +101,10 @@ static bool check_limits(struct osl *o, const struct job_spec *spec, int *max_te
     return true;
 }
 
-static bool choose_tiles(struct osl *o, const struct technique_ctx *ctx, int max_tex,
+static bool choose_tiles(struct osl *o, const struct technique_env *env, int max_tex,
                          char *err, size_t errlen)
 {
-    const struct scene *s = ctx->scene;
+    const struct scene *s = env->scene;
     int n = s->instance_count;
     int *sizes = malloc((size_t)n * sizeof(int));
     if (!sizes) {
@@ -105,14 +112,15 @@ static bool choose_tiles(struct osl *o, const struct technique_ctx *ctx, int max
         return false;
     }
     for (int i = 0; i < n; i++) {
-        if (ctx->spec->osl.resolution) {
-            sizes[i] = ctx->spec->osl.resolution;
+        const struct osl_options *opt = env->options;
+        if (opt->resolution) {
+            sizes[i] = opt->resolution;
             continue;
         }
         double ppu = scene_projected_diameter(s, i) / (2.0 * scene_instance_bound(s, i));
         const struct mesh *m = &s->meshes[s->instances[i].mesh];
         sizes[i] = osl_auto_tile_size(ppu, m->uv_per_unit / s->instances[i].scale,
-                                      ctx->spec->osl.texel_density);
+                                      opt->texel_density);
     }
     bool ok = osl_atlas_pack(sizes, n, max_tex, OSL_MAX_ATLAS_BYTES, o->tiles, &o->atlas_w,
                              &o->atlas_h, err, errlen);
@@ -120,9 +128,9 @@ static bool choose_tiles(struct osl *o, const struct technique_ctx *ctx, int max
     return ok;
 }
 
-static bool generate_textures(struct osl *o, const struct technique_ctx *ctx)
+static bool generate_textures(struct osl *o, const struct technique_env *env)
 {
-    const struct scene *s = ctx->scene;
+    const struct scene *s = env->scene;
     GLuint fbo;
     glGenFramebuffers(1, &fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
@@ -169,7 +177,7 @@ static bool generate_textures(struct osl *o, const struct technique_ctx *ctx)
             glViewport(0, 0, size, size);
             glClearColor(0, 0, 0, 0);
             glClear(GL_COLOR_BUFFER_BIT);
-            glBindVertexArray(ctx->gpu->vao[m]);
+            glBindVertexArray(env->gpu->vao[m]);
             glDrawElements(GL_TRIANGLES, (GLsizei)s->meshes[m].index_count, GL_UNSIGNED_INT, NULL);
         }
     }
@@ -180,10 +188,10 @@ static bool generate_textures(struct osl *o, const struct technique_ctx *ctx)
 
 static void osl_destroy(void *state);
 
-static bool osl_create(const struct technique_ctx *ctx, void **state, char *err,
+static bool osl_create(const struct technique_env *env, void **state, char *err,
                        size_t errlen)
 {
-    const struct scene *s = ctx->scene;
+    const struct scene *s = env->scene;
     int n = s->instance_count;
     struct osl *o = calloc(1, sizeof(*o));
     if (!o)
@@ -192,7 +200,7 @@ static bool osl_create(const struct technique_ctx *ctx, void **state, char *err,
     o->tiles = calloc((size_t)n, sizeof(*o->tiles));
     o->plan = calloc((size_t)n, sizeof(*o->plan));
     o->work = calloc((size_t)n * 4, sizeof(GLuint));
-    o->frames = ctx->spec->frames;
+    o->frames = env->spec->frames;
     double *dist = calloc((size_t)n, sizeof(double));
     if (!o->tiles || !o->plan || !o->work || !dist) {
         free(dist);
@@ -200,7 +208,7 @@ static bool osl_create(const struct technique_ctx *ctx, void **state, char *err,
     }
     for (int i = 0; i < n; i++)
         dist[i] = scene_instance_distance(s, i);
-    bool sched = osl_schedule_init(&o->schedule, dist, n, ctx->spec->async_distance);
+    bool sched = osl_schedule_init(&o->schedule, dist, n, env->spec->async_distance);
     free(dist);
     o->rows = calloc((size_t)o->schedule.max_period, sizeof(int64_t));
     if (!sched || !o->rows)
@@ -208,28 +216,28 @@ static bool osl_create(const struct technique_ctx *ctx, void **state, char *err,
 
     int max_tex = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
-    if (!choose_tiles(o, ctx, max_tex, err, errlen) ||
-        !check_limits(o, ctx->spec, &max_tex, err, errlen))
+    if (!choose_tiles(o, env, max_tex, err, errlen) ||
+        !check_limits(o, env, &max_tex, err, errlen))
         goto fail;
 
     const struct gl_stage texgen[] = {
         {GL_VERTEX_SHADER, {"osl_texgen.vert"}},
         {GL_FRAGMENT_SHADER, {"osl_texgen.frag"}},
     };
-    const struct gl_stage light[] = {{GL_COMPUTE_SHADER, {"scene_data.glsl", "lighting.glsl", "osl_light.comp"}}};
+    const struct gl_stage light[] = {{GL_COMPUTE_SHADER, {"osl_light.comp"}}};
     const struct gl_stage draw[] = {
-        {GL_VERTEX_SHADER, {"scene_data.glsl", "osl_draw.vert"}},
+        {GL_VERTEX_SHADER, {"osl_draw.vert"}},
         {GL_FRAGMENT_SHADER, {"osl_draw.frag"}},
     };
     GLuint light_prog = 0, draw_prog = 0;
     if (!(o->texgen_prog = gl_program_build("osl texgen", texgen, 2, NULL, err, errlen)) ||
-        !(light_prog = gl_program_build("osl lighting", light, 1, NULL, err, errlen)) ||
+        !(light_prog = gl_program_build("osl lighting", light, 1, env->defines, err, errlen)) ||
         !(draw_prog = gl_program_build("osl draw", draw, 2, NULL, err, errlen))) {
         glDeleteProgram(light_prog);
         goto fail;
     }
-    o->light = gpu_scene_program(ctx->gpu, light_prog);
-    o->draw = gpu_scene_program(ctx->gpu, draw_prog);
+    o->light = gpu_scene_program(env->gpu, light_prog);
+    o->draw = gpu_scene_program(env->gpu, draw_prog);
     o->work_count_loc = glGetUniformLocation(light_prog, "u_work_count");
     o->groups_x_loc = glGetUniformLocation(light_prog, "u_groups_x");
     /* Texture units never change: position and normal of mesh m on units
@@ -237,13 +245,15 @@ static bool osl_create(const struct technique_ctx *ctx, void **state, char *err,
     for (int m = 0; m < SCENE_MESH_COUNT; m++) {
         char name[32];
         snprintf(name, sizeof(name), "u_position[%d]", m);
-        glProgramUniform1i(light_prog, glGetUniformLocation(light_prog, name), 1 + m * 2);
+        glProgramUniform1i(light_prog, glGetUniformLocation(light_prog, name),
+                           SB_TEX_OSL_MESH + m * 2);
         snprintf(name, sizeof(name), "u_normal[%d]", m);
-        glProgramUniform1i(light_prog, glGetUniformLocation(light_prog, name), 2 + m * 2);
+        glProgramUniform1i(light_prog, glGetUniformLocation(light_prog, name),
+                           SB_TEX_OSL_MESH + 1 + m * 2);
     }
-    glProgramUniform1i(draw_prog, glGetUniformLocation(draw_prog, "u_atlas"), 0);
+    glProgramUniform1i(draw_prog, glGetUniformLocation(draw_prog, "u_atlas"), SB_TEX_OSL_ATLAS);
 
-    if (!generate_textures(o, ctx)) {
+    if (!generate_textures(o, env)) {
         snprintf(err, errlen, "osl: texture generation framebuffer incomplete");
         goto fail;
     }
@@ -287,7 +297,7 @@ fail:
 }
 
 /* Dispatches the lighting pass for the planned objects. Returns texels shaded. */
-static double light_pass(struct osl *o, const struct technique_ctx *ctx, int64_t frame,
+static double light_pass(struct osl *o, const struct technique_env *env, int64_t frame,
                          int count)
 {
     int rows = 1;
@@ -307,19 +317,19 @@ static double light_pass(struct osl *o, const struct technique_ctx *ctx, int64_t
     }
     for (int r = 0; r < rows; r++)
         o->rows[r] = frame - r;
-    gpu_scene_set_light_rows(ctx->gpu, o->rows, rows);
+    gpu_scene_set_light_rows(env->gpu, o->rows, rows);
 
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, o->work_buffer);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)((size_t)count * 4 * sizeof(GLuint)),
                  o->work, GL_STREAM_DRAW);
-    gpu_scene_bind(ctx->gpu, &o->light);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, o->tile_buffer);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, o->work_buffer);
-    glBindImageTexture(0, o->atlas, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
+    gpu_scene_bind(env->gpu, &o->light);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_TILES, o->tile_buffer);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_WORK, o->work_buffer);
+    glBindImageTexture(SB_IMG_OSL_ATLAS, o->atlas, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
     for (int m = 0; m < SCENE_MESH_COUNT; m++) {
-        glActiveTexture(GL_TEXTURE1 + m * 2);
+        glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_MESH + m * 2);
         glBindTexture(GL_TEXTURE_2D, o->position_tex[m]);
-        glActiveTexture(GL_TEXTURE2 + m * 2);
+        glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_MESH + 1 + m * 2);
         glBindTexture(GL_TEXTURE_2D, o->normal_tex[m]);
     }
     glActiveTexture(GL_TEXTURE0);
@@ -332,14 +342,14 @@ static double light_pass(struct osl *o, const struct technique_ctx *ctx, int64_t
     return texels;
 }
 
-static bool osl_render(void *state, const struct technique_ctx *ctx, int64_t frame,
+static bool osl_render(void *state, const struct technique_env *env, int64_t frame,
                        char *err, size_t errlen)
 {
     (void)err, (void)errlen;
     struct osl *o = state;
-    int count = osl_schedule_plan(&o->schedule, ctx->scene, frame, !o->shaded_once,
-                                  ctx->spec->osl.reshade, o->plan);
-    double texels = count ? light_pass(o, ctx, frame, count) : 0.0;
+    int count = osl_schedule_plan(&o->schedule, env->scene, frame, !o->shaded_once,
+                                  ((const struct osl_options *)env->options)->reshade, o->plan);
+    double texels = count ? light_pass(o, env, frame, count) : 0.0;
     if (!o->shaded_once) {
         o->initial_objects = count;
         o->initial_texels = texels;
@@ -357,16 +367,15 @@ static bool osl_render(void *state, const struct technique_ctx *ctx, int64_t fra
     }
     o->shaded_once = true;
 
-    gpu_timer_section(ctx->timer, SECTION_RASTER);
-    glEnable(GL_DEPTH_TEST);
-    glEnable(GL_CULL_FACE);
+    gpu_pass_begin(env->passes, PASS_RASTER, env->output_fbo, env->width, env->height);
     glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    gpu_scene_bind(ctx->gpu, &o->draw);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, o->tile_buffer);
-    glActiveTexture(GL_TEXTURE0);
+    gpu_scene_bind(env->gpu, &o->draw);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_TILES, o->tile_buffer);
+    glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_ATLAS);
     glBindTexture(GL_TEXTURE_2D, o->atlas);
-    gpu_scene_draw(ctx->gpu, &o->draw);
+    gpu_scene_draw(env->gpu, &o->draw);
+    gpu_pass_end(env->passes);
     return true;
 }
 
@@ -425,10 +434,7 @@ static void osl_destroy(void *state)
 }
 
 const struct technique technique_osl = {
-    .name = "osl",
-    .summary = "object space lighting: texgen, compute lighting into a shared atlas, "
-               "rasterization sampling it; async shading by camera distance",
-    .sections = sections,
+    .info = &osl_info,
     .create = osl_create,
     .render = osl_render,
     .describe = osl_describe,

@@ -15,7 +15,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "daemon/jobs/job_spec.h"
+#include "daemon/techniques/osl/osl_info.h"
 #include "daemon/scene/scene.h"
 
 struct osl_schedule {

@@ -1,0 +1,191 @@
+#!/usr/bin/env python3
+"""How often does the timing gate cry wolf, and how often does it miss?
+
+On one daemon, with busy-loop processes loading the CPU the whole time (as
+on a shared CI box), this benchmark:
+  1. finds a light count that makes the job about 10% slower (measured with
+     `shadebench ab`, paired runs), unless --slow-lights is given;
+  2. takes a baseline of the unchanged job (`submit --runs N --out`);
+  3. runs the gate --trials times on the unchanged job and --trials times on
+     the slowed one (--allow-mismatch, since more lights is another spec),
+     interleaved so that both see the same conditions over time;
+  4. reports the false-regression rate (unchanged job judged a regression)
+     and the catch rate (slowed job judged a regression), with the
+     inconclusive verdicts, the runs each gate used and the measured
+     slowdowns.
+
+    SHADEBENCHD=build/shadebenchd SHADEBENCH_CLIENT=build/shadebench bench/bench_gate.py
+
+Standard library only. Writes every gate's files and a summary.json under
+--out (default: a temporary folder, printed)."""
+
+import argparse
+import json
+import os
+import signal
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+SHADEBENCHD = os.environ.get("SHADEBENCHD", "build/shadebenchd")
+CLIENT = os.environ.get("SHADEBENCH_CLIENT", "build/shadebench")
+
+
+def start_daemon(tmp):
+    port_file = os.path.join(tmp, "port")
+    log = open(os.path.join(tmp, "daemon.log"), "w")
+    proc = subprocess.Popen([SHADEBENCHD, "--listen", "127.0.0.1:0", "--port-file", port_file,
+                             "--state-dir", os.path.join(tmp, "state")], stdout=log,
+                            stderr=subprocess.STDOUT)
+    deadline = time.time() + 60
+    while not os.path.exists(port_file):
+        if proc.poll() is not None or time.time() > deadline:
+            raise RuntimeError("shadebenchd did not start (see %s/daemon.log)" % tmp)
+        time.sleep(0.05)
+    time.sleep(0.1)
+    with open(port_file) as f:
+        return proc, "http://127.0.0.1:%d" % int(f.read())
+
+
+def client(server, *args):
+    return subprocess.run([CLIENT, "--server", server, "--quiet"] + [str(a) for a in args],
+                          capture_output=True, text=True)
+
+
+def write(path, obj):
+    with open(path, "w") as f:
+        json.dump(obj, f)
+    return path
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--trials", type=int, default=20)
+    ap.add_argument("--runs", type=int, default=5, help="runs per side (the gate's default)")
+    ap.add_argument("--width", type=int, default=320)
+    ap.add_argument("--height", type=int, default=240)
+    ap.add_argument("--frames", type=int, default=60)
+    ap.add_argument("--lights", type=int, default=10)
+    ap.add_argument("--slow-lights", type=int, default=0,
+                    help="light count of the slowed job (default: the smallest found ~10%% slower)")
+    ap.add_argument("--target", type=float, default=0.10, help="slowdown to calibrate for")
+    ap.add_argument("--load", type=int, default=1, help="busy-loop processes (default 1)")
+    ap.add_argument("--out", default=None)
+    a = ap.parse_args()
+
+    out = a.out or tempfile.mkdtemp(prefix="bench-gate-")
+    os.makedirs(out, exist_ok=True)
+    job = {"technique": "forward", "frames": a.frames, "warmup_frames": 10,
+           "scene": {"width": a.width, "height": a.height, "dynamic": True, "lights": a.lights}}
+    loads = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(a.load)]
+    daemon, server = start_daemon(out)
+    t0 = time.time()
+    try:
+        base_file = write(os.path.join(out, "job.json"), job)
+
+        def slowed(n):
+            return write(os.path.join(out, "job-%d-lights.json" % n),
+                         dict(job, scene=dict(job["scene"], lights=n)))
+
+        # 1. The slowdown, measured with paired runs.
+        calibration = []
+        candidates = [a.slow_lights] if a.slow_lights else [12, 14, 16, 18, 20, 24, 28, 32, 40]
+        slow_lights, slow_ratio = None, None
+        for n in candidates:
+            ab_dir = os.path.join(out, "ab-%d" % n)
+            r = client(server, "ab", base_file, slowed(n), "--runs", 8, "--max-reruns", 0,
+                       "--max-slowdown", "100%", "--out", ab_dir)
+            with open(os.path.join(ab_dir, "ab.json")) as f:
+                ab = json.load(f)
+            calibration.append({"lights": n, "ratio": ab["ratio"], "ci": [ab["ci_low"], ab["ci_high"]]})
+            print("calibration: %d lights: B/A = %.3f [%.3f, %.3f]" % (n, ab["ratio"], ab["ci_low"],
+                                                                      ab["ci_high"]), flush=True)
+            if ab["ratio"] >= 1 + a.target or a.slow_lights:
+                slow_lights, slow_ratio = n, ab["ratio"]
+                break
+        if slow_lights is None:
+            slow_lights, slow_ratio = candidates[-1], calibration[-1]["ratio"]
+        slow_file = slowed(slow_lights)
+
+        # 2. The baseline.
+        base_dir = os.path.join(out, "baseline")
+        r = client(server, "submit", base_file, "--wait", "--runs", a.runs, "--out", base_dir)
+        if r.returncode != 0:
+            raise RuntimeError("baseline failed: %s" % r.stderr[-500:])
+        baseline = os.path.join(base_dir, "result.json")
+
+        # 3. The gates, interleaved.
+        results = {"unchanged": [], "slowed": []}
+        for i in range(a.trials):
+            for kind, path, extra in (("unchanged", base_file, []),
+                                      ("slowed", slow_file, ["--allow-mismatch"])):
+                gate_dir = os.path.join(out, "%s-%02d" % (kind, i + 1))
+                start = time.time()
+                r = client(server, "submit", path, "--wait", "--baseline", baseline, "--out",
+                           gate_dir, *extra)
+                took = time.time() - start
+                try:
+                    with open(os.path.join(gate_dir, "gate.json")) as f:
+                        g = json.load(f)
+                    with open(os.path.join(gate_dir, "result.json")) as f:
+                        runs = json.load(f)["gate_runs"]
+                except (OSError, ValueError, KeyError):
+                    g, runs = {"outcome": "error", "why": r.stderr[-300:]}, []
+                rec = {"rc": r.returncode, "outcome": g["outcome"], "ratio": g.get("ratio"),
+                       "ci": [g.get("ci_low"), g.get("ci_high")], "runs": len(runs),
+                       "noisy": sum(1 for x in runs if x.get("noisy")), "seconds": took,
+                       "why": g.get("why")}
+                results[kind].append(rec)
+                print("%-9s %2d: %-12s ratio %s, %d runs (%d noisy), %.0f s" % (
+                    kind, i + 1, rec["outcome"], "%.3f" % rec["ratio"] if rec["ratio"] else "-",
+                    rec["runs"], rec["noisy"], took), flush=True)
+    finally:
+        daemon.send_signal(signal.SIGTERM)
+        daemon.wait(timeout=60)
+        for p in loads:
+            p.kill()
+            p.wait()
+
+    def count(kind, outcome):
+        return sum(1 for x in results[kind] if x["outcome"] == outcome)
+
+    n = a.trials
+    summary = {
+        "trials": n, "runs": a.runs, "job": job, "slow_lights": slow_lights,
+        "slowdown_paired": slow_ratio - 1, "calibration": calibration,
+        "slowdown_in_gates": statistics.median(x["ratio"] for x in results["slowed"] if x["ratio"]) - 1,
+        "false_regressions": count("unchanged", "regression"),
+        "unchanged_pass": count("unchanged", "pass"),
+        "unchanged_inconclusive": count("unchanged", "inconclusive"),
+        "caught": count("slowed", "regression"),
+        "slowed_pass": count("slowed", "pass"),
+        "slowed_inconclusive": count("slowed", "inconclusive"),
+        "errors": count("unchanged", "error") + count("slowed", "error"),
+        "mean_runs": statistics.mean(x["runs"] for k in results for x in results[k]),
+        "mean_gate_s": statistics.mean(x["seconds"] for k in results for x in results[k]),
+        "load_processes": a.load, "minutes": (time.time() - t0) / 60, "results": results,
+    }
+    write(os.path.join(out, "summary.json"), summary)
+    print()
+    print("| measurement | value |")
+    print("|---|---|")
+    print("| job | forward, %dx%d, %d frames, %d lights; %d busy-loop process(es) |" % (
+        a.width, a.height, a.frames, a.lights, a.load))
+    print("| slowed job | %d lights: %+.1f%% (paired, ab), %+.1f%% (median over the gates) |" % (
+        slow_lights, 100 * summary["slowdown_paired"], 100 * summary["slowdown_in_gates"]))
+    print("| unchanged job: false regressions | %d of %d (pass %d, inconclusive %d) |" % (
+        summary["false_regressions"], n, summary["unchanged_pass"], summary["unchanged_inconclusive"]))
+    print("| slowed job: caught | %d of %d (pass %d, inconclusive %d) |" % (
+        summary["caught"], n, summary["slowed_pass"], summary["slowed_inconclusive"]))
+    print("| runs per gate (mean), seconds per gate (mean) | %.1f, %.0f |" % (
+        summary["mean_runs"], summary["mean_gate_s"]))
+    print("| errors | %d |" % summary["errors"])
+    print("\nfiles in %s (%.0f minutes)" % (out, summary["minutes"]))
+    ok = summary["false_regressions"] <= max(1, n // 20) and summary["caught"] >= n - max(1, n // 20)
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,119 @@
+/* Light layouts: where the light centres stand in the scene's light volume.
+ * Every layout is deterministic (Halton digits or a fixed hash), so a spec
+ * builds the same lights on every run and machine. */
+#include <math.h>
+#include <stdlib.h>
+
+#include "daemon/scene/scene_build.h"
+
+/* The thesis's spread, written so that the grid preset's volume gives
+ * exactly the floats it always had: x = (h2 - 1/2) 40, y = 10 h3 - 0.5,
+ * z = 1.5 - 24 h5. */
+static void place_halton(const struct scene_box *b, int i, float out[3])
+{
+    unsigned k = (unsigned)i + 1;
+    double size[3] = {(double)b->max[0] - b->min[0], (double)b->max[1] - b->min[1],
+                      (double)b->max[2] - b->min[2]};
+    double centre_x = 0.5 * ((double)b->min[0] + b->max[0]);
+    out[0] = (float)((scene_radical_inverse(k, 2) - 0.5) * size[0] + centre_x);
+    out[1] = (float)(scene_radical_inverse(k, 3) * size[1] + b->min[1]);
+    out[2] = (float)(b->max[2] - scene_radical_inverse(k, 5) * size[2]);
+}
+
+static void place_uniform(const struct scene_box *b, int i, float out[3])
+{
+    for (int a = 0; a < 3; a++)
+        out[a] = (float)(b->min[a] + scene_hash01((uint32_t)i, 11u + (uint32_t)a) *
+                                         ((double)b->max[a] - b->min[a]));
+}
+
+/* A lattice with about equal spacing along each axis, filled layer by
+ * layer from the bottom; the top layer's lights are spread evenly over its
+ * cells, so no corner is left dark. */
+static void place_grid(const struct scene_box *b, int n, int i, float out[3])
+{
+    double size[3];
+    for (int a = 0; a < 3; a++)
+        size[a] = fmax((double)b->max[a] - b->min[a], 1e-3);
+    double t = cbrt((double)n / (size[0] * size[1] * size[2]));
+    int dims[3];
+    for (int a = 0; a < 3; a++)
+        dims[a] = (int)fmax(1.0, floor(size[a] * t));
+    while ((long)dims[0] * dims[1] * dims[2] < n) {
+        int widest = 0;
+        for (int a = 1; a < 3; a++)
+            if (size[a] / dims[a] > size[widest] / dims[widest])
+                widest = a;
+        dims[widest]++;
+    }
+    int per_layer = dims[0] * dims[2];
+    int layers = (n + per_layer - 1) / per_layer;
+    int layer = i / per_layer, cell = i % per_layer;
+    if (layer == layers - 1) {
+        int in_last = n - (layers - 1) * per_layer;
+        cell = (int)((long)cell * per_layer / in_last);
+    }
+    int ix = cell % dims[0], iz = cell / dims[0];
+    out[0] = (float)(b->min[0] + (ix + 0.5) * size[0] / dims[0]);
+    out[1] = (float)(b->min[1] + (layer + 0.5) * size[1] / layers);
+    out[2] = (float)(b->min[2] + (iz + 0.5) * size[2] / dims[2]);
+}
+
+/* About sqrt(n)/2 clusters at hashed centres (kept 15% inside the volume),
+ * each light near its cluster's centre: a bell of width 3% of the volume
+ * across and 10% of its height, clamped to the volume. */
+static void place_clustered(const struct scene_box *b, int n, int i, float out[3])
+{
+    int clusters = (int)fmax(1.0, lround(sqrt((double)n) / 2.0));
+    uint32_t c = (uint32_t)(i % clusters);
+    for (int a = 0; a < 3; a++) {
+        double lo = b->min[a], size = (double)b->max[a] - b->min[a];
+        double centre = lo + size * (0.15 + 0.7 * scene_hash01(c, 21u + (uint32_t)a));
+        double bell = scene_hash01((uint32_t)i, 31u + (uint32_t)a) +
+                      scene_hash01((uint32_t)i, 41u + (uint32_t)a) +
+                      scene_hash01((uint32_t)i, 51u + (uint32_t)a) - 1.5;
+        double sigma = size * (a == 1 ? 0.1 : 0.03);
+        out[a] = (float)fmin(fmax(centre + 2.0 * sigma * bell, lo), (double)b->max[a]);
+    }
+}
+
+bool scene_place_lights(struct scene *s, float orbit)
+{
+    const struct scene_spec *spec = &s->spec;
+    s->light_count = spec->lights;
+    s->lights = calloc((size_t)(spec->lights ? spec->lights : 1), sizeof(*s->lights));
+    if (!s->lights)
+        return false;
+    for (int i = 0; i < s->light_count; i++) {
+        struct scene_light *l = &s->lights[i];
+        switch (spec->light_layout) {
+        case SCENE_LAYOUT_HALTON:
+            place_halton(&s->light_volume, i, l->centre);
+            break;
+        case SCENE_LAYOUT_UNIFORM:
+            place_uniform(&s->light_volume, i, l->centre);
+            break;
+        case SCENE_LAYOUT_GRID:
+            place_grid(&s->light_volume, s->light_count, i, l->centre);
+            break;
+        case SCENE_LAYOUT_CLUSTERED:
+            place_clustered(&s->light_volume, s->light_count, i, l->centre);
+            break;
+        }
+        l->orbit = orbit;
+        /* grid's radius 5 reaches about 100 objects a frame at async
+         * distance 20, close to the 90 the thesis reports (chapter 4.1). */
+        l->radius = (float)spec->light_radius;
+        scene_hsv_to_rgb(i * 0.618033988749895, 0.6, 1.6, l->color);
+        for (int k = 0; k < 3; k++)
+            l->color[k] *= (float)spec->light_intensity;
+        /* Whole frames per revolution keep positions exact for any frame
+         * index; light_speed divides the period (0 holds the lights still). */
+        int base_period = 180 + 40 * (i % 7);
+        l->period = spec->light_speed > 0
+                        ? (int)fmax(1.0, lround(base_period / spec->light_speed))
+                        : base_period;
+        l->phase = (i * 37) % base_period % l->period;
+    }
+    return true;
+}

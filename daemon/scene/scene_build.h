@@ -1,0 +1,49 @@
+#ifndef SHADEBENCH_SCENE_BUILD_H
+#define SHADEBENCH_SCENE_BUILD_H
+
+/* The steps of scene_init, shared by the files of daemon/scene only (the
+ * rest of the daemon reads scene.h). GL-free; a scene being built belongs
+ * to the one thread building it. */
+
+#include <stdint.h>
+
+#include "daemon/scene/scene.h"
+
+/* A fixed integer hash to [0, 1): the scene's only source of "randomness",
+ * so that every build of a spec is bit-identical. salt picks a stream. */
+double scene_hash01(uint32_t index, uint32_t salt);
+/* Van der Corput radical inverse of i in base. */
+double scene_radical_inverse(unsigned i, unsigned base);
+void scene_hsv_to_rgb(double h, double s, double v, float out[3]);
+
+/* Object-space sizes of the meshes (presets.c), known before the meshes
+ * are built (the sphere's tessellation depends on where objects stand). */
+extern const float SCENE_SPHERE_RADIUS, SCENE_CUBE_HALF, SCENE_PLANE_HALF;
+
+/* presets.c: instances (grouped by mesh, materials unset), the light
+ * volume, the lights (through scene_place_lights) and the static pose.
+ * Returns false when out of memory. */
+bool scene_build_preset(struct scene *s);
+
+/* lights.c: allocates and places spec.lights lights in s->light_volume
+ * with spec.light_layout, each circling its centre at radius orbit when the
+ * scene is dynamic. */
+bool scene_place_lights(struct scene *s, float orbit);
+
+/* materials.c: each instance's material from spec.materials and the
+ * spec's material values. */
+void scene_assign_materials(struct scene *s);
+
+/* camera.c: the orbit and flythrough parameters from the bounds and the
+ * static pose (needs instances, bounds and rig.eye/target/fovy/near/far). */
+void scene_rig_derive(struct scene *s);
+
+/* tessellation.c: s->sphere_segments from the spec, or for "auto" from the
+ * largest sphere on screen over the camera path (needs the rig). */
+void scene_choose_segments(struct scene *s);
+
+/* Column-major 4x4 helpers (camera.c). */
+void scene_mat4_mul(float out[16], const float a[16], const float b[16]);
+void scene_mat4_transform(const float m[16], const float p[3], float w, float out[4]);
+
+#endif

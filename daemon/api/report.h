@@ -3,7 +3,8 @@
 
 /* Self-contained HTML reports of a sweep or a job: charts and thumbnails are
  * embedded (base64 PNG), so a saved page reads without the daemon. No
- * scripts. GL-free. */
+ * scripts. GL-free; any thread (each call works on its own buffers; the
+ * sweep and job JSON are only read). */
 
 #include <jansson.h>
 #include <stdbool.h>

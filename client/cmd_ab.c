@@ -117,9 +117,21 @@ int cmd_ab(struct conn *ca, struct conn *cb, const struct options *o, const char
         if (nclean >= 2 && paired_log_ratio(va, vb, nclean, o->confidence, &r)) {
             gate_decide(&r, o->max_slowdown, &v);
         } else {
+            /* Too few clean pairs to decide; still report all the pairs. */
             memset(&v, 0, sizeof(v));
             v.outcome = GATE_INCONCLUSIVE;
-            snprintf(v.why, sizeof(v.why), "too few clean pairs (%zu)", nclean);
+            snprintf(v.why, sizeof(v.why), "too few clean pairs (%zu of %zu)", nclean, sa.n);
+            for (size_t i = 0; i < sa.n; i++) {
+                va[i] = sa.runs[i].ms;
+                vb[i] = sb.runs[i].ms;
+            }
+            if (paired_log_ratio(va, vb, sa.n, o->confidence, &r)) {
+                v.r = r;
+                size_t used = strlen(v.why);
+                snprintf(v.why + used, sizeof(v.why) - used,
+                         "; over all pairs, noisy ones included: B/A %.4f [%.4f, %.4f], not a "
+                         "verdict", r.ratio, r.lo, r.hi);
+            }
         }
         if (budget <= 0)
             break;

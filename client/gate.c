@@ -210,7 +210,7 @@ size_t gate_clean_values(const struct gate_run *runs, size_t n, double *values)
 bool gate_nonsemantic_field(const char *key)
 {
     static const char *const skip[] = {"labels", "repeat", "capture_interval", "reference",
-                                       "metrics", NULL};
+                                       "metrics", "timeout_s", NULL};
     for (const char *const *s = skip; *s; s++)
         if (strcmp(*s, key) == 0)
             return true;

@@ -2,6 +2,7 @@
 #include "client/junit.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -246,9 +247,9 @@ void junit_job_name(const json_t *spec, char *out, size_t cap)
         if (gate_nonsemantic_field(k) || !strcmp(k, "technique") || !strcmp(k, "scene") ||
             !strcmp(k, "frames") || !strcmp(k, "warmup_frames"))
             continue;
-        if (json_is_object(v)) {
+        if (json_is_object(v) || !strcmp(k, "look")) {
             if (!tech || strcmp(k, tech) != 0 || json_object_size(v) == 0)
-                continue; /* another technique's options, the look, or none */
+                continue; /* another technique's options, the look (hashed below), or none */
             size_t m;
             const char **sub = sorted_keys(v, &m);
             put(name, ncap, " %s(", k);
@@ -277,12 +278,27 @@ void junit_job_name(const json_t *spec, char *out, size_t cap)
             (long long)json_integer_value(json_object_get(scene, "height")),
             (long long)json_integer_value(json_object_get(scene, "lights")),
             json_is_true(json_object_get(scene, "dynamic")) ? "moving" : "still");
-        json_t *cam = json_object_get(scene, "camera");
-        const char *path = json_is_string(cam) ? json_string_value(cam)
-                                               : json_string_value(json_object_get(cam, "path"));
-        if (path && strcmp(path, "static") != 0)
-            put(name, ncap, " camera %s", path);
     }
+    /* The rest of the scene (layout, camera, materials, ...) and the look
+     * change the workload too, but spelled out they would bury the name:
+     * they go in as a short hash of their sorted JSON, stable across runs. */
+    json_t *rest = json_object();
+    if (json_is_object(scene)) {
+        json_t *s2 = json_deep_copy(scene);
+        static const char *const shown[] = {"preset", "width", "height", "lights", "dynamic"};
+        for (size_t i = 0; i < sizeof(shown) / sizeof(shown[0]); i++)
+            json_object_del(s2, shown[i]);
+        json_object_set_new(rest, "scene", s2);
+    }
+    if (json_object_get(spec, "look"))
+        json_object_set(rest, "look", json_object_get(spec, "look"));
+    char *text_rest = json_dumps(rest, JSON_SORT_KEYS | JSON_COMPACT);
+    uint32_t h = 2166136261u; /* FNV-1a */
+    for (const char *p = text_rest; p && *p; p++)
+        h = (h ^ (unsigned char)*p) * 16777619u;
+    put(name, ncap, " #%08x", h);
+    free(text_rest);
+    json_decref(rest);
     json_t *frames = json_object_get(spec, "frames");
     if (json_is_integer(frames))
         put(name, ncap, ", %lld frames", (long long)json_integer_value(frames));

@@ -19,7 +19,8 @@ static void usage(FILE *f)
             "Usage: shadebench-compare REFERENCE.png TEST.png [OPTION]...\n"
             "Compares TEST with REFERENCE: SSIM, PerceptualDiff, PSNR and FLIP as JSON.\n"
             "Exit status: 0 PerceptualDiff passes (or was not asked for), 1 it fails,\n"
-            "2 bad input.\n\n"
+            "2 bad input (including images over 8192x8192 pixels, refused before they\n"
+            "are decoded).\n\n"
             "  --metrics LIST          comma-separated: ssim,pdiff,psnr,flip (default all)\n"
             "  --fov DEG               PerceptualDiff field of view (default 22.6)\n"
             "  --threshold-pixels N    PerceptualDiff fails from N failing pixels (default 100)\n"
@@ -127,7 +128,7 @@ int main(int argc, char **argv)
         snprintf(flip_path, sizeof(flip_path), "%s/flip.png", diff_out);
     }
     json_t *result = metrics_compare(&ref, &test, &o, diff_out ? ssim_path : NULL,
-                                     diff_out ? flip_path : NULL, err, sizeof(err));
+                                     diff_out ? flip_path : NULL, NULL, err, sizeof(err));
     int rc = 2;
     if (!result) {
         fprintf(stderr, "shadebench-compare: %s\n", err);
@@ -136,6 +137,8 @@ int main(int argc, char **argv)
         json_object_set_new(result, "test", json_string(test_path));
         json_object_set_new(result, "width", json_integer(ref.width));
         json_object_set_new(result, "height", json_integer(ref.height));
+        json_object_set_new(result, "memory_budget_bytes",
+                            json_real(metrics_memory_bytes(ref.width, ref.height, o.flip_ppd)));
         json_dumpf(result, stdout, JSON_INDENT(2) | JSON_REAL_PRECISION(10));
         putchar('\n');
         json_t *pdiff = json_object_get(result, "pdiff");

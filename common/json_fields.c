@@ -149,7 +149,9 @@ bool jf_check_keys(const json_t *obj, const char *prefix, const char *const *kno
         }
         if (!found) {
             char field[64];
-            snprintf(field, sizeof(field), "%s%.*s", prefix, (int)jf_utf8_prefix(key, 40), key);
+            /* An empty key still gets a name the reader can see. */
+            const char *name = key[0] ? key : "\"\"";
+            snprintf(field, sizeof(field), "%s%.*s", prefix, (int)jf_utf8_prefix(name, 40), name);
             if (closest)
                 return job_error_set(err, field, "unknown field (did you mean '%s%s'?)",
                             prefix, closest);

@@ -1,6 +1,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "common/png_io.h"
 
+#include <errno.h>
 #include <png.h>
 #include <setjmp.h>
 #include <stdio.h>
@@ -35,7 +36,10 @@ bool png_write_by_rows(const char *path, int width, int height, png_row_fn row, 
     uint8_t *line = malloc((size_t)width * 3);
     FILE *f = line ? fopen(tmp, "wb") : NULL;
     if (!f) {
-        snprintf(err, errlen, line ? "cannot write %s" : "out of memory encoding %s", tmp);
+        if (line)
+            snprintf(err, errlen, "cannot write %s: %s", tmp, strerror(errno));
+        else
+            snprintf(err, errlen, "out of memory encoding %s", tmp);
         free(line);
         return false;
     }
@@ -65,7 +69,7 @@ bool png_write_by_rows(const char *path, int width, int height, png_row_fn row, 
     png_destroy_write_struct(&png, &info);
     free(line);
     if (fclose(f) != 0 || rename(tmp, path) != 0) {
-        snprintf(err, errlen, "cannot finish %s", path);
+        snprintf(err, errlen, "cannot finish %s: %s", path, strerror(errno));
         remove(tmp);
         return false;
     }
@@ -115,6 +119,15 @@ bool png_read_rgb_limit(const char *path, long long max_pixels, struct image *ou
         snprintf(err, errlen, "%s: cannot open", path);
         return false;
     }
+    bool ok = png_read_rgb_stream(f, path, max_pixels, out, err, errlen);
+    fclose(f);
+    return ok;
+}
+
+bool png_read_rgb_stream(FILE *f, const char *path, long long max_pixels, struct image *out,
+                         char *err, size_t errlen)
+{
+    memset(out, 0, sizeof(*out));
     struct png_errors perr = {""};
     png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &perr, on_png_error,
                                              on_png_warning);
@@ -161,13 +174,11 @@ bool png_read_rgb_limit(const char *path, long long max_pixels, struct image *ou
     out->height = (int)h;
     png_destroy_read_struct(&png, &info, NULL);
     free(rows);
-    fclose(f);
     return true;
 fail:
     png_destroy_read_struct(&png, &info, NULL);
     free(rows);
     image_finish(out);
-    fclose(f);
     return false;
 }
 

@@ -6,6 +6,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 struct image {
     int width, height;
@@ -37,6 +38,9 @@ bool png_write_by_rows(const char *path, int width, int height, png_row_fn row, 
 bool png_read_rgb_limit(const char *path, long long max_pixels, struct image *out, char *err,
                         size_t errlen);
 bool png_read_rgb(const char *path, struct image *out, char *err, size_t errlen);
+/* The same from an open stream (left open); path only names it in errors. */
+bool png_read_rgb_stream(FILE *f, const char *path, long long max_pixels, struct image *out,
+                         char *err, size_t errlen);
 void image_finish(struct image *img);
 
 /* Encodes img, shrunk by a box filter to at most max_width pixels wide, as a

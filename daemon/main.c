@@ -1,10 +1,12 @@
 #define _POSIX_C_SOURCE 200809L
 #include <getopt.h>
 #include <limits.h>
+#include <malloc.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <epoxy/gl.h>
@@ -32,6 +34,9 @@ struct options {
     int queue_size;
     int keep_jobs;
     double keep_days;
+    int max_connections;
+    int max_connections_per_ip;
+    double job_timeout;
     bool list_devices;
     bool gl_debug;
 };
@@ -53,6 +58,11 @@ static void usage(FILE *f)
             "                       FILE on every endpoint but /healthz (SIGHUP rereads it)\n"
             "  --keep-jobs N        keep the newest N finished jobs, remove older ones' files\n"
             "  --keep-days D        remove finished jobs older than D days\n"
+            "  --job-timeout S      running time a job may take when it gives no timeout_s\n"
+            "                       (default 86400; 0: no limit)\n"
+            "  --max-connections N  HTTP connections open at once, in total (default 4096)\n"
+            "  --max-connections-per-ip N\n"
+            "                       HTTP connections open at once from one address (default 64)\n"
             "  --config FILE        settings file (default " DEFAULT_CONFIG " if present)\n"
             "  --port-file FILE     write the bound port to FILE once listening\n"
             "  --list-devices       print the EGL devices and exit\n"
@@ -63,9 +73,12 @@ static void usage(FILE *f)
             "  --version, --help\n\n"
             "Settings come from, in rising order: defaults, the config file (lines of\n"
             "\"key = value\": listen, state-dir, device, queue-size, token, keep-jobs,\n"
-            "keep-days, log-level), the environment (SHADEBENCH_LISTEN, SHADEBENCH_STATE_DIR,\n"
+            "keep-days, job-timeout, max-connections, max-connections-per-ip, log-level),\n"
+            "the environment (SHADEBENCH_LISTEN, SHADEBENCH_STATE_DIR,\n"
             "SHADEBENCH_DEVICE, SHADEBENCH_QUEUE_SIZE, SHADEBENCH_TOKEN_FILE,\n"
-            "SHADEBENCH_KEEP_JOBS, SHADEBENCH_KEEP_DAYS, SHADEBENCH_LOG_LEVEL), the flags.\n");
+            "SHADEBENCH_KEEP_JOBS, SHADEBENCH_KEEP_DAYS, SHADEBENCH_JOB_TIMEOUT,\n"
+            "SHADEBENCH_MAX_CONNECTIONS, SHADEBENCH_MAX_CONNECTIONS_PER_IP,\n"
+            "SHADEBENCH_LOG_LEVEL), the flags.\n");
 }
 
 static bool parse_int(const char *s, int min, int max, int *out)
@@ -111,6 +124,15 @@ static bool apply_setting(struct options *o, const char *key, const char *value,
     } else if (strcmp(key, "keep-days") == 0) {
         if (!parse_number(value, 0, 1e6, &o->keep_days))
             rule = "must be a number of days from 0 (keep all)";
+    } else if (strcmp(key, "job-timeout") == 0) {
+        if (!parse_number(value, 0, 1e7, &o->job_timeout))
+            rule = "must be a number of seconds from 0 (no limit) to 10000000";
+    } else if (strcmp(key, "max-connections") == 0) {
+        if (!parse_int(value, 16, 1000000, &o->max_connections))
+            rule = "must be an integer from 16 to 1000000";
+    } else if (strcmp(key, "max-connections-per-ip") == 0) {
+        if (!parse_int(value, 1, 1000000, &o->max_connections_per_ip))
+            rule = "must be an integer from 1 to 1000000";
     } else if (strcmp(key, "log-level") == 0) {
         static const char *const levels[] = {"debug", "info", "warn", "error"};
         rule = "must be debug, info, warn or error";
@@ -169,7 +191,9 @@ static bool load_config(struct options *o, const char *path, bool required)
 static bool load_environment(struct options *o)
 {
     static const char *const keys[] = {"listen", "state-dir", "device", "queue-size",
-                                       "token-file", "keep-jobs", "keep-days", "log-level", NULL};
+                                       "token-file", "keep-jobs", "keep-days", "job-timeout",
+                                       "max-connections",
+                                       "max-connections-per-ip", "log-level", NULL};
     for (const char *const *k = keys; *k; k++) {
         char name[64] = "SHADEBENCH_";
         size_t n = strlen(name);
@@ -183,16 +207,48 @@ static bool load_environment(struct options *o)
     return true;
 }
 
-/* Reads the bearer token (surrounding whitespace dropped). */
+/* Reads the bearer token (surrounding whitespace dropped). A token that
+ * would not survive an HTTP header intact, or is longer than the server
+ * compares, is refused here with the reason rather than cut. */
 static bool read_token(const char *path, char *token, size_t cap)
 {
     size_t len = 0;
-    char *text = fs_read_file(path, cap - 1, &len);
-    if (!text)
+    char *text = fs_read_file(path, 65536, &len);
+    if (!text) {
+        LOG(LOG_ERROR, "cannot read the token file %s", path);
         return false;
-    snprintf(token, cap, "%s", trim(text));
+    }
+    const char *t = trim(text);
+    size_t n = strlen(t);
+    const char *why = NULL;
+    if (n == 0)
+        why = "it is empty";
+    else if (n >= cap)
+        why = "it is longer than the 4096 bytes a token may have";
+    for (size_t i = 0; !why && i < n; i++)
+        if ((unsigned char)t[i] <= 0x20 || (unsigned char)t[i] >= 0x7f)
+            why = "it must be printable ASCII without spaces";
+    if (why)
+        LOG(LOG_ERROR, "the token in %s (%zu bytes) is refused: %s", path, n, why);
+    else
+        memcpy(token, t, n + 1);
     free(text);
-    return token[0] != '\0';
+    return why == NULL;
+}
+
+/* Every HTTP connection is a descriptor: let the daemon open as many as its
+ * hard limit allows (systemd's default soft limit is 1024). */
+static rlim_t raise_fd_limit(void)
+{
+    struct rlimit rl;
+    if (getrlimit(RLIMIT_NOFILE, &rl) != 0)
+        return 1024;
+    if (rl.rlim_cur < rl.rlim_max) {
+        rl.rlim_cur = rl.rlim_max;
+        if (setrlimit(RLIMIT_NOFILE, &rl) != 0)
+            getrlimit(RLIMIT_NOFILE, &rl);
+    }
+    return rl.rlim_cur;
 }
 
 static int list_devices(void)
@@ -285,13 +341,24 @@ static int run_once(const struct options *o)
 
 static int serve(const struct options *o)
 {
-    char state_dir[PATH_MAX], token[512] = "";
+    char state_dir[PATH_MAX], token[HTTP_MAX_TOKEN_BYTES + 1] = "";
     const char *env = getenv("STATE_DIRECTORY");
     snprintf(state_dir, sizeof(state_dir), "%s",
              o->state_dir[0] ? o->state_dir : (env && *env ? env : "/var/lib/shadebench"));
-    if (o->token_file[0] && !read_token(o->token_file, token, sizeof(token))) {
-        LOG(LOG_ERROR, "cannot read a token from %s", o->token_file);
+    if (o->token_file[0] && !read_token(o->token_file, token, sizeof(token)))
         return 1;
+    struct http_limits limits;
+    http_limits_defaults(&limits);
+    if (o->max_connections)
+        limits.max_connections = (unsigned)o->max_connections;
+    if (o->max_connections_per_ip)
+        limits.max_connections_per_ip = (unsigned)o->max_connections_per_ip;
+    rlim_t fds = raise_fd_limit();
+    if (fds != RLIM_INFINITY && limits.max_connections + 64 > fds) {
+        LOG(LOG_WARN, "--max-connections %u lowered to %u: only %llu file descriptors allowed",
+            limits.max_connections, (unsigned)(fds > 128 ? fds - 64 : 64),
+            (unsigned long long)fds);
+        limits.max_connections = (unsigned)(fds > 128 ? fds - 64 : 64);
     }
     if (!fs_mkdir_p(state_dir)) {
         LOG(LOG_ERROR, "cannot create the state directory %s", state_dir);
@@ -330,7 +397,7 @@ static int serve(const struct options *o)
     }
     struct sweeps *sweeps = sweeps_create(q, technique_catalog());
     struct http_server *http =
-        sweeps ? http_server_create(o->listen, q, r, sweeps, err, sizeof(err)) : NULL;
+        sweeps ? http_server_create(o->listen, &limits, q, r, sweeps, err, sizeof(err)) : NULL;
     if (!http) {
         LOG(LOG_ERROR, "%s", sweeps ? err : "cannot start the sweep thread");
         sweeps_destroy(sweeps);
@@ -354,11 +421,12 @@ static int serve(const struct options *o)
         if (sig != SIGHUP)
             break;
         /* SIGHUP: reread the token so that it can be rotated without a restart. */
-        if (o->token_file[0] && read_token(o->token_file, token, sizeof(token))) {
-            http_server_set_token(http, token);
+        if (o->token_file[0] && read_token(o->token_file, token, sizeof(token)) &&
+            http_server_set_token(http, token)) {
             LOG(LOG_INFO, "SIGHUP: token reread from %s", o->token_file);
         } else {
-            LOG(LOG_INFO, "SIGHUP: nothing to reload");
+            LOG(LOG_INFO, "SIGHUP: %s", o->token_file[0] ? "the token is unchanged"
+                                                         : "nothing to reload");
         }
     }
     LOG(LOG_INFO, "signal %d: stopping", sig);
@@ -378,10 +446,17 @@ int main(int argc, char **argv)
         fprintf(stderr, "shadebenchd: %s\n", technique_catalog_error());
         return 1;
     }
-    struct options o = {.device = -1, .queue_size = 64};
+    /* Measurement integrity: glibc raises its mmap and trim thresholds as it
+     * frees large blocks, and the first job after a larger one then ran its
+     * frames up to 3 times slower (the heap top trimmed and faulted back in
+     * every frame). Fixed thresholds keep a job's timings independent of the
+     * jobs before it, for at most 128 MiB of free heap kept. */
+    mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
+    mallopt(M_TRIM_THRESHOLD, 128 * 1024 * 1024);
+    struct options o = {.device = -1, .queue_size = 64, .job_timeout = 86400};
     snprintf(o.listen, sizeof(o.listen), "127.0.0.1:8460");
     enum { OPT_LISTEN = 256, OPT_STATE, OPT_DEVICE, OPT_QUEUE, OPT_TOKEN, OPT_KEEP_JOBS,
-           OPT_KEEP_DAYS, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_ONCE, OPT_OUT, OPT_DEBUG,
+           OPT_KEEP_DAYS, OPT_JOB_TIMEOUT, OPT_MAX_CONN, OPT_MAX_CONN_IP, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_ONCE, OPT_OUT, OPT_DEBUG,
            OPT_LOG, OPT_VERSION, OPT_HELP };
     static const struct option longopts[] = {
         {"listen", required_argument, NULL, OPT_LISTEN},
@@ -391,6 +466,9 @@ int main(int argc, char **argv)
         {"token", required_argument, NULL, OPT_TOKEN},
         {"keep-jobs", required_argument, NULL, OPT_KEEP_JOBS},
         {"keep-days", required_argument, NULL, OPT_KEEP_DAYS},
+        {"job-timeout", required_argument, NULL, OPT_JOB_TIMEOUT},
+        {"max-connections", required_argument, NULL, OPT_MAX_CONN},
+        {"max-connections-per-ip", required_argument, NULL, OPT_MAX_CONN_IP},
         {"config", required_argument, NULL, OPT_CONFIG},
         {"port-file", required_argument, NULL, OPT_PORT_FILE},
         {"list-devices", no_argument, NULL, OPT_LIST},
@@ -418,6 +496,9 @@ int main(int argc, char **argv)
         case OPT_TOKEN: key = "token"; break;
         case OPT_KEEP_JOBS: key = "keep-jobs"; break;
         case OPT_KEEP_DAYS: key = "keep-days"; break;
+        case OPT_JOB_TIMEOUT: key = "job-timeout"; break;
+        case OPT_MAX_CONN: key = "max-connections"; break;
+        case OPT_MAX_CONN_IP: key = "max-connections-per-ip"; break;
         case OPT_LOG: key = "log-level"; break;
         case OPT_CONFIG: config = optarg; config_required = true; break;
         case OPT_PORT_FILE: o.port_file = optarg; break;
@@ -447,6 +528,7 @@ int main(int argc, char **argv)
         if (!apply_setting(&o, flags[i].key, flags[i].value, origin))
             return 2;
     }
+    job_spec_set_default_timeout(o.job_timeout);
     if (o.list_devices)
         return list_devices();
     if (o.once) {

@@ -6,36 +6,76 @@
 #include <microhttpd.h>
 #include <netdb.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include "config.h"
-#include "daemon/api/charts.h"
-#include "daemon/api/job_filter.h"
-#include "daemon/jobs/job_spec.h"
-#include "daemon/api/report.h"
 #include "common/log.h"
+#include "daemon/api/charts.h"
+#include "daemon/api/connections.h"
+#include "daemon/api/report.h"
+#include "daemon/api/routes.h"
+#include "daemon/harness/telemetry.h"
+#include "daemon/jobs/job_spec.h"
+#include "daemon/quality/metrics.h"
+#include "daemon/api/job_filter.h"
+#include "daemon/jobs/sweep_spec.h"
 #include "daemon/techniques/catalog.h"
 
 #ifndef MHD_HTTP_CONTENT_TOO_LARGE
 #define MHD_HTTP_CONTENT_TOO_LARGE 413
 #endif
+#ifndef MHD_HTTP_REQUEST_HEADER_FIELDS_TOO_LARGE
+#define MHD_HTTP_REQUEST_HEADER_FIELDS_TOO_LARGE 431
+#endif
 
-enum { MAX_CONNECTIONS = 256, MAX_WAIT_S = 3600 };
+enum {
+    MAX_WAIT_S = 3600,
+    /* Headers beyond this are answered 431 here, as JSON; beyond
+     * CONNECTION_MEMORY (libmicrohttpd's per-connection pool) it answers
+     * 431 itself, as HTML. */
+    MAX_HEADER_BYTES = 8192,
+    CONNECTION_MEMORY = 32 * 1024,
+    /* A DELETE of a running job waits this long for the job to stop, so
+     * that the answer usually shows its final state. */
+    CANCEL_WAIT_S = 5,
+    /* SIGTERM: how long the "stopping" answers of ended waits may take. */
+    STOP_GRACE_S = 2,
+};
+
+/* The status codes the request counters of /metrics keep apart. */
+static const unsigned COUNTED_CODES[] = {200, 202, 400, 401, 404, 405, 409, 413,
+                                         429, 431, 500, 503, 507, 0 /* other */};
+enum { NCODES = sizeof(COUNTED_CODES) / sizeof(COUNTED_CODES[0]) };
 
 struct http_server {
     struct MHD_Daemon *mhd;
+    struct connections *conns;
     struct queue *queue;
     struct runner *runner;
     struct sweeps *sweeps;
+    struct http_limits limits;
     int port;
     pthread_mutex_t token_lock;
-    char token[512];
+    char *token;
+    atomic_ullong requests[ROUTE_COUNT][NCODES];
 };
+
+void http_limits_defaults(struct http_limits *l)
+{
+    l->max_connections = 4096;
+    l->max_connections_per_ip = 64;
+    l->threads = 4;
+    l->header_timeout_s = 10;
+    l->body_timeout_s = 30;
+    l->idle_timeout_s = 30;
+}
 
 /* Compares in time that depends on the expected token's length only, never
  * on where the first differing byte is. */
@@ -51,7 +91,7 @@ static bool token_matches(const char *given, const char *expected)
 static bool authorized(struct http_server *s, struct MHD_Connection *c)
 {
     pthread_mutex_lock(&s->token_lock);
-    bool ok = s->token[0] == '\0';
+    bool ok = !s->token || s->token[0] == '\0';
     if (!ok) {
         const char *auth = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Authorization");
         ok = auth && strncmp(auth, "Bearer ", 7) == 0 && token_matches(auth + 7, s->token);
@@ -60,17 +100,29 @@ static bool authorized(struct http_server *s, struct MHD_Connection *c)
     return ok;
 }
 
-void http_server_set_token(struct http_server *s, const char *token)
+bool http_server_set_token(struct http_server *s, const char *token)
 {
+    if (token && strlen(token) > HTTP_MAX_TOKEN_BYTES)
+        return false;
+    char *copy = strdup(token ? token : "");
+    if (!copy)
+        return false;
     pthread_mutex_lock(&s->token_lock);
-    snprintf(s->token, sizeof(s->token), "%s", token ? token : "");
+    free(s->token);
+    s->token = copy;
     pthread_mutex_unlock(&s->token_lock);
+    return true;
 }
 
+/* One request: the route, its body, and what a resumed wait answers. */
 struct request {
+    struct conn *conn;
+    struct route route;
     char *body;
     size_t len;
     bool too_large;
+    bool waiting;         /* suspended; the next call is the resume */
+    unsigned wait_status; /* 200 for ?wait=, 202 for a DELETE that waits */
 };
 
 static enum MHD_Result respond_text(struct MHD_Connection *c, unsigned status,
@@ -84,22 +136,28 @@ static enum MHD_Result respond_text(struct MHD_Connection *c, unsigned status,
     }
     MHD_add_response_header(resp, "Content-Type", type);
     MHD_add_response_header(resp, "Cache-Control", "no-store");
-    if (status == MHD_HTTP_METHOD_NOT_ALLOWED)
-        MHD_add_response_header(resp, "Allow", "GET, HEAD, POST, DELETE");
     if (status == MHD_HTTP_UNAUTHORIZED)
         MHD_add_response_header(resp, "WWW-Authenticate", "Bearer realm=\"shadebench\"");
+    connections_set_status(connections_of(c), status);
     enum MHD_Result ret = MHD_queue_response(c, status, resp);
     MHD_destroy_response(resp);
     return ret;
 }
 
-/* Takes ownership of body. */
+/* Takes ownership of body. A body that cannot be built or printed still
+ * gets an answer: a fixed 500. */
 static enum MHD_Result respond_json(struct MHD_Connection *c, unsigned status, json_t *body)
 {
-    char *text = json_dumps(body, JSON_COMPACT);
+    char *text = body ? json_dumps(body, JSON_COMPACT) : NULL;
     json_decref(body);
-    if (!text)
-        return MHD_NO;
+    if (!text) {
+        static const char fallback[] =
+            "{\"error\":{\"field\":\"body\",\"message\":\"the answer could not be built\"}}\n";
+        text = strdup(fallback);
+        status = MHD_HTTP_INTERNAL_SERVER_ERROR;
+        if (!text)
+            return MHD_NO;
+    }
     size_t len = strlen(text);
     char *with_nl = realloc(text, len + 2);
     if (!with_nl) {
@@ -120,6 +178,26 @@ static enum MHD_Result respond_error(struct MHD_Connection *c, unsigned status,
     return respond_json(c, status, job_error_to_json(&e));
 }
 
+static enum MHD_Result respond_405(struct MHD_Connection *c, const char *allow, const char *rule)
+{
+    struct job_error e;
+    snprintf(e.field, sizeof(e.field), "method");
+    snprintf(e.message, sizeof(e.message), "%s", rule);
+    char *text = json_dumps(job_error_to_json(&e), JSON_COMPACT);
+    struct MHD_Response *resp =
+        text ? MHD_create_response_from_buffer(strlen(text), text, MHD_RESPMEM_MUST_FREE) : NULL;
+    if (!resp) {
+        free(text);
+        return respond_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "method", rule);
+    }
+    MHD_add_response_header(resp, "Content-Type", "application/json");
+    MHD_add_response_header(resp, "Allow", allow);
+    connections_set_status(connections_of(c), MHD_HTTP_METHOD_NOT_ALLOWED);
+    enum MHD_Result ret = MHD_queue_response(c, MHD_HTTP_METHOD_NOT_ALLOWED, resp);
+    MHD_destroy_response(resp);
+    return ret;
+}
+
 static enum MHD_Result respond_file(struct MHD_Connection *c, const char *path,
                                     const char *type)
 {
@@ -136,31 +214,140 @@ static enum MHD_Result respond_file(struct MHD_Connection *c, const char *path,
         return MHD_NO;
     }
     MHD_add_response_header(resp, "Content-Type", type);
+    connections_set_status(connections_of(c), MHD_HTTP_OK);
     enum MHD_Result ret = MHD_queue_response(c, MHD_HTTP_OK, resp);
     MHD_destroy_response(resp);
     return ret;
 }
 
-static bool valid_id(const char *id, size_t len)
+/* The daemon's memory budget: what its own buffers can reach at the limits
+ * the API accepts, by part. The GL driver's memory (framebuffers, textures,
+ * compiled shaders) is the driver's and not counted. */
+static json_t *memory_json(const struct http_server *s, double *total)
 {
-    if (len == 0 || len >= 24)
-        return false;
-    for (size_t i = 0; i < len; i++)
-        if (!((id[i] >= '0' && id[i] <= '9') || id[i] == '-'))
-            return false;
-    return true;
+    const double side = 8192.0, frame = side * side * 4.0;
+    /* The render thread's captures (bounded per job) and one read-back frame
+     * for the reference; its per-frame series (3 doubles a frame, 1,000,000
+     * frames at most). */
+    double captures = JOB_MAX_CAPTURE_BYTES, render = frame + 1e6 * 3 * sizeof(double);
+    /* The metrics thread scores the previous job while the next renders: its
+     * bound at the largest image and the widest FLIP filter. */
+    double metrics = metrics_memory_bytes(8192, 8192, 1000.0);
+    /* libmicrohttpd's per-connection pool plus a body buffer, per connection. */
+    double http = (double)s->limits.max_connections * (CONNECTION_MEMORY + JOB_MAX_BODY_BYTES);
+    *total = captures + render + metrics + http;
+    return json_pack("{s:f, s:f, s:f, s:f, s:f, s:s}", "budget_bytes", *total, "captures_bytes",
+                     captures, "render_bytes", render, "metrics_bytes", metrics, "http_bytes",
+                     http, "excludes", "the GL driver's own memory");
 }
 
 static json_t *info_json(struct http_server *s)
 {
+    double total;
+    json_t *memory = memory_json(s, &total);
     /* From the GL-free catalogue: HTTP threads never touch GL. */
     json_t *techs = technique_catalog_json(technique_catalog());
-    return json_pack("{s:s, s:s, s:s, s:o, s:o, s:o, s:{s:i, s:i, s:i}}", "name", "shadebenchd",
-                     "version", PACKAGE_VERSION, "api", "v1", "device",
-                     runner_device_json(s->runner), "techniques", techs, "sweepable",
-                     sweep_params_json(technique_catalog()), "limits",
+    const struct http_limits *l = &s->limits;
+    return json_pack("{s:s, s:s, s:s, s:o, s:o, s:o, s:o, s:o, s:{s:i, s:i, s:i, s:I, s:I, s:f, "
+                     "s:f, s:I, s:f, s:I, s:I}}",
+                     "name", "shadebenchd", "version", PACKAGE_VERSION, "api", "v1", "memory",
+                     memory, "device",
+                     runner_device_json(s->runner), "techniques", techs,
+                     "effects", effect_catalog_json(), /* post hook: look.post's effects */
+                     "sweepable", sweep_params_json(technique_catalog()), "limits",
                      "max_body_bytes", JOB_MAX_BODY_BYTES, "max_queued_jobs",
-                     queue_max_queued(s->queue), "max_wait_s", MAX_WAIT_S);
+                     queue_max_queued(s->queue), "max_wait_s", MAX_WAIT_S, "max_connections",
+                     (json_int_t)l->max_connections, "max_connections_per_ip",
+                     (json_int_t)l->max_connections_per_ip, "header_timeout_s",
+                     l->header_timeout_s, "body_timeout_s", l->body_timeout_s,
+                     "max_token_bytes", (json_int_t)HTTP_MAX_TOKEN_BYTES, "default_job_timeout_s",
+                     job_spec_default_timeout(), "max_captures",
+                     (json_int_t)JOB_MAX_CAPTURES, "max_image_pixels", (json_int_t)IMAGE_MAX_PIXELS);
+}
+
+/* GET /metrics: Prometheus text format 0.0.4. */
+static enum MHD_Result respond_metrics(struct http_server *s, struct MHD_Connection *c)
+{
+    char *text = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&text, &len);
+    if (!f)
+        return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "metrics", "out of memory");
+    json_t *list = queue_list_json(s->queue);
+    size_t counts[JOB_INTERRUPTED + 1] = {0};
+    size_t i;
+    json_t *job;
+    json_array_foreach(json_object_get(list, "jobs"), i, job) {
+        const char *st = json_string_value(json_object_get(job, "status"));
+        for (int k = JOB_QUEUED; st && k <= JOB_INTERRUPTED; k++)
+            if (strcmp(st, job_status_name((enum job_status)k)) == 0)
+                counts[k]++;
+    }
+    json_decref(list);
+    fprintf(f, "# HELP shadebench_jobs Jobs in the store, by status.\n"
+               "# TYPE shadebench_jobs gauge\n");
+    for (int k = JOB_QUEUED; k <= JOB_INTERRUPTED; k++)
+        fprintf(f, "shadebench_jobs{status=\"%s\"} %zu\n", job_status_name((enum job_status)k),
+                counts[k]);
+    fprintf(f, "# HELP shadebench_queue_depth Jobs waiting for the render thread.\n"
+               "# TYPE shadebench_queue_depth gauge\n"
+               "shadebench_queue_depth %zu\n", counts[JOB_QUEUED]);
+    fprintf(f, "# HELP shadebench_queue_capacity Jobs that may wait at once.\n"
+               "# TYPE shadebench_queue_capacity gauge\n"
+               "shadebench_queue_capacity %d\n", queue_max_queued(s->queue));
+    struct telemetry t;
+    telemetry_read(&t);
+    fprintf(f, "# HELP shadebench_frames_rendered_total Frames rendered for jobs (warm-up and timed).\n"
+               "# TYPE shadebench_frames_rendered_total counter\n"
+               "shadebench_frames_rendered_total %llu\n", t.frames);
+    fprintf(f, "# HELP shadebench_render_busy_seconds_total Seconds the render thread spent on jobs.\n"
+               "# TYPE shadebench_render_busy_seconds_total counter\n"
+               "shadebench_render_busy_seconds_total %.6f\n", t.render_busy_s);
+    fprintf(f, "# HELP shadebench_metrics_seconds_total Seconds the metrics stage spent scoring captures.\n"
+               "# TYPE shadebench_metrics_seconds_total counter\n"
+               "shadebench_metrics_seconds_total %.6f\n", t.metrics_s);
+    fprintf(f, "# HELP shadebench_metrics_captures_total Captures scored against their reference.\n"
+               "# TYPE shadebench_metrics_captures_total counter\n"
+               "shadebench_metrics_captures_total %llu\n", t.captures_scored);
+    struct connections_stats cs;
+    connections_stats(s->conns, &cs);
+    fprintf(f, "# HELP shadebench_http_long_polls Requests suspended in a wait (?wait= or a cancel).\n"
+               "# TYPE shadebench_http_long_polls gauge\n"
+               "shadebench_http_long_polls %zu\n", cs.waiting);
+    fprintf(f, "# HELP shadebench_http_connections Open HTTP connections.\n"
+               "# TYPE shadebench_http_connections gauge\n"
+               "shadebench_http_connections %zu\n", cs.open);
+    fprintf(f, "# HELP shadebench_http_connections_cut_total Connections shut for headers or a body "
+               "later than their deadline.\n"
+               "# TYPE shadebench_http_connections_cut_total counter\n"
+               "shadebench_http_connections_cut_total{phase=\"headers\"} %llu\n"
+               "shadebench_http_connections_cut_total{phase=\"body\"} %llu\n",
+            cs.header_timeouts, cs.body_timeouts);
+    fprintf(f, "# HELP shadebench_http_waits_abandoned_total Waits ended because their client hung up.\n"
+               "# TYPE shadebench_http_waits_abandoned_total counter\n"
+               "shadebench_http_waits_abandoned_total %llu\n", cs.waits_gone);
+    fprintf(f, "# HELP shadebench_http_requests_total HTTP requests answered, by route and status code.\n"
+               "# TYPE shadebench_http_requests_total counter\n");
+    for (int r = 0; r < ROUTE_COUNT; r++)
+        for (size_t k = 0; k < NCODES; k++) {
+            unsigned long long n = atomic_load(&s->requests[r][k]);
+            if (n == 0)
+                continue;
+            char code[8];
+            snprintf(code, sizeof(code), COUNTED_CODES[k] ? "%u" : "other", COUNTED_CODES[k]);
+            fprintf(f, "shadebench_http_requests_total{route=\"%s\",code=\"%s\"} %llu\n",
+                    route_label((enum route_kind)r), code, n);
+        }
+    double budget;
+    json_decref(memory_json(s, &budget));
+    fprintf(f, "# HELP shadebench_memory_budget_bytes The daemon's memory budget (parts in /v1/info).\n"
+               "# TYPE shadebench_memory_budget_bytes gauge\n"
+               "shadebench_memory_budget_bytes %.0f\n", budget);
+    if (fclose(f) != 0 || !text) {
+        free(text);
+        return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "metrics", "out of memory");
+    }
+    return respond_text(c, MHD_HTTP_OK, text, len, "text/plain; version=0.0.4; charset=utf-8");
 }
 
 static enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *c,
@@ -183,9 +370,8 @@ static enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *
     }
     case QUEUE_STOPPING:
         return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "body", "the daemon is stopping");
-    default:
-        return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "body",
-                             "cannot create the job's directory under the state directory");
+    default: /* QUEUE_IO_ERROR: not persisted, so not accepted */
+        return respond_error(c, MHD_HTTP_INSUFFICIENT_STORAGE, "state_dir", queue_submit_error());
     }
     char url[64];
     snprintf(url, sizeof(url), "/v1/jobs/%s", id);
@@ -209,17 +395,10 @@ static bool parse_wait(struct MHD_Connection *c, double *wait)
     return true;
 }
 
-/* ".../charts/NAME.svg" or ".png": renders from the JSON of a sweep or job. */
 static enum MHD_Result respond_chart(struct MHD_Connection *c, const json_t *subject,
-                                     const char *file, bool is_sweep, const json_t *device)
+                                     const struct route *r, bool is_sweep, const json_t *device)
 {
-    char name[32];
-    const char *dot = strrchr(file, '.');
-    if (!dot || (size_t)(dot - file) >= sizeof(name) ||
-        (strcmp(dot, ".svg") != 0 && strcmp(dot, ".png") != 0))
-        return respond_error(c, MHD_HTTP_NOT_FOUND, "chart", "charts are NAME.svg or NAME.png");
-    snprintf(name, sizeof(name), "%.*s", (int)(dot - file), file);
-    enum chart_format format = strcmp(dot, ".svg") == 0 ? CHART_SVG : CHART_PNG;
+    enum chart_format format = r->chart_png ? CHART_PNG : CHART_SVG;
     struct chart_options o = {.device = device};
     o.series = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "series");
     if (o.series && strcmp(o.series, "frame_ms") && strcmp(o.series, "gpu_ms") && strcmp(o.series, "cpu_ms"))
@@ -230,11 +409,11 @@ static enum MHD_Result respond_chart(struct MHD_Connection *c, const json_t *sub
     o.flip = y && strcmp(y, "flip") == 0;
     char err[256];
     size_t len = 0;
-    char *data = is_sweep ? charts_sweep(subject, name, format, &o, &len, err, sizeof(err))
-                          : charts_job(subject, name, format, &o, &len, err, sizeof(err));
+    char *data = is_sweep ? charts_sweep(subject, r->chart, format, &o, &len, err, sizeof(err))
+                          : charts_job(subject, r->chart, format, &o, &len, err, sizeof(err));
     if (!data)
         return respond_error(c, MHD_HTTP_NOT_FOUND, "chart", err);
-    return respond_text(c, MHD_HTTP_OK, data, len, format == CHART_SVG ? "image/svg+xml" : "image/png");
+    return respond_text(c, MHD_HTTP_OK, data, len, r->chart_png ? "image/png" : "image/svg+xml");
 }
 
 struct list_args {
@@ -272,56 +451,110 @@ static enum MHD_Result respond_html(struct MHD_Connection *c, char *html, size_t
     return respond_text(c, MHD_HTTP_OK, html, len, "text/html; charset=utf-8");
 }
 
-static enum MHD_Result job_routes(struct http_server *s, struct MHD_Connection *c,
-                                  const char *method, const char *rest)
+static bool finished_status(enum job_status st)
 {
-    /* rest is what follows "/v1/jobs/": ID, ID/timings.csv or ID/frames/K.png */
-    const char *slash = strchr(rest, '/');
-    size_t id_len = slash ? (size_t)(slash - rest) : strlen(rest);
-    if (!valid_id(rest, id_len))
-        return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
-    char id[24];
-    memcpy(id, rest, id_len);
-    id[id_len] = '\0';
-    bool get = strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
+    return st != JOB_QUEUED && st != JOB_RUNNING;
+}
 
-    if (!slash) {
-        if (get) {
-            double wait;
-            if (!parse_wait(c, &wait))
-                return respond_error(c, MHD_HTTP_BAD_REQUEST, "wait",
-                                     "must be a number of seconds from 0 to 3600");
-            json_t *job = queue_job_json(s->queue, id, wait);
-            if (!job)
-                return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
-            return respond_json(c, MHD_HTTP_OK, job);
-        }
-        if (strcmp(method, "DELETE") == 0) {
-            switch (queue_cancel(s->queue, id)) {
-            case CANCEL_NOT_FOUND:
-                return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
-            case CANCEL_FINISHED:
-                return respond_error(c, MHD_HTTP_CONFLICT, "id",
-                                     "the job has already finished");
-            case CANCEL_DONE:
-                return respond_json(c, MHD_HTTP_OK, queue_job_json(s->queue, id, 0));
-            case CANCEL_REQUESTED:
-                /* The render thread stops at the next frame; give it a moment so
-                 * the answer usually shows the final state. */
-                return respond_json(c, MHD_HTTP_ACCEPTED, queue_job_json(s->queue, id, 5));
-            }
-        }
-        return respond_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "method",
-                             "use GET or DELETE on a job");
-    }
+static bool sweep_finished(const json_t *sw)
+{
+    const char *st = json_string_value(json_object_get(sw, "status"));
+    return !st || (strcmp(st, "queued") != 0 && strcmp(st, "running") != 0);
+}
 
-    if (strcmp(slash + 1, "report.html") == 0) {
-        if (!get)
-            return respond_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "method", "use GET");
+/* The watcher's question: may a wait on kind/id end now? */
+static bool wait_done(void *ctx, enum wait_kind kind, const char *id)
+{
+    struct http_server *s = ctx;
+    if (kind == WAIT_JOB) {
         char dir[PATH_MAX];
-        enum job_status status;
-        json_t *job = queue_job_json(s->queue, id, 0);
-        if (!job || !queue_job_dir(s->queue, id, dir, sizeof(dir), &status)) {
+        enum job_status st;
+        return !queue_job_dir(s->queue, id, dir, sizeof(dir), &st) || finished_status(st);
+    }
+    json_t *sw = sweeps_json(s->sweeps, id, 0);
+    bool done = sweep_finished(sw);
+    json_decref(sw);
+    return done;
+}
+
+static void on_queue_change(void *ctx)
+{
+    connections_poke(ctx);
+}
+
+/* Holds the request without a thread until the job or sweep finishes or
+ * wait_s pass (answered by answer_waited once resumed). */
+static enum MHD_Result suspend(struct http_server *s, struct MHD_Connection *c,
+                               struct request *req, enum wait_kind kind, double wait_s,
+                               unsigned status)
+{
+    if (!connections_suspend(s->conns, req->conn, kind, req->route.id, wait_s))
+        return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "wait",
+                             "the daemon is stopping; ask again once it is back");
+    req->waiting = true;
+    req->wait_status = status;
+    return MHD_YES;
+}
+
+static enum MHD_Result answer_waited(struct http_server *s, struct MHD_Connection *c,
+                                     struct request *req)
+{
+    req->waiting = false;
+    enum wake why = connections_wake(req->conn);
+    if (why == WAKE_GONE)
+        return MHD_NO; /* nobody to answer: close */
+    if (why == WAKE_STOPPING && req->wait_status == MHD_HTTP_OK)
+        return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "wait",
+                             "the daemon is stopping: the wait ended early; ask again once it "
+                             "is back");
+    bool sweep = req->route.kind == ROUTE_SWEEP;
+    json_t *body = sweep ? sweeps_json(s->sweeps, req->route.id, 0)
+                         : queue_job_json(s->queue, req->route.id, 0);
+    if (!body)
+        return respond_error(c, MHD_HTTP_NOT_FOUND, "id", sweep ? "no such sweep" : "no such job");
+    return respond_json(c, req->wait_status, body);
+}
+
+static enum MHD_Result job_resource(struct http_server *s, struct MHD_Connection *c,
+                                    const char *method, struct request *req)
+{
+    const struct route *r = &req->route;
+    bool get = strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
+    char dir[PATH_MAX], path[PATH_MAX + 64];
+    enum job_status status;
+
+    if (r->kind == ROUTE_JOB && get) {
+        double wait;
+        if (!parse_wait(c, &wait))
+            return respond_error(c, MHD_HTTP_BAD_REQUEST, "wait",
+                                 "must be a number of seconds from 0 to 3600");
+        if (!queue_job_dir(s->queue, r->id, dir, sizeof(dir), &status))
+            return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
+        if (wait > 0 && !finished_status(status))
+            return suspend(s, c, req, WAIT_JOB, wait, MHD_HTTP_OK);
+        json_t *job = queue_job_json(s->queue, r->id, 0);
+        if (!job)
+            return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
+        return respond_json(c, MHD_HTTP_OK, job);
+    }
+    if (r->kind == ROUTE_JOB) { /* DELETE */
+        switch (queue_cancel(s->queue, r->id)) {
+        case CANCEL_NOT_FOUND:
+            return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
+        case CANCEL_FINISHED:
+            return respond_error(c, MHD_HTTP_CONFLICT, "id", "the job has already finished");
+        case CANCEL_DONE:
+            return respond_json(c, MHD_HTTP_OK, queue_job_json(s->queue, r->id, 0));
+        case CANCEL_REQUESTED:
+            /* The job stops at its next frame or metric tile; give it a moment
+             * so that the answer usually shows the final state. */
+            return suspend(s, c, req, WAIT_JOB, CANCEL_WAIT_S, MHD_HTTP_ACCEPTED);
+        }
+        return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "id", "unexpected cancel result");
+    }
+    if (r->kind == ROUTE_JOB_REPORT) {
+        json_t *job = queue_job_json(s->queue, r->id, 0);
+        if (!job || !queue_job_dir(s->queue, r->id, dir, sizeof(dir), &status)) {
             json_decref(job);
             return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
         }
@@ -332,50 +565,28 @@ static enum MHD_Result job_routes(struct http_server *s, struct MHD_Connection *
         json_decref(job);
         return respond_html(c, html, len);
     }
-    if (strncmp(slash + 1, "charts/", 7) == 0) {
-        if (!get)
-            return respond_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "method", "use GET");
-        json_t *job = queue_job_json(s->queue, id, 0);
+    if (r->kind == ROUTE_JOB_CHART) {
+        json_t *job = queue_job_json(s->queue, r->id, 0);
         if (!job)
             return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
         enum MHD_Result ret =
             json_object_get(job, "result")
-                ? respond_chart(c, job, slash + 8, false, NULL)
+                ? respond_chart(c, job, r, false, NULL)
                 : respond_error(c, MHD_HTTP_CONFLICT, "id", "the job has no result yet");
         json_decref(job);
         return ret;
     }
-    /* Per-capture images: URL folder -> file prefix in the job's directory. */
-    static const char *const kinds[][2] = {
-        {"frames/", "frame"}, {"reference/", "reference"}, {"ssim/", "ssim"}, {"flip/", "flip"},
-    };
-    const char *sub = slash + 1, *prefix = NULL;
-    char dir[PATH_MAX], path[PATH_MAX + 64];
-    enum job_status status;
-    bool csv = strcmp(sub, "timings.csv") == 0;
-    int frame = 0;
-    char tail[8] = "";
-    for (size_t k = 0; k < sizeof(kinds) / sizeof(kinds[0]) && !prefix; k++) {
-        size_t len = strlen(kinds[k][0]);
-        if (strncmp(sub, kinds[k][0], len) == 0 &&
-            sscanf(sub + len, "%9d%7s", &frame, tail) == 2 && strcmp(tail, ".png") == 0 && frame > 0)
-            prefix = kinds[k][1];
-    }
-    bool png = prefix != NULL;
-    if (!csv && !png)
-        return respond_error(c, MHD_HTTP_NOT_FOUND, "url", "no such resource");
-    if (!get)
-        return respond_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "method", "use GET");
-    if (!queue_job_dir(s->queue, id, dir, sizeof(dir), &status))
+    /* Files: timings.csv and the per-capture images. */
+    if (!queue_job_dir(s->queue, r->id, dir, sizeof(dir), &status))
         return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
     if (status != JOB_DONE)
         return respond_error(c, MHD_HTTP_CONFLICT, "id",
                              "the job has not finished: its files exist once it is done");
-    if (csv) {
+    if (r->kind == ROUTE_JOB_TIMINGS) {
         snprintf(path, sizeof(path), "%s/timings.csv", dir);
         return respond_file(c, path, "text/csv");
     }
-    snprintf(path, sizeof(path), "%s/%s-%06d.png", dir, prefix, frame);
+    snprintf(path, sizeof(path), "%s/%s-%06d.png", dir, route_image_prefix(r->image), r->frame);
     if (access(path, R_OK) != 0)
         return respond_error(c, MHD_HTTP_NOT_FOUND, "frame",
                              "no such image: this frame was not captured, or the job has no "
@@ -383,126 +594,114 @@ static enum MHD_Result job_routes(struct http_server *s, struct MHD_Connection *
     return respond_file(c, path, "image/png");
 }
 
-static enum MHD_Result sweep_routes(struct http_server *s, struct MHD_Connection *c,
-                                    const char *method, const char *rest, struct request *req)
+static enum MHD_Result post_sweep(struct http_server *s, struct MHD_Connection *c,
+                                  struct request *req)
 {
-    bool get = strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
-    if (!*rest) {
-        if (strcmp(method, "POST") == 0) {
-            if (req->too_large)
-                return respond_error(c, MHD_HTTP_CONTENT_TOO_LARGE, "body",
-                                     "the sweep must be at most 65536 bytes");
-            json_error_t jerr;
-            json_t *body = json_loadb(req->body ? req->body : "", req->len, JSON_REJECT_DUPLICATES, &jerr);
-            if (!body) {
-                char msg[256];
-                snprintf(msg, sizeof(msg), "malformed JSON at line %d, column %d: %s", jerr.line,
-                         jerr.column, jerr.text);
-                return respond_error(c, MHD_HTTP_BAD_REQUEST, "body", msg);
-            }
-            struct sweep_spec spec;
-            struct job_error err;
-            if (!sweep_spec_parse(body, technique_catalog(), &spec, &err)) {
-                sweep_spec_finish(&spec);
-                json_decref(body);
-                return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
-            }
-            char id[24];
-            bool ok = sweeps_submit(s->sweeps, &spec, body, id);
-            sweep_spec_finish(&spec);
-            json_decref(body);
-            if (!ok)
-                return respond_error(c, MHD_HTTP_TOO_MANY_REQUESTS, "body",
-                                     "too many sweeps are waiting; retry later");
-            char url[64];
-            snprintf(url, sizeof(url), "/v1/sweeps/%s", id);
-            return respond_json(c, MHD_HTTP_ACCEPTED,
-                                json_pack("{s:s, s:s, s:s}", "id", id, "status", "queued", "url", url));
-        }
-        if (get)
-            return respond_json(c, MHD_HTTP_OK, sweeps_list_json(s->sweeps));
-        return respond_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "method",
-                             "use GET to list sweeps or POST to start one");
+    json_error_t jerr;
+    json_t *body = json_loadb(req->body ? req->body : "", req->len, JSON_REJECT_DUPLICATES, &jerr);
+    if (!body) {
+        struct job_error e;
+        job_error_set(&e, "body", "malformed JSON at line %d, column %d: %s", jerr.line,
+                      jerr.column, jerr.text);
+        return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&e));
     }
-    size_t id_len = strcspn(rest, "/");
-    if (!valid_id(rest, id_len))
-        return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such sweep");
+    struct sweep_spec spec;
+    struct job_error err;
+    if (!sweep_spec_parse(body, technique_catalog(), &spec, &err)) {
+        sweep_spec_finish(&spec);
+        json_decref(body);
+        return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
+    }
     char id[24];
-    memcpy(id, rest, id_len);
-    id[id_len] = '\0';
-    if (rest[id_len]) {
-        const char *sub = rest + id_len + 1;
-        if (!get)
-            return respond_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "method", "use GET");
-        json_t *sw = sweeps_json(s->sweeps, id, 0);
-        if (!sw)
-            return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such sweep");
-        enum MHD_Result ret;
-        if (strncmp(sub, "charts/", 7) == 0) {
-            json_t *device = runner_device_json(s->runner);
-            ret = respond_chart(c, sw, sub + 7, true, device);
-            json_decref(device);
-        } else if (strcmp(sub, "report.html") == 0) {
-            json_t *device = runner_device_json(s->runner);
-            size_t len = 0;
-            char *html = report_sweep_html(sw, device, point_job_dir, s, &len);
-            json_decref(device);
-            ret = respond_html(c, html, len);
-        } else
-            ret = respond_error(c, MHD_HTTP_NOT_FOUND, "url", "no such resource");
-        json_decref(sw);
-        return ret;
-    }
-    if (get) {
+    enum queue_submit_result r = sweeps_submit(s->sweeps, &spec, body, id);
+    sweep_spec_finish(&spec);
+    json_decref(body);
+    if (r == QUEUE_IO_ERROR) /* not persisted, so not accepted */
+        return respond_error(c, MHD_HTTP_INSUFFICIENT_STORAGE, "state_dir", queue_submit_error());
+    if (r != QUEUE_OK)
+        return respond_error(c, MHD_HTTP_TOO_MANY_REQUESTS, "body",
+                             "too many sweeps are waiting; retry later");
+    char url[64];
+    snprintf(url, sizeof(url), "/v1/sweeps/%s", id);
+    return respond_json(c, MHD_HTTP_ACCEPTED,
+                        json_pack("{s:s, s:s, s:s}", "id", id, "status", "queued", "url", url));
+}
+
+static enum MHD_Result sweep_resource(struct http_server *s, struct MHD_Connection *c,
+                                      const char *method, struct request *req)
+{
+    const struct route *r = &req->route;
+    bool get = strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
+    if (r->kind == ROUTE_SWEEP && get) {
         double wait;
         if (!parse_wait(c, &wait))
             return respond_error(c, MHD_HTTP_BAD_REQUEST, "wait",
                                  "must be a number of seconds from 0 to 3600");
-        json_t *sw = sweeps_json(s->sweeps, id, wait);
-        return sw ? respond_json(c, MHD_HTTP_OK, sw)
-                  : respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such sweep");
+        json_t *sw = sweeps_json(s->sweeps, r->id, 0);
+        if (!sw)
+            return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such sweep");
+        if (wait > 0 && !sweep_finished(sw)) {
+            json_decref(sw);
+            return suspend(s, c, req, WAIT_SWEEP, wait, MHD_HTTP_OK);
+        }
+        return respond_json(c, MHD_HTTP_OK, sw);
     }
-    if (strcmp(method, "DELETE") == 0) {
-        switch (sweeps_cancel(s->sweeps, id)) {
+    if (r->kind == ROUTE_SWEEP) { /* DELETE */
+        switch (sweeps_cancel(s->sweeps, r->id)) {
         case CANCEL_NOT_FOUND:
             return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such sweep");
         case CANCEL_FINISHED:
             return respond_error(c, MHD_HTTP_CONFLICT, "id", "the sweep has already finished");
         case CANCEL_DONE:
-            return respond_json(c, MHD_HTTP_OK, sweeps_json(s->sweeps, id, 0));
+            return respond_json(c, MHD_HTTP_OK, sweeps_json(s->sweeps, r->id, 0));
         case CANCEL_REQUESTED:
-            return respond_json(c, MHD_HTTP_ACCEPTED, sweeps_json(s->sweeps, id, 5));
+            return suspend(s, c, req, WAIT_SWEEP, CANCEL_WAIT_S, MHD_HTTP_ACCEPTED);
         }
+        return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "id", "unexpected cancel result");
     }
-    return respond_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "method", "use GET or DELETE on a sweep");
+    json_t *sw = sweeps_json(s->sweeps, r->id, 0);
+    if (!sw)
+        return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such sweep");
+    enum MHD_Result ret;
+    if (r->kind == ROUTE_SWEEP_CHART) {
+        json_t *device = runner_device_json(s->runner);
+        ret = respond_chart(c, sw, r, true, device);
+        json_decref(device);
+    } else {
+        json_t *device = runner_device_json(s->runner);
+        size_t len = 0;
+        char *html = report_sweep_html(sw, device, point_job_dir, s, &len);
+        json_decref(device);
+        ret = respond_html(c, html, len);
+    }
+    json_decref(sw);
+    return ret;
 }
 
-static enum MHD_Result route(struct http_server *s, struct MHD_Connection *c,
-                             const char *url, const char *method, struct request *req)
+static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
+                                const char *method, struct request *req)
 {
-    bool get = strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
-    if (strcmp(url, "/healthz") == 0) {
-        if (!get)
-            return respond_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "method", "use GET");
+    bool post = strcmp(method, "POST") == 0;
+    switch (req->route.kind) {
+    case ROUTE_HEALTHZ:
         if (!runner_alive(s->runner))
             return respond_json(c, MHD_HTTP_SERVICE_UNAVAILABLE,
                                 json_pack("{s:s}", "status", "render thread is not running"));
         return respond_json(c, MHD_HTTP_OK, json_pack("{s:s}", "status", "ok"));
-    }
-    if (strcmp(url, "/v1/info") == 0) {
-        if (!get)
-            return respond_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "method", "use GET");
+    case ROUTE_INFO:
         return respond_json(c, MHD_HTTP_OK, info_json(s));
-    }
-    if (strcmp(url, "/v1/jobs") == 0 || strcmp(url, "/v1/jobs/") == 0) {
-        if (strcmp(method, "POST") == 0) {
+    case ROUTE_METRICS:
+        return respond_metrics(s, c);
+    case ROUTE_JOBS:
+        if (post) {
             if (req->too_large)
                 return respond_error(c, MHD_HTTP_CONTENT_TOO_LARGE, "body",
                                      "the job must be at most 65536 bytes");
             return submit_job(s, c, req);
         }
-        if (get) {
-            /* ?technique=&status=&label.KEY=VALUE&since= (daemon/api/job_filter.h) */
+        {
+            /* The route allows only POST, GET and HEAD here. Filters:
+             * ?technique=&status=&label.KEY=VALUE&since= (daemon/api/job_filter.h) */
             struct list_args a = {.ok = true};
             job_filter_init(&a.filter);
             MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, list_arg, &a);
@@ -511,16 +710,98 @@ static enum MHD_Result route(struct http_server *s, struct MHD_Connection *c,
             return respond_json(c, MHD_HTTP_OK,
                                 queue_list_json_with(s->queue, job_filter_visit, &a.filter));
         }
-        return respond_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "method",
-                             "use GET to list jobs or POST to submit one");
+    case ROUTE_SWEEPS:
+        if (post) {
+            if (req->too_large)
+                return respond_error(c, MHD_HTTP_CONTENT_TOO_LARGE, "body",
+                                     "the sweep must be at most 65536 bytes");
+            return post_sweep(s, c, req);
+        }
+        return respond_json(c, MHD_HTTP_OK, sweeps_list_json(s->sweeps));
+    case ROUTE_JOB:
+    case ROUTE_JOB_REPORT:
+    case ROUTE_JOB_CHART:
+    case ROUTE_JOB_TIMINGS:
+    case ROUTE_JOB_IMAGE:
+        return job_resource(s, c, method, req);
+    case ROUTE_SWEEP:
+    case ROUTE_SWEEP_CHART:
+    case ROUTE_SWEEP_REPORT:
+        return sweep_resource(s, c, method, req);
+    default:
+        return respond_error(c, MHD_HTTP_NOT_FOUND, req->route.field ? req->route.field : "url",
+                             req->route.message ? req->route.message : "no such route");
     }
-    if (strncmp(url, "/v1/jobs/", 9) == 0)
-        return job_routes(s, c, method, url + 9);
-    if (strcmp(url, "/v1/sweeps") == 0)
-        return sweep_routes(s, c, method, "", req);
-    if (strncmp(url, "/v1/sweeps/", 11) == 0)
-        return sweep_routes(s, c, method, url + 11, req);
-    return respond_error(c, MHD_HTTP_NOT_FOUND, "url", "no such route");
+}
+
+struct header_scan {
+    size_t bytes;
+    int content_length, transfer_encoding;
+};
+
+static enum MHD_Result scan_header(void *cls, enum MHD_ValueKind kind, const char *key,
+                                   size_t key_size, const char *value, size_t value_size)
+{
+    (void)kind;
+    struct header_scan *h = cls;
+    h->bytes += key_size + value_size + 4; /* ": " and CRLF */
+    if (strcasecmp(key, "Content-Length") == 0)
+        h->content_length++;
+    else if (strcasecmp(key, "Transfer-Encoding") == 0)
+        h->transfer_encoding++;
+    (void)value;
+    return MHD_YES;
+}
+
+/* Checks made as soon as the headers are in, before any body is read:
+ * answers the request (returns true) when it must be refused. */
+static bool refuse_early(struct http_server *s, struct MHD_Connection *c, const char *method,
+                         struct request *req, enum MHD_Result *ret)
+{
+    struct header_scan h = {0};
+    MHD_get_connection_values_n(c, MHD_HEADER_KIND, scan_header, &h);
+    const char *te = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Transfer-Encoding");
+    if (h.bytes > MAX_HEADER_BYTES) {
+        *ret = respond_error(c, MHD_HTTP_REQUEST_HEADER_FIELDS_TOO_LARGE, "headers",
+                             "the request's headers must be at most 8192 bytes in all");
+        return true;
+    }
+    /* Two lengths, or a length and chunks, leave the body's end ambiguous:
+     * the classic way to smuggle a second request past a proxy. */
+    if (h.content_length > 1) {
+        *ret = respond_error(c, MHD_HTTP_BAD_REQUEST, "Content-Length",
+                             "must appear at most once");
+        return true;
+    }
+    if (h.transfer_encoding > 1 || (h.transfer_encoding && h.content_length) ||
+        (te && strcasecmp(te, "chunked") != 0)) {
+        *ret = respond_error(c, MHD_HTTP_BAD_REQUEST, "Transfer-Encoding",
+                             "must be \"chunked\" alone, once, and without Content-Length");
+        return true;
+    }
+    if (req->route.kind != ROUTE_HEALTHZ && !authorized(s, c)) {
+        *ret = respond_error(c, MHD_HTTP_UNAUTHORIZED, "Authorization",
+                             "this daemon needs \"Authorization: Bearer <token>\"");
+        return true;
+    }
+    if (req->route.kind == ROUTE_NONE) {
+        *ret = dispatch(s, c, method, req);
+        return true;
+    }
+    const char *allow, *rule;
+    if (!route_method_ok(req->route.kind, method, &allow, &rule)) {
+        *ret = respond_405(c, allow, rule);
+        return true;
+    }
+    const char *cl = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Content-Length");
+    if (cl && strtoull(cl, NULL, 10) > JOB_MAX_BODY_BYTES) {
+        /* libmicrohttpd closes the connection after this answer. */
+        req->too_large = true;
+        *ret = respond_error(c, MHD_HTTP_CONTENT_TOO_LARGE, "body",
+                             "the body must be at most 65536 bytes");
+        return true;
+    }
+    return false;
 }
 
 static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const char *url,
@@ -532,20 +813,18 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
     struct http_server *s = cls;
     struct request *req = *con_cls;
     if (!req) {
+        /* The headers are in; nothing of the body has been read. */
         req = calloc(1, sizeof(*req));
         if (!req)
             return MHD_NO;
         *con_cls = req;
-        /* Refuse before reading any body. */
-        if (strcmp(url, "/healthz") != 0 && !authorized(s, c))
-            return respond_error(c, MHD_HTTP_UNAUTHORIZED, "Authorization",
-                                 "this daemon needs \"Authorization: Bearer <token>\"");
-        const char *cl = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Content-Length");
-        if (cl && strtoull(cl, NULL, 10) > JOB_MAX_BODY_BYTES) {
-            /* Answer before reading the body; MHD closes the connection after. */
-            req->too_large = true;
-            return respond_error(c, MHD_HTTP_CONTENT_TOO_LARGE, "body",
-                                 "the job must be at most 65536 bytes");
+        req->conn = connections_of(c);
+        connections_headers_in(s->conns, req->conn);
+        route_parse(url, &req->route);
+        enum MHD_Result ret;
+        if (refuse_early(s, c, method, req, &ret)) {
+            connections_answering(s->conns, req->conn);
+            return ret;
         }
         return MHD_YES;
     }
@@ -564,19 +843,36 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
         *upload_data_size = 0;
         return MHD_YES;
     }
-    return route(s, c, url, method, req);
+    if (req->waiting)
+        return answer_waited(s, c, req);
+    connections_answering(s->conns, req->conn);
+    return dispatch(s, c, method, req);
+}
+
+static size_t code_index(unsigned status)
+{
+    for (size_t i = 0; i + 1 < NCODES; i++)
+        if (COUNTED_CODES[i] == status)
+            return i;
+    return NCODES - 1;
 }
 
 static void on_completed(void *cls, struct MHD_Connection *c, void **con_cls,
                          enum MHD_RequestTerminationCode code)
 {
-    (void)cls, (void)c, (void)code;
+    (void)code;
+    struct http_server *s = cls;
     struct request *req = *con_cls;
+    struct conn *k = connections_of(c);
     if (req) {
+        unsigned status = connections_status(k);
+        if (status)
+            atomic_fetch_add(&s->requests[req->route.kind][code_index(status)], 1);
         free(req->body);
         free(req);
         *con_cls = NULL;
     }
+    connections_request_done(s->conns, k);
 }
 
 static void on_mhd_log(void *cls, const char *fmt, va_list ap)
@@ -590,9 +886,9 @@ static void on_mhd_log(void *cls, const char *fmt, va_list ap)
     LOG(LOG_WARN, "libmicrohttpd: %s", msg);
 }
 
-struct http_server *http_server_create(const char *listen, struct queue *q,
-                                       struct runner *r, struct sweeps *sweeps, char *err,
-                                       size_t errlen)
+struct http_server *http_server_create(const char *listen, const struct http_limits *limits,
+                                       struct queue *q, struct runner *r,
+                                       struct sweeps *sweeps, char *err, size_t errlen)
 {
     char host[256];
     const char *colon = strrchr(listen, ':');
@@ -633,36 +929,61 @@ struct http_server *http_server_create(const char *listen, struct queue *q,
     s->queue = q;
     s->runner = r;
     s->sweeps = sweeps;
+    s->limits = *limits;
     pthread_mutex_init(&s->token_lock, NULL);
-    unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_THREAD_PER_CONNECTION |
-                     MHD_USE_ERROR_LOG;
-    if (ai->ai_family == AF_INET6)
-        flags |= MHD_USE_IPv6;
-    s->mhd = MHD_start_daemon(flags, (uint16_t)port, NULL, NULL, on_request, s,
-                              MHD_OPTION_EXTERNAL_LOGGER, on_mhd_log, s,
-                              MHD_OPTION_SOCK_ADDR, ai->ai_addr,
-                              MHD_OPTION_CONNECTION_LIMIT, (unsigned)MAX_CONNECTIONS,
-                              MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)60,
-                              MHD_OPTION_NOTIFY_COMPLETED, on_completed, s,
-                              MHD_OPTION_END);
-    freeaddrinfo(ai);
-    if (!s->mhd) {
-        snprintf(err, errlen, "cannot listen on %s (address in use or not allowed?)", listen);
+    struct connections_config cc = {.header_s = limits->header_timeout_s,
+                                    .body_s = limits->body_timeout_s};
+    s->conns = connections_create(&cc, wait_done, s, err, errlen);
+    if (!s->conns) {
+        freeaddrinfo(ai);
         pthread_mutex_destroy(&s->token_lock);
         free(s);
         return NULL;
     }
+    /* Event-driven: a small pool of polling threads serves every connection,
+     * and a long-poll is a suspended connection, not a blocked thread. */
+    unsigned flags = MHD_USE_AUTO_INTERNAL_THREAD | MHD_ALLOW_SUSPEND_RESUME | MHD_USE_ERROR_LOG;
+    if (ai->ai_family == AF_INET6)
+        flags |= MHD_USE_IPv6;
+    s->mhd = MHD_start_daemon(
+        flags, (uint16_t)port, NULL, NULL, on_request, s, MHD_OPTION_EXTERNAL_LOGGER, on_mhd_log,
+        s, MHD_OPTION_SOCK_ADDR, ai->ai_addr, MHD_OPTION_THREAD_POOL_SIZE,
+        (unsigned)(limits->threads ? limits->threads : 1), MHD_OPTION_CONNECTION_LIMIT,
+        (unsigned)limits->max_connections, MHD_OPTION_PER_IP_CONNECTION_LIMIT,
+        (unsigned)limits->max_connections_per_ip, MHD_OPTION_CONNECTION_TIMEOUT,
+        (unsigned)limits->idle_timeout_s, MHD_OPTION_CONNECTION_MEMORY_LIMIT,
+        (size_t)CONNECTION_MEMORY, MHD_OPTION_NOTIFY_CONNECTION, connections_notify, s->conns,
+        MHD_OPTION_NOTIFY_COMPLETED, on_completed, s, MHD_OPTION_END);
+    freeaddrinfo(ai);
+    if (!s->mhd) {
+        snprintf(err, errlen, "cannot listen on %s (address in use or not allowed?)", listen);
+        connections_destroy(s->conns);
+        pthread_mutex_destroy(&s->token_lock);
+        free(s);
+        return NULL;
+    }
+    queue_set_listener(q, on_queue_change, s->conns);
     const union MHD_DaemonInfo *info = MHD_get_daemon_info(s->mhd, MHD_DAEMON_INFO_BIND_PORT);
     s->port = info ? info->port : (int)port;
     return s;
+}
+
+void http_server_stop_waits(struct http_server *s)
+{
+    if (s)
+        connections_stop(s->conns, STOP_GRACE_S);
 }
 
 void http_server_destroy(struct http_server *s)
 {
     if (!s)
         return;
+    connections_stop(s->conns, STOP_GRACE_S);
+    queue_set_listener(s->queue, NULL, NULL);
     MHD_stop_daemon(s->mhd);
+    connections_destroy(s->conns);
     pthread_mutex_destroy(&s->token_lock);
+    free(s->token);
     free(s);
 }
 

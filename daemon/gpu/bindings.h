@@ -6,6 +6,7 @@
 
 /* Uniform blocks. */
 #define SB_UBO_FRAME 0
+#define SB_UBO_LIGHT_GRID 1 /* light grid dimensions, slices, list bounds */
 
 /* Shader storage blocks. */
 #define SB_SSBO_INSTANCES 0
@@ -16,15 +17,34 @@
 #define SB_SSBO_LIGHT_GRID 5    /* per tile or cluster: offset, count */
 #define SB_SSBO_LIGHT_INDICES 6 /* the lists the grid points into */
 #define SB_SSBO_CULL_STATS 7    /* overflow and evaluation counters */
+#define SB_SSBO_LIGHT_BITS 8    /* per cell, one bit per light while binning */
+#define SB_SSBO_TILE_DEPTH 9    /* per tile: nearest and farthest view depth */
+#define SB_SSBO_NONFINITE 10    /* the harness's NaN and infinity pixel counters */
+#define SB_SSBO_LIGHT_SUMMARY 11 /* per cell, one bit per non-zero word of light bits */
 
 /* Texture units. */
 #define SB_TEX_HDR 0
 #define SB_TEX_DEPTH 1
 #define SB_TEX_GBUFFER0 2 /* 2..5: g-buffer planes */
+#define SB_TEX_GBUFFER1 3
+#define SB_TEX_GBUFFER2 4
 #define SB_TEX_OSL_ATLAS 0
 #define SB_TEX_OSL_MESH 1 /* 1 + 2m: position of mesh m, 2 + 2m: normal */
+#define SB_TEX_POST_SRC 0    /* post effects: the colour the effect reads */
+#define SB_TEX_POST_DEPTH 1  /* the technique's depth texture */
+#define SB_TEX_POST_NORMAL 2 /* the technique's g-buffer normals, when it has them */
+#define SB_TEX_POST_AUX 3    /* an effect's own intermediate (bloom level, occlusion) */
+
+/* Uniform locations, explicit so that timed code never looks a name up.
+ * Arrays take one location per element. */
+#define SB_LOC_EXPOSURE 0     /* resolve: float */
+#define SB_LOC_POST_PARAMS 0  /* post effects: vec4 of the effect's options */
+#define SB_LOC_POST_WEIGHTS 1 /* bloom: float[33] Gaussian weights */
+#define SB_LOC_SSAO_NOISE 1   /* ssao: float[16] rotation angles */
+#define SB_LOC_SSAO_KERNEL 17 /* ssao: vec4[64] hemisphere samples */
 
 /* Image units. */
 #define SB_IMG_OSL_ATLAS 0
+#define SB_IMG_HEAT 1 /* light evaluations per pixel (r32ui) */
 
 #endif

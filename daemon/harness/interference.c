@@ -36,7 +36,8 @@ bool interference_parse_stat(const char *text, struct cpu_times *out)
     return out->cpus > 0 && out->total > 0;
 }
 
-bool interference_parse_self_stat(const char *text, unsigned long long *ticks)
+bool interference_parse_self_stat(const char *text, unsigned long long *ticks,
+                                  unsigned long long *minor_faults)
 {
     /* Field 2 is "(comm)", and comm may hold anything: the fields after it
      * start after the last ')'. */
@@ -44,8 +45,9 @@ bool interference_parse_self_stat(const char *text, unsigned long long *ticks)
     if (!p)
         return false;
     p++;
-    /* Fields 3 (state) to 13 (cmajflt), then utime and stime. */
-    for (int field = 3; field <= 13; field++) {
+    /* Fields 3 (state) to 9 (flags), then minflt, cminflt, majflt, cmajflt,
+     * utime and stime. */
+    for (int field = 3; field <= 9; field++) {
         while (*p == ' ')
             p++;
         if (!*p)
@@ -53,10 +55,12 @@ bool interference_parse_self_stat(const char *text, unsigned long long *ticks)
         while (*p && *p != ' ')
             p++;
     }
-    unsigned long long utime, stime;
-    if (sscanf(p, " %llu %llu", &utime, &stime) != 2)
+    unsigned long long minflt, cminflt, majflt, cmajflt, utime, stime;
+    if (sscanf(p, " %llu %llu %llu %llu %llu %llu", &minflt, &cminflt, &majflt, &cmajflt, &utime,
+               &stime) != 6)
         return false;
     *ticks = utime + stime;
+    *minor_faults = minflt;
     return true;
 }
 
@@ -115,7 +119,7 @@ void interference_sample(struct interference_sample *s)
     }
     if (!read_proc("/proc/self/stat", small, sizeof(small), s->error, sizeof(s->error)))
         goto out;
-    if (!interference_parse_self_stat(small, &s->self_ticks)) {
+    if (!interference_parse_self_stat(small, &s->self_ticks, &s->self_minor_faults)) {
         snprintf(s->error, sizeof(s->error), "/proc/self/stat has no utime and stime");
         goto out;
     }
@@ -164,7 +168,8 @@ json_t *interference_json(const struct interference_sample *start,
     if (!start->ok || !end->ok) {
         json_object_set_new(o, "error", json_string(!start->ok ? start->error : end->error));
         static const char *const unknown[] = {"loadavg_start", "loadavg_end", "other_cpu_share",
-                                              "daemon_cpu_share", "noisy", "cpus", "cpu_ticks"};
+                                              "daemon_cpu_share", "noisy", "cpus", "cpu_ticks",
+                                              "daemon_minor_faults"};
         for (size_t i = 0; i < sizeof(unknown) / sizeof(unknown[0]); i++)
             json_object_set_new(o, unknown[i], json_null());
         return o;
@@ -180,5 +185,10 @@ json_t *interference_json(const struct interference_sample *start,
     json_object_set_new(o, "noisy", json_boolean(f.noisy));
     json_object_set_new(o, "cpus", json_integer(start->cpu.cpus));
     json_object_set_new(o, "cpu_ticks", json_integer((json_int_t)f.ticks));
+    json_object_set_new(o, "daemon_minor_faults",
+                        json_integer(end->self_minor_faults >= start->self_minor_faults
+                                         ? (json_int_t)(end->self_minor_faults -
+                                                        start->self_minor_faults)
+                                         : 0));
     return o;
 }

@@ -28,8 +28,10 @@ struct cpu_times {
 
 bool interference_parse_stat(const char *text, struct cpu_times *out);
 /* utime + stime (fields 14 and 15) of a /proc/PID/stat line, in clock
- * ticks; the command name may hold spaces and parentheses. */
-bool interference_parse_self_stat(const char *text, unsigned long long *ticks);
+ * ticks, and the minor page faults (field 10); the command name may hold
+ * spaces and parentheses. */
+bool interference_parse_self_stat(const char *text, unsigned long long *ticks,
+                                  unsigned long long *minor_faults);
 /* The three load averages of /proc/loadavg. */
 bool interference_parse_loadavg(const char *text, double load[3]);
 
@@ -42,6 +44,7 @@ struct interference_sample {
     double loadavg[3];
     struct cpu_times cpu;
     unsigned long long self_ticks;
+    unsigned long long self_minor_faults;
 };
 
 void interference_sample(struct interference_sample *s);
@@ -66,8 +69,10 @@ void interference_compute(const struct interference_sample *start,
                           const struct interference_sample *end, struct interference_figures *f);
 
 /* result.interference: loadavg_start, loadavg_end, other_cpu_share,
- * daemon_cpu_share, noisy, rule, plus cpus, interval_s, cpu_ticks and the
- * timed region's timed_start_unix and timed_end_unix. When a sample failed,
+ * daemon_cpu_share, noisy, rule, plus cpus, interval_s, cpu_ticks, the
+ * daemon's minor page faults (a heap that shrinks and grows back every
+ * frame shows there) and the timed region's timed_start_unix and
+ * timed_end_unix. When a sample failed,
  * the figures are null and error says why. New reference. */
 json_t *interference_json(const struct interference_sample *start,
                           const struct interference_sample *end);

@@ -15,6 +15,8 @@
 #include "common/log.h"
 #include "daemon/quality/metrics.h"
 #include "common/png_io.h"
+#include "daemon/harness/deadline.h"
+#include "daemon/harness/telemetry.h"
 
 struct task {
     struct job *job;
@@ -33,10 +35,19 @@ struct metrics_worker {
     bool stopping;
 };
 
+/* The metric loops ask between tiles: a DELETE (or SIGTERM) sets the job's
+ * cancel flag, and the job's timeout_s may run out. */
+static bool cancel_requested(void *ctx)
+{
+    const struct job *job = ctx;
+    return atomic_load(&job->cancel) || job_timed_out(job);
+}
+
 /* Fills capture's metrics and URLs; updates the job-wide summary. */
-static bool score_capture(const struct job *job, json_t *capture, json_t *summary, char *err,
+static bool score_capture(struct job *job, json_t *capture, json_t *summary, char *err,
                           size_t errlen)
 {
+    const struct metrics_stop stop = {cancel_requested, job};
     int frame = (int)json_integer_value(json_object_get(capture, "frame"));
     char test_path[PATH_MAX + 32], ref_path[PATH_MAX + 32], ssim_path[PATH_MAX + 32],
         flip_path[PATH_MAX + 32], url[128];
@@ -49,7 +60,8 @@ static bool score_capture(const struct job *job, json_t *capture, json_t *summar
               png_read_rgb(test_path, &test, err, errlen);
     const struct metrics_options *o = &job->spec.metrics;
     json_t *m = ok ? metrics_compare(&ref, &test, o, (o->which & METRIC_SSIM) ? ssim_path : NULL,
-                                     (o->which & METRIC_FLIP) ? flip_path : NULL, err, errlen)
+                                     (o->which & METRIC_FLIP) ? flip_path : NULL, &stop, err,
+                                     errlen)
                    : NULL;
     image_finish(&ref);
     image_finish(&test);
@@ -112,13 +124,19 @@ static void run_task(struct metrics_worker *w, struct task *t)
     json_t *captures = json_object_get(t->result, "captures");
     size_t i;
     json_t *capture;
-    bool ok = true;
+    bool ok = true, cancelled = false, timed_out = false;
     json_array_foreach(captures, i, capture) {
-        if (!(ok = score_capture(job, capture, summary, err, sizeof(err))))
+        if (cancel_requested(job) || !(ok = score_capture(job, capture, summary, err, sizeof(err)))) {
+            cancelled = atomic_load(&job->cancel);
+            timed_out = !cancelled && job_timed_out(job);
+            ok = false;
             break;
+        }
         json_object_set_new(summary, "captures_compared", json_integer((json_int_t)i + 1));
     }
     double t1 = clock_mono_s();
+    telemetry_metrics(t1 - t0,
+                      (unsigned)json_integer_value(json_object_get(summary, "captures_compared")));
     if (ok) {
         json_t *failed = json_object_get(summary, "pdiff_failed_frames");
         json_object_set_new(summary, "pdiff_failed_captures",
@@ -137,6 +155,20 @@ static void run_task(struct metrics_worker *w, struct task *t)
     if (ok) {
         LOG(LOG_INFO, "job %s done: metrics for %zu captures", job->id, json_array_size(captures));
         queue_finish(w->queue, job, JOB_DONE, NULL, t->result);
+    } else if (timed_out) {
+        char msg[200];
+        job_timeout_message(job, "metrics", msg, sizeof(msg));
+        LOG(LOG_WARN, "job %s failed: %s", job->id, msg);
+        queue_finish(w->queue, job, JOB_FAILED, msg, NULL);
+        json_decref(t->result);
+    } else if (cancelled) {
+        LOG(LOG_INFO, "job %s cancelled in the metrics phase (%zu of %zu captures scored)", job->id,
+            i, json_array_size(captures));
+        char msg[160];
+        snprintf(msg, sizeof(msg), "cancelled in the metrics phase, after %zu of %zu captures",
+                 i, json_array_size(captures));
+        queue_finish(w->queue, job, JOB_CANCELLED, msg, NULL);
+        json_decref(t->result);
     } else {
         LOG(LOG_WARN, "job %s failed in metrics: %s", job->id, err);
         char msg[600];

@@ -14,6 +14,7 @@
 #include "common/clock.h"
 #include "daemon/gpu/egl.h"
 #include "common/fsutil.h"
+#include "daemon/effects/post_chain.h"
 #include "daemon/gpu/bindings.h"
 #include "daemon/gpu/caps.h"
 #include "daemon/gpu/glutil.h"
@@ -23,6 +24,8 @@
 #include "daemon/gpu/targets.h"
 #include "common/log.h"
 #include "daemon/harness/interference.h"
+#include "daemon/harness/deadline.h"
+#include "daemon/harness/telemetry.h"
 #include "daemon/harness/metrics_stage.h"
 #include "common/png_io.h"
 #include "daemon/service.h"
@@ -47,7 +50,8 @@ struct runner {
     struct gpu_caps caps;
     struct gpu_targets *targets;
     struct gpu_frame_block frame_block;
-    GLuint empty_vao, resolve_prog;
+    GLuint empty_vao;
+    GLuint resolve_progs[3]; /* post hook: by look.tonemap (none, reinhard, aces) */
 };
 
 static json_t *stats_json(const double *v, size_t n)
@@ -101,14 +105,20 @@ struct run {
     void *state;
     uint8_t **captures;
     int capture_count;
+    json_t *heatmap; /* result.heatmap: captured heat maps, when the technique publishes one */
     double *cpu_ms;
     double *frame_ms;
     GLsync fences[FRAMES_IN_FLIGHT];
     struct interference_sample interference[2]; /* store hook: start and end of the timed region */
+    /* Post hook: the look this run renders with (the job's, or its
+     * reference_look), its effects, the HDR colour the resolve reads, and
+     * the non-finite pixels of each capture. */
+    const struct look_spec *look;
+    struct post_chain *post;
+    GLuint hdr_resolved;
+    struct post_nonfinite *nonfinite;
     char err[1024];
 };
-
-static const char *hdr_name(int hdr) { return hdr == LOOK_HDR_RGBA16F ? "rgba16f" : "rgba32f"; }
 
 /* The output every technique draws into (HDR colour and a depth texture
  * later passes may sample) and the 8-bit image the resolve writes, from the
@@ -126,7 +136,7 @@ static bool setup_targets(struct run *run)
                  w, h, caps->max_texture_size, caps->max_viewport[0], caps->max_viewport[1]);
         return false;
     }
-    GLenum hdr_format = run->spec->look.hdr == LOOK_HDR_RGBA16F ? GL_RGBA16F : GL_RGBA32F;
+    GLenum hdr_format = run->look->hdr == LOOK_HDR_RGBA16F ? GL_RGBA16F : GL_RGBA32F;
     GLuint color = gpu_targets_texture(pool, "output.hdr", hdr_format, w, h, run->err,
                                        sizeof(run->err));
     GLuint depth = color ? gpu_targets_texture(pool, "output.depth", GL_DEPTH_COMPONENT24, w, h,
@@ -143,7 +153,7 @@ static bool setup_targets(struct run *run)
     if (!run->ldr_fbo)
         return false;
     snprintf(run->defines, sizeof(run->defines), "#define LIGHTING_%s 1\n",
-             run->spec->look.lighting == LOOK_BLINN_PHONG ? "BLINN_PHONG" : "PHONG");
+             run->look->lighting == LOOK_BLINN_PHONG ? "BLINN_PHONG" : "PHONG");
     run->env = (struct technique_env){
         .spec = run->spec,
         .scene = &run->scene,
@@ -200,28 +210,79 @@ static void resolve(const struct run *run)
                    run->env.height);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
-    glUseProgram(r->resolve_prog);
+    glUseProgram(r->resolve_progs[run->look->tonemap]);
+    glUniform1f(SB_LOC_EXPOSURE, (float)run->look->exposure); /* post hook */
     glActiveTexture(GL_TEXTURE0 + SB_TEX_HDR);
-    glBindTexture(GL_TEXTURE_2D, run->env.output_color);
+    glBindTexture(GL_TEXTURE_2D, run->hdr_resolved);
     glBindVertexArray(r->empty_vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindVertexArray(0);
     gpu_pass_end(&run->passes);
 }
 
-/* Builds the technique for a run: its options, passes (its own, then the
- * harness's resolve) and timer. */
+/* Post hook: the look's effects on the technique's HDR output, each a
+ * timed pass, between the technique's render and the resolve. */
+static void post_chain_run_frame(struct run *run)
+{
+    run->hdr_resolved = post_chain_run(run->post);
+}
+
+/* Post hook: how many pixels of the colour the resolve read were NaN or
+ * infinite, at a captured frame, outside the timed region. */
+static bool count_nonfinite(struct run *run, int capture)
+{
+    return post_chain_count_nonfinite(run->post, run->hdr_resolved, &run->nonfinite[capture],
+                                      run->err, sizeof(run->err));
+}
+
+/* Post hook: a capture's non-finite pixels, and over the job whether every
+ * capture was finite (null without captures): the sweeps' finite criterion. */
+static json_int_t nonfinite_pixels(const struct post_nonfinite *n)
+{
+    return (json_int_t)n->nan_pixels + n->inf_pixels + n->overflow_pixels;
+}
+
+static json_t *nonfinite_json(const struct post_nonfinite *n)
+{
+    return json_pack("{s:I, s:I, s:I, s:I}", "pixels", nonfinite_pixels(n), "nan",
+                     (json_int_t)n->nan_pixels, "inf", (json_int_t)n->inf_pixels, "overflow",
+                     (json_int_t)n->overflow_pixels);
+}
+
+static json_t *nonfinite_summary(const struct run *run)
+{
+    json_int_t worst = 0, with = 0;
+    for (int c = 0; c < run->capture_count; c++) {
+        json_int_t px = nonfinite_pixels(&run->nonfinite[c]);
+        worst = px > worst ? px : worst;
+        with += px > 0;
+    }
+    return json_pack("{s:i, s:I, s:I, s:o, s:s}", "captures", run->capture_count,
+                     "captures_with_nonfinite", with, "pixels_max", worst, "finite",
+                     run->capture_count ? json_boolean(with == 0) : json_null(), "counted",
+                     "pixels of the HDR colour the resolve read, at each captured frame, with "
+                     "R, G or B NaN, infinite, or (rgba16f) at 65504, where a driver that "
+                     "clamps an overflowing write leaves it");
+}
+
+/* Builds the technique for a run: its options, passes (its own, the post
+ * chain's, then the harness's resolve) and timer. */
 static bool setup_technique(struct run *run, const struct technique *tech, const void *options,
                             int64_t timed_frames)
 {
-    run->timer = gpu_timer_create(technique_pass_count(tech) + 1, timed_frames);
+    int post_passes = post_spec_pass_names(&run->look->post, NULL, 0); /* post hook */
+    run->timer = gpu_timer_create(technique_pass_count(tech) + post_passes + 1, timed_frames);
     if (!run->timer) {
         snprintf(run->err, sizeof(run->err), "cannot create GPU timer queries");
         return false;
     }
-    if (!gpu_passes_init(&run->passes, run->timer, tech->info->passes,
-                         run->runner->caps.debug_groups) ||
-        (run->resolve_pass = gpu_passes_add(&run->passes, "resolve")) < 0) {
+    bool fits = gpu_passes_init(&run->passes, run->timer, tech->info->passes,
+                                run->runner->caps.debug_groups);
+    /* Post hook: the chain's passes; its effects are built once the technique exists. */
+    if (fits && !(run->post = post_chain_create(&run->env, run->look, &run->passes, run->err,
+                                                sizeof(run->err))))
+        return false;
+    if (!fits || (run->resolve_pass = gpu_passes_add(&run->passes, "resolve")) < 0) {
         snprintf(run->err, sizeof(run->err), "%s declares more passes than the harness times",
                  tech->info->name);
         return false;
@@ -234,11 +295,14 @@ static void teardown(struct run *run)
 {
     if (run->tech && run->state)
         run->tech->destroy(run->state);
+    post_chain_destroy(run->post); /* post hook */
+    free(run->nonfinite);
     gpu_timer_destroy(run->timer);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     gpu_scene_finish(&run->gpu);
     if (run->scene_ok)
         scene_finish(&run->scene);
+    json_decref(run->heatmap);
     for (int i = 0; run->captures && i < run->capture_count; i++)
         free(run->captures[i]);
     free(run->captures);
@@ -283,9 +347,11 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
                                spec->scene.height, run->err, sizeof(run->err)))
             goto out;
         free(run->captures[c]);
-        run->captures[c++] = NULL;
-        json_array_append_new(captures, json_pack("{s:i, s:s, s:s}", "frame", k, "url",
-                                                  url, "file", name));
+        run->captures[c] = NULL;
+        json_array_append_new(captures, json_pack("{s:i, s:s, s:s, s:o}", "frame", k, "url",
+                                                  url, "file", name, "nonfinite", /* post hook */
+                                                  nonfinite_json(&run->nonfinite[c])));
+        c++;
     }
 
     /* timings.csv: one row per timed frame. */
@@ -345,10 +411,11 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
         json_object_set_new(by_section, run->passes.names[s], stats_json(sec, (size_t)n));
     }
     json_object_set_new(result, "gpu_sections_ms", by_section);
-    json_object_set_new(result, "look", json_pack("{s:s, s:s}", "lighting",
-                                                  look_lighting_name(run->spec->look.lighting),
-                                                  "hdr", hdr_name(run->spec->look.hdr)));
+    json_object_set_new(result, "look", look_spec_to_json(&run->spec->look));
+    json_object_set_new(result, "nonfinite", nonfinite_summary(run)); /* post hook */
     json_object_set_new(result, "targets_bytes", json_real(gpu_targets_bytes(run->runner->targets)));
+    if (run->heatmap)
+        json_object_set(result, "heatmap", run->heatmap);
     json_object_set_new(result, "scene", scene_describe(&run->scene));
     /* Store hook: what could have disturbed the timed region. */
     json_object_set_new(result, "interference",
@@ -371,6 +438,19 @@ out:
     return result;
 }
 
+/* Post hook: the reference's output targets and lighting for its look
+ * (reference_look may differ in format and lighting), over the run's scene. */
+static bool reference_targets(struct run *rr, struct run *run)
+{
+    if (!setup_targets(rr)) {
+        snprintf(run->err, sizeof(run->err), "%.1000s", rr->err);
+        return false;
+    }
+    rr->env.scene = run->env.scene;
+    rr->env.gpu = run->env.gpu;
+    return true;
+}
+
 /* Renders the reference technique at exactly the captured frame indices,
  * after the timed run (its time is in no figure). Each frame gets a fresh
  * technique instance, since frame k is a pure function of k: a stateful
@@ -383,13 +463,10 @@ static bool render_reference(struct run *run, enum job_status *status)
     uint8_t *pixels = malloc((size_t)w * (size_t)h * 4);
     /* The reference gets a run of its own over the same scene and targets. */
     struct run rr = {.runner = run->runner, .job = run->job, .spec = spec, .tech = ref,
-                     .env = run->env, .ldr_fbo = run->ldr_fbo};
-    memcpy(rr.defines, run->defines, sizeof(rr.defines));
-    rr.env.defines = rr.defines;
-    rr.env.passes = &rr.passes;
-    rr.env.products = &rr.products;
+                     .look = &spec->reference_look};
     bool ok = false;
-    if (!ref || !pixels || !setup_technique(&rr, ref, job_spec_reference_options(spec), 1)) {
+    if (!ref || !pixels || !reference_targets(&rr, run) ||
+        !setup_technique(&rr, ref, job_spec_reference_options(spec), 1)) {
         snprintf(run->err, sizeof(run->err), "reference %s: cannot prepare it: %.900s",
                  spec->reference, rr.err);
         goto out;
@@ -400,11 +477,17 @@ static bool render_reference(struct run *run, enum job_status *status)
             snprintf(run->err, sizeof(run->err), "cancelled while rendering the reference");
             goto out;
         }
+        if (job_timed_out(run->job)) {
+            job_timeout_message(run->job, "reference", run->err, sizeof(run->err));
+            goto out;
+        }
         void *state = NULL;
         char why[900] = "";
-        if (!ref->create(&rr.env, &state, why, sizeof(why))) {
+        if (!ref->create(&rr.env, &state, why, sizeof(why)) ||
+            !post_chain_build(rr.post, why, sizeof(why))) { /* post hook */
             snprintf(run->err, sizeof(run->err), "reference %s cannot run: %s", ref->info->name,
                      why);
+            ref->destroy(state);
             goto out;
         }
         struct gpu_frame_data fd = {0};
@@ -412,6 +495,7 @@ static bool render_reference(struct run *run, enum job_status *status)
         gpu_frame_block_update(&run->runner->frame_block, &fd);
         gpu_timer_begin_frame(rr.timer);
         bool drawn = ref->render(state, &rr.env, k, why, sizeof(why));
+        post_chain_run_frame(&rr);
         resolve(&rr);
         gpu_timer_end_frame(rr.timer);
         if (drawn) {
@@ -431,7 +515,58 @@ static bool render_reference(struct run *run, enum job_status *status)
     ok = true;
 out:
     gpu_timer_destroy(rr.timer);
+    post_chain_destroy(rr.post);
     free(pixels);
+    return ok;
+}
+
+/* The light-count heat map a technique publishes (products.heat_tex: light
+ * evaluations per pixel), read back at captured frame k inside the capture
+ * bracket (so outside every timed figure) and written as heatmap-NNNNNN.png
+ * on a colour ramp from 0 (black) to the frame's largest count (white),
+ * with the frame's mean and max in result.heatmap. */
+static bool capture_heatmap(struct run *run, int k)
+{
+    static const float ramp[6][3] = {{0, 0, 0}, {0, 0, 1}, {0, 1, 1}, {0, 1, 0}, {1, 1, 0}, {1, 1, 1}};
+    size_t n = (size_t)run->env.width * (size_t)run->env.height;
+    uint32_t *count = malloc(n * sizeof(uint32_t));
+    uint8_t *rgba = malloc(n * 4);
+    bool ok = count && rgba;
+    if (ok) {
+        glBindTexture(GL_TEXTURE_2D, run->products.heat_tex);
+        glGetTexImage(GL_TEXTURE_2D, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, count);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        double sum = 0;
+        uint32_t max = 0;
+        for (size_t i = 0; i < n; i++)
+            sum += count[i], max = count[i] > max ? count[i] : max;
+        for (size_t i = 0; i < n; i++) {
+            float t = max ? 5.0f * (float)count[i] / (float)max : 0.0f;
+            int seg = t >= 5.0f ? 4 : (int)t;
+            float f = t - (float)seg;
+            for (int ch = 0; ch < 3; ch++)
+                rgba[i * 4 + ch] = (uint8_t)(255.0f * (ramp[seg][ch] + f * (ramp[seg + 1][ch] - ramp[seg][ch])) + 0.5f);
+            rgba[i * 4 + 3] = 255;
+        }
+        char name[64], url[128], path[PATH_MAX + 64];
+        snprintf(name, sizeof(name), "heatmap-%06d.png", k);
+        snprintf(url, sizeof(url), "/v1/jobs/%s/heatmap/%d.png", run->job->id, k);
+        snprintf(path, sizeof(path), "%s/%s", run->job->dir, name);
+        ok = png_write_gl_rgba(path, rgba, run->env.width, run->env.height, run->err, sizeof(run->err));
+        if (ok && !run->heatmap)
+            run->heatmap = json_pack("{s:s, s:s, s:[]}", "unit", "light evaluations per pixel",
+                                     "ramp", "black (0), blue, cyan, green, yellow, white (scale_max)",
+                                     "captures");
+        if (ok)
+            json_array_append_new(json_object_get(run->heatmap, "captures"),
+                                  json_pack("{s:i, s:s, s:s, s:f, s:i, s:i}", "frame", k, "url", url,
+                                            "file", name, "mean", sum / (double)n, "max", (int)max,
+                                            "scale_max", (int)max));
+    } else {
+        snprintf(run->err, sizeof(run->err), "out of memory for the heat map");
+    }
+    free(count);
+    free(rgba);
     return ok;
 }
 
@@ -444,12 +579,14 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
     const struct job_spec *spec = run->spec;
     struct job *job = run->job;
     int w0 = spec->warmup_frames, n = spec->frames;
+    run->look = &spec->look; /* post hook */
     run->scene_ok = scene_init(&run->scene, &spec->scene);
     run->capture_count = capture ? job_spec_capture_count(spec) : 0;
     run->captures = calloc((size_t)run->capture_count + 1, sizeof(*run->captures));
+    run->nonfinite = calloc((size_t)run->capture_count + 1, sizeof(*run->nonfinite));
     run->cpu_ms = calloc((size_t)n, sizeof(double));
     run->frame_ms = calloc((size_t)n, sizeof(double));
-    if (!run->scene_ok || !run->captures || !run->cpu_ms || !run->frame_ms) {
+    if (!run->scene_ok || !run->captures || !run->nonfinite || !run->cpu_ms || !run->frame_ms) {
         snprintf(run->err, sizeof(run->err), "out of memory preparing the job");
         return false;
     }
@@ -458,6 +595,7 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
         !setup_technique(run, run->tech, job_spec_technique_options(spec), (int64_t)w0 + n))
         return false;
     if (!run->tech->create(&run->env, &run->state, run->err, sizeof(run->err)) ||
+        !post_chain_build(run->post, run->err, sizeof(run->err)) || /* post hook */
         gl_error_take("setup", run->err, sizeof(run->err)))
         return false;
 
@@ -479,6 +617,10 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
             *status = JOB_CANCELLED;
             snprintf(run->err, sizeof(run->err), "cancelled at frame %" PRId64 " of run %d", k,
                      run_index + 1);
+            return false;
+        }
+        if (job_timed_out(job)) {
+            job_timeout_message(job, "rendering", run->err, sizeof(run->err));
             return false;
         }
         if (k == 1) {
@@ -503,6 +645,7 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
         gpu_frame_block_update(&r->frame_block, &fd);
         gpu_timer_begin_frame(run->timer);
         bool ok = run->tech->render(run->state, &run->env, k, run->err, sizeof(run->err));
+        post_chain_run_frame(run);
         resolve(run);
         gpu_timer_end_frame(run->timer);
         glFlush(); /* where a swap would hand the frame to the GPU */
@@ -516,7 +659,11 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
             double c0 = clock_mono_s();
             glBindFramebuffer(GL_READ_FRAMEBUFFER, run->ldr_fbo);
             glReadPixels(0, 0, spec->scene.width, spec->scene.height, GL_RGBA,
-                         GL_UNSIGNED_BYTE, run->captures[captured++]);
+                         GL_UNSIGNED_BYTE, run->captures[captured]);
+            if (!count_nonfinite(run, captured++)) /* post hook, billed to the capture */
+                return false;
+            if (run->products.heat_tex && !capture_heatmap(run, (int)k))
+                return false;
             double c = clock_mono_s() - c0;
             *capture_s += c;
             run->frame_ms[k - 1] -= c * 1e3;
@@ -524,6 +671,7 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
         if ((seq & 15) == 15 && gl_error_take("rendering", run->err, sizeof(run->err)))
             return false;
         queue_progress(r->queue, job, run_index * n + (k > 0 ? (int)k : 0));
+        telemetry_frames(1);
     }
     glFinish();
     double wall_end = clock_mono_s();
@@ -531,6 +679,8 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
     run->frame_ms[n - 1] += (wall_end - frame_begin) * 1e3;
     *wall_s = wall_end - wall_start;
     gpu_timer_drain(run->timer);
+    if (run->tech->verify && !run->tech->verify(run->state, run->err, sizeof(run->err)))
+        return false;
     return !gl_error_take("rendering", run->err, sizeof(run->err));
 }
 
@@ -690,9 +840,16 @@ static bool harness_gl_init(struct runner *r, char *err, size_t errlen)
         {GL_VERTEX_SHADER, {"fullscreen.vert"}},
         {GL_FRAGMENT_SHADER, {"resolve.frag"}},
     };
+    /* Post hook: one resolve per tone map, in enum look_tonemap order. */
+    static const char *const tonemaps[3] = {"#define TONEMAP_NONE 1\n",
+                                            "#define TONEMAP_REINHARD 1\n",
+                                            "#define TONEMAP_ACES 1\n"};
     r->targets = gpu_targets_create();
-    if (!r->targets || !gpu_frame_block_init(&r->frame_block) ||
-        !(r->resolve_prog = gl_program_build("resolve", stages, 2, NULL, err, errlen))) {
+    bool ok = r->targets && gpu_frame_block_init(&r->frame_block);
+    for (int i = 0; ok && i < 3; i++)
+        ok = (r->resolve_progs[i] = gl_program_build("resolve", stages, 2, tonemaps[i], err,
+                                                     errlen)) != 0;
+    if (!ok) {
         if (!err[0])
             snprintf(err, errlen, "cannot set up the harness's GL objects");
         return false;
@@ -706,7 +863,8 @@ static void harness_gl_finish(struct runner *r)
     gpu_targets_destroy(r->targets);
     r->targets = NULL;
     gpu_frame_block_finish(&r->frame_block);
-    glDeleteProgram(r->resolve_prog);
+    for (int i = 0; i < 3; i++)
+        glDeleteProgram(r->resolve_progs[i]);
     glDeleteVertexArrays(1, &r->empty_vao);
 }
 
@@ -737,8 +895,11 @@ static void *runner_main(void *arg)
 
     struct job *job;
     /* Store hook: the metrics and files of earlier jobs finish before the next job is timed. */
-    while ((metrics_worker_wait_idle(r->metrics), job = queue_next(r->queue)))
+    while ((metrics_worker_wait_idle(r->metrics), job = queue_next(r->queue))) {
+        double busy_from = telemetry_now();
         run_job(r, job);
+        telemetry_render_busy(telemetry_now() - busy_from);
+    }
     atomic_store(&r->alive, false);
     harness_gl_finish(r);
     egl_context_destroy(egl);

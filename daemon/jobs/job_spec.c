@@ -29,6 +29,21 @@ static bool get_technique(const json_t *v, const char *field,
     return job_error_set(err, field, "must be one of: %s%s", list, nullable ? ", or null" : "");
 }
 
+/* Today's image: Phong, 32-bit floats, clamped, no effects. */
+static void look_defaults(struct look_spec *look)
+{
+    memset(look, 0, sizeof(*look));
+    look->lighting = LOOK_PHONG;
+    look->hdr = LOOK_HDR_RGBA32F;
+    look->exposure = 1.0;
+    look->tonemap = LOOK_TONEMAP_NONE;
+}
+
+static double default_timeout_s;
+
+void job_spec_set_default_timeout(double seconds) { default_timeout_s = seconds; }
+double job_spec_default_timeout(void) { return default_timeout_s; }
+
 void job_spec_defaults(struct job_spec *out, const struct technique_catalog *techniques)
 {
     memset(out, 0, sizeof(*out));
@@ -41,14 +56,15 @@ void job_spec_defaults(struct job_spec *out, const struct technique_catalog *tec
     out->capture_interval = 0;
     out->async_distance = 0.0;
     scene_spec_defaults(&out->scene);
-    out->look.lighting = LOOK_PHONG;
-    out->look.hdr = LOOK_HDR_RGBA32F;
+    look_defaults(&out->look);
+    out->reference_look = out->look;
     for (int i = 0; i < techniques->count; i++)
         technique_options_defaults(techniques->infos[i], &out->options[i]);
     out->repeat = 1;
     out->repeat_auto = false;
     out->reference[0] = '\0';
     metrics_options_defaults(&out->metrics);
+    out->timeout_s = default_timeout_s;
 }
 
 const void *job_spec_technique_options(const struct job_spec *spec)
@@ -63,22 +79,37 @@ const void *job_spec_reference_options(const struct job_spec *spec)
 
 static const char *const LIGHTING_NAMES[] = {"phong", "blinn_phong", NULL};
 static const char *const HDR_NAMES[] = {"rgba32f", "rgba16f", NULL};
+static const char *const TONEMAP_NAMES[] = {"none", "reinhard", "aces", NULL};
 
 const char *look_lighting_name(int lighting) { return LIGHTING_NAMES[lighting]; }
+const char *look_tonemap_name(int tonemap) { return TONEMAP_NAMES[tonemap]; }
 
-/* "look": {"lighting": "phong" | "blinn_phong", "hdr": "rgba32f" | "rgba16f"}. */
-static bool parse_look(const json_t *v, struct look_spec *look, struct job_error *err)
+/* "look": {"lighting": "phong" | "blinn_phong", "hdr": "rgba32f" | "rgba16f",
+ * "exposure": x, "tonemap": "none" | "reinhard" | "aces", "post": [...]};
+ * name is "look" or "reference_look", for the errors. */
+static bool parse_look(const json_t *v, const char *name, struct look_spec *look,
+                       struct job_error *err)
 {
-    static const char *const keys[] = {"lighting", "hdr", NULL};
-    return jf_check_keys(v, "look.", keys, err) &&
-           jf_get_choice(v, "lighting", "look.lighting", LIGHTING_NAMES, &look->lighting, err) &&
-           jf_get_choice(v, "hdr", "look.hdr", HDR_NAMES, &look->hdr, err);
+    static const char *const keys[] = {"lighting", "hdr", "exposure", "tonemap", "post", NULL};
+    char prefix[32], field[5][48];
+    static const char *const fields[] = {"lighting", "hdr", "exposure", "tonemap", "post"};
+    snprintf(prefix, sizeof(prefix), "%s.", name);
+    for (int i = 0; i < 5; i++)
+        snprintf(field[i], sizeof(field[i]), "%s.%s", name, fields[i]);
+    json_t *post = json_object_get(v, "post");
+    return jf_check_keys(v, prefix, keys, err) &&
+           jf_get_choice(v, "lighting", field[0], LIGHTING_NAMES, &look->lighting, err) &&
+           jf_get_choice(v, "hdr", field[1], HDR_NAMES, &look->hdr, err) &&
+           jf_get_number(v, "exposure", field[2], 1.0 / 1024.0, 1024.0, &look->exposure, err) &&
+           jf_get_choice(v, "tonemap", field[3], TONEMAP_NAMES, &look->tonemap, err) &&
+           (!post || post_spec_parse(post, field[4], &look->post, err));
 }
 
-static json_t *look_to_json(const struct look_spec *look)
+json_t *look_spec_to_json(const struct look_spec *look)
 {
-    return json_pack("{s:s, s:s}", "lighting", LIGHTING_NAMES[look->lighting], "hdr",
-                     HDR_NAMES[look->hdr]);
+    return json_pack("{s:s, s:s, s:f, s:s, s:o}", "lighting", LIGHTING_NAMES[look->lighting],
+                     "hdr", HDR_NAMES[look->hdr], "exposure", look->exposure, "tonemap",
+                     TONEMAP_NAMES[look->tonemap], "post", post_spec_to_json(&look->post));
 }
 
 /* "repeat": N, or {"auto": true, "max": M}. */
@@ -237,7 +268,8 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
 {
     static const char *const fixed[] = {"technique", "frames", "warmup_frames",
                                         "capture_interval", "async_distance", "scene", "look",
-                                        "reference", "metrics", "repeat", "labels"};
+                                        "reference", "reference_look", "metrics", "repeat",
+                                        "labels", "timeout_s"};
     enum { NFIXED = sizeof(fixed) / sizeof(fixed[0]) };
     /* Every technique's options live under its own name. */
     const char *keys[NFIXED + TECHNIQUE_MAX + 1];
@@ -281,8 +313,20 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
         out->options_given &= ~(1u << out->reference_index);
     json_t *look;
     if (!jf_get_object(body, "look", "look", &look, err) ||
-        (look && !parse_look(look, &out->look, err)))
+        (look && !parse_look(look, "look", &out->look, err)))
         return false;
+    /* The reference renders with the same look unless told otherwise; a
+     * reference_look is a whole look, read over the defaults. */
+    json_t *ref_look;
+    out->reference_look = out->look;
+    if (!jf_get_object(body, "reference_look", "reference_look", &ref_look, err))
+        return false;
+    if (ref_look) {
+        look_defaults(&out->reference_look);
+        out->reference_look_given = true;
+        if (!parse_look(ref_look, "reference_look", &out->reference_look, err))
+            return false;
+    }
     json_t *metrics = json_object_get(body, "metrics");
     if (metrics && !parse_metrics(metrics, &out->metrics, err))
         return false;
@@ -298,7 +342,8 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
         !jf_get_int(body, "capture_interval", "capture_interval", 0, 1000000,
                  &out->capture_interval, err) ||
         !jf_get_number(body, "async_distance", "async_distance", 0.0, 1e6,
-                    &out->async_distance, err))
+                    &out->async_distance, err) ||
+        !jf_get_number(body, "timeout_s", "timeout_s", 0.0, 1e7, &out->timeout_s, err))
         return false;
 
     json_t *scene;
@@ -311,12 +356,18 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
                     "captured frames with the reference's");
     if (metrics && !out->reference[0])
         return job_error_set(err, "metrics", "needs a reference technique to compare with");
+    if (ref_look && !out->reference[0])
+        return job_error_set(err, "reference_look", "needs a reference technique to render "
+                             "with it");
     if (out->reference[0] && (out->metrics.which & METRIC_SSIM) &&
         (out->scene.width < SSIM_WINDOW || out->scene.height < SSIM_WINDOW))
         return job_error_set(err, "metrics.ssim", "needs frames of at least 11x11 pixels");
     if (out->capture_interval > out->frames)
         return job_error_set(err, "capture_interval",
                     "must be 0 (no captures) or at most frames (%d)", out->frames);
+    if (job_spec_capture_count(out) > JOB_MAX_CAPTURES)
+        return job_error_set(err, "capture_interval", "would capture %d frames; at most %d a job",
+                             job_spec_capture_count(out), JOB_MAX_CAPTURES);
     /* Captured frames are kept in memory until the timed run ends, so that
      * encoding never lands inside the measurement: bound that memory. */
     double bytes = (double)job_spec_capture_count(out) * out->scene.width *
@@ -389,7 +440,7 @@ json_t *job_spec_to_json(const struct job_spec *spec)
                             "frames", spec->frames, "warmup_frames", spec->warmup_frames,
                             "capture_interval", spec->capture_interval, "async_distance",
                             spec->async_distance, "scene", scene_spec_to_json(&spec->scene),
-                            "look", look_to_json(&spec->look));
+                            "look", look_spec_to_json(&spec->look));
     /* The options of what runs (technique and reference) and of whatever the
      * body set, so that the spec round-trips. */
     const struct technique_catalog *c = spec->catalog;
@@ -403,8 +454,11 @@ json_t *job_spec_to_json(const struct job_spec *spec)
                                           : json_integer(spec->repeat));
     json_object_set_new(out, "reference",
                         spec->reference[0] ? json_string(spec->reference) : json_null());
+    json_object_set_new(out, "timeout_s", json_real(spec->timeout_s));
     if (spec->reference[0])
         json_object_set_new(out, "metrics", metrics_to_json(&spec->metrics));
+    if (spec->reference_look_given)
+        json_object_set_new(out, "reference_look", look_spec_to_json(&spec->reference_look));
     json_t *labels = json_object();
     for (int i = 0; i < spec->nlabels; i++)
         json_object_set_new(labels, spec->labels[i].key, json_string(spec->labels[i].value));

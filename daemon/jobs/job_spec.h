@@ -10,21 +10,28 @@
 #include <stddef.h>
 
 #include "common/json_fields.h"
+#include "daemon/effects/effect_info.h"
 #include "daemon/quality/metrics.h"
 #include "daemon/scene/scene_spec.h"
 #include "daemon/techniques/technique_info.h"
 
 #define JOB_MAX_BODY_BYTES (64 * 1024)
 #define JOB_MAX_CAPTURE_BYTES (1024.0 * 1024.0 * 1024.0)
+#define JOB_MAX_CAPTURES 1000
 
 /* The job's "look": what the image should look like, independent of the
  * technique that renders it; the reference renders with the same look. */
 enum look_lighting { LOOK_PHONG, LOOK_BLINN_PHONG };
 enum look_hdr { LOOK_HDR_RGBA32F, LOOK_HDR_RGBA16F };
+/* none: today's clamp, no encoding; the curves write 8-bit sRGB. */
+enum look_tonemap { LOOK_TONEMAP_NONE, LOOK_TONEMAP_REINHARD, LOOK_TONEMAP_ACES };
 
 struct look_spec {
-    int lighting; /* enum look_lighting */
-    int hdr;      /* enum look_hdr: the format of the HDR target techniques draw into */
+    int lighting;    /* enum look_lighting */
+    int hdr;         /* enum look_hdr: the format of the HDR target techniques draw into */
+    double exposure; /* scales the HDR colour in the resolve, before the tone curve */
+    int tonemap;     /* enum look_tonemap */
+    struct post_spec post; /* effects the harness runs on the HDR output, in order */
 };
 
 /* labels: free-form tags for history (commit, branch, driver version). Keys
@@ -48,6 +55,10 @@ struct job_spec {
     double async_distance;
     struct scene_spec scene;
     struct look_spec look;
+    /* The look the reference renders with: the job's look unless the body
+     * gave reference_look (for scoring an effect itself). */
+    struct look_spec reference_look;
+    bool reference_look_given;
     int repeat;                    /* runs of the job; with repeat_auto, the most */
     bool repeat_auto;              /* stop once the 95% interval is within 2.5% */
     char reference[32];            /* technique to compare captures with; "" for none */
@@ -61,7 +72,13 @@ struct job_spec {
     struct technique_options options[TECHNIQUE_MAX];
     int nlabels;                   /* sorted by key */
     struct job_label labels[JOB_MAX_LABELS];
+    double timeout_s;              /* running time allowed, all phases; 0: no limit */
 };
+
+/* The timeout_s a job gets when it names none (--job-timeout). Set once at
+ * start-up, before any thread parses jobs. */
+void job_spec_set_default_timeout(double seconds);
+double job_spec_default_timeout(void);
 
 
 /* Fills defaults, then applies and validates the body. techniques is the
@@ -82,6 +99,9 @@ const void *job_spec_reference_options(const struct job_spec *spec);
 
 /* The look's names, for shaders and results. */
 const char *look_lighting_name(int lighting);
+const char *look_tonemap_name(int tonemap);
+/* The look as understood, every field and effect option. New reference. */
+json_t *look_spec_to_json(const struct look_spec *look);
 
 /* The job as understood, defaults filled in. New reference. */
 json_t *job_spec_to_json(const struct job_spec *spec);

@@ -28,6 +28,8 @@ struct queue {
     double keep_days;
     struct record_kind kind; /* STATE_DIR/jobs/ID/job.json */
     const struct technique_catalog *techniques; /* for queue_load */
+    void (*listener)(void *ctx);
+    void *listener_ctx;
 };
 
 /* A job's state as taken under the store lock, written after it is
@@ -38,7 +40,13 @@ struct snapshot {
     json_t *json;
 };
 
-static _Thread_local char submit_error[PATH_MAX + 200];
+void queue_set_listener(struct queue *q, void (*fn)(void *ctx), void *ctx)
+{
+    q->listener = fn;
+    q->listener_ctx = ctx;
+}
+
+#define NOTIFY_LISTENER(q) ((q)->listener ? (q)->listener((q)->listener_ctx) : (void)0)
 
 const char *job_status_name(enum job_status s)
 {
@@ -164,7 +172,7 @@ void queue_retention(struct queue *q, int *keep_jobs, double *keep_days)
     pthread_mutex_unlock(&q->lock);
 }
 
-const char *queue_submit_error(void) { return submit_error; }
+const char *queue_submit_error(void) { return records_submit_error(); }
 
 static struct job *find_locked(struct queue *q, const char *id)
 {
@@ -223,7 +231,8 @@ static bool write_spec_record(const struct job *job, char *err, size_t errlen)
 enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *spec,
                                       const char *dir_override, char id_out[24])
 {
-    submit_error[0] = '\0';
+    char why[PATH_MAX + 200] = "";
+    records_set_submit_error("%s", "");
     pthread_mutex_lock(&q->lock);
     enum queue_submit_result res = q->stopping                  ? QUEUE_STOPPING
                                    : q->queued >= q->max_queued ? QUEUE_FULL
@@ -240,27 +249,26 @@ enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *sp
     struct job *job = job_new();
     bool made_dir = false;
     if (!job) {
-        snprintf(submit_error, sizeof(submit_error), "out of memory");
+        snprintf(why, sizeof(why), "out of memory");
         goto fail;
     }
-    if (!record_create_dir(&q->kind, dir_override, job->id, job->dir, sizeof(job->dir),
-                           submit_error, sizeof(submit_error)))
+    if (!record_create_dir(&q->kind, dir_override, job->id, job->dir, sizeof(job->dir), why,
+                           sizeof(why)))
         goto fail;
     made_dir = !dir_override;
     job->spec = *spec;
     job->status = JOB_QUEUED;
     job->frames_total = spec->frames * job_spec_runs(spec);
     job->created = clock_unix_s();
-    if (!dir_override && !write_spec_record(job, submit_error, sizeof(submit_error)))
+    if (!dir_override && !write_spec_record(job, why, sizeof(why)))
         goto fail;
     json_t *first = job_record_locked(job); /* not shared yet: no lock needed */
     char path[PATH_MAX + 16];
     snprintf(path, sizeof(path), "%s/job.json", job->dir);
     job->seq = 1;
-    bool written = first && record_writer_write(&job->writer, 1, path, first, submit_error,
-                                                sizeof(submit_error));
+    bool written = first && record_writer_write(&job->writer, 1, path, first, why, sizeof(why));
     if (!first)
-        snprintf(submit_error, sizeof(submit_error), "out of memory");
+        snprintf(why, sizeof(why), "out of memory");
     json_decref(first);
     if (!written)
         goto fail;
@@ -270,14 +278,19 @@ enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *sp
         pthread_cond_broadcast(&q->changed);
     pthread_mutex_unlock(&q->lock);
     if (!inserted) {
-        snprintf(submit_error, sizeof(submit_error), "out of memory");
+        snprintf(why, sizeof(why), "out of memory");
         goto fail;
     }
     snprintf(id_out, 24, "%s", job->id);
     return QUEUE_OK;
 
 fail:
-    LOG(LOG_ERROR, "job refused, it cannot be persisted: %s", submit_error);
+    records_set_submit_error("the job cannot be persisted in the state directory %s: %s",
+                             q->kind.state_dir[0] ? q->kind.state_dir
+                             : dir_override       ? dir_override
+                                                  : "(none)",
+                             why);
+    LOG(LOG_ERROR, "job refused: %s", records_submit_error());
     if (made_dir) {
         /* Never accepted, so not a record: remove what was made of it. */
         static const char *const files[] = {"job.json", "job.json.tmp", "spec.json",
@@ -370,8 +383,6 @@ void queue_finish(struct queue *q, struct job *job, enum job_status status,
 
     pthread_mutex_lock(&q->lock);
     if (requeue) {
-        LOG(LOG_INFO, "job %s: stopped by the daemon's exit; back to the head of the queue",
-            job->id);
         job->status = JOB_QUEUED;
         job->phase = NULL;
         job->started = 0;
@@ -394,9 +405,13 @@ void queue_finish(struct queue *q, struct job *job, enum job_status status,
     if (again)
         snapshot_locked(job, &snap);
     pthread_cond_broadcast(&q->changed);
+    NOTIFY_LISTENER(q);
     pthread_mutex_unlock(&q->lock);
     if (again)
         write_snapshot(q, &snap, NULL, 0);
+    if (requeue)
+        LOG(LOG_INFO, "job %s: stopped by the daemon's exit; back to the head of the queue",
+            job->id);
     apply_retention(q);
 }
 
@@ -412,6 +427,7 @@ void queue_stop(struct queue *q)
             atomic_store(&q->jobs[i]->cancel, true);
         }
     pthread_cond_broadcast(&q->changed);
+    NOTIFY_LISTENER(q);
     pthread_mutex_unlock(&q->lock);
 }
 
@@ -432,6 +448,7 @@ enum queue_cancel_result queue_cancel(struct queue *q, const char *id)
         snapshot_locked(job, &snap);
         res = CANCEL_DONE;
         pthread_cond_broadcast(&q->changed);
+        NOTIFY_LISTENER(q);
         break;
     case JOB_RUNNING:
         job->user_cancel = true;
@@ -667,11 +684,26 @@ static void load_job(void *ctx, const char *id, const char *dir)
         json_decref(o);
 
         if (job->status == JOB_RUNNING) {
-            job->status = JOB_INTERRUPTED;
-            job->finished = clock_unix_s();
-            snprintf(job->error, sizeof(job->error),
-                     "interrupted: the daemon stopped (killed or crashed) while this job ran; "
-                     "its files may be incomplete, submit it again to measure it");
+            /* A complete result.json is the last thing a job writes before it
+             * is done: the daemon died (or the disk was full) between that
+             * and writing job.json. Anything less was cut short. */
+            snprintf(path, sizeof(path), "%s/result.json", dir);
+            json_t *result = access(path, F_OK) == 0 ? record_read(path, why, sizeof(why)) : NULL;
+            if (result && result_complete(&job->spec, result)) {
+                job->status = JOB_DONE;
+                job->result = result;
+                job->finished = file_mtime(path);
+                atomic_store(&job->frames_done, job->frames_total);
+                LOG(LOG_WARN, "job %s: job.json says running, but its result.json is complete: "
+                    "done", id);
+            } else {
+                json_decref(result);
+                job->status = JOB_INTERRUPTED;
+                job->finished = clock_unix_s();
+                snprintf(job->error, sizeof(job->error),
+                         "interrupted: the daemon stopped (killed or crashed) while this job ran; "
+                         "its files may be incomplete, submit it again to measure it");
+            }
             changed = true;
         } else if (job->status == JOB_DONE) {
             snprintf(path, sizeof(path), "%s/result.json", dir);

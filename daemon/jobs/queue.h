@@ -82,8 +82,8 @@ int queue_max_queued(const struct queue *q);
 /* Accepts a job only once its spec.json and job.json are on disk. */
 enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *spec,
                                       const char *dir_override, char id_out[24]);
-/* Why the calling thread's last queue_submit returned QUEUE_IO_ERROR: names
- * the file or directory and the errno text. */
+/* Why the calling thread's last queue_submit (or sweeps_submit) returned
+ * QUEUE_IO_ERROR: names the state directory, the file and the errno text. */
 const char *queue_submit_error(void);
 
 /* Render thread: blocks until a job is queued (marks it running) or the
@@ -123,5 +123,10 @@ bool queue_job_dir(struct queue *q, const char *id, char *dir, size_t cap,
                    enum job_status *status);
 
 const char *job_status_name(enum job_status s);
+
+/* fn(ctx) is called whenever a job finishes or is cancelled, and when the
+ * queue stops, with the queue's lock held: it must return at once and take
+ * no lock (the HTTP layer writes to an eventfd). Set once, before serving. */
+void queue_set_listener(struct queue *q, void (*fn)(void *ctx), void *ctx);
 
 #endif

@@ -3,6 +3,7 @@
 
 #include <dirent.h>
 #include <errno.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,6 +13,18 @@
 
 #include "common/fsutil.h"
 #include "common/log.h"
+
+static _Thread_local char submit_error[PATH_MAX + 300];
+
+const char *records_submit_error(void) { return submit_error; }
+
+void records_set_submit_error(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(submit_error, sizeof(submit_error), fmt, ap);
+    va_end(ap);
+}
 
 void record_kind_init(struct record_kind *k, const char *state_dir, const char *name,
                       const char *file)
@@ -172,8 +185,9 @@ bool record_quarantine(const struct record_kind *k, const char *id, const char *
         char suffix[16] = "";
         if (n)
             snprintf(suffix, sizeof(suffix), ".%d", n);
-        if (snprintf(dest, sizeof(dest), "%s/%s-%.32s%s%.200s-%s%s", qdir, k->name, id,
-                     is_dir ? "" : "-", is_dir ? "" : base, stamp, suffix) >= (int)sizeof(dest)) {
+        bool named = is_dir || strcmp(base, id) == 0; /* the id says it all */
+        if (snprintf(dest, sizeof(dest), "%s/%s-%.64s%s%.200s-%s%s", qdir, k->name, id,
+                     named ? "" : "-", named ? "" : base, stamp, suffix) >= (int)sizeof(dest)) {
             LOG(LOG_ERROR, "cannot quarantine %s: the state directory's path is too long (%s)",
                 path, reason);
             return false;
@@ -287,7 +301,7 @@ int record_scan(struct record_kind *k, record_load_fn load, void *ctx, char *err
         if (lstat(path, &st) != 0)
             continue; /* gone meanwhile */
         if (!S_ISDIR(st.st_mode) || !record_id_valid(names[i])) {
-            record_quarantine(k, "entry", path,
+            record_quarantine(k, names[i], path,
                               S_ISDIR(st.st_mode) ? "a directory whose name is not a record id"
                                                   : "not a record directory",
                               NULL, 0);

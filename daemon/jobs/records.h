@@ -75,7 +75,7 @@ bool record_writer_write(struct record_writer *w, uint64_t seq, const char *path
 json_t *record_read(const char *path, char *why, size_t whylen);
 
 /* Moves path (a record's directory or one of its files) to
- * STATE_DIR/quarantine/<kind>-<id>[-<file>]-<UTC time>, with the reason
+ * STATE_DIR/quarantine/<kind>-<id>[-<file name>]-<UTC time>, with the reason
  * written beside it as <that name>.reason, and logs both. true when moved;
  * false (logged, with errno) leaves it where it was. Any thread. */
 bool record_quarantine(const struct record_kind *k, const char *id, const char *path,
@@ -89,6 +89,12 @@ bool record_quarantine(const struct record_kind *k, const char *id, const char *
 typedef void (*record_load_fn)(void *ctx, const char *id, const char *dir);
 int record_scan(struct record_kind *k, record_load_fn load, void *ctx, char *err,
                 size_t errlen);
+
+/* Why the calling thread's last submission (of a job or a sweep) could not
+ * be persisted: the state directory, the file and the errno text. Each
+ * thread has its own. */
+const char *records_submit_error(void);
+void records_set_submit_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 
 /* Retention, a pure function: finished[i] is record i's finish time (unix
  * seconds), or negative while it has not finished. Marks victim[i] for

@@ -14,22 +14,43 @@ enum param_type { PARAM_INT, PARAM_NUMBER, PARAM_BOOL, PARAM_CHOICE };
 static const struct {
     const char *path;
     enum param_type type;
+    int step; /* integers: valid values are from + k step (sphere segments are even) */
 } PARAMS[] = {
-    {"technique", PARAM_CHOICE},        {"reference", PARAM_CHOICE},
-    {"frames", PARAM_INT},              {"warmup_frames", PARAM_INT},
-    {"capture_interval", PARAM_INT},    {"async_distance", PARAM_NUMBER},
-    {"scene.lights", PARAM_INT},        {"scene.dynamic", PARAM_BOOL},
-    {"scene.width", PARAM_INT},         {"scene.height", PARAM_INT},
-    {"scene.sphere_segments", PARAM_INT}, {"scene.light_speed", PARAM_NUMBER},
-    {"look.lighting", PARAM_CHOICE},    {"look.hdr", PARAM_CHOICE},
-    {"scene.preset", PARAM_CHOICE},     {"scene.light_layout", PARAM_CHOICE},
-    {"scene.light_radius", PARAM_NUMBER}, {"scene.light_intensity", PARAM_NUMBER},
-    {"scene.tessellation_error_px", PARAM_NUMBER}, {"scene.camera", PARAM_CHOICE},
-    {"scene.materials", PARAM_CHOICE},  {"scene.specular", PARAM_NUMBER},
-    {"scene.shininess", PARAM_NUMBER},  {"scene.metallic", PARAM_NUMBER},
-    {"scene.roughness", PARAM_NUMBER},
+    {"technique", PARAM_CHOICE, 0},        {"reference", PARAM_CHOICE, 0},
+    {"frames", PARAM_INT, 1},              {"warmup_frames", PARAM_INT, 1},
+    {"capture_interval", PARAM_INT, 1},    {"async_distance", PARAM_NUMBER, 0},
+    {"scene.lights", PARAM_INT, 1},        {"scene.dynamic", PARAM_BOOL, 0},
+    {"scene.width", PARAM_INT, 1},         {"scene.height", PARAM_INT, 1},
+    {"scene.sphere_segments", PARAM_INT, 2}, {"scene.light_speed", PARAM_NUMBER, 0},
+    {"look.lighting", PARAM_CHOICE, 0},    {"look.hdr", PARAM_CHOICE, 0},
+    {"look.exposure", PARAM_NUMBER, 0},    {"look.tonemap", PARAM_CHOICE, 0},
+    {"scene.preset", PARAM_CHOICE, 0},     {"scene.light_layout", PARAM_CHOICE, 0},
+    {"scene.light_radius", PARAM_NUMBER, 0}, {"scene.light_intensity", PARAM_NUMBER, 0},
+    {"scene.tessellation_error_px", PARAM_NUMBER, 0}, {"scene.camera", PARAM_CHOICE, 0},
+    {"scene.materials", PARAM_CHOICE, 0},  {"scene.specular", PARAM_NUMBER, 0},
+    {"scene.shininess", PARAM_NUMBER, 0},  {"scene.metallic", PARAM_NUMBER, 0},
+    {"scene.roughness", PARAM_NUMBER, 0},
 };
 enum { NPARAMS = sizeof(PARAMS) / sizeof(PARAMS[0]) };
+
+/* "look.post.<effect>.<option>": the option of every <effect> in the
+ * base job's look.post (post hook: an effect's breaking point, e.g.
+ * look.post.bloom.intensity against the finite criterion). */
+#define POST_PARAM "look.post."
+static const struct technique_option *post_param(const char *path, char *effect, size_t cap)
+{
+    if (strncmp(path, POST_PARAM, strlen(POST_PARAM)) != 0)
+        return NULL;
+    const char *name = path + strlen(POST_PARAM), *dot = strchr(name, '.');
+    if (!dot || (size_t)(dot - name) >= cap)
+        return NULL;
+    snprintf(effect, cap, "%.*s", (int)(dot - name), name);
+    int e = effect_find(effect);
+    for (const struct technique_option *o = e >= 0 ? effect_infos[e]->options : NULL; o && o->name; o++)
+        if (strcmp(o->name, dot + 1) == 0)
+            return o;
+    return NULL;
+}
 
 /* The type of a sweepable path; false when a sweep cannot vary it. */
 static bool param_type(const struct technique_catalog *techniques, const char *path,
@@ -40,7 +61,10 @@ static bool param_type(const struct technique_catalog *techniques, const char *p
             *type = PARAMS[i].type;
             return true;
         }
+    char effect[32];
     const struct technique_option *opt = technique_catalog_option(techniques, path);
+    if (!opt)
+        opt = post_param(path, effect, sizeof(effect));
     if (!opt)
         return false;
     *type = opt->type == TOPT_INT ? PARAM_INT : opt->type == TOPT_NUMBER ? PARAM_NUMBER
@@ -48,13 +72,45 @@ static bool param_type(const struct technique_catalog *techniques, const char *p
     return true;
 }
 
+/* The grid an integer parameter's values lie on (sphere segments are even);
+ * 1 for technique options, which take any integer in their range. */
+static int param_step(const char *path)
+{
+    for (int i = 0; i < (int)NPARAMS; i++)
+        if (strcmp(PARAMS[i].path, path) == 0)
+            return PARAMS[i].step > 0 ? PARAMS[i].step : 1;
+    return 1;
+}
+
 static bool unknown_param(const struct technique_catalog *techniques, struct job_error *err,
                           const char *field)
 {
     (void)techniques;
     return job_error_set(err, field, "not a parameter a sweep can vary: scene, look and "
-                         "top-level job fields, or TECHNIQUE.OPTION; GET /v1/info lists "
-                         "them under \"sweepable\"");
+                         "top-level job fields, TECHNIQUE.OPTION or look.post.EFFECT.OPTION; "
+                         "GET /v1/info lists them under \"sweepable\"");
+}
+
+/* Sets a post effect's option in every entry of that effect in look.post;
+ * false when the list has none. */
+static bool set_post_option(json_t *job, const char *effect, const char *option, json_t *value)
+{
+    json_t *list = json_object_get(json_object_get(job, "look"), "post");
+    bool any = false;
+    for (size_t i = 0; i < json_array_size(list); i++) {
+        json_t *entry = json_array_get(list, i), *opts = NULL;
+        if (json_is_string(entry) && strcmp(json_string_value(entry), effect) == 0) {
+            opts = json_object();
+            json_array_set_new(list, i, json_pack("{s:o}", effect, opts));
+        } else if (json_is_object(entry)) {
+            opts = json_object_get(entry, effect);
+        }
+        if (json_is_object(opts)) {
+            json_object_set(opts, option, value);
+            any = true;
+        }
+    }
+    return any;
 }
 
 json_t *sweep_params_json(const struct technique_catalog *techniques)
@@ -73,6 +129,15 @@ json_t *sweep_params_json(const struct technique_catalog *techniques)
                 json_object_set_new(o, path, json_string(types[type]));
         }
     }
+    /* Post hook: every effect's options, set in each entry of that effect. */
+    for (int e = 0; effect_infos[e]; e++)
+        for (const struct technique_option *opt = effect_infos[e]->options; opt && opt->name; opt++) {
+            char path[128];
+            enum param_type type;
+            snprintf(path, sizeof(path), POST_PARAM "%s.%s", effect_infos[e]->name, opt->name);
+            if (param_type(techniques, path, &type))
+                json_object_set_new(o, path, json_string(types[type]));
+        }
     return o;
 }
 
@@ -81,6 +146,12 @@ json_t *sweep_params_json(const struct technique_catalog *techniques)
 static json_t *with_field(const json_t *job, const char *path, json_t *value)
 {
     json_t *copy = json_deep_copy(job), *obj = copy;
+    char effect[32];
+    const struct technique_option *post = post_param(path, effect, sizeof(effect));
+    if (post) {
+        set_post_option(copy, effect, post->name, value);
+        return copy;
+    }
     const char *dot;
     while ((dot = strchr(path, '.'))) {
         char head[64];
@@ -114,6 +185,19 @@ static json_t *point_defaults(const struct sweep_spec *s, json_t *job)
     return job;
 }
 
+/* A post effect's option can only vary where the base job runs the effect. */
+static bool post_param_in_base(const json_t *base, const char *path, const char *field,
+                               struct job_error *err)
+{
+    char effect[32];
+    if (!post_param(path, effect, sizeof(effect)))
+        return true;
+    json_t *copy = json_deep_copy(base);
+    bool any = set_post_option(copy, effect, "unused", json_null());
+    json_decref(copy);
+    return any || job_error_set(err, field, "the base job's look.post has no %s to vary", effect);
+}
+
 static bool check_point(const json_t *job, const struct technique_catalog *techniques, const char *field,
                         struct job_error *err)
 {
@@ -122,6 +206,33 @@ static bool check_point(const json_t *job, const struct technique_catalog *techn
     if (job_spec_parse(job, techniques, &spec, &inner))
         return true;
     return job_error_set(err, field, "%s: %s", inner.field, inner.message);
+}
+
+/* Point p of a grid, exactly as it will be submitted; the error names the
+ * combination ("vary", point 3: frames=2, capture_interval=5) and the job
+ * field and rule it breaks. */
+static bool check_combination(const struct sweep_spec *s, size_t p, const struct technique_catalog *techniques,
+                              struct job_error *err)
+{
+    json_t *values, *job = sweep_point_job(s, p, &values);
+    struct job_spec spec;
+    struct job_error inner;
+    bool ok = job_spec_parse(job, techniques, &spec, &inner);
+    if (!ok) {
+        char combo[160] = "";
+        size_t used = 0;
+        for (int i = 0; i < s->nparams && used < sizeof(combo); i++) {
+            char *v = json_dumps(json_object_get(values, s->params[i]), JSON_ENCODE_ANY | JSON_COMPACT);
+            used += (size_t)snprintf(combo + used, sizeof(combo) - used, "%s%s=%.40s",
+                                     i ? ", " : "", s->params[i], v ? v : "?");
+            free(v);
+        }
+        job_error_set(err, "vary", "point %zu (%s) is not a valid job: %s: %s", p + 1, combo,
+                      inner.field, inner.message);
+    }
+    json_decref(values);
+    json_decref(job);
+    return ok;
 }
 
 static bool workload_param(const char *path)
@@ -179,33 +290,6 @@ static bool add_reference_points(struct sweep_spec *out, const json_t *body,
     return true;
 }
 
-/* Point p of a grid, exactly as it will be submitted; the error names the
- * combination ("vary", point 3: frames=2, capture_interval=5) and the job
- * field and rule it breaks. */
-static bool check_combination(const struct sweep_spec *s, size_t p, const struct technique_catalog *techniques,
-                              struct job_error *err)
-{
-    json_t *values, *job = sweep_point_job(s, p, &values);
-    struct job_spec spec;
-    struct job_error inner;
-    bool ok = job_spec_parse(job, techniques, &spec, &inner);
-    if (!ok) {
-        char combo[160] = "";
-        size_t used = 0;
-        for (int i = 0; i < s->nparams && used < sizeof(combo); i++) {
-            char *v = json_dumps(json_object_get(values, s->params[i]), JSON_ENCODE_ANY | JSON_COMPACT);
-            used += (size_t)snprintf(combo + used, sizeof(combo) - used, "%s%s=%.40s",
-                                     i ? ", " : "", s->params[i], v ? v : "?");
-            free(v);
-        }
-        job_error_set(err, "vary", "point %zu (%s) is not a valid job: %s: %s", p + 1, combo,
-                      inner.field, inner.message);
-    }
-    json_decref(values);
-    json_decref(job);
-    return ok;
-}
-
 static bool parse_criterion(const char *text, struct sweep_spec *s)
 {
     double x;
@@ -215,6 +299,8 @@ static bool parse_criterion(const char *text, struct sweep_spec *s)
         s->criterion = CRITERION_PDIFF_PASS;
     else if (strcmp(text, "stable") == 0)
         s->criterion = CRITERION_STABLE;
+    else if (strcmp(text, "finite") == 0)
+        s->criterion = CRITERION_FINITE;
     else if (sscanf(text, "ssim_min >= %lf%1s", &x, tail) == 1 && x >= -1 && x <= 1)
         s->criterion = CRITERION_SSIM_MIN, s->threshold = x;
     else if (sscanf(text, "flip_max <= %lf%1s", &x, tail) == 1 && x >= 0 && x <= 1)
@@ -308,6 +394,8 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
             enum param_type unused;
             if (!param_type(techniques, key, &unused))
                 return unknown_param(techniques, err, field);
+            if (!post_param_in_base(base, key, field, err))
+                return false;
             if (!json_is_array(v) || json_array_size(v) == 0)
                 return job_error_set(err, field, "must be a non-empty list of values");
             snprintf(out->params[out->nparams], sizeof(out->params[0]), "%s", key);
@@ -360,11 +448,14 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
         return job_error_set(err, "find.param", "must name a parameter");
     if (!param_type(techniques, param, &type))
         return unknown_param(techniques, err, "find.param");
+    if (!post_param_in_base(base, param, "find.param", err))
+        return false;
     if (type != PARAM_INT && type != PARAM_NUMBER)
         return job_error_set(err, "find.param", "%s is not numeric: find bisects a numeric parameter", param);
     snprintf(out->params[0], sizeof(out->params[0]), "%s", param);
     out->nparams = 1;
     out->integer = type == PARAM_INT;
+    out->step = type == PARAM_INT ? param_step(param) : 0;
     json_t *from = json_object_get(find, "from"), *to = json_object_get(find, "to");
     if (!json_is_number(from))
         return job_error_set(err, "find.from", "must be a number");
@@ -378,7 +469,7 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
     const char *crit = json_string_value(json_object_get(find, "while"));
     if (!crit || !parse_criterion(crit, out))
         return job_error_set(err, "find.while", "must be one of \"pdiff_pass\", \"stable\", "
-                    "\"ssim_min >= X\", \"flip_max <= X\"");
+                    "\"finite\", \"ssim_min >= X\", \"flip_max <= X\"");
     out->max_probes = 10;
     json_t *steps = json_object_get(find, "steps");
     if (steps) {
@@ -444,6 +535,11 @@ json_t *sweep_point_job(const struct sweep_spec *s, size_t index, json_t **value
 
 json_t *sweep_probe_job(const struct sweep_spec *s, double v)
 {
+    /* Bisection halves the range; on a field with a step (sphere segments
+     * are even) a probe goes down to the step's grid, so that it is valid
+     * whenever both ends are. */
+    if (s->integer && s->step > 1)
+        v = s->from + floor((llround(v) - s->from) / s->step) * s->step;
     json_t *value = s->integer ? json_integer((json_int_t)llround(v)) : json_real(v);
     json_t *job = with_field(s->base, s->params[0], value);
     json_decref(value);
@@ -466,6 +562,8 @@ bool sweep_criterion_holds(const struct sweep_spec *s, const json_t *result)
     }
     case CRITERION_STABLE:
         return json_is_true(json_object_get(json_object_get(result, "repeat"), "stable"));
+    case CRITERION_FINITE:
+        return json_is_true(json_object_get(json_object_get(result, "nonfinite"), "finite"));
     }
     return false;
 }

@@ -16,7 +16,8 @@
 
 enum sweep_kind { SWEEP_VARY, SWEEP_FIND };
 
-enum sweep_criterion { CRITERION_PDIFF_PASS, CRITERION_SSIM_MIN, CRITERION_FLIP_MAX, CRITERION_STABLE };
+enum sweep_criterion { CRITERION_PDIFF_PASS, CRITERION_SSIM_MIN, CRITERION_FLIP_MAX, CRITERION_STABLE,
+                       CRITERION_FINITE /* no capture had NaN or infinite HDR pixels */ };
 
 struct sweep_spec {
     enum sweep_kind kind;
@@ -30,6 +31,7 @@ struct sweep_spec {
     /* SWEEP_FIND */
     double from, to;
     bool integer;
+    int step;               /* integer fields: probes are from + k step */
     int max_probes;
     enum sweep_criterion criterion;
     double threshold;

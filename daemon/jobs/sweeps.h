@@ -3,7 +3,16 @@
 
 /* Running sweeps: a thread of their own submits each point as an ordinary
  * job (so points show up in /v1/jobs too), waits for it, and fills the
- * sweep's table; find sweeps bisect. GL-free. */
+ * sweep's table; find sweeps bisect. GL-free.
+ *
+ * Sweeps persist like jobs (records.h): STATE_DIR/sweeps/ID/sweep.json,
+ * written atomically on every change, with no lock held across the write.
+ * On start, finished sweeps are served as before; a sweep stopped by
+ * SIGTERM was put back in the queue and resumes (after the points it has,
+ * waiting for its requeued point job rather than running it twice); one
+ * that was running when the daemon was killed is marked interrupted, its
+ * points kept. Retention follows the jobs' settings. Any thread, except
+ * create and destroy (the main thread). */
 
 #include <jansson.h>
 #include <stdbool.h>
@@ -15,12 +24,18 @@
 
 struct sweeps;
 
+/* Reloads the sweeps under the queue's state directory (after queue_load,
+ * so that a resumed sweep finds its point job), then starts the thread. */
 struct sweeps *sweeps_create(struct queue *q, const struct technique_catalog *techniques);
-/* Cancels the running sweep and stops. Accepts NULL. */
+/* Stops: the running sweep goes back to the queue, persisted, to resume on
+ * the next start. Before the runner stops the job queue. Accepts NULL. */
 void sweeps_destroy(struct sweeps *s);
 
-/* Takes ownership of spec (on success). false when too many are waiting. */
-bool sweeps_submit(struct sweeps *s, struct sweep_spec *spec, const json_t *body, char id_out[24]);
+/* Takes ownership of spec on QUEUE_OK. QUEUE_FULL when too many are
+ * waiting, QUEUE_IO_ERROR when sweep.json cannot be written (nothing is
+ * accepted; queue_submit_error says why). */
+enum queue_submit_result sweeps_submit(struct sweeps *s, struct sweep_spec *spec,
+                                       const json_t *body, char id_out[24]);
 json_t *sweeps_json(struct sweeps *s, const char *id, double wait_s);
 json_t *sweeps_list_json(struct sweeps *s);
 enum queue_cancel_result sweeps_cancel(struct sweeps *s, const char *id);

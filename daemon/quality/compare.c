@@ -37,6 +37,7 @@ struct flip_task {
     const struct image *ref, *test;
     double ppd;
     const char *map_path;
+    const struct metrics_stop *stop;
     struct flip_result result;
     double ms;
     bool ok;
@@ -47,8 +48,8 @@ static void *flip_thread(void *arg)
 {
     struct flip_task *t = arg;
     double t0 = now_ms();
-    t->ok = flip_compute(t->ref, t->test, t->ppd, t->map_path != NULL, &t->result, t->err,
-                         sizeof(t->err));
+    t->ok = flip_compute(t->ref, t->test, t->ppd, t->map_path != NULL, t->stop, &t->result,
+                         t->err, sizeof(t->err));
     if (t->ok && t->map_path) {
         if (!t->result.map) {
             snprintf(t->err, sizeof(t->err), "flip: out of memory for the map");
@@ -64,16 +65,42 @@ static void *flip_thread(void *arg)
     return NULL;
 }
 
+bool metrics_stopped(const struct metrics_stop *stop, char *err, size_t errlen)
+{
+    if (!stop || !stop->requested || !stop->requested(stop->ctx))
+        return false;
+    snprintf(err, errlen, "stopped");
+    return true;
+}
+
+double metrics_memory_bytes(int width, int height, double flip_ppd)
+{
+    double n = (double)width * (double)height;
+    /* The two images, FLIP (its map and tiles) beside SSIM (its 8-bit map and
+     * four planes' strips) and PerceptualDiff's tiles, and the PNG writer's
+     * row for a map. */
+    return 2.0 * n * 3.0 + (double)flip_memory_bytes(width, height, flip_ppd) +
+           (double)ssim_memory_bytes(width, height) + (double)pdiff_memory_bytes(width, height) +
+           2.0 * width * 3.0;
+}
+
 json_t *metrics_compare(const struct image *ref, const struct image *test,
                         const struct metrics_options *o, const char *ssim_map_path,
-                        const char *flip_map_path, char *err, size_t errlen)
+                        const char *flip_map_path, const struct metrics_stop *stop, char *err,
+                        size_t errlen)
 {
     if (ref->width != test->width || ref->height != test->height) {
         snprintf(err, errlen, "image sizes differ: %dx%d and %dx%d", ref->width, ref->height,
                  test->width, test->height);
         return NULL;
     }
-    struct flip_task flip = {.ref = ref, .test = test, .ppd = o->flip_ppd, .map_path = flip_map_path};
+    if ((long long)ref->width * ref->height > IMAGE_MAX_PIXELS) {
+        snprintf(err, errlen, "%dx%d is %lld pixels, over the limit of %lld", ref->width,
+                 ref->height, (long long)ref->width * ref->height, IMAGE_MAX_PIXELS);
+        return NULL;
+    }
+    struct flip_task flip = {.ref = ref, .test = test, .ppd = o->flip_ppd,
+                             .map_path = flip_map_path, .stop = stop};
     double start = now_ms();
     pthread_t flip_tid;
     bool flip_threaded = false;
@@ -87,7 +114,7 @@ json_t *metrics_compare(const struct image *ref, const struct image *test,
     double t0 = now_ms();
     if (o->which & METRIC_SSIM) {
         struct ssim_result s;
-        if (!ssim_compute(ref, test, ssim_map_path != NULL, &s, err, errlen))
+        if (!ssim_compute(ref, test, ssim_map_path != NULL, stop, &s, err, errlen))
             goto fail;
         json_object_set_new(out, "ssim", json_real(s.luma));
         json_object_set_new(out, "ssim_rgb", json_real(s.rgb));
@@ -104,7 +131,7 @@ json_t *metrics_compare(const struct image *ref, const struct image *test,
     }
     if (o->which & METRIC_PDIFF) {
         struct pdiff_result p;
-        if (!pdiff_compute(ref, test, &o->pdiff, &p, err, errlen))
+        if (!pdiff_compute(ref, test, &o->pdiff, stop, &p, err, errlen))
             goto fail;
         json_object_set_new(out, "pdiff",
                             json_pack("{s:b, s:I, s:f, s:I}", "pass", p.pass, "failing_pixels",
@@ -113,7 +140,7 @@ json_t *metrics_compare(const struct image *ref, const struct image *test,
         json_object_set_new(timing, "pdiff", json_real(now_ms() - t0));
         t0 = now_ms();
     }
-    if (o->which & METRIC_PSNR) {
+    if ((o->which & METRIC_PSNR) && !metrics_stopped(stop, err, errlen)) {
         struct psnr_result p;
         if (!psnr_compute(ref, test, &p, err, errlen))
             goto fail;
@@ -127,6 +154,8 @@ json_t *metrics_compare(const struct image *ref, const struct image *test,
     if (flip_threaded)
         pthread_join(flip_tid, NULL);
     flip_threaded = false;
+    if (metrics_stopped(stop, err, errlen))
+        goto fail;
     if (o->which & METRIC_FLIP) {
         if (!flip.ok) {
             snprintf(err, errlen, "%s", flip.err);

@@ -80,33 +80,33 @@ static float hyab(const float a[3], const float b[3])
     return fabsf(dl) + sqrtf(da * da + db * db);
 }
 
-/* Separable filter with replicated borders: dst = ky (x) kx * src. Taps
- * run outermost so the inner loops vectorize; row holds one padded row. */
-METRICS_SIMD static void filter(float *dst, const float *src, float *tmp, float *row, int w, int h,
-                   const float *kx, int rx, const float *ky, int ry)
+/* Separable filter of one tile: src is the tile with a halo of H pixels
+ * (ew wide), whose out-of-image pixels repeat the nearest border pixel (the
+ * replicated borders of the whole-image filter); dst gets the tw x th
+ * interior. Taps run outermost so the inner loops vectorize, in the order
+ * the whole-image filter adds them, so results match it bit for bit. */
+METRICS_SIMD static void filter(float *dst, const float *src, float *tmp, int ew, int H, int tw,
+                                int th, const float *kx, int rx, const float *ky, int ry)
 {
-    for (int y = 0; y < h; y++) {
-        const float *in = src + (size_t)y * (size_t)w;
-        float *out = tmp + (size_t)y * (size_t)w;
-        for (int x = -rx; x < w + rx; x++)
-            row[x + rx] = in[x < 0 ? 0 : (x >= w ? w - 1 : x)];
-        for (int x = 0; x < w; x++)
+    for (int y = H - ry; y < H + th + ry; y++) {
+        const float *in = src + (size_t)y * (size_t)ew + H;
+        float *out = tmp + (size_t)y * (size_t)ew + H;
+        for (int x = 0; x < tw; x++)
             out[x] = 0.0f;
         for (int i = 0; i <= 2 * rx; i++) {
-            const float k = kx[i], *r = row + i;
-            for (int x = 0; x < w; x++)
+            const float k = kx[i], *r = in + i - rx;
+            for (int x = 0; x < tw; x++)
                 out[x] += k * r[x];
         }
     }
-    for (int y = 0; y < h; y++) {
-        float *out = dst + (size_t)y * (size_t)w;
-        for (int x = 0; x < w; x++)
+    for (int y = 0; y < th; y++) {
+        float *out = dst + (size_t)y * (size_t)tw;
+        for (int x = 0; x < tw; x++)
             out[x] = 0.0f;
         for (int j = -ry; j <= ry; j++) {
-            int yy = y + j < 0 ? 0 : (y + j >= h ? h - 1 : y + j);
-            const float *in = tmp + (size_t)yy * (size_t)w;
+            const float *in = tmp + (size_t)(H + y + j) * (size_t)ew + H;
             const float k = ky[j + ry];
-            for (int x = 0; x < w; x++)
+            for (int x = 0; x < tw; x++)
                 out[x] += k * in[x];
         }
     }
@@ -145,17 +145,17 @@ static void make_csf(struct csf_filter *f, double ppd, double a1, double b1, dou
         f->weight[t] = (float)(mass[t] / total);
 }
 
-static void apply_csf(float *plane, float *acc, float *tmp, float *tmp2, float *row, int w,
-                      int h, const struct csf_filter *f)
+/* The CSF-filtered interior of one colour plane of a tile, into acc. */
+static void apply_csf(float *acc, const float *plane, float *tmp, float *tmp2, int ew, int H,
+                      int tw, int th, const struct csf_filter *f)
 {
-    size_t n = (size_t)w * (size_t)h;
+    size_t n = (size_t)tw * (size_t)th;
     memset(acc, 0, n * sizeof(float));
     for (int t = 0; t < f->terms; t++) {
-        filter(tmp2, plane, tmp, row, w, h, f->kernel[t], f->radius, f->kernel[t], f->radius);
+        filter(tmp2, plane, tmp, ew, H, tw, th, f->kernel[t], f->radius, f->kernel[t], f->radius);
         for (size_t i = 0; i < n; i++)
             acc[i] += f->weight[t] * tmp2[i];
     }
-    memcpy(plane, acc, n * sizeof(float));
 }
 
 struct feature_filter {
@@ -194,68 +194,154 @@ static void make_features(struct feature_filter *f, double ppd)
     }
 }
 
-/* Edge and point magnitudes of a luminance plane. */
+/* Edge and point magnitudes of a tile's luminance plane (with its halo). */
 static void features(const float *y, float *edge, float *point, float *tmp, float *a, float *b,
-                     float *row, int w, int h, const struct feature_filter *f)
+                     int ew, int H, int tw, int th, const struct feature_filter *f)
 {
-    size_t n = (size_t)w * (size_t)h;
+    size_t n = (size_t)tw * (size_t)th;
     int r = f->radius;
-    filter(a, y, tmp, row, w, h, f->edge, r, f->gauss, r);
-    filter(b, y, tmp, row, w, h, f->gauss, r, f->edge, r);
+    filter(a, y, tmp, ew, H, tw, th, f->edge, r, f->gauss, r);
+    filter(b, y, tmp, ew, H, tw, th, f->gauss, r, f->edge, r);
     for (size_t i = 0; i < n; i++)
         edge[i] = sqrtf(a[i] * a[i] + b[i] * b[i]);
-    filter(a, y, tmp, row, w, h, f->point, r, f->gauss, r);
-    filter(b, y, tmp, row, w, h, f->gauss, r, f->point, r);
+    filter(a, y, tmp, ew, H, tw, th, f->point, r, f->gauss, r);
+    filter(b, y, tmp, ew, H, tw, th, f->gauss, r, f->point, r);
     for (size_t i = 0; i < n; i++)
         point[i] = sqrtf(a[i] * a[i] + b[i] * b[i]);
 }
 
-/* Sorts non-negative floats: their bit patterns order as unsigned integers,
- * so two 16-bit radix passes do it in linear time. */
-static bool sort_nonnegative(float *v, size_t n)
+/* FLIP's weighted percentiles: with the errors sorted ascending and each
+ * weighted by itself, the first value at which the running sum exceeds p of
+ * the total. The map is not sorted (that would double its memory): a
+ * histogram of the upper 16 bits of the values' bit patterns (non-negative
+ * floats order as their bits do) finds the bucket where the sum crosses,
+ * and a histogram of that bucket's lower 16 bits the value itself. The
+ * running sum adds bucket by bucket, so it may differ from a one-by-one sum
+ * in its last bits; the value differs only if the sum lands that close to
+ * the threshold. */
+static bool weighted_percentiles(const float *map, size_t n, double total, const double *p,
+                                 double *out, int count, float largest)
 {
-    uint32_t *a = (uint32_t *)v, *b = malloc(n * sizeof(uint32_t));
-    size_t *count = calloc(65536, sizeof(size_t));
-    if (!b || !count) {
-        free(b);
-        free(count);
+    enum { BUCKETS = 65536 };
+    uint32_t *hi = calloc(BUCKETS, sizeof(uint32_t)), *lo = calloc(BUCKETS, sizeof(uint32_t));
+    double *hi_sum = calloc(BUCKETS, sizeof(double));
+    if (!hi || !lo || !hi_sum) {
+        free(hi), free(lo), free(hi_sum);
         return false;
     }
-    for (int pass = 0; pass < 2; pass++) {
-        int shift = pass * 16;
-        memset(count, 0, 65536 * sizeof(size_t));
-        for (size_t i = 0; i < n; i++)
-            count[(a[i] >> shift) & 0xffff]++;
-        size_t pos = 0;
-        for (size_t k = 0; k < 65536; k++) {
-            size_t c = count[k];
-            count[k] = pos;
-            pos += c;
-        }
-        for (size_t i = 0; i < n; i++)
-            b[count[(a[i] >> shift) & 0xffff]++] = a[i];
-        memcpy(a, b, n * sizeof(uint32_t));
+    for (size_t i = 0; i < n; i++) {
+        if (map[i] <= 0.0f)
+            continue;
+        uint32_t bits;
+        memcpy(&bits, &map[i], sizeof(bits));
+        hi[bits >> 16]++;
+        hi_sum[bits >> 16] += map[i];
     }
-    free(b);
-    free(count);
+    for (int q = 0; q < count; q++) {
+        double run = 0, threshold = p[q] * total;
+        int bucket = -1;
+        for (int b = 0; b < BUCKETS && bucket < 0; b++) {
+            if (hi[b] && run + hi_sum[b] > threshold)
+                bucket = b;
+            else
+                run += hi_sum[b];
+        }
+        out[q] = largest;
+        if (bucket < 0)
+            continue;
+        memset(lo, 0, BUCKETS * sizeof(uint32_t));
+        for (size_t i = 0; i < n; i++) {
+            uint32_t bits;
+            memcpy(&bits, &map[i], sizeof(bits));
+            if (map[i] > 0.0f && (int)(bits >> 16) == bucket)
+                lo[bits & 0xffff]++;
+        }
+        for (int l = 0; l < BUCKETS; l++) {
+            if (!lo[l])
+                continue;
+            uint32_t bits = (uint32_t)bucket << 16 | (uint32_t)l;
+            float v;
+            memcpy(&v, &bits, sizeof(v));
+            out[q] = v;
+            run += (double)lo[l] * v;
+            if (run > threshold)
+                break;
+        }
+    }
+    free(hi), free(lo), free(hi_sum);
     return true;
 }
 
-/* FLIP's weighted percentile: each error weighted by itself; the first
- * value, in ascending order, at which the running sum exceeds p of the total. */
-static double weighted_percentile(const float *sorted, size_t n, double total, double p)
+/* Tiles are TILE pixels square (the last of a row or column takes the rest,
+ * up to 1.5 tiles), with a halo as wide as the widest filter. */
+enum { TILE = 256 };
+
+static int tile_span(int pos, int size)
 {
-    double run = 0;
-    for (size_t i = 0; i < n; i++) {
-        run += sorted[i];
-        if (run > p * total)
-            return sorted[i];
+    return size - pos <= TILE + TILE / 2 ? size - pos : TILE;
+}
+
+/* The widest tile_span over an extent of size. */
+static int tile_max(int size)
+{
+    return size < TILE + TILE / 2 ? size : TILE + TILE / 2;
+}
+
+struct flip_buffers {
+    float *ext[4];      /* Yy, Cx, Cz, normalised luminance: tile and halo */
+    float *tmp;         /* the row pass, tile and halo */
+    float *col[2][3];   /* filtered Yy, Cx, Cz of both images, interior */
+    float *edge[2], *point[2];
+    float *s0, *s1;     /* scratch, interior */
+    float *block;
+};
+
+static bool buffers_init(struct flip_buffers *b, int w, int h, int H)
+{
+    size_t ext = (size_t)(tile_max(w) + 2 * H) * (size_t)(tile_max(h) + 2 * H);
+    size_t in = (size_t)tile_max(w) * (size_t)tile_max(h);
+    float *p = b->block = malloc((5 * ext + 12 * in) * sizeof(float));
+    if (!p)
+        return false;
+    for (int c = 0; c < 4; c++, p += ext)
+        b->ext[c] = p;
+    b->tmp = p, p += ext;
+    for (int k = 0; k < 2; k++) {
+        for (int c = 0; c < 3; c++, p += in)
+            b->col[k][c] = p;
+        b->edge[k] = p, p += in;
+        b->point[k] = p, p += in;
     }
-    return n ? sorted[n - 1] : 0.0;
+    b->s0 = p, p += in;
+    b->s1 = p;
+    return true;
+}
+
+static int flip_halo(const struct csf_filter *csf, const struct feature_filter *feat)
+{
+    int H = feat->radius;
+    for (int c = 0; c < 3; c++)
+        H = csf[c].radius > H ? csf[c].radius : H;
+    return H;
+}
+
+size_t flip_memory_bytes(int width, int height, double ppd)
+{
+    struct csf_filter csf[3];
+    struct feature_filter feat;
+    make_csf(&csf[0], ppd, 1.0, 0.0047, 0.0, 1e-5);
+    csf[1] = csf[2] = csf[0];
+    make_features(&feat, ppd);
+    int H = flip_halo(csf, &feat);
+    size_t ext = (size_t)(tile_max(width) + 2 * H) * (size_t)(tile_max(height) + 2 * H);
+    size_t in = (size_t)tile_max(width) * (size_t)tile_max(height);
+    return (5 * ext + 12 * in) * sizeof(float) + (size_t)width * (size_t)height * sizeof(float) +
+           65536 * (2 * sizeof(uint32_t) + sizeof(double));
 }
 
 bool flip_compute(const struct image *ref, const struct image *test, double ppd,
-                  bool keep_map, struct flip_result *out, char *err, size_t errlen)
+                  bool keep_map, const struct metrics_stop *stop, struct flip_result *out,
+                  char *err, size_t errlen)
 {
     memset(out, 0, sizeof(*out));
     if (ref->width != test->width || ref->height != test->height) {
@@ -268,113 +354,140 @@ bool flip_compute(const struct image *ref, const struct image *test, double ppd,
     }
     int w = ref->width, h = ref->height;
     size_t n = (size_t)w * (size_t)h;
-    /* planes: 3 colour + 1 luminance per image, error map, 4 scratch, a row */
-    float *buf = malloc(n * sizeof(float) * 13 + ((size_t)w + 2 * MAX_RADIUS + 2) * sizeof(float));
-    if (!buf) {
-        snprintf(err, errlen, "flip: out of memory");
-        return false;
-    }
-    float *img[2][4], *map = buf + n * 8, *s0 = map + n, *s1 = s0 + n, *s2 = s1 + n, *s3 = s2 + n;
-    float *row = s3 + n;
-    for (int k = 0; k < 2; k++)
-        for (int c = 0; c < 4; c++)
-            img[k][c] = buf + n * (size_t)(k * 4 + c);
-
     struct csf_filter csf[3];
     make_csf(&csf[0], ppd, 1.0, 0.0047, 0.0, 1e-5);
     make_csf(&csf[1], ppd, 1.0, 0.0053, 0.0, 1e-5);
     make_csf(&csf[2], ppd, 34.1, 0.04, 13.5, 0.025);
     struct feature_filter feat;
     make_features(&feat, ppd);
+    const int H = flip_halo(csf, &feat);
+
+    /* The error map is the one whole-image buffer: the weighted percentiles
+     * need every value. */
+    float *map = malloc(n * sizeof(float));
+    struct flip_buffers buf = {0};
+    if (!map || !buffers_init(&buf, w, h, H)) {
+        free(map);
+        free(buf.block);
+        snprintf(err, errlen, "flip: out of memory");
+        return false;
+    }
 
     double lut[256];
     for (int i = 0; i < 256; i++)
         lut[i] = srgb_to_linear(i / 255.0);
-    const struct image *src[2] = {ref, test};
-    for (int k = 0; k < 2; k++) {
-        for (size_t i = 0; i < n; i++) {
-            const uint8_t *p = src[k]->rgb + i * 3;
-            double rgb[3] = {lut[p[0]], lut[p[1]], lut[p[2]]}, xyz[3];
-            mat3(RGB2XYZ, rgb, xyz);
-            double x = xyz[0] * INV_WHITE[0], y = xyz[1] * INV_WHITE[1], z = xyz[2] * INV_WHITE[2];
-            img[k][0][i] = (float)(116.0 * y - 16.0); /* Yy */
-            img[k][1][i] = (float)(500.0 * (x - y));  /* Cx */
-            img[k][2][i] = (float)(200.0 * (y - z));  /* Cz */
-            img[k][3][i] = (float)y;                  /* (Yy + 16) / 116 */
-        }
-        for (int c = 0; c < 3; c++)
-            apply_csf(img[k][c], s0, s1, s2, row, w, h, &csf[c]);
-    }
-
-    /* Colour difference, written into map. */
     float lab_g[3], lab_b[3];
     linear_to_hunt_lab((double[3]){0, 1, 0}, lab_g);
     linear_to_hunt_lab((double[3]){0, 0, 1}, lab_b);
     const double qc = 0.7, qf = 0.5, pc = 0.4, pt = 0.95;
     const float cmax = powf(hyab(lab_g, lab_b), (float)qc), pccmax = (float)pc * cmax;
-    for (size_t i = 0; i < n; i++) {
-        /* Same filtered colour in both images: no colour error, and none in
-         * the final value either (0 raised to 1 - feature error). */
-        if (img[0][0][i] == img[1][0][i] && img[0][1][i] == img[1][1][i] &&
-            img[0][2][i] == img[1][2][i]) {
-            map[i] = 0.0f;
-            continue;
-        }
-        float lab[2][3];
-        for (int k = 0; k < 2; k++) {
-            double yv = (img[k][0][i] + 16.0) / 116.0;
-            double xyz[3] = {(yv + img[k][1][i] / 500.0) * WHITE[0], yv * WHITE[1],
-                             (yv - img[k][2][i] / 200.0) * WHITE[2]};
-            double rgb[3];
-            mat3(XYZ2RGB, xyz, rgb);
-            for (int c = 0; c < 3; c++)
-                rgb[c] = rgb[c] < 0 ? 0 : (rgb[c] > 1 ? 1 : rgb[c]);
-            linear_to_hunt_lab(rgb, lab[k]);
-        }
-        float e = powf(hyab(lab[0], lab[1]), (float)qc);
-        map[i] = e < pccmax ? (float)pt / pccmax * e
-                            : (float)pt + (e - pccmax) / (cmax - pccmax) * (1.0f - (float)pt);
-    }
+    const struct image *src[2] = {ref, test};
 
-    /* Feature difference; the colour planes of both images are free now. */
-    float *edge_r = img[0][0], *point_r = img[0][1], *edge_t = img[1][0], *point_t = img[1][1];
-    features(img[0][3], edge_r, point_r, s0, s1, s2, row, w, h, &feat);
-    features(img[1][3], edge_t, point_t, s0, s1, s2, row, w, h, &feat);
+    for (int ty = 0, th; ty < h; ty += th) {
+        th = tile_span(ty, h);
+        for (int tx = 0, tw; tx < w; tx += tw) {
+            tw = tile_span(tx, w);
+            if (metrics_stopped(stop, err, errlen)) {
+                free(map);
+                free(buf.block);
+                return false;
+            }
+            int ew = tw + 2 * H, eh = th + 2 * H;
+            for (int k = 0; k < 2; k++) {
+                for (int ey = 0; ey < eh; ey++) {
+                    int y = ty - H + ey;
+                    y = y < 0 ? 0 : (y >= h ? h - 1 : y);
+                    for (int ex = 0; ex < ew; ex++) {
+                        int x = tx - H + ex;
+                        x = x < 0 ? 0 : (x >= w ? w - 1 : x);
+                        const uint8_t *p = src[k]->rgb + ((size_t)y * (size_t)w + (size_t)x) * 3;
+                        double rgb[3] = {lut[p[0]], lut[p[1]], lut[p[2]]}, xyz[3];
+                        mat3(RGB2XYZ, rgb, xyz);
+                        double X = xyz[0] * INV_WHITE[0], Y = xyz[1] * INV_WHITE[1],
+                               Z = xyz[2] * INV_WHITE[2];
+                        size_t e = (size_t)ey * (size_t)ew + (size_t)ex;
+                        buf.ext[0][e] = (float)(116.0 * Y - 16.0); /* Yy */
+                        buf.ext[1][e] = (float)(500.0 * (X - Y));  /* Cx */
+                        buf.ext[2][e] = (float)(200.0 * (Y - Z));  /* Cz */
+                        buf.ext[3][e] = (float)Y;                  /* (Yy + 16) / 116 */
+                    }
+                }
+                for (int c = 0; c < 3; c++)
+                    apply_csf(buf.col[k][c], buf.ext[c], buf.tmp, buf.s0, ew, H, tw, th, &csf[c]);
+                features(buf.ext[3], buf.edge[k], buf.point[k], buf.tmp, buf.s0, buf.s1, ew, H, tw,
+                         th, &feat);
+            }
+            for (int y = 0; y < th; y++)
+                for (int x = 0; x < tw; x++) {
+                    size_t i = (size_t)y * (size_t)tw + (size_t)x;
+                    float *m = map + (size_t)(ty + y) * (size_t)w + (size_t)(tx + x);
+                    /* Same filtered colour in both images: no colour error, and
+                     * none in the final value either (0 raised to 1 - feature
+                     * error). */
+                    if (buf.col[0][0][i] == buf.col[1][0][i] &&
+                        buf.col[0][1][i] == buf.col[1][1][i] &&
+                        buf.col[0][2][i] == buf.col[1][2][i]) {
+                        *m = 0.0f;
+                        continue;
+                    }
+                    float lab[2][3];
+                    for (int k = 0; k < 2; k++) {
+                        double yv = (buf.col[k][0][i] + 16.0) / 116.0;
+                        double xyz[3] = {(yv + buf.col[k][1][i] / 500.0) * WHITE[0], yv * WHITE[1],
+                                         (yv - buf.col[k][2][i] / 200.0) * WHITE[2]};
+                        double rgb[3];
+                        mat3(XYZ2RGB, xyz, rgb);
+                        for (int c = 0; c < 3; c++)
+                            rgb[c] = rgb[c] < 0 ? 0 : (rgb[c] > 1 ? 1 : rgb[c]);
+                        linear_to_hunt_lab(rgb, lab[k]);
+                    }
+                    float e = powf(hyab(lab[0], lab[1]), (float)qc);
+                    float colour = e < pccmax ? (float)pt / pccmax * e
+                                              : (float)pt + (e - pccmax) / (cmax - pccmax) *
+                                                                (1.0f - (float)pt);
+                    if (colour == 0.0f) {
+                        *m = 0.0f;
+                        continue;
+                    }
+                    float de = fabsf(buf.edge[0][i] - buf.edge[1][i]);
+                    float dp = fabsf(buf.point[0][i] - buf.point[1][i]);
+                    float f = powf((de > dp ? de : dp) * (float)M_SQRT1_2, (float)qf);
+                    *m = powf(colour, 1.0f - f);
+                }
+        }
+    }
+    free(buf.block);
+
+    /* The summary in raster order, as the whole-image pass adds it. */
     double sum = 0;
+    float largest = 0;
     out->min = INFINITY;
     out->max = 0;
     for (size_t i = 0; i < n; i++) {
-        if (map[i] == 0.0f) {
+        double v = map[i];
+        if (v == 0.0) {
             out->min = 0.0;
             continue;
         }
-        float de = fabsf(edge_r[i] - edge_t[i]), dp = fabsf(point_r[i] - point_t[i]);
-        float f = powf((de > dp ? de : dp) * (float)M_SQRT1_2, (float)qf);
-        double v = powf(map[i], 1.0f - f);
-        map[i] = (float)v;
         sum += v;
         out->min = v < out->min ? v : out->min;
         out->max = v > out->max ? v : out->max;
+        largest = map[i] > largest ? map[i] : largest;
     }
     out->mean = sum / (double)n;
-    /* Zeros weigh nothing in the weighted percentiles: sort the rest only. */
-    size_t nonzero = 0;
-    for (size_t i = 0; i < n; i++)
-        if (map[i] > 0.0f)
-            s3[nonzero++] = map[i];
-    if (!sort_nonnegative(s3, nonzero)) {
+    const double p[3] = {0.25, 0.50, 0.75};
+    double q[3];
+    if (!weighted_percentiles(map, n, sum, p, q, 3, largest)) {
+        free(map);
         snprintf(err, errlen, "flip: out of memory");
-        free(buf);
         return false;
     }
-    out->weighted_q1 = weighted_percentile(s3, nonzero, sum, 0.25);
-    out->weighted_median = weighted_percentile(s3, nonzero, sum, 0.50);
-    out->weighted_q3 = weighted_percentile(s3, nonzero, sum, 0.75);
-    if (keep_map) {
-        out->map = malloc(n * sizeof(float));
-        if (out->map)
-            memcpy(out->map, map, n * sizeof(float));
-    }
-    free(buf);
+    out->weighted_q1 = q[0];
+    out->weighted_median = q[1];
+    out->weighted_q3 = q[2];
+    if (keep_map)
+        out->map = map;
+    else
+        free(map);
     return true;
 }

@@ -4,7 +4,15 @@
 /* Image-quality metrics on 8-bit RGB frames: SSIM (Wang et al. 2004),
  * PerceptualDiff (Yee 2004), PSNR and LDR-FLIP (Andersson et al. 2020).
  * GL-free and thread-safe: the daemon runs them on its metrics thread,
- * shadebench-compare runs them on PNG files. */
+ * shadebench-compare runs them on PNG files.
+ *
+ * Working memory is bounded: SSIM works in strips of rows, PerceptualDiff
+ * and FLIP in square tiles with a halo as wide as their filters, so that
+ * beyond the two images only FLIP's error map (4 bytes a pixel, needed
+ * whole for its weighted percentiles) and SSIM's 8-bit map grow with the
+ * image. metrics_memory_bytes states the bound; images over
+ * IMAGE_MAX_PIXELS are refused. Results are the same, bit for bit, as
+ * computing each metric over the whole image at once. */
 
 #include <jansson.h>
 #include <stdbool.h>
@@ -24,19 +32,28 @@
 /* SSIM's window: 11x11 Gaussian, sigma 1.5 (Wang et al. 2004, section III-C). */
 #define SSIM_WINDOW 11
 
+/* Asked between tiles or strips (milliseconds of work apart): when it returns
+ * true the metric stops and fails with err "stopped". NULL: never stop. */
+struct metrics_stop {
+    bool (*requested)(void *ctx);
+    void *ctx;
+};
+
 struct ssim_result {
     double luma;          /* on Y = 0.299 R + 0.587 G + 0.114 B, unrounded */
     double channel[3];    /* R, G, B */
     double rgb;           /* mean of the three channels */
     double min;           /* smallest local (luma) SSIM */
     int min_x, min_y;     /* centre pixel of that window */
-    float *map;           /* luma SSIM map, map_w x map_h (valid region), or NULL */
+    uint8_t *map;         /* luma SSIM map as grey (clamped to [0, 1], times 255),
+                             map_w x map_h (the valid region), or NULL */
     int map_w, map_h;
 };
 
 /* keep_map: also return the luma map (free with free()). */
 bool ssim_compute(const struct image *a, const struct image *b, bool keep_map,
-                  struct ssim_result *out, char *err, size_t errlen);
+                  const struct metrics_stop *stop, struct ssim_result *out, char *err,
+                  size_t errlen);
 
 struct psnr_result {
     bool identical;      /* PSNR is infinite: reported as null */
@@ -65,8 +82,8 @@ struct pdiff_result {
 
 void pdiff_defaults(struct pdiff_options *o);
 bool pdiff_compute(const struct image *a, const struct image *b,
-                   const struct pdiff_options *o, struct pdiff_result *out, char *err,
-                   size_t errlen);
+                   const struct pdiff_options *o, const struct metrics_stop *stop,
+                   struct pdiff_result *out, char *err, size_t errlen);
 
 enum metric_kind { METRIC_SSIM = 1, METRIC_PDIFF = 2, METRIC_PSNR = 4, METRIC_FLIP = 8 };
 #define METRIC_ALL (METRIC_SSIM | METRIC_PDIFF | METRIC_PSNR | METRIC_FLIP)
@@ -88,14 +105,28 @@ struct flip_result {
 /* The paper's default observer: a 0.7 m wide 4K monitor seen from 0.7 m. */
 double flip_default_ppd(void);
 bool flip_compute(const struct image *ref, const struct image *test, double ppd,
-                  bool keep_map, struct flip_result *out, char *err, size_t errlen);
+                  bool keep_map, const struct metrics_stop *stop, struct flip_result *out,
+                  char *err, size_t errlen);
 
 /* Computes the chosen metrics of test against ref and returns them as JSON
  * (see README, "metrics"); writes the SSIM and FLIP maps where a path is
  * given. NULL on failure with err filled. */
 json_t *metrics_compare(const struct image *ref, const struct image *test,
                         const struct metrics_options *o, const char *ssim_map_path,
-                        const char *flip_map_path, char *err, size_t errlen);
+                        const char *flip_map_path, const struct metrics_stop *stop, char *err,
+                        size_t errlen);
+
+/* The most memory metrics_compare uses on width x height images with the
+ * given FLIP pixels per degree, the two images included. */
+double metrics_memory_bytes(int width, int height, double flip_ppd);
+
+/* Each metric's share of metrics_memory_bytes (images excluded). */
+size_t ssim_memory_bytes(int width, int height);
+size_t pdiff_memory_bytes(int width, int height);
+size_t flip_memory_bytes(int width, int height, double ppd);
+
+/* True (after filling err) when a stop was requested. */
+bool metrics_stopped(const struct metrics_stop *stop, char *err, size_t errlen);
 
 /* Difference images: the SSIM map in grey (white = 1, black = 0 or less) and
  * the FLIP map through a magma-like ramp. */

@@ -78,9 +78,10 @@ static void adobe_rgb_to_xyz(float r, float g, float b, float *x, float *y, floa
 
 static void xyz_to_ab(float x, float y, float z, float *a, float *b)
 {
-    static float white[3];
-    if (white[0] == 0.0f)
-        adobe_rgb_to_xyz(1, 1, 1, &white[0], &white[1], &white[2]);
+    /* Computed per call (a few multiplies) rather than cached in a static,
+     * which concurrent comparisons would race on. */
+    float white[3];
+    adobe_rgb_to_xyz(1, 1, 1, &white[0], &white[1], &white[2]);
     const float epsilon = 216.0f / 24389.0f, kappa = 24389.0f / 27.0f;
     float r[3] = {x / white[0], y / white[1], z / white[2]}, f[3];
     for (int i = 0; i < 3; i++)
@@ -102,37 +103,125 @@ static int mirror(int v, int n)
     return v;
 }
 
-/* Level i+1 = level i blurred (separable: two 1-D passes, taps outermost so
- * the inner loops vectorize). Borders mirror as perceptualdiff's do. */
-METRICS_SIMD static void blur(float *dst, const float *src, float *tmp, float *row, int w, int h)
+/* Tiles: TILE x TILE pixels judged at a time, with a halo of HALO pixels,
+ * enough for the 7 blurs (2 pixels each) that build the top level. */
+enum { TILE = 256, HALO = 2 * (LEVELS - 1) };
+
+/* The extent of the tile starting at pos: the last one of a row or column
+ * takes the rest, up to 1.5 tiles, so that no tile is narrower than its
+ * halo (a mirrored halo at an image border reads across the tile). */
+static int tile_span(int pos, int size)
+{
+    return size - pos <= TILE + TILE / 2 ? size - pos : TILE;
+}
+
+/* The widest tile_span over an extent of size. */
+static int tile_max(int size)
+{
+    return size < TILE + TILE / 2 ? size : TILE + TILE / 2;
+}
+
+/* One tile's pyramids: plane l of image k at pyr[k][l], ew x eh floats
+ * covering image columns ox .. ox + ew - 1 and rows oy .. oy + eh - 1. */
+struct tile {
+    int ox, oy, ew, eh;
+    int w, h;        /* the image */
+    float *pyr[2][LEVELS];
+    float *tmp;
+};
+
+/* Out-of-image positions of a level copy the level at the mirrored
+ * in-image position, exactly as the whole-image code reads them. */
+static void refill_borders(const struct tile *t, float *p, int y0, int y1)
+{
+    int in_x0 = -t->ox > 0 ? -t->ox : 0, in_x1 = t->w - t->ox < t->ew ? t->w - t->ox : t->ew;
+    int in_y0 = -t->oy > 0 ? -t->oy : 0, in_y1 = t->h - t->oy < t->eh ? t->h - t->oy : t->eh;
+    for (int ey = y0; ey < y1; ey++) {
+        if (ey < in_y0 || ey >= in_y1)
+            continue;
+        float *row = p + (size_t)ey * (size_t)t->ew;
+        for (int ex = 0; ex < in_x0; ex++)
+            row[ex] = row[mirror(t->ox + ex, t->w) - t->ox];
+        for (int ex = in_x1; ex < t->ew; ex++)
+            row[ex] = row[mirror(t->ox + ex, t->w) - t->ox];
+    }
+    for (int ey = 0; ey < t->eh; ey++)
+        if (ey < in_y0 || ey >= in_y1)
+            memcpy(p + (size_t)ey * (size_t)t->ew,
+                   p + (size_t)(mirror(t->oy + ey, t->h) - t->oy) * (size_t)t->ew,
+                   (size_t)t->ew * sizeof(float));
+}
+
+/* Level l+1 from level l over the window [x0, x1) x [y0, y1) of valid
+ * values, which shrinks by the kernel's radius (2) on each side; the same
+ * separable blur, in the same order of taps, as perceptualdiff's. */
+METRICS_SIMD static void blur(float *dst, const float *src, float *tmp, int ew, int x0, int x1,
+                              int y0, int y1)
 {
     static const float k[5] = {0.05f, 0.25f, 0.4f, 0.25f, 0.05f};
-    for (int y = 0; y < h; y++) {
-        const float *in = src + (size_t)y * (size_t)w;
-        float *out = tmp + (size_t)y * (size_t)w;
-        for (int x = -2; x < w + 2; x++)
-            row[x + 2] = in[mirror(x, w)];
-        for (int x = 0; x < w; x++)
+    for (int y = y0; y < y1; y++) {
+        const float *in = src + (size_t)y * (size_t)ew;
+        float *out = tmp + (size_t)y * (size_t)ew;
+        for (int x = x0 + 2; x < x1 - 2; x++)
             out[x] = 0.0f;
         for (int i = 0; i < 5; i++)
-            for (int x = 0; x < w; x++)
-                out[x] += k[i] * row[x + i];
+            for (int x = x0 + 2; x < x1 - 2; x++)
+                out[x] += k[i] * in[x + i - 2];
     }
-    for (int y = 0; y < h; y++) {
-        float *out = dst + (size_t)y * (size_t)w;
-        for (int x = 0; x < w; x++)
+    for (int y = y0 + 2; y < y1 - 2; y++) {
+        float *out = dst + (size_t)y * (size_t)ew;
+        for (int x = x0 + 2; x < x1 - 2; x++)
             out[x] = 0.0f;
         for (int j = -2; j <= 2; j++) {
-            const float *in = tmp + (size_t)mirror(y + j, h) * (size_t)w;
-            for (int x = 0; x < w; x++)
+            const float *in = tmp + (size_t)(y + j) * (size_t)ew;
+            for (int x = x0 + 2; x < x1 - 2; x++)
                 out[x] += k[j + 2] * in[x];
         }
     }
 }
 
+/* Builds both pyramids of the tile: level 0 (luminance) over the tile and
+ * its halo, mirrored at the image's borders, then each level blurred from
+ * the one below. Where the tile meets a border of the image, the halo is
+ * refilled by mirroring after each blur, so the window of valid values only
+ * shrinks on the sides that face other tiles. */
+static void build_pyramids(struct tile *t, const struct image *img[2], const float *linear,
+                           float lum)
+{
+    for (int k = 0; k < 2; k++) {
+        float *l0 = t->pyr[k][0];
+        for (int ey = 0; ey < t->eh; ey++) {
+            int y = mirror(t->oy + ey, t->h);
+            for (int ex = 0; ex < t->ew; ex++) {
+                int x = mirror(t->ox + ex, t->w);
+                const uint8_t *p = img[k]->rgb + ((size_t)y * (size_t)t->w + (size_t)x) * 3;
+                float X, Y, Z;
+                adobe_rgb_to_xyz(linear[p[0]], linear[p[1]], linear[p[2]], &X, &Y, &Z);
+                l0[(size_t)ey * (size_t)t->ew + (size_t)ex] = Y * lum;
+            }
+        }
+        bool left = t->ox < 0, right = t->ox + t->ew > t->w;
+        bool top = t->oy < 0, bottom = t->oy + t->eh > t->h;
+        int x0 = 0, x1 = t->ew, y0 = 0, y1 = t->eh;
+        for (int l = 1; l < LEVELS; l++) {
+            blur(t->pyr[k][l], t->pyr[k][l - 1], t->tmp, t->ew, x0, x1, y0, y1);
+            x0 += 2, x1 -= 2, y0 += 2, y1 -= 2;
+            refill_borders(t, t->pyr[k][l], y0, y1);
+            if (left)
+                x0 = 0;
+            if (right)
+                x1 = t->ew;
+            if (top)
+                y0 = 0;
+            if (bottom)
+                y1 = t->eh;
+        }
+    }
+}
+
 bool pdiff_compute(const struct image *a, const struct image *b,
-                   const struct pdiff_options *o, struct pdiff_result *out, char *err,
-                   size_t errlen)
+                   const struct pdiff_options *o, const struct metrics_stop *stop,
+                   struct pdiff_result *out, char *err, size_t errlen)
 {
     memset(out, 0, sizeof(*out));
     if (a->width != b->width || a->height != b->height) {
@@ -146,30 +235,24 @@ bool pdiff_compute(const struct image *a, const struct image *b,
         out->identical = true;
         return true;
     }
-    /* Two pyramids of LEVELS planes and one scratch plane. */
-    float *buf = malloc(n * sizeof(float) * (2 * LEVELS + 1) + ((size_t)w + 4) * sizeof(float));
+    /* Two pyramids of LEVELS planes and one scratch plane, per tile. */
+    struct tile t = {.w = w, .h = h};
+    int tw_max = tile_max(w), th_max = tile_max(h);
+    size_t plane = (size_t)(tw_max + 2 * HALO) * (size_t)(th_max + 2 * HALO);
+    float *buf = malloc(plane * sizeof(float) * (2 * LEVELS + 1));
     if (!buf) {
         snprintf(err, errlen, "pdiff: out of memory");
         return false;
     }
-    float *la = buf, *lb = la + n * LEVELS, *tmp = lb + n * LEVELS, *row = tmp + n;
+    for (int k = 0; k < 2; k++)
+        for (int l = 0; l < LEVELS; l++)
+            t.pyr[k][l] = buf + plane * (size_t)(k * LEVELS + l);
+    t.tmp = buf + plane * 2 * LEVELS;
     /* pow(c / 255, gamma) for every 8-bit value: the same float as computing it. */
     float linear[256];
     for (int v = 0; v < 256; v++)
         linear[v] = powf(v / 255.0f, (float)o->gamma);
     const float lum = (float)o->luminance;
-    for (size_t i = 0; i < n; i++) {
-        float x, y, z;
-        const uint8_t *p = a->rgb + i * 3, *q = b->rgb + i * 3;
-        adobe_rgb_to_xyz(linear[p[0]], linear[p[1]], linear[p[2]], &x, &y, &z);
-        la[i] = y * lum;
-        adobe_rgb_to_xyz(linear[q[0]], linear[q[1]], linear[q[2]], &x, &y, &z);
-        lb[i] = y * lum;
-    }
-    for (int l = 1; l < LEVELS; l++) {
-        blur(la + n * (size_t)l, la + n * (size_t)(l - 1), tmp, row, w, h);
-        blur(lb + n * (size_t)l, lb + n * (size_t)(l - 1), tmp, row, w, h);
-    }
 
     /* Pixels spanning one degree at this field of view, and the pyramid level
      * whose blur matches that adaptation area. */
@@ -191,50 +274,75 @@ bool pdiff_compute(const struct image *a, const struct image *b,
     for (int i = 0; i < LEVELS - 2; i++)
         f_freq[i] = csf_max / csf(cpd[i], 100.0f);
 
+    const struct image *img[2] = {a, b};
     long failed = 0;
-    for (size_t i = 0; i < n; i++) {
-        /* Identical colours give a zero luminance and colour difference, which
-         * pass both tests whatever the threshold: no need to compute it. */
-        const uint8_t *p = a->rgb + i * 3, *q = b->rgb + i * 3;
-        if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2])
-            continue;
-        float adapt = (la[n * (size_t)adapt_level + i] + lb[n * (size_t)adapt_level + i]) * 0.5f;
-        if (adapt < 1e-5f)
-            adapt = 1e-5f;
-        float sum_contrast = 0, factor = 0;
-        for (int l = 0; l < LEVELS - 2; l++) {
-            float n1 = fabsf(la[n * (size_t)l + i] - la[n * (size_t)(l + 1) + i]);
-            float n2 = fabsf(lb[n * (size_t)l + i] - lb[n * (size_t)(l + 1) + i]);
-            float numerator = n1 > n2 ? n1 : n2;
-            float d1 = fabsf(la[n * (size_t)(l + 2) + i]), d2 = fabsf(lb[n * (size_t)(l + 2) + i]);
-            float denominator = d1 > d2 ? d1 : d2;
-            if (denominator < 1e-5f)
-                denominator = 1e-5f;
-            float contrast = numerator / denominator;
-            factor += contrast * f_freq[l] * mask(contrast * csf(cpd[l], adapt));
-            sum_contrast += contrast;
+    for (int ty = 0, th; ty < h; ty += th) {
+        th = tile_span(ty, h);
+        for (int tx = 0, tw; tx < w; tx += tw) {
+            tw = tile_span(tx, w);
+            if (metrics_stopped(stop, err, errlen)) {
+                free(buf);
+                return false;
+            }
+            t.ox = tx - HALO, t.oy = ty - HALO;
+            t.ew = tw + 2 * HALO, t.eh = th + 2 * HALO;
+            build_pyramids(&t, img, linear, lum);
+            for (int y = 0; y < th; y++)
+                for (int x = 0; x < tw; x++) {
+                    /* Identical colours give a zero luminance and colour difference,
+                     * which pass both tests whatever the threshold: skip them. */
+                    size_t src = (size_t)(ty + y) * (size_t)w + (size_t)(tx + x);
+                    const uint8_t *p = a->rgb + src * 3, *q = b->rgb + src * 3;
+                    if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2])
+                        continue;
+                    size_t i = (size_t)(y + HALO) * (size_t)t.ew + (size_t)(x + HALO);
+                    float *const *la = t.pyr[0], *const *lb = t.pyr[1];
+                    float adapt = (la[adapt_level][i] + lb[adapt_level][i]) * 0.5f;
+                    if (adapt < 1e-5f)
+                        adapt = 1e-5f;
+                    float sum_contrast = 0, factor = 0;
+                    for (int l = 0; l < LEVELS - 2; l++) {
+                        float n1 = fabsf(la[l][i] - la[l + 1][i]);
+                        float n2 = fabsf(lb[l][i] - lb[l + 1][i]);
+                        float numerator = n1 > n2 ? n1 : n2;
+                        float d1 = fabsf(la[l + 2][i]), d2 = fabsf(lb[l + 2][i]);
+                        float denominator = d1 > d2 ? d1 : d2;
+                        if (denominator < 1e-5f)
+                            denominator = 1e-5f;
+                        float contrast = numerator / denominator;
+                        factor += contrast * f_freq[l] * mask(contrast * csf(cpd[l], adapt));
+                        sum_contrast += contrast;
+                    }
+                    if (sum_contrast < 1e-5f)
+                        sum_contrast = 1e-5f;
+                    factor /= sum_contrast;
+                    factor = factor < 1.0f ? 1.0f : (factor > 10.0f ? 10.0f : factor);
+                    float delta = fabsf(la[0][i] - lb[0][i]);
+                    bool pass = delta <= factor * tvi(adapt);
+                    if (!o->luminance_only) {
+                        float color_scale = adapt < 10.0f ? 0.0f : (float)o->color_factor;
+                        float X, Y, Z, aa, ab, ba, bb;
+                        adobe_rgb_to_xyz(linear[p[0]], linear[p[1]], linear[p[2]], &X, &Y, &Z);
+                        xyz_to_ab(X, Y, Z, &aa, &ab);
+                        adobe_rgb_to_xyz(linear[q[0]], linear[q[1]], linear[q[2]], &X, &Y, &Z);
+                        xyz_to_ab(X, Y, Z, &ba, &bb);
+                        float da = aa - ba, db = ab - bb;
+                        if ((da * da + db * db) * color_scale > factor)
+                            pass = false;
+                    }
+                    failed += !pass;
+                }
         }
-        if (sum_contrast < 1e-5f)
-            sum_contrast = 1e-5f;
-        factor /= sum_contrast;
-        factor = factor < 1.0f ? 1.0f : (factor > 10.0f ? 10.0f : factor);
-        float delta = fabsf(la[i] - lb[i]);
-        bool pass = delta <= factor * tvi(adapt);
-        if (!o->luminance_only) {
-            float color_scale = adapt < 10.0f ? 0.0f : (float)o->color_factor;
-            float x, y, z, aa, ab, ba, bb;
-            adobe_rgb_to_xyz(linear[p[0]], linear[p[1]], linear[p[2]], &x, &y, &z);
-            xyz_to_ab(x, y, z, &aa, &ab);
-            adobe_rgb_to_xyz(linear[q[0]], linear[q[1]], linear[q[2]], &x, &y, &z);
-            xyz_to_ab(x, y, z, &ba, &bb);
-            float da = aa - ba, db = ab - bb;
-            if ((da * da + db * db) * color_scale > factor)
-                pass = false;
-        }
-        failed += !pass;
     }
     free(buf);
     out->failing_pixels = failed;
     out->pass = failed < o->threshold_pixels;
     return true;
+}
+
+size_t pdiff_memory_bytes(int width, int height)
+{
+    size_t tw = (size_t)tile_max(width) + 2 * HALO;
+    size_t th = (size_t)tile_max(height) + 2 * HALO;
+    return tw * th * sizeof(float) * (2 * LEVELS + 1);
 }

@@ -84,73 +84,89 @@ METRICS_SIMD static double horizontal_pass(int ow, const float *k, const float *
     return sum;
 }
 
-/* One plane's SSIM over the valid region. x and y hold samples minus 128:
- * variances come from E[x^2] - E[x]^2, and centred values shrink that
- * cancellation; variance and covariance do not move with the offset, the
- * means get it back. */
-static double ssim_plane(const float *x, const float *y, int w, int h, const float *k,
-                         float *map, double *min_out, int *min_x, int *min_y, float *scratch)
-{
-    const int ow = w - 2 * R, oh = h - 2 * R;
-    float *vx = scratch, *vy = vx + w, *vxx = vy + w, *vyy = vxx + w, *vxy = vyy + w;
-    float *acc = vxy + w, *row = acc + 5 * (size_t)ow;
-    double sum = 0, min = INFINITY;
-    int mx = 0, my = 0;
-    for (int oy = 0; oy < oh; oy++) {
-        vertical_pass(x + (size_t)oy * (size_t)w, y + (size_t)oy * (size_t)w, w, k, vx, vy, vxx,
-                      vyy, vxy);
-        sum += horizontal_pass(ow, k, vx, vy, vxx, vyy, vxy, acc, row);
-        for (int ox = 0; ox < ow; ox++) {
-            if (map)
-                map[(size_t)oy * (size_t)ow + (size_t)ox] = row[ox];
-            if (row[ox] < min) {
-                min = row[ox];
-                mx = ox;
-                my = oy;
-            }
-        }
-    }
-    if (min_out) {
-        *min_out = min;
-        *min_x = mx + R;
-        *min_y = my + R;
-    }
-    return sum / ((double)ow * oh);
-}
+/* Output rows per strip: a strip converts STRIP + 10 input rows to float,
+ * so memory per plane is about 2 (STRIP + 10) w floats whatever the height. */
+enum { STRIP = 64 };
 
 /* One plane per task: 0 is luma, 1 to 3 are R, G, B. Planes are
  * independent, so they spread over the cores. */
 struct plane_task {
     const struct image *a, *b;
     int plane;
-    float *map; /* luma only */
+    uint8_t *map; /* luma only */
+    const struct metrics_stop *stop;
     double ssim, min;
     int min_x, min_y;
-    bool ok;
+    bool ok, stopped;
 };
+
+/* Input rows [y0, y1) of the task's plane, minus 128: variances come from
+ * E[x^2] - E[x]^2, and centred values shrink that cancellation; variance
+ * and covariance do not move with the offset, the means get it back. */
+static void load_rows(const struct plane_task *t, int y0, int y1, float *x, float *y)
+{
+    int w = t->a->width;
+    for (int row = y0; row < y1; row++) {
+        const uint8_t *p = t->a->rgb + (size_t)row * (size_t)w * 3;
+        const uint8_t *q = t->b->rgb + (size_t)row * (size_t)w * 3;
+        float *xr = x + (size_t)(row - y0) * (size_t)w, *yr = y + (size_t)(row - y0) * (size_t)w;
+        for (int i = 0; i < w; i++, p += 3, q += 3) {
+            if (t->plane == 0) {
+                xr[i] = 0.299f * p[0] + 0.587f * p[1] + 0.114f * p[2] - 128.0f;
+                yr[i] = 0.299f * q[0] + 0.587f * q[1] + 0.114f * q[2] - 128.0f;
+            } else {
+                xr[i] = (float)p[t->plane - 1] - 128.0f;
+                yr[i] = (float)q[t->plane - 1] - 128.0f;
+            }
+        }
+    }
+}
 
 static void *plane_worker(void *arg)
 {
     struct plane_task *t = arg;
     int w = t->a->width, h = t->a->height;
-    size_t n = (size_t)w * (size_t)h;
-    float *x = malloc(n * sizeof(float)), *y = malloc(n * sizeof(float));
-    float *scratch = malloc(11 * (size_t)w * sizeof(float));
+    const int ow = w - 2 * R, oh = h - 2 * R;
+    size_t strip_floats = (size_t)(STRIP + 2 * R) * (size_t)w;
+    float *x = malloc(strip_floats * sizeof(float)), *y = malloc(strip_floats * sizeof(float));
+    float *scratch = malloc((5 * (size_t)w + 6 * (size_t)ow) * sizeof(float));
     float k[SSIM_WINDOW];
     t->ok = x && y && scratch;
-    if (t->ok) {
-        gaussian_kernel(k);
-        for (size_t i = 0; i < n; i++) {
-            const uint8_t *p = t->a->rgb + i * 3, *q = t->b->rgb + i * 3;
-            if (t->plane == 0) {
-                x[i] = 0.299f * p[0] + 0.587f * p[1] + 0.114f * p[2] - 128.0f;
-                y[i] = 0.299f * q[0] + 0.587f * q[1] + 0.114f * q[2] - 128.0f;
-            } else {
-                x[i] = (float)p[t->plane - 1] - 128.0f;
-                y[i] = (float)q[t->plane - 1] - 128.0f;
+    double sum = 0, min = INFINITY;
+    int mx = 0, my = 0;
+    gaussian_kernel(k);
+    float *vx = scratch, *vy = vx + w, *vxx = vy + w, *vyy = vxx + w, *vxy = vyy + w;
+    float *acc = vxy + w, *row = acc + 5 * (size_t)ow;
+    for (int s0 = 0; t->ok && s0 < oh; s0 += STRIP) {
+        if (t->stop && t->stop->requested && t->stop->requested(t->stop->ctx)) {
+            t->ok = false;
+            t->stopped = true;
+            break;
+        }
+        int s1 = s0 + STRIP < oh ? s0 + STRIP : oh;
+        load_rows(t, s0, s1 + 2 * R, x, y);
+        for (int oy = s0; oy < s1; oy++) {
+            size_t off = (size_t)(oy - s0) * (size_t)w;
+            vertical_pass(x + off, y + off, w, k, vx, vy, vxx, vyy, vxy);
+            sum += horizontal_pass(ow, k, vx, vy, vxx, vyy, vxy, acc, row);
+            for (int ox = 0; ox < ow; ox++) {
+                if (t->map) {
+                    float v = row[ox] < 0 ? 0 : (row[ox] > 1 ? 1 : row[ox]);
+                    t->map[(size_t)oy * (size_t)ow + (size_t)ox] = (uint8_t)lrintf(v * 255.0f);
+                }
+                if (row[ox] < min) {
+                    min = row[ox];
+                    mx = ox;
+                    my = oy;
+                }
             }
         }
-        t->ssim = ssim_plane(x, y, w, h, k, t->map, &t->min, &t->min_x, &t->min_y, scratch);
+    }
+    if (t->ok) {
+        t->ssim = sum / ((double)ow * oh);
+        t->min = min;
+        t->min_x = mx + R;
+        t->min_y = my + R;
     }
     free(x);
     free(y);
@@ -159,7 +175,8 @@ static void *plane_worker(void *arg)
 }
 
 bool ssim_compute(const struct image *a, const struct image *b, bool keep_map,
-                  struct ssim_result *out, char *err, size_t errlen)
+                  const struct metrics_stop *stop, struct ssim_result *out, char *err,
+                  size_t errlen)
 {
     memset(out, 0, sizeof(*out));
     if (a->width != b->width || a->height != b->height) {
@@ -173,7 +190,7 @@ bool ssim_compute(const struct image *a, const struct image *b, bool keep_map,
                  w, h, SSIM_WINDOW, SSIM_WINDOW);
         return false;
     }
-    float *map = keep_map ? malloc((size_t)(w - 2 * R) * (size_t)(h - 2 * R) * sizeof(float)) : NULL;
+    uint8_t *map = keep_map ? malloc((size_t)(w - 2 * R) * (size_t)(h - 2 * R)) : NULL;
     if (keep_map && !map) {
         snprintf(err, errlen, "ssim: out of memory");
         return false;
@@ -182,23 +199,25 @@ bool ssim_compute(const struct image *a, const struct image *b, bool keep_map,
     pthread_t threads[4];
     bool started[4] = {false};
     for (int p = 0; p < 4; p++) {
-        tasks[p] = (struct plane_task){.a = a, .b = b, .plane = p, .map = p == 0 ? map : NULL};
+        tasks[p] = (struct plane_task){.a = a, .b = b, .plane = p, .map = p == 0 ? map : NULL,
+                                       .stop = stop};
         /* Planes 1-3 on threads of their own; luma on the calling thread. */
         if (p > 0)
             started[p] = pthread_create(&threads[p], NULL, plane_worker, &tasks[p]) == 0;
     }
     plane_worker(&tasks[0]);
-    bool ok = tasks[0].ok;
+    bool ok = tasks[0].ok, stopped = tasks[0].stopped;
     for (int p = 1; p < 4; p++) {
         if (started[p])
             pthread_join(threads[p], NULL);
         else
             plane_worker(&tasks[p]);
         ok = ok && tasks[p].ok;
+        stopped = stopped || tasks[p].stopped;
     }
     if (!ok) {
         free(map);
-        snprintf(err, errlen, "ssim: out of memory");
+        snprintf(err, errlen, stopped ? "stopped" : "ssim: out of memory");
         return false;
     }
     out->luma = tasks[0].ssim;
@@ -214,4 +233,12 @@ bool ssim_compute(const struct image *a, const struct image *b, bool keep_map,
         out->map_h = h - 2 * R;
     }
     return true;
+}
+
+size_t ssim_memory_bytes(int width, int height)
+{
+    size_t w = (size_t)width;
+    size_t per_plane = (2 * (size_t)(STRIP + 2 * R) * w + 5 * w + 6 * w) * sizeof(float);
+    size_t map = height > 2 * R && width > 2 * R ? (w - 2 * R) * (size_t)(height - 2 * R) : 0;
+    return 4 * per_plane + map;
 }

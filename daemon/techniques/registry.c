@@ -9,11 +9,18 @@
 #include "daemon/gpu/glutil.h"
 
 extern const struct technique technique_forward, technique_unlit, technique_osl;
+extern const struct technique technique_deferred, technique_tiled_deferred,
+    technique_forward_plus, technique_clustered_forward, technique_clustered_deferred;
 
 const struct technique *const technique_registry[] = {
     &technique_forward,
     &technique_unlit,
     &technique_osl,
+    &technique_deferred,
+    &technique_tiled_deferred,
+    &technique_forward_plus,
+    &technique_clustered_forward,
+    &technique_clustered_deferred,
     NULL,
 };
 

@@ -69,6 +69,11 @@ struct technique {
      * bound; must leave the output framebuffer's attachments as they are. */
     bool (*render)(void *state, const struct technique_env *env, int64_t frame, char *err,
                    size_t errlen);
+    /* Optional. After the last timed frame has finished on the GPU, outside
+     * the timed region: fails the job (false, err naming the option) when
+     * the frames recorded a failure only the GPU saw, such as a light list
+     * that overflowed under overflow "fail". */
+    bool (*verify)(void *state, char *err, size_t errlen);
     /* Technique-specific figures for the result (timed frames only); NULL
      * when it has none. Called after the last timed frame. */
     json_t *(*describe)(void *state);

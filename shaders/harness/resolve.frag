@@ -1,11 +1,32 @@
-// The harness's resolve: the technique's HDR output to the 8-bit image that
-// is read back and scored. Tone mapping "none": a clamp, as an 8-bit
-// framebuffer would have done.
+// The harness's resolve: the HDR colour (the technique's output, or the post
+// chain's) to the 8-bit image that is read back and scored, scaled by the
+// look's exposure. TONEMAP_NONE: a clamp, as an 8-bit framebuffer would
+// have done, no encoding (today's image, byte for byte at exposure 1).
+// TONEMAP_REINHARD and TONEMAP_ACES: the curve, then the sRGB transfer
+// function, since a tone-mapped image is display-referred.
+// daemon/effects/effect_kernels.c has the same curves in C, unit-tested.
 layout(binding = SB_TEX_HDR) uniform sampler2D u_hdr;
+layout(location = SB_LOC_EXPOSURE) uniform float u_exposure;
 layout(location = 0) out vec4 out_color;
+
+vec3 srgb_encode(vec3 c)
+{
+    c = clamp(c, 0.0, 1.0);
+    return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, greaterThan(c, vec3(0.0031308)));
+}
 
 void main()
 {
-    vec3 c = texelFetch(u_hdr, ivec2(gl_FragCoord.xy), 0).rgb;
-    out_color = vec4(clamp(c, 0.0, 1.0), 1.0);
+    vec3 c = texelFetch(u_hdr, ivec2(gl_FragCoord.xy), 0).rgb * u_exposure;
+#if defined(TONEMAP_REINHARD)
+    c = max(c, 0.0);
+    c = srgb_encode(c / (1.0 + c));
+#elif defined(TONEMAP_ACES)
+    // Narkowicz 2015, with the 0.6 exposure his fit assumes.
+    c = max(c, 0.0) * 0.6;
+    c = srgb_encode((c * (2.51 * c + 0.03)) / (c * (2.43 * c + 0.59) + 0.14));
+#else
+    c = clamp(c, 0.0, 1.0);
+#endif
+    out_color = vec4(c, 1.0);
 }

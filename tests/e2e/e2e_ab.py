@@ -38,7 +38,8 @@ try:
 
     separate_runs(("forward", "unlit", "unlit", "forward"))
     outdir, junit = cl.path("ab"), cl.path("ab.xml")
-    out = cl.run("ab", fa, fb, "--runs", "6", "--max-reruns", "4", "--confidence", "99%",
+    out = cl.run("ab", fa, fb, "--runs", "6", "--max-reruns", "6", "--confidence", "99%",
+                 "--noise-tolerance", "30%",
                  "--out", outdir, "--junit", junit)
     check(out.returncode == 0, "unlit is not slower than forward: exit 0: %s" % out.stderr[-600:])
     with open(os.path.join(outdir, "ab.json")) as f:

@@ -25,7 +25,7 @@ static void sample_from(struct interference_sample *s, const char *stat, const c
 {
     memset(s, 0, sizeof(*s));
     s->ok = interference_parse_stat(stat, &s->cpu) &&
-            interference_parse_self_stat(self, &s->self_ticks) &&
+            interference_parse_self_stat(self, &s->self_ticks, &s->self_minor_faults) &&
             interference_parse_loadavg(load, s->loadavg);
     s->unix_s = 1700000000.0 + t;
     s->mono_s = 100.0 + t;
@@ -47,13 +47,14 @@ int main(void)
     CHECK(!interference_parse_stat("", &ct));
 
     /* A command name with spaces and parentheses does not shift the fields. */
-    unsigned long long ticks = 0;
+    unsigned long long ticks = 0, faults = 0;
     const char *self =
         "4242 (shade (bench) d) S 1 4242 4242 0 -1 4194560 900 0 0 0 1234 567 0 0 20 0 9 0 "
         "113618 3133440 365 18446744073709551615\n";
-    CHECK(interference_parse_self_stat(self, &ticks) && ticks == 1234 + 567);
-    CHECK(!interference_parse_self_stat("4242 (x) S 1 2 3", &ticks));
-    CHECK(!interference_parse_self_stat("no parenthesis", &ticks));
+    CHECK(interference_parse_self_stat(self, &ticks, &faults) && ticks == 1234 + 567 &&
+          faults == 900);
+    CHECK(!interference_parse_self_stat("4242 (x) S 1 2 3", &ticks, &faults));
+    CHECK(!interference_parse_self_stat("no parenthesis", &ticks, &faults));
 
     double load[3];
     CHECK(interference_parse_loadavg("1.61 0.99 0.72 3/115 884\n", load) && load[0] == 1.61 &&
@@ -86,8 +87,8 @@ int main(void)
 
     /* A quiet interval after a busy minute: the load average alone makes it
      * noisy above twice the CPU count, not at it. */
-    sample_from(&a, STAT_A, "1 (d) S 1 1 1 0 -1 0 0 0 0 0 100 50 0", "4.00 2.00 1.00 1/1 1", 0);
-    sample_from(&b, STAT_B, "1 (d) S 1 1 1 0 -1 0 0 0 0 0 120 60 0", "4.00 2.00 1.00 1/1 1", 1);
+    sample_from(&a, STAT_A, "1 (d) S 1 1 1 0 -1 0 7 0 0 0 100 50 0", "4.00 2.00 1.00 1/1 1", 0);
+    sample_from(&b, STAT_B, "1 (d) S 1 1 1 0 -1 0 19 0 0 0 120 60 0", "4.00 2.00 1.00 1/1 1", 1);
     interference_compute(&a, &b, &f);
     CHECK(!f.noisy);
     a.loadavg[0] = 4.01;
@@ -111,6 +112,7 @@ int main(void)
           strstr(json_string_value(json_object_get(j, "rule")), "0.05"));
     CHECK(json_integer_value(json_object_get(j, "cpus")) == 2);
     CHECK(json_integer_value(json_object_get(j, "cpu_ticks")) == 200);
+    CHECK(json_integer_value(json_object_get(j, "daemon_minor_faults")) == 12);
     CHECK_NEAR(json_real_value(json_object_get(j, "interval_s")), 1.0, 1e-9);
     CHECK(json_real_value(json_object_get(j, "timed_end_unix")) >
           json_real_value(json_object_get(j, "timed_start_unix")));

@@ -144,7 +144,7 @@ int main(void)
           spec.look.lighting == LOOK_BLINN_PHONG && spec.look.hdr == LOOK_HDR_RGBA16F);
     rejects("{\"look\":{\"lighting\":\"pbr2\"}}", "look.lighting");
     rejects("{\"look\":{\"hdr\":\"rgb8\"}}", "look.hdr");
-    rejects("{\"look\":{\"tonemap\":\"aces\"}}", "look.tonemap");
+    rejects("{\"look\":{\"tonemap\":\"hable\"}}", "look.tonemap");
 
     /* Labels: sorted by key, kept in the spec as understood, and round-tripped. */
     CHECK(parse("{\"labels\":{\"commit\":\"abc123\",\"branch\":\"main\",\"ci.run\":\"\"}}",
@@ -178,6 +178,21 @@ int main(void)
         strcat(many, "}}");
         rejects(many, "labels");
     }
+
+    /* timeout_s: the daemon's default unless the job gives one; 0 is no limit. */
+    job_spec_set_default_timeout(600);
+    CHECK(parse("{}", &spec, &err) && spec.timeout_s == 600);
+    CHECK(parse("{\"timeout_s\":2.5}", &spec, &err) && spec.timeout_s == 2.5);
+    CHECK(parse("{\"timeout_s\":0}", &spec, &err) && spec.timeout_s == 0);
+    rejects("{\"timeout_s\":-1}", "timeout_s");
+    rejects("{\"timeout_s\":\"1h\"}", "timeout_s");
+    job_spec_set_default_timeout(0);
+
+    /* At most 1000 captures a job, however small the frames. */
+    rejects("{\"frames\":100000,\"capture_interval\":99,\"scene\":{\"width\":16,\"height\":16}}",
+            "capture_interval");
+    CHECK(parse("{\"frames\":100000,\"capture_interval\":100,\"scene\":{\"width\":16,"
+                "\"height\":16}}", &spec, &err) && job_spec_capture_count(&spec) == 1000);
 
     /* A typo gets a suggestion. */
     parse("{\"frame\":10}", &spec, &err);

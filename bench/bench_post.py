@@ -1,0 +1,173 @@
+#!/usr/bin/env python3
+"""Post-effect benchmark, in one run on one daemon, interleaved over repeats:
+
+1. bloom: separable (2 x (2r+1) taps) against 2d ((2r+1)^2 taps) at radius
+   2, 4, 8 and 16; seed 001 measured 2.5 times at 5x5 (r = 2), and the
+   arithmetic limit of the ratio is (2r+1)/2;
+2. SSAO: cost against sample count (4 to 64), with its quality as the SSIM
+   against 64 samples (reference_look renders the 64-sample image);
+3. the whole chain (bloom, toon with Sobel outlines, SSAO, ACES) as a share
+   of each technique's frame.
+
+  bench/bench_post.py [--frames N] [--warmup N] [--repeat R] [--width W --height H]
+                      [--only bloom,ssao,chain] [--json FILE]
+
+Effect costs are the medians of the effect passes' GL_TIME_ELAPSED
+(gpu_sections_ms): on llvmpipe that covers rasterization, which is all a
+full-screen pass does, so they compare there too. frame_ms is reported
+beside them."""
+
+import argparse
+import json
+import os
+import statistics
+import sys
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
+import testlib  # noqa: E402
+
+ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap.add_argument("--frames", type=int, default=10)
+ap.add_argument("--warmup", type=int, default=2)
+ap.add_argument("--repeat", type=int, default=2)
+ap.add_argument("--width", type=int, default=480)
+ap.add_argument("--height", type=int, default=320)
+ap.add_argument("--only", default="bloom,ssao,chain",
+                help="comma-separated parts to run: bloom, ssao, chain")
+ap.add_argument("--json", help="write every result here")
+args = ap.parse_args()
+
+RADII = (2, 4, 8, 16)
+SAMPLES = (4, 8, 16, 32, 64)
+TECHNIQUES = (("forward", {}), ("unlit", {}), ("osl-auto", {"technique": "osl", "osl": {"resolution": "auto"}}))
+CHAIN = {"post": [{"bloom": {"radius": 4}}, {"toon": {"edges": "sobel"}}, {"ssao": {"samples": 16}}],
+         "tonemap": "aces"}
+
+
+def base_job(**kw):
+    job = {"technique": "forward", "frames": args.frames, "warmup_frames": args.warmup,
+           "capture_interval": 0,
+           "scene": {"dynamic": True, "width": args.width, "height": args.height}}
+    job.update(kw)
+    return job
+
+
+PARTS = set(args.only.split(","))
+CONFIGS = []
+for r in RADII if "bloom" in PARTS else ():
+    for kernel in ("separable", "2d"):
+        CONFIGS.append(("bloom-%s-r%d" % (kernel, r),
+                        base_job(look={"post": [{"bloom": {"kernel": kernel, "radius": r, "threshold": 0}}]})))
+for n in SAMPLES if "ssao" in PARTS else ():
+    CONFIGS.append(("ssao-%d" % n,
+                    base_job(look={"post": [{"ssao": {"samples": n}}]}, capture_interval=args.frames,
+                             reference="forward", metrics=["ssim"],
+                             reference_look={"post": [{"ssao": {"samples": 64}}]})))
+for name, extra in TECHNIQUES if "chain" in PARTS else ():
+    CONFIGS.append(("%s-plain" % name, base_job(**extra)))
+    CONFIGS.append(("%s-chain" % name, base_job(look=CHAIN, **extra)))
+
+
+def med(values):
+    return statistics.median(values) if values else float("nan")
+
+
+def section(r, prefix):
+    """Sum of the median GPU ms of the passes whose names start with prefix."""
+    return sum(v["median"] for k, v in r["gpu_sections_ms"].items() if k.startswith(prefix))
+
+
+def m(name, f):
+    """Median over repeats of f(result)."""
+    return med([f(r) for r in results[name]])
+
+
+def paired(a, b, f):
+    """Median over repeats of f(b) / f(a), each pair run side by side."""
+    return med([f(y) / f(x) for x, y in zip(results[a], results[b]) if f(x) > 0])
+
+
+def frame_ms(x):
+    return x["frame_ms"]["median"]
+
+
+def post_ms(x):
+    return section(x, "bloom.") + section(x, "toon.") + section(x, "ssao.")
+
+
+def bloom_table():
+    print("## Bloom: separable against 2d (medians over repeats of job medians, ms; ratios "
+          "paired within each repeat)\n")
+    print("| radius | taps 2d / separable | sep. blur | 2d blur | blur ratio 2d/sep. | "
+          "arithmetic limit (2r+1)/2 | whole bloom ratio | frame_ms sep. | frame_ms 2d | frame ratio |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for r in RADII:
+        sep, two = "bloom-separable-r%d" % r, "bloom-2d-r%d" % r
+        taps = 2 * r + 1
+        print("| %d (%dx%d) | %d / %d | %.2f | %.2f | %.2f | %.1f | %.2f | %.2f | %.2f | %.2f |"
+              % (r, taps, taps, taps * taps, 2 * taps,
+                 m(sep, lambda x: section(x, "bloom.blur")), m(two, lambda x: section(x, "bloom.blur")),
+                 paired(sep, two, lambda x: section(x, "bloom.blur")), taps / 2.0,
+                 paired(sep, two, lambda x: section(x, "bloom.")), m(sep, frame_ms), m(two, frame_ms),
+                 paired(sep, two, frame_ms)))
+
+
+def ssao_table():
+    print("\n## SSAO: cost and quality against samples\n")
+    print("| samples | ssao.ao ms | ssao.blur ms | both | frame_ms | SSIM against 64 samples |")
+    print("|---|---|---|---|---|---|")
+    for n in SAMPLES:
+        name = "ssao-%d" % n
+        ao, bl = m(name, lambda x: section(x, "ssao.ao")), m(name, lambda x: section(x, "ssao.blur"))
+        ssim = m(name, lambda x: x.get("quality", {}).get("worst_ssim", {}).get("value", float("nan")))
+        print("| %d | %.2f | %.2f | %.2f | %.2f | %.5f |" % (n, ao, bl, ao + bl, m(name, frame_ms), ssim))
+
+
+def chain_table():
+    print("\n## The whole chain (bloom r4, toon Sobel, SSAO 16, ACES) against each technique's frame\n")
+    print("| technique | frame_ms plain | frame_ms chain | chain share of frame_ms (paired) | "
+          "post passes gpu ms | post share of gpu_ms | per effect gpu ms (bloom, toon, ssao) |")
+    print("|---|---|---|---|---|---|---|")
+    for name, _ in TECHNIQUES:
+        plain, chain = name + "-plain", name + "-chain"
+        share = 1.0 - paired(chain, plain, frame_ms)  # (chain - plain) / chain
+        per = [m(chain, lambda x, p=p: section(x, p)) for p in ("bloom.", "toon.", "ssao.")]
+        print("| %s | %.2f | %.2f | %.1f %% | %.2f | %.1f %% | %.2f, %.2f, %.2f |"
+              % (name, m(plain, frame_ms), m(chain, frame_ms), 100.0 * share, m(chain, post_ms),
+                 100.0 * m(chain, lambda x: post_ms(x) / x["gpu_ms"]["median"]), *per))
+
+
+d = testlib.Daemon()
+results = {name: [] for name, _ in CONFIGS}
+try:
+    info = d.json("GET", "/v1/info")[1]["device"]
+    print("device: %s | %s" % (info["gl_renderer"], info["gl_version"]))
+    print("scene: grid %dx%d, moving lights, %d timed frames after %d warm-up, %d repeats\n"
+          % (args.width, args.height, args.frames, args.warmup, args.repeat))
+    t_start, load0 = time.time(), os.getloadavg()[0]
+    for rep in range(args.repeat):
+        for name, job in CONFIGS:
+            t0 = time.time()
+            done = d.wait(d.submit(job), timeout=3600)
+            if done.get("status") != "done":
+                sys.exit("%s failed: %s" % (name, done.get("error")))
+            r = done["result"]
+            results[name].append(r)
+            print("  [%d/%d] %-22s frame %9.2f ms  gpu %9.2f ms  (%.0f s)"
+                  % (rep + 1, args.repeat, name, r["frame_ms"]["median"], r["gpu_ms"]["median"],
+                     time.time() - t0), flush=True)
+    print("\n(%.0f s in all; load average %.2f before, %.2f after, on %d cores)\n"
+          % (time.time() - t_start, load0, os.getloadavg()[0], os.cpu_count()))
+    if "bloom" in PARTS:
+        bloom_table()
+    if "ssao" in PARTS:
+        ssao_table()
+    if "chain" in PARTS:
+        chain_table()
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(results, f, indent=1)
+finally:
+    d.stop()
+    d.cleanup()

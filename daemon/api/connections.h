@@ -1,0 +1,82 @@
+#ifndef SHADEBENCH_CONNECTIONS_H
+#define SHADEBENCH_CONNECTIONS_H
+
+/* Every open HTTP connection, from accept to close, so that no client can
+ * hold the daemon:
+ *  - deadlines that activity cannot stretch: the request's headers must be
+ *    in within header_s of the accept (or of the previous request on the
+ *    connection), its body within body_s of the headers; a late connection
+ *    is shut down (libmicrohttpd's own timeout restarts on every byte);
+ *  - long-polls (?wait=) hold no thread: the connection is suspended
+ *    (MHD_suspend_connection) and one watcher thread resumes it when its job
+ *    or sweep has finished, its time is up, its client has gone away
+ *    (EPOLLRDHUP on the suspended socket) or the daemon stops.
+ * The watcher is the only thread of this module. The functions are called
+ * from libmicrohttpd's threads; connections_poke from any thread, and never
+ * blocks (it is called under the job store's lock). */
+
+#include <microhttpd.h>
+#include <stdbool.h>
+#include <stddef.h>
+
+struct connections;
+struct conn;
+
+/* Why a suspended request was resumed. */
+enum wake { WAKE_NONE, WAKE_READY, WAKE_TIMEOUT, WAKE_GONE, WAKE_STOPPING };
+
+enum wait_kind { WAIT_JOB, WAIT_SWEEP };
+
+/* True when a wait on kind/id can end now (finished, or no longer there).
+ * Called on the watcher thread, which holds no lock of the caller's. */
+typedef bool (*wait_done_fn)(void *ctx, enum wait_kind kind, const char *id);
+
+struct connections_config {
+    double header_s; /* accept (or the previous request) to complete headers */
+    double body_s;   /* complete headers to complete body */
+};
+
+struct connections *connections_create(const struct connections_config *cfg, wait_done_fn done,
+                                       void *ctx, char *err, size_t errlen);
+/* Stops the watcher. Every connection must have been closed (after
+ * MHD_stop_daemon). Accepts NULL. */
+void connections_destroy(struct connections *cs);
+
+/* MHD_OPTION_NOTIFY_CONNECTION, with cs as its closure. */
+void connections_notify(void *cls, struct MHD_Connection *c, void **socket_context,
+                        enum MHD_ConnectionNotificationCode code);
+/* The tracked state of c; NULL if it could not be tracked (out of memory). */
+struct conn *connections_of(struct MHD_Connection *c);
+
+/* The request's headers are in: its body deadline starts. */
+void connections_headers_in(struct connections *cs, struct conn *k);
+/* The request is complete and being answered: no deadline but libmicrohttpd's
+ * idle timeout while the answer is sent. */
+void connections_answering(struct connections *cs, struct conn *k);
+/* The answer is sent: the next request's header deadline starts. */
+void connections_request_done(struct connections *cs, struct conn *k);
+/* The answer's status, for the request counters. */
+void connections_set_status(struct conn *k, unsigned status);
+unsigned connections_status(const struct conn *k);
+
+/* Suspends the request until kind/id is done or wait_s pass; false (and not
+ * suspended) while stopping. Call from the access handler, then return
+ * MHD_YES without a response; it is called again once resumed. */
+bool connections_suspend(struct connections *cs, struct conn *k, enum wait_kind kind,
+                         const char *id, double wait_s);
+/* After the resume: why (and the request is no longer waiting). */
+enum wake connections_wake(const struct conn *k);
+
+/* Something a wait may be waiting for has changed. Lock-free. */
+void connections_poke(struct connections *cs);
+/* Ends every wait at once (WAKE_STOPPING); later suspends are refused. Then
+ * waits up to grace_s until those answers have gone out. */
+void connections_stop(struct connections *cs, double grace_s);
+
+struct connections_stats {
+    size_t open, waiting;
+    unsigned long long header_timeouts, body_timeouts, waits_gone;
+};
+void connections_stats(struct connections *cs, struct connections_stats *out);
+
+#endif

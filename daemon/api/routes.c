@@ -1,0 +1,196 @@
+#define _POSIX_C_SOURCE 200809L
+#include "daemon/api/routes.h"
+
+#include <stdio.h>
+#include <string.h>
+
+static const struct {
+    const char *label, *allow, *rule;
+} KINDS[ROUTE_COUNT] = {
+    [ROUTE_NONE] = {"other", "GET", "use GET"},
+    [ROUTE_HEALTHZ] = {"/healthz", "GET, HEAD", "use GET"},
+    [ROUTE_METRICS] = {"/metrics", "GET, HEAD", "use GET"},
+    [ROUTE_INFO] = {"/v1/info", "GET, HEAD", "use GET"},
+    [ROUTE_JOBS] = {"/v1/jobs", "GET, HEAD, POST", "use GET to list jobs or POST to submit one"},
+    [ROUTE_JOB] = {"/v1/jobs/{id}", "GET, HEAD, DELETE", "use GET or DELETE on a job"},
+    [ROUTE_JOB_REPORT] = {"/v1/jobs/{id}/report.html", "GET, HEAD", "use GET"},
+    [ROUTE_JOB_CHART] = {"/v1/jobs/{id}/charts/{name}", "GET, HEAD", "use GET"},
+    [ROUTE_JOB_TIMINGS] = {"/v1/jobs/{id}/timings.csv", "GET, HEAD", "use GET"},
+    [ROUTE_JOB_IMAGE] = {"/v1/jobs/{id}/{images}/{frame}.png", "GET, HEAD", "use GET"},
+    [ROUTE_SWEEPS] = {"/v1/sweeps", "GET, HEAD, POST", "use GET to list sweeps or POST to start one"},
+    [ROUTE_SWEEP] = {"/v1/sweeps/{id}", "GET, HEAD, DELETE", "use GET or DELETE on a sweep"},
+    [ROUTE_SWEEP_CHART] = {"/v1/sweeps/{id}/charts/{name}", "GET, HEAD", "use GET"},
+    [ROUTE_SWEEP_REPORT] = {"/v1/sweeps/{id}/report.html", "GET, HEAD", "use GET"},
+};
+
+static const char *const IMAGE_DIRS[][2] = {
+    [IMAGE_FRAME] = {"frames/", "frame"},
+    [IMAGE_REFERENCE] = {"reference/", "reference"},
+    [IMAGE_SSIM] = {"ssim/", "ssim"},
+    [IMAGE_FLIP] = {"flip/", "flip"},
+    [IMAGE_HEATMAP] = {"heatmap/", "heatmap"}, /* light evaluations per pixel */
+};
+
+static bool none(struct route *r, const char *field, const char *message)
+{
+    r->kind = ROUTE_NONE;
+    r->field = field;
+    r->message = message;
+    return false;
+}
+
+/* Job and sweep ids are time stamps with a serial: digits and dashes. */
+static bool take_id(const char *s, size_t len, struct route *r)
+{
+    if (len == 0 || len >= sizeof(r->id))
+        return false;
+    for (size_t i = 0; i < len; i++)
+        if (!((s[i] >= '0' && s[i] <= '9') || s[i] == '-'))
+            return false;
+    memcpy(r->id, s, len);
+    r->id[len] = '\0';
+    return true;
+}
+
+/* "NAME.svg" or "NAME.png", NAME of letters, digits and underscores. */
+static bool take_chart(const char *s, struct route *r)
+{
+    const char *dot = strrchr(s, '.');
+    if (!dot || dot == s || (size_t)(dot - s) >= sizeof(r->chart))
+        return false;
+    if (strcmp(dot, ".svg") != 0 && strcmp(dot, ".png") != 0)
+        return false;
+    for (const char *p = s; p < dot; p++)
+        if (!((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || (*p >= '0' && *p <= '9') ||
+              *p == '_'))
+            return false;
+    memcpy(r->chart, s, (size_t)(dot - s));
+    r->chart[dot - s] = '\0';
+    r->chart_png = strcmp(dot, ".png") == 0;
+    return true;
+}
+
+/* "K.png" with K a positive decimal of at most 9 digits, no sign or spaces. */
+static bool take_frame(const char *s, struct route *r)
+{
+    int frame = 0, digits = 0;
+    /* Nine digits at most: their value always fits an int. */
+    while (digits < 9 && s[digits] >= '0' && s[digits] <= '9')
+        frame = frame * 10 + (s[digits] - '0'), digits++;
+    if (digits == 0 || strcmp(s + digits, ".png") != 0 || frame <= 0)
+        return false;
+    r->frame = frame;
+    return true;
+}
+
+static bool job_routes(const char *rest, struct route *r)
+{
+    const char *slash = strchr(rest, '/');
+    if (!take_id(rest, slash ? (size_t)(slash - rest) : strlen(rest), r))
+        return none(r, "id", "no such job");
+    if (!slash) {
+        r->kind = ROUTE_JOB;
+        return true;
+    }
+    const char *sub = slash + 1;
+    if (strcmp(sub, "report.html") == 0) {
+        r->kind = ROUTE_JOB_REPORT;
+        return true;
+    }
+    if (strcmp(sub, "timings.csv") == 0) {
+        r->kind = ROUTE_JOB_TIMINGS;
+        return true;
+    }
+    if (strncmp(sub, "charts/", 7) == 0) {
+        if (!take_chart(sub + 7, r))
+            return none(r, "chart", "charts are NAME.svg or NAME.png");
+        r->kind = ROUTE_JOB_CHART;
+        return true;
+    }
+    for (size_t k = 0; k < sizeof(IMAGE_DIRS) / sizeof(IMAGE_DIRS[0]); k++) {
+        size_t len = strlen(IMAGE_DIRS[k][0]);
+        if (strncmp(sub, IMAGE_DIRS[k][0], len) == 0) {
+            if (!take_frame(sub + len, r))
+                return none(r, "frame", "images are K.png with K a captured frame (see result.captures)");
+            r->kind = ROUTE_JOB_IMAGE;
+            r->image = (enum route_image)k;
+            return true;
+        }
+    }
+    return none(r, "url", "no such resource");
+}
+
+static bool sweep_routes(const char *rest, struct route *r)
+{
+    if (!*rest) {
+        r->kind = ROUTE_SWEEPS;
+        return true;
+    }
+    size_t id_len = strcspn(rest, "/");
+    if (!take_id(rest, id_len, r))
+        return none(r, "id", "no such sweep");
+    if (!rest[id_len]) {
+        r->kind = ROUTE_SWEEP;
+        return true;
+    }
+    const char *sub = rest + id_len + 1;
+    if (strcmp(sub, "report.html") == 0) {
+        r->kind = ROUTE_SWEEP_REPORT;
+        return true;
+    }
+    if (strncmp(sub, "charts/", 7) == 0) {
+        if (!take_chart(sub + 7, r))
+            return none(r, "chart", "charts are NAME.svg or NAME.png");
+        r->kind = ROUTE_SWEEP_CHART;
+        return true;
+    }
+    return none(r, "url", "no such resource");
+}
+
+bool route_parse(const char *url, struct route *r)
+{
+    memset(r, 0, sizeof(*r));
+    if (strcmp(url, "/healthz") == 0)
+        r->kind = ROUTE_HEALTHZ;
+    else if (strcmp(url, "/metrics") == 0)
+        r->kind = ROUTE_METRICS;
+    else if (strcmp(url, "/v1/info") == 0)
+        r->kind = ROUTE_INFO;
+    else if (strcmp(url, "/v1/jobs") == 0 || strcmp(url, "/v1/jobs/") == 0)
+        r->kind = ROUTE_JOBS;
+    else if (strncmp(url, "/v1/jobs/", 9) == 0)
+        return job_routes(url + 9, r);
+    else if (strcmp(url, "/v1/sweeps") == 0)
+        r->kind = ROUTE_SWEEPS;
+    else if (strncmp(url, "/v1/sweeps/", 11) == 0)
+        return sweep_routes(url + 11, r);
+    else
+        return none(r, "url", "no such route");
+    return true;
+}
+
+bool route_method_ok(enum route_kind kind, const char *method, const char **allow,
+                     const char **rule)
+{
+    if ((unsigned)kind >= ROUTE_COUNT)
+        kind = ROUTE_NONE;
+    *allow = KINDS[kind].allow;
+    *rule = KINDS[kind].rule;
+    if (strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0)
+        return true;
+    if (strcmp(method, "POST") == 0)
+        return kind == ROUTE_JOBS || kind == ROUTE_SWEEPS;
+    if (strcmp(method, "DELETE") == 0)
+        return kind == ROUTE_JOB || kind == ROUTE_SWEEP;
+    return false;
+}
+
+const char *route_label(enum route_kind kind)
+{
+    return (unsigned)kind < ROUTE_COUNT ? KINDS[kind].label : KINDS[ROUTE_NONE].label;
+}
+
+const char *route_image_prefix(enum route_image image)
+{
+    return IMAGE_DIRS[image][1];
+}

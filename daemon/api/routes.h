@@ -1,0 +1,58 @@
+#ifndef SHADEBENCH_ROUTES_H
+#define SHADEBENCH_ROUTES_H
+
+/* The URL space of the HTTP API as data: which resource a path names, its
+ * id and sub-resource, and the methods it takes. Pure functions of the
+ * strings (no socket, no store), so that the routing is unit-tested and
+ * fuzzed on its own. GL-free; any thread. */
+
+#include <stdbool.h>
+
+enum route_kind {
+    ROUTE_NONE, /* no such route or resource: 404 */
+    ROUTE_HEALTHZ,
+    ROUTE_METRICS,
+    ROUTE_INFO,
+    ROUTE_JOBS,
+    ROUTE_JOB,
+    ROUTE_JOB_REPORT,
+    ROUTE_JOB_CHART,
+    ROUTE_JOB_TIMINGS,
+    ROUTE_JOB_IMAGE,
+    ROUTE_SWEEPS,
+    ROUTE_SWEEP,
+    ROUTE_SWEEP_CHART,
+    ROUTE_SWEEP_REPORT,
+    ROUTE_COUNT
+};
+
+/* Per-capture images of a job: URL folder and file prefix. */
+enum route_image { IMAGE_FRAME, IMAGE_REFERENCE, IMAGE_SSIM, IMAGE_FLIP, IMAGE_HEATMAP };
+
+struct route {
+    enum route_kind kind;
+    char id[24];       /* jobs and sweeps: digits and dashes, 1 to 23 of them */
+    char chart[32];    /* charts: the name without its extension */
+    bool chart_png;    /* charts: .png (else .svg) */
+    enum route_image image;
+    int frame;         /* images: 1 to 999999999 */
+    /* ROUTE_NONE: what the 404 names. */
+    const char *field, *message;
+};
+
+/* Parses an already URL-decoded path (no query). Always fills out; returns
+ * false for ROUTE_NONE. */
+bool route_parse(const char *url, struct route *out);
+
+/* Does kind take method (GET and HEAD alike)? If not, *allow is the Allow
+ * header and *rule the message of the 405. */
+bool route_method_ok(enum route_kind kind, const char *method, const char **allow,
+                     const char **rule);
+
+/* A fixed label per kind, for the request counters of /metrics. */
+const char *route_label(enum route_kind kind);
+
+/* The file prefix of an image kind in a job's directory ("frame", ...). */
+const char *route_image_prefix(enum route_image image);
+
+#endif

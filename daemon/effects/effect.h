@@ -1,0 +1,58 @@
+#ifndef SHADEBENCH_EFFECT_H
+#define SHADEBENCH_EFFECT_H
+
+/* The GL half of a post effect: what the post chain (post_chain.h) calls to
+ * build an effect for a run and to run it on a frame. An effect reads the
+ * colour it is handed (HDR, full size, the look's format) plus the
+ * technique's depth and normals, and writes its result into the framebuffer
+ * it is handed; it times each of its passes with gpu_pass_begin/end, in the
+ * order its info's active_passes lists them, starting at env->first_pass.
+ * Render thread only. */
+
+#include <epoxy/gl.h>
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "daemon/effects/effect_info.h"
+#include "daemon/techniques/technique.h"
+
+/* What the chain hands an effect; valid from create to destroy. */
+struct effect_env {
+    const struct technique_env *tech; /* size, depth, products, targets, defines */
+    const struct gpu_passes *passes;
+    int first_pass;      /* index of its first active pass */
+    const char *label;   /* "bloom", "bloom2": prefixes its target names */
+    GLenum hdr_format;   /* the look's HDR format, for the effect's colour planes */
+    GLuint empty_vao;    /* for full-screen triangles (fullscreen.vert) */
+    GLuint linear_sampler; /* bilinear, clamped: for reading a plane of another size */
+    /* "#define HAVE_NORMAL_TEX 1" and its encoding when the technique
+     * publishes normals, for programs that include post_common.glsl. */
+    const char *normal_defines;
+};
+
+struct effect {
+    const struct effect_info *info;
+    /* Builds programs and asks the pool for planes. Outside the timed
+     * region; may take any GL state. opts is the effect's options struct. */
+    bool (*create)(const struct effect_env *env, const void *opts, void **state, char *err,
+                   size_t errlen);
+    /* One frame: reads src, writes dst_fbo (full size). Timed: no
+     * allocation, no readback, no uniform lookups by name. Leaves every
+     * sampler unit it bound to a sampler object unbound again. */
+    void (*run)(void *state, const struct effect_env *env, GLuint src, GLuint dst_fbo);
+    /* Frees what create made (pool planes stay in the pool). Accepts NULL. */
+    void (*destroy)(void *state);
+};
+
+extern const struct effect effect_bloom, effect_toon, effect_ssao;
+
+/* Draws the full-screen triangle with prog into the bound framebuffer;
+ * shared by the effects. */
+void effect_draw_fullscreen(const struct effect_env *env, GLuint prog);
+
+/* A named plane of the pool at a size and the framebuffer over it; the
+ * name is "<label>.<suffix>". False with err filled. */
+bool effect_plane(const struct effect_env *env, const char *suffix, GLenum format, int w, int h,
+                  GLuint *tex, GLuint *fbo, char *err, size_t errlen);
+
+#endif

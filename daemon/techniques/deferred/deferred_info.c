@@ -1,0 +1,24 @@
+#include "daemon/techniques/deferred/deferred_info.h"
+
+#include <stddef.h>
+
+static const char *const passes[] = {"gbuffer", "lighting", NULL};
+
+static const struct technique_option options[] = {
+    {.name = "light_bounds", .type = TOPT_CHOICE, .def = LIGHT_BOUNDS_SCISSOR_TIGHT,
+     .choices = light_bounds_choices,
+     .summary = "pixels each light shades: scissor_tight (its sphere's silhouette rectangle, "
+                "seed 001's fix), scissor_loose (the projected box of its AABB corners, seed "
+                "001's first version), volume (its sphere rasterised) or fullscreen",
+     .offset = offsetof(struct deferred_options, light_bounds)},
+    GBUFFER_OPTION_ROWS(struct deferred_options, gbuffer),
+    {0},
+};
+
+const struct technique_info deferred_info = {
+    .name = "deferred",
+    .summary = "g-buffer, then each light added over the pixels its bound covers (seed 001)",
+    .passes = passes,
+    .options = options,
+    .options_size = sizeof(struct deferred_options),
+};

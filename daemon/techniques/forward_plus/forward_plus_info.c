@@ -1,0 +1,21 @@
+#include "daemon/techniques/forward_plus/forward_plus_info.h"
+
+#include <stddef.h>
+
+static const char *const passes[] = {"depth_prepass", "binning", "shading", NULL};
+
+static const struct technique_option options[] = {
+    {.name = "tile_size", .type = TOPT_INT, .def = 16, .min = 8, .max = 128,
+     .summary = "tile edge in pixels",
+     .offset = offsetof(struct forward_plus_options, tile_size)},
+    {0},
+};
+
+const struct technique_info forward_plus_info = {
+    .name = "forward_plus",
+    .summary = "depth pre-pass, per-tile light lists with depth bounds (compute), forward "
+               "shading over each tile's lights",
+    .passes = passes,
+    .options = options,
+    .options_size = sizeof(struct forward_plus_options),
+};

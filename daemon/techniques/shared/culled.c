@@ -1,0 +1,154 @@
+#include "daemon/techniques/shared/culled.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "daemon/gpu/glutil.h"
+#include "daemon/techniques/shared/depth_prepass.h"
+#include "daemon/techniques/shared/gbuffer.h"
+#include "daemon/techniques/shared/heat.h"
+
+struct culled {
+    struct culled_config cfg;
+    struct gbuffer gbuffer;
+    struct depth_prepass prepass;
+    struct light_grid grid;
+    struct heat heat;
+    struct scene_program shade;
+    GLint heat_loc;
+    GLuint light_fbo, empty_vao;
+    int pass_geometry, pass_binning, pass_shading;
+};
+
+bool culled_create(const struct technique_env *env, const struct culled_config *cfg,
+                   void **state, char *err, size_t errlen)
+{
+    struct culled *c = calloc(1, sizeof(*c));
+    if (!c) {
+        snprintf(err, errlen, "%s: out of memory", cfg->grid.technique);
+        return false;
+    }
+    *state = c;
+    c->cfg = *cfg;
+    bool tiles = cfg->grid.kind == LIGHT_GRID_TILES;
+    c->pass_geometry = tiles ? 0 : 1;
+    c->pass_binning = tiles ? 1 : 0;
+    c->pass_shading = 2;
+    if (!light_grid_init(&c->grid, env, &cfg->grid, err, errlen) ||
+        !heat_init(&c->heat, env, err, errlen))
+        goto fail;
+    GLuint prog = 0;
+    if (cfg->deferred) {
+        if (!gbuffer_init(&c->gbuffer, env, &cfg->gbuffer, err, errlen))
+            goto fail;
+        c->light_fbo = gpu_targets_fbo(env->targets, "culled.light", &env->output_color, 1, 0,
+                                       err, errlen);
+        const struct gl_stage stages[] = {
+            {GL_VERTEX_SHADER, {"fullscreen.vert"}},
+            {GL_FRAGMENT_SHADER, {"culled_deferred.frag"}},
+        };
+        if (!c->light_fbo ||
+            !(prog = gl_program_build("culled deferred lighting", stages, 2, c->gbuffer.defines,
+                                      err, errlen)))
+            goto fail;
+        glGenVertexArrays(1, &c->empty_vao);
+    } else {
+        const struct gl_stage stages[] = {
+            {GL_VERTEX_SHADER, {"scene.vert"}},
+            {GL_FRAGMENT_SHADER, {"culled_forward.frag"}},
+        };
+        if (!depth_prepass_init(&c->prepass, env, err, errlen) ||
+            !(prog = gl_program_build("culled forward shading", stages, 2, env->defines, err,
+                                      errlen)))
+            goto fail;
+    }
+    c->shade = gpu_scene_program(env->gpu, prog);
+    c->heat_loc = heat_location(prog);
+    return true;
+fail:
+    culled_destroy(c);
+    *state = NULL;
+    return false;
+}
+
+static void binning(struct culled *c, const struct technique_env *env, int64_t frame)
+{
+    gpu_pass_begin(env->passes, c->pass_binning, env->output_fbo, env->width, env->height);
+    light_grid_build(&c->grid, env, frame);
+    gpu_pass_end(env->passes);
+}
+
+bool culled_render(void *state, const struct technique_env *env, int64_t frame, char *err,
+                   size_t errlen)
+{
+    (void)err, (void)errlen;
+    struct culled *c = state;
+    bool tiles = c->cfg.grid.kind == LIGHT_GRID_TILES;
+    bool heat = heat_wanted(env, frame);
+    gpu_scene_set_light_rows(env->gpu, &frame, 1);
+    heat_enable(c->shade.prog, c->heat_loc, heat);
+    if (!tiles)
+        binning(c, env, frame);
+    if (c->cfg.deferred)
+        gbuffer_draw(&c->gbuffer, env, c->pass_geometry);
+    else
+        depth_prepass_draw(&c->prepass, env, c->pass_geometry);
+    if (tiles)
+        binning(c, env, frame);
+
+    if (c->cfg.deferred) {
+        gpu_pass_begin(env->passes, c->pass_shading, c->light_fbo, env->width, env->height);
+        glDisable(GL_DEPTH_TEST);
+        glDisable(GL_CULL_FACE);
+        gbuffer_bind(&c->gbuffer, env);
+        if (heat)
+            heat_bind(&c->heat);
+        gpu_scene_bind(env->gpu, &c->shade);
+        light_grid_bind(&c->grid);
+        glBindVertexArray(c->empty_vao);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        glBindVertexArray(0);
+    } else {
+        gpu_pass_begin(env->passes, c->pass_shading, env->output_fbo, env->width, env->height);
+        depth_prepass_shading_state();
+        if (heat)
+            heat_clear(&c->heat, env->output_fbo);
+        gpu_scene_bind(env->gpu, &c->shade);
+        light_grid_bind(&c->grid);
+        gpu_scene_draw(env->gpu, &c->shade);
+    }
+    if (heat)
+        heat_done();
+    gpu_pass_end(env->passes);
+    return true;
+}
+
+json_t *culled_describe(void *state)
+{
+    struct culled *c = state;
+    json_t *d = light_grid_describe(&c->grid);
+    if (d && c->cfg.deferred)
+        json_object_set_new(d, "gbuffer", gbuffer_describe(&c->gbuffer));
+    return d;
+}
+
+bool culled_verify(void *state, char *err, size_t errlen)
+{
+    struct culled *c = state;
+    return light_grid_verify(&c->grid, err, errlen);
+}
+
+void culled_destroy(void *state)
+{
+    struct culled *c = state;
+    if (!c)
+        return;
+    if (c->shade.prog)
+        glDeleteProgram(c->shade.prog);
+    if (c->empty_vao)
+        glDeleteVertexArrays(1, &c->empty_vao);
+    gbuffer_finish(&c->gbuffer);
+    depth_prepass_finish(&c->prepass);
+    light_grid_finish(&c->grid);
+    free(c);
+}

@@ -1,0 +1,21 @@
+// Tiled and clustered deferred lighting: one full-screen pass, each surface
+// pixel looping over its cell's lights (light_grid.glsl).
+#include "gbuffer.glsl"
+#include "light_grid.glsl"
+#include "heat.glsl"
+layout(location = 0) out vec4 out_color;
+
+void main()
+{
+    ivec2 pixel = ivec2(gl_FragCoord.xy);
+    Surface s;
+    uint evaluations = 0u;
+    vec3 color = vec3(0.0);
+    if (gbuffer_surface(pixel, s)) {
+        float d = -(u_frame.view * vec4(s.P, 1.0)).z;
+        color = shade_cell(grid_cell(gl_FragCoord.xy, d), s.P, s.N, s.albedo, s.specular,
+                           s.shininess, evaluations);
+    }
+    heat_set(pixel, evaluations);
+    out_color = vec4(color, 1.0);
+}

@@ -1,0 +1,187 @@
+"""The many-lights family against forward, beyond the conformance bar of
+e2e_techniques.py:
+- accuracy: every technique at defaults matches forward at SSIM >= 0.999 and
+  passes PerceptualDiff, on the thesis grid (10 and 256 lights) and the
+  lights preset (16, 256 and 1,024 lights), and with an orbiting camera;
+  every lossless non-default option does too;
+- lossy layouts show their loss: xy_reconstruct_z, pack_shift and
+  pack_base10 score a higher FLIP than the default layout (and never a
+  higher SSIM);
+- overflow is never silent: a tiny max_lights_per_cluster with many lights
+  is counted per frame; under "fallback" the image still matches, under
+  "fail" the job fails naming the option and the overflow;
+- the heat map: served as a PNG per capture, with a mean and max that grow
+  with the light count;
+- bad options answer 400 naming the field; a grid only the device refuses
+  fails the job at create, naming the field.
+Small frames (160x120), few frames, so the suite stays short on 2 cores."""
+
+import os
+
+import testlib
+from testlib import check
+
+testlib.skip_without_egl()
+
+SSIM_BOUND = 0.999
+TECHS = ["deferred", "tiled_deferred", "forward_plus", "clustered_forward", "clustered_deferred"]
+
+
+def job(tech, lights=64, opts=None, frames=4, capture=4, preset="grid", camera="static", **extra):
+    j = {"technique": tech, "frames": frames, "warmup_frames": 1, "capture_interval": capture,
+         "reference": "forward", "metrics": ["ssim", "pdiff", "flip"],
+         "scene": {"preset": preset, "width": 160, "height": 120, "dynamic": True,
+                   "lights": lights, "camera": camera}}
+    if opts is not None:
+        j[tech] = opts
+    j.update(extra)
+    if j.get("reference") is None:
+        del j["reference"], j["metrics"]
+    return j
+
+
+def quality(done):
+    """(worst SSIM, worst FLIP mean, PerceptualDiff passed on every capture)."""
+    caps = done.get("result", {}).get("captures", [])
+    ms = [c.get("metrics", {}) for c in caps]
+    if not ms:
+        return 0.0, 1.0, False
+    return (min(m.get("ssim", 0) for m in ms), max(m.get("flip", {}).get("mean", 1) for m in ms),
+            all(m.get("pdiff", {}).get("pass") for m in ms))
+
+
+def matches(d, j, what):
+    done = d.run(j)
+    ok = check(done.get("status") == "done", "%s runs: %s" % (what, done.get("error")))
+    ssim, flip, pdiff = quality(done)
+    print("  %-60s SSIM %.6f  FLIP %.5f  PerceptualDiff %s" % (what, ssim, flip, pdiff))
+    if ok:
+        check(ssim >= SSIM_BOUND and pdiff,
+              "%s matches forward: SSIM %.6f >= %s, PerceptualDiff %s" % (what, ssim, SSIM_BOUND, pdiff))
+    return done, ssim, flip
+
+
+d = testlib.Daemon()
+try:
+    # Accuracy at defaults: the thesis grid, and the lights preset with 16,
+    # 256 and 1,024 lights; then a moving camera (the grid's slices and the
+    # CPU binning follow it).
+    for preset, counts in (("grid", (10, 256)), ("lights", (16, 256, 1024))):
+        for lights in counts:
+            for tech in TECHS:
+                matches(d, job(tech, lights, preset=preset),
+                        "%s at defaults, %s, %d lights" % (tech, preset, lights))
+    for tech, opts in (("clustered_deferred", {}), ("tiled_deferred", {"binning": "cpu"})):
+        matches(d, job(tech, 256, opts, preset="lights", camera="orbit"),
+                "%s %s, lights, 256 lights, orbiting camera" % (tech, opts))
+
+    # Every lossless non-default option, on the grid with 64 lights.
+    lossless = [
+        ("deferred", {"light_bounds": "scissor_loose"}),
+        ("deferred", {"light_bounds": "volume"}),
+        ("deferred", {"light_bounds": "fullscreen"}),
+        ("deferred", {"gbuffer": {"normal": "float3"}}),
+        ("tiled_deferred", {"binning": "cpu"}),
+        ("tiled_deferred", {"tile_size": 8}),
+        ("tiled_deferred", {"tile_size": 128, "binning": "cpu"}),
+        ("forward_plus", {"tile_size": 128}),
+        ("clustered_forward", {"grid": [32, 18, 48], "slices": "linear"}),
+        ("clustered_deferred", {"grid": [4, 3, 2], "slices": "linear", "max_lights_per_cluster": 64}),
+        ("clustered_deferred", {"overflow": "fail", "gbuffer": {"normal": "float3"}}),
+    ]
+    for tech, opts in lossless:
+        matches(d, job(tech, 64, opts), "%s %s" % (tech, opts))
+
+    # Lossy layouts show their loss against the default layout.
+    for tech in ("deferred", "clustered_deferred"):
+        _, base_ssim, base_flip = matches(d, job(tech, 64), "%s default layout" % tech)
+        for layout in ({"normal": "xy_reconstruct_z"}, {"albedo": "pack_shift"},
+                       {"albedo": "pack_base10"}):
+            done = d.run(job(tech, 64, {"gbuffer": layout}))
+            ssim, flip, pdiff = quality(done)
+            print("  %-60s SSIM %.6f  FLIP %.5f  PerceptualDiff %s" % ("%s %s" % (tech, layout), ssim, flip, pdiff))
+            check(done.get("status") == "done" and flip > base_flip and ssim <= base_ssim,
+                  "%s gbuffer %s shows its loss: FLIP %.5f > %.5f, SSIM %.6f <= %.6f"
+                  % (tech, layout, flip, base_flip, ssim, base_ssim))
+
+    # Overflow, forced: 256 lights, at most 4 a cluster.
+    tiny = {"max_lights_per_cluster": 4}
+    done, _, _ = matches(d, job("clustered_deferred", 256, dict(tiny, overflow="fallback")),
+                         "clustered_deferred overflowing with fallback")
+    ov = done.get("result", {}).get("clustered_deferred", {}).get("overflow", {})
+    check(ov.get("frames") == 4 and ov.get("cells_per_frame", {}).get("max", 0) > 0
+          and ov.get("lights_dropped_per_frame", {}).get("max", 0) > 0 and ov.get("first_frame") == 1,
+          "fallback counts the overflow per frame: %s" % ov)
+    for tech in ("clustered_forward", "clustered_deferred"):
+        done = d.run(job(tech, 256, dict(tiny, overflow="fail")))
+        err = done.get("error") or ""
+        check(done.get("status") == "failed" and "overflow" in err
+              and "%s.max_lights_per_cluster" % tech in err,
+              "%s overflow fail fails the job naming it: %s %s" % (tech, done.get("status"), err))
+    # No overflow at defaults: the counters read zero.
+    done = d.run(job("clustered_forward", 64, capture=0, reference=None))
+    ov = done.get("result", {}).get("clustered_forward", {}).get("overflow", {})
+    check(ov.get("frames") == 0 and ov.get("first_frame") is None, "no overflow at defaults: %s" % ov)
+
+    # The heat map grows with the light count and is served beside the frames.
+    means = []
+    for lights in (16, 256):
+        done = d.run(job("clustered_deferred", lights, frames=2, capture=1, reference=None))
+        heat = done.get("result", {}).get("heatmap", {})
+        caps = heat.get("captures", [])
+        check(len(caps) == 2 and heat.get("unit") and heat.get("ramp"),
+              "heat map per capture: %s" % heat)
+        if caps:
+            means.append(caps[-1]["mean"])
+            path = os.path.join(d.tmp, "heat%d.png" % lights)
+            check(d.download(caps[-1]["url"], path) == 200 and
+                  (testlib.png_info(path) or {}).get("width") == 160,
+                  "heat map PNG served at %s" % caps[-1]["url"])
+            check(caps[-1]["max"] >= caps[-1]["mean"] > 0 and caps[-1]["scale_max"] == caps[-1]["max"],
+                  "heat map figures: %s" % caps[-1])
+            status, _, _ = d.request("GET", "/v1/jobs/%s/heatmap/99.png" % done["id"])
+            check(status == 404, "no heat map for an uncaptured frame: %d" % status)
+    check(len(means) == 2 and means[1] > 2 * means[0], "heat grows with the lights: %s" % means)
+    done = d.run(job("forward", 16, frames=2, capture=1, reference=None))
+    check("heatmap" not in done.get("result", {}), "forward publishes no heat map")
+
+    # Bad options: 400 naming the field.
+    base = {"frames": 2, "scene": {"width": 160, "height": 120}}
+    testlib.rejects(d, dict(base, technique="tiled_deferred", tiled_deferred={"tile_size": 0}),
+                    "tiled_deferred.tile_size")
+    testlib.rejects(d, dict(base, technique="forward_plus", forward_plus={"tile_size": 256}),
+                    "forward_plus.tile_size")
+    testlib.rejects(d, dict(base, technique="deferred", deferred={"gbuffer": {"normal": "spherical"}}),
+                    "deferred.gbuffer.normal")
+    testlib.rejects(d, dict(base, technique="clustered_deferred",
+                            clustered_deferred={"gbuffer": {"albedo": "rgb565"}}),
+                    "clustered_deferred.gbuffer.albedo")
+    testlib.rejects(d, dict(base, technique="clustered_forward", clustered_forward={"grid": [16, 9]}),
+                    "clustered_forward.grid")
+    testlib.rejects(d, dict(base, technique="clustered_forward",
+                            clustered_forward={"grid": [1024, 1024, 2]}), "clustered_forward.grid")
+    testlib.rejects(d, dict(base, technique="clustered_deferred",
+                            clustered_deferred={"max_lights_per_cluster": 0}),
+                    "clustered_deferred.max_lights_per_cluster")
+    testlib.rejects(d, dict(base, technique="clustered_deferred", clustered_deferred={"overflow": "drop"}),
+                    "clustered_deferred.overflow")
+    # Grids only the device (or the image) refuses: the job fails at create,
+    # naming the field and the limit. The bit buffer takes cells x lights / 8
+    # bytes: pick a grid just past this device's storage-buffer limit.
+    caps = d.json("GET", "/v1/info")[1].get("device", {}).get("caps", {})
+    lights = 65536
+    cells = caps.get("max_ssbo_bytes", 1 << 27) // (lights // 8) + 1
+    z = -(-cells // (160 * 120))
+    refusals = [([200, 9, 24], "image", 1024)]
+    if 160 * 120 * z <= 1 << 20:
+        refusals.append(([160, 120, z], "GL_MAX_SHADER_STORAGE_BLOCK_SIZE", lights))
+    for grid, why, n in refusals:
+        done = d.run(dict(base, technique="clustered_deferred",
+                          scene={"preset": "lights", "width": 160, "height": 120, "lights": n},
+                          clustered_deferred={"grid": grid}))
+        err = done.get("error") or ""
+        check(done.get("status") == "failed" and "clustered_deferred.grid" in err and why in err,
+              "grid %s refused at create: %s" % (grid, err))
+finally:
+    testlib.stop_and_check(d)
+testlib.finish("e2e_many_lights")

@@ -1,0 +1,52 @@
+/* The HTTP routing on any method and path. Invariants: it never crashes;
+ * every path maps to one kind; a resource's id holds only digits and
+ * dashes, its frame is positive, its chart name has no path characters;
+ * every refusal names a field and a message; every kind has a label and an
+ * Allow header. */
+#include <string.h>
+
+#include "daemon/api/routes.h"
+#include "tests/fuzz/fuzz.h"
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    static const char *const METHODS[] = {"GET", "HEAD", "POST", "DELETE", "PUT", "OPTIONS",
+                                          "PATCH", ""};
+    if (size == 0 || size > 4096)
+        return 0;
+    const char *method = METHODS[data[0] % 8];
+    char url[4097];
+    memcpy(url, data + 1, size - 1);
+    url[size - 1] = '\0';
+    struct route r;
+    bool found = route_parse(url, &r);
+    FUZZ_ASSERT(found == (r.kind != ROUTE_NONE));
+    FUZZ_ASSERT((unsigned)r.kind < ROUTE_COUNT);
+    if (!found) {
+        FUZZ_ASSERT(r.field && r.field[0] && r.message && r.message[0]);
+    } else {
+        for (const char *p = r.id; *p; p++)
+            FUZZ_ASSERT((*p >= '0' && *p <= '9') || *p == '-');
+        bool has_id = r.kind != ROUTE_HEALTHZ && r.kind != ROUTE_METRICS && r.kind != ROUTE_INFO &&
+                      r.kind != ROUTE_JOBS && r.kind != ROUTE_SWEEPS;
+        FUZZ_ASSERT(has_id == (r.id[0] != '\0'));
+        if (r.kind == ROUTE_JOB_IMAGE)
+            FUZZ_ASSERT(r.frame >= 1 && r.frame <= 999999999);
+        if (r.kind == ROUTE_JOB_CHART || r.kind == ROUTE_SWEEP_CHART) {
+            FUZZ_ASSERT(r.chart[0] != '\0');
+            FUZZ_ASSERT(strpbrk(r.chart, "/.%\\\\") == NULL);
+        }
+        /* What a path names does not depend on trailing bytes after a NUL. */
+        FUZZ_ASSERT(strlen(url) < sizeof(url));
+    }
+    FUZZ_ASSERT((route_label(r.kind) != NULL && route_label(r.kind)[0] == '/') ||
+                strcmp(route_label(r.kind), "other") == 0);
+    const char *allow, *rule;
+    bool ok = route_method_ok(r.kind, method, &allow, &rule);
+    FUZZ_ASSERT(allow && allow[0] && rule && rule[0]);
+    if (strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0)
+        FUZZ_ASSERT(ok);
+    if (strcmp(method, "PUT") == 0 || strcmp(method, "PATCH") == 0 || method[0] == '\0')
+        FUZZ_ASSERT(!ok);
+    return 0;
+}

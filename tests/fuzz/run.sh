@@ -1,0 +1,77 @@
+#!/bin/sh
+# Builds the libFuzzer targets with clang (AddressSanitizer and
+# UndefinedBehaviorSanitizer) in build-fuzz/ and runs each for SECONDS:
+#   tests/fuzz/run.sh SECONDS [TARGET...]     (targets: job sweep png_metrics route)
+# Each starts from its seed corpus (tests/fuzz/corpus/TARGET) and the inputs
+# that once broke it (tests/fuzz/regressions/TARGET); new inputs go to
+# build-fuzz/corpus/TARGET, a crash to build-fuzz/crashes/TARGET/ (copy it to
+# tests/fuzz/regressions/TARGET/ once fixed: make check replays those).
+# Prints "PASS: fuzz_TARGET ..." or "FAIL: ..." per target, then
+# "fuzz: N passed, N failed"; exits non-zero when any failed.
+set -u
+cd "$(dirname "$0")/../.."
+seconds=${1:-60}
+[ $# -gt 0 ] && shift
+targets=${*:-job sweep png_metrics route}
+out=${FUZZ_BUILD:-build-fuzz}
+cc=${FUZZ_CC:-clang}
+mkdir -p "$out/obj"
+
+if ! command -v "$cc" >/dev/null 2>&1; then
+    echo "FAIL: fuzz: $cc is not installed (apt-get install clang)"
+    echo "fuzz: 0 passed, 1 failed"
+    exit 1
+fi
+flags="-g -O1 -std=c11 -I. -fno-omit-frame-pointer -fsanitize=address,undefined
+  -fno-sanitize-recover=undefined $(pkg-config --cflags jansson libpng)"
+libs="$(pkg-config --libs jansson libpng) -lm -pthread"
+sources="common/json_fields.c common/png_io.c common/log.c common/clock.c
+  daemon/quality/ssim.c daemon/quality/psnr.c daemon/quality/pdiff.c daemon/quality/flip.c
+  daemon/quality/diffmap.c daemon/quality/compare.c daemon/scene/scene_spec.c
+  daemon/jobs/job_spec.c daemon/jobs/sweep_spec.c daemon/api/routes.c"
+objs=""
+for src in $sources; do
+    obj="$out/obj/$(echo "$src" | tr / _ | sed 's/\.c$/.o/')"
+    if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ -n "$(find "$(dirname "$src")" common -name '*.h' -newer "$obj" 2>/dev/null | head -n1)" ]; then
+        # shellcheck disable=SC2086
+        "$cc" $flags -fsanitize=fuzzer-no-link -c "$src" -o "$obj" || { echo "FAIL: fuzz: cannot build $src"; exit 1; }
+    fi
+    objs="$objs $obj"
+done
+
+pass=0
+fail=0
+for t in $targets; do
+    bin="$out/fuzz_$t"
+    # shellcheck disable=SC2086
+    if ! "$cc" $flags -fsanitize=fuzzer "tests/fuzz/fuzz_$t.c" $objs $libs -o "$bin"; then
+        echo "FAIL: fuzz_$t (does not build)"
+        fail=$((fail + 1))
+        continue
+    fi
+    mkdir -p "$out/corpus/$t" "$out/crashes/$t"
+    dict=""
+    [ -f "tests/fuzz/$t.dict" ] && dict="-dict=tests/fuzz/$t.dict"
+    seeds="tests/fuzz/corpus/$t"
+    [ -d "tests/fuzz/regressions/$t" ] && seeds="$seeds tests/fuzz/regressions/$t"
+    start=$(date +%s)
+    # Leaks are checked too (LSan, part of ASan): each input must free what it takes.
+    # shellcheck disable=SC2086
+    ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 \
+    "$bin" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2560 -max_len=65536 \
+        -artifact_prefix="$out/crashes/$t/" -print_final_stats=1 $dict \
+        "$out/corpus/$t" $seeds >"$out/$t.log" 2>&1
+    rc=$?
+    took=$(( $(date +%s) - start ))
+    runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$out/$t.log" | tail -n1)
+    if [ "$rc" -eq 0 ]; then
+        echo "PASS: fuzz_$t (${runs:-?} inputs in ${took} s)"
+        pass=$((pass + 1))
+    else
+        echo "FAIL: fuzz_$t (exit $rc after ${took} s; see $out/$t.log, input in $out/crashes/$t/)"
+        grep -m1 -A12 "ERROR\|invariant broken" "$out/$t.log"
+        fail=$((fail + 1))
+    fi
+done
+echo "fuzz: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]

@@ -1,0 +1,57 @@
+/* The URL space: which resource a path names, its id and sub-resource, and
+ * the methods each takes. */
+#include <string.h>
+
+#include "daemon/api/routes.h"
+#include "tests/unit/check.h"
+
+static enum route_kind kind_of(const char *url, struct route *r)
+{
+    route_parse(url, r);
+    return r->kind;
+}
+
+int main(void)
+{
+    struct route r;
+    CHECK(kind_of("/healthz", &r) == ROUTE_HEALTHZ);
+    CHECK(kind_of("/metrics", &r) == ROUTE_METRICS);
+    CHECK(kind_of("/v1/info", &r) == ROUTE_INFO);
+    CHECK(kind_of("/v1/jobs", &r) == ROUTE_JOBS && kind_of("/v1/jobs/", &r) == ROUTE_JOBS);
+    CHECK(kind_of("/v1/jobs/20260101-000000-0001", &r) == ROUTE_JOB &&
+          strcmp(r.id, "20260101-000000-0001") == 0);
+    CHECK(kind_of("/v1/jobs/1/frames/100.png", &r) == ROUTE_JOB_IMAGE && r.frame == 100 &&
+          r.image == IMAGE_FRAME && strcmp(route_image_prefix(r.image), "frame") == 0);
+    CHECK(kind_of("/v1/jobs/1/flip/7.png", &r) == ROUTE_JOB_IMAGE && r.image == IMAGE_FLIP);
+    CHECK(kind_of("/v1/jobs/1/heatmap/7.png", &r) == ROUTE_JOB_IMAGE && r.image == IMAGE_HEATMAP);
+    CHECK(kind_of("/v1/jobs/1/timings.csv", &r) == ROUTE_JOB_TIMINGS);
+    CHECK(kind_of("/v1/jobs/1/report.html", &r) == ROUTE_JOB_REPORT);
+    CHECK(kind_of("/v1/jobs/1/charts/distribution.svg", &r) == ROUTE_JOB_CHART &&
+          strcmp(r.chart, "distribution") == 0 && !r.chart_png);
+    CHECK(kind_of("/v1/sweeps", &r) == ROUTE_SWEEPS && kind_of("/v1/sweeps/", &r) == ROUTE_SWEEPS);
+    CHECK(kind_of("/v1/sweeps/5/charts/speed_accuracy.png", &r) == ROUTE_SWEEP_CHART && r.chart_png);
+    CHECK(kind_of("/v1/sweeps/5/report.html", &r) == ROUTE_SWEEP_REPORT);
+
+    /* Refusals name what is wrong. */
+    CHECK(kind_of("/v1/jobs/../../etc/passwd", &r) == ROUTE_NONE && strcmp(r.field, "id") == 0);
+    CHECK(kind_of("/v1/jobs/1/frames/0.png", &r) == ROUTE_NONE && strcmp(r.field, "frame") == 0);
+    CHECK(kind_of("/v1/jobs/1/frames/-1.png", &r) == ROUTE_NONE);
+    CHECK(kind_of("/v1/jobs/1/frames/ 5.png", &r) == ROUTE_NONE);
+    CHECK(kind_of("/v1/jobs/1/frames/1234567890.png", &r) == ROUTE_NONE);
+    CHECK(kind_of("/v1/jobs/1/frames/5.png.png", &r) == ROUTE_NONE);
+    CHECK(kind_of("/v1/jobs/1/charts/../x.svg", &r) == ROUTE_NONE && strcmp(r.field, "chart") == 0);
+    CHECK(kind_of("/v1/jobs/1/unknown", &r) == ROUTE_NONE && strcmp(r.field, "url") == 0);
+    CHECK(kind_of("/v1/jobs/123456789012345678901234", &r) == ROUTE_NONE);
+    CHECK(kind_of("/v1/nothing", &r) == ROUTE_NONE && strcmp(r.message, "no such route") == 0);
+    CHECK(kind_of("", &r) == ROUTE_NONE);
+
+    const char *allow, *rule;
+    CHECK(route_method_ok(ROUTE_JOBS, "POST", &allow, &rule));
+    CHECK(route_method_ok(ROUTE_JOB, "HEAD", &allow, &rule));
+    CHECK(!route_method_ok(ROUTE_JOBS, "PUT", &allow, &rule) && strstr(allow, "POST"));
+    CHECK(!route_method_ok(ROUTE_INFO, "DELETE", &allow, &rule) && strcmp(allow, "GET, HEAD") == 0);
+    CHECK(!route_method_ok(ROUTE_HEALTHZ, "POST", &allow, &rule));
+    CHECK(strcmp(route_label(ROUTE_JOB), "/v1/jobs/{id}") == 0);
+    CHECK(strcmp(route_label((enum route_kind)99), "other") == 0);
+    return check_finish("test_routes");
+}

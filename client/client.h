@@ -24,7 +24,7 @@ struct options {
     double min_ssim, max_flip; /* NAN: no gate */
     double timeout_s;         /* 0: wait as long as it takes */
     double confidence;        /* of the intervals, 0.95 */
-    double noise_tolerance;   /* other-process CPU share, 0.10 */
+    double noise_tolerance;   /* relative change of the CPU left, 0.10; INFINITY: off */
     int runs;                 /* 0: the command's default */
     int max_reruns;
     bool wait, quiet, allow_mismatch, fail_inconclusive;

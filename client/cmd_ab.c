@@ -15,16 +15,17 @@
 #include "client/verdicts.h"
 #include "common/fsutil.h"
 
-/* A pair is noisy when its two runs saw different conditions: their
- * other-process CPU shares differ by more than the tolerance (or, without
- * figures, the daemon flagged either). */
+/* A pair is noisy when its two runs saw different conditions: other
+ * processes left one of them more than the tolerance more or less CPU than
+ * the other (or, without figures, the daemon flagged either). */
 static void mark_pairs(struct run_set *sa, struct run_set *sb, double tolerance)
 {
     for (size_t i = 0; i < sa->n && i < sb->n; i++) {
         struct gate_run *a = &sa->runs[i], *b = &sb->runs[i];
         a->noisy = b->noisy = false;
         a->why[0] = b->why[0] = '\0';
-        if (a->has_share && b->has_share && fabs(a->other_share - b->other_share) > tolerance) {
+        if (a->has_share && b->has_share &&
+            fabs(gate_cpu_left_change(b->other_share, a->other_share)) > tolerance) {
             snprintf(a->why, sizeof(a->why), "other processes used %.0f%% of the CPU during A "
                      "and %.0f%% during B", 100 * a->other_share, 100 * b->other_share);
             a->noisy = b->noisy = true;
@@ -116,9 +117,21 @@ int cmd_ab(struct conn *ca, struct conn *cb, const struct options *o, const char
         if (nclean >= 2 && paired_log_ratio(va, vb, nclean, o->confidence, &r)) {
             gate_decide(&r, o->max_slowdown, &v);
         } else {
+            /* Too few clean pairs to decide; still report all the pairs. */
             memset(&v, 0, sizeof(v));
             v.outcome = GATE_INCONCLUSIVE;
-            snprintf(v.why, sizeof(v.why), "too few clean pairs (%zu)", nclean);
+            snprintf(v.why, sizeof(v.why), "too few clean pairs (%zu of %zu)", nclean, sa.n);
+            for (size_t i = 0; i < sa.n; i++) {
+                va[i] = sa.runs[i].ms;
+                vb[i] = sb.runs[i].ms;
+            }
+            if (paired_log_ratio(va, vb, sa.n, o->confidence, &r)) {
+                v.r = r;
+                size_t used = strlen(v.why);
+                snprintf(v.why + used, sizeof(v.why) - used,
+                         "; over all pairs, noisy ones included: B/A %.4f [%.4f, %.4f], not a "
+                         "verdict", r.ratio, r.lo, r.hi);
+            }
         }
         if (budget <= 0)
             break;

@@ -126,6 +126,23 @@ static void evaluate(const struct options *o, struct gate_run *base, size_t nb, 
     *nb_clean = bv ? gate_clean_values(base, nb, bv) : 0;
     *nc_clean = cv ? gate_clean_values(s->runs, s->n, cv) : 0;
     gate_compare(bv, *nb_clean, cv, *nc_clean, o->confidence, o->max_slowdown, v);
+    if (v->outcome == GATE_INCONCLUSIVE && v->r.ratio == 0 && bv && cv) {
+        /* Too few clean runs to decide: still report what all the runs,
+         * noisy ones included, say, so that the log is not empty. */
+        for (size_t i = 0; i < nb; i++)
+            bv[i] = base[i].ms;
+        for (size_t i = 0; i < s->n; i++)
+            cv[i] = s->runs[i].ms;
+        struct ratio_interval all;
+        if (welch_log_ratio(bv, nb, cv, s->n, o->confidence, &all)) {
+            v->r = all;
+            size_t used = strlen(v->why);
+            snprintf(v->why + used, sizeof(v->why) - used,
+                     "; over all runs, noisy ones included: %+.1f%% (%.0f%% interval %+.1f%% to "
+                     "%+.1f%%), not a verdict", 100 * (all.ratio - 1), 100 * o->confidence,
+                     100 * (all.lo - 1), 100 * (all.hi - 1));
+        }
+    }
     free(bv);
     free(cv);
 }

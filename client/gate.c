@@ -167,19 +167,27 @@ bool gate_typical_share(const struct gate_run *runs, size_t n, double *share)
     return k > 0;
 }
 
+double gate_cpu_left_change(double share, double reference)
+{
+    /* The CPU other processes left over, relative to the reference's: what
+     * a CPU-bound renderer's speed follows when the machine is shared. */
+    return (1.0 - share) / fmax(1.0 - reference, 0.01) - 1.0;
+}
+
 size_t gate_mark_noisy(struct gate_run *runs, size_t n, bool have_reference, double reference,
                        double tolerance)
 {
     size_t noisy = 0;
     for (size_t i = 0; i < n; i++) {
         struct gate_run *r = &runs[i];
-        if (!r->noisy && r->has_share && have_reference &&
-            fabs(r->other_share - reference) > tolerance) {
+        double change = r->has_share ? gate_cpu_left_change(r->other_share, reference) : 0.0;
+        if (!r->noisy && r->has_share && have_reference && fabs(change) > tolerance) {
             r->noisy = true;
             snprintf(r->why, sizeof(r->why),
                      "other processes used %.0f%% of the CPU during it, against %.0f%% for the "
-                     "runs it is compared with (tolerance %.0f points)",
-                     100 * r->other_share, 100 * reference, 100 * tolerance);
+                     "runs it is compared with: %.0f%% %s CPU left (tolerance %.0f%%)",
+                     100 * r->other_share, 100 * reference, 100 * fabs(change),
+                     change < 0 ? "less" : "more", 100 * tolerance);
         } else if (!r->noisy && !have_reference && r->daemon_noisy) {
             r->noisy = true;
             snprintf(r->why, sizeof(r->why), "the daemon marked it noisy (load %.2f to %.2f)",

@@ -72,11 +72,19 @@ bool gate_run_from_result(const json_t *result, const char *job_id, const char *
  * when none has interference figures. */
 bool gate_typical_share(const struct gate_run *runs, size_t n, double *share);
 
-/* Marks runs noisy whose other-process CPU share differs from reference by
- * more than tolerance (0.10 = ten points of the machine's CPU): such a run
- * was measured under other conditions than the runs it is compared with.
- * Without a reference share, a run the daemon flagged noisy is marked.
- * Runs without figures are kept (older results). Returns the noisy count. */
+/* How much more (> 0) or less (< 0) CPU other processes left than in the
+ * reference, relatively: (1 - share) / (1 - reference) - 1. A CPU-bound
+ * renderer on a shared machine slows down with the CPU left to it, so 0.85
+ * against 0.80 (15% left instead of 20%) is -25%, while 0.05 against 0.02
+ * is -3%. */
+double gate_cpu_left_change(double share, double reference);
+
+/* Marks runs noisy when the CPU other processes left them differs from the
+ * reference's by more than tolerance (0.10: by more than 10%, either way):
+ * such a run was measured under other conditions than the runs it is
+ * compared with. Without a reference share, a run the daemon flagged noisy
+ * is marked. Runs without figures are kept (older results). Returns the
+ * noisy count. */
 size_t gate_mark_noisy(struct gate_run *runs, size_t n, bool have_reference, double reference,
                        double tolerance);
 

@@ -231,9 +231,11 @@ static void put(char *out, size_t cap, const char *fmt, ...)
 
 void junit_job_name(const json_t *spec, char *out, size_t cap)
 {
-    out[0] = '\0';
+    /* At most 240 characters, so that a check's suffix always fits. */
+    char name[241] = "";
+    size_t ncap = sizeof(name) < cap ? sizeof(name) : cap;
     const char *tech = json_string_value(json_object_get(spec, "technique"));
-    put(out, cap, "%s", tech ? tech : "job");
+    put(name, ncap, "%s", tech ? tech : "job");
     size_t n;
     const char **keys = sorted_keys(spec, &n);
     char text[128];
@@ -246,16 +248,16 @@ void junit_job_name(const json_t *spec, char *out, size_t cap)
             !strcmp(k, "frames") || !strcmp(k, "warmup_frames"))
             continue;
         if (json_is_object(v) || !strcmp(k, "look")) {
-            if (!tech || strcmp(k, tech) != 0)
-                continue; /* another technique's options, or the look (hashed below) */
+            if (!tech || strcmp(k, tech) != 0 || json_object_size(v) == 0)
+                continue; /* another technique's options, the look (hashed below), or none */
             size_t m;
             const char **sub = sorted_keys(v, &m);
-            put(out, cap, " %s(", k);
+            put(name, ncap, " %s(", k);
             for (size_t s = 0; sub && s < m; s++) {
                 scalar_text(json_object_get(v, sub[s]), text, sizeof(text));
-                put(out, cap, "%s%s=%s", s ? " " : "", sub[s], text);
+                put(name, ncap, "%s%s=%s", s ? " " : "", sub[s], text);
             }
-            put(out, cap, ")");
+            put(name, ncap, ")");
             free(sub);
             continue;
         }
@@ -263,13 +265,15 @@ void junit_job_name(const json_t *spec, char *out, size_t cap)
             json_is_null(v))
             continue;
         scalar_text(v, text, sizeof(text));
-        put(out, cap, " %s=%s", k, text);
+        put(name, ncap, " %s=%s", k, text);
     }
     free(keys);
+    /* The scene by what shapes the work most: preset, size, lights, their
+     * motion and the camera's. */
     json_t *scene = json_object_get(spec, "scene");
     if (scene) {
         const char *preset = json_string_value(json_object_get(scene, "preset"));
-        put(out, cap, " %s %lldx%lld %lld lights %s", preset ? preset : "scene",
+        put(name, ncap, " %s %lldx%lld %lld lights %s", preset ? preset : "scene",
             (long long)json_integer_value(json_object_get(scene, "width")),
             (long long)json_integer_value(json_object_get(scene, "height")),
             (long long)json_integer_value(json_object_get(scene, "lights")),
@@ -292,10 +296,11 @@ void junit_job_name(const json_t *spec, char *out, size_t cap)
     uint32_t h = 2166136261u; /* FNV-1a */
     for (const char *p = text_rest; p && *p; p++)
         h = (h ^ (unsigned char)*p) * 16777619u;
-    put(out, cap, " #%08x", h);
+    put(name, ncap, " #%08x", h);
     free(text_rest);
     json_decref(rest);
     json_t *frames = json_object_get(spec, "frames");
     if (json_is_integer(frames))
-        put(out, cap, ", %lld frames", (long long)json_integer_value(frames));
+        put(name, ncap, ", %lld frames", (long long)json_integer_value(frames));
+    snprintf(out, cap, "%s", name);
 }

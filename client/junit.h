@@ -48,10 +48,14 @@ void junit_print(const struct junit *j, FILE *f);
 
 /* A stable name for a job from its spec as the daemon understood it:
  * "osl async_distance=20 osl(reshade=touched resolution=auto texel_density=1)
- *  grid 160x120 10 lights moving, 20 frames". Options of other techniques,
- * and the fields that do not change what is measured (labels, repeat,
- * captures, reference, metrics), are left out; so are top-level numbers that
- * are 0 and flags that are false. */
+ *  grid 160x120 10 lights moving #1a2b3c4d, 20 frames": the technique and
+ * its options (top-level numbers that are set, and the object named after
+ * it), the scene's preset, size, lights and their motion, a hash of the
+ * rest of the scene and the look (FNV-1a of their sorted JSON: jobs that
+ * differ there get different names, without burying the name), and the
+ * frames. Options of other techniques and the fields that do not change
+ * what is measured (labels, repeat, captures, reference, metrics) are left
+ * out. At most 240 characters. */
 void junit_job_name(const json_t *spec, char *out, size_t cap);
 
 #endif

@@ -70,8 +70,9 @@ static void usage(FILE *f)
             "  --series NAME       frame_ms, gpu_ms or cpu_ms (default: frame_ms on software\n"
             "                      renderers such as llvmpipe, gpu_ms on GPUs)\n"
             "  --confidence P      of the intervals (default 95%%)\n"
-            "  --noise-tolerance X a run whose other-process CPU share differs from the compared\n"
-            "                      runs' by more than X (default 0.10) is noisy\n"
+            "  --noise-tolerance P a run left by other processes more than P more or less CPU\n"
+            "                      than the runs it is compared with is noisy and rerun\n"
+            "                      (default 10%%; off: never)\n"
             "  --server-b URL      ab: the second daemon\n\n"
             "History:\n"
             "  --filter KEY=VALUE  technique=, status=, label.NAME= (repeatable)\n"
@@ -197,7 +198,10 @@ int main(int argc, char **argv)
         case O_BASELINE: o.baseline = optarg; break;
         case O_SLOWDOWN: o.max_slowdown = fraction(optarg, "--max-slowdown", 0, 100); break;
         case O_CONFIDENCE: o.confidence = fraction(optarg, "--confidence", 0.5, 0.999); break;
-        case O_NOISE: o.noise_tolerance = fraction(optarg, "--noise-tolerance", 0, 1); break;
+        case O_NOISE:
+            o.noise_tolerance = !strcmp(optarg, "off") ? INFINITY
+                                : fraction(optarg, "--noise-tolerance", 0, 100);
+            break;
         case O_RUNS: o.runs = count(optarg, "--runs", 1, 100); break;
         case O_RERUNS: o.max_reruns = count(optarg, "--max-reruns", 0, 1000); break;
         case O_FAIL_INC: o.fail_inconclusive = true; break;

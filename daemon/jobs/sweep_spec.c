@@ -422,12 +422,19 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
         }
         /* Each value may be fine alone and a combination still refused
          * (frames 2 with capture_interval 5): every point is parsed as the
-         * job it will run, so that no sweep fails after earlier points ran. */
+         * job it will run, so that no sweep fails after earlier points ran;
+         * the timed reference points too. */
         out->ngrid = out->npoints;
         for (size_t p = 0; p < out->npoints; p++)
             if (!check_combination(out, p, techniques, err))
                 return false;
-        return add_reference_points(out, body, err);
+        size_t grid = out->npoints;
+        if (!add_reference_points(out, body, err))
+            return false;
+        for (size_t p = grid; p < out->npoints; p++)
+            if (!check_combination(out, p, techniques, err))
+                return false;
+        return true;
     }
 
     out->kind = SWEEP_FIND;

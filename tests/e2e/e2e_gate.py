@@ -5,7 +5,8 @@ device exits 2 before measuring, and a verdict that cannot be reached is
 a warning or, with --fail-inconclusive, a failure. Jobs stay tiny: CI has
 two cores and runs other tests beside this one, which is also why the
 "same job" check allows 60%: it must pass whatever the neighbours do,
-while 200 lights (several times slower on llvmpipe) must still fail."""
+while 1000 lights (tens of times slower on llvmpipe, and still several
+times slower when the neighbours take most of the CPU) must still fail."""
 
 import json
 import os
@@ -47,24 +48,27 @@ try:
     check(len(gate) == 1 and gate[0][2].get("outcome") in ("pass", "inconclusive") and
           float(gate[0][2]["ci_low"]) < float(gate[0][2]["ratio"]) < float(gate[0][2]["ci_high"]) and
           gate[0][1] > 0, "the gate case: outcome, ratio inside its interval, a real time: %s" % (gate,))
-    check(gate and int(gate[0][2]["runs"]) >= 3 and int(gate[0][2]["baseline_runs"]) >= 2,
-          "judged on runs, not frames")
+    check(gate and int(gate[0][2]["runs"]) + int(gate[0][2]["noisy_runs"]) >= 3,
+          "judged on runs, not frames: %s %s" % (gate, out.stderr[-1500:]))
     check("baseline runs:" in out.stderr and "gate:" in out.stderr, "the runs and the verdict are in the log")
 
     # Many more lights: a different job, refused unless --allow-mismatch...
-    slow = cl.write("slow", dict(JOB, scene=dict(JOB["scene"], lights=200)))
+    slow = cl.write("slow", dict(JOB, scene=dict(JOB["scene"], lights=1000)))
     n_before = len(d.json("GET", "/v1/jobs")[1]["jobs"])
     out = cl.run("submit", slow, "--wait", "--baseline", baseline)
-    check(out.returncode == 2 and "scene.lights: 10 in the baseline, 200 here" in out.stderr,
+    check(out.returncode == 2 and "scene.lights: 10 in the baseline, 1000 here" in out.stderr,
           "a mismatched baseline exits 2 naming the field: %s" % out.stderr[-300:])
     listed = d.json("GET", "/v1/jobs")[1]["jobs"]
     check(len(listed) == n_before + 1 and listed[-1]["status"] == "cancelled",
           "the mismatched job was cancelled at once, not measured")
     # ...and with it, a regression.
     junit = cl.path("slow.xml")
+    # (Noise marking off: this checks detection; a neighbour's burst must
+    # not turn the verdict into "cannot tell".)
     out = cl.run("submit", slow, "--wait", "--baseline", baseline, "--allow-mismatch", "--runs", "3",
-                 "--max-reruns", "3", "--max-slowdown", "60%", "--junit", junit)
-    check(out.returncode == 1 and "REGRESSION" in out.stderr, "200 lights is a regression: %s" % out.stderr[-600:])
+                 "--max-reruns", "6", "--max-slowdown", "60%", "--noise-tolerance", "off",
+                 "--junit", junit)
+    check(out.returncode == 1 and "REGRESSION" in out.stderr, "1000 lights is a regression: %s" % out.stderr[-600:])
     fails = [c[0] for c in junit_cases(junit)[1].values() if c[0]]
     check(len(fails) == 1 and "slower by" in fails[0], "JUnit explains the regression: %s" % fails)
     check("confirming" in out.stderr, "a regression is confirmed on fresh runs before it fails")

@@ -55,11 +55,22 @@ int main(void)
     json_object_set_new(osl, "look", json_pack("{s:s}", "lighting", "blinn_phong"));
     junit_job_name(osl, name, sizeof(name));
     CHECK(strcmp(name, other) != 0);
+    /* However long the options, the name stays within 240 characters. */
+    json_t *many = json_object();
+    for (int i = 0; i < 40; i++) {
+        char k[16];
+        snprintf(k, sizeof(k), "option%02d", i);
+        json_object_set_new(many, k, json_integer(i + 1000));
+    }
+    json_object_set_new(osl, "osl", many);
+    junit_job_name(osl, other, sizeof(other));
+    CHECK(strlen(other) <= 240);
     json_decref(osl);
     /* Forward leaves OSL's options and a zero async distance out. */
     json_t *fwd = json_loads("{\"technique\":\"forward\",\"frames\":40,\"async_distance\":0,"
                              "\"scene\":{\"preset\":\"grid\",\"lights\":10,\"dynamic\":false,"
-                             "\"width\":160,\"height\":120},\"osl\":{\"resolution\":256}}", 0,
+                             "\"width\":160,\"height\":120},\"osl\":{\"resolution\":256},"
+                             "\"forward\":{}}", 0,
                              NULL);
     junit_job_name(fwd, name, sizeof(name));
     CHECK(strncmp(name, "forward grid 160x120 10 lights still #", 38) == 0 &&

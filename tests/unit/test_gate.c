@@ -199,7 +199,14 @@ int main(void)
         {.ms = 10, .has_share = true, .other_share = 0.12},
     };
     CHECK(gate_mark_noisy(nr, 4, true, 0.04, 0.10) == 1 && nr[1].noisy &&
-          strstr(nr[1].why, "45%") && !nr[3].noisy && !nr[2].noisy);
+          strstr(nr[1].why, "45%") && strstr(nr[1].why, "43% less CPU left") && !nr[3].noisy &&
+          !nr[2].noisy);
+    /* On a saturated machine five points matter: 15% left instead of 20%. */
+    CHECK_NEAR(gate_cpu_left_change(0.85, 0.80), -0.25, 1e-12);
+    CHECK_NEAR(gate_cpu_left_change(0.05, 0.02), -0.0306122, 1e-6);
+    struct gate_run busy[2] = {{.ms = 10, .has_share = true, .other_share = 0.85},
+                               {.ms = 10, .has_share = true, .other_share = 0.81}};
+    CHECK(gate_mark_noisy(busy, 2, true, 0.80, 0.10) == 1 && busy[0].noisy && !busy[1].noisy);
     struct gate_run nr2[2] = {{.ms = 10, .daemon_noisy = true}, {.ms = 10}};
     CHECK(gate_mark_noisy(nr2, 2, false, 0, 0.10) == 1 && nr2[0].noisy);
     return check_finish("test_gate");

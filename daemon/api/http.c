@@ -19,6 +19,7 @@
 #include "common/log.h"
 #include "daemon/api/charts.h"
 #include "daemon/api/connections.h"
+#include "daemon/api/links.h"
 #include "daemon/api/report.h"
 #include "daemon/api/routes.h"
 #include "daemon/harness/telemetry.h"
@@ -375,8 +376,8 @@ static enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *
     default: /* QUEUE_IO_ERROR: not persisted, so not accepted */
         return respond_error(c, MHD_HTTP_INSUFFICIENT_STORAGE, "state_dir", queue_submit_error());
     }
-    char url[64];
-    snprintf(url, sizeof(url), "/v1/jobs/%s", id);
+    char url[ROUTE_URL_MAX];
+    route_job_url(id, url);
     LOG(LOG_INFO, "queued job %s (%s)", id, spec.technique);
     return respond_json(c, MHD_HTTP_ACCEPTED,
                         json_pack("{s:s, s:s, s:s}", "id", id, "status", "queued", "url", url));
@@ -453,6 +454,21 @@ static enum MHD_Result respond_html(struct MHD_Connection *c, char *html, size_t
     return respond_text(c, MHD_HTTP_OK, html, len, "text/html; charset=utf-8");
 }
 
+/* A job or sweep as the API serves it: the stored JSON plus its URLs. */
+static json_t *served_job(struct http_server *s, const char *id)
+{
+    json_t *job = queue_job_json(s->queue, id, 0);
+    links_add_job(job);
+    return job;
+}
+
+static json_t *served_sweep(struct http_server *s, const char *id)
+{
+    json_t *sw = sweeps_json(s->sweeps, id, 0);
+    links_add_sweep(sw);
+    return sw;
+}
+
 static bool finished_status(enum job_status st)
 {
     return st != JOB_QUEUED && st != JOB_RUNNING;
@@ -510,8 +526,7 @@ static enum MHD_Result answer_waited(struct http_server *s, struct MHD_Connectio
                              "the daemon is stopping: the wait ended early; ask again once it "
                              "is back");
     bool sweep = req->route.kind == ROUTE_SWEEP;
-    json_t *body = sweep ? sweeps_json(s->sweeps, req->route.id, 0)
-                         : queue_job_json(s->queue, req->route.id, 0);
+    json_t *body = sweep ? served_sweep(s, req->route.id) : served_job(s, req->route.id);
     if (!body)
         return respond_error(c, MHD_HTTP_NOT_FOUND, "id", sweep ? "no such sweep" : "no such job");
     return respond_json(c, req->wait_status, body);
@@ -534,7 +549,7 @@ static enum MHD_Result job_resource(struct http_server *s, struct MHD_Connection
             return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
         if (wait > 0 && !finished_status(status))
             return suspend(s, c, req, WAIT_JOB, wait, MHD_HTTP_OK);
-        json_t *job = queue_job_json(s->queue, r->id, 0);
+        json_t *job = served_job(s, r->id);
         if (!job)
             return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
         return respond_json(c, MHD_HTTP_OK, job);
@@ -546,7 +561,7 @@ static enum MHD_Result job_resource(struct http_server *s, struct MHD_Connection
         case CANCEL_FINISHED:
             return respond_error(c, MHD_HTTP_CONFLICT, "id", "the job has already finished");
         case CANCEL_DONE:
-            return respond_json(c, MHD_HTTP_OK, queue_job_json(s->queue, r->id, 0));
+            return respond_json(c, MHD_HTTP_OK, served_job(s, r->id));
         case CANCEL_REQUESTED:
             /* The job stops at its next frame or metric tile; give it a moment
              * so that the answer usually shows the final state. */
@@ -623,8 +638,8 @@ static enum MHD_Result post_sweep(struct http_server *s, struct MHD_Connection *
     if (r != QUEUE_OK)
         return respond_error(c, MHD_HTTP_TOO_MANY_REQUESTS, "body",
                              "too many sweeps are waiting; retry later");
-    char url[64];
-    snprintf(url, sizeof(url), "/v1/sweeps/%s", id);
+    char url[ROUTE_URL_MAX];
+    route_sweep_url(id, url);
     return respond_json(c, MHD_HTTP_ACCEPTED,
                         json_pack("{s:s, s:s, s:s}", "id", id, "status", "queued", "url", url));
 }
@@ -646,6 +661,7 @@ static enum MHD_Result sweep_resource(struct http_server *s, struct MHD_Connecti
             json_decref(sw);
             return suspend(s, c, req, WAIT_SWEEP, wait, MHD_HTTP_OK);
         }
+        links_add_sweep(sw);
         return respond_json(c, MHD_HTTP_OK, sw);
     }
     if (r->kind == ROUTE_SWEEP) { /* DELETE */
@@ -655,7 +671,7 @@ static enum MHD_Result sweep_resource(struct http_server *s, struct MHD_Connecti
         case CANCEL_FINISHED:
             return respond_error(c, MHD_HTTP_CONFLICT, "id", "the sweep has already finished");
         case CANCEL_DONE:
-            return respond_json(c, MHD_HTTP_OK, sweeps_json(s->sweeps, r->id, 0));
+            return respond_json(c, MHD_HTTP_OK, served_sweep(s, r->id));
         case CANCEL_REQUESTED:
             return suspend(s, c, req, WAIT_SWEEP, CANCEL_WAIT_S, MHD_HTTP_ACCEPTED);
         }
@@ -709,8 +725,9 @@ static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
             MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, list_arg, &a);
             if (!a.ok)
                 return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&a.err));
-            return respond_json(c, MHD_HTTP_OK,
-                                queue_list_json_with(s->queue, job_filter_visit, &a.filter));
+            json_t *list = queue_list_json_with(s->queue, job_filter_visit, &a.filter);
+            links_add_job_list(list);
+            return respond_json(c, MHD_HTTP_OK, list);
         }
     case ROUTE_SWEEPS:
         if (post) {
@@ -719,7 +736,9 @@ static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
                                      "the sweep must be at most 65536 bytes");
             return post_sweep(s, c, req);
         }
-        return respond_json(c, MHD_HTTP_OK, sweeps_list_json(s->sweeps));
+        json_t *list = sweeps_list_json(s->sweeps);
+        links_add_sweep_list(list);
+        return respond_json(c, MHD_HTTP_OK, list);
     case ROUTE_JOB:
     case ROUTE_JOB_REPORT:
     case ROUTE_JOB_CHART:

@@ -194,3 +194,18 @@ const char *route_image_prefix(enum route_image image)
 {
     return IMAGE_DIRS[image][1];
 }
+
+void route_job_url(const char *id, char out[ROUTE_URL_MAX])
+{
+    snprintf(out, ROUTE_URL_MAX, "/v1/jobs/%s", id);
+}
+
+void route_sweep_url(const char *id, char out[ROUTE_URL_MAX])
+{
+    snprintf(out, ROUTE_URL_MAX, "/v1/sweeps/%s", id);
+}
+
+void route_image_url(const char *id, enum route_image image, int frame, char out[ROUTE_URL_MAX])
+{
+    snprintf(out, ROUTE_URL_MAX, "/v1/jobs/%s/%s%d.png", id, IMAGE_DIRS[image][0], frame);
+}

@@ -55,4 +55,12 @@ const char *route_label(enum route_kind kind);
 /* The file prefix of an image kind in a job's directory ("frame", ...). */
 const char *route_image_prefix(enum route_image image);
 
+/* The URLs the API hands out, built here and nowhere else (the jobs and the
+ * harness record ids and file names only). Each writes a path of at most
+ * ROUTE_URL_MAX bytes, NUL included. */
+#define ROUTE_URL_MAX 96
+void route_job_url(const char *id, char out[ROUTE_URL_MAX]);
+void route_sweep_url(const char *id, char out[ROUTE_URL_MAX]);
+void route_image_url(const char *id, enum route_image image, int frame, char out[ROUTE_URL_MAX]);
+
 #endif

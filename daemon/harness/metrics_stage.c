@@ -43,14 +43,14 @@ static bool cancel_requested(void *ctx)
     return atomic_load(&job->cancel) || job_timed_out(job);
 }
 
-/* Fills capture's metrics and URLs; updates the job-wide summary. */
+/* Fills capture's metrics and the names of its reference and maps; updates the job-wide summary. */
 static bool score_capture(struct job *job, json_t *capture, json_t *summary, char *err,
                           size_t errlen)
 {
     const struct metrics_stop stop = {cancel_requested, job};
     int frame = (int)json_integer_value(json_object_get(capture, "frame"));
     char test_path[PATH_MAX + 32], ref_path[PATH_MAX + 32], ssim_path[PATH_MAX + 32],
-        flip_path[PATH_MAX + 32], url[128];
+        flip_path[PATH_MAX + 32];
     snprintf(test_path, sizeof(test_path), "%s/frame-%06d.png", job->dir, frame);
     snprintf(ref_path, sizeof(ref_path), "%s/reference-%06d.png", job->dir, frame);
     snprintf(ssim_path, sizeof(ssim_path), "%s/ssim-%06d.png", job->dir, frame);
@@ -68,16 +68,12 @@ static bool score_capture(struct job *job, json_t *capture, json_t *summary, cha
     if (!m)
         return false;
     json_object_set_new(capture, "metrics", m);
-    snprintf(url, sizeof(url), "/v1/jobs/%s/reference/%d.png", job->id, frame);
-    json_object_set_new(capture, "reference_url", json_string(url));
-    if (o->which & METRIC_SSIM) {
-        snprintf(url, sizeof(url), "/v1/jobs/%s/ssim/%d.png", job->id, frame);
-        json_object_set_new(capture, "ssim_map_url", json_string(url));
-    }
-    if (o->which & METRIC_FLIP) {
-        snprintf(url, sizeof(url), "/v1/jobs/%s/flip/%d.png", job->id, frame);
-        json_object_set_new(capture, "flip_map_url", json_string(url));
-    }
+    /* File names only: the API layer turns them into URLs (api/links.c). */
+    json_object_set_new(capture, "reference_file", json_string(strrchr(ref_path, '/') + 1));
+    if (o->which & METRIC_SSIM)
+        json_object_set_new(capture, "ssim_map_file", json_string(strrchr(ssim_path, '/') + 1));
+    if (o->which & METRIC_FLIP)
+        json_object_set_new(capture, "flip_map_file", json_string(strrchr(flip_path, '/') + 1));
 
     /* Worst cases over the captures, and which frame they came from. */
     json_t *ssim = json_object_get(m, "ssim");

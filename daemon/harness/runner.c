@@ -368,16 +368,15 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
     for (int k = 1; k <= n; k++) {
         if (!job_spec_is_capture_frame(spec, k))
             continue;
-        char name[64], url[128];
+        char name[64];
         snprintf(name, sizeof(name), "frame-%06d.png", k);
-        snprintf(url, sizeof(url), "/v1/jobs/%s/frames/%d.png", job->id, k);
         snprintf(path, sizeof(path), "%s/%s", job->dir, name);
         if (!png_write_gl_rgba(path, run->captures[c], spec->scene.width,
                                spec->scene.height, run->err, sizeof(run->err)))
             goto out;
         free(run->captures[c]);
         run->captures[c] = NULL;
-        json_t *entry = json_pack("{s:i, s:s, s:s, s:o}", "frame", k, "url", url, "file", name,
+        json_t *entry = json_pack("{s:i, s:s, s:o}", "frame", k, "file", name,
                                   "nonfinite", /* post hook */
                                   nonfinite_json(&run->nonfinite[c]));
         if (run->hdr)
@@ -585,9 +584,8 @@ static bool capture_heatmap(struct run *run, int k)
                 rgba[i * 4 + ch] = (uint8_t)(255.0f * (ramp[seg][ch] + f * (ramp[seg + 1][ch] - ramp[seg][ch])) + 0.5f);
             rgba[i * 4 + 3] = 255;
         }
-        char name[64], url[128], path[PATH_MAX + 64];
+        char name[64], path[PATH_MAX + 64];
         snprintf(name, sizeof(name), "heatmap-%06d.png", k);
-        snprintf(url, sizeof(url), "/v1/jobs/%s/heatmap/%d.png", run->job->id, k);
         snprintf(path, sizeof(path), "%s/%s", run->job->dir, name);
         ok = png_write_gl_rgba(path, rgba, run->env.width, run->env.height, run->err, sizeof(run->err));
         if (ok && !run->heatmap)
@@ -596,7 +594,7 @@ static bool capture_heatmap(struct run *run, int k)
                                      "captures");
         if (ok)
             json_array_append_new(json_object_get(run->heatmap, "captures"),
-                                  json_pack("{s:i, s:s, s:s, s:f, s:i, s:i}", "frame", k, "url", url,
+                                  json_pack("{s:i, s:s, s:f, s:i, s:i}", "frame", k,
                                             "file", name, "mean", sum / (double)n, "max", (int)max,
                                             "scale_max", (int)max));
     } else {

@@ -488,10 +488,8 @@ static struct job_state state_of(const struct job *job)
 
 static json_t *state_json(const struct job *job, const struct job_state *st, bool full)
 {
-    char url[64];
-    snprintf(url, sizeof(url), "/v1/jobs/%s", job->id);
-    json_t *o = json_pack("{s:s, s:s, s:s, s:s, s:{s:i, s:i}, s:o, s:o, s:o}",
-                          "id", job->id, "url", url, "status", job_status_name(st->status),
+    json_t *o = json_pack("{s:s, s:s, s:s, s:{s:i, s:i}, s:o, s:o, s:o}",
+                          "id", job->id, "status", job_status_name(st->status),
                           "technique", job->spec.technique, "progress", "frames_done",
                           st->frames_done, "frames_total", job->frames_total, "created",
                           iso_time(job->created), "started", iso_time(st->started),

@@ -712,9 +712,7 @@ static struct sweep *find_locked(struct sweeps *s, const char *id)
 
 static json_t *sweep_json_locked(const struct sweep *sw, bool full)
 {
-    char url[64];
-    snprintf(url, sizeof(url), "/v1/sweeps/%s", sw->id);
-    json_t *o = json_pack("{s:s, s:s, s:s, s:s, s:{s:I, s:I}}", "id", sw->id, "url", url, "kind",
+    json_t *o = json_pack("{s:s, s:s, s:s, s:{s:I, s:I}}", "id", sw->id, "kind",
                           sw->spec.kind == SWEEP_VARY ? "vary" : "find", "status",
                           job_status_name(sw->status), "progress", "points_done",
                           (json_int_t)json_array_size(sw->points), "points_total",

@@ -53,5 +53,21 @@ int main(void)
     CHECK(!route_method_ok(ROUTE_HEALTHZ, "POST", &allow, &rule));
     CHECK(strcmp(route_label(ROUTE_JOB), "/v1/jobs/{id}") == 0);
     CHECK(strcmp(route_label((enum route_kind)99), "other") == 0);
+
+    /* Every URL the API hands out routes back to what it names. */
+    char url[ROUTE_URL_MAX];
+    struct route back;
+    route_job_url("20261122-091703-0001", url);
+    CHECK(route_parse(url, &back) && back.kind == ROUTE_JOB &&
+          strcmp(back.id, "20261122-091703-0001") == 0);
+    route_sweep_url("20261122-091703-0002", url);
+    CHECK(route_parse(url, &back) && back.kind == ROUTE_SWEEP &&
+          strcmp(back.id, "20261122-091703-0002") == 0);
+    for (int image = IMAGE_FRAME; image <= IMAGE_HEATMAP; image++) {
+        route_image_url("1-2", (enum route_image)image, 999999999, url);
+        CHECK(route_parse(url, &back) && back.kind == ROUTE_JOB_IMAGE &&
+              back.image == (enum route_image)image && back.frame == 999999999 &&
+              strcmp(back.id, "1-2") == 0);
+    }
     return check_finish("test_routes");
 }

@@ -1,0 +1,83 @@
+#include "daemon/api/links.h"
+
+#include "daemon/api/routes.h"
+
+/* A capture's files and the URL key each one gets. */
+static const struct {
+    const char *file_key, *url_key;
+    enum route_image image;
+} CAPTURE_FILES[] = {
+    {"file", "url", IMAGE_FRAME},
+    {"reference_file", "reference_url", IMAGE_REFERENCE},
+    {"ssim_map_file", "ssim_map_url", IMAGE_SSIM},
+    {"flip_map_file", "flip_map_url", IMAGE_FLIP},
+};
+
+static void link_captures(const char *id, json_t *captures, bool heatmap)
+{
+    size_t i;
+    json_t *c;
+    char url[ROUTE_URL_MAX];
+    json_array_foreach(captures, i, c) {
+        json_t *frame = json_object_get(c, "frame");
+        if (!json_is_integer(frame))
+            continue;
+        int k = (int)json_integer_value(frame);
+        for (size_t f = 0; f < sizeof(CAPTURE_FILES) / sizeof(CAPTURE_FILES[0]); f++) {
+            if (!json_is_string(json_object_get(c, CAPTURE_FILES[f].file_key)))
+                continue;
+            route_image_url(id, heatmap ? IMAGE_HEATMAP : CAPTURE_FILES[f].image, k, url);
+            json_object_set_new(c, CAPTURE_FILES[f].url_key, json_string(url));
+            if (heatmap)
+                break;
+        }
+    }
+}
+
+void links_add_job(json_t *job)
+{
+    const char *id = json_string_value(json_object_get(job, "id"));
+    if (!id)
+        return;
+    char url[ROUTE_URL_MAX];
+    route_job_url(id, url);
+    json_object_set_new(job, "url", json_string(url));
+    json_t *result = json_object_get(job, "result");
+    link_captures(id, json_object_get(result, "captures"), false);
+    link_captures(id, json_object_get(json_object_get(result, "heatmap"), "captures"), true);
+}
+
+void links_add_sweep(json_t *sweep)
+{
+    const char *id = json_string_value(json_object_get(sweep, "id"));
+    if (!id)
+        return;
+    char url[ROUTE_URL_MAX];
+    route_sweep_url(id, url);
+    json_object_set_new(sweep, "url", json_string(url));
+    size_t i;
+    json_t *point;
+    json_array_foreach(json_object_get(sweep, "points"), i, point) {
+        const char *job = json_string_value(json_object_get(point, "job"));
+        if (job) {
+            route_job_url(job, url);
+            json_object_set_new(point, "job_url", json_string(url));
+        }
+    }
+}
+
+void links_add_job_list(json_t *list)
+{
+    size_t i;
+    json_t *job;
+    json_array_foreach(json_object_get(list, "jobs"), i, job)
+        links_add_job(job);
+}
+
+void links_add_sweep_list(json_t *list)
+{
+    size_t i;
+    json_t *sweep;
+    json_array_foreach(json_object_get(list, "sweeps"), i, sweep)
+        links_add_sweep(sweep);
+}

@@ -1,0 +1,24 @@
+#ifndef SHADEBENCH_LINKS_H
+#define SHADEBENCH_LINKS_H
+
+/* Adds the URLs to a job's or a sweep's JSON just before the API serves it.
+ * The store and the harness record ids and file names only, so that the
+ * URL space lives in the API layer (routes.c) and a stored record is never
+ * tied to it. HTTP threads; GL-free. */
+
+#include <jansson.h>
+
+/* job.url; per capture (result.captures) url from its frame, and
+ * reference_url, ssim_map_url and flip_map_url where the capture names
+ * that file; each heat map capture's url. Takes a job as GET /v1/jobs/ID
+ * or an item of the job list shows it; ignores what it does not know. */
+void links_add_job(json_t *job);
+
+/* sweep.url and, for each point, job_url. */
+void links_add_sweep(json_t *sweep);
+
+/* Each item of {"jobs": [...]} or {"sweeps": [...]}. */
+void links_add_job_list(json_t *list);
+void links_add_sweep_list(json_t *list);
+
+#endif

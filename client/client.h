@@ -13,6 +13,8 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "common/clock.h" /* clock_mono_s: every interval the client measures */
+
 enum { EXIT_PASS = 0, EXIT_FAIL = 1, EXIT_ERROR = 2 };
 
 struct options {
@@ -94,7 +96,6 @@ json_t *fetch_job_files(struct conn *c, const json_t *job, const char *dir, bool
  * files written). New reference; NULL without a result. */
 json_t *result_with_samples(struct conn *c, const json_t *job);
 
-double now_s(void);
 
 /* A job file with --label added and repeat overridden (repeat > 0).
  * Returns malloc'ed JSON text, or NULL with a message in err. */

@@ -14,6 +14,7 @@
 #include "client/junit.h"
 #include "client/verdicts.h"
 #include "common/fsutil.h"
+#include "common/result_keys.h"
 
 /* A pair is noisy when its two runs saw different conditions: other
  * processes left one of them more than the tolerance more or less CPU than
@@ -53,7 +54,7 @@ static size_t clean_pairs(const struct run_set *sa, const struct run_set *sb, do
 int cmd_ab(struct conn *ca, struct conn *cb, const struct options *o, const char *file_a,
            const char *file_b)
 {
-    double t0 = now_s();
+    double t0 = clock_mono_s();
     char err[600];
     int rc = EXIT_ERROR;
     if (o->baseline) {
@@ -210,7 +211,7 @@ int cmd_ab(struct conn *ca, struct conn *cb, const struct options *o, const char
                             "ci_low", v.r.lo, "ci_high", v.r.hi, "confidence", o->confidence,
                             "pairs", (json_int_t)nclean, "server_b", cb->server, "runs", pairs);
     }
-    rc = junit_conclude(o, &j, name, now_s() - t0);
+    rc = junit_conclude(o, &j, name, clock_mono_s() - t0);
     if (o->out_dir && summary) {
         char path[4096];
         snprintf(path, sizeof(path), "%s/A", o->out_dir);

@@ -10,6 +10,7 @@
 #include "client/client.h"
 #include "client/trend.h"
 #include "common/fsutil.h"
+#include "common/result_keys.h"
 
 static double iso_to_unix(const char *s)
 {
@@ -29,17 +30,17 @@ static bool figure_of(const json_t *entry, const char *figure, double *y, double
 {
     json_t *figs = json_object_get(entry, "figures");
     *lo = *hi = NAN;
-    if (!strcmp(figure, "worst_ssim")) {
-        json_t *v = json_object_get(figs, "worst_ssim");
+    if (!strcmp(figure, RK_WORST_SSIM)) {
+        json_t *v = json_object_get(figs, RK_WORST_SSIM);
         *y = json_is_number(v) ? json_number_value(v) : NAN;
         return json_is_number(v);
     }
     json_t *f = json_object_get(figs, figure);
-    json_t *m = json_object_get(f, "median");
+    json_t *m = json_object_get(f, RK_MEDIAN);
     if (!json_is_number(m))
         return false;
     *y = json_number_value(m);
-    json_t *ci = json_object_get(f, "ci95");
+    json_t *ci = json_object_get(f, RK_CI95);
     if (json_array_size(ci) == 2) {
         *lo = json_number_value(json_array_get(ci, 0));
         *hi = json_number_value(json_array_get(ci, 1));
@@ -98,14 +99,14 @@ int cmd_history(struct conn *c, const struct options *o)
      * device (frame_ms on llvmpipe, where gpu_ms covers rasterization only). */
     const char *figure = o->figure ? o->figure : o->series;
     if (!figure) {
-        figure = "frame_ms";
+        figure = RK_FRAME_MS;
         size_t i;
         json_t *e;
         json_array_foreach(jobs, i, e) {
             const char *r = json_string_value(json_object_get(json_object_get(e, "figures"), "gl_renderer"));
             if (r) {
                 figure = strstr(r, "llvmpipe") || strstr(r, "softpipe") || strstr(r, "SwiftShader")
-                             ? "frame_ms" : "gpu_ms";
+                             ? RK_FRAME_MS : RK_GPU_MS;
                 break;
             }
         }
@@ -132,7 +133,7 @@ int cmd_history(struct conn *c, const struct options *o)
         double y, lo, hi;
         bool has = figure_of(e, figure, &y, &lo, &hi);
         json_t *figs = json_object_get(e, "figures");
-        json_t *ssim = json_object_get(figs, "worst_ssim");
+        json_t *ssim = json_object_get(figs, RK_WORST_SSIM);
         char labels[512], interval[64] = "", ssim_text[32] = "-";
         labels_text(json_object_get(e, "labels"), labels, sizeof(labels));
         if (!isnan(lo))
@@ -184,7 +185,7 @@ int cmd_history(struct conn *c, const struct options *o)
         ok = fs_write_json_atomic(file, list);
         char title[160], ylabel[96];
         snprintf(title, sizeof(title), "%s over time (%zu jobs)", figure, npts);
-        snprintf(ylabel, sizeof(ylabel), "%s%s", strcmp(figure, "worst_ssim") ? "median " : "",
+        snprintf(ylabel, sizeof(ylabel), "%s%s", strcmp(figure, RK_WORST_SSIM) ? "median " : "",
                  figure);
         char *svg = trend_svg(pts, npts, title, ylabel);
         snprintf(file, sizeof(file), "%s/trend.svg", o->out_dir);

@@ -10,6 +10,7 @@
 #include "client/junit.h"
 #include "client/verdicts.h"
 #include "common/fsutil.h"
+#include "common/result_keys.h"
 
 /* ---- the baseline ---- */
 
@@ -38,7 +39,7 @@ static bool baseline_load(const char *path, struct baseline *b)
         fprintf(stderr, "shadebench: --baseline %s: %s\n", path, jerr.text);
         return false;
     }
-    json_t *inner = json_object_get(b->root, "result");
+    json_t *inner = json_object_get(b->root, RK_RESULT);
     b->result = inner ? inner : b->root;
     b->spec = json_object_get(inner ? b->root : b->result, "spec");
     if (!b->spec) {
@@ -52,7 +53,7 @@ static bool baseline_load(const char *path, struct baseline *b)
         b->spec = json_object_get(b->beside, "spec");
     }
     b->device = json_object_get(b->result, "device");
-    if (!json_is_object(b->result) || !json_object_get(b->result, "frame_ms")) {
+    if (!json_is_object(b->result) || !json_object_get(b->result, RK_FRAME_MS)) {
         fprintf(stderr, "shadebench: --baseline %s: not a finished job's result (no frame_ms)\n",
                 path);
         baseline_finish(b);
@@ -161,7 +162,7 @@ static size_t trailing_noisy(const struct run_set *s)
 static int gate_or_runs(struct conn *c, const struct options *o, const char *file,
                         const struct baseline *base, int planned)
 {
-    double t0 = now_s();
+    double t0 = clock_mono_s();
     int rc = EXIT_ERROR;
     char err[512];
     struct run_set s;
@@ -267,7 +268,7 @@ static int gate_or_runs(struct conn *c, const struct options *o, const char *fil
         junit_out(jc, "%zu runs, each a job of its own", s.n);
     }
     if (s.n)
-        quality_cases(o, json_object_get(first, "result"), classname, name, &j);
+        quality_cases(o, json_object_get(first, RK_RESULT), classname, name, &j);
     if (!o->quiet && s.n) {
         fprintf(stderr, "runs (%s):\n", series);
         run_set_print(&s, series, stderr);
@@ -320,7 +321,7 @@ static int gate_or_runs(struct conn *c, const struct options *o, const char *fil
                               "allowed_slowdown", o->max_slowdown, "baseline_runs",
                               (json_int_t)nb_clean, "runs", (json_int_t)nc_clean, "why", v.why);
     }
-    rc = junit_conclude(o, &j, name, now_s() - t0);
+    rc = junit_conclude(o, &j, name, clock_mono_s() - t0);
     if (o->out_dir && s.n) {
         json_t *extra = json_pack("{s:o}", "gate_runs", run_set_json(&s));
         if (gate_json)
@@ -368,7 +369,7 @@ static int finish_single(struct conn *c, const struct options *o, json_t *job, d
     junit_job_name(spec, name, sizeof(name));
     job_classname(spec, classname, sizeof(classname));
     job_case(&j, classname, name, job, time_s);
-    json_t *result = json_object_get(job, "result");
+    json_t *result = json_object_get(job, RK_RESULT);
     if (result)
         quality_cases(o, result, classname, name, &j);
     int verdict = junit_conclude(o, &j, name, time_s);
@@ -410,7 +411,7 @@ int cmd_submit(struct conn *c, const struct options *o, const char *file)
         fprintf(stderr, "shadebench: %s\n", err);
         return EXIT_ERROR;
     }
-    double t0 = now_s();
+    double t0 = clock_mono_s();
     json_t *reply = conn_json(c, "POST", "/v1/jobs", text, NULL);
     free(text);
     if (!reply)
@@ -425,7 +426,7 @@ int cmd_submit(struct conn *c, const struct options *o, const char *file)
     json_t *job = conn_follow_job(c, id, NULL, o->quiet, o->timeout_s);
     if (!job)
         return EXIT_ERROR;
-    int rc = finish_single(c, o, job, now_s() - t0);
+    int rc = finish_single(c, o, job, clock_mono_s() - t0);
     json_decref(job);
     return rc;
 }

@@ -10,6 +10,7 @@
 #include "client/junit.h"
 #include "client/verdicts.h"
 #include "common/fsutil.h"
+#include "common/result_keys.h"
 
 static void csv_cell(FILE *f, const json_t *v)
 {
@@ -42,7 +43,7 @@ static bool write_csv(const json_t *sweep, const char *path)
         }
     }
     json_array_foreach(keys, k, key) fprintf(f, "%s,", json_string_value(key));
-    static const char *const series[] = {"frame_ms", "gpu_ms", "cpu_ms"};
+    static const char *const series[] = {RK_FRAME_MS, RK_GPU_MS, RK_CPU_MS};
     fprintf(f, "technique,job,status");
     for (int s = 0; s < 3; s++)
         fprintf(f, ",%s_median,%s_ci95_low,%s_ci95_high,%s_over", series[s], series[s], series[s],
@@ -61,9 +62,9 @@ static bool write_csv(const json_t *sweep, const char *path)
         csv_cell(f, json_object_get(row, "status"));
         for (int s = 0; s < 3; s++) {
             json_t *cell = json_object_get(row, series[s]);
-            json_t *ci = json_object_get(cell, "ci95");
+            json_t *ci = json_object_get(cell, RK_CI95);
             fputc(',', f);
-            csv_cell(f, json_object_get(cell, "median"));
+            csv_cell(f, json_object_get(cell, RK_MEDIAN));
             fputc(',', f);
             csv_cell(f, json_array_get(ci, 0));
             fputc(',', f);
@@ -71,8 +72,8 @@ static bool write_csv(const json_t *sweep, const char *path)
             fputc(',', f);
             csv_cell(f, json_object_get(cell, "over"));
         }
-        static const char *const tail[] = {"worst_ssim", "worst_ssim_min", "worst_flip",
-                                           "pdiff_failed_captures", "criterion_holds"};
+        static const char *const tail[] = {RK_WORST_SSIM, RK_WORST_SSIM_MIN, RK_WORST_FLIP,
+                                           RK_PDIFF_FAILED_CAPTURES, "criterion_holds"};
         for (size_t t = 0; t < sizeof(tail) / sizeof(tail[0]); t++) {
             fputc(',', f);
             csv_cell(f, json_object_get(row, tail[t]));
@@ -121,32 +122,32 @@ static void point_cases(const struct options *o, const json_t *sweep, struct jun
             junit_fail(t, "point job %s: %s", status ? status : "?", error ? error : "");
             continue;
         }
-        static const char *const series[] = {"frame_ms", "gpu_ms", "cpu_ms"};
+        static const char *const series[] = {RK_FRAME_MS, RK_GPU_MS, RK_CPU_MS};
         char prop[48];
         for (int s = 0; s < 3; s++) {
             json_t *cell = json_object_get(row, series[s]);
             snprintf(prop, sizeof(prop), "%s_median", series[s]);
-            junit_prop_num(t, prop, json_number_value(json_object_get(cell, "median")));
+            junit_prop_num(t, prop, json_number_value(json_object_get(cell, RK_MEDIAN)));
         }
-        junit_prop_num(t, "wall_s", json_number_value(json_object_get(json_object_get(row, "wall_s"),
-                                                                      "mean")));
-        t->time_s = json_number_value(json_object_get(json_object_get(row, "wall_s"), "mean")) *
-                    (double)json_integer_value(json_object_get(json_object_get(row, "wall_s"),
-                                                               "runs"));
+        junit_prop_num(t, RK_WALL_S, json_number_value(json_object_get(json_object_get(row, RK_WALL_S),
+                                                                      RK_MEAN)));
+        t->time_s = json_number_value(json_object_get(json_object_get(row, RK_WALL_S), RK_MEAN)) *
+                    (double)json_integer_value(json_object_get(json_object_get(row, RK_WALL_S),
+                                                               RK_RUNS));
         junit_out(t, "frame_ms median %.4f ms",
-                  json_number_value(json_object_get(json_object_get(row, "frame_ms"), "median")));
-        json_t *pf = json_object_get(row, "pdiff_failed_captures");
-        json_t *ssim = json_object_get(row, "worst_ssim");
-        json_t *flip = json_object_get(row, "worst_flip");
+                  json_number_value(json_object_get(json_object_get(row, RK_FRAME_MS), RK_MEDIAN)));
+        json_t *pf = json_object_get(row, RK_PDIFF_FAILED_CAPTURES);
+        json_t *ssim = json_object_get(row, RK_WORST_SSIM);
+        json_t *flip = json_object_get(row, RK_WORST_FLIP);
         if (!pf && !json_is_number(ssim))
             continue; /* no reference: nothing judged */
         snprintf(cname, sizeof(cname), "%s: quality", name);
         struct junit_case *q = junit_add(j, "shadebench.sweep", cname);
         if (!q)
             return;
-        junit_prop_num(q, "worst_ssim", json_number_value(ssim));
-        junit_prop_num(q, "worst_flip", json_number_value(flip));
-        junit_prop_num(q, "pdiff_failed_captures", (double)json_integer_value(pf));
+        junit_prop_num(q, RK_WORST_SSIM, json_number_value(ssim));
+        junit_prop_num(q, RK_WORST_FLIP, json_number_value(flip));
+        junit_prop_num(q, RK_PDIFF_FAILED_CAPTURES, (double)json_integer_value(pf));
         json_t *holds = json_object_get(row, "criterion_holds");
         if (find) {
             /* Probes of a bisection fail above the boundary by design: their
@@ -163,7 +164,7 @@ static void point_cases(const struct options *o, const json_t *sweep, struct jun
             json_number_value(flip) > o->max_flip)
             junit_fail(q, "worst FLIP mean %.6f above %.6f", json_number_value(flip), o->max_flip);
     }
-    json_t *result = json_object_get(sweep, "result");
+    json_t *result = json_object_get(sweep, RK_RESULT);
     json_t *bp = json_object_get(result, "breaking_point");
     if (bp) {
         snprintf(cname, sizeof(cname), "breaking point of %s while %s",
@@ -259,7 +260,7 @@ int cmd_sweep(struct conn *c, const struct options *o, const char *file)
     }
     char *text = json_dumps(body, JSON_COMPACT);
     json_decref(body);
-    double t0 = now_s();
+    double t0 = clock_mono_s();
     json_t *reply = text ? conn_json(c, "POST", "/v1/sweeps", text, NULL) : NULL;
     free(text);
     if (!reply)
@@ -279,7 +280,7 @@ int cmd_sweep(struct conn *c, const struct options *o, const char *file)
     const char *status = json_string_value(json_object_get(sweep, "status"));
     struct junit_case *t = junit_add(&j, "shadebench.sweep", "sweep");
     if (t) {
-        t->time_s = now_s() - t0;
+        t->time_s = clock_mono_s() - t0;
         junit_prop_str(t, "sweep", id);
         junit_prop_num(t, "points",
                        (double)json_array_size(json_object_get(sweep, "points")));
@@ -289,7 +290,7 @@ int cmd_sweep(struct conn *c, const struct options *o, const char *file)
         }
     }
     point_cases(o, sweep, &j);
-    int rc = junit_conclude(o, &j, "sweep", now_s() - t0);
+    int rc = junit_conclude(o, &j, "sweep", clock_mono_s() - t0);
     if (o->out_dir) {
         if (!download_all(c, sweep, o->out_dir))
             rc = EXIT_ERROR;

@@ -10,6 +10,7 @@
 
 #include "client/client.h"
 #include "common/fsutil.h"
+#include "common/result_keys.h"
 
 bool out_dir_claim(const char *dir, const char *marker_file, const char *id, char *err,
                    size_t cap)
@@ -56,7 +57,7 @@ bool out_dir_claim(const char *dir, const char *marker_file, const char *id, cha
 
 json_t *result_with_samples(struct conn *c, const json_t *job)
 {
-    json_t *result = json_object_get(job, "result");
+    json_t *result = json_object_get(job, RK_RESULT);
     if (!result)
         return NULL;
     const char *id = json_string_value(json_object_get(job, "id"));
@@ -85,7 +86,7 @@ json_t *fetch_job_files(struct conn *c, const json_t *job, const char *dir, bool
     const char *id = json_string_value(json_object_get(job, "id"));
     snprintf(path, sizeof(path), "%s/job.json", dir);
     bool ok = fs_write_json_atomic(path, job);
-    json_t *result = json_object_get(job, "result");
+    json_t *result = json_object_get(job, RK_RESULT);
     if (!result)
         return ok ? json_object() : NULL;
     snprintf(url, sizeof(url), "/v1/jobs/%s/timings.csv", id ? id : "");
@@ -110,7 +111,7 @@ json_t *fetch_job_files(struct conn *c, const json_t *job, const char *dir, bool
         {"url", "frame"}, {"reference_url", "reference"}, {"ssim_map_url", "ssim"},
         {"flip_map_url", "flip"},
     };
-    json_array_foreach(images ? json_object_get(result, "captures") : NULL, i, capture) {
+    json_array_foreach(images ? json_object_get(result, RK_CAPTURES) : NULL, i, capture) {
         int frame = (int)json_integer_value(json_object_get(capture, "frame"));
         for (size_t k = 0; k < sizeof(kinds) / sizeof(kinds[0]); k++) {
             const char *u = json_string_value(json_object_get(capture, kinds[k][0]));

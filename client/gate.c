@@ -1,5 +1,6 @@
 #define _POSIX_C_SOURCE 200809L
 #include "client/gate.h"
+#include "common/result_keys.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -86,7 +87,7 @@ static void read_interference(const json_t *inter, struct gate_run *run)
 
 static double series_median(const json_t *holder, const char *series)
 {
-    json_t *m = json_object_get(json_object_get(holder, series), "median");
+    json_t *m = json_object_get(json_object_get(holder, series), RK_MEDIAN);
     return json_is_number(m) ? json_number_value(m) : NAN;
 }
 
@@ -96,7 +97,7 @@ bool gate_run_from_result(const json_t *result, const char *job_id, const char *
     memset(out, 0, sizeof(*out));
     snprintf(out->job, sizeof(out->job), "%s", job_id ? job_id : "");
     out->ms = series_median(result, series);
-    read_interference(json_object_get(result, "interference"), out);
+    read_interference(json_object_get(result, RK_INTERFERENCE), out);
     return isfinite(out->ms);
 }
 
@@ -104,7 +105,7 @@ size_t gate_runs_from_result(const json_t *result, const char *series, struct ga
 {
     *out = NULL;
     json_t *gate_runs = json_object_get(result, "gate_runs");
-    json_t *runs = json_object_get(result, "runs");
+    json_t *runs = json_object_get(result, RK_RUNS);
     json_t *list = json_array_size(gate_runs) ? gate_runs : json_array_size(runs) ? runs : NULL;
     size_t n = list ? json_array_size(list) : 1;
     struct gate_run *v = calloc(n, sizeof(*v));
@@ -116,7 +117,7 @@ size_t gate_runs_from_result(const json_t *result, const char *series, struct ga
         if (gate_run_from_result(result, result_job, series, &v[0]))
             kept = 1;
     } else {
-        json_t *job_inter = json_object_get(result, "interference");
+        json_t *job_inter = json_object_get(result, RK_INTERFERENCE);
         for (size_t i = 0; i < n; i++) {
             json_t *r = json_array_get(list, i);
             struct gate_run *g = &v[kept];
@@ -127,7 +128,7 @@ size_t gate_runs_from_result(const json_t *result, const char *series, struct ga
             g->ms = json_is_number(m) ? json_number_value(m) : series_median(r, series);
             const char *job = json_string_value(json_object_get(r, "job"));
             snprintf(g->job, sizeof(g->job), "%s", job ? job : result_job ? result_job : "");
-            json_t *inter = json_object_get(r, "interference");
+            json_t *inter = json_object_get(r, RK_INTERFERENCE);
             read_interference(inter ? inter : job_inter, g);
             if (json_is_true(json_object_get(r, "noisy"))) {
                 g->noisy = true;
@@ -295,10 +296,10 @@ const char *gate_default_series(const json_t *device)
 {
     const char *r = json_string_value(json_object_get(device, "gl_renderer"));
     if (!r)
-        return "frame_ms";
+        return RK_FRAME_MS;
     static const char *const software[] = {"llvmpipe", "softpipe", "SwiftShader", NULL};
     for (const char *const *s = software; *s; s++)
         if (strstr(r, *s))
-            return "frame_ms";
-    return "gpu_ms";
+            return RK_FRAME_MS;
+    return RK_GPU_MS;
 }

@@ -15,6 +15,7 @@
 #include "client/client.h"
 #include "common/fsutil.h"
 #include "config.h"
+#include "common/result_keys.h"
 
 static void die_usage(const char *fmt, ...) __attribute__((format(printf, 1, 2), noreturn));
 static void die_usage(const char *fmt, ...)
@@ -211,8 +212,8 @@ int main(int argc, char **argv)
         case O_SINCE: o.since = optarg; break;
         case O_SERIES:
         case O_FIGURE:
-            if (strcmp(optarg, "frame_ms") && strcmp(optarg, "gpu_ms") &&
-                strcmp(optarg, "cpu_ms") && (opt == O_SERIES || strcmp(optarg, "worst_ssim")))
+            if (strcmp(optarg, RK_FRAME_MS) && strcmp(optarg, RK_GPU_MS) &&
+                strcmp(optarg, RK_CPU_MS) && (opt == O_SERIES || strcmp(optarg, RK_WORST_SSIM)))
                 die_usage("%s must be frame_ms, gpu_ms or cpu_ms%s",
                           opt == O_SERIES ? "--series" : "--figure",
                           opt == O_SERIES ? "" : " (or worst_ssim)");

@@ -10,13 +10,6 @@
 #include "client/client.h"
 #include "common/fsutil.h"
 
-double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec / 1e9;
-}
-
 bool conn_init(struct conn *c, const char *server, const char *token)
 {
     memset(c, 0, sizeof(*c));
@@ -127,7 +120,7 @@ json_t *conn_follow_job(struct conn *c, const char *id, const char *what, bool q
     char path[256];
     snprintf(path, sizeof(path), "/v1/jobs/%s?wait=2", id);
     bool tty = isatty(STDERR_FILENO);
-    double start = now_s(), first_running = 0, last_line = 0;
+    double start = clock_mono_s(), first_running = 0, last_line = 0;
     int first_frames = 0;
     char last_phase[32] = "";
     what = what ? what : id;
@@ -147,7 +140,7 @@ json_t *conn_follow_job(struct conn *c, const char *id, const char *what, bool q
         int total = (int)json_integer_value(json_object_get(progress, "frames_total"));
         const char *phase = json_string_value(json_object_get(job, "phase"));
         phase = phase ? phase : status;
-        double t = now_s();
+        double t = clock_mono_s();
         if (strcmp(status, "running") == 0 && first_running == 0) {
             first_running = t;
             first_frames = done;
@@ -181,7 +174,7 @@ json_t *conn_follow_sweep(struct conn *c, const char *id, bool quiet, double tim
 {
     char path[256];
     snprintf(path, sizeof(path), "/v1/sweeps/%s?wait=5", id);
-    double start = now_s();
+    double start = clock_mono_s();
     long last_done = -1;
     for (;;) {
         json_t *sw = conn_json(c, "GET", path, NULL, NULL);
@@ -202,7 +195,7 @@ json_t *conn_follow_sweep(struct conn *c, const char *id, bool quiet, double tim
         if (!running)
             return sw;
         json_decref(sw);
-        if (timeout_s > 0 && now_s() - start > timeout_s) {
+        if (timeout_s > 0 && clock_mono_s() - start > timeout_s) {
             fprintf(stderr, "shadebench: sweep %s did not end within %.0f s\n", id, timeout_s);
             return NULL;
         }

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "common/fsutil.h"
+#include "common/result_keys.h"
 
 void job_classname(const json_t *spec, char *out, size_t cap)
 {
@@ -19,7 +20,7 @@ void quality_cases(const struct options *o, const json_t *result, const char *cl
 {
     size_t i;
     json_t *capture;
-    json_array_foreach(json_object_get(result, "captures"), i, capture) {
+    json_array_foreach(json_object_get(result, RK_CAPTURES), i, capture) {
         char cname[400];
         snprintf(cname, sizeof(cname), "%s: frame %lld quality", name,
                  (long long)json_integer_value(json_object_get(capture, "frame")));
@@ -79,28 +80,28 @@ struct junit_case *job_case(struct junit *j, const char *classname, const char *
                    error ? error : "");
         return t;
     }
-    json_t *r = json_object_get(job, "result");
-    static const char *const series[] = {"frame_ms", "gpu_ms", "cpu_ms"};
+    json_t *r = json_object_get(job, RK_RESULT);
+    static const char *const series[] = {RK_FRAME_MS, RK_GPU_MS, RK_CPU_MS};
     char prop[32];
     for (int k = 0; k < 3; k++) {
         json_t *st = json_object_get(r, series[k]);
         if (!st)
             continue;
         snprintf(prop, sizeof(prop), "%s_median", series[k]);
-        junit_prop_num(t, prop, json_number_value(json_object_get(st, "median")));
+        junit_prop_num(t, prop, json_number_value(json_object_get(st, RK_MEDIAN)));
         snprintf(prop, sizeof(prop), "%s_p95", series[k]);
-        junit_prop_num(t, prop, json_number_value(json_object_get(st, "p95")));
+        junit_prop_num(t, prop, json_number_value(json_object_get(st, RK_P95)));
     }
-    junit_prop_num(t, "fps", json_number_value(json_object_get(r, "fps")));
-    junit_prop_num(t, "wall_s", json_number_value(json_object_get(r, "wall_s")));
+    junit_prop_num(t, RK_FPS, json_number_value(json_object_get(r, RK_FPS)));
+    junit_prop_num(t, RK_WALL_S, json_number_value(json_object_get(r, RK_WALL_S)));
     junit_prop_str(t, "gl_renderer",
                    json_string_value(json_object_get(json_object_get(r, "device"), "gl_renderer")));
     junit_out(t, "job %s: frame_ms median %.4f, gpu_ms median %.4f, cpu_ms median %.4f, %.1f fps",
               id ? id : "?",
-              json_number_value(json_object_get(json_object_get(r, "frame_ms"), "median")),
-              json_number_value(json_object_get(json_object_get(r, "gpu_ms"), "median")),
-              json_number_value(json_object_get(json_object_get(r, "cpu_ms"), "median")),
-              json_number_value(json_object_get(r, "fps")));
+              json_number_value(json_object_get(json_object_get(r, RK_FRAME_MS), RK_MEDIAN)),
+              json_number_value(json_object_get(json_object_get(r, RK_GPU_MS), RK_MEDIAN)),
+              json_number_value(json_object_get(json_object_get(r, RK_CPU_MS), RK_MEDIAN)),
+              json_number_value(json_object_get(r, RK_FPS)));
     return t;
 }
 
@@ -133,7 +134,7 @@ bool run_set_add(struct run_set *s, const struct options *o, const char *text,
         s->runs = grown;
         s->cap = cap;
     }
-    double start = now_s();
+    double start = clock_mono_s();
     json_t *reply = conn_json(s->conn, "POST", "/v1/jobs", text, NULL);
     if (!reply)
         return false;
@@ -157,7 +158,7 @@ bool run_set_add(struct run_set *s, const struct options *o, const char *text,
     json_t *job = conn_follow_job(s->conn, id, what, o->quiet, o->timeout_s);
     if (!job)
         return false;
-    s->elapsed_s += now_s() - start;
+    s->elapsed_s += clock_mono_s() - start;
     const char *status = json_string_value(json_object_get(job, "status"));
     if (!status || strcmp(status, "done") != 0) {
         json_decref(s->failed);
@@ -165,7 +166,7 @@ bool run_set_add(struct run_set *s, const struct options *o, const char *text,
         return true;
     }
     struct gate_run *r = &s->runs[s->n];
-    if (!gate_run_from_result(json_object_get(job, "result"), id, series, r)) {
+    if (!gate_run_from_result(json_object_get(job, RK_RESULT), id, series, r)) {
         fprintf(stderr, "shadebench: job %s has no %s figures\n", id, series);
         json_decref(job);
         return false;
@@ -178,19 +179,19 @@ bool run_set_add(struct run_set *s, const struct options *o, const char *text,
 json_t *run_set_json(const struct run_set *s)
 {
     json_t *list = json_array();
-    static const char *const series[] = {"frame_ms", "gpu_ms", "cpu_ms"};
+    static const char *const series[] = {RK_FRAME_MS, RK_GPU_MS, RK_CPU_MS};
     for (size_t i = 0; i < s->n; i++) {
         json_t *job = json_array_get(s->jobs, i);
-        json_t *r = json_object_get(job, "result");
+        json_t *r = json_object_get(job, RK_RESULT);
         json_t *o = json_pack("{s:s}", "job", s->runs[i].job);
         for (int k = 0; k < 3; k++) {
-            json_t *m = json_object_get(json_object_get(r, series[k]), "median");
+            json_t *m = json_object_get(json_object_get(r, series[k]), RK_MEDIAN);
             if (json_is_number(m))
                 json_object_set(o, series[k], m);
         }
-        json_t *inter = json_object_get(r, "interference");
+        json_t *inter = json_object_get(r, RK_INTERFERENCE);
         if (inter)
-            json_object_set(o, "interference", inter);
+            json_object_set(o, RK_INTERFERENCE, inter);
         json_object_set_new(o, "noisy", json_boolean(s->runs[i].noisy));
         if (s->runs[i].noisy)
             json_object_set_new(o, "why", json_string(s->runs[i].why));

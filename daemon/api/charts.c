@@ -1,6 +1,7 @@
 #define _DEFAULT_SOURCE /* M_PI */
 #define _POSIX_C_SOURCE 200809L
 #include "daemon/api/charts.h"
+#include "common/result_keys.h"
 
 #include <cairo-svg.h>
 #include <cairo.h>
@@ -64,18 +65,18 @@ const char *charts_default_series(const json_t *device)
 {
     const char *r = json_string_value(json_object_get(device, "gl_renderer"));
     if (!r)
-        return "frame_ms";
+        return RK_FRAME_MS;
     static const char *const software[] = {"llvmpipe", "softpipe", "SwiftShader", NULL};
     for (const char *const *s = software; *s; s++)
         if (strstr(r, *s))
-            return "frame_ms";
-    return "gpu_ms";
+            return RK_FRAME_MS;
+    return RK_GPU_MS;
 }
 
 static bool software_device(const json_t *device)
 {
     return device && json_string_value(json_object_get(device, "gl_renderer")) &&
-           strcmp(charts_default_series(device), "frame_ms") == 0;
+           strcmp(charts_default_series(device), RK_FRAME_MS) == 0;
 }
 
 /* What the series measures here, for the chart's subtitle. */
@@ -83,10 +84,10 @@ static void series_note(const char *series, const json_t *device, bool chosen, c
                         size_t cap)
 {
     bool sw = software_device(device);
-    if (!strcmp(series, "frame_ms"))
+    if (!strcmp(series, RK_FRAME_MS))
         snprintf(out, cap, "frame_ms: present-to-present time%s", chosen && sw
                  ? ", the default on llvmpipe, whose gpu_ms covers rasterization only" : "");
-    else if (!strcmp(series, "gpu_ms"))
+    else if (!strcmp(series, RK_GPU_MS))
         snprintf(out, cap, "gpu_ms: GPU time from timer queries%s",
                  sw ? "; on llvmpipe it covers rasterization only, frame_ms compares techniques"
                     : chosen ? ", the default on GPUs" : "");
@@ -584,7 +585,7 @@ static json_t *layout_json(const struct chart *c)
         json_t *o = json_pack("{s:f, s:f, s:f, s:f, s:f, s:f, s:b, s:s, s:s, s:i, s:b, s:b}", "x",
                               p->x, "y", p->y, "x_lo", p->x_lo, "x_hi", p->x_hi, "y_lo", p->y_lo,
                               "y_hi", p->y_hi, "lo_clamped", p->lo_clamped, "label", p->label,
-                              "series", c->series[p->series], "workload", p->workload, "pareto",
+                              "series", c->series[p->series], RK_WORKLOAD, p->workload, "pareto",
                               p->pareto, "reference", p->reference);
         json_object_set_new(o, "label_box", p->placed ? json_pack("[f, f, f, f]", p->lx, p->ly,
                                                                   p->lw, p->lh)
@@ -793,8 +794,8 @@ static const char *sweep_reference(const json_t *sweep)
  * interval below zero (few runs, Student's t) says only "very uncertain". */
 static void time_interval(const json_t *cell, double *v, double *lo, double *hi, bool *clamped)
 {
-    *v = num(json_object_get(cell, "median"), NAN);
-    json_t *ci = json_object_get(cell, "ci95");
+    *v = num(json_object_get(cell, RK_MEDIAN), NAN);
+    json_t *ci = json_object_get(cell, RK_CI95);
     *lo = num(json_array_get(ci, 0), *v);
     *hi = num(json_array_get(ci, 1), *v);
     *clamped = *lo < 0;
@@ -842,7 +843,7 @@ char *charts_sweep(const json_t *sweep, const char *name, enum chart_format form
     bool any_runs = false;
     json_array_foreach(points, i, row) {
         json_t *t = json_object_get(row, series);
-        if (!t || !json_is_number(json_object_get(t, "median")))
+        if (!t || !json_is_number(json_object_get(t, RK_MEDIAN)))
             continue; /* a failed or cancelled point */
         struct point *p = &c.pts[c.n];
         const char *tech = json_string_value(json_object_get(row, "technique"));
@@ -866,7 +867,7 @@ char *charts_sweep(const json_t *sweep, const char *name, enum chart_format form
         if (!(tvp && p->reference && !(param && json_object_get(values, param))))
             p->series = series_of(&c, sname);
         if (sa) {
-            json_t *q = json_object_get(row, o->flip ? "worst_flip" : "worst_ssim");
+            json_t *q = json_object_get(row, o->flip ? RK_WORST_FLIP : RK_WORST_SSIM);
             if (!json_is_number(q) && !p->reference)
                 continue;
             /* The reference against itself: SSIM 1, FLIP 0, exactly. */
@@ -909,7 +910,7 @@ char *charts_sweep(const json_t *sweep, const char *name, enum chart_format form
             p->y = median, p->y_lo = lo, p->y_hi = hi;
         } else {
             c.boxes = c.categorical_x = true;
-            static const char *const keys[6] = {"min", "p5", "median", "p95", "p99", "max"};
+            static const char *const keys[6] = {RK_MIN, RK_P5, RK_MEDIAN, RK_P95, RK_P99, RK_MAX};
             for (int k = 0; k < 6; k++)
                 p->box[k] = num(json_object_get(t, keys[k]), median);
             const char *over = json_string_value(json_object_get(t, "over"));
@@ -979,7 +980,7 @@ char *charts_job(const json_t *job, const char *name, enum chart_format format,
         snprintf(err, errlen, "no chart named %s for a job (distribution)", name);
         return NULL;
     }
-    json_t *result = json_object_get(job, "result");
+    json_t *result = json_object_get(job, RK_RESULT);
     /* One box per series. */
     struct chart c;
     memset(&c, 0, sizeof(c));
@@ -988,8 +989,8 @@ char *charts_job(const json_t *job, const char *name, enum chart_format format,
     memset(pts, 0, sizeof(pts));
     c.pts = pts;
     c.boxes = c.categorical_x = true;
-    static const char *const all[3] = {"frame_ms", "gpu_ms", "cpu_ms"};
-    static const char *const keys[6] = {"min", "p5", "median", "p95", "p99", "max"};
+    static const char *const all[3] = {RK_FRAME_MS, RK_GPU_MS, RK_CPU_MS};
+    static const char *const keys[6] = {RK_MIN, RK_P5, RK_MEDIAN, RK_P95, RK_P99, RK_MAX};
     for (int s = 0; s < 3; s++) {
         if (o->series && strcmp(o->series, all[s]) != 0)
             continue;
@@ -1022,7 +1023,7 @@ char *charts_job(const json_t *job, const char *name, enum chart_format format,
 char *charts_job_timeline(const json_t *job, const json_t *samples, enum chart_format format,
                           const struct chart_options *o, size_t *len, char *err, size_t errlen)
 {
-    const json_t *device = json_object_get(json_object_get(job, "result"), "device");
+    const json_t *device = json_object_get(json_object_get(job, RK_RESULT), "device");
     const char *series = o->series ? o->series : charts_default_series(device);
     json_t *main = json_object_get(samples, series);
     size_t n = json_array_size(main);
@@ -1047,10 +1048,10 @@ char *charts_job_timeline(const json_t *job, const json_t *samples, enum chart_f
         p->series = s;
     }
     /* The median as a level, so that drift over the run stands out. */
-    json_t *st = json_object_get(json_object_get(job, "result"), series);
-    if (json_is_number(json_object_get(st, "median"))) {
+    json_t *st = json_object_get(json_object_get(job, RK_RESULT), series);
+    if (json_is_number(json_object_get(st, RK_MEDIAN))) {
         struct level *l = &c.levels[c.nlevels++];
-        l->y = l->lo = l->hi = json_number_value(json_object_get(st, "median"));
+        l->y = l->lo = l->hi = json_number_value(json_object_get(st, RK_MEDIAN));
         snprintf(l->label, sizeof(l->label), "median %.3f ms", l->y);
     }
     snprintf(c.title, sizeof(c.title), "%s over the run of job %s", series,

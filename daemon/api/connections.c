@@ -13,6 +13,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "common/clock.h"
 #include "common/log.h"
 
 /* The watcher looks at deadlines and sweeps this often; job waits end as
@@ -57,13 +58,6 @@ struct connections {
     struct connections_config cfg;
     unsigned long long header_timeouts, body_timeouts, waits_gone;
 };
-
-static double mono_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec / 1e9;
-}
 
 static void resume_locked(struct connections *cs, struct conn *k, enum wake why)
 {
@@ -155,9 +149,9 @@ static void *watcher_main(void *arg)
 {
     struct connections *cs = arg;
     struct epoll_event ev[64];
-    double next = mono_s(), last_sweep_check = 0;
+    double next = clock_mono_s(), last_sweep_check = 0;
     for (;;) {
-        double now = mono_s();
+        double now = clock_mono_s();
         int timeout = (int)((next - now) * 1000.0) + 1;
         if (timeout > TICK_MS)
             timeout = TICK_MS;
@@ -189,7 +183,7 @@ static void *watcher_main(void *arg)
                     break;
                 }
         }
-        now = mono_s();
+        now = clock_mono_s();
         bool sweep_tick = now - last_sweep_check >= TICK_MS / 1000.0 || poked;
         if (sweep_tick)
             last_sweep_check = now;
@@ -276,7 +270,7 @@ void connections_notify(void *cls, struct MHD_Connection *c, void **socket_conte
         k->mhd = c;
         k->fd = info->connect_fd;
         k->state = K_HEADERS;
-        k->deadline = mono_s() + cs->cfg.header_s;
+        k->deadline = clock_mono_s() + cs->cfg.header_s;
         pthread_mutex_lock(&cs->lock);
         k->serial = cs->next_serial++;
         k->next = cs->head;
@@ -325,7 +319,7 @@ void connections_headers_in(struct connections *cs, struct conn *k)
     pthread_mutex_lock(&cs->lock);
     if (k->state == K_HEADERS) {
         k->state = K_BODY;
-        k->deadline = mono_s() + cs->cfg.body_s;
+        k->deadline = clock_mono_s() + cs->cfg.body_s;
     }
     k->status = 0;
     pthread_mutex_unlock(&cs->lock);
@@ -354,7 +348,7 @@ void connections_request_done(struct connections *cs, struct conn *k)
     }
     if (k->state != K_CUT && k->state != K_WAITING) {
         k->state = K_HEADERS;
-        k->deadline = mono_s() + cs->cfg.header_s;
+        k->deadline = clock_mono_s() + cs->cfg.header_s;
     }
     pthread_mutex_unlock(&cs->lock);
 }
@@ -380,7 +374,7 @@ bool connections_suspend(struct connections *cs, struct conn *k, enum wait_kind 
     k->state = K_WAITING;
     k->kind = kind;
     snprintf(k->id, sizeof(k->id), "%s", id);
-    k->wait_until = mono_s() + wait_s;
+    k->wait_until = clock_mono_s() + wait_s;
     k->wake = WAKE_NONE;
     /* Not EPOLLIN: a client may send its next request early; only a hang-up
      * ends the wait. */

@@ -28,6 +28,7 @@
 #include "daemon/api/job_filter.h"
 #include "daemon/jobs/sweep_spec.h"
 #include "daemon/techniques/catalog.h"
+#include "common/result_keys.h"
 
 #ifndef MHD_HTTP_CONTENT_TOO_LARGE
 #define MHD_HTTP_CONTENT_TOO_LARGE 413
@@ -404,7 +405,7 @@ static enum MHD_Result respond_chart(struct MHD_Connection *c, const json_t *sub
     enum chart_format format = r->chart_png ? CHART_PNG : CHART_SVG;
     struct chart_options o = {.device = device};
     o.series = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "series");
-    if (o.series && strcmp(o.series, "frame_ms") && strcmp(o.series, "gpu_ms") && strcmp(o.series, "cpu_ms"))
+    if (o.series && strcmp(o.series, RK_FRAME_MS) && strcmp(o.series, RK_GPU_MS) && strcmp(o.series, RK_CPU_MS))
         return respond_error(c, MHD_HTTP_BAD_REQUEST, "series", "must be frame_ms, gpu_ms or cpu_ms");
     const char *y = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "y");
     if (y && strcmp(y, "ssim") && strcmp(y, "flip"))
@@ -441,7 +442,7 @@ static bool point_job_dir(void *ctx, const char *job_id, char *dir, size_t cap, 
     if (!queue_job_dir(s->queue, job_id, dir, cap, &status))
         return false;
     json_t *job = queue_job_json(s->queue, job_id, 0);
-    json_t *caps = json_object_get(json_object_get(job, "result"), "captures");
+    json_t *caps = json_object_get(json_object_get(job, RK_RESULT), RK_CAPTURES);
     *last_frame = (int)json_integer_value(json_object_get(json_array_get(caps, json_array_size(caps) - 1), "frame"));
     json_decref(job);
     return true;
@@ -587,7 +588,7 @@ static enum MHD_Result job_resource(struct http_server *s, struct MHD_Connection
         if (!job)
             return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
         enum MHD_Result ret =
-            json_object_get(job, "result")
+            json_object_get(job, RK_RESULT)
                 ? respond_chart(c, job, r, false, NULL)
                 : respond_error(c, MHD_HTTP_CONFLICT, "id", "the job has no result yet");
         json_decref(job);

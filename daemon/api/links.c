@@ -1,6 +1,7 @@
 #include "daemon/api/links.h"
 
 #include "daemon/api/routes.h"
+#include "common/result_keys.h"
 
 /* A capture's files and the URL key each one gets. */
 static const struct {
@@ -42,9 +43,9 @@ void links_add_job(json_t *job)
     char url[ROUTE_URL_MAX];
     route_job_url(id, url);
     json_object_set_new(job, "url", json_string(url));
-    json_t *result = json_object_get(job, "result");
-    link_captures(id, json_object_get(result, "captures"), false);
-    link_captures(id, json_object_get(json_object_get(result, "heatmap"), "captures"), true);
+    json_t *result = json_object_get(job, RK_RESULT);
+    link_captures(id, json_object_get(result, RK_CAPTURES), false);
+    link_captures(id, json_object_get(json_object_get(result, RK_HEATMAP), RK_CAPTURES), true);
 }
 
 void links_add_sweep(json_t *sweep)

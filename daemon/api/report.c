@@ -11,6 +11,7 @@
 #include "config.h"
 #include "daemon/api/charts.h"
 #include "common/png_io.h"
+#include "common/result_keys.h"
 
 /* Points of a sweep that get thumbnails: enough to see how the image
  * changes, few enough that the page stays a reasonable size. */
@@ -174,17 +175,17 @@ static void head(struct html *h, const char *title, const json_t *device)
 
 static void ms_cell(struct html *h, const json_t *cell)
 {
-    json_t *ci = json_object_get(cell, "ci95");
-    if (!json_is_number(json_object_get(cell, "median"))) {
+    json_t *ci = json_object_get(cell, RK_CI95);
+    if (!json_is_number(json_object_get(cell, RK_MEDIAN))) {
         add(h, "<td>-</td>");
         return;
     }
     if (json_array_size(ci) == 2)
-        add(h, "<td>%.3f [%.3f, %.3f]</td>", json_number_value(json_object_get(cell, "median")),
+        add(h, "<td>%.3f [%.3f, %.3f]</td>", json_number_value(json_object_get(cell, RK_MEDIAN)),
             fmax(0.0, json_number_value(json_array_get(ci, 0))),
             json_number_value(json_array_get(ci, 1)));
     else
-        add(h, "<td>%.3f</td>", json_number_value(json_object_get(cell, "median")));
+        add(h, "<td>%.3f</td>", json_number_value(json_object_get(cell, RK_MEDIAN)));
 }
 
 static void num_cell(struct html *h, const json_t *v, const char *fmt)
@@ -231,7 +232,7 @@ static bool keep_variant(const char *k, const char *skip)
 
 static double row_ms(const json_t *row, const char *series)
 {
-    json_t *m = json_object_get(json_object_get(row, series), "median");
+    json_t *m = json_object_get(json_object_get(row, series), RK_MEDIAN);
     return json_is_number(m) ? json_number_value(m) : NAN;
 }
 
@@ -280,8 +281,8 @@ static void cross(const json_t *a, const json_t *b, const char *param, json_t *l
         json_array_append_new(list, json_pack("{s:O, s:O, s:s, s:[f, f], s:f, s:O}", "faster_below",
                                               json_object_get(below, "name"), "faster_above",
                                               json_object_get(above, "name"), "param", param,
-                                              "between", x[i], x[i + 1], "at", at, "workload",
-                                              json_object_get(a, "workload")));
+                                              "between", x[i], x[i + 1], "at", at, RK_WORKLOAD,
+                                              json_object_get(a, RK_WORKLOAD)));
     }
     free(x);
     free(d);
@@ -290,7 +291,7 @@ static void cross(const json_t *a, const json_t *b, const char *param, json_t *l
 json_t *report_sweep_verdict(const json_t *sweep, const char *series)
 {
     json_t *v = json_pack("{s:s}", "series", series);
-    json_t *result = json_object_get(sweep, "result");
+    json_t *result = json_object_get(sweep, RK_RESULT);
     static const char *const copied[] = {"largest_pdiff_pass", "breaking_point"};
     for (int i = 0; i < 2; i++)
         if (json_object_get(result, copied[i]))
@@ -324,17 +325,17 @@ json_t *report_sweep_verdict(const json_t *sweep, const char *series)
         values_text(values, keep_workload, NULL, wl, sizeof(wl));
         json_t *w = json_object_get(by_workload, wl);
         if (!w) {
-            w = json_pack("{s:s, s:s}", "workload", wl, "reference", ref);
+            w = json_pack("{s:s, s:s}", RK_WORKLOAD, wl, "reference", ref);
             json_object_set_new(by_workload, wl, w);
         }
         if (is_ref) {
-            json_object_set_new(w, "reference_ms", json_real(ms));
+            json_object_set_new(w, RK_REFERENCE_MS, json_real(ms));
         } else {
             json_t *pt = json_pack("{s:s, s:O, s:f}", "technique", tech, "values", values, "ms", ms);
             json_t *fastest = json_object_get(w, "fastest");
             if (!fastest || ms < json_number_value(json_object_get(fastest, "ms")))
                 json_object_set(w, "fastest", pt);
-            json_t *pf = json_object_get(row, "pdiff_failed_captures");
+            json_t *pf = json_object_get(row, RK_PDIFF_FAILED_CAPTURES);
             json_t *fp = json_object_get(w, "fastest_passing");
             if (json_is_integer(pf) && json_integer_value(pf) == 0 &&
                 (!fp || ms < json_number_value(json_object_get(fp, "ms"))))
@@ -354,7 +355,7 @@ json_t *report_sweep_verdict(const json_t *sweep, const char *series)
         snprintf(key, sizeof(key), "%s|%s", full, wl);
         json_t *c = json_object_get(curves, key);
         if (!c) {
-            c = json_pack("{s:s, s:s, s:b, s:[], s:[]}", "name", full, "workload", wl, "flat",
+            c = json_pack("{s:s, s:s, s:b, s:[], s:[]}", "name", full, RK_WORKLOAD, wl, "flat",
                           pv == NULL, "xs", "ys");
             json_object_set_new(curves, key, c);
         }
@@ -371,8 +372,8 @@ json_t *report_sweep_verdict(const json_t *sweep, const char *series)
                 after = true;
                 continue;
             }
-            if (after && !strcmp(json_string_value(json_object_get(a, "workload")),
-                                 json_string_value(json_object_get(b, "workload"))))
+            if (after && !strcmp(json_string_value(json_object_get(a, RK_WORKLOAD)),
+                                 json_string_value(json_object_get(b, RK_WORKLOAD))))
                 cross(a, b, param, crossovers);
         }
     }
@@ -381,7 +382,7 @@ json_t *report_sweep_verdict(const json_t *sweep, const char *series)
     const char *k;
     json_t *w;
     json_object_foreach(by_workload, k, w) {
-        json_t *rm = json_object_get(w, "reference_ms");
+        json_t *rm = json_object_get(w, RK_REFERENCE_MS);
         static const char *const which[] = {"fastest", "fastest_passing"};
         for (int j = 0; j < 2 && rm; j++) {
             json_t *pt = json_object_get(w, which[j]);
@@ -433,9 +434,9 @@ static void verdict_html(struct html *h, const json_t *v)
             json_number_value(json_array_get(bt, 1)));
         escaped(h, str(c, "faster_above"));
         add(h, "</b> above it");
-        if (str(c, "workload")[0]) {
+        if (str(c, RK_WORKLOAD)[0]) {
             add(h, " (");
-            escaped(h, str(c, "workload"));
+            escaped(h, str(c, RK_WORKLOAD));
             add(h, ")");
         }
         add(h, ".</li>");
@@ -445,12 +446,12 @@ static void verdict_html(struct html *h, const json_t *v)
                "another on the same workload.</li>");
     json_t *w;
     json_array_foreach(json_object_get(v, "against_reference"), i, w) {
-        json_t *rm = json_object_get(w, "reference_ms");
+        json_t *rm = json_object_get(w, RK_REFERENCE_MS);
         if (!rm)
             continue;
         add(h, "<li>");
-        if (str(w, "workload")[0]) {
-            escaped(h, str(w, "workload"));
+        if (str(w, RK_WORKLOAD)[0]) {
+            escaped(h, str(w, RK_WORKLOAD));
             add(h, ": ");
         }
         escaped(h, str(w, "reference"));
@@ -498,27 +499,27 @@ static void thesis_tables(struct html *h, const json_t *points)
                 continue;
             rows[strcmp(str(row, "technique"), "osl") == 0] = row;
         }
-        double fwd = json_number_value(json_object_get(json_object_get(rows[0], "wall_s"), "mean"));
+        double fwd = json_number_value(json_object_get(json_object_get(rows[0], RK_WALL_S), RK_MEAN));
         for (int t = 0; t < 2; t++) {
             const json_t *r = rows[t];
             if (!r)
                 continue;
-            json_t *wall = json_object_get(r, "wall_s");
-            double mean = json_number_value(json_object_get(wall, "mean"));
+            json_t *wall = json_object_get(r, RK_WALL_S);
+            double mean = json_number_value(json_object_get(wall, RK_MEAN));
             add(h, "<tr><td class=\"l\">%s lights</td><td class=\"l\">%s</td><td>%lld</td>"
                    "<td>%.3f</td><td>%.3f</td><td>%.3f</td>",
                 dynamic ? "moving" : "still", t ? "OSL (256, async 20)" : "forward",
-                (long long)json_integer_value(json_object_get(wall, "runs")), mean,
-                json_number_value(json_object_get(wall, "median")),
-                json_number_value(json_object_get(wall, "stddev")));
+                (long long)json_integer_value(json_object_get(wall, RK_RUNS)), mean,
+                json_number_value(json_object_get(wall, RK_MEDIAN)),
+                json_number_value(json_object_get(wall, RK_STDDEV)));
             if (t && fwd > 0)
                 add(h, "<td>%.2f</td>", mean / fwd);
             else
                 add(h, "<td></td>");
-            json_t *pf = json_object_get(r, "pdiff_failed_captures");
+            json_t *pf = json_object_get(r, RK_PDIFF_FAILED_CAPTURES);
             add(h, "<td class=\"%s\">%s</td>", json_integer_value(pf) ? "fail" : "pass",
                 json_integer_value(pf) ? "fail" : "pass");
-            num_cell(h, json_object_get(r, "worst_ssim"), "<td>%.5f</td>");
+            num_cell(h, json_object_get(r, RK_WORST_SSIM), "<td>%.5f</td>");
             add(h, "</tr>");
         }
     }
@@ -568,11 +569,11 @@ char *report_sweep_html(const json_t *sweep, const json_t *device, report_job_di
         add(&h, " (%s)%s</td>", str(row, "status"),
             !strcmp(str(row, "technique"), reference) ? " reference, timed" : "");
         free(values);
-        ms_cell(&h, json_object_get(row, "frame_ms"));
-        ms_cell(&h, json_object_get(row, "gpu_ms"));
-        num_cell(&h, json_object_get(row, "worst_ssim"), "<td>%.6f</td>");
-        num_cell(&h, json_object_get(row, "worst_flip"), "<td>%.5f</td>");
-        json_t *pf = json_object_get(row, "pdiff_failed_captures");
+        ms_cell(&h, json_object_get(row, RK_FRAME_MS));
+        ms_cell(&h, json_object_get(row, RK_GPU_MS));
+        num_cell(&h, json_object_get(row, RK_WORST_SSIM), "<td>%.6f</td>");
+        num_cell(&h, json_object_get(row, RK_WORST_FLIP), "<td>%.5f</td>");
+        json_t *pf = json_object_get(row, RK_PDIFF_FAILED_CAPTURES);
         if (json_is_integer(pf))
             add(&h, "<td class=\"%s\">%lld</td>", json_integer_value(pf) ? "fail" : "pass",
                 (long long)json_integer_value(pf));
@@ -627,7 +628,7 @@ char *report_sweep_html(const json_t *sweep, const json_t *device, report_job_di
 static void stats_row(struct html *h, const char *name, const json_t *s)
 {
     add(h, "<tr><td class=\"l\">%s</td>", name);
-    static const char *const keys[] = {"mean", "median", "stddev", "min", "p5", "p95", "p99", "max", "cv"};
+    static const char *const keys[] = {RK_MEAN, RK_MEDIAN, RK_STDDEV, RK_MIN, RK_P5, RK_P95, RK_P99, RK_MAX, RK_CV};
     for (size_t k = 0; k < sizeof(keys) / sizeof(keys[0]); k++)
         num_cell(h, json_object_get(s, keys[k]), "<td>%.4f</td>");
     add(h, "</tr>");
@@ -695,32 +696,32 @@ static void technique_figures(struct html *h, const json_t *r, const char *techn
         add(h, "<tr><td class=\"l\">gpu_ms of pass ");
         escaped(h, key);
         add(h, "</td><td class=\"l\">median %.4f, p95 %.4f</td></tr>",
-            json_number_value(json_object_get(v, "median")),
-            json_number_value(json_object_get(v, "p95")));
+            json_number_value(json_object_get(v, RK_MEDIAN)),
+            json_number_value(json_object_get(v, RK_P95)));
     }
     add(h, "</table>");
 }
 
 static void runs_table(struct html *h, const json_t *r)
 {
-    json_t *runs = json_object_get(r, "runs");
+    json_t *runs = json_object_get(r, RK_RUNS);
     if (!json_array_size(runs))
         return;
-    json_t *rep = json_object_get(r, "repeat");
+    json_t *rep = json_object_get(r, RK_REPEAT);
     add(h, "<h2>Runs</h2><p>%lld runs (%s); across runs, the median frame_ms of the run "
            "medians is %.4f ms.</p><table><tr><th>run</th><th>frame_ms median</th>"
            "<th>gpu_ms median</th><th>cpu_ms median</th><th>wall s</th></tr>",
-        (long long)json_integer_value(json_object_get(rep, "runs")),
-        json_is_true(json_object_get(rep, "stable")) ? "stable" : "not stable to 2.5%",
-        json_number_value(json_object_get(json_object_get(rep, "frame_ms"), "median")));
+        (long long)json_integer_value(json_object_get(rep, RK_RUNS)),
+        json_is_true(json_object_get(rep, RK_STABLE)) ? "stable" : "not stable to 2.5%",
+        json_number_value(json_object_get(json_object_get(rep, RK_FRAME_MS), RK_MEDIAN)));
     size_t i;
     json_t *run;
     json_array_foreach(runs, i, run) {
         add(h, "<tr><td>%lld</td>", (long long)json_integer_value(json_object_get(run, "run")));
-        num_cell(h, json_object_get(json_object_get(run, "frame_ms"), "median"), "<td>%.4f</td>");
-        num_cell(h, json_object_get(json_object_get(run, "gpu_ms"), "median"), "<td>%.4f</td>");
-        num_cell(h, json_object_get(json_object_get(run, "cpu_ms"), "median"), "<td>%.4f</td>");
-        num_cell(h, json_object_get(run, "wall_s"), "<td>%.3f</td>");
+        num_cell(h, json_object_get(json_object_get(run, RK_FRAME_MS), RK_MEDIAN), "<td>%.4f</td>");
+        num_cell(h, json_object_get(json_object_get(run, RK_GPU_MS), RK_MEDIAN), "<td>%.4f</td>");
+        num_cell(h, json_object_get(json_object_get(run, RK_CPU_MS), RK_MEDIAN), "<td>%.4f</td>");
+        num_cell(h, json_object_get(run, RK_WALL_S), "<td>%.3f</td>");
         add(h, "</tr>");
     }
     add(h, "</table>");
@@ -732,7 +733,7 @@ char *report_job_html(const json_t *job, const char *dir, const json_t *device, 
     char title[128];
     snprintf(title, sizeof(title), "shadebench job %s (%s)", str(job, "id"), str(job, "technique"));
     head(&h, title, device);
-    json_t *r = json_object_get(job, "result");
+    json_t *r = json_object_get(job, RK_RESULT);
     add(&h, "<p>Status: <b>%s</b>", str(job, "status"));
     if (json_object_get(job, "error")) {
         add(&h, ": ");
@@ -744,13 +745,13 @@ char *report_job_html(const json_t *job, const char *dir, const json_t *device, 
                 "%lld triangles a frame.</p>",
             (long long)json_integer_value(json_object_get(r, "frames")),
             (long long)json_integer_value(json_object_get(r, "warmup_frames")),
-            json_number_value(json_object_get(r, "wall_s")), json_number_value(json_object_get(r, "fps")),
+            json_number_value(json_object_get(r, RK_WALL_S)), json_number_value(json_object_get(r, RK_FPS)),
             (long long)json_integer_value(json_object_get(r, "triangles_per_frame")));
         add(&h, "<table><tr><th class=\"l\">ms</th><th>mean</th><th>median</th><th>stddev</th>"
                 "<th>min</th><th>p5</th><th>p95</th><th>p99</th><th>max</th><th>cv</th></tr>");
-        stats_row(&h, "frame_ms", json_object_get(r, "frame_ms"));
-        stats_row(&h, "gpu_ms", json_object_get(r, "gpu_ms"));
-        stats_row(&h, "cpu_ms", json_object_get(r, "cpu_ms"));
+        stats_row(&h, RK_FRAME_MS, json_object_get(r, RK_FRAME_MS));
+        stats_row(&h, RK_GPU_MS, json_object_get(r, RK_GPU_MS));
+        stats_row(&h, RK_CPU_MS, json_object_get(r, RK_CPU_MS));
         add(&h, "</table>");
         struct chart_options o = {.device = device};
         json_t *samples = read_timings(dir);
@@ -766,20 +767,20 @@ char *report_job_html(const json_t *job, const char *dir, const json_t *device, 
         chart(&h, job, "distribution", false, &o, "frame-time distribution");
         runs_table(&h, r);
         technique_figures(&h, r, str(job, "technique"));
-        json_t *q = json_object_get(r, "quality");
+        json_t *q = json_object_get(r, RK_QUALITY);
         if (q) {
             add(&h, "<h2>Quality against %s</h2><p>Worst SSIM %.6f, worst FLIP mean %.5f, "
                     "PerceptualDiff failed on %lld of %lld captures.</p>",
                 str(q, "reference"),
-                json_number_value(json_object_get(json_object_get(q, "worst_ssim"), "value")),
-                json_number_value(json_object_get(json_object_get(q, "worst_flip"), "mean")),
-                (long long)json_integer_value(json_object_get(q, "pdiff_failed_captures")),
+                json_number_value(json_object_get(json_object_get(q, RK_WORST_SSIM), "value")),
+                json_number_value(json_object_get(json_object_get(q, RK_WORST_FLIP), "mean")),
+                (long long)json_integer_value(json_object_get(q, RK_PDIFF_FAILED_CAPTURES)),
                 (long long)json_integer_value(json_object_get(q, "captures_compared")));
         }
         add(&h, "<h2>Captures</h2>");
         size_t i;
         json_t *c;
-        json_array_foreach(json_object_get(r, "captures"), i, c) {
+        json_array_foreach(json_object_get(r, RK_CAPTURES), i, c) {
             int frame = (int)json_integer_value(json_object_get(c, "frame"));
             json_t *m = json_object_get(c, "metrics");
             add(&h, "<div><h3>Frame %d", frame);

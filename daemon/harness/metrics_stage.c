@@ -17,6 +17,7 @@
 #include "common/png_io.h"
 #include "daemon/harness/deadline.h"
 #include "daemon/harness/telemetry.h"
+#include "common/result_keys.h"
 
 struct task {
     struct job *job;
@@ -77,28 +78,28 @@ static bool score_capture(struct job *job, json_t *capture, json_t *summary, cha
 
     /* Worst cases over the captures, and which frame they came from. */
     json_t *ssim = json_object_get(m, "ssim");
-    json_t *worst = json_object_get(summary, "worst_ssim");
+    json_t *worst = json_object_get(summary, RK_WORST_SSIM);
     if (ssim && (!worst || json_real_value(ssim) < json_real_value(json_object_get(worst, "value"))))
-        json_object_set_new(summary, "worst_ssim",
+        json_object_set_new(summary, RK_WORST_SSIM,
                             json_pack("{s:f, s:i}", "value", json_real_value(ssim), "frame", frame));
     json_t *smin = json_object_get(m, "ssim_min");
-    worst = json_object_get(summary, "worst_ssim_min");
+    worst = json_object_get(summary, RK_WORST_SSIM_MIN);
     if (smin && (!worst || json_real_value(json_object_get(smin, "value")) <
                                json_real_value(json_object_get(worst, "value")))) {
         json_t *w = json_deep_copy(smin);
         json_object_set_new(w, "frame", json_integer(frame));
-        json_object_set_new(summary, "worst_ssim_min", w);
+        json_object_set_new(summary, RK_WORST_SSIM_MIN, w);
     }
     json_t *flip = json_object_get(m, "flip");
-    worst = json_object_get(summary, "worst_flip");
+    worst = json_object_get(summary, RK_WORST_FLIP);
     double fmean = flip ? json_real_value(json_object_get(flip, "mean")) : 0;
     if (flip && (!worst || fmean > json_real_value(json_object_get(worst, "mean"))))
-        json_object_set_new(summary, "worst_flip",
+        json_object_set_new(summary, RK_WORST_FLIP,
                             json_pack("{s:f, s:f, s:i}", "mean", fmean, "max",
                                       json_real_value(json_object_get(flip, "max")), "frame", frame));
     json_t *pdiff = json_object_get(m, "pdiff");
     if (pdiff && !json_is_true(json_object_get(pdiff, "pass")))
-        json_array_append_new(json_object_get(summary, "pdiff_failed_frames"), json_integer(frame));
+        json_array_append_new(json_object_get(summary, RK_PDIFF_FAILED_FRAMES), json_integer(frame));
     json_t *psnr = json_object_get(m, "psnr");
     json_t *overall = psnr ? json_object_get(psnr, "overall") : NULL;
     worst = json_object_get(summary, "worst_psnr");
@@ -116,8 +117,8 @@ static void run_task(struct metrics_worker *w, struct task *t)
     char err[512] = "";
     double t0 = clock_mono_s();
     json_t *summary = json_pack("{s:s, s:i, s:[]}", "reference", job->spec.reference,
-                                "captures_compared", 0, "pdiff_failed_frames");
-    json_t *captures = json_object_get(t->result, "captures");
+                                "captures_compared", 0, RK_PDIFF_FAILED_FRAMES);
+    json_t *captures = json_object_get(t->result, RK_CAPTURES);
     size_t i;
     json_t *capture;
     bool ok = true, cancelled = false, timed_out = false;
@@ -134,11 +135,11 @@ static void run_task(struct metrics_worker *w, struct task *t)
     telemetry_metrics(t1 - t0,
                       (unsigned)json_integer_value(json_object_get(summary, "captures_compared")));
     if (ok) {
-        json_t *failed = json_object_get(summary, "pdiff_failed_frames");
-        json_object_set_new(summary, "pdiff_failed_captures",
+        json_t *failed = json_object_get(summary, RK_PDIFF_FAILED_FRAMES);
+        json_object_set_new(summary, RK_PDIFF_FAILED_CAPTURES,
                             json_integer((json_int_t)json_array_size(failed)));
         json_object_set_new(summary, "metrics_s", json_real(t1 - t0));
-        json_object_set_new(t->result, "quality", summary);
+        json_object_set_new(t->result, RK_QUALITY, summary);
         summary = NULL;
         char path[PATH_MAX + 16];
         snprintf(path, sizeof(path), "%s/result.json", job->dir);

@@ -33,6 +33,7 @@
 #include "daemon/service.h"
 #include "common/stats.h"
 #include "daemon/techniques/technique.h"
+#include "common/result_keys.h"
 
 struct runner {
     struct queue *queue;
@@ -60,10 +61,10 @@ static json_t *stats_json(const double *v, size_t n)
 {
     struct stats s;
     stats_compute(v, n, &s);
-    return json_pack("{s:I, s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:[f, f]}", "n",
-                     (json_int_t)s.n, "mean", s.mean, "median", s.median, "stddev",
-                     s.stddev, "min", s.min, "max", s.max, "p5", s.p5, "p95", s.p95,
-                     "p99", s.p99, "cv", s.cv, "median_ci95", s.median_lo, s.median_hi);
+    return json_pack("{s:I, s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:[f, f]}", RK_N,
+                     (json_int_t)s.n, RK_MEAN, s.mean, RK_MEDIAN, s.median, RK_STDDEV,
+                     s.stddev, RK_MIN, s.min, RK_MAX, s.max, RK_P5, s.p5, RK_P95, s.p95,
+                     RK_P99, s.p99, RK_CV, s.cv, RK_MEDIAN_CI95, s.median_lo, s.median_hi);
 }
 
 static const char *gl_str(GLenum name)
@@ -265,7 +266,7 @@ static json_t *nonfinite_summary(const struct run *run)
         worst = px > worst ? px : worst;
         with += px > 0;
     }
-    return json_pack("{s:i, s:I, s:I, s:o, s:s}", "captures", run->capture_count,
+    return json_pack("{s:i, s:I, s:I, s:o, s:s}", RK_CAPTURES, run->capture_count,
                      "captures_with_nonfinite", with, "pixels_max", worst, "finite",
                      run->capture_count ? json_boolean(with == 0) : json_null(), "counted",
                      "pixels of the HDR colour the resolve read, at each captured frame, with "
@@ -416,13 +417,13 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
     double timed_wall = wall_s - capture_s;
     result = json_pack(
         "{s:s, s:i, s:i, s:f, s:f, s:f, s:o, s:o, s:o, s:I, s:i, s:i, s:o, s:s, s:s, s:I, s:O}",
-        "technique", run->tech->info->name, "frames", n, "warmup_frames", w0, "wall_s",
-        timed_wall, "wall_s_including_captures", wall_s, "fps",
-        timed_wall > 0 ? n / timed_wall : 0.0, "gpu_ms", stats_json(gpu, (size_t)n),
-        "cpu_ms", stats_json(run->cpu_ms, (size_t)n), "frame_ms",
+        "technique", run->tech->info->name, "frames", n, "warmup_frames", w0, RK_WALL_S,
+        timed_wall, "wall_s_including_captures", wall_s, RK_FPS,
+        timed_wall > 0 ? n / timed_wall : 0.0, RK_GPU_MS, stats_json(gpu, (size_t)n),
+        RK_CPU_MS, stats_json(run->cpu_ms, (size_t)n), RK_FRAME_MS,
         stats_json(run->frame_ms, (size_t)n), "triangles_per_frame",
         (json_int_t)scene_triangles(&run->scene), "instances", run->scene.instance_count,
-        "lights", run->scene.light_count, "captures", captures, "capture_policy",
+        "lights", run->scene.light_count, RK_CAPTURES, captures, "capture_policy",
         "each captured frame is read back with glReadPixels after its GPU timer "
         "query has ended and its CPU time was taken; the readback time is "
         "subtracted from wall_s (wall_s_including_captures keeps it), and PNG "
@@ -448,10 +449,10 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
     harness_look_describe(&run->hlook, result);
     json_object_set_new(result, "targets_bytes", json_real(gpu_targets_bytes(run->runner->targets)));
     if (run->heatmap)
-        json_object_set(result, "heatmap", run->heatmap);
+        json_object_set(result, RK_HEATMAP, run->heatmap);
     json_object_set_new(result, "scene", scene_describe(&run->scene));
     /* Store hook: what could have disturbed the timed region. */
-    json_object_set_new(result, "interference",
+    json_object_set_new(result, RK_INTERFERENCE,
                         interference_json(&run->interference[0], &run->interference[1]));
     if (run->tech->describe) {
         json_t *d = run->tech->describe(run->state);
@@ -591,9 +592,9 @@ static bool capture_heatmap(struct run *run, int k)
         if (ok && !run->heatmap)
             run->heatmap = json_pack("{s:s, s:s, s:[]}", "unit", "light evaluations per pixel",
                                      "ramp", "black (0), blue, cyan, green, yellow, white (scale_max)",
-                                     "captures");
+                                     RK_CAPTURES);
         if (ok)
-            json_array_append_new(json_object_get(run->heatmap, "captures"),
+            json_array_append_new(json_object_get(run->heatmap, RK_CAPTURES),
                                   json_pack("{s:i, s:s, s:f, s:i, s:i}", "frame", k,
                                             "file", name, "mean", sum / (double)n, "max", (int)max,
                                             "scale_max", (int)max));
@@ -743,8 +744,8 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
 /* Median of each series in one run's figures, for the across-run summary. */
 static json_t *run_summary(int index, double wall_s, json_t *frame, json_t *gpu, json_t *cpu)
 {
-    return json_pack("{s:i, s:f, s:o, s:o, s:o}", "run", index, "wall_s", wall_s, "frame_ms",
-                     frame, "gpu_ms", gpu, "cpu_ms", cpu);
+    return json_pack("{s:i, s:f, s:o, s:o, s:o}", "run", index, RK_WALL_S, wall_s, RK_FRAME_MS,
+                     frame, RK_GPU_MS, gpu, RK_CPU_MS, cpu);
 }
 
 static json_t *across_runs(const double *medians, size_t n)
@@ -753,8 +754,8 @@ static json_t *across_runs(const double *medians, size_t n)
     stats_compute(medians, n, &s);
     double lo, hi;
     json_t *ci = stats_mean_ci95(medians, n, &lo, &hi) ? json_pack("[f, f]", lo, hi) : json_null();
-    return json_pack("{s:f, s:f, s:f, s:f, s:f, s:o}", "mean", s.mean, "median", s.median,
-                     "stddev", s.stddev, "min", s.min, "max", s.max, "ci95", ci);
+    return json_pack("{s:f, s:f, s:f, s:f, s:f, s:o}", RK_MEAN, s.mean, RK_MEDIAN, s.median,
+                     RK_STDDEV, s.stddev, RK_MIN, s.min, RK_MAX, s.max, RK_CI95, ci);
 }
 
 /* Runs 2..N of a repeated job, each with the scene rebuilt; with automatic
@@ -768,20 +769,20 @@ static bool repeat_runs(struct runner *r, struct run *first, json_t *result,
     double *med = calloc((size_t)planned * 3, sizeof(double)); /* frame, gpu, cpu */
     double *gpu = malloc((size_t)n * sizeof(double));
     json_t *runs = json_array();
-    static const char *const series[3] = {"frame_ms", "gpu_ms", "cpu_ms"};
+    static const char *const series[3] = {RK_FRAME_MS, RK_GPU_MS, RK_CPU_MS};
     bool ok = med && gpu;
     if (!ok)
         snprintf(first->err, sizeof(first->err), "out of memory for repeats");
     for (int k = 0; ok && k < 3; k++)
-        med[k * planned] = json_real_value(json_object_get(json_object_get(result, series[k]), "median"));
+        med[k * planned] = json_real_value(json_object_get(json_object_get(result, series[k]), RK_MEDIAN));
     if (ok)
-        json_array_append_new(runs, run_summary(1, json_real_value(json_object_get(result, "wall_s")),
-                                                json_deep_copy(json_object_get(result, "frame_ms")),
-                                                json_deep_copy(json_object_get(result, "gpu_ms")),
-                                                json_deep_copy(json_object_get(result, "cpu_ms"))));
+        json_array_append_new(runs, run_summary(1, json_real_value(json_object_get(result, RK_WALL_S)),
+                                                json_deep_copy(json_object_get(result, RK_FRAME_MS)),
+                                                json_deep_copy(json_object_get(result, RK_GPU_MS)),
+                                                json_deep_copy(json_object_get(result, RK_CPU_MS))));
     if (ok) /* store hook: each run's interference */
-        json_object_set_new(json_array_get(runs, 0), "interference",
-                            json_deep_copy(json_object_get(result, "interference")));
+        json_object_set_new(json_array_get(runs, 0), RK_INTERFERENCE,
+                            json_deep_copy(json_object_get(result, RK_INTERFERENCE)));
     int done = 1;
     while (ok && done < planned && !(spec->repeat_auto && stats_is_stable(med, (size_t)done, 0.025))) {
         struct run extra = {.runner = r, .job = first->job, .spec = spec, .tech = first->tech};
@@ -792,11 +793,11 @@ static bool repeat_runs(struct runner *r, struct run *first, json_t *result,
                 gpu[i] = gpu_timer_ms(extra.timer, w0 + i, -1);
             json_t *f = stats_json(extra.frame_ms, (size_t)n), *g = stats_json(gpu, (size_t)n),
                    *c = stats_json(extra.cpu_ms, (size_t)n);
-            med[done] = json_real_value(json_object_get(f, "median"));
-            med[planned + done] = json_real_value(json_object_get(g, "median"));
-            med[2 * planned + done] = json_real_value(json_object_get(c, "median"));
+            med[done] = json_real_value(json_object_get(f, RK_MEDIAN));
+            med[planned + done] = json_real_value(json_object_get(g, RK_MEDIAN));
+            med[2 * planned + done] = json_real_value(json_object_get(c, RK_MEDIAN));
             json_array_append_new(runs, run_summary(done + 1, wall_s, f, g, c));
-            json_object_set_new(json_array_get(runs, done), "interference", /* store hook */
+            json_object_set_new(json_array_get(runs, done), RK_INTERFERENCE, /* store hook */
                                 interference_json(&extra.interference[0], &extra.interference[1]));
             done++;
         } else {
@@ -808,15 +809,15 @@ static bool repeat_runs(struct runner *r, struct run *first, json_t *result,
     }
     if (ok) {
         bool stable = stats_is_stable(med, (size_t)done, 0.025);
-        json_t *rep = json_pack("{s:i, s:i, s:b, s:b, s:s, s:s}", "runs", done, "planned", planned,
-                                "auto", spec->repeat_auto, "stable", stable, "rule_series",
-                                "frame_ms", "rule",
+        json_t *rep = json_pack("{s:i, s:i, s:b, s:b, s:s, s:s}", RK_RUNS, done, "planned", planned,
+                                "auto", spec->repeat_auto, RK_STABLE, stable, "rule_series",
+                                RK_FRAME_MS, "rule",
                                 "stable when the 95% confidence interval (Student's t) of the mean "
                                 "of per-run median frame_ms is within 2.5% of it, from 3 runs");
         for (int k = 0; k < 3; k++)
             json_object_set_new(rep, series[k], across_runs(med + k * planned, (size_t)done));
-        json_object_set_new(result, "repeat", rep);
-        json_object_set_new(result, "runs", runs);
+        json_object_set_new(result, RK_REPEAT, rep);
+        json_object_set_new(result, RK_RUNS, runs);
         runs = NULL;
         queue_progress(r->queue, first->job, planned * n);
         char path[PATH_MAX + 16];
@@ -952,9 +953,9 @@ static void *runner_main(void *arg)
     struct job *job;
     /* Store hook: the metrics and files of earlier jobs finish before the next job is timed. */
     while ((metrics_worker_wait_idle(r->metrics), job = queue_next(r->queue))) {
-        double busy_from = telemetry_now();
+        double busy_from = clock_mono_s();
         run_job(r, job);
-        telemetry_render_busy(telemetry_now() - busy_from);
+        telemetry_render_busy(clock_mono_s() - busy_from);
     }
     atomic_store(&r->alive, false);
     harness_gl_finish(r);

@@ -7,13 +7,6 @@
 /* Seconds are kept as nanoseconds so that they add up atomically. */
 static atomic_ullong frames, render_ns, metrics_ns, captures;
 
-double telemetry_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec / 1e9;
-}
-
 void telemetry_frames(unsigned n) { atomic_fetch_add(&frames, n); }
 
 void telemetry_render_busy(double seconds)

@@ -12,8 +12,6 @@ struct telemetry {
     unsigned long long captures_scored;
 };
 
-/* Monotonic seconds, for the callers' intervals. */
-double telemetry_now(void);
 void telemetry_frames(unsigned n);
 void telemetry_render_busy(double seconds);
 void telemetry_metrics(double seconds, unsigned captures);

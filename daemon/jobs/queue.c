@@ -4,6 +4,7 @@
 #include "common/fsutil.h"
 #include "common/clock.h"
 #include "common/log.h"
+#include "common/result_keys.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -503,7 +504,7 @@ static json_t *state_json(const struct job *job, const struct job_state *st, boo
     if (full) {
         json_object_set_new(o, "spec", job_spec_to_json(&job->spec));
         if (job->result)
-            json_object_set_new(o, "result", json_deep_copy(job->result));
+            json_object_set_new(o, RK_RESULT, json_deep_copy(job->result));
     }
     return o;
 }
@@ -548,7 +549,7 @@ static bool status_from_name(const char *name, enum job_status *out)
  * add "repeat". An earlier version means the job never finished. */
 static bool result_complete(const struct job_spec *spec, const json_t *result)
 {
-    if (spec->reference[0] && !json_object_get(result, "quality"))
+    if (spec->reference[0] && !json_object_get(result, RK_QUALITY))
         return false;
     if (job_spec_runs(spec) > 1 && !json_object_get(result, "repeat"))
         return false;

@@ -1,5 +1,6 @@
 #define _POSIX_C_SOURCE 200809L
 #include "daemon/jobs/sweep_spec.h"
+#include "common/result_keys.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -553,20 +554,20 @@ json_t *sweep_probe_job(const struct sweep_spec *s, double v)
 
 bool sweep_criterion_holds(const struct sweep_spec *s, const json_t *result)
 {
-    json_t *q = json_object_get(result, "quality");
+    json_t *q = json_object_get(result, RK_QUALITY);
     switch (s->criterion) {
     case CRITERION_PDIFF_PASS:
-        return q && json_integer_value(json_object_get(q, "pdiff_failed_captures")) == 0;
+        return q && json_integer_value(json_object_get(q, RK_PDIFF_FAILED_CAPTURES)) == 0;
     case CRITERION_SSIM_MIN: {
-        json_t *w = json_object_get(json_object_get(q, "worst_ssim_min"), "value");
+        json_t *w = json_object_get(json_object_get(q, RK_WORST_SSIM_MIN), "value");
         return w && json_number_value(w) >= s->threshold;
     }
     case CRITERION_FLIP_MAX: {
-        json_t *w = json_object_get(json_object_get(q, "worst_flip"), "max");
+        json_t *w = json_object_get(json_object_get(q, RK_WORST_FLIP), "max");
         return w && json_number_value(w) <= s->threshold;
     }
     case CRITERION_STABLE:
-        return json_is_true(json_object_get(json_object_get(result, "repeat"), "stable"));
+        return json_is_true(json_object_get(json_object_get(result, RK_REPEAT), RK_STABLE));
     case CRITERION_FINITE:
         return json_is_true(json_object_get(json_object_get(result, "nonfinite"), "finite"));
     }

@@ -14,6 +14,7 @@
 #include "common/log.h"
 #include "common/stats.h"
 #include "daemon/jobs/records.h"
+#include "common/result_keys.h"
 
 struct sweep {
     char id[RECORD_ID_LEN];
@@ -159,7 +160,7 @@ static bool insert_locked(struct sweeps *s, struct sweep *sw)
 /* One row of the table from a finished point job. */
 static json_t *point_row(const json_t *job, json_t *values)
 {
-    json_t *r = json_object_get(job, "result");
+    json_t *r = json_object_get(job, RK_RESULT);
     json_t *spec = json_object_get(job, "spec");
     json_t *row = json_pack("{s:o, s:s, s:s, s:O}", "values", values, "job",
                             json_string_value(json_object_get(job, "id")), "status",
@@ -169,46 +170,46 @@ static json_t *point_row(const json_t *job, json_t *values)
         json_object_set(row, "error", json_object_get(job, "error"));
     if (!r)
         return row;
-    json_t *rep = json_object_get(r, "repeat");
-    static const char *const series[] = {"frame_ms", "gpu_ms", "cpu_ms"};
+    json_t *rep = json_object_get(r, RK_REPEAT);
+    static const char *const series[] = {RK_FRAME_MS, RK_GPU_MS, RK_CPU_MS};
     for (int k = 0; k < 3; k++) {
         json_t *st = json_object_get(r, series[k]);
         json_t *across = rep ? json_object_get(rep, series[k]) : NULL;
         /* Repeated jobs: the mean of run medians and its interval; single runs:
          * the median and its distribution-free interval. */
         json_t *cell =
-            across ? json_pack("{s:O, s:O, s:s}", "median", json_object_get(across, "mean"), "ci95",
-                               json_object_get(across, "ci95"), "over", "runs")
-                   : json_pack("{s:O, s:O, s:s}", "median", json_object_get(st, "median"), "ci95",
-                               json_object_get(st, "median_ci95"), "over", "frames");
+            across ? json_pack("{s:O, s:O, s:s}", RK_MEDIAN, json_object_get(across, RK_MEAN), RK_CI95,
+                               json_object_get(across, RK_CI95), "over", "runs")
+                   : json_pack("{s:O, s:O, s:s}", RK_MEDIAN, json_object_get(st, RK_MEDIAN), RK_CI95,
+                               json_object_get(st, RK_MEDIAN_CI95), "over", "frames");
         /* The distribution of the (first run's) frames, for the charts. */
-        static const char *const keep[] = {"min", "p5", "p95", "p99", "max"};
+        static const char *const keep[] = {RK_MIN, RK_P5, RK_P95, RK_P99, RK_MAX};
         for (int i = 0; i < 5; i++)
             json_object_set(cell, keep[i], json_object_get(st, keep[i]));
         json_object_set_new(row, series[k], cell);
     }
     if (rep)
-        json_object_set(row, "stable", json_object_get(rep, "stable"));
+        json_object_set(row, RK_STABLE, json_object_get(rep, RK_STABLE));
     /* Execution time of the timed frames, over runs: what the thesis tabled. */
-    json_t *runs = json_object_get(r, "runs");
+    json_t *runs = json_object_get(r, RK_RUNS);
     size_t nruns = runs ? json_array_size(runs) : 1;
     double *walls = malloc(nruns * sizeof(double));
     if (walls) {
         for (size_t i = 0; i < nruns; i++)
-            walls[i] = json_number_value(json_object_get(runs ? json_array_get(runs, i) : r, "wall_s"));
+            walls[i] = json_number_value(json_object_get(runs ? json_array_get(runs, i) : r, RK_WALL_S));
         struct stats st;
         stats_compute(walls, nruns, &st);
-        json_object_set_new(row, "wall_s", json_pack("{s:I, s:f, s:f, s:f}", "runs", (json_int_t)nruns,
-                                                     "mean", st.mean, "median", st.median, "stddev",
+        json_object_set_new(row, RK_WALL_S, json_pack("{s:I, s:f, s:f, s:f}", RK_RUNS, (json_int_t)nruns,
+                                                     RK_MEAN, st.mean, RK_MEDIAN, st.median, RK_STDDEV,
                                                      st.stddev));
         free(walls);
     }
-    json_t *q = json_object_get(r, "quality");
+    json_t *q = json_object_get(r, RK_QUALITY);
     if (q) {
-        json_object_set(row, "worst_ssim", json_object_get(json_object_get(q, "worst_ssim"), "value"));
-        json_object_set(row, "worst_ssim_min", json_object_get(json_object_get(q, "worst_ssim_min"), "value"));
-        json_object_set(row, "worst_flip", json_object_get(json_object_get(q, "worst_flip"), "mean"));
-        json_object_set(row, "pdiff_failed_captures", json_object_get(q, "pdiff_failed_captures"));
+        json_object_set(row, RK_WORST_SSIM, json_object_get(json_object_get(q, RK_WORST_SSIM), "value"));
+        json_object_set(row, RK_WORST_SSIM_MIN, json_object_get(json_object_get(q, RK_WORST_SSIM_MIN), "value"));
+        json_object_set(row, RK_WORST_FLIP, json_object_get(json_object_get(q, RK_WORST_FLIP), "mean"));
+        json_object_set(row, RK_PDIFF_FAILED_CAPTURES, json_object_get(q, RK_PDIFF_FAILED_CAPTURES));
     }
     /* Post hook: the worst capture's non-finite pixels, for breaking points. */
     json_t *nonfinite = json_object_get(r, "nonfinite");
@@ -340,7 +341,7 @@ static int probe(double v, void *arg)
                         c->sw->spec.integer ? json_integer((json_int_t)v) : json_real(v));
     json_t *row = point_row(job, values);
     if (strcmp(json_string_value(json_object_get(job, "status")), "done") == 0)
-        holds = sweep_criterion_holds(&c->sw->spec, json_object_get(job, "result"));
+        holds = sweep_criterion_holds(&c->sw->spec, json_object_get(job, RK_RESULT));
     else
         snprintf(c->sw->error, sizeof(c->sw->error), "probe at %g %s: %s", v,
                  json_string_value(json_object_get(job, "status")),
@@ -360,7 +361,7 @@ static json_t *vary_result(const struct sweep *sw)
     json_t *passing = json_array(), *best = NULL, *row;
     size_t i;
     json_array_foreach(sw->points, i, row) {
-        json_t *failed = json_object_get(row, "pdiff_failed_captures");
+        json_t *failed = json_object_get(row, RK_PDIFF_FAILED_CAPTURES);
         if (json_is_integer(failed) && json_integer_value(failed) == 0)
             json_array_append(passing, json_object_get(row, "values"));
     }
@@ -521,7 +522,7 @@ static void load_sweep(void *ctx, const char *id, const char *dir)
     snprintf(sw->dir, sizeof(sw->dir), "%s", dir);
     sw->body = json_incref(json_object_get(o, "spec"));
     sw->points = json_incref(json_object_get(o, "points"));
-    sw->result = json_incref(json_object_get(o, "result"));
+    sw->result = json_incref(json_object_get(o, RK_RESULT));
     sw->status = status;
     json_t *times = json_object_get(o, "times_unix");
     sw->created = json_number_value(json_array_get(times, 0));
@@ -729,7 +730,7 @@ static json_t *sweep_json_locked(const struct sweep *sw, bool full)
         json_object_set(o, "spec", sw->body);
         json_object_set(o, "points", sw->points);
         if (sw->result)
-            json_object_set(o, "result", sw->result);
+            json_object_set(o, RK_RESULT, sw->result);
     }
     return o;
 }

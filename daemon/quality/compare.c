@@ -9,6 +9,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "common/clock.h"
 #include "daemon/quality/metrics.h"
 
 void metrics_options_defaults(struct metrics_options *o)
@@ -16,13 +17,6 @@ void metrics_options_defaults(struct metrics_options *o)
     o->which = METRIC_ALL;
     pdiff_defaults(&o->pdiff);
     o->flip_ppd = flip_default_ppd();
-}
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
 }
 
 /* Infinite PSNR (identical planes) is JSON null. */
@@ -47,7 +41,7 @@ struct flip_task {
 static void *flip_thread(void *arg)
 {
     struct flip_task *t = arg;
-    double t0 = now_ms();
+    double t0 = (clock_mono_s() * 1e3);
     t->ok = flip_compute(t->ref, t->test, t->ppd, t->map_path != NULL, t->stop, &t->result,
                          t->err, sizeof(t->err));
     if (t->ok && t->map_path) {
@@ -61,7 +55,7 @@ static void *flip_thread(void *arg)
     }
     free(t->result.map);
     t->result.map = NULL;
-    t->ms = now_ms() - t0;
+    t->ms = (clock_mono_s() * 1e3) - t0;
     return NULL;
 }
 
@@ -101,7 +95,7 @@ json_t *metrics_compare(const struct image *ref, const struct image *test,
     }
     struct flip_task flip = {.ref = ref, .test = test, .ppd = o->flip_ppd,
                              .map_path = flip_map_path, .stop = stop};
-    double start = now_ms();
+    double start = (clock_mono_s() * 1e3);
     pthread_t flip_tid;
     bool flip_threaded = false;
     if (o->which & METRIC_FLIP) {
@@ -111,7 +105,7 @@ json_t *metrics_compare(const struct image *ref, const struct image *test,
     }
     json_t *out = json_object(), *timing = json_object();
     json_object_set_new(out, "timing_ms", timing);
-    double t0 = now_ms();
+    double t0 = (clock_mono_s() * 1e3);
     if (o->which & METRIC_SSIM) {
         struct ssim_result s;
         if (!ssim_compute(ref, test, ssim_map_path != NULL, stop, &s, err, errlen))
@@ -126,8 +120,8 @@ json_t *metrics_compare(const struct image *ref, const struct image *test,
         free(s.map);
         if (!ok)
             goto fail;
-        json_object_set_new(timing, "ssim", json_real(now_ms() - t0));
-        t0 = now_ms();
+        json_object_set_new(timing, "ssim", json_real((clock_mono_s() * 1e3) - t0));
+        t0 = (clock_mono_s() * 1e3);
     }
     if (o->which & METRIC_PDIFF) {
         struct pdiff_result p;
@@ -137,8 +131,8 @@ json_t *metrics_compare(const struct image *ref, const struct image *test,
                             json_pack("{s:b, s:I, s:f, s:I}", "pass", p.pass, "failing_pixels",
                                       (json_int_t)p.failing_pixels, "fov", o->pdiff.fov,
                                       "threshold_pixels", (json_int_t)o->pdiff.threshold_pixels));
-        json_object_set_new(timing, "pdiff", json_real(now_ms() - t0));
-        t0 = now_ms();
+        json_object_set_new(timing, "pdiff", json_real((clock_mono_s() * 1e3) - t0));
+        t0 = (clock_mono_s() * 1e3);
     }
     if ((o->which & METRIC_PSNR) && !metrics_stopped(stop, err, errlen)) {
         struct psnr_result p;
@@ -148,8 +142,8 @@ json_t *metrics_compare(const struct image *ref, const struct image *test,
                             json_pack("{s:o, s:o, s:o, s:o, s:b, s:f}", "overall", db(p.overall),
                                       "r", db(p.channel[0]), "g", db(p.channel[1]), "b",
                                       db(p.channel[2]), "identical", p.identical, "mse", p.mse));
-        json_object_set_new(timing, "psnr", json_real(now_ms() - t0));
-        t0 = now_ms();
+        json_object_set_new(timing, "psnr", json_real((clock_mono_s() * 1e3) - t0));
+        t0 = (clock_mono_s() * 1e3);
     }
     if (flip_threaded)
         pthread_join(flip_tid, NULL);
@@ -170,7 +164,7 @@ json_t *metrics_compare(const struct image *ref, const struct image *test,
         json_object_set_new(timing, "flip", json_real(flip.ms));
     }
     /* FLIP overlaps the others: the wall time of the whole comparison. */
-    json_object_set_new(timing, "total", json_real(now_ms() - start));
+    json_object_set_new(timing, "total", json_real((clock_mono_s() * 1e3) - start));
     return out;
 fail:
     if (flip_threaded)

@@ -13,6 +13,10 @@ on a shared CI box), this benchmark:
   3. runs the gate --trials times on the unchanged job and --trials times on
      the slowed one (--allow-mismatch, since more lights is another spec),
      interleaved so that both see the same conditions over time;
+     With --mode ab, step 2 is skipped and each gate is `shadebench ab`
+     instead: the job against itself, or against the slowed job, in
+     alternating runs, so that a drift of the machine between gates cannot
+     pass for a change;
   4. reports the false-regression rate (unchanged job judged a regression)
      and the catch rate (slowed job judged a regression), with the
      inconclusive verdicts, the runs each gate used and the measured
@@ -78,6 +82,10 @@ def main():
     ap.add_argument("--target", type=float, default=0.10, help="slowdown to calibrate for")
     ap.add_argument("--calibration-pairs", type=int, default=10)
     ap.add_argument("--load", type=int, default=1, help="busy-loop processes (default 1)")
+    ap.add_argument("--mode", choices=("baseline", "ab"), default="baseline",
+                    help="baseline: submit --baseline against one baseline taken first; "
+                         "ab: shadebench ab, the job against itself or the slowed job, "
+                         "alternating runs within each gate")
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
 
@@ -128,12 +136,14 @@ def main():
         print("slowed job: %d lights: B/A = %.3f [%.3f, %.3f]" % (slow_lights, ab["ratio"], ab["ci_low"],
                                                                   ab["ci_high"]), flush=True)
 
-        # 2. The baseline.
-        base_dir = os.path.join(out, "baseline")
-        r = client(server, "submit", base_file, "--wait", "--runs", a.runs, "--out", base_dir)
-        if r.returncode != 0:
-            raise RuntimeError("baseline failed: %s" % r.stderr[-500:])
-        baseline = os.path.join(base_dir, "result.json")
+        # 2. The baseline (ab measures its own, alternately, in every gate).
+        baseline = None
+        if a.mode == "baseline":
+            base_dir = os.path.join(out, "baseline")
+            r = client(server, "submit", base_file, "--wait", "--runs", a.runs, "--out", base_dir)
+            if r.returncode != 0:
+                raise RuntimeError("baseline failed: %s" % r.stderr[-500:])
+            baseline = os.path.join(base_dir, "result.json")
 
         # 3. The gates, interleaved.
         results = {"unchanged": [], "slowed": []}
@@ -142,16 +152,23 @@ def main():
                                       ("slowed", slow_file, ["--allow-mismatch"])):
                 gate_dir = os.path.join(out, "%s-%02d" % (kind, i + 1))
                 start = time.time()
-                r = client(server, "submit", path, "--wait", "--baseline", baseline, "--out",
-                           gate_dir, *extra)
-                took = time.time() - start
                 try:
-                    with open(os.path.join(gate_dir, "gate.json")) as f:
-                        g = json.load(f)
-                    with open(os.path.join(gate_dir, "result.json")) as f:
-                        runs = json.load(f)["gate_runs"]
+                    if a.mode == "ab":
+                        r = client(server, "ab", base_file, path, "--runs", a.runs, "--out", gate_dir)
+                        with open(os.path.join(gate_dir, "ab.json")) as f:
+                            g = json.load(f)
+                        # A pair is two runs, noisy together.
+                        runs = [p for p in g["runs"] for _ in (0, 1)]
+                    else:
+                        r = client(server, "submit", path, "--wait", "--baseline", baseline, "--out",
+                                   gate_dir, *extra)
+                        with open(os.path.join(gate_dir, "gate.json")) as f:
+                            g = json.load(f)
+                        with open(os.path.join(gate_dir, "result.json")) as f:
+                            runs = json.load(f)["gate_runs"]
                 except (OSError, ValueError, KeyError):
                     g, runs = {"outcome": "error", "why": r.stderr[-300:]}, []
+                took = time.time() - start
                 rec = {"rc": r.returncode, "outcome": g["outcome"], "ratio": g.get("ratio"),
                        "ci": [g.get("ci_low"), g.get("ci_high")], "runs": len(runs),
                        "noisy": sum(1 for x in runs if x.get("noisy")), "seconds": took,
@@ -172,7 +189,7 @@ def main():
 
     n = a.trials
     summary = {
-        "trials": n, "runs": a.runs, "job": job, "slow_lights": slow_lights,
+        "trials": n, "runs": a.runs, "mode": a.mode, "job": job, "slow_lights": slow_lights,
         "slowdown_paired": slow_ratio - 1, "calibration": calibration,
         "slowdown_in_gates": statistics.median(x["ratio"] for x in results["slowed"] if x["ratio"]) - 1,
         "false_regressions": count("unchanged", "regression"),
@@ -190,6 +207,8 @@ def main():
     print()
     print("| measurement | value |")
     print("|---|---|")
+    print("| gate | %s |" % ("shadebench ab: A and B alternately in each gate" if a.mode == "ab"
+                             else "submit --baseline: one baseline taken before the trials"))
     print("| job | forward, %dx%d, %d frames, %d lights; %d busy-loop process(es) |" % (
         a.width, a.height, a.frames, a.lights, a.load))
     print("| slowed job | %d lights: %+.1f%% (paired, ab), %+.1f%% (median over its gates) |" % (

@@ -51,6 +51,43 @@ static size_t clean_pairs(const struct run_set *sa, const struct run_set *sb, do
     return k;
 }
 
+/* With too few clean pairs, the noisy ones still decide when the CPU their
+ * runs were short of cannot explain the difference: a regression if B/A
+ * stays one with every B bounded down by its pair's CPU change, a pass if it
+ * stays one with every B bounded up. (A 20-fold slowdown is not made
+ * undecidable by a busy machine.) Uses va and vb (sa->n each) as scratch;
+ * false when neither holds. */
+static bool bounded_verdict(const struct run_set *sa, const struct run_set *sb,
+                            const struct options *o, double *va, double *vb,
+                            struct gate_verdict *v)
+{
+    for (int upper = 0; upper <= 1; upper++) {
+        size_t m = 0;
+        for (size_t i = 0; i < sa->n && i < sb->n; i++) {
+            const struct gate_run *a = &sa->runs[i], *b = &sb->runs[i];
+            if (!a->has_share || !b->has_share)
+                continue;
+            va[m] = a->ms;
+            vb[m++] = gate_pair_bound_ms(a, b, upper);
+        }
+        struct ratio_interval r;
+        if (m < 2 || !paired_log_ratio(va, vb, m, o->confidence, &r))
+            return false;
+        struct gate_verdict bounded;
+        gate_decide(&r, o->max_slowdown, &bounded);
+        if (bounded.outcome == (upper ? GATE_PASS : GATE_REGRESSION)) {
+            *v = bounded;
+            size_t used = strlen(v->why);
+            snprintf(v->why + used, sizeof(v->why) - used,
+                     " (over %zu pairs, noisy ones included, each B's time %s by as much as "
+                     "the CPU its run %s could explain)", m, upper ? "raised" : "lowered",
+                     upper ? "had over A's" : "lacked against A's");
+            return true;
+        }
+    }
+    return false;
+}
+
 int cmd_ab(struct conn *ca, struct conn *cb, const struct options *o, const char *file_a,
            const char *file_b)
 {
@@ -117,7 +154,7 @@ int cmd_ab(struct conn *ca, struct conn *cb, const struct options *o, const char
         struct ratio_interval r;
         if (nclean >= 2 && paired_log_ratio(va, vb, nclean, o->confidence, &r)) {
             gate_decide(&r, o->max_slowdown, &v);
-        } else {
+        } else if (!bounded_verdict(&sa, &sb, o, va, vb, &v)) {
             /* Too few clean pairs to decide; still report all the pairs. */
             memset(&v, 0, sizeof(v));
             v.outcome = GATE_INCONCLUSIVE;

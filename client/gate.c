@@ -175,6 +175,14 @@ double gate_cpu_left_change(double share, double reference)
     return (1.0 - share) / fmax(1.0 - reference, 0.01) - 1.0;
 }
 
+double gate_pair_bound_ms(const struct gate_run *a, const struct gate_run *b, bool upper)
+{
+    if (!a->has_share || !b->has_share)
+        return b->ms;
+    double scaled = b->ms * (1.0 + gate_cpu_left_change(b->other_share, a->other_share));
+    return upper ? fmax(b->ms, scaled) : fmin(b->ms, scaled);
+}
+
 size_t gate_mark_noisy(struct gate_run *runs, size_t n, bool have_reference, double reference,
                        double tolerance)
 {

@@ -79,6 +79,14 @@ bool gate_typical_share(const struct gate_run *runs, size_t n, double *share);
  * is -3%. */
 double gate_cpu_left_change(double share, double reference);
 
+/* B's run time of a pair as it might have been with the CPU A's run was
+ * left: a renderer is at most CPU-bound, so its time scales by at most
+ * (1 + gate_cpu_left_change(b, a)). upper = false gives the smaller of the
+ * measured and the fully scaled time (the bound a regression must clear),
+ * upper = true the larger (the bound a pass must clear). Without interference
+ * figures on both runs, the measured time. */
+double gate_pair_bound_ms(const struct gate_run *a, const struct gate_run *b, bool upper);
+
 /* Marks runs noisy when the CPU other processes left them differs from the
  * reference's by more than tolerance (0.10: by more than 10%, either way):
  * such a run was measured under other conditions than the runs it is

@@ -288,7 +288,8 @@ int record_scan(struct record_kind *k, record_load_fn load, void *ctx, char *err
         snprintf(err, errlen, "out of memory reading %s", k->root);
         goto out;
     }
-    qsort(names, n, sizeof(*names), by_name);
+    if (n > 1) /* names is NULL in an empty folder, which qsort may not take */
+        qsort(names, n, sizeof(*names), by_name);
     for (size_t i = 0; i < n; i++) {
         char path[PATH_MAX + 300];
         snprintf(path, sizeof(path), "%s/%s", k->root, names[i]);

@@ -353,8 +353,8 @@ static json_t *thesis_sweep(const json_t *body, struct job_error *err)
                      "technique", "forward", "osl");
 }
 
-bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techniques, struct sweep_spec *out,
-                      struct job_error *err)
+static bool parse_into(const json_t *body, const struct technique_catalog *techniques,
+                       struct sweep_spec *out, struct job_error *err)
 {
     memset(out, 0, sizeof(*out));
     memset(err, 0, sizeof(*err));
@@ -492,6 +492,17 @@ bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techni
             return false;
     }
     return true;
+}
+
+bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techniques, struct sweep_spec *out,
+                      struct job_error *err)
+{
+    /* A refusal may come after base and values were taken: release them, so
+     * that a refused sweep holds nothing (finishing it again is harmless). */
+    if (parse_into(body, techniques, out, err))
+        return true;
+    sweep_spec_finish(out);
+    return false;
 }
 
 void sweep_spec_finish(struct sweep_spec *s)

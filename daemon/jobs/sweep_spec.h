@@ -39,6 +39,8 @@ struct sweep_spec {
     bool thesis; /* {"preset": "thesis"}: the thesis's experiment */
 };
 
+/* Fills out, or returns false with err naming the field and out holding
+ * nothing (sweep_spec_finish on it is harmless). */
 bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techniques, struct sweep_spec *out,
                       struct job_error *err);
 void sweep_spec_finish(struct sweep_spec *s);

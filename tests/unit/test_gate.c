@@ -204,6 +204,19 @@ int main(void)
     /* On a saturated machine five points matter: 15% left instead of 20%. */
     CHECK_NEAR(gate_cpu_left_change(0.85, 0.80), -0.25, 1e-12);
     CHECK_NEAR(gate_cpu_left_change(0.05, 0.02), -0.0306122, 1e-6);
+
+    /* A noisy pair's B bounded by the CPU change: B left 40% of the CPU
+     * where A was left 80% could be up to twice as slow for that alone. */
+    {
+        struct gate_run a = {.ms = 10, .has_share = true, .other_share = 0.2};
+        struct gate_run b = {.ms = 30, .has_share = true, .other_share = 0.6};
+        CHECK_NEAR(gate_pair_bound_ms(&a, &b, false), 15.0, 1e-9);
+        CHECK_NEAR(gate_pair_bound_ms(&a, &b, true), 30.0, 1e-9);
+        CHECK_NEAR(gate_pair_bound_ms(&b, &a, true), 20.0, 1e-9); /* had twice the CPU */
+        CHECK_NEAR(gate_pair_bound_ms(&b, &a, false), 10.0, 1e-9);
+        b.has_share = false;
+        CHECK_NEAR(gate_pair_bound_ms(&a, &b, false), 30.0, 1e-9);
+    }
     struct gate_run busy[2] = {{.ms = 10, .has_share = true, .other_share = 0.85},
                                {.ms = 10, .has_share = true, .other_share = 0.81}};
     CHECK(gate_mark_noisy(busy, 2, true, 0.80, 0.10) == 1 && busy[0].noisy && !busy[1].noisy);

@@ -107,13 +107,46 @@ static int default_runs(const char *file)
     return n > 1 ? (n > 100 ? 100 : n) : 5;
 }
 
+/* With too few clean runs, all the runs still decide when the CPU the noisy
+ * ones lacked or had in excess cannot explain the difference: a regression
+ * if it holds with the new runs bounded down and the baseline's up (each by
+ * its CPU change against the reference share), a pass if it holds the other
+ * way round. bv and cv (nb and s->n long) are scratch. */
+static bool bounded_verdict(const struct options *o, const struct gate_run *base, size_t nb,
+                            const struct run_set *s, bool have, double ref, double *bv,
+                            double *cv, struct gate_verdict *v)
+{
+    for (int upper = 0; upper <= 1; upper++) {
+        for (size_t i = 0; i < nb; i++)
+            bv[i] = gate_run_bound_ms(&base[i], have, ref, !upper);
+        for (size_t i = 0; i < s->n; i++)
+            cv[i] = gate_run_bound_ms(&s->runs[i], have, ref, upper);
+        struct ratio_interval r;
+        if (!have || s->n < 2 || nb + s->n < 3 ||
+            !welch_log_ratio(bv, nb, cv, s->n, o->confidence, &r))
+            return false;
+        struct gate_verdict bounded;
+        gate_decide(&r, o->max_slowdown, &bounded);
+        if (bounded.outcome == (upper ? GATE_PASS : GATE_REGRESSION)) {
+            *v = bounded;
+            size_t used = strlen(v->why);
+            snprintf(v->why + used, sizeof(v->why) - used,
+                     " (over all runs, noisy ones included, each bounded by as much as its "
+                     "CPU change against the typical %.0f%% taken by other processes could "
+                     "explain)", 100 * ref);
+            return true;
+        }
+    }
+    return false;
+}
+
 /* Marks noise on both sides and compares. The candidate runs are judged
  * against the baseline's typical other-process CPU share when it has one,
  * else against their own. */
 static void evaluate(const struct options *o, struct gate_run *base, size_t nb, struct run_set *s,
                      struct gate_verdict *v, size_t *nb_clean, size_t *nc_clean)
 {
-    double ref;
+    double ref = 0;
     bool have = gate_typical_share(base, nb, &ref);
     gate_mark_noisy(base, nb, have, ref, o->noise_tolerance);
     for (size_t i = 0; i < s->n; i++) {
@@ -127,7 +160,8 @@ static void evaluate(const struct options *o, struct gate_run *base, size_t nb, 
     *nb_clean = bv ? gate_clean_values(base, nb, bv) : 0;
     *nc_clean = cv ? gate_clean_values(s->runs, s->n, cv) : 0;
     gate_compare(bv, *nb_clean, cv, *nc_clean, o->confidence, o->max_slowdown, v);
-    if (v->outcome == GATE_INCONCLUSIVE && v->r.ratio == 0 && bv && cv) {
+    bool too_few = v->outcome == GATE_INCONCLUSIVE && v->r.ratio == 0 && bv && cv;
+    if (too_few && !bounded_verdict(o, base, nb, s, have, ref, bv, cv, v)) {
         /* Too few clean runs to decide: still report what all the runs,
          * noisy ones included, say, so that the log is not empty. */
         for (size_t i = 0; i < nb; i++)

@@ -175,12 +175,18 @@ double gate_cpu_left_change(double share, double reference)
     return (1.0 - share) / fmax(1.0 - reference, 0.01) - 1.0;
 }
 
+double gate_run_bound_ms(const struct gate_run *r, bool have_reference, double reference,
+                         bool upper)
+{
+    if (!r->has_share || !have_reference)
+        return r->ms;
+    double scaled = r->ms * (1.0 + gate_cpu_left_change(r->other_share, reference));
+    return upper ? fmax(r->ms, scaled) : fmin(r->ms, scaled);
+}
+
 double gate_pair_bound_ms(const struct gate_run *a, const struct gate_run *b, bool upper)
 {
-    if (!a->has_share || !b->has_share)
-        return b->ms;
-    double scaled = b->ms * (1.0 + gate_cpu_left_change(b->other_share, a->other_share));
-    return upper ? fmax(b->ms, scaled) : fmin(b->ms, scaled);
+    return gate_run_bound_ms(b, a->has_share, a->other_share, upper);
 }
 
 size_t gate_mark_noisy(struct gate_run *runs, size_t n, bool have_reference, double reference,

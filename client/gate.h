@@ -79,12 +79,17 @@ bool gate_typical_share(const struct gate_run *runs, size_t n, double *share);
  * is -3%. */
 double gate_cpu_left_change(double share, double reference);
 
-/* B's run time of a pair as it might have been with the CPU A's run was
- * left: a renderer is at most CPU-bound, so its time scales by at most
- * (1 + gate_cpu_left_change(b, a)). upper = false gives the smaller of the
- * measured and the fully scaled time (the bound a regression must clear),
- * upper = true the larger (the bound a pass must clear). Without interference
- * figures on both runs, the measured time. */
+/* A run's time as it might have been with the reference's CPU share: a
+ * renderer is at most CPU-bound, so its time scales by at most
+ * (1 + gate_cpu_left_change(share, reference)). upper = false gives the
+ * smaller of the measured and the fully scaled time, upper = true the
+ * larger: a slowdown that survives the new runs bounded down and the
+ * baseline bounded up is one the CPU difference cannot explain. Without
+ * interference figures, the measured time. */
+double gate_run_bound_ms(const struct gate_run *r, bool have_reference, double reference,
+                         bool upper);
+
+/* The same for B's run of a pair, against the share A's run had. */
 double gate_pair_bound_ms(const struct gate_run *a, const struct gate_run *b, bool upper);
 
 /* Marks runs noisy when the CPU other processes left them differs from the

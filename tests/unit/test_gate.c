@@ -216,6 +216,11 @@ int main(void)
         CHECK_NEAR(gate_pair_bound_ms(&b, &a, false), 10.0, 1e-9);
         b.has_share = false;
         CHECK_NEAR(gate_pair_bound_ms(&a, &b, false), 30.0, 1e-9);
+        /* Against a typical share: the baseline gate's bound. */
+        b.has_share = true;
+        CHECK_NEAR(gate_run_bound_ms(&b, true, 0.2, false), 15.0, 1e-9);
+        CHECK_NEAR(gate_run_bound_ms(&b, true, 0.2, true), 30.0, 1e-9);
+        CHECK_NEAR(gate_run_bound_ms(&b, false, 0.2, false), 30.0, 1e-9);
     }
     struct gate_run busy[2] = {{.ms = 10, .has_share = true, .other_share = 0.85},
                                {.ms = 10, .has_share = true, .other_share = 0.81}};

@@ -7,10 +7,16 @@
 2. SSAO: cost against sample count (4 to 64), with its quality as the SSIM
    against 64 samples (reference_look renders the 64-sample image);
 3. the whole chain (bloom, toon with Sobel outlines, SSAO, ACES) as a share
-   of each technique's frame.
+   of each technique's frame;
+4. toon outlines against resolution: the same view at 1080x720 down to
+   90x60, toon with Sobel outlines scored against the same ramp without
+   outlines (reference_look), and the share of the objects' pixels the
+   outlines blacken: outlines keep their width in pixels while the objects
+   shrink, so at some resolution they cover the objects (where outlines
+   break). Images, not times: run once, whatever --repeat says.
 
   bench/bench_post.py [--frames N] [--warmup N] [--repeat R] [--width W --height H]
-                      [--only bloom,ssao,chain] [--json FILE]
+                      [--only bloom,ssao,chain,toon] [--json FILE]
 
 Effect costs are the medians of the effect passes' GL_TIME_ELAPSED
 (gpu_sections_ms): on llvmpipe that covers rasterization, which is all a
@@ -33,14 +39,17 @@ ap.add_argument("--warmup", type=int, default=2)
 ap.add_argument("--repeat", type=int, default=2)
 ap.add_argument("--width", type=int, default=480)
 ap.add_argument("--height", type=int, default=320)
-ap.add_argument("--only", default="bloom,ssao,chain",
-                help="comma-separated parts to run: bloom, ssao, chain")
+ap.add_argument("--only", default="bloom,ssao,chain,toon",
+                help="comma-separated parts to run: bloom, ssao, chain, toon")
 ap.add_argument("--json", help="write every result here")
 args = ap.parse_args()
 
 RADII = (2, 4, 8, 16)
 SAMPLES = (4, 8, 16, 32, 64)
 TECHNIQUES = (("forward", {}), ("unlit", {}), ("osl-auto", {"technique": "osl", "osl": {"resolution": "auto"}}))
+TOON_SIZES = ((1080, 720), (540, 360), (360, 240), (270, 180), (180, 120), (135, 90), (90, 60))
+TOON_EDGES = (("sobel", {"edges": "sobel"}), ("depth_diff", {"edges": "depth_diff"}),
+              ("depth_diff-t2", {"edges": "depth_diff", "thickness": 2}))
 CHAIN = {"post": [{"bloom": {"radius": 4}}, {"toon": {"edges": "sobel"}}, {"ssao": {"samples": 16}}],
          "tonemap": "aces"}
 
@@ -67,6 +76,13 @@ for n in SAMPLES if "ssao" in PARTS else ():
 for name, extra in TECHNIQUES if "chain" in PARTS else ():
     CONFIGS.append(("%s-plain" % name, base_job(**extra)))
     CONFIGS.append(("%s-chain" % name, base_job(look=CHAIN, **extra)))
+TOON_CONFIGS = []
+for w, h in TOON_SIZES if "toon" in PARTS else ():
+    for label, toon in TOON_EDGES:
+        job = base_job(look={"post": [{"toon": toon}]}, capture_interval=args.frames, reference="forward",
+                       reference_look={"post": [{"toon": {"edges": "none"}}]}, metrics=["ssim", "flip"])
+        job["scene"] = dict(job["scene"], width=w, height=h)
+        TOON_CONFIGS.append(("toon-%s-%dx%d" % (label, w, h), job))
 
 
 def med(values):
@@ -124,6 +140,37 @@ def ssao_table():
         print("| %d | %.2f | %.2f | %.2f | %.2f | %.5f |" % (n, ao, bl, ao + bl, m(name, frame_ms), ssim))
 
 
+def outline_share(d, done, tmp):
+    """(outline pixels / object pixels, outline pixels / all pixels): an
+    object pixel is lit (not black) in the image without outlines, an
+    outline pixel is one of those that the outlines turn black."""
+    cap = done["result"]["captures"][-1]
+    paths = []
+    for key in ("url", "reference_url"):
+        path = os.path.join(tmp, key + ".png")
+        if d.download(cap[key], path) != 200:
+            sys.exit("cannot download %s" % cap[key])
+        paths.append(path)
+    w, h, toon = testlib.png_pixels(paths[0])
+    _, _, plain = testlib.png_pixels(paths[1])
+    objects = sum(1 for p in plain if any(p))
+    outlined = sum(1 for a, b in zip(toon, plain) if any(b) and not any(a))
+    return outlined / max(objects, 1), outlined / float(w * h)
+
+
+def toon_table():
+    print("\n## Toon outlines against resolution (grid, moving lights, frame %d; against the same ramp "
+          "without outlines)\n" % args.frames)
+    print("| size | outlines | objects' pixels outlined | image outlined | SSIM | FLIP mean |")
+    print("|---|---|---|---|---|---|")
+    for name, _ in TOON_CONFIGS:
+        r = toon_results[name]
+        q = r["result"].get("quality", {})
+        print("| %s | %s | %.1f %% | %.1f %% | %.4f | %.4f |"
+              % (name.rsplit("-", 1)[1], name[5:].rsplit("-", 1)[0], 100.0 * r["share"][0], 100.0 * r["share"][1],
+                 q.get("worst_ssim", {}).get("value", float("nan")), q.get("worst_flip", {}).get("mean", float("nan"))))
+
+
 def chain_table():
     print("\n## The whole chain (bloom r4, toon Sobel, SSAO 16, ACES) against each technique's frame\n")
     print("| technique | frame_ms plain | frame_ms chain | chain share of frame_ms (paired) | "
@@ -140,6 +187,7 @@ def chain_table():
 
 d = testlib.Daemon()
 results = {name: [] for name, _ in CONFIGS}
+toon_results = {}
 try:
     info = d.json("GET", "/v1/info")[1]["device"]
     print("device: %s | %s" % (info["gl_renderer"], info["gl_version"]))
@@ -157,6 +205,12 @@ try:
             print("  [%d/%d] %-22s frame %9.2f ms  gpu %9.2f ms  (%.0f s)"
                   % (rep + 1, args.repeat, name, r["frame_ms"]["median"], r["gpu_ms"]["median"],
                      time.time() - t0), flush=True)
+    for name, job in TOON_CONFIGS:
+        done = d.wait(d.submit(job), timeout=3600)
+        if done.get("status") != "done":
+            sys.exit("%s failed: %s" % (name, done.get("error")))
+        toon_results[name] = {"result": done["result"], "share": outline_share(d, done, d.tmp)}
+        print("  %-26s objects outlined %5.1f %%" % (name, 100.0 * toon_results[name]["share"][0]), flush=True)
     print("\n(%.0f s in all; load average %.2f before, %.2f after, on %d cores)\n"
           % (time.time() - t_start, load0, os.getloadavg()[0], os.cpu_count()))
     if "bloom" in PARTS:
@@ -165,9 +219,11 @@ try:
         ssao_table()
     if "chain" in PARTS:
         chain_table()
+    if "toon" in PARTS:
+        toon_table()
     if args.json:
         with open(args.json, "w") as f:
-            json.dump(results, f, indent=1)
+            json.dump({"repeats": results, "toon": toon_results}, f, indent=1)
 finally:
     d.stop()
     d.cleanup()

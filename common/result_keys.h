@@ -49,4 +49,14 @@
 #define RK_PDIFF_FAILED_CAPTURES "pdiff_failed_captures"
 #define RK_PDIFF_FAILED_FRAMES "pdiff_failed_frames"
 
+/* Where a method breaks, for sweeps' criteria and rows. */
+#define RK_TECHNIQUE "technique"     /* result[technique]: the technique's own figures */
+#define RK_NONFINITE "nonfinite"     /* {pixels_max, finite, ...} over the captures */
+#define RK_PIXELS_MAX "pixels_max"
+#define RK_FINITE "finite"
+#define RK_OVERFLOW "overflow"       /* result[technique].overflow: bounded light lists */
+#define RK_OVERFLOW_FRAMES "frames"  /* ... frames in which a list overflowed */
+#define RK_SHADOWS "shadows"         /* result.shadows.overflow: the shadow atlas */
+#define RK_FRAMES_WITH_DROPS "frames_with_drops"
+
 #endif

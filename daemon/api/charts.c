@@ -51,6 +51,9 @@ struct chart {
     struct point *pts;
     int n;
     bool lines, boxes, categorical_x, no_markers, x_log_ok;
+    /* A swept parameter: log x only when every value is above zero (light
+     * counts 16 to 16,384), never for a 0 that log would misplace. */
+    bool x_log_param;
     char categories[64][112];
     int ncategories;
     char workloads[MAX_WORKLOADS][128];
@@ -685,7 +688,8 @@ static void fit_axes(struct chart *c)
         xl = yl = xpos = ypos = 0, xh = yh = 1;
     if (c->n == 0)
         xl = xpos = 0, xh = 1;
-    bool x_log_ok = c->x_log_ok && xpos > 0 && xh / xpos > 10.0;
+    bool x_log_ok = (c->x_log_ok && xpos > 0 && xh / xpos > 10.0) ||
+                    (c->x_log_param && xl > 0 && xh / xl > 10.0);
     bool y_log_ok = !c->x_log_ok && strcmp(c->name, "speed_accuracy") != 0 && ypos > 0 &&
                     yh / ypos > 10.0;
     /* Times never go below zero; a swept parameter or SSIM may. */
@@ -823,9 +827,11 @@ char *charts_sweep(const json_t *sweep, const char *name, enum chart_format form
         snprintf(err, errlen, "out of memory");
         return NULL;
     }
-    /* The first swept parameter: the first key of a grid point's values
-     * other than a timed reference point's technique. */
-    const char *param = NULL;
+    /* The x axis: the first numeric swept parameter, as the report's
+     * crossovers use (a sweep over technique and light count charts time
+     * against the light count, a line per technique); with none, the first
+     * swept parameter other than a timed reference point's technique. */
+    const char *param = NULL, *numeric = NULL;
     size_t i;
     json_t *row;
     json_array_foreach(points, i, row) {
@@ -835,11 +841,14 @@ char *charts_sweep(const json_t *sweep, const char *name, enum chart_format form
             if (!param && !(strcmp(key, "technique") == 0 &&
                             json_object_size(json_object_get(row, "values")) == 1))
                 param = key;
+            if (!numeric && json_is_number(v))
+                numeric = key;
         }
-        if (param)
-            break;
     }
+    if (numeric)
+        param = numeric;
     c.x_log_ok = sa;
+    c.x_log_param = tvp;
     bool any_runs = false;
     json_array_foreach(points, i, row) {
         json_t *t = json_object_get(row, series);

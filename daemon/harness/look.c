@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "common/result_keys.h"
 #include "common/clock.h"
 #include "daemon/lighting/pbr_math.h"
 #include "daemon/lighting/shadow_plan.h"
@@ -116,7 +117,7 @@ void harness_look_describe(const struct harness_look *l, json_t *result)
     if (l->ibl)
         json_object_set_new(result, "ibl", harness_ibl_describe(l->ibl));
     if (l->shadows)
-        json_object_set_new(result, "shadows", harness_shadows_describe(l->shadows));
+        json_object_set_new(result, RK_SHADOWS, harness_shadows_describe(l->shadows));
     if (l->ibl || l->shadows || l->sky_on)
         json_object_set_new(result, "setup_ms",
                             json_pack("{s:f, s:s}", "look", l->setup_ms, "includes",

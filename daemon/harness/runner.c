@@ -267,7 +267,7 @@ static json_t *nonfinite_summary(const struct run *run)
         with += px > 0;
     }
     return json_pack("{s:i, s:I, s:I, s:o, s:s}", RK_CAPTURES, run->capture_count,
-                     "captures_with_nonfinite", with, "pixels_max", worst, "finite",
+                     "captures_with_nonfinite", with, RK_PIXELS_MAX, worst, RK_FINITE,
                      run->capture_count ? json_boolean(with == 0) : json_null(), "counted",
                      "pixels of the HDR colour the resolve read, at each captured frame, with "
                      "R, G or B NaN, infinite, or (rgba16f) at 65504, where a driver that "
@@ -417,7 +417,7 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
     double timed_wall = wall_s - capture_s;
     result = json_pack(
         "{s:s, s:i, s:i, s:f, s:f, s:f, s:o, s:o, s:o, s:I, s:i, s:i, s:o, s:s, s:s, s:I, s:O}",
-        "technique", run->tech->info->name, "frames", n, "warmup_frames", w0, RK_WALL_S,
+        RK_TECHNIQUE, run->tech->info->name, "frames", n, "warmup_frames", w0, RK_WALL_S,
         timed_wall, "wall_s_including_captures", wall_s, RK_FPS,
         timed_wall > 0 ? n / timed_wall : 0.0, RK_GPU_MS, stats_json(gpu, (size_t)n),
         RK_CPU_MS, stats_json(run->cpu_ms, (size_t)n), RK_FRAME_MS,
@@ -445,7 +445,7 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
     }
     json_object_set_new(result, "gpu_sections_ms", by_section);
     json_object_set_new(result, "look", look_spec_to_json(&run->spec->look));
-    json_object_set_new(result, "nonfinite", nonfinite_summary(run)); /* post hook */
+    json_object_set_new(result, RK_NONFINITE, nonfinite_summary(run)); /* post hook */
     harness_look_describe(&run->hlook, result);
     json_object_set_new(result, "targets_bytes", json_real(gpu_targets_bytes(run->runner->targets)));
     if (run->heatmap)
@@ -457,7 +457,7 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
     if (run->tech->describe) {
         json_t *d = run->tech->describe(run->state);
         if (d)
-            json_object_set_new(result, run->tech->info->name, d);
+            json_object_set_new(result, run->tech->info->name, d); /* RK_TECHNIQUE */
     }
     snprintf(path, sizeof(path), "%s/result.json", job->dir);
     if (!fs_write_json_atomic(path, result)) {

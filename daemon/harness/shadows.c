@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/result_keys.h"
 #include "daemon/gpu/bindings.h"
 #include "daemon/gpu/glutil.h"
 #include "daemon/lighting/cube_faces.h"
@@ -298,7 +299,7 @@ json_t *harness_shadows_describe(const struct harness_shadows *sh)
         sh->texels_sum / n, "texels_max", sh->texels_max, "fraction_mean",
         sh->texels_sum / n / capacity, "fraction_max", sh->texels_max / capacity, "faces_per_frame",
         sh->faces_sum / n, "caster_draws_per_frame", sh->draws_sum / n, "faces_by_size_at_frame_1",
-        tiles, "overflow", "policy", shadow_overflow_names[spec->overflow], "frames_with_drops",
+        tiles, RK_OVERFLOW, "policy", shadow_overflow_names[spec->overflow], RK_FRAMES_WITH_DROPS,
         sh->frames_with_drops, "dropped_mean", sh->dropped_sum / n, "dropped_max",
         sh->dropped_max, "lights_dropped", sh->dropped_distinct, "lights", dropped, "rule",
         "lights that needed a map but did not fit the atlas at min_tile, least important "

@@ -307,6 +307,8 @@ static bool parse_criterion(const char *text, struct sweep_spec *s)
         s->criterion = CRITERION_STABLE;
     else if (strcmp(text, "finite") == 0)
         s->criterion = CRITERION_FINITE;
+    else if (strcmp(text, "no_overflow") == 0)
+        s->criterion = CRITERION_NO_OVERFLOW;
     else if (sscanf(text, "ssim_min >= %lf%1s", &x, tail) == 1 && x >= -1 && x <= 1)
         s->criterion = CRITERION_SSIM_MIN, s->threshold = x;
     else if (sscanf(text, "flip_max <= %lf%1s", &x, tail) == 1 && x >= 0 && x <= 1)
@@ -391,7 +393,7 @@ static bool parse_into(const json_t *body, const struct technique_catalog *techn
 
     if (vary) {
         out->kind = SWEEP_VARY;
-        if (!json_is_object(vary) || json_object_size(vary) < 1 || json_object_size(vary) > 2)
+        if (!json_is_object(vary) || json_object_size(vary) < 1 || json_object_size(vary) > SWEEP_MAX_PARAMS)
             return job_error_set(err, "vary", "must be an object of one or two parameters, each with a list of values");
         out->npoints = 1;
         json_object_foreach(vary, key, v) {
@@ -475,7 +477,7 @@ static bool parse_into(const json_t *body, const struct technique_catalog *techn
     const char *crit = json_string_value(json_object_get(find, "while"));
     if (!crit || !parse_criterion(crit, out))
         return job_error_set(err, "find.while", "must be one of \"pdiff_pass\", \"stable\", "
-                    "\"finite\", \"ssim_min >= X\", \"flip_max <= X\"");
+                    "\"finite\", \"no_overflow\", \"ssim_min >= X\", \"flip_max <= X\"");
     out->max_probes = 10;
     json_t *steps = json_object_get(find, "steps");
     if (steps) {
@@ -536,17 +538,20 @@ json_t *sweep_point_job(const struct sweep_spec *s, size_t index, json_t **value
         return job;
     }
     json_t *job = json_deep_copy(s->base);
-    *values = json_object();
+    json_t *chosen[SWEEP_MAX_PARAMS];
     /* Row-major: the last parameter varies fastest. */
     for (int p = s->nparams - 1; p >= 0; p--) {
         size_t n = json_array_size(s->values[p]);
-        json_t *value = json_array_get(s->values[p], index % n);
+        chosen[p] = json_array_get(s->values[p], index % n);
         index /= n;
-        json_t *next = with_field(job, s->params[p], value);
+        json_t *next = with_field(job, s->params[p], chosen[p]);
         json_decref(job);
         job = next;
-        json_object_set(*values, s->params[p], value);
     }
+    /* values keep the order of vary: the first is the charts' axis. */
+    *values = json_object();
+    for (int p = 0; p < s->nparams; p++)
+        json_object_set(*values, s->params[p], chosen[p]);
     return point_defaults(s, job);
 }
 
@@ -580,9 +585,25 @@ bool sweep_criterion_holds(const struct sweep_spec *s, const json_t *result)
     case CRITERION_STABLE:
         return json_is_true(json_object_get(json_object_get(result, RK_REPEAT), RK_STABLE));
     case CRITERION_FINITE:
-        return json_is_true(json_object_get(json_object_get(result, "nonfinite"), "finite"));
+        return json_is_true(json_object_get(json_object_get(result, RK_NONFINITE), RK_FINITE));
+    case CRITERION_NO_OVERFLOW: {
+        json_int_t lists, shadows;
+        sweep_overflow_frames(result, &lists, &shadows);
+        return lists <= 0 && shadows <= 0;
+    }
     }
     return false;
+}
+
+void sweep_overflow_frames(const json_t *result, json_int_t *light_lists, json_int_t *shadows)
+{
+    const char *tech = json_string_value(json_object_get(result, RK_TECHNIQUE));
+    json_t *own = tech ? json_object_get(result, tech) : NULL;
+    json_t *f = json_object_get(json_object_get(own, RK_OVERFLOW), RK_OVERFLOW_FRAMES);
+    *light_lists = json_is_integer(f) ? json_integer_value(f) : -1;
+    f = json_object_get(json_object_get(json_object_get(result, RK_SHADOWS), RK_OVERFLOW),
+                        RK_FRAMES_WITH_DROPS);
+    *shadows = json_is_integer(f) ? json_integer_value(f) : -1;
 }
 
 void sweep_bisect(double from, double to, bool integer, int max_probes,

@@ -13,18 +13,21 @@
 #include "daemon/jobs/job_spec.h"
 
 #define SWEEP_MAX_POINTS 256
+/* Fields a grid may vary at once. */
+#define SWEEP_MAX_PARAMS 2
 
 enum sweep_kind { SWEEP_VARY, SWEEP_FIND };
 
 enum sweep_criterion { CRITERION_PDIFF_PASS, CRITERION_SSIM_MIN, CRITERION_FLIP_MAX, CRITERION_STABLE,
-                       CRITERION_FINITE /* no capture had NaN or infinite HDR pixels */ };
+                       CRITERION_FINITE,     /* no capture had NaN or infinite HDR pixels */
+                       CRITERION_NO_OVERFLOW /* no light list overflowed, no shadow dropped */ };
 
 struct sweep_spec {
     enum sweep_kind kind;
     json_t *base;           /* the base job, as given */
     int nparams;
-    char params[2][64];     /* dotted paths */
-    json_t *values[2];      /* arrays, for SWEEP_VARY */
+    char params[SWEEP_MAX_PARAMS][64]; /* dotted paths, in the order vary gives them */
+    json_t *values[SWEEP_MAX_PARAMS]; /* arrays, for SWEEP_VARY */
     size_t npoints;         /* the grid, then the timed reference points */
     size_t ngrid;           /* SWEEP_VARY: points of the grid itself */
     json_t *reference_values; /* SWEEP_VARY: values of each timed reference point */
@@ -64,6 +67,13 @@ json_t *sweep_probe_job(const struct sweep_spec *s, double v);
 
 /* Does a finished job's result meet the criterion? */
 bool sweep_criterion_holds(const struct sweep_spec *s, const json_t *result);
+
+/* The frames of a result in which the technique's bounded light lists
+ * overflowed (result[technique].overflow.frames) and in which the shadow
+ * atlas dropped lights (result.shadows.overflow.frames_with_drops); -1 for
+ * a record the result does not have (a technique without light lists, a
+ * look without shadows). */
+void sweep_overflow_frames(const json_t *result, json_int_t *light_lists, json_int_t *shadows);
 
 /* Bisection for the largest value in [from, to] at which holds() is true,
  * for a criterion that holds below some boundary and fails above it. Probes

@@ -212,9 +212,16 @@ static json_t *point_row(const json_t *job, json_t *values)
         json_object_set(row, RK_PDIFF_FAILED_CAPTURES, json_object_get(q, RK_PDIFF_FAILED_CAPTURES));
     }
     /* Post hook: the worst capture's non-finite pixels, for breaking points. */
-    json_t *nonfinite = json_object_get(r, "nonfinite");
+    json_t *nonfinite = json_object_get(r, RK_NONFINITE);
     if (nonfinite)
-        json_object_set(row, "nonfinite_pixels", json_object_get(nonfinite, "pixels_max"));
+        json_object_set(row, "nonfinite_pixels", json_object_get(nonfinite, RK_PIXELS_MAX));
+    /* Bounded light lists and the shadow atlas: where they overflow. */
+    json_int_t lists, shadows;
+    sweep_overflow_frames(r, &lists, &shadows);
+    if (lists >= 0)
+        json_object_set_new(row, "light_overflow_frames", json_integer(lists));
+    if (shadows >= 0)
+        json_object_set_new(row, "shadow_drop_frames", json_integer(shadows));
     return row;
 }
 

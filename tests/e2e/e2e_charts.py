@@ -1,5 +1,5 @@
 """Charts that cannot mislead, and shadebench sweep, end to end: a sweep over
-two workloads (2 and 40 lights) and two async distances, repeated twice,
+two async distances and two workloads (2 and 40 lights), repeated twice,
 run through the client, which downloads the table (JSON and CSV), charts
 and report and turns the criteria into JUnit cases. The charts' SVG carries
 its layout: no Pareto front joins points of two workloads, forward (the
@@ -21,7 +21,7 @@ testlib.skip_without_egl()
 SWEEP = {"base": {"technique": "osl", "frames": 8, "warmup_frames": 2, "repeat": 2,
                   "osl": {"resolution": "auto"},
                   "scene": {"dynamic": True, "width": 160, "height": 120}},
-         "vary": {"scene.lights": [2, 40], "async_distance": [0, 5]}}
+         "vary": {"async_distance": [0, 5], "scene.lights": [2, 40]}}
 
 
 def layout(path):

@@ -9,7 +9,8 @@ e2e_techniques.py:
   SSIM);
 - overflow is never silent: a tiny max_lights_per_cluster with many lights
   is counted per frame; under "fallback" the image still matches, under
-  "fail" the job fails naming the option and the overflow;
+  "fail" the job fails naming the option and the overflow; a sweep's
+  no_overflow criterion bisects the light count to the bound;
 - the heat map: served as a PNG per capture, with a mean and max that grow
   with the light count;
 - frame k is a pure function of k (the same capture after 1 or 3 warm-up
@@ -18,7 +19,9 @@ e2e_techniques.py:
   fails the job at create, naming the field.
 Small frames (160x120), few frames, so the suite stays short on 2 cores."""
 
+import json
 import os
+import xml.etree.ElementTree as ET
 
 import testlib
 from testlib import check
@@ -26,6 +29,13 @@ from testlib import check
 testlib.skip_without_egl()
 
 SSIM_BOUND = 0.999
+
+
+def layout_of(path):
+    """The layout a chart's SVG carries in its metadata."""
+    meta = [e for e in ET.parse(path).getroot().iter()
+            if e.tag.endswith("metadata") and e.get("id") == "shadebench-chart"]
+    return json.loads(meta[0].text) if meta else None
 TECHS = ["deferred", "tiled_deferred", "forward_plus", "clustered_forward", "clustered_deferred"]
 
 
@@ -122,6 +132,56 @@ try:
         check(done.get("status") == "failed" and "overflow" in err
               and "%s.max_lights_per_cluster" % tech in err,
               "%s overflow fail fails the job naming it: %s %s" % (tech, done.get("status"), err))
+    # A sweep finds the light count from which a cluster bound overflows:
+    # the breaking point's fullest cluster fits the bound, the first failing
+    # count's does not, and every row counts its overflowing frames.
+    tight = 8
+    status, sub = d.json("POST", "/v1/sweeps", {
+        "base": {"technique": "clustered_deferred", "frames": 2, "warmup_frames": 0, "capture_interval": 2,
+                 "scene": {"preset": "lights", "width": 160, "height": 120},
+                 "clustered_deferred": {"max_lights_per_cluster": tight}},
+        "find": {"param": "scene.lights", "from": 1, "to": 1024, "while": "no_overflow", "steps": 12}})
+    sw = d.wait_sweep(sub["id"]) if status == 202 else {}
+    bp = sw.get("result", {}).get("breaking_point", {})
+    rows = {r["values"]["scene.lights"]: r for r in sw.get("points", [])}
+    check(sw.get("status") == "done" and bp.get("outcome") == "boundary" and bp.get("criterion") == "no_overflow"
+          and bp.get("first_failing") == bp.get("value", -2) + 1, "no_overflow bisects to a boundary: %s" % bp)
+
+    def fullest(n):
+        r = d.json("GET", "/v1/jobs/" + rows[n]["job"])[1].get("result", {})
+        return r.get("clustered_deferred", {}).get("lights_per_cell", {}).get("fullest", {}).get("max", -1)
+    if bp.get("outcome") == "boundary":
+        ok, bad = rows[bp["value"]], rows[bp["first_failing"]]
+        check(ok.get("light_overflow_frames") == 0 and bad.get("light_overflow_frames") == 2 and
+              ok.get("criterion_holds") is True and bad.get("criterion_holds") is False,
+              "rows count the overflowing frames: %s / %s" % (ok.get("light_overflow_frames"),
+                                                              bad.get("light_overflow_frames")))
+        check(0 < fullest(bp["value"]) <= tight < fullest(bp["first_failing"]),
+              "the breaking point is where the fullest cluster passes the bound: %s, %s"
+              % (fullest(bp["value"]), fullest(bp["first_failing"])))
+
+    # A sweep over technique and light count charts time against the light
+    # count, a line per technique, and its report names the crossovers.
+    status, sub = d.json("POST", "/v1/sweeps", {
+        "base": {"frames": 2, "warmup_frames": 0, "capture_interval": 2,
+                 "scene": {"preset": "lights", "width": 160, "height": 120}},
+        "vary": {"technique": ["forward", "clustered_deferred"], "scene.lights": [4, 64]}})
+    sw = d.wait_sweep(sub["id"]) if status == 202 else {}
+    check(sw.get("status") == "done" and len(sw.get("points", [])) == 4 and
+          list(sw["points"][0]["values"]) == ["technique", "scene.lights"],
+          "a grid over technique and light count, values in vary's order")
+    path = os.path.join(d.tmp, "tvp.svg")
+    tvp = (layout_of(path) if d.download("/v1/sweeps/%s/charts/time_vs_param.svg" % sub.get("id"), path) == 200
+           else None) or {}
+    pts = tvp.get("points", [])
+    check(sorted({p["x"] for p in pts}) == [4, 64] and
+          {p["series"] for p in pts} == {"forward (reference)", "clustered_deferred"} and
+          "scene.lights" in tvp.get("xlabel", "") and tvp.get("x_log") is True,
+          "time_vs_param: x is the light count (log), a line per technique: %s %s"
+          % (tvp.get("xlabel"), sorted({p.get("series") for p in pts})))
+    page = d.request("GET", "/v1/sweeps/%s/report.html" % sub.get("id"))[2].decode()
+    check("<h2>Verdict</h2>" in page and "scene.lights" in page, "the report's verdict reads along the light count")
+
     # No overflow at defaults: the counters read zero.
     done = d.run(job("clustered_forward", 64, capture=0, reference=None))
     ov = done.get("result", {}).get("clustered_forward", {}).get("overflow", {})

@@ -81,6 +81,11 @@ int main(void)
     json_t *values, *job = sweep_point_job(&s, 3, &values);
     CHECK(json_integer_value(json_object_get(values, "async_distance")) == 5);
     CHECK(json_integer_value(json_object_get(values, "scene.lights")) == 8);
+    /* values keep vary's order: the charts' x axis is the first. */
+    {
+        void *it = json_object_iter(values);
+        CHECK(it && !strcmp(json_object_iter_key(it), "async_distance"));
+    }
     CHECK(json_integer_value(json_object_get(json_object_get(job, "scene"), "lights")) == 8);
     CHECK(strcmp(json_string_value(json_object_get(job, "reference")), "forward") == 0);
     CHECK(json_integer_value(json_object_get(job, "capture_interval")) == 20);
@@ -128,6 +133,32 @@ int main(void)
     result = json_pack("{s:{s:{s:f}}}", "quality", "worst_ssim_min", "value", 0.90);
     CHECK(!sweep_criterion_holds(&s, result));
     json_decref(result);
+    sweep_spec_finish(&s);
+    /* no_overflow: light lists and the shadow atlas; a result without
+     * either record has nothing to overflow. */
+    CHECK(parse("{\"base\":{},\"find\":{\"param\":"
+                "\"scene.lights\",\"from\":1,\"to\":4096,\"while\":\"no_overflow\"}}", &s, &err));
+    CHECK(s.criterion == CRITERION_NO_OVERFLOW);
+    {
+        static const char *const cases[][2] = {
+            {"{\"technique\":\"clustered_deferred\",\"clustered_deferred\":{\"overflow\":{\"frames\":0}}}", "1"},
+            {"{\"technique\":\"clustered_deferred\",\"clustered_deferred\":{\"overflow\":{\"frames\":3}}}", "0"},
+            {"{\"technique\":\"forward\",\"clustered_deferred\":{\"overflow\":{\"frames\":3}}}", "1"},
+            {"{\"technique\":\"forward\",\"shadows\":{\"overflow\":{\"frames_with_drops\":1}}}", "0"},
+            {"{\"technique\":\"forward\",\"shadows\":{\"overflow\":{\"frames_with_drops\":0}}}", "1"},
+            {"{\"technique\":\"forward\"}", "1"},
+        };
+        for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
+            json_t *r = json_loads(cases[i][0], 0, NULL);
+            CHECK(r && sweep_criterion_holds(&s, r) == (cases[i][1][0] == '1'));
+            json_decref(r);
+        }
+        json_int_t lists, shadows;
+        json_t *r = json_loads(cases[3][0], 0, NULL);
+        sweep_overflow_frames(r, &lists, &shadows);
+        CHECK(lists == -1 && shadows == 1);
+        json_decref(r);
+    }
     sweep_spec_finish(&s);
     CHECK(parse("{\"base\":{},\"find\":{\"param\":\"scene.lights\",\"from\":1,\"to\":64,"
                 "\"while\":\"stable\"}}", &s, &err) && s.integer);

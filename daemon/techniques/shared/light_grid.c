@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/result_keys.h"
 #include "common/clock.h"
 #include "common/log.h"
 #include "common/stats.h"
@@ -525,7 +526,7 @@ json_t *light_grid_describe(struct light_grid *g)
                         json_string("mean: lights per non-empty cell; fullest: the longest "
                                     "list a frame needed (before any bound)"));
     json_object_set_new(out, "lights_per_cell", per_cell);
-    json_t *ov = json_pack("{s:i, s:o}", "frames", overflow_frames, "first_frame",
+    json_t *ov = json_pack("{s:i, s:o}", RK_OVERFLOW_FRAMES, overflow_frames, "first_frame",
                            first ? json_integer(first) : json_null());
     for (int k = 1; k <= n; k++)
         v[k - 1] = g->stats[k].overflow_cells;
@@ -537,7 +538,7 @@ json_t *light_grid_describe(struct light_grid *g)
                         json_string(tiles || g->cfg.overflow == CLUSTER_OVERFLOW_FALLBACK
                                         ? "overflowed cells shade with every light"
                                         : "the job fails"));
-    json_object_set_new(out, "overflow", ov);
+    json_object_set_new(out, RK_OVERFLOW, ov);
     struct stats st;
     stats_compute(g->bin_ms + 1, (size_t)n, &st);
     json_object_set_new(out, "binning_cpu_ms",

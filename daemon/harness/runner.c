@@ -457,7 +457,7 @@ static json_t *write_outputs(struct run *run, double wall_s, double capture_s)
     if (run->tech->describe) {
         json_t *d = run->tech->describe(run->state);
         if (d)
-            json_object_set_new(result, run->tech->info->name, d); /* RK_TECHNIQUE */
+            json_object_set_new(result, run->tech->info->name, d); /* result[result.technique] */
     }
     snprintf(path, sizeof(path), "%s/result.json", job->dir);
     if (!fs_write_json_atomic(path, result)) {

@@ -595,6 +595,18 @@ bool sweep_criterion_holds(const struct sweep_spec *s, const json_t *result)
     return false;
 }
 
+const char *sweep_criterion_unjudged(const struct sweep_spec *s, const json_t *result)
+{
+    if (s->criterion != CRITERION_NO_OVERFLOW)
+        return NULL;
+    json_int_t lists, shadows;
+    sweep_overflow_frames(result, &lists, &shadows);
+    if (lists < 0 && shadows < 0)
+        return "\"no_overflow\" needs bounded light lists (tiled_deferred, forward_plus, "
+               "clustered_forward, clustered_deferred) or look.shadows, and the job has neither";
+    return NULL;
+}
+
 void sweep_overflow_frames(const json_t *result, json_int_t *light_lists, json_int_t *shadows)
 {
     const char *tech = json_string_value(json_object_get(result, RK_TECHNIQUE));

@@ -68,6 +68,11 @@ json_t *sweep_probe_job(const struct sweep_spec *s, double v);
 /* Does a finished job's result meet the criterion? */
 bool sweep_criterion_holds(const struct sweep_spec *s, const json_t *result);
 
+/* NULL when the result carries what the criterion reads; otherwise why it
+ * cannot be judged (no_overflow on a technique without bounded light lists
+ * and a look without shadows would hold everywhere and find nothing). */
+const char *sweep_criterion_unjudged(const struct sweep_spec *s, const json_t *result);
+
 /* The frames of a result in which the technique's bounded light lists
  * overflowed (result[technique].overflow.frames) and in which the shadow
  * atlas dropped lights (result.shadows.overflow.frames_with_drops); -1 for

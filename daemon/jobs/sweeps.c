@@ -347,12 +347,15 @@ static int probe(double v, void *arg)
     json_object_set_new(values, c->sw->spec.params[0],
                         c->sw->spec.integer ? json_integer((json_int_t)v) : json_real(v));
     json_t *row = point_row(job, values);
-    if (strcmp(json_string_value(json_object_get(job, "status")), "done") == 0)
-        holds = sweep_criterion_holds(&c->sw->spec, json_object_get(job, RK_RESULT));
-    else
+    const char *unjudged = NULL;
+    if (strcmp(json_string_value(json_object_get(job, "status")), "done") != 0)
         snprintf(c->sw->error, sizeof(c->sw->error), "probe at %g %s: %s", v,
                  json_string_value(json_object_get(job, "status")),
                  json_string_value(json_object_get(job, "error")) ? json_string_value(json_object_get(job, "error")) : "");
+    else if ((unjudged = sweep_criterion_unjudged(&c->sw->spec, json_object_get(job, RK_RESULT))))
+        snprintf(c->sw->error, sizeof(c->sw->error), "find.while: %s", unjudged);
+    else
+        holds = sweep_criterion_holds(&c->sw->spec, json_object_get(job, RK_RESULT));
     if (holds >= 0)
         json_object_set_new(row, "criterion_holds", json_boolean(holds));
     add_row(c->s, c->sw, row);

@@ -36,6 +36,8 @@ def layout_of(path):
     meta = [e for e in ET.parse(path).getroot().iter()
             if e.tag.endswith("metadata") and e.get("id") == "shadebench-chart"]
     return json.loads(meta[0].text) if meta else None
+
+
 TECHS = ["deferred", "tiled_deferred", "forward_plus", "clustered_forward", "clustered_deferred"]
 
 
@@ -159,6 +161,17 @@ try:
         check(0 < fullest(bp["value"]) <= tight < fullest(bp["first_failing"]),
               "the breaking point is where the fullest cluster passes the bound: %s, %s"
               % (fullest(bp["value"]), fullest(bp["first_failing"])))
+
+    # Nothing bounded to overflow: the sweep fails on its first probe,
+    # naming the criterion, instead of finding that it holds everywhere.
+    status, sub = d.json("POST", "/v1/sweeps", {
+        "base": {"technique": "forward", "frames": 2, "warmup_frames": 0, "capture_interval": 2,
+                 "scene": {"preset": "lights", "width": 160, "height": 120}},
+        "find": {"param": "scene.lights", "from": 1, "to": 64, "while": "no_overflow"}})
+    sw = d.wait_sweep(sub["id"]) if status == 202 else {}
+    check(sw.get("status") == "failed" and sw.get("error", "").startswith("find.while:") and
+          "look.shadows" in sw.get("error", "") and len(sw.get("points", [])) == 1,
+          "no_overflow on forward fails naming the criterion: %s %s" % (sw.get("status"), sw.get("error")))
 
     # A sweep over technique and light count charts time against the light
     # count, a line per technique, and its report names the crossovers.

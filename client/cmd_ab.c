@@ -51,7 +51,7 @@ static size_t clean_pairs(const struct run_set *sa, const struct run_set *sb, do
     return k;
 }
 
-/* With too few clean pairs, the noisy ones still decide when the CPU their
+/* With too few clean pairs to decide, the noisy ones still decide when the CPU their
  * runs were short of cannot explain the difference: a regression if B/A
  * stays one with every B bounded down by its pair's CPU change, a pass if it
  * stays one with every B bounded up. (A 20-fold slowdown is not made
@@ -154,6 +154,10 @@ int cmd_ab(struct conn *ca, struct conn *cb, const struct options *o, const char
         struct ratio_interval r;
         if (nclean >= 2 && paired_log_ratio(va, vb, nclean, o->confidence, &r)) {
             gate_decide(&r, o->max_slowdown, &v);
+            /* Two or three clean pairs give an interval too wide to decide
+             * on; the noisy ones, bounded, may still settle it. */
+            if (v.outcome == GATE_INCONCLUSIVE && nclean < sa.n)
+                bounded_verdict(&sa, &sb, o, va, vb, &v);
         } else if (!bounded_verdict(&sa, &sb, o, va, vb, &v)) {
             /* Too few clean pairs to decide; still report all the pairs. */
             memset(&v, 0, sizeof(v));

@@ -107,7 +107,7 @@ static int default_runs(const char *file)
     return n > 1 ? (n > 100 ? 100 : n) : 5;
 }
 
-/* With too few clean runs, all the runs still decide when the CPU the noisy
+/* With too few clean runs to decide, all the runs still decide when the CPU the noisy
  * ones lacked or had in excess cannot explain the difference: a regression
  * if it holds with the new runs bounded down and the baseline's up (each by
  * its CPU change against the reference share), a pass if it holds the other
@@ -160,8 +160,14 @@ static void evaluate(const struct options *o, struct gate_run *base, size_t nb, 
     *nb_clean = bv ? gate_clean_values(base, nb, bv) : 0;
     *nc_clean = cv ? gate_clean_values(s->runs, s->n, cv) : 0;
     gate_compare(bv, *nb_clean, cv, *nc_clean, o->confidence, o->max_slowdown, v);
-    bool too_few = v->outcome == GATE_INCONCLUSIVE && v->r.ratio == 0 && bv && cv;
-    if (too_few && !bounded_verdict(o, base, nb, s, have, ref, bv, cv, v)) {
+    /* Too few clean runs for an interval, or an interval too wide to
+     * decide while noisy runs were left out: the bounded runs may settle it. */
+    bool undecided = v->outcome == GATE_INCONCLUSIVE && bv && cv;
+    bool too_few = undecided && v->r.ratio == 0;
+    bool left_out = *nb_clean < nb || *nc_clean < s->n;
+    bool settled = undecided && (too_few || left_out) &&
+                   bounded_verdict(o, base, nb, s, have, ref, bv, cv, v);
+    if (too_few && !settled) {
         /* Too few clean runs to decide: still report what all the runs,
          * noisy ones included, say, so that the log is not empty. */
         for (size_t i = 0; i < nb; i++)

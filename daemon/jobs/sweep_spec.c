@@ -321,20 +321,28 @@ static bool parse_criterion(const char *text, struct sweep_spec *s)
 /* The thesis's experiment (chapter 3.3): forward and OSL (256 texels an
  * object, async distance 20) with still and moving lights on the grid at
  * 1080x720, repeated, captures judged with SSIM and PerceptualDiff at 22.6
- * degrees. frames and repeat may be lowered to fit a slow machine. */
+ * degrees. frames, warmup_frames and repeat may be lowered to fit a slow
+ * machine. */
 static json_t *thesis_sweep(const json_t *body, struct job_error *err)
 {
     const char *key;
     json_t *v;
     json_object_foreach((json_t *)body, key, v) if (strcmp(key, "preset") && strcmp(key, "frames") &&
+                                                  strcmp(key, "warmup_frames") &&
                                                   strcmp(key, "repeat")) {
-        job_error_set(err, key, "unknown field (the thesis preset takes frames and repeat)");
+        job_error_set(err, key, "unknown field (the thesis preset takes frames, warmup_frames and repeat)");
         return NULL;
     }
     json_t *frames = json_object_get(body, "frames"), *repeat = json_object_get(body, "repeat");
+    json_t *warmup = json_object_get(body, "warmup_frames");
     if (frames && (!json_is_integer(frames) || json_integer_value(frames) < 1 ||
                    json_integer_value(frames) > 100000)) {
         job_error_set(err, "frames", "must be an integer from 1 to 100000");
+        return NULL;
+    }
+    if (warmup && (!json_is_integer(warmup) || json_integer_value(warmup) < 0 ||
+                   json_integer_value(warmup) > 10000)) {
+        job_error_set(err, "warmup_frames", "must be an integer from 0 to 10000");
         return NULL;
     }
     if (repeat && (!json_is_integer(repeat) || json_integer_value(repeat) < 1 ||
@@ -346,7 +354,8 @@ static json_t *thesis_sweep(const json_t *body, struct job_error *err)
     json_t *base = json_pack(
         "{s:s, s:I, s:i, s:I, s:f, s:{s:i}, s:I, s:s, s:{s:b, s:{s:f}, s:b, s:b},"
         " s:{s:s, s:i, s:b, s:i, s:i}}",
-        "technique", "forward", "frames", n, "warmup_frames", 10, "capture_interval",
+        "technique", "forward", "frames", n, "warmup_frames",
+        warmup ? json_integer_value(warmup) : (json_int_t)10, "capture_interval",
         n >= 3 ? n / 3 : n, "async_distance", 20.0, "osl", "resolution", 256, "repeat",
         repeat ? json_integer_value(repeat) : (json_int_t)5, "reference", "forward", "metrics",
         "ssim", 1, "pdiff", "fov", 22.6, "psnr", 0, "flip", 0, "scene", "preset", "grid", "lights",

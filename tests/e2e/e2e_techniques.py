@@ -22,6 +22,13 @@ testlib.skip_without_egl()
 SSIM_BOUND = 0.995
 SCENE = {"width": 160, "height": 120, "dynamic": True}
 JOB = {"frames": 4, "warmup_frames": 1, "capture_interval": 4, "scene": SCENE}
+# Options for the checks past the defaults one (moving camera, Blinn-Phong),
+# which test that every pass sees the camera and the look, not the default
+# options again: OSL at its default 256 texels an object costs 90 to 150 s a
+# job on llvmpipe, with "auto" tiles under 2 s (SSIM 0.9989 and 0.9992).
+# PBR keeps the defaults: OSL's undersampled GGX highlights drop to SSIM
+# 0.9945 at 128 texels, and the check is that the default agrees.
+CHEAP = {"osl": {"resolution": "auto"}}
 
 
 def bad_value(opt):
@@ -98,6 +105,8 @@ try:
             # camera reaches every pass of the technique.
             moving = dict(JOB, technique=name, reference="forward",
                           scene=dict(SCENE, preset="lights", lights=64, camera="orbit"))
+            if name in CHEAP:
+                moving[name] = CHEAP[name]
             done = d.run(moving)
             ssim = done.get("result", {}).get("quality", {}).get("worst_ssim", {}).get("value", 0)
             check(done.get("status") == "done" and ssim >= SSIM_BOUND,
@@ -120,7 +129,7 @@ try:
         d.download(done["result"]["captures"][-1]["url"], paths[lighting])
     diff = testlib.png_diff(paths["phong"], paths["blinn_phong"])
     check(diff and diff["max_abs"] > 0, "Blinn-Phong differs from Phong: %s" % diff)
-    done = d.run(dict(JOB, technique="osl", reference="forward", look={"lighting": "blinn_phong"}))
+    done = d.run(dict(JOB, technique="osl", reference="forward", look={"lighting": "blinn_phong"}, **CHEAP))
     ssim = done.get("result", {}).get("quality", {}).get("worst_ssim", {}).get("value", 0)
     check(ssim >= SSIM_BOUND, "osl with Blinn-Phong agrees with forward with Blinn-Phong: %.5f" % ssim)
     diff = testlib.png_diff(paths["phong"], paths["pbr"])

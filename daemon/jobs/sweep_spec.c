@@ -325,39 +325,19 @@ static bool parse_criterion(const char *text, struct sweep_spec *s)
  * machine. */
 static json_t *thesis_sweep(const json_t *body, struct job_error *err)
 {
-    const char *key;
-    json_t *v;
-    json_object_foreach((json_t *)body, key, v) if (strcmp(key, "preset") && strcmp(key, "frames") &&
-                                                  strcmp(key, "warmup_frames") &&
-                                                  strcmp(key, "repeat")) {
-        job_error_set(err, key, "unknown field (the thesis preset takes frames, warmup_frames and repeat)");
+    static const char *const keys[] = {"preset", "frames", "warmup_frames", "repeat", NULL};
+    int n = 300, warmup = 10, repeat = 5;
+    if (!jf_check_keys(body, "", keys, err) ||
+        !jf_get_int(body, "frames", "frames", 1, 100000, &n, err) ||
+        !jf_get_int(body, "warmup_frames", "warmup_frames", 0, 10000, &warmup, err) ||
+        !jf_get_int(body, "repeat", "repeat", 1, 1000, &repeat, err))
         return NULL;
-    }
-    json_t *frames = json_object_get(body, "frames"), *repeat = json_object_get(body, "repeat");
-    json_t *warmup = json_object_get(body, "warmup_frames");
-    if (frames && (!json_is_integer(frames) || json_integer_value(frames) < 1 ||
-                   json_integer_value(frames) > 100000)) {
-        job_error_set(err, "frames", "must be an integer from 1 to 100000");
-        return NULL;
-    }
-    if (warmup && (!json_is_integer(warmup) || json_integer_value(warmup) < 0 ||
-                   json_integer_value(warmup) > 10000)) {
-        job_error_set(err, "warmup_frames", "must be an integer from 0 to 10000");
-        return NULL;
-    }
-    if (repeat && (!json_is_integer(repeat) || json_integer_value(repeat) < 1 ||
-                   json_integer_value(repeat) > 1000)) {
-        job_error_set(err, "repeat", "must be an integer from 1 to 1000");
-        return NULL;
-    }
-    json_int_t n = frames ? json_integer_value(frames) : 300;
     json_t *base = json_pack(
-        "{s:s, s:I, s:i, s:I, s:f, s:{s:i}, s:I, s:s, s:{s:b, s:{s:f}, s:b, s:b},"
+        "{s:s, s:i, s:i, s:i, s:f, s:{s:i}, s:i, s:s, s:{s:b, s:{s:f}, s:b, s:b},"
         " s:{s:s, s:i, s:b, s:i, s:i}}",
-        "technique", "forward", "frames", n, "warmup_frames",
-        warmup ? json_integer_value(warmup) : (json_int_t)10, "capture_interval",
-        n >= 3 ? n / 3 : n, "async_distance", 20.0, "osl", "resolution", 256, "repeat",
-        repeat ? json_integer_value(repeat) : (json_int_t)5, "reference", "forward", "metrics",
+        "technique", "forward", "frames", n, "warmup_frames", warmup, "capture_interval",
+        n >= 3 ? n / 3 : n, "async_distance", 20.0, "osl", "resolution", 256, "repeat", repeat,
+        "reference", "forward", "metrics",
         "ssim", 1, "pdiff", "fov", 22.6, "psnr", 0, "flip", 0, "scene", "preset", "grid", "lights",
         10, "dynamic", 0, "width", 1080, "height", 720);
     return json_pack("{s:o, s:{s:[b, b], s:[s, s]}}", "base", base, "vary", "scene.dynamic", 0, 1,

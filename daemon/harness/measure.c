@@ -12,7 +12,7 @@
 
 /* Between frames: a DELETE or a stop sets the job's cancel flag, and the
  * job's timeout_s may run out. */
-static bool keep_going(struct run *run, int64_t k, int run_index, enum job_status *status)
+static bool keep_going(struct harness_run *run, int64_t k, int run_index, enum job_status *status)
 {
     if (atomic_load(&run->job->cancel)) {
         *status = JOB_CANCELLED;
@@ -32,7 +32,7 @@ static bool keep_going(struct run *run, int64_t k, int run_index, enum job_statu
     return true;
 }
 
-bool measure_run(struct run *run, int run_index, enum job_status *status)
+bool measure_run(struct harness_run *run, int run_index, enum job_status *status)
 {
     const struct job_spec *spec = run->spec;
     int w0 = spec->warmup_frames, n = spec->frames;

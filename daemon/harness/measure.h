@@ -15,6 +15,6 @@
 /* Renders the run's frames; run_index places it in the job's progress and
  * in messages. On false, run->err says why and *status is JOB_CANCELLED
  * when the job was cancelled (else left as it was). */
-bool measure_run(struct run *run, int run_index, enum job_status *status);
+bool measure_run(struct harness_run *run, int run_index, enum job_status *status);
 
 #endif

@@ -59,7 +59,7 @@ static json_t *hdr_stats_json(const struct hdr_stats *s)
                      "mean", s->mean[0], s->mean[1], s->mean[2], "min", s->min, "max", s->max);
 }
 
-bool outputs_read_capture(struct run *run, int k)
+bool outputs_read_capture(struct harness_run *run, int k)
 {
     struct run_capture *cap = &run->capture[run->captured];
     int w = run->env.width, h = run->env.height;
@@ -94,7 +94,7 @@ static json_t *nonfinite_json(const struct post_nonfinite *n)
                      (json_int_t)n->overflow_pixels);
 }
 
-static json_t *nonfinite_summary(const struct run *run)
+static json_t *nonfinite_summary(const struct harness_run *run)
 {
     json_int_t worst = 0, with = 0;
     for (int c = 0; c < run->capture_count; c++) {
@@ -112,7 +112,7 @@ static json_t *nonfinite_summary(const struct run *run)
 
 /* The heat maps as PNG on a colour ramp from 0 (black) to the frame's
  * largest count (white), with each frame's mean and max: result.heatmap. */
-static json_t *write_heatmaps(struct run *run)
+static json_t *write_heatmaps(struct harness_run *run)
 {
     static const float ramp[6][3] = {{0, 0, 0}, {0, 0, 1}, {0, 1, 1}, {0, 1, 0}, {1, 1, 0}, {1, 1, 1}};
     size_t n = (size_t)run->env.width * (size_t)run->env.height;
@@ -158,7 +158,7 @@ fail:
 }
 
 /* The captured frames as PNG files, each with its figures. */
-static json_t *write_captures(struct run *run)
+static json_t *write_captures(struct harness_run *run)
 {
     json_t *captures = json_array();
     for (int c = 0; c < run->captured; c++) {
@@ -185,7 +185,7 @@ static json_t *write_captures(struct run *run)
 }
 
 /* timings.csv: one row per timed frame, every pass in frame order. */
-static bool write_timings(struct run *run, const double *gpu, const int *order, int sections)
+static bool write_timings(struct harness_run *run, const double *gpu, const int *order, int sections)
 {
     int n = run->spec->frames, w0 = run->spec->warmup_frames;
     size_t cap = (size_t)n * (80 + 24 * (size_t)sections) + 256, used = 0;
@@ -215,7 +215,7 @@ static bool write_timings(struct run *run, const double *gpu, const int *order, 
     return ok;
 }
 
-json_t *outputs_write(struct run *run)
+json_t *outputs_write(struct harness_run *run)
 {
     const struct job_spec *spec = run->spec;
     int n = spec->frames, w0 = spec->warmup_frames;

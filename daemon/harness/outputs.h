@@ -14,12 +14,12 @@
 
 /* Reads back timed frame k, which the job captures, into the run's next
  * capture slot. Stalls: only inside the capture bracket. */
-bool outputs_read_capture(struct run *run, int k);
+bool outputs_read_capture(struct harness_run *run, int k);
 
 /* Encodes the captures, writes timings.csv and result.json in the job's
  * directory, and returns the result (new reference), or NULL with
  * run->err. Outside every timed region. */
-json_t *outputs_write(struct run *run);
+json_t *outputs_write(struct harness_run *run);
 
 /* Statistics of a series of per-frame figures, as the result reports them
  * (mean, median, spread, percentiles, the median's 95% interval). */

@@ -13,7 +13,7 @@
 /* Each frame gets a fresh technique instance, since frame k is a pure
  * function of k: a stateful technique (OSL) then shows what it would at
  * frame k in a run of its own. */
-bool reference_render(struct run *run, enum job_status *status)
+bool reference_render(struct harness_run *run, enum job_status *status)
 {
     const struct job_spec *spec = run->spec;
     const struct technique *ref = technique_find(spec->reference);
@@ -22,7 +22,7 @@ bool reference_render(struct run *run, enum job_status *status)
     /* A run of its own over the same scene, look stages and targets, with
      * the look the reference renders with (reference_look may differ in
      * format and lighting). */
-    struct run rr = {.gl = run->gl, .queue = run->queue, .job = run->job, .spec = spec,
+    struct harness_run rr = {.gl = run->gl, .queue = run->queue, .job = run->job, .spec = spec,
                      .tech = ref, .look = &spec->reference_look, .stages = run->stages,
                      .shadow_pass = -1, .sky_pass = -1};
     bool ok = false;

@@ -13,6 +13,6 @@
 /* run is the job's measured first run (its technique already destroyed).
  * On false, run->err says why and *status is JOB_CANCELLED when the job was
  * cancelled. */
-bool reference_render(struct run *run, enum job_status *status);
+bool reference_render(struct harness_run *run, enum job_status *status);
 
 #endif

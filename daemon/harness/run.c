@@ -47,7 +47,7 @@ void harness_gl_finish(struct harness_gl *g)
 /* The output every technique draws into (HDR colour and a depth texture
  * later passes may sample) and the 8-bit image the resolve writes, from the
  * pool: allocated once per size and format, not per job. */
-bool run_setup_targets(struct run *run)
+bool run_setup_targets(struct harness_run *run)
 {
     const struct gpu_caps *caps = &run->gl->caps;
     struct gpu_targets *pool = run->gl->targets;
@@ -96,7 +96,7 @@ bool run_setup_targets(struct run *run)
     return true;
 }
 
-bool run_setup_passes(struct run *run, const void *options, int64_t timed_frames)
+bool run_setup_passes(struct harness_run *run, const void *options, int64_t timed_frames)
 {
     const struct technique *tech = run->tech;
     int post_passes = post_spec_pass_names(&run->look->post, NULL, 0);
@@ -124,7 +124,7 @@ bool run_setup_passes(struct run *run, const void *options, int64_t timed_frames
     return true;
 }
 
-static bool alloc_captures(struct run *run)
+static bool alloc_captures(struct harness_run *run)
 {
     const struct job_spec *spec = run->spec;
     size_t pixels = (size_t)spec->scene.width * (size_t)spec->scene.height;
@@ -147,7 +147,7 @@ static bool alloc_captures(struct run *run)
     return true;
 }
 
-bool run_prepare(struct run *run, bool capture)
+bool run_prepare(struct harness_run *run, bool capture)
 {
     const struct job_spec *spec = run->spec;
     int n = spec->frames;
@@ -181,7 +181,7 @@ bool run_prepare(struct run *run, bool capture)
     return true;
 }
 
-void run_finish(struct run *run)
+void run_finish(struct harness_run *run)
 {
     if (run->tech && run->state)
         run->tech->destroy(run->state);
@@ -211,7 +211,7 @@ void run_finish(struct run *run)
 
 /* A still camera's block is the same every frame, so only a moving one is
  * rebuilt. */
-void run_frame_data(const struct run *run, int64_t k, struct gpu_frame_data *d)
+void run_frame_data(const struct harness_run *run, int64_t k, struct gpu_frame_data *d)
 {
     const struct scene *s = run->env.scene;
     if (d->viewport[0] != 0 && !scene_camera_moves(s)) {
@@ -240,7 +240,7 @@ void run_frame_data(const struct run *run, int64_t k, struct gpu_frame_data *d)
 
 /* HDR output to the 8-bit image, timed as a pass of every frame so that
  * every technique pays it alike. */
-static void resolve(const struct run *run)
+static void resolve(const struct harness_run *run)
 {
     const struct harness_gl *g = run->gl;
     gpu_pass_begin(&run->passes, run->resolve_pass, run->ldr_fbo, run->env.width,
@@ -257,7 +257,7 @@ static void resolve(const struct run *run)
     gpu_pass_end(&run->passes);
 }
 
-bool run_frame(struct run *run, int64_t k, bool timed)
+bool run_frame(struct harness_run *run, int64_t k, bool timed)
 {
     run_frame_data(run, k, &run->frame_data);
     gpu_frame_block_update(&run->gl->frame_block, &run->frame_data);
@@ -273,7 +273,7 @@ bool run_frame(struct run *run, int64_t k, bool timed)
     return ok;
 }
 
-int run_pass_order(const struct run *run, int *order)
+int run_pass_order(const struct harness_run *run, int *order)
 {
     int n = 0;
     if (run->shadow_pass >= 0)

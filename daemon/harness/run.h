@@ -62,7 +62,7 @@ struct run_capture {
     uint32_t *heat;                  /* light evaluations per pixel, when published */
 };
 
-struct run {
+struct harness_run {
     struct harness_gl *gl;
     struct queue *queue;
     struct job *job;
@@ -107,25 +107,25 @@ struct run {
  * stages, the technique with its passes and timer, the post chain, and the
  * capture buffers when capture is set (the first run of a job). The run
  * must be zeroed but for gl, queue, job, spec and tech. False with run->err. */
-bool run_prepare(struct run *run, bool capture);
+bool run_prepare(struct harness_run *run, bool capture);
 /* Frees what run_prepare and the frames made. Takes a run in any state. */
-void run_finish(struct run *run);
+void run_finish(struct harness_run *run);
 
 /* The output targets and the technique's env for run->look over the run's
  * scene (the reference calls it with the measured run's scene). */
-bool run_setup_targets(struct run *run);
+bool run_setup_targets(struct harness_run *run);
 /* The technique's passes (its own, the look's shadows and sky, the post
  * chain's, then the resolve) and a timer for timed_frames frames. */
-bool run_setup_passes(struct run *run, const void *options, int64_t timed_frames);
+bool run_setup_passes(struct harness_run *run, const void *options, int64_t timed_frames);
 
 /* The per-frame block for frame k: camera, viewport and counts. */
-void run_frame_data(const struct run *run, int64_t k, struct gpu_frame_data *d);
+void run_frame_data(const struct harness_run *run, int64_t k, struct gpu_frame_data *d);
 /* One frame of every stage, from the look's before-passes to the resolve,
  * between the timer's begin and end of frame. Timed. */
-bool run_frame(struct run *run, int64_t k, bool timed);
+bool run_frame(struct harness_run *run, int64_t k, bool timed);
 
 /* Passes in the order a frame runs them (the shadow pass first); returns
  * the count. */
-int run_pass_order(const struct run *run, int *order);
+int run_pass_order(const struct harness_run *run, int *order);
 
 #endif

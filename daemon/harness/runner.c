@@ -61,7 +61,7 @@ static json_t *collect_device(struct egl_context *egl, const struct gpu_caps *ca
 }
 
 /* One measured run: set up, then the timed loop. */
-static bool prepare_and_measure(struct run *run, bool capture, int run_index,
+static bool prepare_and_measure(struct harness_run *run, bool capture, int run_index,
                                 enum job_status *status)
 {
     return run_prepare(run, capture) && measure_run(run, run_index, status);
@@ -86,7 +86,7 @@ static json_t *across_runs(const double *medians, size_t n)
 /* Runs 2..N of a repeated job, each with the scene rebuilt; with automatic
  * repeats, stops as soon as the frame-time interval has tightened. Adds
  * result.runs and result.repeat, and rewrites result.json. */
-static bool repeat_runs(struct runner *r, struct run *first, json_t *result,
+static bool repeat_runs(struct runner *r, struct harness_run *first, json_t *result,
                         enum job_status *status)
 {
     const struct job_spec *spec = first->spec;
@@ -110,7 +110,7 @@ static bool repeat_runs(struct runner *r, struct run *first, json_t *result,
                             json_deep_copy(json_object_get(result, RK_INTERFERENCE)));
     int done = 1;
     while (ok && done < planned && !(spec->repeat_auto && stats_is_stable(med, (size_t)done, 0.025))) {
-        struct run extra = {.gl = &r->gl, .queue = r->queue, .job = first->job, .spec = spec,
+        struct harness_run extra = {.gl = &r->gl, .queue = r->queue, .job = first->job, .spec = spec,
                             .tech = first->tech};
         ok = prepare_and_measure(&extra, false, done, status);
         if (ok) {
@@ -161,7 +161,7 @@ static bool repeat_runs(struct runner *r, struct run *first, json_t *result,
 
 static void run_job(struct runner *r, struct job *job)
 {
-    struct run run = {.gl = &r->gl, .queue = r->queue, .job = job, .spec = &job->spec};
+    struct harness_run run = {.gl = &r->gl, .queue = r->queue, .job = job, .spec = &job->spec};
     const struct job_spec *spec = &job->spec;
     enum job_status status = JOB_FAILED;
     json_t *result = NULL;

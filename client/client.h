@@ -92,10 +92,6 @@ bool out_dir_claim(const char *dir, const char *marker_file, const char *id, cha
 json_t *fetch_job_files(struct conn *c, const json_t *job, const char *dir, bool images,
                         const json_t *extra);
 
-/* The result of a finished job with its per-frame samples attached (no
- * files written). New reference; NULL without a result. */
-json_t *result_with_samples(struct conn *c, const json_t *job);
-
 
 /* A job file with --label added and repeat overridden (repeat > 0).
  * Returns malloc'ed JSON text, or NULL with a message in err. */

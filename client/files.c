@@ -10,6 +10,7 @@
 
 #include "client/client.h"
 #include "common/fsutil.h"
+#include "common/job_files.h"
 #include "common/result_keys.h"
 
 bool out_dir_claim(const char *dir, const char *marker_file, const char *id, char *err,
@@ -55,26 +56,6 @@ bool out_dir_claim(const char *dir, const char *marker_file, const char *id, cha
     return same;
 }
 
-json_t *result_with_samples(struct conn *c, const json_t *job)
-{
-    json_t *result = json_object_get(job, RK_RESULT);
-    if (!result)
-        return NULL;
-    const char *id = json_string_value(json_object_get(job, "id"));
-    json_t *copy = json_deep_copy(result);
-    char url[256];
-    snprintf(url, sizeof(url), "/v1/jobs/%s/timings.csv", id ? id : "");
-    struct buffer b;
-    if (conn_request(c, "GET", url, NULL, &b) == 200)
-        json_object_set_new(copy, "samples", parse_timings(b.data));
-    free(b.data);
-    json_object_set_new(copy, "job_id", json_string(id ? id : ""));
-    json_t *spec = json_object_get(job, "spec");
-    if (spec)
-        json_object_set(copy, "spec", spec);
-    return copy;
-}
-
 json_t *fetch_job_files(struct conn *c, const json_t *job, const char *dir, bool images,
                         const json_t *extra)
 {
@@ -82,16 +63,16 @@ json_t *fetch_job_files(struct conn *c, const json_t *job, const char *dir, bool
         fprintf(stderr, "shadebench: cannot create %s\n", dir);
         return NULL;
     }
-    char path[4096], url[512];
+    char path[4096];
     const char *id = json_string_value(json_object_get(job, "id"));
+    const char *timings_url = json_string_value(json_object_get(job, "timings_url"));
     snprintf(path, sizeof(path), "%s/job.json", dir);
     bool ok = fs_write_json_atomic(path, job);
     json_t *result = json_object_get(job, RK_RESULT);
     if (!result)
         return ok ? json_object() : NULL;
-    snprintf(url, sizeof(url), "/v1/jobs/%s/timings.csv", id ? id : "");
-    snprintf(path, sizeof(path), "%s/timings.csv", dir);
-    ok = conn_download(c, url, path) && ok;
+    job_file_path(dir, JOB_FILE_TIMINGS, path, sizeof(path));
+    ok = timings_url && conn_download(c, timings_url, path) && ok;
     json_t *copy = json_deep_copy(result);
     size_t len;
     char *csv = fs_read_file(path, 256u << 20, &len);
@@ -103,21 +84,20 @@ json_t *fetch_job_files(struct conn *c, const json_t *job, const char *dir, bool
         json_object_set(copy, "spec", json_object_get(job, "spec"));
     if (extra)
         json_object_update(copy, (json_t *)extra);
-    snprintf(path, sizeof(path), "%s/result.json", dir);
+    job_file_path(dir, JOB_FILE_RESULT, path, sizeof(path));
     ok = fs_write_json_atomic(path, copy) && ok;
     size_t i;
     json_t *capture;
-    static const char *const kinds[][2] = {
-        {"url", "frame"}, {"reference_url", "reference"}, {"ssim_map_url", "ssim"},
-        {"flip_map_url", "flip"},
-    };
+    static const enum job_image kinds[] = {JOB_IMAGE_FRAME, JOB_IMAGE_REFERENCE, JOB_IMAGE_SSIM,
+                                           JOB_IMAGE_FLIP};
     json_array_foreach(images ? json_object_get(result, RK_CAPTURES) : NULL, i, capture) {
         int frame = (int)json_integer_value(json_object_get(capture, "frame"));
         for (size_t k = 0; k < sizeof(kinds) / sizeof(kinds[0]); k++) {
-            const char *u = json_string_value(json_object_get(capture, kinds[k][0]));
+            const char *u = json_string_value(
+                json_object_get(capture, job_image_kind(kinds[k])->url_key));
             if (!u)
                 continue;
-            snprintf(path, sizeof(path), "%s/%s-%06d.png", dir, kinds[k][1], frame);
+            job_image_path(dir, kinds[k], frame, path, sizeof(path));
             ok = conn_download(c, u, path) && ok;
         }
     }

@@ -99,17 +99,6 @@ bool png_write_gl_rgba(const char *path, const uint8_t *rgba, int width,
     return png_write_by_rows(path, width, height, gl_row, &g, err, errlen);
 }
 
-static void rgb_row(void *ctx, int y, uint8_t *rgb)
-{
-    const struct image *img = ctx;
-    memcpy(rgb, img->rgb + (size_t)y * (size_t)img->width * 3, (size_t)img->width * 3);
-}
-
-bool png_write_rgb(const char *path, const struct image *img, char *err, size_t errlen)
-{
-    return png_write_by_rows(path, img->width, img->height, rgb_row, (void *)img, err, errlen);
-}
-
 bool png_read_rgb_limit(const char *path, long long max_pixels, struct image *out, char *err,
                         size_t errlen)
 {

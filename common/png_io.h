@@ -19,9 +19,6 @@ struct image {
 bool png_write_gl_rgba(const char *path, const uint8_t *rgba, int width,
                        int height, char *err, size_t errlen);
 
-/* Writes RGB pixels, top row first. */
-bool png_write_rgb(const char *path, const struct image *img, char *err, size_t errlen);
-
 /* Writes an RGB PNG whose rows come from row(ctx, y, rgb) (width * 3 bytes,
  * top row first), so that an image never has to exist whole in memory. */
 typedef void (*png_row_fn)(void *ctx, int y, uint8_t *rgb);

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "config.h"
+#include "common/job_files.h"
 #include "common/log.h"
 #include "daemon/api/charts.h"
 #include "daemon/api/connections.h"
@@ -601,10 +602,10 @@ static enum MHD_Result job_resource(struct http_server *s, struct MHD_Connection
         return respond_error(c, MHD_HTTP_CONFLICT, "id",
                              "the job has not finished: its files exist once it is done");
     if (r->kind == ROUTE_JOB_TIMINGS) {
-        snprintf(path, sizeof(path), "%s/timings.csv", dir);
+        job_file_path(dir, JOB_FILE_TIMINGS, path, sizeof(path));
         return respond_file(c, path, "text/csv");
     }
-    snprintf(path, sizeof(path), "%s/%s-%06d.png", dir, route_image_prefix(r->image), r->frame);
+    job_image_path(dir, r->image, r->frame, path, sizeof(path));
     if (access(path, R_OK) != 0)
         return respond_error(c, MHD_HTTP_NOT_FOUND, "frame",
                              "no such image: this frame was not captured, or the job has no "

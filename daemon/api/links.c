@@ -3,17 +3,12 @@
 #include "daemon/api/routes.h"
 #include "common/result_keys.h"
 
-/* A capture's files and the URL key each one gets. */
-static const struct {
-    const char *file_key, *url_key;
-    enum route_image image;
-} CAPTURE_FILES[] = {
-    {"file", "url", IMAGE_FRAME},
-    {"reference_file", "reference_url", IMAGE_REFERENCE},
-    {"ssim_map_file", "ssim_map_url", IMAGE_SSIM},
-    {"flip_map_file", "flip_map_url", IMAGE_FLIP},
-};
+/* The images a capture entry of result.captures may name. */
+static const enum job_image CAPTURE_IMAGES[] = {JOB_IMAGE_FRAME, JOB_IMAGE_REFERENCE,
+                                                JOB_IMAGE_SSIM, JOB_IMAGE_FLIP};
 
+/* Adds the URL of every file a capture entry names; heat map captures
+ * (result.heatmap.captures) name one file each. */
 static void link_captures(const char *id, json_t *captures, bool heatmap)
 {
     size_t i;
@@ -24,13 +19,14 @@ static void link_captures(const char *id, json_t *captures, bool heatmap)
         if (!json_is_integer(frame))
             continue;
         int k = (int)json_integer_value(frame);
-        for (size_t f = 0; f < sizeof(CAPTURE_FILES) / sizeof(CAPTURE_FILES[0]); f++) {
-            if (!json_is_string(json_object_get(c, CAPTURE_FILES[f].file_key)))
+        size_t count = heatmap ? 1 : sizeof(CAPTURE_IMAGES) / sizeof(CAPTURE_IMAGES[0]);
+        for (size_t f = 0; f < count; f++) {
+            enum job_image image = heatmap ? JOB_IMAGE_HEATMAP : CAPTURE_IMAGES[f];
+            const struct job_image_kind *kind = job_image_kind(image);
+            if (!json_is_string(json_object_get(c, kind->file_key)))
                 continue;
-            route_image_url(id, heatmap ? IMAGE_HEATMAP : CAPTURE_FILES[f].image, k, url);
-            json_object_set_new(c, CAPTURE_FILES[f].url_key, json_string(url));
-            if (heatmap)
-                break;
+            route_image_url(id, image, k, url);
+            json_object_set_new(c, kind->url_key, json_string(url));
         }
     }
 }
@@ -44,6 +40,10 @@ void links_add_job(json_t *job)
     route_job_url(id, url);
     json_object_set_new(job, "url", json_string(url));
     json_t *result = json_object_get(job, RK_RESULT);
+    if (result) {
+        route_timings_url(id, url);
+        json_object_set_new(job, "timings_url", json_string(url));
+    }
     link_captures(id, json_object_get(result, RK_CAPTURES), false);
     link_captures(id, json_object_get(json_object_get(result, RK_HEATMAP), RK_CAPTURES), true);
 }

@@ -10,6 +10,7 @@
 
 #include "config.h"
 #include "daemon/api/charts.h"
+#include "common/job_files.h"
 #include "common/png_io.h"
 #include "common/result_keys.h"
 
@@ -93,11 +94,11 @@ static void png_img(struct html *h, const unsigned char *png, size_t len, const 
 }
 
 /* A thumbnail of a PNG file in the job's directory, or a note if missing. */
-static void thumbnail(struct html *h, const char *dir, const char *prefix, int frame,
+static void thumbnail(struct html *h, const char *dir, enum job_image image, int frame,
                       const char *caption)
 {
-    char path[PATH_MAX + 64], err[256];
-    snprintf(path, sizeof(path), "%s/%s-%06d.png", dir, prefix, frame);
+    char path[PATH_MAX + JOB_IMAGE_NAME_MAX], err[256];
+    job_image_path(dir, image, frame, path, sizeof(path));
     struct image img;
     add(h, "<figure>");
     if (png_read_rgb(path, &img, err, sizeof(err))) {
@@ -608,10 +609,10 @@ char *report_sweep_html(const json_t *sweep, const json_t *device, report_job_di
         escaped(&h, values);
         add(&h, "</h3>");
         free(values);
-        thumbnail(&h, dir, "frame", frame, "frame");
-        thumbnail(&h, dir, "reference", frame, "reference");
-        thumbnail(&h, dir, "ssim", frame, "SSIM map");
-        thumbnail(&h, dir, "flip", frame, "FLIP map");
+        thumbnail(&h, dir, JOB_IMAGE_FRAME, frame, "frame");
+        thumbnail(&h, dir, JOB_IMAGE_REFERENCE, frame, "reference");
+        thumbnail(&h, dir, JOB_IMAGE_SSIM, frame, "SSIM map");
+        thumbnail(&h, dir, JOB_IMAGE_FLIP, frame, "FLIP map");
         add(&h, "</div>");
     }
     add(&h, "<h2>The sweep as posted</h2>");
@@ -638,7 +639,7 @@ static void stats_row(struct html *h, const char *name, const json_t *s)
 static json_t *read_timings(const char *dir)
 {
     char path[PATH_MAX + 16];
-    snprintf(path, sizeof(path), "%s/timings.csv", dir ? dir : "");
+    job_file_path(dir ? dir : "", JOB_FILE_TIMINGS, path, sizeof(path));
     FILE *f = fopen(path, "r");
     if (!f)
         return NULL;
@@ -793,11 +794,11 @@ char *report_job_html(const json_t *job, const char *dir, const json_t *device, 
                     pd ? (json_is_true(json_object_get(pd, "pass")) ? "pass" : "fail") : "-");
             }
             add(&h, "</h3>");
-            thumbnail(&h, dir, "frame", frame, "frame");
+            thumbnail(&h, dir, JOB_IMAGE_FRAME, frame, "frame");
             if (m) {
-                thumbnail(&h, dir, "reference", frame, "reference");
-                thumbnail(&h, dir, "ssim", frame, "SSIM map");
-                thumbnail(&h, dir, "flip", frame, "FLIP map");
+                thumbnail(&h, dir, JOB_IMAGE_REFERENCE, frame, "reference");
+                thumbnail(&h, dir, JOB_IMAGE_SSIM, frame, "SSIM map");
+                thumbnail(&h, dir, JOB_IMAGE_FLIP, frame, "FLIP map");
             }
             add(&h, "</div>");
         }

@@ -23,13 +23,6 @@ static const struct {
     [ROUTE_SWEEP_REPORT] = {"/v1/sweeps/{id}/report.html", "GET, HEAD", "use GET"},
 };
 
-static const char *const IMAGE_DIRS[][2] = {
-    [IMAGE_FRAME] = {"frames/", "frame"},
-    [IMAGE_REFERENCE] = {"reference/", "reference"},
-    [IMAGE_SSIM] = {"ssim/", "ssim"},
-    [IMAGE_FLIP] = {"flip/", "flip"},
-    [IMAGE_HEATMAP] = {"heatmap/", "heatmap"}, /* light evaluations per pixel */
-};
 
 static bool none(struct route *r, const char *field, const char *message)
 {
@@ -97,7 +90,7 @@ static bool job_routes(const char *rest, struct route *r)
         r->kind = ROUTE_JOB_REPORT;
         return true;
     }
-    if (strcmp(sub, "timings.csv") == 0) {
+    if (strcmp(sub, JOB_FILE_TIMINGS) == 0) {
         r->kind = ROUTE_JOB_TIMINGS;
         return true;
     }
@@ -107,13 +100,14 @@ static bool job_routes(const char *rest, struct route *r)
         r->kind = ROUTE_JOB_CHART;
         return true;
     }
-    for (size_t k = 0; k < sizeof(IMAGE_DIRS) / sizeof(IMAGE_DIRS[0]); k++) {
-        size_t len = strlen(IMAGE_DIRS[k][0]);
-        if (strncmp(sub, IMAGE_DIRS[k][0], len) == 0) {
-            if (!take_frame(sub + len, r))
+    for (int k = 0; k < JOB_IMAGE_COUNT; k++) {
+        const char *folder = job_image_kind((enum job_image)k)->folder;
+        size_t len = strlen(folder);
+        if (strncmp(sub, folder, len) == 0 && sub[len] == '/') {
+            if (!take_frame(sub + len + 1, r))
                 return none(r, "frame", "images are K.png with K a captured frame (see result.captures)");
             r->kind = ROUTE_JOB_IMAGE;
-            r->image = (enum route_image)k;
+            r->image = (enum job_image)k;
             return true;
         }
     }
@@ -190,14 +184,14 @@ const char *route_label(enum route_kind kind)
     return (unsigned)kind < ROUTE_COUNT ? KINDS[kind].label : KINDS[ROUTE_NONE].label;
 }
 
-const char *route_image_prefix(enum route_image image)
-{
-    return IMAGE_DIRS[image][1];
-}
-
 void route_job_url(const char *id, char out[ROUTE_URL_MAX])
 {
     snprintf(out, ROUTE_URL_MAX, "/v1/jobs/%s", id);
+}
+
+void route_timings_url(const char *id, char out[ROUTE_URL_MAX])
+{
+    snprintf(out, ROUTE_URL_MAX, "/v1/jobs/%s/%s", id, JOB_FILE_TIMINGS);
 }
 
 void route_sweep_url(const char *id, char out[ROUTE_URL_MAX])
@@ -205,7 +199,7 @@ void route_sweep_url(const char *id, char out[ROUTE_URL_MAX])
     snprintf(out, ROUTE_URL_MAX, "/v1/sweeps/%s", id);
 }
 
-void route_image_url(const char *id, enum route_image image, int frame, char out[ROUTE_URL_MAX])
+void route_image_url(const char *id, enum job_image image, int frame, char out[ROUTE_URL_MAX])
 {
-    snprintf(out, ROUTE_URL_MAX, "/v1/jobs/%s/%s%d.png", id, IMAGE_DIRS[image][0], frame);
+    snprintf(out, ROUTE_URL_MAX, "/v1/jobs/%s/%s/%d.png", id, job_image_kind(image)->folder, frame);
 }

@@ -8,6 +8,8 @@
 
 #include <stdbool.h>
 
+#include "common/job_files.h"
+
 enum route_kind {
     ROUTE_NONE, /* no such route or resource: 404 */
     ROUTE_HEALTHZ,
@@ -26,15 +28,13 @@ enum route_kind {
     ROUTE_COUNT
 };
 
-/* Per-capture images of a job: URL folder and file prefix. */
-enum route_image { IMAGE_FRAME, IMAGE_REFERENCE, IMAGE_SSIM, IMAGE_FLIP, IMAGE_HEATMAP };
 
 struct route {
     enum route_kind kind;
     char id[24];       /* jobs and sweeps: digits and dashes, 1 to 23 of them */
     char chart[32];    /* charts: the name without its extension */
     bool chart_png;    /* charts: .png (else .svg) */
-    enum route_image image;
+    enum job_image image; /* images: which kind (common/job_files.h) */
     int frame;         /* images: 1 to 999999999 */
     /* ROUTE_NONE: what the 404 names. */
     const char *field, *message;
@@ -52,15 +52,14 @@ bool route_method_ok(enum route_kind kind, const char *method, const char **allo
 /* A fixed label per kind, for the request counters of /metrics. */
 const char *route_label(enum route_kind kind);
 
-/* The file prefix of an image kind in a job's directory ("frame", ...). */
-const char *route_image_prefix(enum route_image image);
-
 /* The URLs the API hands out, built here and nowhere else (the jobs and the
  * harness record ids and file names only). Each writes a path of at most
  * ROUTE_URL_MAX bytes, NUL included. */
 #define ROUTE_URL_MAX 96
 void route_job_url(const char *id, char out[ROUTE_URL_MAX]);
 void route_sweep_url(const char *id, char out[ROUTE_URL_MAX]);
-void route_image_url(const char *id, enum route_image image, int frame, char out[ROUTE_URL_MAX]);
+/* A finished job's per-frame figures (timings.csv). */
+void route_timings_url(const char *id, char out[ROUTE_URL_MAX]);
+void route_image_url(const char *id, enum job_image image, int frame, char out[ROUTE_URL_MAX]);
 
 #endif

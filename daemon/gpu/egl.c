@@ -252,16 +252,6 @@ void egl_context_destroy(struct egl_context *ctx)
     free(ctx);
 }
 
-bool egl_context_make_current(struct egl_context *ctx)
-{
-    return eglMakeCurrent(ctx->display, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx->context);
-}
-
-void egl_context_release(struct egl_context *ctx)
-{
-    eglMakeCurrent(ctx->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-}
-
 const char *egl_context_platform(const struct egl_context *ctx) { return ctx->platform; }
 const char *egl_context_device(const struct egl_context *ctx) { return ctx->device; }
 const char *egl_context_egl_version(const struct egl_context *ctx) { return ctx->version; }

@@ -27,8 +27,6 @@ struct egl_context;
 struct egl_context *egl_context_create(int device, bool debug, char *err,
                                        size_t errlen);
 void egl_context_destroy(struct egl_context *ctx);
-bool egl_context_make_current(struct egl_context *ctx);
-void egl_context_release(struct egl_context *ctx);
 
 const char *egl_context_platform(const struct egl_context *ctx);
 /* Short description of the selected device, e.g. "device 0 (/dev/dri/renderD128)". */

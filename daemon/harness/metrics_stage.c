@@ -12,6 +12,7 @@
 
 #include "common/clock.h"
 #include "common/fsutil.h"
+#include "common/job_files.h"
 #include "common/log.h"
 #include "daemon/quality/metrics.h"
 #include "common/png_io.h"
@@ -50,12 +51,12 @@ static bool score_capture(struct job *job, json_t *capture, json_t *summary, cha
 {
     const struct metrics_stop stop = {cancel_requested, job};
     int frame = (int)json_integer_value(json_object_get(capture, "frame"));
-    char test_path[PATH_MAX + 32], ref_path[PATH_MAX + 32], ssim_path[PATH_MAX + 32],
-        flip_path[PATH_MAX + 32];
-    snprintf(test_path, sizeof(test_path), "%s/frame-%06d.png", job->dir, frame);
-    snprintf(ref_path, sizeof(ref_path), "%s/reference-%06d.png", job->dir, frame);
-    snprintf(ssim_path, sizeof(ssim_path), "%s/ssim-%06d.png", job->dir, frame);
-    snprintf(flip_path, sizeof(flip_path), "%s/flip-%06d.png", job->dir, frame);
+    char test_path[PATH_MAX + JOB_IMAGE_NAME_MAX], ref_path[PATH_MAX + JOB_IMAGE_NAME_MAX],
+        ssim_path[PATH_MAX + JOB_IMAGE_NAME_MAX], flip_path[PATH_MAX + JOB_IMAGE_NAME_MAX];
+    job_image_path(job->dir, JOB_IMAGE_FRAME, frame, test_path, sizeof(test_path));
+    job_image_path(job->dir, JOB_IMAGE_REFERENCE, frame, ref_path, sizeof(ref_path));
+    job_image_path(job->dir, JOB_IMAGE_SSIM, frame, ssim_path, sizeof(ssim_path));
+    job_image_path(job->dir, JOB_IMAGE_FLIP, frame, flip_path, sizeof(flip_path));
     struct image ref = {0}, test = {0};
     bool ok = png_read_rgb(ref_path, &ref, err, errlen) &&
               png_read_rgb(test_path, &test, err, errlen);
@@ -70,11 +71,14 @@ static bool score_capture(struct job *job, json_t *capture, json_t *summary, cha
         return false;
     json_object_set_new(capture, "metrics", m);
     /* File names only: the API layer turns them into URLs (api/links.c). */
-    json_object_set_new(capture, "reference_file", json_string(strrchr(ref_path, '/') + 1));
+    json_object_set_new(capture, job_image_kind(JOB_IMAGE_REFERENCE)->file_key,
+                        json_string(strrchr(ref_path, '/') + 1));
     if (o->which & METRIC_SSIM)
-        json_object_set_new(capture, "ssim_map_file", json_string(strrchr(ssim_path, '/') + 1));
+        json_object_set_new(capture, job_image_kind(JOB_IMAGE_SSIM)->file_key,
+                            json_string(strrchr(ssim_path, '/') + 1));
     if (o->which & METRIC_FLIP)
-        json_object_set_new(capture, "flip_map_file", json_string(strrchr(flip_path, '/') + 1));
+        json_object_set_new(capture, job_image_kind(JOB_IMAGE_FLIP)->file_key,
+                            json_string(strrchr(flip_path, '/') + 1));
 
     /* Worst cases over the captures, and which frame they came from. */
     json_t *ssim = json_object_get(m, "ssim");
@@ -142,7 +146,7 @@ static void run_task(struct metrics_worker *w, struct task *t)
         json_object_set_new(t->result, RK_QUALITY, summary);
         summary = NULL;
         char path[PATH_MAX + 16];
-        snprintf(path, sizeof(path), "%s/result.json", job->dir);
+        job_file_path(job->dir, JOB_FILE_RESULT, path, sizeof(path));
         if (!fs_write_json_atomic(path, t->result)) {
             ok = false;
             snprintf(err, sizeof(err), "cannot write %.400s: %s", path, strerror(errno));

@@ -59,14 +59,6 @@ static void *flip_thread(void *arg)
     return NULL;
 }
 
-bool metrics_stopped(const struct metrics_stop *stop, char *err, size_t errlen)
-{
-    if (!stop || !stop->requested || !stop->requested(stop->ctx))
-        return false;
-    snprintf(err, errlen, "stopped");
-    return true;
-}
-
 double metrics_memory_bytes(int width, int height, double flip_ppd)
 {
     double n = (double)width * (double)height;

@@ -12,6 +12,7 @@
 
 #include "daemon/scene/scene_spec.h"
 #include "daemon/scene/mesh.h"
+#include "daemon/scene/scene_math.h"
 
 /* Instances are grouped by mesh in this order, one instanced draw each. */
 enum scene_mesh {
@@ -122,10 +123,6 @@ float scene_instance_distance(const struct scene *s, int i);
 /* Diameter in pixels of instance i's bounding sphere on screen (frame 0). */
 float scene_projected_diameter(const struct scene *s, int i);
 
-/* True when the sphere (centre, radius) lies at least partly inside the
- * frustum of view_proj (inside: fully == false), or entirely inside it. */
-bool scene_sphere_in_frustum(const float view_proj[16], const float centre[3], float radius,
-                             bool fully);
 
 /* Semi-major axis in pixels of the sphere's projected silhouette (an
  * ellipse) for camera c on a width x height image, exact for a perspective

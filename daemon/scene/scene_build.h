@@ -8,13 +8,7 @@
 #include <stdint.h>
 
 #include "daemon/scene/scene.h"
-
-/* A fixed integer hash to [0, 1): the scene's only source of "randomness",
- * so that every build of a spec is bit-identical. salt picks a stream. */
-double scene_hash01(uint32_t index, uint32_t salt);
-/* Van der Corput radical inverse of i in base. */
-double scene_radical_inverse(unsigned i, unsigned base);
-void scene_hsv_to_rgb(double h, double s, double v, float out[3]);
+#include "daemon/scene/scene_math.h"
 
 /* Object-space sizes of the meshes (presets.c), known before the meshes
  * are built (the sphere's tessellation depends on where objects stand). */

@@ -21,9 +21,9 @@ int main(void)
     CHECK(kind_of("/v1/jobs/20260101-000000-0001", &r) == ROUTE_JOB &&
           strcmp(r.id, "20260101-000000-0001") == 0);
     CHECK(kind_of("/v1/jobs/1/frames/100.png", &r) == ROUTE_JOB_IMAGE && r.frame == 100 &&
-          r.image == IMAGE_FRAME && strcmp(route_image_prefix(r.image), "frame") == 0);
-    CHECK(kind_of("/v1/jobs/1/flip/7.png", &r) == ROUTE_JOB_IMAGE && r.image == IMAGE_FLIP);
-    CHECK(kind_of("/v1/jobs/1/heatmap/7.png", &r) == ROUTE_JOB_IMAGE && r.image == IMAGE_HEATMAP);
+          r.image == JOB_IMAGE_FRAME && strcmp(job_image_kind(r.image)->prefix, "frame") == 0);
+    CHECK(kind_of("/v1/jobs/1/flip/7.png", &r) == ROUTE_JOB_IMAGE && r.image == JOB_IMAGE_FLIP);
+    CHECK(kind_of("/v1/jobs/1/heatmap/7.png", &r) == ROUTE_JOB_IMAGE && r.image == JOB_IMAGE_HEATMAP);
     CHECK(kind_of("/v1/jobs/1/timings.csv", &r) == ROUTE_JOB_TIMINGS);
     CHECK(kind_of("/v1/jobs/1/report.html", &r) == ROUTE_JOB_REPORT);
     CHECK(kind_of("/v1/jobs/1/charts/distribution.svg", &r) == ROUTE_JOB_CHART &&
@@ -63,10 +63,13 @@ int main(void)
     route_sweep_url("20261122-091703-0002", url);
     CHECK(route_parse(url, &back) && back.kind == ROUTE_SWEEP &&
           strcmp(back.id, "20261122-091703-0002") == 0);
-    for (int image = IMAGE_FRAME; image <= IMAGE_HEATMAP; image++) {
-        route_image_url("1-2", (enum route_image)image, 999999999, url);
+    route_timings_url("20261122-091703-0001", url);
+    CHECK(route_parse(url, &back) && back.kind == ROUTE_JOB_TIMINGS &&
+          strcmp(back.id, "20261122-091703-0001") == 0);
+    for (int image = 0; image < JOB_IMAGE_COUNT; image++) {
+        route_image_url("1-2", (enum job_image)image, 999999999, url);
         CHECK(route_parse(url, &back) && back.kind == ROUTE_JOB_IMAGE &&
-              back.image == (enum route_image)image && back.frame == 999999999 &&
+              back.image == (enum job_image)image && back.frame == 999999999 &&
               strcmp(back.id, "1-2") == 0);
     }
     return check_finish("test_routes");

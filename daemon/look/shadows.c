@@ -5,7 +5,7 @@
  * compared against the far side of their own object and the bias only has
  * to cover contact. */
 #define _POSIX_C_SOURCE 200809L
-#include "daemon/harness/shadows.h"
+#include "daemon/look/shadows.h"
 
 #include <epoxy/gl.h>
 #include <math.h>
@@ -30,7 +30,7 @@ struct shadow_light_gpu {
 
 enum { MAX_DROPPED_LISTED = 64 };
 
-struct harness_shadows {
+struct look_shadows {
     struct shadow_spec spec;
     const struct scene *scene;
     struct gpu_scene *gpu;
@@ -51,12 +51,12 @@ struct harness_shadows {
     int tile_hist[16]; /* faces by log2 size at the first timed frame */
 };
 
-struct harness_shadows *harness_shadows_create(const struct shadow_spec *spec,
+struct look_shadows *look_shadows_create(const struct shadow_spec *spec,
                                                const struct scene *s, struct gpu_scene *gpu,
                                                const struct gpu_caps *caps, char *err,
                                                size_t errlen)
 {
-    struct harness_shadows *sh = calloc(1, sizeof(*sh));
+    struct look_shadows *sh = calloc(1, sizeof(*sh));
     if (!sh) {
         snprintf(err, errlen, "look.shadows: out of memory");
         return NULL;
@@ -123,7 +123,7 @@ struct harness_shadows *harness_shadows_create(const struct shadow_spec *spec,
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
     return sh;
 fail:
-    harness_shadows_destroy(sh);
+    look_shadows_destroy(sh);
     return NULL;
 }
 
@@ -143,7 +143,7 @@ static bool sphere_meets_face(const float d[3], float r, const float fw[3], cons
            (f * w + t) / norm >= -r;
 }
 
-static void draw_casters(struct harness_shadows *sh, int ncasters, const float light[3], int face,
+static void draw_casters(struct look_shadows *sh, int ncasters, const float light[3], int face,
                          float widen)
 {
     const struct scene *s = sh->scene;
@@ -167,7 +167,7 @@ static void draw_casters(struct harness_shadows *sh, int ncasters, const float l
     }
 }
 
-bool harness_shadows_render(struct harness_shadows *sh, const struct gpu_passes *passes, int pass,
+bool look_shadows_render(struct look_shadows *sh, const struct gpu_passes *passes, int pass,
                             int64_t frame, bool timed, char *err, size_t errlen)
 {
     const struct scene *s = sh->scene;
@@ -275,7 +275,7 @@ bool harness_shadows_render(struct harness_shadows *sh, const struct gpu_passes 
     return true;
 }
 
-json_t *harness_shadows_describe(const struct harness_shadows *sh)
+json_t *look_shadows_describe(const struct look_shadows *sh)
 {
     const struct shadow_spec *spec = &sh->spec;
     double n = sh->frames > 0 ? sh->frames : 1;
@@ -308,7 +308,7 @@ json_t *harness_shadows_describe(const struct harness_shadows *sh)
         sh->no_casters_last);
 }
 
-void harness_shadows_destroy(struct harness_shadows *sh)
+void look_shadows_destroy(struct look_shadows *sh)
 {
     if (!sh)
         return;

@@ -1,10 +1,10 @@
-#include "daemon/harness/sky.h"
+#include "daemon/look/sky.h"
 
 #include <string.h>
 
 #include "daemon/gpu/glutil.h"
 
-bool harness_sky_init(struct harness_sky *s, const char *defines, char *err, size_t errlen)
+bool look_sky_init(struct look_sky *s, const char *defines, char *err, size_t errlen)
 {
     memset(s, 0, sizeof(*s));
     const struct gl_stage stages[] = {
@@ -18,7 +18,7 @@ bool harness_sky_init(struct harness_sky *s, const char *defines, char *err, siz
     return true;
 }
 
-void harness_sky_draw(const struct harness_sky *s)
+void look_sky_draw(const struct look_sky *s)
 {
     glDepthFunc(GL_LEQUAL);
     glDepthMask(GL_FALSE);
@@ -31,7 +31,7 @@ void harness_sky_draw(const struct harness_sky *s)
     glDepthFunc(GL_LESS);
 }
 
-void harness_sky_finish(struct harness_sky *s)
+void look_sky_finish(struct look_sky *s)
 {
     if (!s)
         return;

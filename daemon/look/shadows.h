@@ -1,5 +1,5 @@
-#ifndef SHADEBENCH_HARNESS_SHADOWS_H
-#define SHADEBENCH_HARNESS_SHADOWS_H
+#ifndef SHADEBENCH_LOOK_SHADOWS_H
+#define SHADEBENCH_LOOK_SHADOWS_H
 
 /* Omni shadow maps (look.shadows), run by the harness for every technique:
  * each frame, in its own timed pass before the technique's, it plans which
@@ -21,23 +21,23 @@
 #include "daemon/lighting/look_lighting.h"
 #include "daemon/scene/scene.h"
 
-struct harness_shadows;
+struct look_shadows;
 
 /* NULL with err filled (out of memory, or an atlas past the device's
  * texture size limit, naming look.shadows.atlas). */
-struct harness_shadows *harness_shadows_create(const struct shadow_spec *spec,
+struct look_shadows *look_shadows_create(const struct shadow_spec *spec,
                                                const struct scene *s, struct gpu_scene *gpu,
                                                const struct gpu_caps *caps, char *err,
                                                size_t errlen);
 /* Frame's maps, in pass `pass` of passes; then binds them. Timed: no
  * allocation, no lookups. False (err set) only when overflow is "fail"
  * and a light lost its shadow. `timed` counts the frame in the figures. */
-bool harness_shadows_render(struct harness_shadows *sh, const struct gpu_passes *passes, int pass,
+bool look_shadows_render(struct look_shadows *sh, const struct gpu_passes *passes, int pass,
                             int64_t frame, bool timed, char *err, size_t errlen);
 /* Atlas use and lights per timed frame, the lights that lost shadows. New
  * reference. */
-json_t *harness_shadows_describe(const struct harness_shadows *sh);
+json_t *look_shadows_describe(const struct look_shadows *sh);
 /* Accepts NULL. */
-void harness_shadows_destroy(struct harness_shadows *sh);
+void look_shadows_destroy(struct look_shadows *sh);
 
 #endif

@@ -1,5 +1,5 @@
 #define _POSIX_C_SOURCE 200809L
-#include "daemon/harness/look.h"
+#include "daemon/look/look.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -18,7 +18,7 @@ static void glsl_float(char *out, size_t cap, double v)
         strcat(out, ".0");
 }
 
-void harness_look_defines(const struct look_spec *look, char *out, size_t cap)
+void look_defines(const struct look_spec *look, char *out, size_t cap)
 {
     static const char *const models[] = {"PHONG", "BLINN_PHONG", "PBR"};
     char rough[32], intensity[32], bias[32], offset[32];
@@ -44,7 +44,7 @@ void harness_look_defines(const struct look_spec *look, char *out, size_t cap)
     }
 }
 
-bool harness_look_init(struct harness_look *l, const struct look_spec *look,
+bool look_stages_init(struct look_stages *l, const struct look_spec *look,
                        const struct scene *scene, struct gpu_scene *gpu,
                        struct gpu_frame_block *frame_block, const struct gpu_caps *caps,
                        const char *defines, char *err, size_t errlen)
@@ -54,34 +54,34 @@ bool harness_look_init(struct harness_look *l, const struct look_spec *look,
     l->scene = scene;
     double t0 = clock_mono_s();
     l->sky_on = scene->sky;
-    if ((l->sky_on || look->ibl.enabled) && !harness_sky_init(&l->sky, defines, err, errlen))
+    if ((l->sky_on || look->ibl.enabled) && !look_sky_init(&l->sky, defines, err, errlen))
         goto fail;
     if (look->ibl.enabled) {
-        struct harness_ibl_env env = {&look->ibl, scene, gpu, frame_block, &l->sky};
-        if (!(l->ibl = harness_ibl_create(&env, err, errlen)))
+        struct look_ibl_env env = {&look->ibl, scene, gpu, frame_block, &l->sky};
+        if (!(l->ibl = look_ibl_create(&env, err, errlen)))
             goto fail;
     }
     if (look->shadows.enabled &&
-        !(l->shadows = harness_shadows_create(&look->shadows, scene, gpu, caps, err, errlen)))
+        !(l->shadows = look_shadows_create(&look->shadows, scene, gpu, caps, err, errlen)))
         goto fail;
     l->setup_ms = (clock_mono_s() - t0) * 1e3;
     return true;
 fail:
-    harness_look_finish(l);
+    look_stages_finish(l);
     return false;
 }
 
-void harness_look_finish(struct harness_look *l)
+void look_stages_finish(struct look_stages *l)
 {
     if (!l)
         return;
-    harness_shadows_destroy(l->shadows);
-    harness_ibl_destroy(l->ibl);
-    harness_sky_finish(&l->sky);
+    look_shadows_destroy(l->shadows);
+    look_ibl_destroy(l->ibl);
+    look_sky_finish(&l->sky);
     memset(l, 0, sizeof(*l));
 }
 
-bool harness_look_add_passes(const struct harness_look *l, struct gpu_passes *passes,
+bool look_stages_add_passes(const struct look_stages *l, struct gpu_passes *passes,
                              int *shadow_pass, int *sky_pass)
 {
     *shadow_pass = *sky_pass = -1;
@@ -92,32 +92,32 @@ bool harness_look_add_passes(const struct harness_look *l, struct gpu_passes *pa
     return true;
 }
 
-bool harness_look_before(struct harness_look *l, const struct gpu_passes *passes, int shadow_pass,
+bool look_stages_before(struct look_stages *l, const struct gpu_passes *passes, int shadow_pass,
                          int64_t frame, bool timed, char *err, size_t errlen)
 {
     if (l->ibl)
-        harness_ibl_frame(l->ibl, frame);
+        look_ibl_frame(l->ibl, frame);
     if (l->shadows && shadow_pass >= 0)
-        return harness_shadows_render(l->shadows, passes, shadow_pass, frame, timed, err, errlen);
+        return look_shadows_render(l->shadows, passes, shadow_pass, frame, timed, err, errlen);
     return true;
 }
 
-void harness_look_after(struct harness_look *l, const struct gpu_passes *passes, int sky_pass,
+void look_stages_after(struct look_stages *l, const struct gpu_passes *passes, int sky_pass,
                         GLuint output_fbo, int width, int height)
 {
     if (!l->sky_on || sky_pass < 0)
         return;
     gpu_pass_begin(passes, sky_pass, output_fbo, width, height);
-    harness_sky_draw(&l->sky);
+    look_sky_draw(&l->sky);
     gpu_pass_end(passes);
 }
 
-void harness_look_describe(const struct harness_look *l, json_t *result)
+void look_stages_describe(const struct look_stages *l, json_t *result)
 {
     if (l->ibl)
-        json_object_set_new(result, "ibl", harness_ibl_describe(l->ibl));
+        json_object_set_new(result, "ibl", look_ibl_describe(l->ibl));
     if (l->shadows)
-        json_object_set_new(result, RK_SHADOWS, harness_shadows_describe(l->shadows));
+        json_object_set_new(result, RK_SHADOWS, look_shadows_describe(l->shadows));
     if (l->ibl || l->shadows || l->sky_on)
         json_object_set_new(result, "setup_ms",
                             json_pack("{s:f, s:s}", "look", l->setup_ms, "includes",
@@ -134,38 +134,4 @@ void harness_look_describe(const struct harness_look *l, json_t *result)
                                       "roughness below min_roughness is shaded at it: GGX at "
                                       "roughness 0 divides 0 by 0 where N = H"));
     }
-}
-
-void harness_hdr_stats(GLuint fbo, int w, int h, float *scratch, struct hdr_stats *out)
-{
-    memset(out, 0, sizeof(*out));
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, scratch);
-    long long finite = 0;
-    double sum[3] = {0, 0, 0};
-    out->min = INFINITY;
-    for (long long p = 0; p < (long long)w * h; p++) {
-        const float *c = &scratch[p * 4];
-        if (!isfinite(c[0]) || !isfinite(c[1]) || !isfinite(c[2])) {
-            out->nonfinite++;
-            continue;
-        }
-        finite++;
-        for (int k = 0; k < 3; k++) {
-            sum[k] += c[k];
-            out->max = c[k] > out->max ? c[k] : out->max;
-            out->min = c[k] < out->min ? c[k] : out->min;
-        }
-    }
-    for (int k = 0; k < 3; k++)
-        out->mean[k] = finite ? sum[k] / (double)finite : 0.0;
-    if (!finite)
-        out->min = 0.0;
-}
-
-json_t *hdr_stats_json(const struct hdr_stats *s)
-{
-    return json_pack("{s:I, s:[f, f, f], s:f, s:f}", "nonfinite", (json_int_t)s->nonfinite,
-                     "mean", s->mean[0], s->mean[1], s->mean[2], "min", s->min, "max", s->max);
 }

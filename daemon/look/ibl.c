@@ -3,7 +3,7 @@
  * probes see the scene lit by the point lights and the uniform ambient),
  * and without shadows. */
 #define _POSIX_C_SOURCE 200809L
-#include "daemon/harness/ibl.h"
+#include "daemon/look/ibl.h"
 
 #include <epoxy/gl.h>
 #include <math.h>
@@ -33,7 +33,7 @@ struct ibl_block {
     int32_t layer[IBL_MAX_BLEND][4];
 };
 
-struct harness_ibl {
+struct look_ibl {
     struct ibl_spec spec;
     const struct scene *scene;
     int probes;
@@ -110,7 +110,7 @@ static void filters_finish(struct filters *f)
     glDeleteRenderbuffers(1, &f->depth);
 }
 
-static bool filters_init(struct filters *f, struct harness_ibl *ibl, const struct gpu_scene *gpu,
+static bool filters_init(struct filters *f, struct look_ibl *ibl, const struct gpu_scene *gpu,
                          char *err, size_t errlen)
 {
     memset(f, 0, sizeof(*f));
@@ -147,7 +147,7 @@ static bool filters_init(struct filters *f, struct harness_ibl *ibl, const struc
 
 /* Layer `layer`'s source: the environment alone (probe NULL) or the scene
  * from the probe, into the source cube map with its mip chain. */
-static bool capture(struct harness_ibl *ibl, struct filters *f, const struct harness_ibl_env *env,
+static bool capture(struct look_ibl *ibl, struct filters *f, const struct look_ibl_env *env,
                     const struct ibl_probe *probe)
 {
     const struct scene *s = env->scene;
@@ -196,7 +196,7 @@ static bool capture(struct harness_ibl *ibl, struct filters *f, const struct har
             gpu_scene_draw(env->gpu, &f->capture);
         }
         glEnable(GL_DEPTH_TEST);
-        harness_sky_draw(env->sky);
+        look_sky_draw(env->sky);
     }
     glBindTexture(GL_TEXTURE_CUBE_MAP, f->source);
     glGenerateMipmap(GL_TEXTURE_CUBE_MAP);
@@ -211,7 +211,7 @@ static void draw_face(struct filters *f, GLuint target, int level, int layer_fac
     glDrawArrays(GL_TRIANGLES, 0, 3);
 }
 
-static bool filter(struct harness_ibl *ibl, struct filters *f, int layer)
+static bool filter(struct look_ibl *ibl, struct filters *f, int layer)
 {
     int res = ibl->resolution;
     glBindFramebuffer(GL_FRAMEBUFFER, f->fbo);
@@ -246,9 +246,9 @@ static bool filter(struct harness_ibl *ibl, struct filters *f, int layer)
     return glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
 }
 
-struct harness_ibl *harness_ibl_create(const struct harness_ibl_env *env, char *err, size_t errlen)
+struct look_ibl *look_ibl_create(const struct look_ibl_env *env, char *err, size_t errlen)
 {
-    struct harness_ibl *ibl = calloc(1, sizeof(*ibl));
+    struct look_ibl *ibl = calloc(1, sizeof(*ibl));
     float *table = malloc(LUT_SIZE * LUT_SIZE * 2 * sizeof(float));
     struct filters f;
     struct phase phase = {0};
@@ -316,7 +316,7 @@ struct harness_ibl *harness_ibl_create(const struct harness_ibl_env *env, char *
     }
     ibl->total_ms = (clock_mono_s() - t_start) * 1e3;
     /* The choice at frame 1, for the result. */
-    harness_ibl_frame(ibl, 1);
+    look_ibl_frame(ibl, 1);
     memcpy(ibl->first_selected, ibl->selected, sizeof(ibl->selected));
     ibl->first_nselected = ibl->nselected;
     ok = true;
@@ -327,13 +327,13 @@ out:
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     free(table);
     if (!ok) {
-        harness_ibl_destroy(ibl);
+        look_ibl_destroy(ibl);
         return NULL;
     }
     return ibl;
 }
 
-void harness_ibl_frame(struct harness_ibl *ibl, int64_t frame)
+void look_ibl_frame(struct look_ibl *ibl, int64_t frame)
 {
     const struct scene *s = ibl->scene;
     if (!ibl->bound_once || scene_camera_moves(s)) {
@@ -370,7 +370,7 @@ void harness_ibl_frame(struct harness_ibl *ibl, int64_t frame)
     glActiveTexture(GL_TEXTURE0);
 }
 
-json_t *harness_ibl_describe(const struct harness_ibl *ibl)
+json_t *look_ibl_describe(const struct look_ibl *ibl)
 {
     json_t *probes = json_array(), *chosen = json_array();
     for (int i = 0; i < ibl->probes; i++)
@@ -397,7 +397,7 @@ json_t *harness_ibl_describe(const struct harness_ibl *ibl)
         "GL_TIME_ELAPSED around the same phases, which llvmpipe does not measure reliably");
 }
 
-void harness_ibl_destroy(struct harness_ibl *ibl)
+void look_ibl_destroy(struct look_ibl *ibl)
 {
     if (!ibl)
         return;

@@ -1,5 +1,5 @@
-#ifndef SHADEBENCH_HARNESS_IBL_H
-#define SHADEBENCH_HARNESS_IBL_H
+#ifndef SHADEBENCH_LOOK_IBL_H
+#define SHADEBENCH_LOOK_IBL_H
 
 /* Image-based lighting (look.ibl), run by the harness for every technique:
  * before the timed frames it captures the environment and each light probe
@@ -18,31 +18,31 @@
 
 #include "daemon/gpu/gpu_scene.h"
 #include "daemon/gpu/pass.h"
-#include "daemon/harness/sky.h"
+#include "daemon/look/sky.h"
 #include "daemon/lighting/look_lighting.h"
 #include "daemon/scene/scene.h"
 
-struct harness_ibl;
+struct look_ibl;
 
-struct harness_ibl_env {
+struct look_ibl_env {
     const struct ibl_spec *spec;
     const struct scene *scene;
     struct gpu_scene *gpu;
     struct gpu_frame_block *frame_block; /* overwritten by the captures */
-    const struct harness_sky *sky;
+    const struct look_sky *sky;
 };
 
 /* Captures and filters everything (outside the timed frames; leaves the
  * framebuffer binding at 0). NULL with err filled on failure. */
-struct harness_ibl *harness_ibl_create(const struct harness_ibl_env *env, char *err, size_t errlen);
+struct look_ibl *look_ibl_create(const struct look_ibl_env *env, char *err, size_t errlen);
 /* Chooses frame's probes for its camera and binds the maps, the table and
  * the probe block. Timed: no allocation, no lookups; uploads only when the
  * choice changes. */
-void harness_ibl_frame(struct harness_ibl *ibl, int64_t frame);
+void look_ibl_frame(struct look_ibl *ibl, int64_t frame);
 /* Setup times, probes, maps and their bytes, the choice at frame 1. New
  * reference. */
-json_t *harness_ibl_describe(const struct harness_ibl *ibl);
+json_t *look_ibl_describe(const struct look_ibl *ibl);
 /* Accepts NULL. */
-void harness_ibl_destroy(struct harness_ibl *ibl);
+void look_ibl_destroy(struct look_ibl *ibl);
 
 #endif

@@ -1,5 +1,5 @@
-#ifndef SHADEBENCH_HARNESS_SKY_H
-#define SHADEBENCH_HARNESS_SKY_H
+#ifndef SHADEBENCH_LOOK_SKY_H
+#define SHADEBENCH_LOOK_SKY_H
 
 /* The harness's sky pass: the look's environment (shaders/common/
  * environment.glsl) drawn behind a technique's image in every pixel it left
@@ -10,17 +10,17 @@
 #include <stdbool.h>
 #include <stddef.h>
 
-struct harness_sky {
+struct look_sky {
     GLuint prog, vao;
 };
 
 /* defines: the look's (the environment's #defines among them). */
-bool harness_sky_init(struct harness_sky *s, const char *defines, char *err, size_t errlen);
+bool look_sky_init(struct look_sky *s, const char *defines, char *err, size_t errlen);
 /* Draws into the bound framebuffer, whose depth attachment holds the scene's
  * depth, in the frame block's camera; depth test GL_LEQUAL, no writes.
  * Leaves depth writes on, as the pass baseline has them. */
-void harness_sky_draw(const struct harness_sky *s);
+void look_sky_draw(const struct look_sky *s);
 /* Takes a zeroed or initialised sky. */
-void harness_sky_finish(struct harness_sky *s);
+void look_sky_finish(struct look_sky *s);
 
 #endif

@@ -1,0 +1,94 @@
+#define _POSIX_C_SOURCE 200809L
+#include "daemon/harness/measure.h"
+
+#include <inttypes.h>
+#include <stdio.h>
+
+#include "common/clock.h"
+#include "daemon/gpu/glutil.h"
+#include "daemon/harness/deadline.h"
+#include "daemon/harness/outputs.h"
+#include "daemon/harness/telemetry.h"
+
+/* Between frames: a DELETE or a stop sets the job's cancel flag, and the
+ * job's timeout_s may run out. */
+static bool keep_going(struct harness_run *run, int64_t k, int run_index, enum job_status *status)
+{
+    if (atomic_load(&run->job->cancel)) {
+        *status = JOB_CANCELLED;
+        if (k >= 1)
+            snprintf(run->err, sizeof(run->err), "cancelled at frame %" PRId64 " of run %d", k,
+                     run_index + 1);
+        else
+            snprintf(run->err, sizeof(run->err), "cancelled during warm-up frame %" PRId64
+                     " of %d, run %d", k + run->spec->warmup_frames, run->spec->warmup_frames,
+                     run_index + 1);
+        return false;
+    }
+    if (job_timed_out(run->job)) {
+        job_timeout_message(run->job, "rendering", run->err, sizeof(run->err));
+        return false;
+    }
+    return true;
+}
+
+bool measure_run(struct harness_run *run, int run_index, enum job_status *status)
+{
+    const struct job_spec *spec = run->spec;
+    int w0 = spec->warmup_frames, n = spec->frames;
+    double wall_start = 0, frame_begin = 0;
+    run->capture_s = 0;
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    for (int seq = 0; seq < w0 + n; seq++) {
+        int64_t k = (int64_t)seq - w0 + 1;
+        if (!keep_going(run, k, run_index, status))
+            return false;
+        if (k == 1) {
+            /* Warm-up work still queued must not be billed to the timed frames. */
+            glFinish();
+            interference_sample(&run->interference[0]);
+            wall_start = clock_mono_s();
+        }
+        /* Bound the frames in flight like a swap chain would; the wait is part
+         * of the frame interval, never of the CPU submit time. */
+        GLsync *fence = &run->fences[seq % RUN_FRAMES_IN_FLIGHT];
+        if (*fence) {
+            glClientWaitSync(*fence, GL_SYNC_FLUSH_COMMANDS_BIT, UINT64_MAX);
+            glDeleteSync(*fence);
+            *fence = NULL;
+        }
+        double t0 = clock_mono_s();
+        if (k >= 2)
+            run->frame_ms[k - 2] += (t0 - frame_begin) * 1e3;
+        frame_begin = t0;
+        bool ok = run_frame(run, k, k >= 1);
+        glFlush(); /* where a swap would hand the frame to the GPU */
+        double t1 = clock_mono_s();
+        *fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+        if (!ok)
+            return false;
+        if (k >= 1)
+            run->cpu_ms[k - 1] = (t1 - t0) * 1e3;
+        if (run->capture_count && job_spec_is_capture_frame(spec, (int)k)) {
+            double c0 = clock_mono_s();
+            if (!outputs_read_capture(run, (int)k))
+                return false;
+            double c = clock_mono_s() - c0;
+            run->capture_s += c;
+            run->frame_ms[k - 1] -= c * 1e3;
+        }
+        if ((seq & 15) == 15 && gl_error_take("rendering", run->err, sizeof(run->err)))
+            return false;
+        queue_progress(run->queue, run->job, run_index * n + (k > 0 ? (int)k : 0));
+        telemetry_frames(1);
+    }
+    glFinish();
+    double wall_end = clock_mono_s();
+    interference_sample(&run->interference[1]);
+    run->frame_ms[n - 1] += (wall_end - frame_begin) * 1e3;
+    run->wall_s = wall_end - wall_start;
+    gpu_timer_drain(run->timer);
+    if (run->tech->verify && !run->tech->verify(run->state, run->err, sizeof(run->err)))
+        return false;
+    return !gl_error_take("rendering", run->err, sizeof(run->err));
+}

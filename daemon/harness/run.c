@@ -1,0 +1,285 @@
+#define _POSIX_C_SOURCE 200809L
+#include "daemon/harness/run.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "daemon/gpu/bindings.h"
+#include "daemon/gpu/glutil.h"
+
+bool harness_gl_init(struct harness_gl *g, char *err, size_t errlen)
+{
+    gl_debug_install();
+    gpu_caps_query(&g->caps);
+    const struct gl_stage stages[] = {
+        {GL_VERTEX_SHADER, {"fullscreen.vert"}},
+        {GL_FRAGMENT_SHADER, {"resolve.frag"}},
+    };
+    /* One resolve per tone map, in enum look_tonemap order. */
+    static const char *const tonemaps[3] = {"#define TONEMAP_NONE 1\n",
+                                            "#define TONEMAP_REINHARD 1\n",
+                                            "#define TONEMAP_ACES 1\n"};
+    g->targets = gpu_targets_create();
+    bool ok = g->targets && gpu_frame_block_init(&g->frame_block);
+    for (int i = 0; ok && i < 3; i++)
+        ok = (g->resolve_progs[i] = gl_program_build("resolve", stages, 2, tonemaps[i], err,
+                                                     errlen)) != 0;
+    if (!ok) {
+        if (!err[0])
+            snprintf(err, errlen, "cannot set up the harness's GL objects");
+        return false;
+    }
+    glGenVertexArrays(1, &g->empty_vao);
+    return !gl_error_take("harness setup", err, errlen);
+}
+
+void harness_gl_finish(struct harness_gl *g)
+{
+    gpu_targets_destroy(g->targets);
+    g->targets = NULL;
+    gpu_frame_block_finish(&g->frame_block);
+    for (int i = 0; i < 3; i++)
+        glDeleteProgram(g->resolve_progs[i]);
+    glDeleteVertexArrays(1, &g->empty_vao);
+}
+
+/* The output every technique draws into (HDR colour and a depth texture
+ * later passes may sample) and the 8-bit image the resolve writes, from the
+ * pool: allocated once per size and format, not per job. */
+bool run_setup_targets(struct harness_run *run)
+{
+    const struct gpu_caps *caps = &run->gl->caps;
+    struct gpu_targets *pool = run->gl->targets;
+    int w = run->spec->scene.width, h = run->spec->scene.height;
+    if (w > caps->max_texture_size || h > caps->max_texture_size ||
+        w > caps->max_viewport[0] || h > caps->max_viewport[1]) {
+        snprintf(run->err, sizeof(run->err),
+                 "scene.width/height %dx%d exceed this device's limits "
+                 "(GL_MAX_TEXTURE_SIZE %d, GL_MAX_VIEWPORT_DIMS %dx%d)",
+                 w, h, caps->max_texture_size, caps->max_viewport[0], caps->max_viewport[1]);
+        return false;
+    }
+    GLenum hdr_format = run->look->hdr == LOOK_HDR_RGBA16F ? GL_RGBA16F : GL_RGBA32F;
+    GLuint color = gpu_targets_texture(pool, "output.hdr", hdr_format, w, h, run->err,
+                                       sizeof(run->err));
+    GLuint depth = color ? gpu_targets_texture(pool, "output.depth", GL_DEPTH_COMPONENT24, w, h,
+                                               run->err, sizeof(run->err))
+                         : 0;
+    GLuint ldr = depth ? gpu_targets_texture(pool, "output.ldr", GL_RGBA8, w, h, run->err,
+                                             sizeof(run->err))
+                       : 0;
+    if (!ldr)
+        return false;
+    GLuint out = gpu_targets_fbo(pool, "output", &color, 1, depth, run->err, sizeof(run->err));
+    run->ldr_fbo = out ? gpu_targets_fbo(pool, "resolve", &ldr, 1, 0, run->err, sizeof(run->err))
+                       : 0;
+    if (!run->ldr_fbo)
+        return false;
+    look_defines(run->look, run->defines, sizeof(run->defines));
+    run->env = (struct technique_env){
+        .spec = run->spec,
+        .look = run->look,
+        .scene = &run->scene,
+        .gpu = &run->gpu,
+        .caps = caps,
+        .targets = pool,
+        .passes = &run->passes,
+        .output_fbo = out,
+        .output_color = color,
+        .output_depth = depth,
+        .width = w,
+        .height = h,
+        .defines = run->defines,
+        .products = &run->products,
+    };
+    return true;
+}
+
+bool run_setup_passes(struct harness_run *run, const void *options, int64_t timed_frames)
+{
+    const struct technique *tech = run->tech;
+    int post_passes = post_spec_pass_names(&run->look->post, NULL, 0);
+    int look_passes = (run->stages.shadows != NULL) + run->stages.sky_on;
+    run->timer = gpu_timer_create(technique_pass_count(tech) + look_passes + post_passes + 1,
+                                  timed_frames);
+    if (!run->timer) {
+        snprintf(run->err, sizeof(run->err), "cannot create GPU timer queries");
+        return false;
+    }
+    bool fits = gpu_passes_init(&run->passes, run->timer, tech->info->passes,
+                                run->gl->caps.debug_groups) &&
+                look_stages_add_passes(&run->stages, &run->passes, &run->shadow_pass,
+                                       &run->sky_pass);
+    /* The chain's passes now; its effects are built once the technique exists. */
+    if (fits && !(run->post = post_chain_create(&run->env, run->look, &run->passes, run->err,
+                                                sizeof(run->err))))
+        return false;
+    if (!fits || (run->resolve_pass = gpu_passes_add(&run->passes, "resolve")) < 0) {
+        snprintf(run->err, sizeof(run->err), "%s declares more passes than the harness times",
+                 tech->info->name);
+        return false;
+    }
+    run->env.options = options;
+    return true;
+}
+
+static bool alloc_captures(struct harness_run *run)
+{
+    const struct job_spec *spec = run->spec;
+    size_t pixels = (size_t)spec->scene.width * (size_t)spec->scene.height;
+    int n = run->capture_count;
+    if (!n)
+        return true;
+    if (!(run->capture = calloc((size_t)n, sizeof(*run->capture))))
+        return false;
+    for (int c = 0; c < n; c++) {
+        struct run_capture *cap = &run->capture[c];
+        if (!(cap->pixels = malloc(pixels * 4)) ||
+            (run->products.heat_tex && !(cap->heat = malloc(pixels * sizeof(uint32_t)))))
+            return false;
+    }
+    /* Physically based looks report each capture's HDR figures: non-finite
+     * pixels (what the roughness clamp keeps out), mean and peak. */
+    if (run->look->lighting == LOOK_PBR &&
+        !(run->hdr_scratch = malloc(pixels * 4 * sizeof(float))))
+        return false;
+    return true;
+}
+
+bool run_prepare(struct harness_run *run, bool capture)
+{
+    const struct job_spec *spec = run->spec;
+    int n = spec->frames;
+    run->look = &spec->look;
+    run->shadow_pass = run->sky_pass = -1;
+    run->scene_ok = scene_init(&run->scene, &spec->scene);
+    run->capture_count = capture ? job_spec_capture_count(spec) : 0;
+    run->cpu_ms = calloc((size_t)n, sizeof(double));
+    run->frame_ms = calloc((size_t)n, sizeof(double));
+    if (!run->scene_ok || !run->cpu_ms || !run->frame_ms) {
+        snprintf(run->err, sizeof(run->err), "out of memory preparing the job");
+        return false;
+    }
+    if (!gpu_scene_init(&run->gpu, &run->scene, run->err, sizeof(run->err)) ||
+        !run_setup_targets(run) ||
+        !look_stages_init(&run->stages, &spec->look, &run->scene, &run->gpu,
+                          &run->gl->frame_block, &run->gl->caps, run->defines, run->err,
+                          sizeof(run->err)) ||
+        !run_setup_passes(run, job_spec_technique_options(spec),
+                          (int64_t)spec->warmup_frames + n))
+        return false;
+    if (!run->tech->create(&run->env, &run->state, run->err, sizeof(run->err)) ||
+        !post_chain_build(run->post, run->err, sizeof(run->err)) ||
+        gl_error_take("setup", run->err, sizeof(run->err)))
+        return false;
+    /* After create: whether the technique publishes a heat map is known now. */
+    if (!alloc_captures(run)) {
+        snprintf(run->err, sizeof(run->err), "out of memory for captures");
+        return false;
+    }
+    return true;
+}
+
+void run_finish(struct harness_run *run)
+{
+    if (run->tech && run->state)
+        run->tech->destroy(run->state);
+    run->state = NULL;
+    look_stages_finish(&run->stages);
+    free(run->hdr_scratch);
+    post_chain_destroy(run->post);
+    gpu_timer_destroy(run->timer);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    gpu_scene_finish(&run->gpu);
+    if (run->scene_ok)
+        scene_finish(&run->scene);
+    for (int i = 0; run->capture && i < run->capture_count; i++) {
+        free(run->capture[i].pixels);
+        free(run->capture[i].heat);
+    }
+    free(run->capture);
+    free(run->cpu_ms);
+    free(run->frame_ms);
+    for (int i = 0; i < RUN_FRAMES_IN_FLIGHT; i++)
+        if (run->fences[i])
+            glDeleteSync(run->fences[i]);
+    /* Leave no error behind for the next job to trip over. */
+    char drop[16];
+    gl_error_take("teardown", drop, sizeof(drop));
+}
+
+/* A still camera's block is the same every frame, so only a moving one is
+ * rebuilt. */
+void run_frame_data(const struct harness_run *run, int64_t k, struct gpu_frame_data *d)
+{
+    const struct scene *s = run->env.scene;
+    if (d->viewport[0] != 0 && !scene_camera_moves(s)) {
+        d->counts[0] = (int32_t)(k & 0x7fffffff);
+        return;
+    }
+    struct scene_camera cam;
+    scene_camera_at(s, k, &cam);
+    memcpy(d->view, cam.view, sizeof(d->view));
+    memcpy(d->proj, cam.proj, sizeof(d->proj));
+    memcpy(d->view_proj, cam.view_proj, sizeof(d->view_proj));
+    memcpy(d->inv_view, cam.inv_view, sizeof(d->inv_view));
+    memcpy(d->inv_proj, cam.inv_proj, sizeof(d->inv_proj));
+    mat4_invert(d->view_proj, d->inv_view_proj);
+    d->eye[0] = cam.eye[0], d->eye[1] = cam.eye[1], d->eye[2] = cam.eye[2], d->eye[3] = 1.0f;
+    d->viewport[0] = (float)run->env.width;
+    d->viewport[1] = (float)run->env.height;
+    d->viewport[2] = 1.0f / (float)run->env.width;
+    d->viewport[3] = 1.0f / (float)run->env.height;
+    d->clip[0] = cam.near_z, d->clip[1] = cam.far_z, d->clip[2] = d->clip[3] = 0.0f;
+    d->counts[0] = (int32_t)(k & 0x7fffffff);
+    d->counts[1] = s->light_count;
+    d->counts[2] = s->instance_count;
+    d->counts[3] = 0;
+}
+
+/* HDR output to the 8-bit image, timed as a pass of every frame so that
+ * every technique pays it alike. */
+static void resolve(const struct harness_run *run)
+{
+    const struct harness_gl *g = run->gl;
+    gpu_pass_begin(&run->passes, run->resolve_pass, run->ldr_fbo, run->env.width,
+                   run->env.height);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glUseProgram(g->resolve_progs[run->look->tonemap]);
+    glUniform1f(SB_LOC_EXPOSURE, (float)run->look->exposure);
+    glActiveTexture(GL_TEXTURE0 + SB_TEX_HDR);
+    glBindTexture(GL_TEXTURE_2D, run->hdr_resolved);
+    glBindVertexArray(g->empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindVertexArray(0);
+    gpu_pass_end(&run->passes);
+}
+
+bool run_frame(struct harness_run *run, int64_t k, bool timed)
+{
+    run_frame_data(run, k, &run->frame_data);
+    gpu_frame_block_update(&run->gl->frame_block, &run->frame_data);
+    gpu_timer_begin_frame(run->timer);
+    bool ok = look_stages_before(&run->stages, &run->passes, run->shadow_pass, k, timed, run->err,
+                                 sizeof(run->err)) &&
+              run->tech->render(run->state, &run->env, k, run->err, sizeof(run->err));
+    look_stages_after(&run->stages, &run->passes, run->sky_pass, run->env.output_fbo,
+                      run->env.width, run->env.height);
+    run->hdr_resolved = post_chain_run(run->post);
+    resolve(run);
+    gpu_timer_end_frame(run->timer);
+    return ok;
+}
+
+int run_pass_order(const struct harness_run *run, int *order)
+{
+    int n = 0;
+    if (run->shadow_pass >= 0)
+        order[n++] = run->shadow_pass;
+    for (int s = 0; s < run->passes.count; s++)
+        if (s != run->shadow_pass)
+            order[n++] = s;
+    return n;
+}

@@ -1,0 +1,131 @@
+#ifndef SHADEBENCH_RUN_H
+#define SHADEBENCH_RUN_H
+
+/* One run of a job on the render thread, and the render-thread state every
+ * run shares. A run is prepared (scene, targets, the look's stages, the
+ * technique and its passes, capture buffers: run_prepare), measured
+ * (measure.h), written out (outputs.h) and finished (run_finish); the
+ * reference render (reference.h) borrows the measured run's scene and look.
+ * The job loop and repeats are runner.c's. Render thread only. */
+
+#include <epoxy/gl.h>
+#include <jansson.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "daemon/effects/post_chain.h"
+#include "daemon/gpu/caps.h"
+#include "daemon/gpu/gpu_scene.h"
+#include "daemon/gpu/gpu_timer.h"
+#include "daemon/gpu/pass.h"
+#include "daemon/gpu/targets.h"
+#include "daemon/harness/interference.h"
+#include "daemon/jobs/queue.h"
+#include "daemon/look/look.h"
+#include "daemon/scene/scene.h"
+#include "daemon/techniques/technique.h"
+
+/* Frames the GPU may run behind the CPU, as a double-buffered swap chain allows. */
+#define RUN_FRAMES_IN_FLIGHT 2
+
+/* What every job shares on the render thread, made once the context is up:
+ * limits, the target pool (re-created only when a size or format changes),
+ * the frame block, the resolve programs and the device strings. */
+struct harness_gl {
+    struct gpu_caps caps;
+    struct gpu_targets *targets;
+    struct gpu_frame_block frame_block;
+    GLuint empty_vao;
+    GLuint resolve_progs[3]; /* by look.tonemap: none, reinhard, aces */
+    json_t *device_json;     /* the owner's: immutable once made, read by other threads */
+};
+
+/* Once the context is current. finish frees the GL objects, not device_json. */
+bool harness_gl_init(struct harness_gl *g, char *err, size_t errlen);
+void harness_gl_finish(struct harness_gl *g);
+
+/* HDR statistics of one captured frame. */
+struct hdr_stats {
+    long long nonfinite; /* pixels with a NaN or infinite R, G or B */
+    double mean[3];      /* of the finite pixels */
+    double min, max;     /* smallest and largest finite channel */
+};
+
+/* One captured frame, as read back in the capture bracket of the timed
+ * loop and encoded after it. */
+struct run_capture {
+    int frame;
+    uint8_t *pixels;                 /* the 8-bit frame, RGBA */
+    struct post_nonfinite nonfinite; /* of the HDR colour the resolve read */
+    struct hdr_stats hdr;            /* physically based looks (run->hdr_scratch set) */
+    uint32_t *heat;                  /* light evaluations per pixel, when published */
+};
+
+struct harness_run {
+    struct harness_gl *gl;
+    struct queue *queue;
+    struct job *job;
+    const struct job_spec *spec;
+    const struct technique *tech;
+    /* The look this run renders with: the job's, or its reference_look. */
+    const struct look_spec *look;
+    struct scene scene;
+    bool scene_ok;
+    struct gpu_scene gpu;
+    struct gpu_timer *timer;
+    struct gpu_passes passes;
+    int resolve_pass;
+    /* The look's stages (probes, shadow maps, sky): owned by the run that
+     * measures; the reference borrows them. */
+    struct look_stages stages;
+    int shadow_pass, sky_pass; /* -1 when the look has none */
+    struct post_chain *post;
+    GLuint hdr_resolved; /* the HDR colour the resolve reads this frame */
+    /* Zeroed with the run, so that a still camera's block is built once. */
+    struct gpu_frame_data frame_data;
+    GLuint ldr_fbo;
+    struct technique_env env;
+    struct technique_products products;
+    char defines[512];
+    void *state;
+    /* The captures (the first run of a job only): capture_count slots, the
+     * first `captured` of them filled. */
+    int capture_count, captured;
+    struct run_capture *capture;
+    float *hdr_scratch; /* physically based looks: one HDR frame, for the statistics */
+    /* Figures of the timed frames. */
+    double *cpu_ms;
+    double *frame_ms;
+    double wall_s, capture_s;
+    struct interference_sample interference[2]; /* start and end of the timed region */
+    GLsync fences[RUN_FRAMES_IN_FLIGHT];
+    char err[1024];
+};
+
+/* Everything before the first frame: the scene, the targets, the look's
+ * stages, the technique with its passes and timer, the post chain, and the
+ * capture buffers when capture is set (the first run of a job). The run
+ * must be zeroed but for gl, queue, job, spec and tech. False with run->err. */
+bool run_prepare(struct harness_run *run, bool capture);
+/* Frees what run_prepare and the frames made. Takes a run in any state. */
+void run_finish(struct harness_run *run);
+
+/* The output targets and the technique's env for run->look over the run's
+ * scene (the reference calls it with the measured run's scene). */
+bool run_setup_targets(struct harness_run *run);
+/* The technique's passes (its own, the look's shadows and sky, the post
+ * chain's, then the resolve) and a timer for timed_frames frames. */
+bool run_setup_passes(struct harness_run *run, const void *options, int64_t timed_frames);
+
+/* The per-frame block for frame k: camera, viewport and counts. */
+void run_frame_data(const struct harness_run *run, int64_t k, struct gpu_frame_data *d);
+/* One frame of every stage, from the look's before-passes to the resolve,
+ * between the timer's begin and end of frame. Timed. */
+bool run_frame(struct harness_run *run, int64_t k, bool timed);
+
+/* Passes in the order a frame runs them (the shadow pass first); returns
+ * the count. */
+int run_pass_order(const struct harness_run *run, int *order);
+
+#endif

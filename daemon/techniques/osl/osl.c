@@ -39,7 +39,7 @@ struct osl {
     GLuint atlas, tile_buffer, work_buffer;
     int atlas_w, atlas_h;
     int groups_x_max;
-    struct osl_tile *tiles;
+    struct atlas_tile *tiles;
     struct osl_schedule schedule;
     struct osl_work *plan;
     GLuint *work; /* 4 uints per planned object */

@@ -13,7 +13,7 @@
  * Dotted names nest: "gbuffer.normal" is read from {"gbuffer": {"normal":
  * ...}}, and a job may as well write {"gbuffer.normal": ...}, as /v1/info
  * lists it; giving both is refused, naming the option. Errors always name
- * the dotted path under the part's prefix ("deferred.gbuffer.normal").
+ * the dotted path under the part's prefix ("<technique>.gbuffer.normal").
  *
  * GL-free. Tables are immutable: any thread. */
 
@@ -71,7 +71,7 @@ struct opt_table {
     size_t size;                    /* of the options struct: at most OPT_MAX_BYTES */
     /* Rules across fields, after every field was read; may complete the
      * options (a default that depends on another). prefix is the part's
-     * path ("clustered_forward", "look.shadows"), for the field an error
+     * path ("<technique>", "look.shadows"), for the field an error
      * names. May be NULL. */
     bool (*check)(void *opts, const char *prefix, struct job_error *err);
 };
@@ -114,7 +114,7 @@ const struct opt_field *opt_find(const struct opt_table *t, const char *name);
 /* Checks a table at registration: names unique and not both an option and
  * a group, every member inside the struct, the struct within
  * OPT_MAX_BYTES, choices and hooks present, defaults within the rules.
- * err starts with owner ("technique deferred"). */
+ * err starts with owner ("technique <name>"). */
 bool opt_table_check(const struct opt_table *t, const char *owner, char *err, size_t errlen);
 
 #endif

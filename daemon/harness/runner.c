@@ -163,7 +163,9 @@ static bool setup_targets(struct run *run)
         return false;
     harness_look_defines(run->look, run->defines, sizeof(run->defines));
     run->env = (struct technique_env){
-        .spec = run->spec,
+        .frames = run->spec->frames,
+        .warmup_frames = run->spec->warmup_frames,
+        .capture_interval = run->spec->capture_interval,
         .look = run->look,
         .scene = &run->scene,
         .gpu = &run->gpu,
@@ -229,6 +231,15 @@ static void resolve(const struct run *run)
     gpu_pass_end(&run->passes);
 }
 
+/* Post hook: the chain's effects, once the technique has published the
+ * normals (if any) that choose their programs. */
+static bool build_post_chain(struct run *run, char *err, size_t errlen)
+{
+    const struct technique_products *p = &run->products;
+    return post_chain_build(run->post, p->normal_tex,
+                            p->normal_encoding == TECHNIQUE_NORMAL_OCTAHEDRAL, err, errlen);
+}
+
 /* Post hook: the look's effects on the technique's HDR output, each a
  * timed pass, between the technique's render and the resolve. */
 static void post_chain_run_frame(struct run *run)
@@ -292,7 +303,15 @@ static bool setup_technique(struct run *run, const struct technique *tech, const
                 harness_look_add_passes(&run->hlook, &run->passes, &run->shadow_pass,
                                         &run->sky_pass);
     /* Post hook: the chain's passes; its effects are built once the technique exists. */
-    if (fits && !(run->post = post_chain_create(&run->env, run->look, &run->passes, run->err,
+    const struct post_frame frame = {
+        .width = run->env.width,
+        .height = run->env.height,
+        .hdr_format = run->look->hdr == LOOK_HDR_RGBA16F ? GL_RGBA16F : GL_RGBA32F,
+        .color = run->env.output_color,
+        .depth = run->env.output_depth,
+        .targets = run->env.targets,
+    };
+    if (fits && !(run->post = post_chain_create(&frame, &run->look->post, &run->passes, run->err,
                                                 sizeof(run->err))))
         return false;
     if (!fits || (run->resolve_pass = gpu_passes_add(&run->passes, "resolve")) < 0) {
@@ -518,7 +537,7 @@ static bool render_reference(struct run *run, enum job_status *status)
         void *state = NULL;
         char why[900] = "";
         if (!ref->create(&rr.env, &state, why, sizeof(why)) ||
-            !post_chain_build(rr.post, why, sizeof(why))) { /* post hook */
+            !build_post_chain(&rr, why, sizeof(why))) { /* post hook */
             snprintf(run->err, sizeof(run->err), "reference %s cannot run: %s", ref->info->name,
                      why);
             ref->destroy(state);
@@ -645,7 +664,7 @@ static bool measure(struct runner *r, struct run *run, bool capture, int run_ind
         }
     }
     if (!run->tech->create(&run->env, &run->state, run->err, sizeof(run->err)) ||
-        !post_chain_build(run->post, run->err, sizeof(run->err)) || /* post hook */
+        !build_post_chain(run, run->err, sizeof(run->err)) || /* post hook */
         gl_error_take("setup", run->err, sizeof(run->err)))
         return false;
 

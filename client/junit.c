@@ -253,9 +253,14 @@ void junit_job_name(const json_t *spec, char *out, size_t cap)
             size_t m;
             const char **sub = sorted_keys(v, &m);
             put(name, ncap, " %s(", k);
-            for (size_t s = 0; sub && s < m; s++) {
-                scalar_text(json_object_get(v, sub[s]), text, sizeof(text));
-                put(name, ncap, "%s%s=%s", s ? " " : "", sub[s], text);
+            for (size_t s = 0, shown = 0; sub && s < m; s++) {
+                json_t *sv = json_object_get(v, sub[s]);
+                /* An option the spec also states at the top level (an
+                 * alias kept for older clients) is named there, once. */
+                if (json_equal(sv, json_object_get(spec, sub[s])))
+                    continue;
+                scalar_text(sv, text, sizeof(text));
+                put(name, ncap, "%s%s=%s", shown++ ? " " : "", sub[s], text);
             }
             put(name, ncap, ")");
             free(sub);

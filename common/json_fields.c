@@ -232,6 +232,23 @@ bool jf_get_choice(const json_t *obj, const char *key, const char *field,
     return job_error_set(err, field, "must be one of: %s", list);
 }
 
+void jf_set_path(json_t *obj, const char *path, json_t *value)
+{
+    const char *dot;
+    while ((dot = strchr(path, '.'))) {
+        char head[64];
+        snprintf(head, sizeof(head), "%.*s", (int)(dot - path), path);
+        json_t *inner = json_object_get(obj, head);
+        if (!json_is_object(inner)) {
+            inner = json_object();
+            json_object_set_new(obj, head, inner);
+        }
+        obj = inner;
+        path = dot + 1;
+    }
+    json_object_set_new(obj, path, value);
+}
+
 void jf_list_choices(const char *const *choices, char *buf, size_t cap)
 {
     size_t used = 0;

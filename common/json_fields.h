@@ -53,6 +53,10 @@ bool jf_get_object(const json_t *obj, const char *key, const char *field, json_t
 bool jf_get_choice(const json_t *obj, const char *key, const char *field,
                    const char *const *choices, int *out, struct job_error *err);
 
+/* Sets value (a reference it takes) at a dotted path ("a.b.c") inside obj,
+ * making the objects between and replacing what is not an object. */
+void jf_set_path(json_t *obj, const char *path, json_t *value);
+
 /* "a", "b" and "c" as `"a", "b", "c"` into buf, for rule messages. */
 void jf_list_choices(const char *const *choices, char *buf, size_t cap);
 

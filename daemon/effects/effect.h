@@ -14,11 +14,18 @@
 #include <stddef.h>
 
 #include "daemon/effects/effect_info.h"
-#include "daemon/techniques/technique.h"
+#include "daemon/gpu/pass.h"
+#include "daemon/gpu/targets.h"
 
-/* What the chain hands an effect; valid from create to destroy. */
+/* What the chain hands an effect: the frame it works on, and nothing of the
+ * technique that drew it or of the job. Valid from create to destroy. */
 struct effect_env {
-    const struct technique_env *tech; /* size, depth, products, targets, defines */
+    int width, height;     /* of the frame and of dst */
+    GLuint depth_tex;      /* the technique's depth texture */
+    /* World-space normals the technique published, or 0: effects then
+     * rebuild them from depth (normal_defines says which). */
+    GLuint normal_tex;
+    struct gpu_targets *targets; /* the pool effect_plane takes planes from */
     const struct gpu_passes *passes;
     int first_pass;      /* index of its first active pass */
     const char *label;   /* "bloom", "bloom2": prefixes its target names */
@@ -44,7 +51,9 @@ struct effect {
     void (*destroy)(void *state);
 };
 
-extern const struct effect effect_bloom, effect_toon, effect_ssao;
+/* The GL half of the registry: every registered effect, in the order of
+ * effect_infos (each folder's effect_NAME), NULL-terminated. */
+extern const struct effect *const effect_registry[];
 
 /* Draws the full-screen triangle with prog into the bound framebuffer;
  * shared by the effects. */

@@ -9,18 +9,9 @@
 #include "daemon/gpu/bindings.h"
 #include "daemon/gpu/glutil.h"
 
-/* The GL registry, in the order of effect_infos (checked at create). */
-static const struct effect *const effect_registry[] = {&effect_bloom, &effect_toon, &effect_ssao,
-                                                       NULL};
-
-/* The timer's sections hold a technique's passes, the chain's and the
- * resolve: the GL-free budget must agree with the timer. */
-_Static_assert(TECHNIQUE_MAX_PASSES + POST_MAX_PASSES + 1 <= GPU_MAX_PASSES,
-               "the post pass budget does not fit the GPU timer");
-
 struct post_chain {
-    const struct technique_env *tech;
-    const struct look_spec *look;
+    struct post_frame frame;
+    const struct post_spec *post;
     const struct gpu_passes *passes;
     int first_pass;
     bool built;
@@ -53,22 +44,17 @@ bool effect_plane(const struct effect_env *env, const char *suffix, GLenum forma
 {
     char name[32];
     snprintf(name, sizeof(name), "%.15s.%.15s", env->label, suffix);
-    *tex = gpu_targets_texture(env->tech->targets, name, format, w, h, err, errlen);
-    *fbo = *tex ? gpu_targets_fbo(env->tech->targets, name, tex, 1, 0, err, errlen) : 0;
+    *tex = gpu_targets_texture(env->targets, name, format, w, h, err, errlen);
+    *fbo = *tex ? gpu_targets_fbo(env->targets, name, tex, 1, 0, err, errlen) : 0;
     return *fbo != 0;
-}
-
-static GLenum hdr_format(const struct look_spec *look)
-{
-    return look->hdr == LOOK_HDR_RGBA16F ? GL_RGBA16F : GL_RGBA32F;
 }
 
 static bool build_counter(struct post_chain *c, char *err, size_t errlen)
 {
     const struct gl_stage stage = {GL_COMPUTE_SHADER, {"nonfinite.comp"}};
     c->count_prog = gl_program_build("nonfinite", &stage, 1,
-                                     c->look->hdr == LOOK_HDR_RGBA16F ? "#define HALF_TARGET 1\n"
-                                                                      : NULL,
+                                     c->frame.hdr_format == GL_RGBA16F ? "#define HALF_TARGET 1\n"
+                                                                       : NULL,
                                      err, errlen);
     if (!c->count_prog)
         return false;
@@ -79,7 +65,7 @@ static bool build_counter(struct post_chain *c, char *err, size_t errlen)
     return true;
 }
 
-struct post_chain *post_chain_create(const struct technique_env *tech, const struct look_spec *look,
+struct post_chain *post_chain_create(const struct post_frame *frame, const struct post_spec *post,
                                      struct gpu_passes *passes, char *err, size_t errlen)
 {
     struct post_chain *c = calloc(1, sizeof(*c));
@@ -87,21 +73,15 @@ struct post_chain *post_chain_create(const struct technique_env *tech, const str
         snprintf(err, errlen, "post chain: out of memory");
         return NULL;
     }
-    c->tech = tech;
-    c->look = look;
+    c->frame = *frame;
+    c->post = post;
     c->first_pass = passes->count;
     c->passes = passes;
     if (!build_counter(c, err, errlen))
         goto fail;
-    const struct post_spec *post = &look->post;
     if (!post->count)
         return c;
 
-    for (int i = 0; effect_infos[i] || effect_registry[i]; i++)
-        if (!effect_infos[i] || !effect_registry[i] || effect_registry[i]->info != effect_infos[i]) {
-            snprintf(err, errlen, "post chain: the GL registry does not follow effect_infos");
-            goto fail;
-        }
     int npasses = post_spec_pass_names(post, c->names, POST_MAX_PASSES);
     if (npasses > POST_MAX_PASSES) {
         snprintf(err, errlen, "look.post needs %d passes; at most %d", npasses, POST_MAX_PASSES);
@@ -119,23 +99,21 @@ fail:
     return NULL;
 }
 
-bool post_chain_build(struct post_chain *c, char *err, size_t errlen)
+bool post_chain_build(struct post_chain *c, GLuint normal_tex, bool normal_octahedral, char *err,
+                      size_t errlen)
 {
     if (c->built)
         return true;
     c->built = true;
-    const struct technique_env *tech = c->tech;
-    const struct look_spec *look = c->look;
-    const struct post_spec *post = &look->post;
+    const struct post_frame *frame = &c->frame;
+    const struct post_spec *post = c->post;
     int first = c->first_pass;
     if (!post->count)
         return true;
 
-    const struct technique_products *pr = tech->products;
-    if (pr && pr->normal_tex)
+    if (normal_tex)
         snprintf(c->normal_defines, sizeof(c->normal_defines), "#define HAVE_NORMAL_TEX 1\n%s",
-                 pr->normal_encoding == TECHNIQUE_NORMAL_OCTAHEDRAL
-                     ? "#define NORMAL_OCTAHEDRAL 1\n" : "");
+                 normal_octahedral ? "#define NORMAL_OCTAHEDRAL 1\n" : "");
     glGenVertexArrays(1, &c->empty_vao);
     glGenSamplers(1, &c->linear_sampler);
     glSamplerParameteri(c->linear_sampler, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
@@ -146,9 +124,9 @@ bool post_chain_build(struct post_chain *c, char *err, size_t errlen)
     for (int k = 0; k < 2; k++) {
         char name[16];
         snprintf(name, sizeof(name), "post.%c", 'a' + k);
-        c->plane[k] = gpu_targets_texture(tech->targets, name, hdr_format(look), tech->width,
-                                          tech->height, err, errlen);
-        c->plane_fbo[k] = c->plane[k] ? gpu_targets_fbo(tech->targets, name, &c->plane[k], 1, 0,
+        c->plane[k] = gpu_targets_texture(frame->targets, name, frame->hdr_format, frame->width,
+                                          frame->height, err, errlen);
+        c->plane_fbo[k] = c->plane[k] ? gpu_targets_fbo(frame->targets, name, &c->plane[k], 1, 0,
                                                         err, errlen)
                                       : 0;
         if (!c->plane_fbo[k])
@@ -161,11 +139,15 @@ bool post_chain_build(struct post_chain *c, char *err, size_t errlen)
         post_effect_label(post, i, c->fx[i].label, sizeof(c->fx[i].label));
         c->fx[i].ops = ops;
         c->fx[i].env = (struct effect_env){
-            .tech = tech,
+            .width = frame->width,
+            .height = frame->height,
+            .depth_tex = frame->depth,
+            .normal_tex = normal_tex,
+            .targets = frame->targets,
             .passes = c->passes,
             .first_pass = first,
             .label = c->fx[i].label,
-            .hdr_format = hdr_format(look),
+            .hdr_format = frame->hdr_format,
             .empty_vao = c->empty_vao,
             .linear_sampler = c->linear_sampler,
             .normal_defines = c->normal_defines,
@@ -199,7 +181,7 @@ void post_chain_destroy(struct post_chain *c)
 
 GLuint post_chain_run(struct post_chain *c)
 {
-    GLuint cur = c->tech->output_color;
+    GLuint cur = c->frame.color;
     for (int i = 0; i < c->count; i++) {
         c->fx[i].ops->run(c->fx[i].state, &c->fx[i].env, cur, c->plane_fbo[i & 1]);
         cur = c->plane[i & 1];
@@ -217,7 +199,7 @@ bool post_chain_count_nonfinite(struct post_chain *c, GLuint tex, struct post_no
     glUseProgram(c->count_prog);
     glActiveTexture(GL_TEXTURE0 + SB_TEX_HDR);
     glBindTexture(GL_TEXTURE_2D, tex);
-    glDispatchCompute((GLuint)(c->tech->width + 7) / 8, (GLuint)(c->tech->height + 7) / 8, 1);
+    glDispatchCompute((GLuint)(c->frame.width + 7) / 8, (GLuint)(c->frame.height + 7) / 8, 1);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     uint32_t counts[3] = {0, 0, 0};
     glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof(counts), counts);

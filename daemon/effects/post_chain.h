@@ -13,10 +13,20 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "daemon/jobs/job_spec.h"
-#include "daemon/techniques/technique.h"
+#include "daemon/effects/post_spec.h"
+#include "daemon/gpu/pass.h"
+#include "daemon/gpu/targets.h"
 
 struct post_chain;
+
+/* The frame a chain works on: what the harness hands it of the
+ * technique's output, nothing of the technique itself. */
+struct post_frame {
+    int width, height;
+    GLenum hdr_format;           /* of color, and of the chain's planes */
+    GLuint color, depth;         /* the technique's HDR output and depth texture */
+    struct gpu_targets *targets; /* the pool the chain and its effects take planes from */
+};
 
 /* NaN and infinite pixels (any of R, G, B) in one frame's HDR colour. */
 struct post_nonfinite {
@@ -28,16 +38,19 @@ struct post_nonfinite {
     uint32_t overflow_pixels;
 };
 
-/* Starts the chain of look's effects over tech's output: appends its passes
- * to passes, in frame order (the chain keeps their names, so it must outlive
- * every reader of passes), and prepares the counter. tech, look and passes
- * must outlive the chain. NULL with err filled. */
-struct post_chain *post_chain_create(const struct technique_env *tech, const struct look_spec *look,
+/* Starts the chain of post's effects over the frame (copied): appends its
+ * passes to passes, in frame order (the chain keeps their names, so it must
+ * outlive every reader of passes), and prepares the counter. post and
+ * passes must outlive the chain. NULL with err filled. */
+struct post_chain *post_chain_create(const struct post_frame *frame, const struct post_spec *post,
                                      struct gpu_passes *passes, char *err, size_t errlen);
-/* Builds the effects (programs, planes from tech->targets) once the
- * technique was created, since its products (g-buffer normals) choose the
- * programs' variants. Later calls do nothing. */
-bool post_chain_build(struct post_chain *c, char *err, size_t errlen);
+/* Builds the effects (programs, planes from the frame's pool) once the
+ * technique was created, since the normals it publishes choose the
+ * programs' variants: normal_tex holds world-space normals (octahedral
+ * when normal_octahedral, else rgb), or is 0 and effects rebuild them from
+ * depth. Later calls do nothing. */
+bool post_chain_build(struct post_chain *c, GLuint normal_tex, bool normal_octahedral, char *err,
+                      size_t errlen);
 /* Frees what create made. Accepts NULL. */
 void post_chain_destroy(struct post_chain *c);
 
@@ -46,8 +59,8 @@ void post_chain_destroy(struct post_chain *c);
  * allocation, no uniform lookups. */
 GLuint post_chain_run(struct post_chain *c);
 
-/* Counts the non-finite (and, in a 16-bit target, overflowed) pixels of tex (width x height of the output) with
- * a compute pass and reads the two counters back. Stalls: outside every
+/* Counts the non-finite (and, in a 16-bit target, overflowed) pixels of
+ * tex (the frame's size) with a compute pass and reads the counters back. Stalls: outside every
  * timed region only. */
 bool post_chain_count_nonfinite(struct post_chain *c, GLuint tex, struct post_nonfinite *out,
                                 char *err, size_t errlen);

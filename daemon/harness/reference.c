@@ -50,7 +50,7 @@ bool reference_render(struct harness_run *run, enum job_status *status)
         }
         rr.err[0] = '\0';
         if (!ref->create(&rr.env, &rr.state, rr.err, sizeof(rr.err)) ||
-            !post_chain_build(rr.post, rr.err, sizeof(rr.err))) {
+            !run_build_post_chain(&rr)) {
             snprintf(run->err, sizeof(run->err), "reference %s cannot run: %.900s",
                      ref->info->name, rr.err);
             ref->destroy(rr.state);

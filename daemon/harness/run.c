@@ -78,7 +78,9 @@ bool run_setup_targets(struct harness_run *run)
         return false;
     look_defines(run->look, run->defines, sizeof(run->defines));
     run->env = (struct technique_env){
-        .spec = run->spec,
+        .frames = run->spec->frames,
+        .warmup_frames = run->spec->warmup_frames,
+        .capture_interval = run->spec->capture_interval,
         .look = run->look,
         .scene = &run->scene,
         .gpu = &run->gpu,
@@ -94,6 +96,14 @@ bool run_setup_targets(struct harness_run *run)
         .products = &run->products,
     };
     return true;
+}
+
+bool run_build_post_chain(struct harness_run *run)
+{
+    const struct technique_products *p = &run->products;
+    return post_chain_build(run->post, p->normal_tex,
+                            p->normal_encoding == TECHNIQUE_NORMAL_OCTAHEDRAL, run->err,
+                            sizeof(run->err));
 }
 
 bool run_setup_passes(struct harness_run *run, const void *options, int64_t timed_frames)
@@ -112,7 +122,15 @@ bool run_setup_passes(struct harness_run *run, const void *options, int64_t time
                 look_stages_add_passes(&run->stages, &run->passes, &run->shadow_pass,
                                        &run->sky_pass);
     /* The chain's passes now; its effects are built once the technique exists. */
-    if (fits && !(run->post = post_chain_create(&run->env, run->look, &run->passes, run->err,
+    const struct post_frame frame = {
+        .width = run->env.width,
+        .height = run->env.height,
+        .hdr_format = run->look->hdr == LOOK_HDR_RGBA16F ? GL_RGBA16F : GL_RGBA32F,
+        .color = run->env.output_color,
+        .depth = run->env.output_depth,
+        .targets = run->env.targets,
+    };
+    if (fits && !(run->post = post_chain_create(&frame, &run->look->post, &run->passes, run->err,
                                                 sizeof(run->err))))
         return false;
     if (!fits || (run->resolve_pass = gpu_passes_add(&run->passes, "resolve")) < 0) {
@@ -170,7 +188,7 @@ bool run_prepare(struct harness_run *run, bool capture)
                           (int64_t)spec->warmup_frames + n))
         return false;
     if (!run->tech->create(&run->env, &run->state, run->err, sizeof(run->err)) ||
-        !post_chain_build(run->post, run->err, sizeof(run->err)) ||
+        !run_build_post_chain(run) ||
         gl_error_take("setup", run->err, sizeof(run->err)))
         return false;
     /* After create: whether the technique publishes a heat map is known now. */

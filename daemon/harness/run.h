@@ -118,6 +118,10 @@ bool run_setup_targets(struct harness_run *run);
  * chain's, then the resolve) and a timer for timed_frames frames. */
 bool run_setup_passes(struct harness_run *run, const void *options, int64_t timed_frames);
 
+/* Builds the post chain's effects once the technique was created: the
+ * normals it publishes (if any) choose their programs. */
+bool run_build_post_chain(struct harness_run *run);
+
 /* The per-frame block for frame k: camera, viewport and counts. */
 void run_frame_data(const struct harness_run *run, int64_t k, struct gpu_frame_data *d);
 /* One frame of every stage, from the look's before-passes to the resolve,

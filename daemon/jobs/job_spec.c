@@ -25,20 +25,46 @@ static bool get_technique(const json_t *v, const char *field,
         return true;
     }
     char list[400];
-    technique_catalog_list(techniques, list, sizeof(list));
+    technique_catalog_list(techniques, 0, list, sizeof(list));
     return job_error_set(err, field, "must be one of: %s%s", list, nullable ? ", or null" : "");
 }
 
-/* Today's image: Phong, 32-bit floats, clamped, no effects. */
-static void look_defaults(struct look_spec *look)
+/* Top-level fields that became options of a technique, still accepted (and
+ * written back) for the bodies and clients written before. */
+static const struct {
+    const char *field, *path;
+} ALIASES[] = {
+    {"async_distance", "osl.async_distance"},
+};
+enum { NALIASES = sizeof(ALIASES) / sizeof(ALIASES[0]) };
+
+const char *job_spec_alias(const char *field)
 {
-    memset(look, 0, sizeof(*look));
-    look->lighting = LOOK_PHONG;
-    look->hdr = LOOK_HDR_RGBA32F;
-    look->exposure = 1.0;
-    look->tonemap = LOOK_TONEMAP_NONE;
-    ibl_spec_defaults(&look->ibl);
-    shadow_spec_defaults(&look->shadows);
+    for (int i = 0; i < NALIASES; i++)
+        if (strcmp(ALIASES[i].field, field) == 0)
+            return ALIASES[i].path;
+    return NULL;
+}
+
+const char *job_spec_aliased(const char *path)
+{
+    for (int i = 0; i < NALIASES; i++)
+        if (strcmp(ALIASES[i].path, path) == 0)
+            return ALIASES[i].field;
+    return NULL;
+}
+
+/* The technique (catalogue index) and option an alias stands for; false
+ * when the catalogue has no such option. */
+static bool alias_target(const struct technique_catalog *c, int alias, int *technique,
+                         const struct opt_field **opt)
+{
+    const char *path = ALIASES[alias].path, *dot = strchr(path, '.');
+    char name[32];
+    snprintf(name, sizeof(name), "%.*s", (int)(dot - path), path);
+    *technique = technique_catalog_find(c, name);
+    *opt = technique_catalog_option(c, path);
+    return *technique >= 0 && *opt;
 }
 
 static double default_timeout_s;
@@ -50,18 +76,20 @@ void job_spec_defaults(struct job_spec *out, const struct technique_catalog *tec
 {
     memset(out, 0, sizeof(*out));
     out->catalog = techniques;
-    out->technique_index = technique_catalog_find(techniques, "forward");
-    snprintf(out->technique, sizeof(out->technique), "forward");
+    /* A job that names no technique runs the baseline. */
+    out->technique_index = techniques->baseline;
+    if (techniques->baseline >= 0)
+        snprintf(out->technique, sizeof(out->technique), "%s",
+                 techniques->infos[techniques->baseline]->name);
     out->reference_index = -1;
     out->frames = 300;
     out->warmup_frames = 10;
     out->capture_interval = 0;
-    out->async_distance = 0.0;
     scene_spec_defaults(&out->scene);
-    look_defaults(&out->look);
+    look_spec_defaults(&out->look);
     out->reference_look = out->look;
     for (int i = 0; i < techniques->count; i++)
-        technique_options_defaults(techniques->infos[i], &out->options[i]);
+        opt_defaults(&techniques->infos[i]->options, out->options[i].bytes);
     out->repeat = 1;
     out->repeat_auto = false;
     out->reference[0] = '\0';
@@ -77,54 +105,6 @@ const void *job_spec_technique_options(const struct job_spec *spec)
 const void *job_spec_reference_options(const struct job_spec *spec)
 {
     return spec->reference_index >= 0 ? spec->options[spec->reference_index].bytes : NULL;
-}
-
-static const char *const LIGHTING_NAMES[] = {"phong", "blinn_phong", "pbr", NULL};
-static const char *const HDR_NAMES[] = {"rgba32f", "rgba16f", NULL};
-static const char *const TONEMAP_NAMES[] = {"none", "reinhard", "aces", NULL};
-
-const char *look_lighting_name(int lighting) { return LIGHTING_NAMES[lighting]; }
-const char *look_tonemap_name(int tonemap) { return TONEMAP_NAMES[tonemap]; }
-
-/* "look": {"lighting": "phong" | "blinn_phong" | "pbr", "hdr": "rgba32f" | "rgba16f",
- * "exposure": x, "tonemap": "none" | "reinhard" | "aces", "post": [...], "ibl": ...,
- * "shadows": ...}; name is "look" or "reference_look", for the errors. */
-static bool parse_look(const json_t *v, const char *name, struct look_spec *look,
-                       struct job_error *err)
-{
-    static const char *const keys[] = {"lighting", "hdr", "exposure", "tonemap", "post",
-                                       "ibl", "shadows", NULL};
-    char prefix[32], field[7][48];
-    static const char *const fields[] = {"lighting", "hdr", "exposure", "tonemap", "post",
-                                         "ibl", "shadows"};
-    snprintf(prefix, sizeof(prefix), "%s.", name);
-    for (int i = 0; i < 7; i++)
-        snprintf(field[i], sizeof(field[i]), "%s.%s", name, fields[i]);
-    json_t *post = json_object_get(v, "post");
-    json_t *ibl = json_object_get(v, "ibl"), *shadows = json_object_get(v, "shadows");
-    if (!(jf_check_keys(v, prefix, keys, err) &&
-          jf_get_choice(v, "lighting", field[0], LIGHTING_NAMES, &look->lighting, err) &&
-          jf_get_choice(v, "hdr", field[1], HDR_NAMES, &look->hdr, err) &&
-          jf_get_number(v, "exposure", field[2], 1.0 / 1024.0, 1024.0, &look->exposure, err) &&
-          jf_get_choice(v, "tonemap", field[3], TONEMAP_NAMES, &look->tonemap, err) &&
-          (!post || post_spec_parse(post, field[4], &look->post, err)) &&
-          (!ibl || ibl_spec_parse(ibl, field[5], &look->ibl, err)) &&
-          (!shadows || shadow_spec_parse(shadows, field[6], &look->shadows, err))))
-        return false;
-    /* The split sum lights a metallic-roughness material: nothing else. */
-    if (look->ibl.enabled && look->lighting != LOOK_PBR)
-        return job_error_set(err, field[5], "needs %s \"pbr\"", field[0]);
-    return true;
-}
-
-json_t *look_spec_to_json(const struct look_spec *look)
-{
-    json_t *o = json_pack("{s:s, s:s, s:f, s:s, s:o}", "lighting", LIGHTING_NAMES[look->lighting],
-                          "hdr", HDR_NAMES[look->hdr], "exposure", look->exposure, "tonemap",
-                          TONEMAP_NAMES[look->tonemap], "post", post_spec_to_json(&look->post));
-    json_object_set_new(o, "ibl", ibl_spec_to_json(&look->ibl));
-    json_object_set_new(o, "shadows", shadow_spec_to_json(&look->shadows));
-    return o;
 }
 
 /* "repeat": N, or {"auto": true, "max": M}. */
@@ -282,15 +262,22 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
                     struct job_spec *out, struct job_error *err)
 {
     static const char *const fixed[] = {"technique", "frames", "warmup_frames",
-                                        "capture_interval", "async_distance", "scene", "look",
-                                        "reference", "reference_look", "metrics", "repeat",
-                                        "labels", "timeout_s"};
+                                        "capture_interval", "scene", "look", "reference",
+                                        "reference_look", "metrics", "repeat", "labels",
+                                        "timeout_s"};
     enum { NFIXED = sizeof(fixed) / sizeof(fixed[0]) };
-    /* Every technique's options live under its own name. */
-    const char *keys[NFIXED + TECHNIQUE_MAX + 1];
+    /* Every technique's options live under its own name; an alias is known
+     * when the catalogue has the option it stands for. */
+    const char *keys[NFIXED + NALIASES + TECHNIQUE_MAX + 1];
     int nkeys = 0;
     for (int i = 0; i < NFIXED; i++)
         keys[nkeys++] = fixed[i];
+    for (int a = 0; a < NALIASES; a++) {
+        int t;
+        const struct opt_field *opt;
+        if (alias_target(techniques, a, &t, &opt))
+            keys[nkeys++] = ALIASES[a].field;
+    }
     for (int i = 0; i < techniques->count; i++)
         keys[nkeys++] = techniques->infos[i]->name;
     keys[nkeys] = NULL;
@@ -307,19 +294,42 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
                                sizeof(out->technique), &out->technique_index, err))
         return false;
     if (out->technique_index < 0)
-        return job_error_set(err, "technique", "no technique named \"forward\" is available: "
-                             "name one");
+        return job_error_set(err, "technique", "must be given: no technique is the baseline "
+                             "a job runs by default");
     json_t *ref = json_object_get(body, "reference");
     if (ref && !get_technique(ref, "reference", techniques, true, out->reference,
                               sizeof(out->reference), &out->reference_index, err))
         return false;
+    /* An alias first, so that the technique's own object may state the
+     * same value again, and a different one is caught below. */
+    for (int a = 0; a < NALIASES; a++) {
+        json_t *v = json_object_get(body, ALIASES[a].field);
+        int t;
+        const struct opt_field *opt;
+        if (v && (!alias_target(techniques, a, &t, &opt) ||
+                  !opt_parse_value(opt, v, ALIASES[a].field, out->options[t].bytes, err)))
+            return false;
+    }
     for (int i = 0; i < techniques->count; i++) {
         json_t *opts = json_object_get(body, techniques->infos[i]->name);
         if (!opts)
             continue;
-        if (!technique_options_parse(techniques->infos[i], opts, &out->options[i], err))
+        const struct technique_info *t = techniques->infos[i];
+        if (!opt_parse(&t->options, opts, t->name, out->options[i].bytes, err))
             return false;
         out->options_given |= 1u << i;
+    }
+    for (int a = 0; a < NALIASES; a++) {
+        json_t *v = json_object_get(body, ALIASES[a].field);
+        int t;
+        const struct opt_field *opt;
+        if (!v || !alias_target(techniques, a, &t, &opt))
+            continue;
+        struct opt_values again = out->options[t];
+        opt_parse_value(opt, v, ALIASES[a].field, again.bytes, err);
+        if (memcmp(&again, &out->options[t], sizeof(again)) != 0)
+            return job_error_set(err, ALIASES[a].field, "is an alias of %s, which the job "
+                                 "gives another value: give one of them", ALIASES[a].path);
     }
     /* What runs is always written back; the bit records only the rest, so
      * that the spec is the same after a round trip. */
@@ -328,7 +338,7 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
         out->options_given &= ~(1u << out->reference_index);
     json_t *look;
     if (!jf_get_object(body, "look", "look", &look, err) ||
-        (look && !parse_look(look, "look", &out->look, err)))
+        (look && !look_spec_parse(look, "look", &out->look, err)))
         return false;
     /* The reference renders with the same look unless told otherwise; a
      * reference_look is a whole look, read over the defaults. */
@@ -337,7 +347,7 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
     if (!jf_get_object(body, "reference_look", "reference_look", &ref_look, err))
         return false;
     if (ref_look) {
-        look_defaults(&out->reference_look);
+        look_spec_defaults(&out->reference_look);
         out->reference_look_given = true;
         /* Probes and shadow maps are made once a run, for both: a
          * reference_look takes the look's, or states them the same. */
@@ -345,7 +355,7 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
             out->reference_look.ibl = out->look.ibl;
         if (!json_object_get(ref_look, "shadows"))
             out->reference_look.shadows = out->look.shadows;
-        if (!parse_look(ref_look, "reference_look", &out->reference_look, err))
+        if (!look_spec_parse(ref_look, "reference_look", &out->reference_look, err))
             return false;
         if (memcmp(&out->reference_look.ibl, &out->look.ibl, sizeof(out->look.ibl)) != 0)
             return job_error_set(err, "reference_look.ibl", "must equal look.ibl (leave it out): "
@@ -369,8 +379,6 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
                  &out->warmup_frames, err) ||
         !jf_get_int(body, "capture_interval", "capture_interval", 0, 1000000,
                  &out->capture_interval, err) ||
-        !jf_get_number(body, "async_distance", "async_distance", 0.0, 1e6,
-                    &out->async_distance, err) ||
         !jf_get_number(body, "timeout_s", "timeout_s", 0.0, 1e7, &out->timeout_s, err))
         return false;
 
@@ -464,19 +472,31 @@ static json_t *metrics_to_json(const struct metrics_options *m)
 
 json_t *job_spec_to_json(const struct job_spec *spec)
 {
-    json_t *out = json_pack("{s:s, s:i, s:i, s:i, s:f, s:o, s:o}", "technique", spec->technique,
-                            "frames", spec->frames, "warmup_frames", spec->warmup_frames,
-                            "capture_interval", spec->capture_interval, "async_distance",
-                            spec->async_distance, "scene", scene_spec_to_json(&spec->scene),
-                            "look", look_spec_to_json(&spec->look));
+    json_t *out = json_pack("{s:s, s:i, s:i, s:i}", "technique", spec->technique, "frames",
+                            spec->frames, "warmup_frames", spec->warmup_frames,
+                            "capture_interval", spec->capture_interval);
+    const struct technique_catalog *c = spec->catalog;
+    /* Aliases keep their place for the clients that read them there. */
+    for (int a = 0; c && a < NALIASES; a++) {
+        int t;
+        const struct opt_field *opt;
+        if (!alias_target(c, a, &t, &opt))
+            continue;
+        json_t *options = opt_to_json(&c->infos[t]->options, spec->options[t].bytes);
+        json_t *v = json_object_get(options, opt->name);
+        if (v)
+            json_object_set(out, ALIASES[a].field, v);
+        json_decref(options);
+    }
+    json_object_set_new(out, "scene", scene_spec_to_json(&spec->scene));
+    json_object_set_new(out, "look", look_spec_to_json(&spec->look));
     /* The options of what runs (technique and reference) and of whatever the
      * body set, so that the spec round-trips. */
-    const struct technique_catalog *c = spec->catalog;
     for (int i = 0; c && i < c->count; i++)
         if (i == spec->technique_index || i == spec->reference_index ||
             (spec->options_given & (1u << i)))
             json_object_set_new(out, c->infos[i]->name,
-                                technique_options_to_json(c->infos[i], &spec->options[i]));
+                                opt_to_json(&c->infos[i]->options, spec->options[i].bytes));
     json_object_set_new(out, "repeat",
                         spec->repeat_auto ? json_pack("{s:b, s:i}", "auto", 1, "max", spec->repeat)
                                           : json_integer(spec->repeat));

@@ -10,32 +10,15 @@
 #include <stddef.h>
 
 #include "common/json_fields.h"
-#include "daemon/lighting/look_lighting.h"
-#include "daemon/effects/effect_info.h"
+#include "common/options.h"
+#include "daemon/lighting/look_spec.h"
 #include "daemon/quality/metrics.h"
 #include "daemon/scene/scene_spec.h"
-#include "daemon/techniques/technique_info.h"
+#include "daemon/techniques/catalog.h"
 
 #define JOB_MAX_BODY_BYTES (64 * 1024)
 #define JOB_MAX_CAPTURE_BYTES (1024.0 * 1024.0 * 1024.0)
 #define JOB_MAX_CAPTURES 1000
-
-/* The job's "look": what the image should look like, independent of the
- * technique that renders it; the reference renders with the same look. */
-enum look_lighting { LOOK_PHONG, LOOK_BLINN_PHONG, LOOK_PBR };
-enum look_hdr { LOOK_HDR_RGBA32F, LOOK_HDR_RGBA16F };
-/* none: today's clamp, no encoding; the curves write 8-bit sRGB. */
-enum look_tonemap { LOOK_TONEMAP_NONE, LOOK_TONEMAP_REINHARD, LOOK_TONEMAP_ACES };
-
-struct look_spec {
-    int lighting;    /* enum look_lighting */
-    int hdr;         /* enum look_hdr: the format of the HDR target techniques draw into */
-    double exposure; /* scales the HDR colour in the resolve, before the tone curve */
-    int tonemap;     /* enum look_tonemap */
-    struct post_spec post; /* effects the harness runs on the HDR output, in order */
-    struct ibl_spec ibl;         /* image-based lighting (needs lighting pbr) */
-    struct shadow_spec shadows;  /* omni shadow maps for the point lights */
-};
 
 /* labels: free-form tags for history (commit, branch, driver version). Keys
  * are 1 to 32 characters of [A-Za-z0-9_.-] so that they fit a query
@@ -55,7 +38,6 @@ struct job_spec {
     int frames;
     int warmup_frames;
     int capture_interval;
-    double async_distance;
     struct scene_spec scene;
     struct look_spec look;
     /* The look the reference renders with: the job's look unless the body
@@ -72,7 +54,7 @@ struct job_spec {
     int technique_index, reference_index; /* reference_index -1 without one */
     unsigned options_given;               /* bit i: the body gave technique i's object,
                                            * and i is neither technique nor reference */
-    struct technique_options options[TECHNIQUE_MAX];
+    struct opt_values options[TECHNIQUE_MAX];
     int nlabels;                   /* sorted by key */
     struct job_label labels[JOB_MAX_LABELS];
     double timeout_s;              /* running time allowed, all phases; 0: no limit */
@@ -100,11 +82,12 @@ void job_spec_defaults(struct job_spec *out, const struct technique_catalog *tec
 const void *job_spec_technique_options(const struct job_spec *spec);
 const void *job_spec_reference_options(const struct job_spec *spec);
 
-/* The look's names, for shaders and results. */
-const char *look_lighting_name(int lighting);
-const char *look_tonemap_name(int tonemap);
-/* The look as understood, every field and effect option. New reference. */
-json_t *look_spec_to_json(const struct look_spec *look);
+/* The canonical dotted path of a top-level job field that is an alias of a
+ * technique's option ("async_distance" is "osl.async_distance"), or NULL.
+ * A job may give either, or both with the same value; sweeps vary either. */
+const char *job_spec_alias(const char *field);
+/* The alias of a technique option's dotted path, or NULL: the other way. */
+const char *job_spec_aliased(const char *path);
 
 /* The job as understood, defaults filled in. New reference. */
 json_t *job_spec_to_json(const struct job_spec *spec);

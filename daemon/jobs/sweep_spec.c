@@ -11,7 +11,8 @@
 enum param_type { PARAM_INT, PARAM_NUMBER, PARAM_BOOL, PARAM_CHOICE };
 
 /* Every job field a sweep may vary, besides each technique's options
- * ("<technique>.<option>", from the catalogue). */
+ * ("<technique>.<option>", from the catalogue), the job's aliases of them
+ * and each effect's options. */
 static const struct {
     const char *path;
     enum param_type type;
@@ -19,7 +20,7 @@ static const struct {
 } PARAMS[] = {
     {"technique", PARAM_CHOICE, 0},        {"reference", PARAM_CHOICE, 0},
     {"frames", PARAM_INT, 1},              {"warmup_frames", PARAM_INT, 1},
-    {"capture_interval", PARAM_INT, 1},    {"async_distance", PARAM_NUMBER, 0},
+    {"capture_interval", PARAM_INT, 1},
     {"scene.lights", PARAM_INT, 1},        {"scene.dynamic", PARAM_BOOL, 0},
     {"scene.width", PARAM_INT, 1},         {"scene.height", PARAM_INT, 1},
     {"scene.sphere_segments", PARAM_INT, 2}, {"scene.light_speed", PARAM_NUMBER, 0},
@@ -43,7 +44,7 @@ enum { NPARAMS = sizeof(PARAMS) / sizeof(PARAMS[0]) };
  * base job's look.post (post hook: an effect's breaking point, e.g.
  * look.post.bloom.intensity against the finite criterion). */
 #define POST_PARAM "look.post."
-static const struct technique_option *post_param(const char *path, char *effect, size_t cap)
+static const struct opt_field *post_param(const char *path, char *effect, size_t cap)
 {
     if (strncmp(path, POST_PARAM, strlen(POST_PARAM)) != 0)
         return NULL;
@@ -52,10 +53,7 @@ static const struct technique_option *post_param(const char *path, char *effect,
         return NULL;
     snprintf(effect, cap, "%.*s", (int)(dot - name), name);
     int e = effect_find(effect);
-    for (const struct technique_option *o = e >= 0 ? effect_infos[e]->options : NULL; o && o->name; o++)
-        if (strcmp(o->name, dot + 1) == 0)
-            return o;
-    return NULL;
+    return e >= 0 ? opt_find(&effect_infos[e]->options, dot + 1) : NULL;
 }
 
 /* The type of a sweepable path; false when a sweep cannot vary it. */
@@ -68,13 +66,14 @@ static bool param_type(const struct technique_catalog *techniques, const char *p
             return true;
         }
     char effect[32];
-    const struct technique_option *opt = technique_catalog_option(techniques, path);
+    const char *canonical = job_spec_alias(path);
+    const struct opt_field *opt = technique_catalog_option(techniques, canonical ? canonical : path);
     if (!opt)
         opt = post_param(path, effect, sizeof(effect));
     if (!opt)
         return false;
-    *type = opt->type == TOPT_INT ? PARAM_INT : opt->type == TOPT_NUMBER ? PARAM_NUMBER
-                                              : PARAM_CHOICE;
+    *type = opt->type == OPT_INT ? PARAM_INT : opt->type == OPT_NUMBER ? PARAM_NUMBER
+                                             : PARAM_CHOICE;
     return true;
 }
 
@@ -127,17 +126,21 @@ json_t *sweep_params_json(const struct technique_catalog *techniques)
         json_object_set_new(o, PARAMS[i].path, json_string(types[PARAMS[i].type]));
     for (int t = 0; t < techniques->count; t++) {
         const struct technique_info *info = techniques->infos[t];
-        for (const struct technique_option *opt = info->options; opt && opt->name; opt++) {
+        for (const struct opt_field *opt = info->options.fields; opt && opt->name; opt++) {
             char path[128];
             enum param_type type;
             snprintf(path, sizeof(path), "%s.%s", info->name, opt->name);
             if (param_type(techniques, path, &type))
                 json_object_set_new(o, path, json_string(types[type]));
+            const char *alias = job_spec_aliased(path);
+            if (alias && param_type(techniques, alias, &type))
+                json_object_set_new(o, alias, json_string(types[type]));
         }
     }
     /* Post hook: every effect's options, set in each entry of that effect. */
     for (int e = 0; effect_infos[e]; e++)
-        for (const struct technique_option *opt = effect_infos[e]->options; opt && opt->name; opt++) {
+        for (const struct opt_field *opt = effect_infos[e]->options.fields; opt && opt->name;
+             opt++) {
             char path[128];
             enum param_type type;
             snprintf(path, sizeof(path), POST_PARAM "%s.%s", effect_infos[e]->name, opt->name);
@@ -147,39 +150,58 @@ json_t *sweep_params_json(const struct technique_catalog *techniques)
     return o;
 }
 
+/* Removes the field at a dotted path, if the job has it. */
+static void del_field(json_t *job, const char *path)
+{
+    const char *dot;
+    while (json_is_object(job) && (dot = strchr(path, '.'))) {
+        char head[64];
+        snprintf(head, sizeof(head), "%.*s", (int)(dot - path), path);
+        /* The dotted spelling an option table accepts too. */
+        json_object_del(job, path);
+        job = json_object_get(job, head);
+        path = dot + 1;
+    }
+    if (json_is_object(job))
+        json_object_del(job, path);
+}
+
 /* A copy of job with the field at a dotted path set to value, creating the
  * objects between. */
 static json_t *with_field(const json_t *job, const char *path, json_t *value)
 {
-    json_t *copy = json_deep_copy(job), *obj = copy;
+    json_t *copy = json_deep_copy(job);
     char effect[32];
-    const struct technique_option *post = post_param(path, effect, sizeof(effect));
+    const struct opt_field *post = post_param(path, effect, sizeof(effect));
     if (post) {
         set_post_option(copy, effect, post->name, value);
         return copy;
     }
-    const char *dot;
-    while ((dot = strchr(path, '.'))) {
-        char head[64];
-        snprintf(head, sizeof(head), "%.*s", (int)(dot - path), path);
-        json_t *inner = json_object_get(obj, head);
-        if (!json_is_object(inner)) {
-            inner = json_object();
-            json_object_set_new(obj, head, inner);
-        }
-        obj = inner;
-        path = dot + 1;
-    }
-    json_object_set(obj, path, value);
+    /* A field a job may spell two ways (an alias and its option) is set in
+     * the spelling the sweep names and dropped from the other, so that the
+     * point does not give it twice. */
+    const char *other = job_spec_alias(path);
+    if (!other)
+        other = job_spec_aliased(path);
+    if (other)
+        del_field(copy, other);
+    jf_set_path(copy, path, json_incref(value));
     return copy;
 }
 
-/* Every point measures quality against a reference (forward unless the base
- * names one), on at least its last frame. */
+/* The technique a sweep scores against and times beside its points when
+ * the base names none. */
+static const char *baseline(const struct technique_catalog *c)
+{
+    return c->baseline >= 0 ? c->infos[c->baseline]->name : "";
+}
+
+/* Every point measures quality against a reference (the baseline unless the
+ * base names one), on at least its last frame. */
 static json_t *point_defaults(const struct sweep_spec *s, json_t *job)
 {
     if (!json_object_get(job, "reference") || json_is_null(json_object_get(job, "reference")))
-        json_object_set_new(job, "reference", json_string("forward"));
+        json_object_set_new(job, "reference", json_string(baseline(s->catalog)));
     json_t *ci = json_object_get(job, "capture_interval");
     if (!ci || json_integer_value(ci) == 0) {
         json_t *frames = json_object_get(job, "frames");
@@ -259,7 +281,7 @@ static bool add_reference_points(struct sweep_spec *out, const json_t *body,
     if (json_is_false(flag))
         return true;
     json_t *r = json_object_get(out->base, "reference");
-    const char *ref = json_is_string(r) ? json_string_value(r) : "forward";
+    const char *ref = json_is_string(r) ? json_string_value(r) : baseline(out->catalog);
     json_t *t = json_object_get(out->base, "technique");
     bool varied = false;
     for (int p = 0; p < out->nparams; p++) {
@@ -271,7 +293,7 @@ static bool add_reference_points(struct sweep_spec *out, const json_t *body,
         json_array_foreach(out->values[p], i, v) if (json_is_string(v) &&
                                                      !strcmp(json_string_value(v), ref)) return true;
     }
-    if (!varied && !strcmp(json_is_string(t) ? json_string_value(t) : "forward", ref))
+    if (!varied && !strcmp(json_is_string(t) ? json_string_value(t) : baseline(out->catalog), ref))
         return true;
     /* Every combination of the workload parameters' values, first parameter
      * slowest (as in the grid). */
@@ -333,10 +355,10 @@ static json_t *thesis_sweep(const json_t *body, struct job_error *err)
         !jf_get_int(body, "repeat", "repeat", 1, 1000, &repeat, err))
         return NULL;
     json_t *base = json_pack(
-        "{s:s, s:i, s:i, s:i, s:f, s:{s:i}, s:i, s:s, s:{s:b, s:{s:f}, s:b, s:b},"
+        "{s:s, s:i, s:i, s:i, s:{s:i, s:f}, s:i, s:s, s:{s:b, s:{s:f}, s:b, s:b},"
         " s:{s:s, s:i, s:b, s:i, s:i}}",
         "technique", "forward", "frames", n, "warmup_frames", warmup, "capture_interval",
-        n >= 3 ? n / 3 : n, "async_distance", 20.0, "osl", "resolution", 256, "repeat", repeat,
+        n >= 3 ? n / 3 : n, "osl", "resolution", 256, "async_distance", 20.0, "repeat", repeat,
         "reference", "forward", "metrics",
         "ssim", 1, "pdiff", "fov", 22.6, "psnr", 0, "flip", 0, "scene", "preset", "grid", "lights",
         10, "dynamic", 0, "width", 1080, "height", 720);
@@ -349,6 +371,7 @@ static bool parse_into(const json_t *body, const struct technique_catalog *techn
 {
     memset(out, 0, sizeof(*out));
     memset(err, 0, sizeof(*err));
+    out->catalog = techniques;
     if (!json_is_object(body))
         return job_error_set(err, "body", "the sweep must be a JSON object");
     json_t *preset = json_object_get(body, "preset");
@@ -467,6 +490,13 @@ static bool parse_into(const json_t *body, const struct technique_catalog *techn
     if (!crit || !parse_criterion(crit, out))
         return job_error_set(err, "find.while", "must be one of \"pdiff_pass\", \"stable\", "
                     "\"finite\", \"no_overflow\", \"ssim_min >= X\", \"flip_max <= X\"");
+    if (out->criterion == CRITERION_NO_OVERFLOW) {
+        char list[200];
+        technique_catalog_list(techniques, TECHNIQUE_BOUNDED_LIGHT_LISTS, list, sizeof(list));
+        snprintf(out->unjudged_text, sizeof(out->unjudged_text),
+                 "\"no_overflow\" needs bounded light lists (%s) or look.shadows, and the job "
+                 "has neither", list[0] ? list : "no technique has them");
+    }
     out->max_probes = 10;
     json_t *steps = json_object_get(find, "steps");
     if (steps) {
@@ -590,10 +620,7 @@ const char *sweep_criterion_unjudged(const struct sweep_spec *s, const json_t *r
         return NULL;
     json_int_t lists, shadows;
     sweep_overflow_frames(result, &lists, &shadows);
-    if (lists < 0 && shadows < 0)
-        return "\"no_overflow\" needs bounded light lists (tiled_deferred, forward_plus, "
-               "clustered_forward, clustered_deferred) or look.shadows, and the job has neither";
-    return NULL;
+    return lists < 0 && shadows < 0 ? s->unjudged_text : NULL;
 }
 
 void sweep_overflow_frames(const json_t *result, json_int_t *light_lists, json_int_t *shadows)

@@ -39,7 +39,11 @@ struct sweep_spec {
     enum sweep_criterion criterion;
     double threshold;
     char criterion_text[64];
+    /* Why a result cannot be judged by the criterion, when it lacks what
+     * the criterion reads (sweep_criterion_unjudged). */
+    char unjudged_text[320];
     bool thesis; /* {"preset": "thesis"}: the thesis's experiment */
+    const struct technique_catalog *catalog; /* the one parsed with: it outlives the sweep */
 };
 
 /* Fills out, or returns false with err naming the field and out holding
@@ -54,7 +58,8 @@ json_t *sweep_params_json(const struct technique_catalog *techniques);
 
 /* The job of grid point index (row-major over the parameters); *values gets
  * {"path": value, ...}. Indices from ngrid on are the timed reference
- * points: the reference technique (forward unless the base names another)
+ * points: the reference technique (the catalogue's baseline unless the
+ * base names another)
  * on each workload of the grid (each combination of swept scene.*, frames
  * and warmup_frames values), timed like the others and not judged, so that
  * charts and reports place it beside them. A sweep adds none when the

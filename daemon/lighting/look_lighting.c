@@ -1,65 +1,14 @@
 #define _POSIX_C_SOURCE 200809L
 #include "daemon/lighting/look_lighting.h"
 
+#include <stddef.h>
 #include <stdio.h>
-#include <string.h>
+
+#include "common/options.h"
 
 const char *const ibl_environment_names[] = {"sky", "uniform", NULL};
 const char *const shadow_overflow_names[] = {"drop_report", "fail", NULL};
 const char *const shadow_layout_names[] = {"atlas", "cubes", NULL};
-
-void ibl_spec_defaults(struct ibl_spec *s)
-{
-    memset(s, 0, sizeof(*s));
-    s->environment = IBL_ENV_SKY;
-    s->intensity = 1.0;
-    s->resolution = 64;
-    s->blend = 4; /* seed 002 blends the four most important probes */
-    s->samples = 64;
-}
-
-void shadow_spec_defaults(struct shadow_spec *s)
-{
-    memset(s, 0, sizeof(*s));
-    s->layout = SHADOW_LAYOUT_ATLAS;
-    s->atlas = 4096;
-    s->tile = 0;
-    s->min_tile = 16;
-    s->max_tile = 512;
-    s->pcf = 1;
-    s->bias = 0.02;
-    s->normal_offset = 1.0;
-    s->overflow = SHADOW_OVERFLOW_DROP_REPORT;
-}
-
-static bool is_pow2(int v) { return v > 0 && (v & (v - 1)) == 0; }
-
-/* An integer that is a power of two in [lo, hi]. */
-static bool get_pow2(const json_t *obj, const char *key, const char *field, int lo, int hi, int *out,
-                     struct job_error *err)
-{
-    int v = *out;
-    if (!jf_get_int(obj, key, field, lo, hi, &v, err) || !is_pow2(v))
-        return job_error_set(err, field, "must be a power of two from %d to %d", lo, hi);
-    *out = v;
-    return true;
-}
-
-/* true / false / null switch with defaults; an object switches on. */
-static bool get_switch(const json_t *v, const char *field, bool *enabled, bool *is_object,
-                       struct job_error *err)
-{
-    *is_object = false;
-    if (json_is_boolean(v) || json_is_null(v)) {
-        *enabled = json_is_true(v);
-        return true;
-    }
-    if (!json_is_object(v))
-        return job_error_set(err, field, "must be true, false or an object of options");
-    *enabled = true;
-    *is_object = true;
-    return true;
-}
 
 static bool parse_probe_list(const json_t *list, const char *field, struct ibl_spec *s,
                              struct job_error *err)
@@ -100,110 +49,165 @@ static bool parse_probe_list(const json_t *list, const char *field, struct ibl_s
     return true;
 }
 
-bool ibl_spec_parse(const json_t *v, const char *field, struct ibl_spec *s, struct job_error *err)
+/* probes: a count (placed over the objects) or a list of positions and radii. */
+static bool parse_probes(const json_t *v, const char *field, void *opts, struct job_error *err)
 {
-    bool object;
-    if (!get_switch(v, field, &s->enabled, &object, err))
-        return false;
-    if (!object)
-        return true;
-    static const char *const keys[] = {"environment", "intensity", "probes", "resolution",
-                                       "blend", "samples", NULL};
-    char prefix[48], f[6][64];
-    static const char *const names[] = {"environment", "intensity", "probes", "resolution",
-                                        "blend", "samples"};
-    snprintf(prefix, sizeof(prefix), "%s.", field);
-    for (int i = 0; i < 6; i++)
-        snprintf(f[i], sizeof(f[i]), "%s.%s", field, names[i]);
-    if (!jf_check_keys(v, prefix, keys, err) ||
-        !jf_get_choice(v, "environment", f[0], ibl_environment_names, &s->environment, err) ||
-        !jf_get_number(v, "intensity", f[1], 0.0, 1000.0, &s->intensity, err) ||
-        !get_pow2(v, "resolution", f[3], 8, 512, &s->resolution, err) ||
-        !jf_get_int(v, "blend", f[4], 1, IBL_MAX_BLEND, &s->blend, err) ||
-        !jf_get_int(v, "samples", f[5], 1, 4096, &s->samples, err))
-        return false;
-    json_t *probes = json_object_get(v, "probes");
-    if (json_is_array(probes))
-        return parse_probe_list(probes, f[2], s, err);
-    if (probes && !jf_get_int(v, "probes", f[2], 0, IBL_MAX_PROBES, &s->probes, err))
-        return job_error_set(err, f[2], "must be a count from 0 to %d, or a list of "
+    struct ibl_spec *s = opts;
+    if (json_is_array(v))
+        return parse_probe_list(v, field, s, err);
+    json_t *wrapped = json_pack("{s:O}", "probes", v);
+    int count = s->probes;
+    bool ok = jf_get_int(wrapped, "probes", field, 0, IBL_MAX_PROBES, &count, err);
+    json_decref(wrapped);
+    if (!ok)
+        return job_error_set(err, field, "must be a count from 0 to %d, or a list of "
                              "{\"position\": [x, y, z], \"radius\": r}", IBL_MAX_PROBES);
-    if (probes)
-        s->placed = false;
+    s->probes = count;
+    s->placed = false;
     return true;
 }
 
-bool shadow_spec_parse(const json_t *v, const char *field, struct shadow_spec *s,
-                       struct job_error *err)
+static json_t *probes_json(const void *opts)
 {
-    bool object;
-    if (!get_switch(v, field, &s->enabled, &object, err))
-        return false;
-    if (!object)
-        return true;
-    static const char *const keys[] = {"layout", "atlas", "tile", "min_tile", "max_tile", "pcf",
-                                       "bias", "normal_offset", "overflow", NULL};
-    char prefix[48], f[9][64];
-    for (int i = 0; i < 9; i++)
-        snprintf(f[i], sizeof(f[i]), "%s.%s", field, keys[i]);
-    snprintf(prefix, sizeof(prefix), "%s.", field);
-    if (!jf_check_keys(v, prefix, keys, err) ||
-        !jf_get_choice(v, "layout", f[0], shadow_layout_names, &s->layout, err) ||
-        !get_pow2(v, "atlas", f[1], 256, SHADOW_MAX_ATLAS, &s->atlas, err) ||
-        !get_pow2(v, "min_tile", f[3], SHADOW_MIN_TILE, SHADOW_MAX_ATLAS, &s->min_tile, err) ||
-        !get_pow2(v, "max_tile", f[4], SHADOW_MIN_TILE, SHADOW_MAX_ATLAS, &s->max_tile, err) ||
-        !jf_get_int(v, "pcf", f[5], 0, 3, &s->pcf, err) ||
-        !jf_get_number(v, "bias", f[6], 0.0, 10.0, &s->bias, err) ||
-        !jf_get_number(v, "normal_offset", f[7], 0.0, 16.0, &s->normal_offset, err) ||
-        !jf_get_choice(v, "overflow", f[8], shadow_overflow_names, &s->overflow, err))
-        return false;
-    json_t *tile = json_object_get(v, "tile");
-    if (json_is_string(tile) && strcmp(json_string_value(tile), "auto") == 0)
-        s->tile = 0;
-    else if (tile && !get_pow2(v, "tile", f[2], SHADOW_MIN_TILE, SHADOW_MAX_ATLAS, &s->tile, err))
-        return job_error_set(err, f[2], "must be \"auto\" (sized by importance on screen) or a "
-                             "power of two from %d to %d", SHADOW_MIN_TILE, SHADOW_MAX_ATLAS);
+    const struct ibl_spec *s = opts;
+    if (!s->placed)
+        return json_integer(s->probes);
+    json_t *probes = json_array();
+    for (int i = 0; i < s->probes; i++)
+        json_array_append_new(probes, json_pack("{s:[f, f, f], s:f}", "position",
+                                                s->probe[i].pos[0], s->probe[i].pos[1],
+                                                s->probe[i].pos[2], "radius",
+                                                s->probe[i].radius));
+    return probes;
+}
+
+static const struct opt_hooks probe_hooks = {
+    .parse = parse_probes, .to_json = probes_json, .type = "count_or_list",
+    .rule = "must be a count from 0 to 32, or a list of {\"position\": [x, y, z], "
+            "\"radius\": r}"};
+
+static const struct opt_field ibl_fields[] = {
+    {.name = "environment", .type = OPT_CHOICE, .def = IBL_ENV_SKY,
+     .choices = ibl_environment_names,
+     .summary = "sky: an analytic sky with a sun; uniform: constant radiance (the white "
+                "furnace's)",
+     .offset = offsetof(struct ibl_spec, environment)},
+    {.name = "intensity", .type = OPT_NUMBER, .def = 1.0, .min = 0.0, .max = 1000.0,
+     .summary = "scales the environment's radiance",
+     .offset = offsetof(struct ibl_spec, intensity)},
+    {.name = "probes", .type = OPT_CUSTOM, .hooks = &probe_hooks,
+     .summary = "light probes capturing the scene: a count placed over the objects, or a "
+                "list; 0 lights with the environment alone",
+     .offset = offsetof(struct ibl_spec, probes)},
+    {.name = "resolution", .type = OPT_POW2, .def = 64, .min = 8, .max = 512,
+     .summary = "capture cube face edge (the prefiltered map's level 0)",
+     .offset = offsetof(struct ibl_spec, resolution)},
+    /* seed 002 blends the four most important probes */
+    {.name = "blend", .type = OPT_INT, .def = 4, .min = 1, .max = IBL_MAX_BLEND,
+     .summary = "probes blended per pixel, the most important first",
+     .offset = offsetof(struct ibl_spec, blend)},
+    {.name = "samples", .type = OPT_INT, .def = 64, .min = 1, .max = 4096,
+     .summary = "GGX samples per prefiltered texel",
+     .offset = offsetof(struct ibl_spec, samples)},
+    {0},
+};
+
+static const struct opt_table ibl_table = {.fields = ibl_fields, .size = sizeof(struct ibl_spec)};
+
+static const struct opt_field shadow_fields[] = {
+    {.name = "layout", .type = OPT_CHOICE, .def = SHADOW_LAYOUT_ATLAS,
+     .choices = shadow_layout_names,
+     .summary = "atlas: every light's six faces in one 2D atlas, sized by importance; cubes: "
+                "one cube map per light, all tile x tile",
+     .offset = offsetof(struct shadow_spec, layout)},
+    {.name = "atlas", .type = OPT_POW2, .def = 4096, .min = 256, .max = SHADOW_MAX_ATLAS,
+     .summary = "atlas edge in texels: the memory bound of either layout",
+     .offset = offsetof(struct shadow_spec, atlas)},
+    {.name = "tile", .type = OPT_POW2_OR_AUTO, .def = 0, .min = SHADOW_MIN_TILE,
+     .max = SHADOW_MAX_ATLAS, .auto_means = "sized by importance on screen",
+     .summary = "face edge for every light", .offset = offsetof(struct shadow_spec, tile)},
+    {.name = "min_tile", .type = OPT_POW2, .def = 16, .min = SHADOW_MIN_TILE,
+     .max = SHADOW_MAX_ATLAS, .summary = "auto's smallest face edge",
+     .offset = offsetof(struct shadow_spec, min_tile)},
+    {.name = "max_tile", .type = OPT_POW2, .def = 512, .min = SHADOW_MIN_TILE,
+     .max = SHADOW_MAX_ATLAS, .summary = "auto's largest face edge",
+     .offset = offsetof(struct shadow_spec, max_tile)},
+    {.name = "pcf", .type = OPT_INT, .def = 1, .min = 0, .max = 3,
+     .summary = "filter radius in texels: (2 pcf + 1)^2 bilinear compares",
+     .offset = offsetof(struct shadow_spec, pcf)},
+    {.name = "bias", .type = OPT_NUMBER, .def = 0.02, .min = 0.0, .max = 10.0,
+     .summary = "depth bias along the light ray, world units",
+     .offset = offsetof(struct shadow_spec, bias)},
+    {.name = "normal_offset", .type = OPT_NUMBER, .def = 1.0, .min = 0.0, .max = 16.0,
+     .summary = "receiver moved along its normal, in shadow-map texels",
+     .offset = offsetof(struct shadow_spec, normal_offset)},
+    {.name = "overflow", .type = OPT_CHOICE, .def = SHADOW_OVERFLOW_DROP_REPORT,
+     .choices = shadow_overflow_names,
+     .summary = "when the atlas cannot hold every light's maps: drop the least important "
+                "lights' shadows and report them, or fail the frame",
+     .offset = offsetof(struct shadow_spec, overflow)},
+    {0},
+};
+
+static bool shadow_check(void *opts, const char *prefix, struct job_error *err)
+{
+    struct shadow_spec *s = opts;
+    char field[64];
     /* A light's six faces must fit the atlas at the smallest size it may take. */
     int smallest = s->tile ? s->tile : s->min_tile;
-    if (smallest * 4 > s->atlas)
-        return job_error_set(err, s->tile ? f[2] : f[3], "%d leaves no room for one light's six "
-                             "faces in a %d atlas: at most atlas / 4", smallest, s->atlas);
-    if (s->min_tile > s->max_tile)
-        return job_error_set(err, f[3], "must be at most max_tile (%d)", s->max_tile);
+    if (smallest * 4 > s->atlas) {
+        snprintf(field, sizeof(field), "%s.%s", prefix, s->tile ? "tile" : "min_tile");
+        return job_error_set(err, field, "%d leaves no room for one light's six faces in a %d "
+                             "atlas: at most atlas / 4", smallest, s->atlas);
+    }
+    if (s->min_tile > s->max_tile) {
+        snprintf(field, sizeof(field), "%s.min_tile", prefix);
+        return job_error_set(err, field, "must be at most max_tile (%d)", s->max_tile);
+    }
     if (s->layout == SHADOW_LAYOUT_CUBES && !s->tile)
         s->tile = s->max_tile < 256 ? s->max_tile : 256;
     return true;
 }
 
+static const struct opt_table shadow_table = {
+    .fields = shadow_fields, .size = sizeof(struct shadow_spec), .check = shadow_check};
+
+void ibl_spec_defaults(struct ibl_spec *s) { opt_defaults(&ibl_table, s); }
+
+void shadow_spec_defaults(struct shadow_spec *s) { opt_defaults(&shadow_table, s); }
+
+/* true, false or null switch it with the options as they stand; an object
+ * switches it on and sets options. */
+static bool parse_switch(const struct opt_table *t, const json_t *v, const char *field,
+                         bool *enabled, void *opts, struct job_error *err)
+{
+    if (json_is_boolean(v) || json_is_null(v)) {
+        *enabled = json_is_true(v);
+        return true;
+    }
+    if (!json_is_object(v))
+        return job_error_set(err, field, "must be true, false or an object of options");
+    *enabled = true;
+    return opt_parse(t, v, field, opts, err);
+}
+
+bool ibl_spec_parse(const json_t *v, const char *field, struct ibl_spec *s, struct job_error *err)
+{
+    return parse_switch(&ibl_table, v, field, &s->enabled, s, err);
+}
+
+bool shadow_spec_parse(const json_t *v, const char *field, struct shadow_spec *s,
+                       struct job_error *err)
+{
+    return parse_switch(&shadow_table, v, field, &s->enabled, s, err);
+}
+
 json_t *ibl_spec_to_json(const struct ibl_spec *s)
 {
-    if (!s->enabled)
-        return json_false();
-    json_t *probes;
-    if (s->placed) {
-        probes = json_array();
-        for (int i = 0; i < s->probes; i++)
-            json_array_append_new(probes, json_pack("{s:[f, f, f], s:f}", "position",
-                                                    s->probe[i].pos[0], s->probe[i].pos[1],
-                                                    s->probe[i].pos[2], "radius",
-                                                    s->probe[i].radius));
-    } else {
-        probes = json_integer(s->probes);
-    }
-    return json_pack("{s:s, s:f, s:o, s:i, s:i, s:i}", "environment",
-                     ibl_environment_names[s->environment], "intensity", s->intensity, "probes",
-                     probes, "resolution", s->resolution, "blend", s->blend, "samples",
-                     s->samples);
+    return s->enabled ? opt_to_json(&ibl_table, s) : json_false();
 }
 
 json_t *shadow_spec_to_json(const struct shadow_spec *s)
 {
-    if (!s->enabled)
-        return json_false();
-    return json_pack("{s:s, s:i, s:o, s:i, s:i, s:i, s:f, s:f, s:s}", "layout",
-                     shadow_layout_names[s->layout], "atlas", s->atlas, "tile",
-                     s->tile ? json_integer(s->tile) : json_string("auto"), "min_tile",
-                     s->min_tile, "max_tile", s->max_tile, "pcf", s->pcf, "bias", s->bias,
-                     "normal_offset", s->normal_offset, "overflow",
-                     shadow_overflow_names[s->overflow]);
+    return s->enabled ? opt_to_json(&shadow_table, s) : json_false();
 }

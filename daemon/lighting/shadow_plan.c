@@ -200,7 +200,7 @@ bool shadow_plan_frame(struct shadow_plan *p, const struct scene *s, const struc
     for (int k = 0; k < kept; k++)
         for (int f = 0; f < 6; f++)
             p->sizes[k * 6 + f] = p->light[p->order[k]].size;
-    osl_atlas_place(p->sizes, kept * 6, spec->atlas, spec->atlas, p->slots, p->tiles);
+    atlas_place(p->sizes, kept * 6, spec->atlas, spec->atlas, p->slots, p->tiles);
     for (int k = 0; k < kept; k++) {
         struct shadow_light_plan *l = &p->light[p->order[k]];
         for (int f = 0; f < 6; f++) {

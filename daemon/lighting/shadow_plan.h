@@ -14,7 +14,7 @@
  * important lights shrink first, down to min_tile, and then lose their
  * shadows, least important first; those are reported (overflow
  * "drop_report") or the frame fails naming them ("fail"). The faces are
- * packed with the OSL atlas packer (largest first, Z-order).
+ * packed as power-of-two tiles (common/pow2_atlas.h: largest first, Z-order).
  *
  * The cubes layout (one cube map per light, every face tile x tile, the
  * same memory bound) takes lights in order of importance until the
@@ -28,7 +28,7 @@
 
 #include "daemon/lighting/look_lighting.h"
 #include "daemon/scene/scene.h"
-#include "daemon/techniques/osl/osl_atlas.h"
+#include "common/pow2_atlas.h"
 
 enum shadow_status {
     SHADOW_CULLED,     /* its light reaches nothing on screen */
@@ -54,7 +54,7 @@ struct shadow_plan {
     double texels; /* atlas texels the faces cover */
     /* Scratch, sized at init. */
     int *order, *sizes, *slots;
-    struct osl_tile *tiles;
+    struct atlas_tile *tiles;
 };
 
 /* Sizes everything for `lights` lights; false when out of memory. */

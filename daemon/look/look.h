@@ -19,7 +19,7 @@
 #include "daemon/look/ibl.h"
 #include "daemon/look/shadows.h"
 #include "daemon/look/sky.h"
-#include "daemon/jobs/job_spec.h"
+#include "daemon/lighting/look_spec.h"
 #include "daemon/scene/scene.h"
 
 /* The #define lines of a look, for every program that lights: the model,

@@ -7,8 +7,9 @@
  * Every chart is an axis-aligned rectangle in UV space that the mesh's
  * triangles cover completely, so a texel whose centre lies inside a chart is
  * always written by the UV-space rasterization; samplers clamp to those
- * texel centres (see shaders/osl/osl_draw.frag), which is what keeps bilinear
- * filtering from bleeding across chart edges at every tile size. */
+ * texel centres (see daemon/techniques/osl/osl_draw.frag), which is what
+ * keeps bilinear filtering from bleeding across chart edges at every tile
+ * size. */
 
 #include <stdbool.h>
 #include <stdint.h>

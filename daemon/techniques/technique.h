@@ -16,9 +16,8 @@
 #include "daemon/gpu/gpu_scene.h"
 #include "daemon/gpu/pass.h"
 #include "daemon/gpu/targets.h"
-#include "daemon/jobs/job_spec.h"
+#include "daemon/lighting/look_spec.h"
 #include "daemon/scene/scene.h"
-#include "daemon/techniques/catalog.h"
 #include "daemon/techniques/technique_info.h"
 
 /* What a technique may publish for the harness after create (0 = none):
@@ -37,9 +36,14 @@ struct technique_products {
     GLuint heat_tex;     /* GL_R32UI, width x height: light evaluations this frame */
 };
 
-/* What the harness hands a technique; valid from create to destroy. */
+/* What the harness hands a technique: what it needs to render a frame, and
+ * nothing of the job it serves. Valid from create to destroy. */
 struct technique_env {
-    const struct job_spec *spec;
+    /* The run's frames: warmup_frames warm-up frames (numbered from
+     * 1 - warmup_frames to 0), then the timed frames 1..frames. Timed frame
+     * k is captured when capture_interval > 0 and k is a multiple of it
+     * (technique_env_captures); 0 captures none. */
+    int frames, warmup_frames, capture_interval;
     /* The look this run renders with: the job's, or the reference's
      * reference_look (lighting model, materials a g-buffer must carry). */
     const struct look_spec *look;
@@ -49,7 +53,7 @@ struct technique_env {
     const struct gpu_caps *caps;
     struct gpu_targets *targets;    /* ask for extra planes by name */
     const struct gpu_passes *passes; /* index i is info->passes[i] */
-    /* The output: HDR colour (spec->look.hdr format) and a depth texture that
+    /* The output: HDR colour (look->hdr format) and a depth texture that
      * later passes may sample, both width x height, attached to output_fbo. */
     GLuint output_fbo, output_color, output_depth;
     int width, height;
@@ -84,21 +88,25 @@ struct technique {
     void (*destroy)(void *state);
 };
 
+/* True when timed frame `frame` is captured: the harness reads the output
+ * back after it, and a technique that publishes a heat map writes it. */
+static inline bool technique_env_captures(const struct technique_env *env, int64_t frame)
+{
+    return env->capture_interval > 0 && frame >= 1 && frame <= env->frames &&
+           frame % env->capture_interval == 0;
+}
+
+/* The GL half of the registry: every registered technique, in the order of
+ * technique_infos (each folder's technique_NAME), NULL-terminated. */
 extern const struct technique *const technique_registry[];
 
 const struct technique *technique_find(const char *name);
 int technique_pass_count(const struct technique *t);
 
-/* Checks a technique's table at start-up: mandatory hooks present, passes
- * within the limit, options fit their storage. */
+/* Checks a technique's GL half: its info and its mandatory hooks. */
 bool technique_check(const struct technique *t, char *err, size_t errlen);
-
-/* Shared by the single-pass techniques (forward, unlit): scene.vert plus one
- * fragment shader, drawn in one pass. */
-bool single_pass_create(const struct technique_env *env, const char *label, const char *frag,
-                        void **state, char *err, size_t errlen);
-bool single_pass_render(void *state, const struct technique_env *env, int64_t frame, char *err,
-                        size_t errlen);
-void single_pass_destroy(void *state);
+/* Checks every registered technique (technique_check) and that the GL
+ * registry follows technique_infos; at start-up, before any job. */
+bool technique_registry_check(char *err, size_t errlen);
 
 #endif

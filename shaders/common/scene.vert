@@ -1,4 +1,5 @@
-// Instanced scene geometry in world space (forward and unlit).
+// Instanced scene geometry in world space, for every program that draws the
+// objects.
 #include "frame.glsl"
 #include "scene_data.glsl"
 layout(location = 0) in vec3 a_pos;

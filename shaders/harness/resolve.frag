@@ -4,7 +4,7 @@
 // have done, no encoding (today's image, byte for byte at exposure 1).
 // TONEMAP_REINHARD and TONEMAP_ACES: the curve, then the sRGB transfer
 // function, since a tone-mapped image is display-referred.
-// daemon/effects/effect_kernels.c has the same curves in C, unit-tested.
+// daemon/lighting/tone_curves.c has the same curves in C, unit-tested.
 layout(binding = SB_TEX_HDR) uniform sampler2D u_hdr;
 layout(location = SB_LOC_EXPOSURE) uniform float u_exposure;
 layout(location = 0) out vec4 out_color;

@@ -20,25 +20,19 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
         }                                                                                \
     } while (0)
 
-#include "daemon/techniques/osl/osl_info.h"
-#include "daemon/techniques/technique_info.h"
+#include "daemon/techniques/catalog.h"
 
 /* The catalogue of the techniques the daemon registers, as the job and sweep
- * parsers take it: OSL's real GL-free half, and forward and unlit as their
- * infos declare them (no options; their GL halves are not linked). */
-static const char *const fuzz_passes[] = {"shading", NULL};
-static const struct technique_info fuzz_forward = {
-    .name = "forward", .summary = "forward", .passes = fuzz_passes};
-static const struct technique_info fuzz_unlit = {
-    .name = "unlit", .summary = "unlit", .passes = fuzz_passes};
-
+ * parsers take it: every registered technique's GL-free half. */
 static inline const struct technique_catalog *fuzz_techniques(void)
 {
     static struct technique_catalog c;
     if (!c.count) {
-        technique_catalog_add(&c, &fuzz_forward);
-        technique_catalog_add(&c, &fuzz_unlit);
-        technique_catalog_add(&c, &osl_info);
+        char err[256];
+        if (!technique_catalog_init(&c, err, sizeof(err))) {
+            fprintf(stderr, "fuzz: %s\n", err);
+            abort();
+        }
     }
     return &c;
 }

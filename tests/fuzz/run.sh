@@ -22,20 +22,30 @@ if ! command -v "$cc" >/dev/null 2>&1; then
     echo "fuzz: 0 passed, 1 failed"
     exit 1
 fi
-flags="-g -O1 -std=c11 -I. -fno-omit-frame-pointer -fsanitize=address,undefined
+flags="-g -O1 -std=c11 -I. -I$out/gen -fno-omit-frame-pointer -fsanitize=address,undefined
   -fno-sanitize-recover=undefined $(pkg-config --cflags jansson libpng)"
 libs="$(pkg-config --libs jansson libpng) -lm -pthread"
-# The GL-free libraries, read from Makefile.am so that this list cannot
-# fall behind the build.
-sources=$(awk '/^libsb_[a-z]*_a_SOURCES *=/ { on = 1 }
-    on { for (i = 1; i <= NF; i++) if ($i ~ /\.c$/) print $i }
-    on && !/\\$/ { on = 0 }' Makefile.am)
+# The registries' lists for C, as the build generates them (rewritten only
+# when they change, so that what includes them is not rebuilt every run).
+for registry in daemon/techniques/registry.mk daemon/effects/registry.mk; do
+    gen="$out/gen/$(dirname "$registry")/registered.h"
+    mkdir -p "$(dirname "$gen")"
+    sh build-aux/gen-registry.sh "$registry" >"$gen.tmp" || { echo "FAIL: fuzz: $registry"; exit 1; }
+    if cmp -s "$gen.tmp" "$gen"; then rm "$gen.tmp"; else mv "$gen.tmp" "$gen"; fi
+done
+# The GL-free libraries, read from Makefile.am and the build fragments
+# (local.mk, registry.mk) that add to them, where %reldir% is the
+# fragment's folder, so that this list cannot fall behind the build.
+sources=$(awk 'FNR == 1 { dir = FILENAME; if (!sub(/\/[^\/]*$/, "", dir)) dir = "." }
+    /^libsb_[a-z]*_a_SOURCES *\+?=/ { on = 1 }
+    on { for (i = 1; i <= NF; i++) if ($i ~ /\.c$/) { f = $i; gsub(/%reldir%/, dir, f); print f } }
+    on && !/\\$/ { on = 0 }' Makefile.am $(find daemon common -name '*.mk' | sort))
 [ -n "$sources" ] || { echo "FAIL: fuzz: no library sources found in Makefile.am"; exit 1; }
 sources="$sources daemon/api/routes.c" # the route target's only GL-free part of the API layer
 objs=""
 for src in $sources; do
     obj="$out/obj/$(echo "$src" | tr / _ | sed 's/\.c$/.o/')"
-    if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ -n "$(find "$(dirname "$src")" common -name '*.h' -newer "$obj" 2>/dev/null | head -n1)" ]; then
+    if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ -n "$(find "$(dirname "$src")" common "$out/gen" -name '*.h' -newer "$obj" 2>/dev/null | head -n1)" ]; then
         # shellcheck disable=SC2086
         "$cc" $flags -fsanitize=fuzzer-no-link -c "$src" -o "$obj" || { echo "FAIL: fuzz: cannot build $src"; exit 1; }
     fi

@@ -37,6 +37,10 @@ int main(void)
           strlen(name) == strlen(osl_prefix) + 8 + strlen(", 20 frames") &&
           strstr(name, ", 20 frames"));
     printf("name: %s\n", name);
+    /* The daemon states async_distance in OSL's options too: named once. */
+    json_object_set_new(json_object_get(osl, "osl"), "async_distance", json_integer(20));
+    junit_job_name(osl, other, sizeof(other));
+    CHECK(strcmp(name, other) == 0);
     /* Labels, repeat, captures and the reference leave the name alone. */
     json_object_set_new(osl, "labels", json_pack("{s:s}", "commit", "def"));
     json_object_set_new(osl, "repeat", json_integer(5));

@@ -95,9 +95,9 @@ int main(void)
            tight_seen, full, empty);
 
     struct job_error err;
-    CHECK(cluster_grid_check((const int[3]){16, 9, 24}, "c.grid", &err));
-    CHECK(cluster_grid_check((const int[3]){1024, 1024, 1}, "c.grid", &err));
-    CHECK(!cluster_grid_check((const int[3]){1024, 1024, 2}, "c.grid", &err));
+    CHECK(cluster_grid_check((const int[3]){16, 9, 24}, "c", &err));
+    CHECK(cluster_grid_check((const int[3]){1024, 1024, 1}, "c", &err));
+    CHECK(!cluster_grid_check((const int[3]){1024, 1024, 2}, "c", &err));
     CHECK(strcmp(err.field, "c.grid") == 0);
     scene_finish(&s);
     return check_finish("test_culling");

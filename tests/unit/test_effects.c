@@ -6,9 +6,11 @@
 #include <math.h>
 #include <string.h>
 
-#include "daemon/effects/effect_info.h"
-#include "daemon/effects/effect_kernels.h"
+#include "daemon/effects/bloom/bloom_info.h"
+#include "daemon/effects/ssao/ssao_info.h"
+#include "daemon/effects/toon/toon_info.h"
 #include "daemon/jobs/job_spec.h"
+#include "daemon/lighting/tone_curves.h"
 #include "daemon/jobs/sweep_spec.h"
 #include "tests/unit/catalog_fixture.h"
 #include "tests/unit/check.h"
@@ -147,6 +149,10 @@ static void test_passes(void)
     }
     /* Counting needs no storage. */
     CHECK(post_spec_pass_names(&spec.look.post, NULL, 0) == 12);
+
+    /* Every registered effect passes its registration checks. */
+    char why[256];
+    CHECK(effect_infos_check(why, sizeof(why)));
 
     json_t *info = effect_catalog_json();
     CHECK(json_array_size(info) == 3);

@@ -44,8 +44,8 @@ int main(void)
                 "\"osl\":{\"resolution\":\"auto\",\"texel_density\":2,\"reshade\":\"all\"}}",
                 &spec, &err));
     CHECK(strcmp(spec.technique, "osl") == 0 && spec.frames == 40 && spec.warmup_frames == 0);
-    CHECK(spec.async_distance == 20.0 && spec.scene.dynamic && spec.scene.lights == 3);
     const struct osl_options *osl = job_spec_technique_options(&spec);
+    CHECK(osl->async_distance == 20.0 && spec.scene.dynamic && spec.scene.lights == 3);
     CHECK(osl->resolution == 0 && osl->texel_density == 2.0);
     CHECK(osl->reshade == OSL_RESHADE_ALL && spec.scene.sphere_segments == 16);
     CHECK(job_spec_capture_count(&spec) == 2);
@@ -77,7 +77,7 @@ int main(void)
     rejects("[1,2]", "body");
     rejects("{\"frames\":1,\"frames\":2}", "body");
     rejects("{\"frame\":10}", "frame");
-    rejects("{\"technique\":\"deferred\"}", "technique");
+    rejects("{\"technique\":\"sponza\"}", "technique");
     rejects("{\"technique\":3}", "technique");
     rejects("{\"frames\":\"300\"}", "frames");
     rejects("{\"frames\":0}", "frames");
@@ -133,9 +133,60 @@ int main(void)
     rejects("{\"demo\":{\"grid\":[8,8]}}", "demo.grid");
     rejects("{\"demo\":{\"grid\":[8,8,0]}}", "demo.grid");
     rejects("{\"demo\":[]}", "demo");
+    /* Dotted names, as /v1/info lists them, read as the nested form. */
+    CHECK(parse("{\"technique\":\"demo\",\"demo\":{\"gbuffer\":{\"normal\":\"float3\"}}}",
+                &spec, &err));
+    CHECK(parse("{\"technique\":\"demo\",\"demo\":{\"gbuffer.normal\":\"float3\"}}", &again,
+                &err));
+    CHECK(memcmp(&again, &spec, sizeof(spec)) == 0 &&
+          ((const struct demo_options *)job_spec_technique_options(&spec))->normal == 1);
+    rejects("{\"demo\":{\"gbuffer\":{\"normal\":\"float3\"},\"gbuffer.normal\":\"float3\"}}",
+            "demo.gbuffer.normal");
+    rejects("{\"demo\":{\"gbuffer.normal\":\"packed\"}}", "demo.gbuffer.normal");
+    rejects("{\"demo\":{\"gbuffer.normals\":\"float3\"}}", "demo.gbuffer.normals");
     rejects("{\"forward\":{\"x\":1}}", "forward.x");
     rejects("{\"forward\":5}", "forward");
     CHECK(parse("{\"forward\":{}}", &spec, &err));
+
+    /* async_distance is OSL's option; the top-level field stays an alias,
+     * and the spec as understood shows it in both places. */
+    CHECK(parse("{\"async_distance\":20}", &spec, &err) &&
+          ((const struct osl_options *)spec.options[2].bytes)->async_distance == 20.0);
+    j = job_spec_to_json(&spec);
+    CHECK(json_number_value(json_object_get(j, "async_distance")) == 20.0);
+    json_decref(j);
+    CHECK(parse("{\"technique\":\"osl\",\"osl\":{\"async_distance\":5}}", &spec, &err));
+    j = job_spec_to_json(&spec);
+    CHECK(json_number_value(json_object_get(json_object_get(j, "osl"), "async_distance")) == 5.0 &&
+          json_number_value(json_object_get(j, "async_distance")) == 5.0);
+    text = json_dumps(j, 0);
+    CHECK(parse(text, &again, &err) && memcmp(&again, &spec, sizeof(spec)) == 0);
+    free(text);
+    json_decref(j);
+    CHECK(parse("{\"technique\":\"osl\",\"async_distance\":5,\"osl\":{\"async_distance\":5.0}}",
+                &spec, &err));
+    rejects("{\"technique\":\"osl\",\"async_distance\":5,\"osl\":{\"async_distance\":0}}",
+            "async_distance");
+    rejects("{\"osl\":{\"async_distance\":-1}}", "osl.async_distance");
+    CHECK(strcmp(job_spec_alias("async_distance"), "osl.async_distance") == 0 &&
+          strcmp(job_spec_aliased("osl.async_distance"), "async_distance") == 0 &&
+          !job_spec_alias("frames"));
+
+    /* The catalogue a daemon builds, without GL: every registered technique
+     * passes its checks, and the baseline is what a job runs by default. */
+    {
+        struct technique_catalog real;
+        char why[256];
+        CHECK(technique_catalog_init(&real, why, sizeof(why)) && real.count >= 8 &&
+              real.baseline >= 0);
+        CHECK(parse("{}", &spec, &err) &&
+              strcmp(spec.technique, real.infos[real.baseline]->name) == 0);
+        char list[400];
+        technique_catalog_list(&real, TECHNIQUE_BOUNDED_LIGHT_LISTS, list, sizeof(list));
+        CHECK(strstr(list, "\"clustered_deferred\"") && !strstr(list, "\"osl\""));
+        CHECK(!technique_catalog_add(&real, real.infos[0], why, sizeof(why)) &&
+              strstr(why, "registered twice"));
+    }
 
     /* The look. */
     CHECK(parse("{}", &spec, &err) && spec.look.lighting == LOOK_PHONG &&

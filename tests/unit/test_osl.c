@@ -6,7 +6,7 @@
 #include "daemon/scene/scene.h"
 #include "tests/unit/check.h"
 
-static void check_packing(const int *sizes, int n, int w, int h, const struct osl_tile *t)
+static void check_packing(const int *sizes, int n, int w, int h, const struct atlas_tile *t)
 {
     for (int i = 0; i < n; i++) {
         CHECK(t[i].size == sizes[i]);
@@ -24,7 +24,7 @@ static void test_atlas(void)
 {
     enum { N = 512 };
     int sizes[N];
-    struct osl_tile tiles[N];
+    struct atlas_tile tiles[N];
     int w, h;
     char err[256];
     for (int i = 0; i < N; i++)

@@ -123,6 +123,33 @@ int main(void)
     sweep_spec_finish(&s);
     rejects("{\"base\":{},\"vary\":{\"frames\":[1]},\"time_reference\":1}", "time_reference");
 
+    /* async_distance is an alias of osl.async_distance: a sweep varies
+     * either, whichever spelling its base uses, and a point never gives it
+     * twice. */
+    CHECK(parse("{\"base\":{\"technique\":\"osl\",\"osl\":{\"async_distance\":20}},"
+                "\"vary\":{\"async_distance\":[0,5]}}", &s, &err));
+    job = sweep_point_job(&s, 1, &values);
+    CHECK(json_integer_value(json_object_get(job, "async_distance")) == 5 &&
+          !json_object_get(json_object_get(job, "osl"), "async_distance"));
+    json_decref(values);
+    json_decref(job);
+    sweep_spec_finish(&s);
+    CHECK(parse("{\"base\":{\"technique\":\"osl\",\"async_distance\":20},"
+                "\"vary\":{\"osl.async_distance\":[0,5]}}", &s, &err));
+    job = sweep_point_job(&s, 1, &values);
+    CHECK(json_integer_value(json_object_get(json_object_get(job, "osl"), "async_distance")) == 5 &&
+          !json_object_get(job, "async_distance"));
+    json_decref(values);
+    json_decref(job);
+    sweep_spec_finish(&s);
+    {
+        json_t *sweepable = sweep_params_json(techniques);
+        CHECK(!strcmp(json_string_value(json_object_get(sweepable, "async_distance")), "number") &&
+              !strcmp(json_string_value(json_object_get(sweepable, "osl.async_distance")),
+                      "number"));
+        json_decref(sweepable);
+    }
+
     /* find: numeric parameter, criterion parsed, probes built. */
     CHECK(parse("{\"base\":{\"technique\":\"osl\"},\"find\":{\"param\":\"async_distance\","
                 "\"from\":0,\"to\":100,\"while\":\"ssim_min >= 0.95\"}}", &s, &err));
@@ -198,7 +225,7 @@ int main(void)
     rejects("{\"base\":{},\"vary\":{\"scene.lightz\":[1,2]}}", "vary.scene.lightz");
     rejects("{\"base\":{},\"vary\":{\"async_distance\":[]}}", "vary.async_distance");
     rejects("{\"base\":{},\"vary\":{\"async_distance\":[0,\"far\"]}}", "vary.async_distance[1]");
-    rejects("{\"base\":{},\"vary\":{\"technique\":[\"forward\",\"deferred\"]}}", "vary.technique[1]");
+    rejects("{\"base\":{},\"vary\":{\"technique\":[\"forward\",\"sponza\"]}}", "vary.technique[1]");
     rejects("{\"base\":{},\"vary\":{\"scene.lights\":[1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17],"
             "\"async_distance\":[0,1,2,3,4,5,6,7,8,9,10,11,12,13,14,15]}}", "vary");
     rejects("{\"base\":{},\"vary\":{\"a\":[1],\"b\":[2],\"c\":[3]}}", "vary");

@@ -4,16 +4,16 @@
 
 static const char *const passes[] = {"binning", "gbuffer", "lighting", NULL};
 
-static const struct technique_option options[] = {
+static const struct opt_field options[] = {
     CLUSTER_OPTION_ROWS(struct clustered_deferred_options, cluster),
     GBUFFER_OPTION_ROWS(struct clustered_deferred_options, gbuffer),
     {0},
 };
 
-static bool check(const void *opts, struct job_error *err)
+static bool check(void *opts, const char *prefix, struct job_error *err)
 {
-    return cluster_grid_check(((const struct clustered_deferred_options *)opts)->cluster.grid,
-                              "clustered_deferred.grid", err);
+    const struct clustered_deferred_options *o = opts;
+    return cluster_grid_check(o->cluster.grid, prefix, err);
 }
 
 const struct technique_info clustered_deferred_info = {
@@ -21,7 +21,8 @@ const struct technique_info clustered_deferred_info = {
     .summary = "froxel light lists (compute), g-buffer, one lighting pass over each "
                "cluster's lights (seed 004)",
     .passes = passes,
-    .options = options,
-    .options_size = sizeof(struct clustered_deferred_options),
-    .check = check,
+    .options = {.fields = options,
+                .size = sizeof(struct clustered_deferred_options),
+                .check = check},
+    .flags = TECHNIQUE_BOUNDED_LIGHT_LISTS,
 };

@@ -6,6 +6,7 @@
  * "overflow", "gbuffer": {...}}) and passes. Any thread. */
 
 #include "daemon/techniques/shared/culling_info.h"
+#include "daemon/techniques/technique_info.h"
 
 struct clustered_deferred_options {
     struct cluster_options cluster;

@@ -4,15 +4,15 @@
 
 static const char *const passes[] = {"binning", "depth_prepass", "shading", NULL};
 
-static const struct technique_option options[] = {
+static const struct opt_field options[] = {
     CLUSTER_OPTION_ROWS(struct clustered_forward_options, cluster),
     {0},
 };
 
-static bool check(const void *opts, struct job_error *err)
+static bool check(void *opts, const char *prefix, struct job_error *err)
 {
-    return cluster_grid_check(((const struct clustered_forward_options *)opts)->cluster.grid,
-                              "clustered_forward.grid", err);
+    const struct clustered_forward_options *o = opts;
+    return cluster_grid_check(o->cluster.grid, prefix, err);
 }
 
 const struct technique_info clustered_forward_info = {
@@ -20,7 +20,8 @@ const struct technique_info clustered_forward_info = {
     .summary = "froxel light lists (compute), depth pre-pass, forward shading over each "
                "cluster's lights (seed 004)",
     .passes = passes,
-    .options = options,
-    .options_size = sizeof(struct clustered_forward_options),
-    .check = check,
+    .options = {.fields = options,
+                .size = sizeof(struct clustered_forward_options),
+                .check = check},
+    .flags = TECHNIQUE_BOUNDED_LIGHT_LISTS,
 };

@@ -18,7 +18,7 @@
 #include "daemon/techniques/shared/heat.h"
 
 enum { PASS_GBUFFER, PASS_LIGHTING };
-/* shaders/deferred/deferred_light.vert's sphere: 16 segments, 8 rings. */
+/* deferred_light.vert's sphere: 16 segments, 8 rings. */
 enum { VOLUME_VERTICES = 16 * 8 * 6, RECT_VERTICES = 6 };
 
 static const char *const bounds_defines[] = {

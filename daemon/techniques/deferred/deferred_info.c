@@ -4,8 +4,8 @@
 
 static const char *const passes[] = {"gbuffer", "lighting", NULL};
 
-static const struct technique_option options[] = {
-    {.name = "light_bounds", .type = TOPT_CHOICE, .def = LIGHT_BOUNDS_SCISSOR_TIGHT,
+static const struct opt_field options[] = {
+    {.name = "light_bounds", .type = OPT_CHOICE, .def = LIGHT_BOUNDS_SCISSOR_TIGHT,
      .choices = light_bounds_choices,
      .summary = "pixels each light shades: scissor_tight (its sphere's silhouette rectangle, "
                 "seed 001's fix), scissor_loose (the projected box of its AABB corners, seed "
@@ -19,6 +19,5 @@ const struct technique_info deferred_info = {
     .name = "deferred",
     .summary = "g-buffer, then each light added over the pixels its bound covers (seed 001)",
     .passes = passes,
-    .options = options,
-    .options_size = sizeof(struct deferred_options),
+    .options = {.fields = options, .size = sizeof(struct deferred_options)},
 };

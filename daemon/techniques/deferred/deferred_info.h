@@ -5,6 +5,7 @@
  * {"light_bounds", "gbuffer": {"normal", "albedo"}}) and passes. Any thread. */
 
 #include "daemon/techniques/shared/culling_info.h"
+#include "daemon/techniques/technique_info.h"
 
 struct deferred_options {
     int light_bounds; /* enum light_bounds */

@@ -4,8 +4,8 @@
 
 static const char *const passes[] = {"depth_prepass", "binning", "shading", NULL};
 
-static const struct technique_option options[] = {
-    {.name = "tile_size", .type = TOPT_INT, .def = 16, .min = 8, .max = 128,
+static const struct opt_field options[] = {
+    {.name = "tile_size", .type = OPT_INT, .def = 16, .min = 8, .max = 128,
      .summary = "tile edge in pixels",
      .offset = offsetof(struct forward_plus_options, tile_size)},
     {0},
@@ -16,6 +16,6 @@ const struct technique_info forward_plus_info = {
     .summary = "depth pre-pass, per-tile light lists with depth bounds (compute), forward "
                "shading over each tile's lights",
     .passes = passes,
-    .options = options,
-    .options_size = sizeof(struct forward_plus_options),
+    .options = {.fields = options, .size = sizeof(struct forward_plus_options)},
+    .flags = TECHNIQUE_BOUNDED_LIGHT_LISTS,
 };

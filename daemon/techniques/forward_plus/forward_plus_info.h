@@ -5,6 +5,7 @@
  * passes. Any thread. */
 
 #include "daemon/techniques/shared/culling_info.h"
+#include "daemon/techniques/technique_info.h"
 
 struct forward_plus_options {
     int tile_size; /* pixels */

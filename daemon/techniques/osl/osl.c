@@ -6,7 +6,7 @@
  *  3. rasterization: every object drawn sampling its tile.
  * Beyond the thesis: osl.resolution "auto" sizes each tile from the object's
  * size on screen, and osl.reshade "touched" reshades only objects a moving
- * light reaches (see daemon/osl_schedule.h). */
+ * light reaches (see osl_schedule.h). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,7 +23,7 @@
 /* The passes of osl_info, in order. */
 enum { PASS_LIGHTING, PASS_RASTER };
 
-/* shaders/osl/osl_light.comp has one position and one normal sampler per
+/* osl_light.comp has one position and one normal sampler per
  * mesh and selects them by branch: keep both in step. */
 _Static_assert(SCENE_MESH_COUNT == 4, "osl_light.comp samples exactly four meshes");
 
@@ -39,7 +39,7 @@ struct osl {
     GLuint atlas, tile_buffer, work_buffer;
     int atlas_w, atlas_h;
     int groups_x_max;
-    struct osl_tile *tiles;
+    struct atlas_tile *tiles;
     struct osl_schedule schedule;
     struct osl_work *plan;
     GLuint *work; /* 4 uints per planned object */
@@ -200,7 +200,7 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
     o->tiles = calloc((size_t)n, sizeof(*o->tiles));
     o->plan = calloc((size_t)n, sizeof(*o->plan));
     o->work = calloc((size_t)n * 4, sizeof(GLuint));
-    o->frames = env->spec->frames;
+    o->frames = env->frames;
     double *dist = calloc((size_t)n, sizeof(double));
     if (!o->tiles || !o->plan || !o->work || !dist) {
         free(dist);
@@ -208,7 +208,8 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
     }
     for (int i = 0; i < n; i++)
         dist[i] = scene_instance_distance(s, i);
-    bool sched = osl_schedule_init(&o->schedule, dist, n, env->spec->async_distance);
+    const struct osl_options *opt = env->options;
+    bool sched = osl_schedule_init(&o->schedule, dist, n, opt->async_distance);
     free(dist);
     o->rows = calloc((size_t)o->schedule.max_period, sizeof(int64_t));
     if (!sched || !o->rows)

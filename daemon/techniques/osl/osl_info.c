@@ -2,22 +2,30 @@
 
 #include <stddef.h>
 
+#include "daemon/techniques/osl/osl_atlas.h"
+
 static const char *const passes[] = {"lighting", "raster", NULL};
 static const char *const reshade_choices[] = {"touched", "all", NULL};
 
-static const struct technique_option options[] = {
-    {.name = "resolution", .type = TOPT_POW2_OR_AUTO, .def = 256, .min = 8, .max = 1024,
+static const struct opt_field options[] = {
+    {.name = "resolution", .type = OPT_POW2_OR_AUTO, .def = 256, .min = OSL_TILE_MIN,
+     .max = OSL_TILE_MAX,
      .summary = "tile edge in texels for every object (256 is the thesis); \"auto\" sizes "
                 "each object's tile from its size on screen",
      .offset = offsetof(struct osl_options, resolution)},
-    {.name = "texel_density", .type = TOPT_NUMBER, .def = 1.0, .min = 0.0625, .max = 16.0,
+    {.name = "texel_density", .type = OPT_NUMBER, .def = 1.0, .min = 0.0625, .max = 16.0,
      .summary = "with resolution \"auto\": texels per covered pixel",
      .offset = offsetof(struct osl_options, texel_density)},
-    {.name = "reshade", .type = TOPT_CHOICE, .def = OSL_RESHADE_TOUCHED,
+    {.name = "reshade", .type = OPT_CHOICE, .def = OSL_RESHADE_TOUCHED,
      .choices = reshade_choices,
      .summary = "touched reshades only objects a moving light reaches; all reshades every "
                 "due object, as the thesis measured",
      .offset = offsetof(struct osl_options, reshade)},
+    {.name = "async_distance", .type = OPT_NUMBER, .def = 0.0, .min = 0.0, .max = 1e6,
+     .summary = "async shading (thesis 3.1.2.3): an object at camera distance r is reshaded "
+                "every floor(r / async_distance) + 1 frames; 0 reshades every frame. The "
+                "job's top-level async_distance is an alias",
+     .offset = offsetof(struct osl_options, async_distance)},
     {0},
 };
 
@@ -26,6 +34,5 @@ const struct technique_info osl_info = {
     .summary = "object space lighting: texgen, compute lighting into a shared atlas, "
                "rasterization sampling it; async shading by camera distance",
     .passes = passes,
-    .options = options,
-    .options_size = sizeof(struct osl_options),
+    .options = {.fields = options, .size = sizeof(struct osl_options)},
 };

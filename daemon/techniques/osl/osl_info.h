@@ -1,8 +1,8 @@
 #ifndef SHADEBENCH_OSL_INFO_H
 #define SHADEBENCH_OSL_INFO_H
 
-/* OSL's GL-free half: its options ("osl": {...} in a job) and description.
- * Any thread. */
+/* OSL's GL-free half: its options ("osl": {...} in a job, async_distance
+ * included) and description. Any thread. */
 
 #include "daemon/techniques/technique_info.h"
 
@@ -15,6 +15,9 @@ struct osl_options {
     int resolution; /* tile edge in texels; 0 means "auto" */
     double texel_density;
     int reshade;    /* enum osl_reshade */
+    /* Async shading (thesis 3.1.2.3): an object at camera distance r is
+     * reshaded every floor(r / async_distance) + 1 frames; 0 every frame. */
+    double async_distance;
 };
 
 extern const struct technique_info osl_info;

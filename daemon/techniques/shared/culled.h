@@ -1,15 +1,14 @@
 #ifndef SHADEBENCH_CULLED_H
 #define SHADEBENCH_CULLED_H
 
-/* The technique hooks shared by the four light-culling techniques, which
- * differ only in their geometry pass and their grid:
- *   tiled_deferred      g-buffer, binning (tiles with depth bounds), lighting
- *   forward_plus        depth pre-pass, binning (tiles with depth bounds), shading
- *   clustered_deferred  binning (froxels), g-buffer, lighting
- *   clustered_forward   binning (froxels), depth pre-pass, shading
+/* The technique hooks shared by the light-culling techniques, which differ
+ * only in their geometry pass (a g-buffer, or a depth pre-pass for forward
+ * shading) and their grid (screen tiles with depth bounds, or froxels):
+ *   tiles:   geometry, binning, lighting or shading
+ *   froxels: binning, geometry, lighting or shading
  * Tiles need the frame's depth before binning; froxels need none, so they
- * bin first and their binning time stands alone. Each technique's info
- * declares its passes in exactly that order. Deferred lighting is one
+ * bin first and their binning time stands alone. Each such technique's info
+ * declares its three passes in exactly that order. Deferred lighting is one
  * full-screen pass over the g-buffer; forward shading draws the objects
  * again with GL_LEQUAL against the pre-pass, so each pixel shades once.
  * Both loop over the pixel's cell (shaders/culling/light_grid.glsl). Render

@@ -1,6 +1,7 @@
 #include "daemon/techniques/shared/culling_info.h"
 
 #include <math.h>
+#include <stdio.h>
 
 const char *const gbuffer_normal_choices[] = {"octahedral", "float3", "xy_reconstruct_z", NULL};
 const char *const gbuffer_albedo_choices[] = {"rgba8", "pack_shift", "pack_base10", NULL};
@@ -11,8 +12,10 @@ const char *const cluster_slices_choices[] = {"linear", "exponential", NULL};
 const char *const cluster_overflow_choices[] = {"fallback", "fail", NULL};
 const int cluster_grid_default[3] = {32, 18, 32};
 
-bool cluster_grid_check(const int grid[3], const char *field, struct job_error *err)
+bool cluster_grid_check(const int grid[3], const char *prefix, struct job_error *err)
 {
+    char field[64];
+    snprintf(field, sizeof(field), "%s.grid", prefix);
     double cells = (double)grid[0] * grid[1] * grid[2];
     if (cells > CLUSTER_GRID_MAX_CELLS)
         return job_error_set(err, field,

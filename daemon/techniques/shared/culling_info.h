@@ -1,10 +1,9 @@
 #ifndef SHADEBENCH_CULLING_INFO_H
 #define SHADEBENCH_CULLING_INFO_H
 
-/* The GL-free half shared by the many-lights techniques (deferred, tiled
- * deferred, Forward+, clustered forward and clustered deferred): the choices
- * of their options, the g-buffer layout options every deferred technique
- * carries, the cluster grid rule, and the light-bounds geometry (the screen
+/* The GL-free half shared by the many-lights techniques (the deferred ones
+ * and those that cull lights into tiles or clusters): the choices of their
+ * options, the g-buffer layout options every deferred technique carries, the cluster grid rule, and the light-bounds geometry (the screen
  * rectangle of a light sphere) that the CPU binning uses and
  * shaders/culling/light_bounds.glsl mirrors line for line. Any thread. */
 
@@ -12,7 +11,7 @@
 #include <stddef.h>
 
 #include "common/json_fields.h"
-#include "daemon/techniques/technique_info.h"
+#include "common/options.h"
 
 /* G-buffer layouts. The lossy ones are there to show their loss. */
 enum gbuffer_normal {
@@ -36,12 +35,12 @@ struct gbuffer_options {
 /* The two option rows of a technique whose options struct opts_type holds a
  * struct gbuffer_options named `member`. */
 #define GBUFFER_OPTION_ROWS(opts_type, member)                                                    \
-    {.name = "gbuffer.normal", .type = TOPT_CHOICE, .def = GBUFFER_NORMAL_OCTAHEDRAL,             \
+    {.name = "gbuffer.normal", .type = OPT_CHOICE, .def = GBUFFER_NORMAL_OCTAHEDRAL,             \
      .choices = gbuffer_normal_choices,                                                           \
      .summary = "normal layout: octahedral (two channels, default), float3, or "                  \
                 "xy_reconstruct_z (seed 004: view-space x and y, z rebuilt without its sign)",    \
      .offset = offsetof(opts_type, member.normal)},                                               \
-    {.name = "gbuffer.albedo", .type = TOPT_CHOICE, .def = GBUFFER_ALBEDO_RGBA8,                  \
+    {.name = "gbuffer.albedo", .type = OPT_CHOICE, .def = GBUFFER_ALBEDO_RGBA8,                  \
      .choices = gbuffer_albedo_choices,                                                           \
      .summary = "albedo layout: rgba8 (default), pack_shift (seed 001: channels in one "          \
                 "float by multiplied shifts) or pack_base10 (three decimal digits a channel)",    \
@@ -76,20 +75,20 @@ struct cluster_options {
 extern const int cluster_grid_default[3];
 
 #define CLUSTER_OPTION_ROWS(opts_type, member)                                                    \
-    {.name = "grid", .type = TOPT_INT_LIST, .def_list = cluster_grid_default, .count = 3,         \
+    {.name = "grid", .type = OPT_INT_LIST, .def_list = cluster_grid_default, .count = 3,         \
      .min = 1, .max = 1024,                                                                       \
      .summary = "froxel grid [x, y, z]: tiles across and down the screen, slices in depth "       \
                 "(at most 1,048,576 clusters, and within the device's buffers)",                  \
      .offset = offsetof(opts_type, member.grid)},                                                 \
-    {.name = "slices", .type = TOPT_CHOICE, .def = CLUSTER_SLICES_EXPONENTIAL,                    \
+    {.name = "slices", .type = OPT_CHOICE, .def = CLUSTER_SLICES_EXPONENTIAL,                    \
      .choices = cluster_slices_choices,                                                           \
      .summary = "depth slices even in view depth (linear) or in its logarithm (exponential), "    \
                 "between the nearest and farthest object",                                        \
      .offset = offsetof(opts_type, member.slices)},                                               \
-    {.name = "max_lights_per_cluster", .type = TOPT_INT, .def = 1024, .min = 1, .max = 65536,     \
+    {.name = "max_lights_per_cluster", .type = OPT_INT, .def = 1024, .min = 1, .max = 65536,     \
      .summary = "lights a cluster's list keeps; more overflow (counted in the result)",           \
      .offset = offsetof(opts_type, member.max_lights_per_cluster)},                               \
-    {.name = "overflow", .type = TOPT_CHOICE, .def = CLUSTER_OVERFLOW_FALLBACK,                   \
+    {.name = "overflow", .type = OPT_CHOICE, .def = CLUSTER_OVERFLOW_FALLBACK,                   \
      .choices = cluster_overflow_choices,                                                         \
      .summary = "an overflowing cluster shades with every light (fallback: correct, slower) "     \
                 "or fails the job (fail)",                                                        \
@@ -99,8 +98,8 @@ extern const int cluster_grid_default[3];
  * grid alone takes more memory than any device here has to give. */
 #define CLUSTER_GRID_MAX_CELLS (1 << 20)
 
-/* Rejects a grid over CLUSTER_GRID_MAX_CELLS, naming field. */
-bool cluster_grid_check(const int grid[3], const char *field, struct job_error *err);
+/* Rejects a grid over CLUSTER_GRID_MAX_CELLS, naming "<prefix>.grid". */
+bool cluster_grid_check(const int grid[3], const char *prefix, struct job_error *err);
 
 /* The pixels a light sphere may touch: [x0, x1) x [y0, y1) in window
  * coordinates (origin bottom left), clamped to the w x h viewport.

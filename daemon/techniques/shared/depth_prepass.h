@@ -1,11 +1,10 @@
 #ifndef SHADEBENCH_DEPTH_PREPASS_H
 #define SHADEBENCH_DEPTH_PREPASS_H
 
-/* The depth pre-pass of the forward many-lights techniques (Forward+,
- * clustered forward): every object's depth into the output's depth texture,
- * no colour, with the same vertex shader as the shading pass so that its
- * depths equal the shading pass's and a GL_LEQUAL test there shades each
- * pixel once. Tiled binning reads the depths for its tile bounds. Render
+/* The depth pre-pass of the forward light-culling techniques: every
+ * object's depth into the output's depth texture, no colour, with the same
+ * vertex shader as the shading pass so that its depths equal the shading
+ * pass's and a GL_LEQUAL test there shades each pixel once. Tiled binning reads the depths for its tile bounds. Render
  * thread only. */
 
 #include <stdbool.h>

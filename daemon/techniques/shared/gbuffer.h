@@ -1,10 +1,9 @@
 #ifndef SHADEBENCH_GBUFFER_H
 #define SHADEBENCH_GBUFFER_H
 
-/* The g-buffer every deferred technique draws (deferred, tiled deferred,
- * clustered deferred): an albedo plane and a normal plane in the layouts the
- * job's gbuffer options choose (shaders/deferred/gbuffer.glsl) and a
- * material plane (specular weight and exponent, exact), over the
+/* The g-buffer every deferred technique draws: an albedo plane and a
+ * normal plane in the layouts the job's gbuffer options choose
+ * (shaders/deferred/gbuffer.glsl) and a material plane (specular weight and exponent, exact), over the
  * output's depth texture, from which lighting rebuilds positions with the
  * frame block's inverse view-projection. Lossless layouts publish their
  * normals in env->products for post effects. Render thread only. */

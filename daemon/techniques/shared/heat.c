@@ -15,8 +15,7 @@ bool heat_init(struct heat *h, const struct technique_env *env, char *err, size_
 
 bool heat_wanted(const struct technique_env *env, int64_t frame)
 {
-    return frame >= 1 && frame <= env->spec->frames && env->spec->capture_interval > 0 &&
-           job_spec_is_capture_frame(env->spec, (int)frame);
+    return technique_env_captures(env, frame);
 }
 
 GLint heat_location(GLuint prog) { return glGetUniformLocation(prog, "u_heat_on"); }

@@ -139,7 +139,7 @@ bool light_grid_init(struct light_grid *g, const struct technique_env *env,
     g->cfg = *cfg;
     g->width = env->width, g->height = env->height;
     g->lights = env->scene->light_count;
-    g->frames = env->spec->frames;
+    g->frames = env->frames;
     g->camera_moves = scene_camera_moves(env->scene);
     for (int m = 0; m < SCENE_MESH_COUNT; m++) {
         const struct mesh *mesh = &env->scene->meshes[m];

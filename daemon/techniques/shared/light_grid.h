@@ -45,7 +45,7 @@ struct light_grid_config {
     int max_per_cell;  /* clusters: the bound on a cell's list; tiles: 0 */
     int overflow;      /* enum cluster_overflow (tiles always fall back) */
     int binning;       /* enum light_binning (cpu: tiles only) */
-    const char *technique; /* for messages naming fields: "clustered_deferred" */
+    const char *technique; /* its name, for messages naming its fields */
 };
 
 /* std140 layout of shaders/culling/light_grid.glsl's LightGridBlock. */

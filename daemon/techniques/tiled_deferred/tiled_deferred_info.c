@@ -4,11 +4,11 @@
 
 static const char *const passes[] = {"gbuffer", "binning", "lighting", NULL};
 
-static const struct technique_option options[] = {
-    {.name = "tile_size", .type = TOPT_INT, .def = 16, .min = 8, .max = 128,
+static const struct opt_field options[] = {
+    {.name = "tile_size", .type = OPT_INT, .def = 16, .min = 8, .max = 128,
      .summary = "tile edge in pixels (seed 003 swept 20 to 100)",
      .offset = offsetof(struct tiled_deferred_options, tile_size)},
-    {.name = "binning", .type = TOPT_CHOICE, .def = LIGHT_BINNING_GPU,
+    {.name = "binning", .type = OPT_CHOICE, .def = LIGHT_BINNING_GPU,
      .choices = light_binning_choices,
      .summary = "gpu: per-tile depth bounds and light lists in compute passes; cpu: seed 003's "
                 "light grid built on the CPU from screen rectangles and uploaded every frame, "
@@ -23,6 +23,6 @@ const struct technique_info tiled_deferred_info = {
     .summary = "g-buffer, per-tile depth bounds and light lists, one lighting pass looping "
                "over each tile's lights (seed 003)",
     .passes = passes,
-    .options = options,
-    .options_size = sizeof(struct tiled_deferred_options),
+    .options = {.fields = options, .size = sizeof(struct tiled_deferred_options)},
+    .flags = TECHNIQUE_BOUNDED_LIGHT_LISTS,
 };

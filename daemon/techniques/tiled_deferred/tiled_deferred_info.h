@@ -6,6 +6,7 @@
  * Any thread. */
 
 #include "daemon/techniques/shared/culling_info.h"
+#include "daemon/techniques/technique_info.h"
 
 struct tiled_deferred_options {
     int tile_size; /* pixels */

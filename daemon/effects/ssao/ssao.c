@@ -9,7 +9,7 @@
 #include <stdlib.h>
 
 #include "daemon/effects/effect.h"
-#include "daemon/effects/effect_kernels.h"
+#include "daemon/effects/ssao/ssao_info.h"
 #include "daemon/gpu/bindings.h"
 #include "daemon/gpu/glutil.h"
 
@@ -39,7 +39,7 @@ static bool ssao_create(const struct effect_env *env, const void *opts, void **s
         return false;
     }
     /* Occlusion is a fraction: 16 bits keep the blur free of banding. */
-    if (!effect_plane(env, "ao", GL_R16F, env->tech->width, env->tech->height, &s->ao, &s->ao_fbo,
+    if (!effect_plane(env, "ao", GL_R16F, env->width, env->height, &s->ao, &s->ao_fbo,
                       err, errlen))
         goto fail;
     char defines[256];
@@ -76,18 +76,17 @@ fail:
 static void ssao_run(void *state, const struct effect_env *env, GLuint src, GLuint dst_fbo)
 {
     struct ssao *s = state;
-    const struct technique_env *te = env->tech;
-    gpu_pass_begin(env->passes, s->pass_ao, s->ao_fbo, te->width, te->height);
+    gpu_pass_begin(env->passes, s->pass_ao, s->ao_fbo, env->width, env->height);
     glActiveTexture(GL_TEXTURE0 + SB_TEX_POST_DEPTH);
-    glBindTexture(GL_TEXTURE_2D, te->output_depth);
-    if (te->products && te->products->normal_tex) {
+    glBindTexture(GL_TEXTURE_2D, env->depth_tex);
+    if (env->normal_tex) {
         glActiveTexture(GL_TEXTURE0 + SB_TEX_POST_NORMAL);
-        glBindTexture(GL_TEXTURE_2D, te->products->normal_tex);
+        glBindTexture(GL_TEXTURE_2D, env->normal_tex);
     }
     effect_draw_fullscreen(env, s->ao_prog);
     gpu_pass_end(env->passes);
 
-    gpu_pass_begin(env->passes, s->pass_apply, dst_fbo, te->width, te->height);
+    gpu_pass_begin(env->passes, s->pass_apply, dst_fbo, env->width, env->height);
     glActiveTexture(GL_TEXTURE0 + SB_TEX_POST_SRC);
     glBindTexture(GL_TEXTURE_2D, src);
     glActiveTexture(GL_TEXTURE0 + SB_TEX_POST_AUX);

@@ -1,14 +1,8 @@
 /* The floor every technique's cost is compared with: forward's geometry and
- * passes with a flat per-object colour and no lighting. */
-#include "daemon/techniques/technique.h"
+ * passes with a flat per-object colour and no lighting (unlit.frag). */
+#include "daemon/techniques/shared/single_pass.h"
 
-static const char *const passes[] = {"shading", NULL};
-
-static const struct technique_info unlit_info = {
-    .name = "unlit",
-    .summary = "forward's geometry and passes, flat colour, no lights: the cost floor",
-    .passes = passes,
-};
+extern const struct technique_info unlit_info;
 
 static bool unlit_create(const struct technique_env *env, void **state, char *err, size_t errlen)
 {

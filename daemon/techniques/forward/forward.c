@@ -1,14 +1,10 @@
 /* Forward shading, the thesis's ForwardProg: one pass, every light for every
- * fragment. The reference every other technique is scored against. */
-#include "daemon/techniques/technique.h"
+ * fragment (shaders/common/forward.frag, which the look's light probes
+ * capture the scene with too). The baseline every other technique is
+ * scored against. */
+#include "daemon/techniques/shared/single_pass.h"
 
-static const char *const passes[] = {"shading", NULL};
-
-static const struct technique_info forward_info = {
-    .name = "forward",
-    .summary = "one pass; every light evaluated per fragment (thesis ForwardProg)",
-    .passes = passes,
-};
+extern const struct technique_info forward_info;
 
 static bool forward_create(const struct technique_env *env, void **state, char *err,
                            size_t errlen)

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 
 #include "daemon/effects/effect.h"
+#include "daemon/effects/toon/toon_info.h"
 #include "daemon/gpu/bindings.h"
 #include "daemon/gpu/glutil.h"
 
@@ -59,12 +60,11 @@ static bool toon_create(const struct effect_env *env, const void *opts, void **s
 static void toon_run(void *state, const struct effect_env *env, GLuint src, GLuint dst_fbo)
 {
     struct toon *t = state;
-    const struct technique_env *te = env->tech;
-    gpu_pass_begin(env->passes, t->pass, dst_fbo, te->width, te->height);
+    gpu_pass_begin(env->passes, t->pass, dst_fbo, env->width, env->height);
     glActiveTexture(GL_TEXTURE0 + SB_TEX_POST_SRC);
     glBindTexture(GL_TEXTURE_2D, src);
     glActiveTexture(GL_TEXTURE0 + SB_TEX_POST_DEPTH);
-    glBindTexture(GL_TEXTURE_2D, te->output_depth);
+    glBindTexture(GL_TEXTURE_2D, env->depth_tex);
     effect_draw_fullscreen(env, t->prog);
     gpu_pass_end(env->passes);
 }

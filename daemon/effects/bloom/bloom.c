@@ -9,7 +9,7 @@
 #include <string.h>
 
 #include "daemon/effects/effect.h"
-#include "daemon/effects/effect_kernels.h"
+#include "daemon/effects/bloom/bloom_info.h"
 #include "daemon/gpu/bindings.h"
 #include "daemon/gpu/glutil.h"
 
@@ -60,7 +60,7 @@ static bool bloom_create(const struct effect_env *env, const void *opts, void **
         return false;
     }
     b->o = *(const struct bloom_options *)opts;
-    int w = env->tech->width, h = env->tech->height, n = b->o.downsample;
+    int w = env->width, h = env->height, n = b->o.downsample;
     b->nlevels = n > 0 ? n : 1;
     for (int i = 0; i < b->nlevels; i++) {
         int shift = n > 0 ? i + 1 : 0;
@@ -181,7 +181,7 @@ static void bloom_run(void *state, const struct effect_env *env, GLuint src, GLu
         gpu_pass_end(ps);
     }
 
-    gpu_pass_begin(ps, b->pass_composite, dst_fbo, env->tech->width, env->tech->height);
+    gpu_pass_begin(ps, b->pass_composite, dst_fbo, env->width, env->height);
     bind(SB_TEX_POST_SRC, src);
     bind(SB_TEX_POST_AUX, sep ? b->level[0].a : b->level[0].b);
     if (b->o.downsample > 0)

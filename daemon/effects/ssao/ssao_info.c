@@ -1,20 +1,45 @@
-#include "daemon/effects/effect_kernels.h"
+#include "daemon/effects/ssao/ssao_info.h"
 
 #include <math.h>
+#include <stddef.h>
 
-bool gauss_weights(int radius, float *w)
+static const char *const ssao_passes[] = {"ao", "blur", "apply", NULL};
+
+static const struct opt_field ssao_options_table[] = {
+    {.name = "samples", .type = OPT_INT, .def = 16, .min = 4, .max = 64,
+     .summary = "hemisphere samples per pixel (a fixed kernel: frame k is a function of k)",
+     .offset = offsetof(struct ssao_options, samples)},
+    {.name = "radius", .type = OPT_NUMBER, .def = 1.0, .min = 0.01, .max = 100.0,
+     .summary = "hemisphere radius in world units",
+     .offset = offsetof(struct ssao_options, radius)},
+    {.name = "bias", .type = OPT_NUMBER, .def = 0.025, .min = 0.0, .max = 10.0,
+     .summary = "depth bias against self-occlusion, world units",
+     .offset = offsetof(struct ssao_options, bias)},
+    {.name = "blur", .type = OPT_BOOL, .def = 1,
+     .summary = "blur the occlusion over the 4x4 noise tile before applying it (seed 002)",
+     .offset = offsetof(struct ssao_options, blur)},
+    {.name = "intensity", .type = OPT_NUMBER, .def = 1.0, .min = 0.0, .max = 8.0,
+     .summary = "exponent on the occlusion term: 0 leaves the image, 1 as computed",
+     .offset = offsetof(struct ssao_options, intensity)},
+    {0},
+};
+
+static int ssao_active_passes(const void *opts, const char **out)
 {
-    if (radius < 1 || radius > BLOOM_MAX_RADIUS)
-        return false;
-    double sigma = radius / 2.0, raw[BLOOM_MAX_RADIUS + 1], sum = 0;
-    for (int i = 0; i <= radius; i++) {
-        raw[i] = exp(-(double)(i * i) / (2.0 * sigma * sigma));
-        sum += i ? 2.0 * raw[i] : raw[i];
-    }
-    for (int i = 0; i <= radius; i++)
-        w[i] = (float)(raw[i] / sum);
-    return true;
+    const struct ssao_options *o = opts;
+    out[0] = "ao";
+    out[1] = o->blur ? "blur" : "apply";
+    return 2;
 }
+
+const struct effect_info ssao_info = {
+    .name = "ssao",
+    .summary = "screen-space ambient occlusion: hemisphere samples against the depth "
+               "texture, normals from the technique's g-buffer or rebuilt from depth",
+    .passes = ssao_passes,
+    .options = {.fields = ssao_options_table, .size = sizeof(struct ssao_options)},
+    .active_passes = ssao_active_passes,
+};
 
 /* xorshift32: tiny, portable and the same everywhere. */
 static uint32_t next(uint32_t *s)
@@ -69,21 +94,4 @@ void ssao_noise(uint32_t seed, float angles[SSAO_NOISE_SIZE * SSAO_NOISE_SIZE])
     }
     for (int i = 0; i < SSAO_NOISE_SIZE * SSAO_NOISE_SIZE; i++)
         angles[i] = (float)(two_pi * (order[i] + 0.5) / (SSAO_NOISE_SIZE * SSAO_NOISE_SIZE));
-}
-
-double tonemap_reinhard(double x) { return x > 0 ? x / (1.0 + x) : 0.0; }
-
-double tonemap_aces(double x)
-{
-    if (x <= 0)
-        return 0.0;
-    x *= 0.6; /* Narkowicz's fit takes the exposure the RRT assumes */
-    double y = (x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14);
-    return y < 0 ? 0 : y > 1 ? 1 : y;
-}
-
-double srgb_encode(double c)
-{
-    c = c < 0 ? 0 : c > 1 ? 1 : c;
-    return c <= 0.0031308 ? 12.92 * c : 1.055 * pow(c, 1.0 / 2.4) - 0.055;
 }

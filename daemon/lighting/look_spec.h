@@ -1,0 +1,46 @@
+#ifndef SHADEBENCH_LOOK_SPEC_H
+#define SHADEBENCH_LOOK_SPEC_H
+
+/* A job's "look": what the image should look like, independent of the
+ * technique that renders it (the reference renders with the same look, or
+ * its own reference_look): the lighting model, the HDR target's format, the
+ * resolve's exposure and tone curve, the post chain, image-based lighting
+ * and shadows. Options, defaults, parsing with field-naming errors and the
+ * JSON written back, from one option table. Techniques and the harness
+ * render with it; jobs hold two. GL-free; any thread. */
+
+#include <jansson.h>
+#include <stdbool.h>
+
+#include "common/json_fields.h"
+#include "daemon/effects/post_spec.h"
+#include "daemon/lighting/look_lighting.h"
+
+enum look_lighting { LOOK_PHONG, LOOK_BLINN_PHONG, LOOK_PBR };
+enum look_hdr { LOOK_HDR_RGBA32F, LOOK_HDR_RGBA16F };
+/* none: a clamp, no encoding; the curves write 8-bit sRGB. */
+enum look_tonemap { LOOK_TONEMAP_NONE, LOOK_TONEMAP_REINHARD, LOOK_TONEMAP_ACES };
+
+struct look_spec {
+    int lighting;    /* enum look_lighting */
+    int hdr;         /* enum look_hdr: the format of the HDR target techniques draw into */
+    double exposure; /* scales the HDR colour in the resolve, before the tone curve */
+    int tonemap;     /* enum look_tonemap */
+    struct post_spec post;      /* effects the harness runs on the HDR output, in order */
+    struct ibl_spec ibl;        /* image-based lighting (needs lighting pbr) */
+    struct shadow_spec shadows; /* omni shadow maps for the point lights */
+};
+
+/* A Phong image in 32-bit floats, clamped, without effects, image-based
+ * lighting or shadows. */
+void look_spec_defaults(struct look_spec *look);
+
+/* Reads the object v over look (defaults or earlier values); field is
+ * "look" or "reference_look", the prefix of every error. */
+bool look_spec_parse(const json_t *v, const char *field, struct look_spec *look,
+                     struct job_error *err);
+
+/* The look as understood, every field and effect option. New reference. */
+json_t *look_spec_to_json(const struct look_spec *look);
+
+#endif

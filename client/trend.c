@@ -157,9 +157,11 @@ char *trend_svg(const struct trend_point *pts, size_t n, const char *title, cons
         ymax = 1;
     }
     bool logy = trend_log_axis(ymin, ymax);
-    if (!(tmax > tmin)) {
-        tmin -= 60;
-        tmax += 60;
+    if (tmax - tmin < 60) {
+        /* Jobs within a minute: a minute's axis, so that it has ticks. */
+        double mid = (tmin + tmax) / 2;
+        tmin = mid - 30;
+        tmax = mid + 30;
     }
     double pad = (tmax - tmin) * 0.05;
     tmin -= pad;

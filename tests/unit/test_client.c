@@ -209,7 +209,13 @@ static void test_trend_workloads(void)
     }
     pts[1].noisy = true;
     pts[1].other_share = 0.79;
-    char *svg = trend_svg(pts, 4, "t", "ms");
+    /* Jobs within two seconds still get an axis with ticks. */
+    struct trend_point close[2] = {pts[0], pts[1]};
+    close[1].t = close[0].t + 1.5;
+    char *svg = trend_svg(close, 2, "t", "ms");
+    CHECK(svg && count(svg, "class=\"tick\"") >= 3);
+    free(svg);
+    svg = trend_svg(pts, 4, "t", "ms");
     CHECK(svg && count(svg, "class=\"series\"") == 2 && strstr(svg, "forward 320x240 workload 0") &&
           strstr(svg, "forward 320x240 workload 1"));
     CHECK(svg && count(svg, "class=\"point noisy\"") == 1 && strstr(svg, "took 79% of the CPU"));

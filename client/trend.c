@@ -254,9 +254,9 @@ char *trend_svg(const struct trend_point *pts, size_t n, const char *title, cons
                     MAPX(p->t), MAPX(p->t), MAPY(lo), MAPY(p->hi), lo, p->hi);
             }
             /* A noisy run: hollow, and the tooltip says what disturbed it. */
-            add(&o, "<circle class=\"point%s\" cx=\"%.1f\" cy=\"%.1f\" r=\"4\" data-value=\"%g\" "
-                    "data-t=\"%.0f\"%s><title>", p->noisy ? " noisy" : "", MAPX(p->t), MAPY(p->y),
-                p->y, p->t, p->noisy ? " fill=\"white\" stroke-width=\"2\"" : "");
+            add(&o, "<circle class=\"point\" cx=\"%.1f\" cy=\"%.1f\" r=\"4\" data-value=\"%g\" "
+                    "data-t=\"%.0f\"%s><title>", MAPX(p->t), MAPY(p->y), p->y, p->t,
+                p->noisy ? " data-noisy=\"true\" fill=\"white\" stroke-width=\"2\"" : "");
             escaped(&o, p->label);
             add(&o, ": %g", p->y);
             if (p->noisy && !isnan(p->other_share))

@@ -294,16 +294,20 @@ static void verdict_html(struct html *h, const json_t *v)
         double worst = 0;
         json_array_foreach(noisy, i, m) worst = fmax(worst, json_number_value(json_object_get(m, "other_cpu_share")));
         add(h, "<li class=\"noisy\"><b>Noise:</b> %zu point%s ran while other processes took CPU "
-               "time (up to %.0f%% of the machine); their times may be inflated, and a comparison "
-               "involving them is only as good as their intervals: ",
-            json_array_size(noisy), json_array_size(noisy) == 1 ? "" : "s", 100 * worst);
+               "time", json_array_size(noisy), json_array_size(noisy) == 1 ? "" : "s");
+        if (worst > 0)
+            add(h, " (up to %.0f%% of the machine)", 100 * worst);
+        add(h, "; their times may be inflated, and a comparison involving them is only as good "
+               "as their intervals: ");
         json_array_foreach(noisy, i, m) {
             char *vals = dump(json_object_get(m, "values"), JSON_COMPACT);
             add(h, "%s", i ? ", " : "");
             escaped(h, str(m, "technique"));
             add(h, " ");
             escaped(h, vals);
-            add(h, " (%.0f%%)", 100 * json_number_value(json_object_get(m, "other_cpu_share")));
+            double share = json_number_value(json_object_get(m, "other_cpu_share"));
+            if (share >= 0)
+                add(h, " (%.0f%%)", 100 * share);
             free(vals);
         }
         add(h, ".</li>");

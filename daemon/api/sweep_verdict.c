@@ -29,7 +29,7 @@ static void values_text(const json_t *values, bool (*keep)(const char *key, cons
     json_object_foreach((json_t *)values, k, v) {
         if (!keep(k, skip))
             continue;
-        char *t = json_dumps(v, JSON_ENCODE_ANY);
+        char *t = json_dumps(v, JSON_ENCODE_ANY | SV_DUMP_REALS);
         size_t used = strlen(out);
         const char *key = short_keys && strrchr(k, '.') ? strrchr(k, '.') + 1 : k;
         snprintf(out + used, cap - used, "%s%s=%s", used ? ", " : "", key, t ? t : "?");

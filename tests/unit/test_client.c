@@ -218,7 +218,7 @@ static void test_trend_workloads(void)
     svg = trend_svg(pts, 4, "t", "ms");
     CHECK(svg && count(svg, "class=\"series\"") == 2 && strstr(svg, "forward 320x240 workload 0") &&
           strstr(svg, "forward 320x240 workload 1"));
-    CHECK(svg && count(svg, "class=\"point noisy\"") == 1 && strstr(svg, "took 79% of the CPU"));
+    CHECK(svg && count(svg, "data-noisy=\"true\"") == 1 && strstr(svg, "took 79% of the CPU"));
     free(svg);
     svg = trend_svg(pts, 12, "t", "ms");
     /* 2 + 8 workloads: 8 drawn, 2 said to be left out. */

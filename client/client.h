@@ -4,9 +4,12 @@
 /* The pieces of the shadebench CI client that its commands share: the
  * options, a connection to a daemon (libcurl, bearer token), following a
  * job or a sweep with progress, and the --out folder with a job's files.
- * Single-threaded: one process, one command. Exit statuses: 0 pass, 1 a
- * regression, a quality failure or a failed job, 2 a usage error, a server
- * that cannot be reached or refuses, or a baseline that does not match. */
+ * Single-threaded: one process, one command. Exit statuses: 0 pass (an
+ * undecided timing check passes with a warning), 1 a regression, a quality
+ * failure or a failed job, 2 a usage error, a server that cannot be reached
+ * or refuses, or a baseline that does not match, 3 a timing check that could
+ * not decide, when asked to fail on that (--fail-inconclusive,
+ * $SHADEBENCH_FAIL_INCONCLUSIVE=1) and nothing failed outright. */
 
 #include <curl/curl.h>
 #include <jansson.h>
@@ -15,7 +18,7 @@
 
 #include "common/clock.h" /* clock_mono_s: every interval the client measures */
 
-enum { EXIT_PASS = 0, EXIT_FAIL = 1, EXIT_ERROR = 2 };
+enum { EXIT_PASS = 0, EXIT_FAIL = 1, EXIT_ERROR = 2, EXIT_INCONCLUSIVE = 3 };
 
 struct options {
     const char *out_dir;
@@ -39,6 +42,7 @@ struct options {
 struct conn {
     char server[1024];
     const char *token;
+    const char *token_source; /* where the token came from, for a refusal's message */
     CURL *curl;
 };
 
@@ -93,6 +97,11 @@ json_t *fetch_job_files(struct conn *c, const json_t *job, const char *dir, bool
                         const json_t *extra);
 
 
+/* A JSON file the user named (what: "job file", "sweep file"). NULL with
+ * err saying which file and why: it cannot be read (the system's reason), or
+ * where its JSON is broken. */
+json_t *load_json_file(const char *what, const char *path, char *err, size_t cap);
+
 /* A job file with --label added and repeat overridden (repeat > 0).
  * Returns malloc'ed JSON text, or NULL with a message in err. */
 char *job_text_for_submit(const char *file, const struct options *o, int repeat, char *err,
@@ -104,6 +113,7 @@ int cmd_fetch(struct conn *c, const struct options *o, const char *id);
 int cmd_status(struct conn *c, const char *id);
 int cmd_list(struct conn *c);
 int cmd_print(struct conn *c, const char *method, const char *path);
+int cmd_info(struct conn *c);
 int cmd_ab(struct conn *a, struct conn *b, const struct options *o, const char *file_a,
            const char *file_b);
 int cmd_sweep(struct conn *c, const struct options *o, const char *file);

@@ -74,7 +74,7 @@ static bool bounded_verdict(const struct run_set *sa, const struct run_set *sb,
         if (m < 2 || !paired_log_ratio(va, vb, m, o->confidence, &r))
             return false;
         struct gate_verdict bounded;
-        gate_decide(&r, o->max_slowdown, &bounded);
+        gate_decide_sides(&r, o->max_slowdown, &GATE_SIDES_AB, &bounded);
         if (bounded.outcome == (upper ? GATE_PASS : GATE_REGRESSION)) {
             *v = bounded;
             size_t used = strlen(v->why);
@@ -129,9 +129,14 @@ int cmd_ab(struct conn *ca, struct conn *cb, const struct options *o, const char
     struct gate_verdict v;
     memset(&v, 0, sizeof(v));
     size_t nclean = 0;
+    char stop_reason[160] = "";
+    sa.planned = sb.planned = planned;
+    sa.budget = sb.budget = budget;
     if (!o->quiet)
-        fprintf(stderr, "A: %s on %s\nB: %s on %s\n%zu pairs, alternating, judged on %s\n", file_a,
-                ca->server, file_b, cb->server, planned, series);
+        fprintf(stderr, "A: %s on %s\nB: %s on %s\n%zu clean pairs wanted, alternating, judged on "
+                "%s; at most %d extra pairs for noisy pairs, an unclear verdict or confirming "
+                "that B is slower (--max-reruns)\n", file_a, ca->server, file_b, cb->server,
+                planned, series, budget);
     for (;;) {
         while (sa.n < target && !sa.failed && !sb.failed) {
             /* A B, then B A: the order flips each pair. */
@@ -153,7 +158,7 @@ int cmd_ab(struct conn *ca, struct conn *cb, const struct options *o, const char
         nclean = clean_pairs(&sa, &sb, va, vb);
         struct ratio_interval r;
         if (nclean >= 2 && paired_log_ratio(va, vb, nclean, o->confidence, &r)) {
-            gate_decide(&r, o->max_slowdown, &v);
+            gate_decide_sides(&r, o->max_slowdown, &GATE_SIDES_AB, &v);
             /* Two or three clean pairs give an interval too wide to decide
              * on; the noisy ones, bounded, may still settle it. */
             if (v.outcome == GATE_INCONCLUSIVE && nclean < sa.n)
@@ -175,23 +180,28 @@ int cmd_ab(struct conn *ca, struct conn *cb, const struct options *o, const char
                          "verdict", r.ratio, r.lo, r.hi);
             }
         }
-        if (budget <= 0)
+        if (budget <= 0) {
+            if (nclean < planned || v.outcome == GATE_INCONCLUSIVE ||
+                (v.outcome == GATE_REGRESSION && !confirmed))
+                snprintf(stop_reason, sizeof(stop_reason),
+                         "all %d extra pairs (--max-reruns) used", o->max_reruns);
             break;
+        }
         size_t batch = planned < (size_t)budget ? planned : (size_t)budget;
         if (nclean < planned) {
             size_t need = planned - nclean < (size_t)budget ? planned - nclean : (size_t)budget;
             if (!o->quiet)
-                fprintf(stderr, "%zu noisy pair(s) left out: running %zu more\n", sa.n - nclean,
-                        need);
+                fprintf(stderr, "%zu noisy pair(s) left out: running %zu more (%d extra left)\n",
+                        sa.n - nclean, need, budget - (int)need);
             target += need;
             budget -= (int)need;
             continue;
         }
         if ((v.outcome == GATE_REGRESSION && !confirmed) || v.outcome == GATE_INCONCLUSIVE) {
             if (!o->quiet)
-                fprintf(stderr, "%s (%s): running %zu more pairs\n",
+                fprintf(stderr, "%s (%s): running %zu more pairs (%d extra left)\n",
                         v.outcome == GATE_REGRESSION ? "B looks slower" : "inconclusive", v.why,
-                        batch);
+                        batch, budget - (int)batch);
             confirmed = confirmed || v.outcome == GATE_REGRESSION;
             target += batch;
             budget -= (int)batch;
@@ -202,30 +212,62 @@ int cmd_ab(struct conn *ca, struct conn *cb, const struct options *o, const char
 
     json_t *ja = sa.n ? json_array_get(sa.jobs, 0) : sa.failed;
     json_t *jb = sb.n ? json_array_get(sb.jobs, 0) : sb.failed;
+    /* Names from the job files as written (a daemon default renames
+     * nothing). */
+    json_t *spec_a = json_loads(ta, 0, NULL), *spec_b = json_loads(tb, 0, NULL);
     char name_a[320], name_b[320], cls[96], name[700];
-    junit_job_name(json_object_get(ja, "spec"), name_a, sizeof(name_a));
-    junit_job_name(json_object_get(jb, "spec"), name_b, sizeof(name_b));
+    junit_job_name(spec_a, name_a, sizeof(name_a));
+    junit_job_name(spec_b, name_b, sizeof(name_b));
     if (ca != cb) {
         snprintf(name_a + strlen(name_a), sizeof(name_a) - strlen(name_a), " on A");
         snprintf(name_b + strlen(name_b), sizeof(name_b) - strlen(name_b), " on B");
     }
-    job_classname(json_object_get(ja, "spec"), cls, sizeof(cls));
-    job_case(&j, cls, name_a, sa.failed ? sa.failed : ja, sa.elapsed_s);
-    job_classname(json_object_get(jb, "spec"), cls, sizeof(cls));
-    job_case(&j, cls, name_b, sb.failed ? sb.failed : jb, sb.elapsed_s);
+    /* Each job case times its own (first) run; the comparison all of them. */
+    job_classname(spec_a, cls, sizeof(cls));
+    job_case(&j, cls, name_a, sa.failed ? sa.failed : ja, sa.n ? sa.runs[0].elapsed_s : sa.elapsed_s);
+    job_classname(spec_b, cls, sizeof(cls));
+    job_case(&j, cls, name_b, sb.failed ? sb.failed : jb, sb.n ? sb.runs[0].elapsed_s : sb.elapsed_s);
+    json_decref(spec_a);
+    json_decref(spec_b);
     snprintf(name, sizeof(name), "%s against %s: %s B/A", name_b, name_a, series);
     if (!sa.failed && !sb.failed) {
+        /* Why pairs were noisy: the runs of both sides, together. */
+        char noise[320] = "";
+        struct gate_run *both = malloc((sa.n + sb.n + 1) * sizeof(*both));
+        if (both) {
+            memcpy(both, sa.runs, sa.n * sizeof(*both));
+            memcpy(both + sa.n, sb.runs, sb.n * sizeof(*both));
+            gate_noise_text(both, sa.n + sb.n, "runs", -1, noise, sizeof(noise));
+            free(both);
+        }
+        if (noise[0]) {
+            size_t used = strlen(noise);
+            snprintf(noise + used, sizeof(noise) - used, " (%zu of %zu pairs)", sa.n - nclean, sa.n);
+        }
         if (!o->quiet) {
-            run_set_print(&sa, series, stderr);
-            run_set_print(&sb, series, stderr);
+            fprintf(stderr, "%zu pairs in all: %zu asked, %zu extra of at most %d "
+                    "(--max-reruns)%s%s\n", sa.n, planned, sa.n > planned ? sa.n - planned : 0,
+                    o->max_reruns, stop_reason[0] ? "; stopped: " : "", stop_reason);
+            for (size_t i = 0; i < sa.n; i++)
+                if (sa.runs[i].noisy)
+                    fprintf(stderr, "  pair %zu (jobs %s and %s) left out: %s\n", i + 1,
+                            sa.runs[i].job, sb.runs[i].job, sa.runs[i].why);
+            if (noise[0])
+                fprintf(stderr, "noise: %s\n", noise);
             fprintf(stderr, "B/A = %.4f, %.0f%% interval [%.4f, %.4f] over %zu pairs: %s (%s)\n",
                     v.r.ratio, 100 * o->confidence, v.r.lo, v.r.hi, nclean,
                     v.outcome == GATE_REGRESSION ? "B SLOWER"
-                    : v.outcome == GATE_PASS ? "pass" : "INCONCLUSIVE", v.why);
+                    : v.outcome == GATE_PASS     ? "pass: B is not slower"
+                                                 : "INCONCLUSIVE",
+                    v.why);
+            if (v.outcome == GATE_INCONCLUSIVE)
+                fprintf(stderr, "shadebench: warning: ab could not tell whether B is slower than "
+                        "A within %d extra pairs%s%s\n", o->max_reruns, noise[0] ? "; " : "",
+                        noise);
         }
         struct junit_case *t = junit_add(&j, "shadebench.ab", name);
         if (t) {
-            t->time_s = sa.elapsed_s + sb.elapsed_s;
+            t->time_s = clock_mono_s() - t0;
             junit_prop_str(t, "outcome", gate_outcome_name(v.outcome));
             junit_prop_str(t, "series", series);
             junit_prop_num(t, "ratio", v.r.ratio);
@@ -234,11 +276,15 @@ int cmd_ab(struct conn *ca, struct conn *cb, const struct options *o, const char
             junit_prop_num(t, "confidence", o->confidence);
             junit_prop_num(t, "pairs", (double)nclean);
             junit_prop_num(t, "noisy_pairs", (double)(sa.n - nclean));
+            junit_prop_num(t, "extra_pairs", (double)(sa.n > planned ? sa.n - planned : 0));
             junit_out(t, "%s: %s", gate_outcome_name(v.outcome), v.why);
             if (v.outcome == GATE_REGRESSION)
                 junit_fail(t, "B is slower than A: %s", v.why);
-            else if (v.outcome == GATE_INCONCLUSIVE && o->fail_inconclusive)
-                junit_fail(t, "inconclusive (--fail-inconclusive): %s", v.why);
+            else if (v.outcome == GATE_INCONCLUSIVE)
+                junit_inconclusive(t, o->fail_inconclusive, "inconclusive%s: %s%s%s%s%s",
+                                   o->fail_inconclusive ? " (--fail-inconclusive)" : "", v.why,
+                                   noise[0] ? "; " : "", noise, stop_reason[0] ? "; stopped: " : "",
+                                   stop_reason);
         }
         json_t *pairs = json_array();
         for (size_t i = 0; i < sa.n; i++)

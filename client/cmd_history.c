@@ -1,6 +1,10 @@
 /* history: the jobs that match filters, with a figure over time: a table on
- * stdout and, with --out, the list as JSON and CSV and a trend chart. */
-#define _DEFAULT_SOURCE /* timegm */
+ * stdout and, with --out, the list as JSON and CSV and a trend chart. Jobs
+ * are grouped by workload (client/workload.h: what makes two jobs the same
+ * measurement), so that the chart has a line per workload and the table a
+ * column for it; noisy runs are marked in both. cmd_history fetches the
+ * list; history_render lays it out. */
+#define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -8,22 +12,11 @@
 #include <time.h>
 
 #include "client/client.h"
+#include "client/verdicts.h"
 #include "client/trend.h"
+#include "client/workload.h"
 #include "common/fsutil.h"
 #include "common/result_keys.h"
-
-static double iso_to_unix(const char *s)
-{
-    struct tm tm;
-    memset(&tm, 0, sizeof(tm));
-    int ms = 0;
-    if (!s || sscanf(s, "%d-%d-%dT%d:%d:%d.%dZ", &tm.tm_year, &tm.tm_mon, &tm.tm_mday,
-                     &tm.tm_hour, &tm.tm_min, &tm.tm_sec, &ms) < 6)
-        return NAN;
-    tm.tm_year -= 1900;
-    tm.tm_mon -= 1;
-    return (double)timegm(&tm) + ms / 1000.0;
-}
 
 /* The figure of one list entry: its value and interval. */
 static bool figure_of(const json_t *entry, const char *figure, double *y, double *lo, double *hi)
@@ -57,6 +50,171 @@ static void labels_text(const json_t *labels, char *out, size_t cap)
         size_t used = strlen(out);
         snprintf(out + used, cap - used, "%s%s=%s", used ? "," : "", key, json_string_value(v));
     }
+}
+
+/* What the list does not carry, from the job itself: the spec (for the
+ * workload: jobs of one workload form one series) and the interference
+ * figures (for marking noisy runs). One request a job. */
+struct job_detail {
+    char key[96], workload[240];
+    bool has_share, noisy;
+    double other_share;
+};
+
+static void job_detail(struct conn *c, const char *id, struct job_detail *d)
+{
+    memset(d, 0, sizeof(*d));
+    d->other_share = NAN;
+    char path[160];
+    snprintf(path, sizeof(path), "/v1/jobs/%s", id);
+    json_t *job = id ? conn_json(c, "GET", path, NULL, NULL) : NULL;
+    json_t *spec = json_object_get(job, "spec");
+    workload_key(spec, d->key, sizeof(d->key));
+    workload_describe(spec, d->workload, sizeof(d->workload));
+    json_t *inter = json_object_get(json_object_get(job, RK_RESULT), RK_INTERFERENCE);
+    json_t *share = json_object_get(inter, "other_cpu_share");
+    d->has_share = json_is_number(share);
+    d->other_share = d->has_share ? json_number_value(share) : NAN;
+    d->noisy = json_is_true(json_object_get(inter, "noisy"));
+    json_decref(job);
+}
+
+/* The table, the CSV, history.json and the trend chart of jobs (the list's
+ * entries). list is what history.json holds. False when a file could not
+ * be written. */
+static bool history_render(struct conn *c, const struct options *o, json_t *jobs, json_t *list)
+{
+    size_t n = json_array_size(jobs);
+    /* The figure: as asked, else the one meaningful on the first job's
+     * device (frame_ms on llvmpipe, where gpu_ms covers rasterization only). */
+    const char *figure = o->figure ? o->figure : o->series;
+    if (!figure) {
+        figure = RK_FRAME_MS;
+        size_t i;
+        json_t *e;
+        json_array_foreach(jobs, i, e) {
+            const char *r = json_string_value(json_object_get(json_object_get(e, "figures"), "gl_renderer"));
+            if (r) {
+                figure = strstr(r, "llvmpipe") || strstr(r, "softpipe") || strstr(r, "SwiftShader")
+                             ? RK_FRAME_MS : RK_GPU_MS;
+                break;
+            }
+        }
+    }
+    struct trend_point *pts = calloc(n ? n : 1, sizeof(*pts));
+    size_t npts = 0;
+    FILE *csv = NULL;
+    char file[4096];
+    bool ok = pts != NULL;
+    if (o->out_dir) {
+        ok = ok && fs_mkdir_p(o->out_dir);
+        snprintf(file, sizeof(file), "%s/history.csv", o->out_dir);
+        if (ok && !(csv = fopen(file, "w")))
+            ok = false;
+        if (csv)
+            fprintf(csv, "id,created,status,technique,%s,%s_ci95_low,%s_ci95_high,worst_ssim,"
+                    "other_cpu_share,noisy,workload,workload_key,gl_renderer,labels\n", figure,
+                    figure, figure);
+    }
+    printf("%-22s %-24s %-9s %-10s %12s %-23s %-10s %-11s %-40s %s\n", "id", "created", "status",
+           "technique", figure, "95% interval", "worst SSIM", "others' CPU", "workload", "labels");
+    size_t i, noisy = 0;
+    json_t *e;
+    json_t *workloads = json_object(); /* key -> describe, for the summary */
+    json_array_foreach(jobs, i, e) {
+        double y, lo, hi;
+        bool has = figure_of(e, figure, &y, &lo, &hi);
+        json_t *figs = json_object_get(e, "figures");
+        json_t *ssim = json_object_get(figs, RK_WORST_SSIM);
+        char labels[512], interval[64] = "", ssim_text[32] = "-", noise[32] = "-";
+        labels_text(json_object_get(e, "labels"), labels, sizeof(labels));
+        if (!isnan(lo))
+            snprintf(interval, sizeof(interval), "[%.4g, %.4g]", lo, hi);
+        if (json_is_number(ssim))
+            snprintf(ssim_text, sizeof(ssim_text), "%.6f", json_number_value(ssim));
+        const char *id = json_string_value(json_object_get(e, "id"));
+        const char *created = json_string_value(json_object_get(e, "created"));
+        const char *tech = json_string_value(json_object_get(e, "technique"));
+        const char *status = json_string_value(json_object_get(e, "status"));
+        const char *renderer = json_string_value(json_object_get(figs, "gl_renderer"));
+        struct job_detail d;
+        job_detail(c, id, &d);
+        json_object_set_new(workloads, d.key, json_string(d.workload));
+        noisy += d.noisy;
+        if (d.has_share)
+            snprintf(noise, sizeof(noise), "%s%.0f%%", d.noisy ? "NOISY " : "", 100 * d.other_share);
+        else if (d.noisy)
+            snprintf(noise, sizeof(noise), "NOISY");
+        /* The workload column without the technique (a column of its own). */
+        const char *wl = d.workload;
+        if (tech && !strncmp(wl, tech, strlen(tech)) && wl[strlen(tech)] == ' ')
+            wl += strlen(tech) + 1;
+        char value[32] = "-";
+        if (has)
+            snprintf(value, sizeof(value), "%.4f", y);
+        printf("%-22s %-24s %-9s %-10s %12s %-23s %-10s %-11s %-40s %s\n", id ? id : "",
+               created ? created : "", status ? status : "", tech ? tech : "", value, interval,
+               ssim_text, noise, wl, labels);
+        if (csv) {
+            char c_lo[32] = "", c_hi[32] = "", c_ssim[32] = "", c_share[32] = "";
+            if (!isnan(lo)) {
+                snprintf(c_lo, sizeof(c_lo), "%.6g", lo);
+                snprintf(c_hi, sizeof(c_hi), "%.6g", hi);
+            }
+            if (json_is_number(ssim))
+                snprintf(c_ssim, sizeof(c_ssim), "%.6f", json_number_value(ssim));
+            if (d.has_share)
+                snprintf(c_share, sizeof(c_share), "%.4f", d.other_share);
+            fprintf(csv, "%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,\"%s\",%s,\"%s\",\"%s\"\n", id ? id : "",
+                    created ? created : "", status ? status : "", tech ? tech : "",
+                    has ? value : "", c_lo, c_hi, c_ssim, c_share, d.noisy ? "true" : "false",
+                    d.workload, d.key, renderer ? renderer : "", labels);
+        }
+        json_object_set_new(e, "workload", json_pack("{s:s, s:s}", "key", d.key, "name", d.workload));
+        if (has && pts) {
+            struct trend_point *p = &pts[npts++];
+            p->t = iso_unix_s(created);
+            p->y = y;
+            p->lo = lo;
+            p->hi = hi;
+            snprintf(p->series, sizeof(p->series), "%.47s", d.key);
+            snprintf(p->name, sizeof(p->name), "%s", d.workload);
+            snprintf(p->label, sizeof(p->label), "%s", id ? id : "");
+            p->noisy = d.noisy;
+            p->other_share = d.other_share;
+            if (isnan(p->t))
+                npts--;
+        }
+    }
+    if (!o->quiet) {
+        fprintf(stderr, "%zu jobs, %zu workload%s (a series each)", n, json_object_size(workloads),
+                json_object_size(workloads) == 1 ? "" : "s");
+        if (noisy)
+            fprintf(stderr, "; %zu noisy run%s (others' CPU marked NOISY): compare them with care",
+                    noisy, noisy == 1 ? "" : "s");
+        fputc('\n', stderr);
+    }
+    json_decref(workloads);
+    if (csv && fclose(csv) != 0)
+        ok = false;
+    if (o->out_dir && ok) {
+        snprintf(file, sizeof(file), "%s/history.json", o->out_dir);
+        json_object_set_new(list, "id", json_string("history"));
+        json_object_set_new(list, "figure", json_string(figure));
+        ok = fs_write_json_atomic(file, list);
+        char title[160], ylabel[96];
+        snprintf(title, sizeof(title), "%s over time (%zu jobs)", figure, npts);
+        snprintf(ylabel, sizeof(ylabel), "%s%s", strcmp(figure, RK_WORST_SSIM) ? "median " : "",
+                 figure);
+        char *svg = trend_svg(pts, npts, title, ylabel);
+        snprintf(file, sizeof(file), "%s/trend.svg", o->out_dir);
+        ok = ok && svg && fs_write_atomic(file, svg, strlen(svg));
+        free(svg);
+        if (ok && !o->quiet)
+            fprintf(stderr, "files in %s\n", o->out_dir);
+    }
+    free(pts);
+    return ok;
 }
 
 int cmd_history(struct conn *c, const struct options *o)
@@ -94,107 +252,7 @@ int cmd_history(struct conn *c, const struct options *o)
     if (!list)
         return EXIT_ERROR;
     json_t *jobs = json_object_get(list, "jobs");
-    size_t n = json_array_size(jobs);
-    /* The figure: as asked, else the one meaningful on the first job's
-     * device (frame_ms on llvmpipe, where gpu_ms covers rasterization only). */
-    const char *figure = o->figure ? o->figure : o->series;
-    if (!figure) {
-        figure = RK_FRAME_MS;
-        size_t i;
-        json_t *e;
-        json_array_foreach(jobs, i, e) {
-            const char *r = json_string_value(json_object_get(json_object_get(e, "figures"), "gl_renderer"));
-            if (r) {
-                figure = strstr(r, "llvmpipe") || strstr(r, "softpipe") || strstr(r, "SwiftShader")
-                             ? RK_FRAME_MS : RK_GPU_MS;
-                break;
-            }
-        }
-    }
-    struct trend_point *pts = calloc(n ? n : 1, sizeof(*pts));
-    size_t npts = 0;
-    FILE *csv = NULL;
-    char file[4096];
-    bool ok = pts != NULL;
-    if (o->out_dir) {
-        ok = ok && fs_mkdir_p(o->out_dir);
-        snprintf(file, sizeof(file), "%s/history.csv", o->out_dir);
-        if (ok && !(csv = fopen(file, "w")))
-            ok = false;
-        if (csv)
-            fprintf(csv, "id,created,status,technique,%s,%s_ci95_low,%s_ci95_high,worst_ssim,"
-                    "gl_renderer,labels\n", figure, figure, figure);
-    }
-    printf("%-22s %-24s %-9s %-10s %12s %-23s %-10s %s\n", "id", "created", "status", "technique",
-           figure, "95% interval", "worst SSIM", "labels");
-    size_t i;
-    json_t *e;
-    json_array_foreach(jobs, i, e) {
-        double y, lo, hi;
-        bool has = figure_of(e, figure, &y, &lo, &hi);
-        json_t *figs = json_object_get(e, "figures");
-        json_t *ssim = json_object_get(figs, RK_WORST_SSIM);
-        char labels[512], interval[64] = "", ssim_text[32] = "-";
-        labels_text(json_object_get(e, "labels"), labels, sizeof(labels));
-        if (!isnan(lo))
-            snprintf(interval, sizeof(interval), "[%.4g, %.4g]", lo, hi);
-        if (json_is_number(ssim))
-            snprintf(ssim_text, sizeof(ssim_text), "%.6f", json_number_value(ssim));
-        const char *id = json_string_value(json_object_get(e, "id"));
-        const char *created = json_string_value(json_object_get(e, "created"));
-        const char *tech = json_string_value(json_object_get(e, "technique"));
-        const char *status = json_string_value(json_object_get(e, "status"));
-        const char *renderer = json_string_value(json_object_get(figs, "gl_renderer"));
-        char value[32] = "-";
-        if (has)
-            snprintf(value, sizeof(value), "%.4f", y);
-        printf("%-22s %-24s %-9s %-10s %12s %-23s %-10s %s\n", id ? id : "", created ? created : "",
-               status ? status : "", tech ? tech : "", value, interval, ssim_text, labels);
-        if (csv) {
-            char c_lo[32] = "", c_hi[32] = "", c_ssim[32] = "";
-            if (!isnan(lo)) {
-                snprintf(c_lo, sizeof(c_lo), "%.6g", lo);
-                snprintf(c_hi, sizeof(c_hi), "%.6g", hi);
-            }
-            if (json_is_number(ssim))
-                snprintf(c_ssim, sizeof(c_ssim), "%.6f", json_number_value(ssim));
-            fprintf(csv, "%s,%s,%s,%s,%s,%s,%s,%s,\"%s\",\"%s\"\n", id ? id : "",
-                    created ? created : "", status ? status : "", tech ? tech : "",
-                    has ? value : "", c_lo, c_hi, c_ssim, renderer ? renderer : "", labels);
-        }
-        if (has && pts) {
-            struct trend_point *p = &pts[npts++];
-            p->t = iso_to_unix(created);
-            p->y = y;
-            p->lo = lo;
-            p->hi = hi;
-            snprintf(p->series, sizeof(p->series), "%s", tech ? tech : "?");
-            snprintf(p->label, sizeof(p->label), "%s", id ? id : "");
-            if (isnan(p->t))
-                npts--;
-        }
-    }
-    if (!o->quiet)
-        fprintf(stderr, "%zu jobs\n", n);
-    if (csv && fclose(csv) != 0)
-        ok = false;
-    if (o->out_dir && ok) {
-        snprintf(file, sizeof(file), "%s/history.json", o->out_dir);
-        json_object_set_new(list, "id", json_string("history"));
-        json_object_set_new(list, "figure", json_string(figure));
-        ok = fs_write_json_atomic(file, list);
-        char title[160], ylabel[96];
-        snprintf(title, sizeof(title), "%s over time (%zu jobs)", figure, npts);
-        snprintf(ylabel, sizeof(ylabel), "%s%s", strcmp(figure, RK_WORST_SSIM) ? "median " : "",
-                 figure);
-        char *svg = trend_svg(pts, npts, title, ylabel);
-        snprintf(file, sizeof(file), "%s/trend.svg", o->out_dir);
-        ok = ok && svg && fs_write_atomic(file, svg, strlen(svg));
-        free(svg);
-        if (ok && !o->quiet)
-            fprintf(stderr, "files in %s\n", o->out_dir);
-    }
-    free(pts);
+    bool ok = history_render(c, o, jobs, list);
     json_decref(list);
     if (!ok) {
         fprintf(stderr, "shadebench: cannot write the history files in %s\n", o->out_dir);

@@ -33,10 +33,10 @@ static void baseline_finish(struct baseline *b)
 static bool baseline_load(const char *path, struct baseline *b)
 {
     memset(b, 0, sizeof(*b));
-    json_error_t jerr;
-    b->root = json_load_file(path, 0, &jerr);
+    char err[600];
+    b->root = load_json_file("baseline", path, err, sizeof(err));
     if (!b->root) {
-        fprintf(stderr, "shadebench: --baseline %s: %s\n", path, jerr.text);
+        fprintf(stderr, "shadebench: --baseline: %s\n", err);
         return false;
     }
     json_t *inner = json_object_get(b->root, RK_RESULT);
@@ -241,9 +241,13 @@ static int gate_or_runs(struct conn *c, const struct options *o, const char *fil
     size_t nb_clean = 0, nc_clean = 0, target = (size_t)planned;
     int budget = o->max_reruns;
     bool confirmed = false;
+    char stop_reason[160] = "";
+    s.planned = (size_t)planned;
+    s.budget = o->max_reruns;
     if (!o->quiet)
-        fprintf(stderr, "%d runs of %s, each a job of its own, judged on %s\n", planned, file,
-                series);
+        fprintf(stderr, "%d clean runs of %s wanted, each a job of its own, judged on %s; at "
+                "most %d extra for noisy runs, an unclear verdict or confirming a regression "
+                "(--max-reruns)\n", planned, file, series, o->max_reruns);
     for (;;) {
         while (s.n < target && !s.failed) {
             if (!run_set_add(&s, o, text, series, base && s.n == 0 ? check_spec : NULL, &sc))
@@ -252,10 +256,20 @@ static int gate_or_runs(struct conn *c, const struct options *o, const char *fil
         if (s.failed)
             break;
         evaluate(o, brun, nb, &s, &v, &nb_clean, &nc_clean);
+        bool batch_noisy = trailing_noisy(&s) >= (size_t)(planned > 3 ? planned : 3);
+        bool wants_more = nc_clean < (size_t)planned ||
+                          (base && (v.outcome == GATE_INCONCLUSIVE ||
+                                    (v.outcome == GATE_REGRESSION && !confirmed)));
+        if (wants_more && budget <= 0)
+            snprintf(stop_reason, sizeof(stop_reason), "all %d extra runs (--max-reruns) used",
+                     o->max_reruns);
+        else if (wants_more && batch_noisy)
+            snprintf(stop_reason, sizeof(stop_reason), "the last %zu runs were all noisy: the "
+                     "machine is busier than when the runs compared were measured",
+                     trailing_noisy(&s));
         if (!base) {
             /* Runs for a later baseline: replace disturbed ones. */
-            if (nc_clean < (size_t)planned && budget > 0 &&
-                trailing_noisy(&s) < (size_t)(planned > 3 ? planned : 3)) {
+            if (nc_clean < (size_t)planned && budget > 0 && !batch_noisy) {
                 target += 1;
                 budget--;
                 continue;
@@ -263,14 +277,14 @@ static int gate_or_runs(struct conn *c, const struct options *o, const char *fil
             break;
         }
         size_t batch = (size_t)planned < (size_t)budget ? (size_t)planned : (size_t)budget;
-        if (budget <= 0 || trailing_noisy(&s) >= (size_t)(planned > 3 ? planned : 3))
+        if (budget <= 0 || batch_noisy)
             break;
         if (nc_clean < (size_t)planned) {
             size_t need = (size_t)planned - nc_clean;
             need = need < (size_t)budget ? need : (size_t)budget;
             if (!o->quiet)
-                fprintf(stderr, "%zu noisy run(s) left out: running %zu more\n", s.n - nc_clean,
-                        need);
+                fprintf(stderr, "%zu noisy run(s) left out: running %zu more (%d extra left)\n",
+                        s.n - nc_clean, need, budget - (int)need);
             target += need;
             budget -= (int)need;
             continue;
@@ -288,7 +302,8 @@ static int gate_or_runs(struct conn *c, const struct options *o, const char *fil
         }
         if (v.outcome == GATE_INCONCLUSIVE) {
             if (!o->quiet)
-                fprintf(stderr, "inconclusive (%s): running %zu more\n", v.why, batch);
+                fprintf(stderr, "inconclusive (%s): running %zu more (%d extra left)\n", v.why,
+                        batch, budget - (int)batch);
             target += batch;
             budget -= (int)batch;
             continue;
@@ -296,34 +311,61 @@ static int gate_or_runs(struct conn *c, const struct options *o, const char *fil
         break;
     }
 
-    /* The verdicts. */
+    /* The verdicts. Names come from the job file as the user wrote it, so
+     * that a default the daemon adds later renames nothing. */
     json_t *first = s.n ? json_array_get(s.jobs, 0) : s.failed;
-    json_t *spec = json_object_get(first, "spec");
+    json_t *user_spec = json_loads(text, 0, NULL);
     char name[320], classname[96];
-    junit_job_name(spec, name, sizeof(name));
-    job_classname(spec, classname, sizeof(classname));
-    struct junit_case *jc = job_case(&j, classname, name, s.failed ? s.failed : first, s.elapsed_s);
+    junit_job_name(user_spec, name, sizeof(name));
+    job_classname(user_spec, classname, sizeof(classname));
+    json_decref(user_spec);
+    /* The job case times its job; the gate case the whole gate. */
+    double job_s = s.n ? s.runs[0].elapsed_s : s.elapsed_s;
+    struct junit_case *jc = job_case(&j, classname, name, s.failed ? s.failed : first, job_s);
     if (jc && s.n > 1) {
         junit_prop_num(jc, "runs", (double)s.n);
-        junit_out(jc, "%zu runs, each a job of its own", s.n);
+        junit_out(jc, "the first of %zu runs, each a job of its own", s.n);
     }
     if (s.n)
         quality_cases(o, json_object_get(first, RK_RESULT), classname, name, &j);
+    char noise_new[320] = "", noise_base[320] = "";
+    double typical = -1;
+    if (!gate_typical_share(brun, nb, &typical) && !gate_typical_share(s.runs, s.n, &typical))
+        typical = -1;
+    gate_noise_text(s.runs, s.n, base ? "runs here" : "runs", typical, noise_new,
+                    sizeof(noise_new));
+    gate_noise_text(brun, nb, "baseline runs", typical, noise_base, sizeof(noise_base));
     if (!o->quiet && s.n) {
-        fprintf(stderr, "runs (%s):\n", series);
-        run_set_print(&s, series, stderr);
+        fprintf(stderr, "%zu runs in all: %zu asked, %zu extra of at most %d (--max-reruns)%s%s\n",
+                s.n, (size_t)planned, s.n > (size_t)planned ? s.n - (size_t)planned : 0,
+                o->max_reruns, stop_reason[0] ? "; stopped: " : "", stop_reason);
+        for (size_t i = 0; i < s.n; i++)
+            if (s.runs[i].noisy)
+                fprintf(stderr, "  run %zu (job %s) left out: %s\n", i + 1, s.runs[i].job,
+                        s.runs[i].why);
+        if (noise_new[0])
+            fprintf(stderr, "noise: %s\n", noise_new);
+    }
+    if (!base && !s.failed && !o->quiet) {
+        fprintf(stderr, "kept %zu clean runs of the %d asked for the baseline\n", nc_clean, planned);
+        if (nc_clean < (size_t)planned)
+            fprintf(stderr, "shadebench: warning: only %zu clean runs within --max-reruns %d: the "
+                    "baseline keeps every run, its noisy ones marked, and a gate against it "
+                    "leaves those out\n", nc_clean, o->max_reruns);
     }
     if (base && !s.failed) {
         if (!o->quiet) {
             struct run_set bs = {.what = "baseline run", .runs = brun, .n = nb};
             fprintf(stderr, "baseline runs:\n");
             run_set_print(&bs, series, stderr);
+            if (noise_base[0])
+                fprintf(stderr, "noise: %s\n", noise_base);
         }
         char cname[400];
         snprintf(cname, sizeof(cname), "%s: median %s against the baseline", name, series);
         struct junit_case *t = junit_add(&j, classname, cname);
         if (t) {
-            t->time_s = s.elapsed_s;
+            t->time_s = clock_mono_s() - t0;
             junit_prop_str(t, "outcome", gate_outcome_name(v.outcome));
             junit_prop_str(t, "series", series);
             junit_prop_num(t, "ratio", v.r.ratio);
@@ -334,6 +376,7 @@ static int gate_or_runs(struct conn *c, const struct options *o, const char *fil
             junit_prop_num(t, "baseline_runs", (double)nb_clean);
             junit_prop_num(t, "runs", (double)nc_clean);
             junit_prop_num(t, "noisy_runs", (double)(s.n - nc_clean + nb - nb_clean));
+            junit_prop_num(t, "extra_runs", (double)(s.n > (size_t)planned ? s.n - (size_t)planned : 0));
             junit_out(t, "%s: %s", gate_outcome_name(v.outcome), v.why);
             junit_out(t, "%zu baseline runs and %zu runs here compared (%zu and %zu left out as "
                       "noisy)", nb_clean, nc_clean, nb - nb_clean, s.n - nc_clean);
@@ -342,8 +385,11 @@ static int gate_or_runs(struct conn *c, const struct options *o, const char *fil
                     junit_out(t, "run %s left out: %s", s.runs[i].job, s.runs[i].why);
             if (v.outcome == GATE_REGRESSION)
                 junit_fail(t, "%s", v.why);
-            else if (v.outcome == GATE_INCONCLUSIVE && o->fail_inconclusive)
-                junit_fail(t, "inconclusive (--fail-inconclusive): %s", v.why);
+            else if (v.outcome == GATE_INCONCLUSIVE)
+                junit_inconclusive(t, o->fail_inconclusive, "inconclusive%s: %s%s%s%s%s%s%s",
+                                   o->fail_inconclusive ? " (--fail-inconclusive)" : "", v.why,
+                                   noise_new[0] ? "; " : "", noise_new, noise_base[0] ? "; " : "",
+                                   noise_base, stop_reason[0] ? "; stopped: " : "", stop_reason);
         }
         if (!o->quiet) {
             fprintf(stderr, "gate: %s: %s\n", v.outcome == GATE_REGRESSION ? "REGRESSION"
@@ -351,15 +397,16 @@ static int gate_or_runs(struct conn *c, const struct options *o, const char *fil
                     v.why);
             if (v.outcome == GATE_INCONCLUSIVE)
                 fprintf(stderr, "shadebench: warning: the timing gate could not decide within "
-                        "%d reruns; %s\n", o->max_reruns,
-                        o->fail_inconclusive ? "failing (--fail-inconclusive)"
-                                             : "passing (--fail-inconclusive fails instead)");
+                        "%d extra runs%s%s%s%s\n", o->max_reruns, noise_new[0] ? "; " : "",
+                        noise_new, noise_base[0] ? "; " : "", noise_base);
         }
         gate_json = json_pack("{s:s, s:s, s:f, s:f, s:f, s:f, s:f, s:I, s:I, s:s}", "outcome",
                               gate_outcome_name(v.outcome), "series", series, "ratio", v.r.ratio,
                               "ci_low", v.r.lo, "ci_high", v.r.hi, "confidence", o->confidence,
                               "allowed_slowdown", o->max_slowdown, "baseline_runs",
                               (json_int_t)nb_clean, "runs", (json_int_t)nc_clean, "why", v.why);
+        if (gate_json && noise_new[0])
+            json_object_set_new(gate_json, "noise", json_string(noise_new));
     }
     rc = junit_conclude(o, &j, name, clock_mono_s() - t0);
     if (o->out_dir && s.n) {
@@ -390,8 +437,11 @@ out:
     return rc;
 }
 
-/* One job, as submitted: the files, the quality verdicts, JUnit. */
-static int finish_single(struct conn *c, const struct options *o, json_t *job, double time_s)
+/* One job, as submitted: the files, the quality verdicts, JUnit. Names
+ * from user_spec (the job file) when there is one, else from the spec the
+ * daemon filled in (fetch). */
+static int finish_single(struct conn *c, const struct options *o, json_t *job,
+                         const json_t *user_spec, double time_s)
 {
     int rc = EXIT_PASS;
     if (o->out_dir) {
@@ -404,7 +454,7 @@ static int finish_single(struct conn *c, const struct options *o, json_t *job, d
     }
     struct junit j;
     junit_init(&j);
-    json_t *spec = json_object_get(job, "spec");
+    const json_t *spec = user_spec ? user_spec : json_object_get(job, "spec");
     char name[320], classname[96];
     junit_job_name(spec, name, sizeof(name));
     job_classname(spec, classname, sizeof(classname));
@@ -453,21 +503,23 @@ int cmd_submit(struct conn *c, const struct options *o, const char *file)
     }
     double t0 = clock_mono_s();
     json_t *reply = conn_json(c, "POST", "/v1/jobs", text, NULL);
+    json_t *user_spec = json_loads(text, 0, NULL);
     free(text);
-    if (!reply)
+    if (!reply) {
+        json_decref(user_spec);
         return EXIT_ERROR;
+    }
     char id[64];
     snprintf(id, sizeof(id), "%s", json_string_value(json_object_get(reply, "id")));
     json_decref(reply);
     printf("%s\n", id);
     fflush(stdout);
-    if (!o->wait)
-        return EXIT_PASS;
-    json_t *job = conn_follow_job(c, id, NULL, o->quiet, o->timeout_s);
-    if (!job)
-        return EXIT_ERROR;
-    int rc = finish_single(c, o, job, clock_mono_s() - t0);
+    json_t *job = o->wait ? conn_follow_job(c, id, NULL, o->quiet, o->timeout_s) : NULL;
+    int rc = !o->wait ? EXIT_PASS
+             : job    ? finish_single(c, o, job, user_spec, clock_mono_s() - t0)
+                      : EXIT_ERROR;
     json_decref(job);
+    json_decref(user_spec);
     return rc;
 }
 
@@ -497,7 +549,7 @@ int cmd_fetch(struct conn *c, const struct options *o, const char *id)
         if (!(job = conn_follow_job(c, id, NULL, o->quiet, o->timeout_s)))
             return EXIT_ERROR;
     }
-    int rc = finish_single(c, o, job, 0);
+    int rc = finish_single(c, o, job, NULL, 0);
     json_decref(job);
     return rc;
 }
@@ -510,6 +562,67 @@ int cmd_print(struct conn *c, const char *method, const char *path)
     json_dumpf(j, stdout, JSON_INDENT(2));
     putchar('\n');
     json_decref(j);
+    return EXIT_PASS;
+}
+
+/* One line of the info summary: a name and its summary, cut to fit a
+ * terminal line. */
+static void info_line(const char *name, const char *summary, size_t options)
+{
+    char opts[32] = "";
+    if (options)
+        snprintf(opts, sizeof(opts), " [%zu option%s]", options, options == 1 ? "" : "s");
+    int room = 100 - 22 - (int)strlen(opts);
+    int len = summary ? (int)strlen(summary) : 0;
+    printf("  %-20s%.*s%s%s\n", name, len > room ? room - 3 : len, summary ? summary : "",
+           len > room ? "..." : "", opts);
+}
+
+int cmd_info(struct conn *c)
+{
+    json_t *info = conn_json(c, "GET", "/v1/info", NULL, NULL);
+    if (!info)
+        return EXIT_ERROR;
+    json_t *dev = json_object_get(info, "device");
+    printf("%s %s (API %s) at %s\n", json_string_value(json_object_get(info, "name")),
+           json_string_value(json_object_get(info, "version")),
+           json_string_value(json_object_get(info, "api")), c->server);
+    printf("device: %s, OpenGL %s, GLSL %s (EGL %s, %s platform)\n",
+           json_string_value(json_object_get(dev, "gl_renderer")),
+           json_string_value(json_object_get(dev, "gl_version")),
+           json_string_value(json_object_get(dev, "glsl_version")),
+           json_string_value(json_object_get(dev, "egl_device")),
+           json_string_value(json_object_get(dev, "egl_platform")));
+    printf("  timing series judged by default: %s\n", gate_default_series(dev));
+    static const char *const lists[] = {"techniques", "effects"};
+    for (int l = 0; l < 2; l++) {
+        json_t *arr = json_object_get(info, lists[l]);
+        printf("%s (%zu):\n", lists[l], json_array_size(arr));
+        size_t i;
+        json_t *t;
+        json_array_foreach(arr, i, t)
+            info_line(json_string_value(json_object_get(t, "name")),
+                      json_string_value(json_object_get(t, "summary")),
+                      json_object_size(json_object_get(t, "options")));
+    }
+    json_t *limits = json_object_get(info, "limits");
+    printf("limits:");
+    const char *key;
+    json_t *v;
+    const char *sep = " ";
+    json_object_foreach(limits, key, v) {
+        if (json_is_integer(v))
+            printf("%s%s %lld", sep, key, (long long)json_integer_value(v));
+        else if (json_is_number(v))
+            printf("%s%s %g", sep, key, json_number_value(v));
+        sep = ", ";
+    }
+    json_t *budget = json_object_get(json_object_get(info, "memory"), "budget_bytes");
+    if (json_is_number(budget))
+        printf("%smemory budget %.1f MiB", sep, json_number_value(budget) / (1024.0 * 1024.0));
+    printf("\n%zu sweepable fields. shadebench info --json prints the daemon's whole answer "
+           "(every option with its rule).\n", json_object_size(json_object_get(info, "sweepable")));
+    json_decref(info);
     return EXIT_PASS;
 }
 

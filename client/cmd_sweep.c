@@ -7,8 +7,8 @@
 #include <string.h>
 
 #include "client/client.h"
-#include "client/junit.h"
 #include "client/verdicts.h"
+#include "client/junit.h"
 #include "common/fsutil.h"
 #include "common/result_keys.h"
 
@@ -102,7 +102,8 @@ static void point_name(const json_t *row, char *out, size_t cap)
     }
 }
 
-static void point_cases(const struct options *o, const json_t *sweep, struct junit *j)
+static void point_cases(struct conn *c, const struct options *o, const json_t *sweep,
+                        struct junit *j)
 {
     bool find = !strcmp(json_string_value(json_object_get(sweep, "kind")) ?
                         json_string_value(json_object_get(sweep, "kind")) : "", "find");
@@ -116,7 +117,20 @@ static void point_cases(const struct options *o, const json_t *sweep, struct jun
         if (!t)
             return;
         const char *status = json_string_value(json_object_get(row, "status"));
-        junit_prop_str(t, "job", json_string_value(json_object_get(row, "job")));
+        const char *job_id = json_string_value(json_object_get(row, "job"));
+        junit_prop_str(t, "job", job_id);
+        /* Real times: the point job's span and its metrics' time, which the
+         * table does not carry. */
+        char path[160];
+        snprintf(path, sizeof(path), "/v1/jobs/%s", job_id ? job_id : "");
+        json_t *job = job_id ? conn_json(c, "GET", path, NULL, NULL) : NULL;
+        double span = iso_unix_s(json_string_value(json_object_get(job, "finished"))) -
+                      iso_unix_s(json_string_value(json_object_get(job, "started")));
+        json_t *metrics_s = json_object_get(
+            json_object_get(json_object_get(job, RK_RESULT), RK_QUALITY), "metrics_s");
+        double quality_s = json_is_number(metrics_s) ? json_number_value(metrics_s) : 0;
+        json_decref(job);
+        t->time_s = isfinite(span) && span > 0 ? span : 0;
         if (!status || strcmp(status, "done") != 0) {
             const char *error = json_string_value(json_object_get(row, "error"));
             junit_fail(t, "point job %s: %s", status ? status : "?", error ? error : "");
@@ -131,9 +145,6 @@ static void point_cases(const struct options *o, const json_t *sweep, struct jun
         }
         junit_prop_num(t, RK_WALL_S, json_number_value(json_object_get(json_object_get(row, RK_WALL_S),
                                                                       RK_MEAN)));
-        t->time_s = json_number_value(json_object_get(json_object_get(row, RK_WALL_S), RK_MEAN)) *
-                    (double)json_integer_value(json_object_get(json_object_get(row, RK_WALL_S),
-                                                               RK_RUNS));
         junit_out(t, "frame_ms median %.4f ms",
                   json_number_value(json_object_get(json_object_get(row, RK_FRAME_MS), RK_MEDIAN)));
         json_t *pf = json_object_get(row, RK_PDIFF_FAILED_CAPTURES);
@@ -145,6 +156,7 @@ static void point_cases(const struct options *o, const json_t *sweep, struct jun
         struct junit_case *q = junit_add(j, "shadebench.sweep", cname);
         if (!q)
             return;
+        q->time_s = quality_s;
         junit_prop_num(q, RK_WORST_SSIM, json_number_value(ssim));
         junit_prop_num(q, RK_WORST_FLIP, json_number_value(flip));
         junit_prop_num(q, RK_PDIFF_FAILED_CAPTURES, (double)json_integer_value(pf));
@@ -185,8 +197,15 @@ static void point_cases(const struct options *o, const json_t *sweep, struct jun
         if (!outcome || !strcmp(outcome, "fails everywhere") || !strcmp(outcome, "aborted"))
             junit_fail(t, "no value holds the criterion (%s)", outcome ? outcome : "no outcome");
     }
+    /* The largest passing value means something along a numeric field
+     * only; a sweep over techniques judges each point in its quality case. */
     json_t *largest = json_object_get(result, "largest_pdiff_pass");
-    if (largest) {
+    bool numeric = false;
+    json_array_foreach(json_object_get(sweep, "points"), i, row)
+        numeric = numeric || json_is_number(json_object_get(
+                                 json_object_get(row, "values"),
+                                 json_string_value(json_object_get(largest, "param"))));
+    if (largest && numeric) {
         snprintf(cname, sizeof(cname), "largest %s passing PerceptualDiff",
                  json_string_value(json_object_get(largest, "param")));
         struct junit_case *t = junit_add(j, "shadebench.sweep", cname);
@@ -241,10 +260,9 @@ int cmd_sweep(struct conn *c, const struct options *o, const char *file)
         fprintf(stderr, "shadebench: %s\n", err);
         return EXIT_ERROR;
     }
-    json_error_t jerr;
-    json_t *body = json_load_file(file, JSON_REJECT_DUPLICATES, &jerr);
+    json_t *body = load_json_file("sweep file", file, err, sizeof(err));
     if (!json_is_object(body)) {
-        fprintf(stderr, "shadebench: %s: %s\n", file, body ? "a sweep is a JSON object" : jerr.text);
+        fprintf(stderr, "shadebench: %s\n", body ? "a sweep is a JSON object" : err);
         json_decref(body);
         return EXIT_ERROR;
     }
@@ -284,12 +302,17 @@ int cmd_sweep(struct conn *c, const struct options *o, const char *file)
         junit_prop_str(t, "sweep", id);
         junit_prop_num(t, "points",
                        (double)json_array_size(json_object_get(sweep, "points")));
+        json_t *progress = json_object_get(sweep, "progress");
+        long long done = json_integer_value(json_object_get(progress, "points_done"));
+        long long total = json_integer_value(json_object_get(progress, "points_total"));
+        junit_prop_num(t, "points_total", (double)total);
         if (!status || strcmp(status, "done") != 0) {
             const char *error = json_string_value(json_object_get(sweep, "error"));
-            junit_fail(t, "sweep %s: %s", status ? status : "?", error ? error : "");
+            junit_fail(t, "sweep %s after %lld of %lld points (a partial sweep)%s%s",
+                       status ? status : "?", done, total, error ? ": " : "", error ? error : "");
         }
     }
-    point_cases(o, sweep, &j);
+    point_cases(c, o, sweep, &j);
     int rc = junit_conclude(o, &j, "sweep", clock_mono_s() - t0);
     if (o->out_dir) {
         if (!download_all(c, sweep, o->out_dir))

@@ -108,15 +108,30 @@ json_t *fetch_job_files(struct conn *c, const json_t *job, const char *dir, bool
     return copy;
 }
 
+json_t *load_json_file(const char *what, const char *path, char *err, size_t cap)
+{
+    /* Opened here, so that a missing file says so with the system's reason
+     * rather than as a parse error at line -1. */
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        snprintf(err, cap, "cannot read the %s %s: %s", what, path, strerror(errno));
+        return NULL;
+    }
+    json_error_t jerr;
+    json_t *j = json_loadf(f, JSON_REJECT_DUPLICATES, &jerr);
+    fclose(f);
+    if (!j)
+        snprintf(err, cap, "the %s %s is not valid JSON: line %d, column %d: %s", what, path,
+                 jerr.line, jerr.column, jerr.text);
+    return j;
+}
+
 char *job_text_for_submit(const char *file, const struct options *o, int repeat, char *err,
                           size_t cap)
 {
-    json_error_t jerr;
-    json_t *job = json_load_file(file, JSON_REJECT_DUPLICATES, &jerr);
-    if (!job) {
-        snprintf(err, cap, "%s: %s (line %d)", file, jerr.text, jerr.line);
+    json_t *job = load_json_file("job file", file, err, cap);
+    if (!job)
         return NULL;
-    }
     if (!json_is_object(job)) {
         snprintf(err, cap, "%s: a job is a JSON object", file);
         json_decref(job);

@@ -16,7 +16,16 @@ const char *gate_outcome_name(enum gate_outcome o)
     }
 }
 
+const struct gate_sides GATE_SIDES_BASELINE = {"in the baseline", "here"};
+const struct gate_sides GATE_SIDES_AB = {"in A", "in B"};
+
 void gate_decide(const struct ratio_interval *r, double min_effect, struct gate_verdict *out)
+{
+    gate_decide_sides(r, min_effect, &GATE_SIDES_BASELINE, out);
+}
+
+void gate_decide_sides(const struct ratio_interval *r, double min_effect,
+                       const struct gate_sides *sides, struct gate_verdict *out)
 {
     memset(out, 0, sizeof(*out));
     out->r = *r;
@@ -40,17 +49,16 @@ void gate_decide(const struct ratio_interval *r, double min_effect, struct gate_
         if (r->ratio > limit)
             snprintf(out->why, sizeof(out->why),
                      "slower by %.1f%%, but the %d%% interval (%+.1f%% to %+.1f%%) reaches no "
-                     "change: runs spread too much to tell (run-to-run spread %.1f%% in the "
-                     "baseline, %.1f%% here)",
+                     "change: runs spread too much to tell (run-to-run spread %.1f%% %s, "
+                     "%.1f%% %s)",
                      100 * (r->ratio - 1), conf, 100 * (r->lo - 1), 100 * (r->hi - 1),
-                     100 * r->cv_a, 100 * r->cv_b);
+                     100 * r->cv_a, sides->old_side, 100 * r->cv_b, sides->new_side);
         else
             snprintf(out->why, sizeof(out->why),
                      "%+.1f%%, but the %d%% interval reaches %+.1f%%: a slowdown over the %.1f%% "
-                     "allowed is not ruled out (run-to-run spread %.1f%% in the baseline, %.1f%% "
-                     "here)",
+                     "allowed is not ruled out (run-to-run spread %.1f%% %s, %.1f%% %s)",
                      100 * (r->ratio - 1), conf, 100 * (r->hi - 1), 100 * min_effect,
-                     100 * r->cv_a, 100 * r->cv_b);
+                     100 * r->cv_a, sides->old_side, 100 * r->cv_b, sides->new_side);
     }
 }
 
@@ -222,10 +230,51 @@ size_t gate_clean_values(const struct gate_run *runs, size_t n, double *values)
     return k;
 }
 
+size_t gate_noise_text(const struct gate_run *runs, size_t n, const char *what,
+                       double reference, char *out, size_t cap)
+{
+    size_t noisy = 0, with_share = 0;
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < n; i++) {
+        if (!runs[i].noisy)
+            continue;
+        noisy++;
+        if (runs[i].has_share) {
+            with_share++;
+            lo = fmin(lo, runs[i].other_share);
+            hi = fmax(hi, runs[i].other_share);
+        }
+    }
+    out[0] = '\0';
+    if (!noisy)
+        return 0;
+    int used = snprintf(out, cap, "%zu of %zu %s %s noisy", noisy, n, what,
+                        noisy == 1 ? "was" : "were");
+    if (used < 0 || (size_t)used >= cap)
+        return noisy;
+    if (with_share) {
+        char range[48];
+        if (lround(100 * lo) == lround(100 * hi))
+            snprintf(range, sizeof(range), "%.0f%%", 100 * hi);
+        else
+            snprintf(range, sizeof(range), "%.0f%% to %.0f%%", 100 * lo, 100 * hi);
+        used += snprintf(out + used, cap - (size_t)used,
+                         ": other processes took %s of the CPU during %s", range,
+                         noisy == 1 ? "it" : "them");
+        if (reference >= 0 && (size_t)used < cap)
+            snprintf(out + used, cap - (size_t)used, ", against a typical %.0f%%",
+                     100 * reference);
+    } else {
+        snprintf(out + used, cap - (size_t)used, ": the daemon flagged %s (no CPU figures)",
+                 noisy == 1 ? "it" : "them");
+    }
+    return noisy;
+}
+
 bool gate_nonsemantic_field(const char *key)
 {
     static const char *const skip[] = {"labels", "repeat", "capture_interval", "reference",
-                                       "metrics", "timeout_s", NULL};
+                                       "metrics", "timeout_s", "reference_look", NULL};
     for (const char *const *s = skip; *s; s++)
         if (strcmp(*s, key) == 0)
             return true;

@@ -35,8 +35,22 @@ struct gate_verdict {
 
 const char *gate_outcome_name(enum gate_outcome o);
 
-/* Decides from an interval (ratio = new / baseline, or B / A). */
+/* How a verdict's sentence names the two sides: the baseline gate compares
+ * "the baseline" with the runs "here"; ab compares "A" with "B" and has no
+ * baseline to speak of. */
+struct gate_sides {
+    const char *old_side;  /* "in the baseline", "in A" */
+    const char *new_side;  /* "here", "in B" */
+};
+extern const struct gate_sides GATE_SIDES_BASELINE, GATE_SIDES_AB;
+
+/* Decides from an interval (ratio = new / baseline), its sentence in the
+ * baseline gate's words. */
 void gate_decide(const struct ratio_interval *r, double min_effect, struct gate_verdict *out);
+
+/* The same with the sides named as asked (B / A for ab). */
+void gate_decide_sides(const struct ratio_interval *r, double min_effect,
+                       const struct gate_sides *sides, struct gate_verdict *out);
 
 /* Welch on log run medians, then gate_decide. With too few runs (fewer than
  * 2 on the new side, or 3 in all) the outcome is inconclusive, and why says
@@ -54,6 +68,7 @@ struct gate_run {
     bool daemon_noisy;   /* the daemon's own flag */
     bool noisy;          /* excluded from the comparison */
     char why[160];       /* why it is noisy */
+    double elapsed_s;    /* submission to end (runs the client ran), else 0 */
 };
 
 /* The runs a result holds, for series ("frame_ms", "gpu_ms", "cpu_ms"):
@@ -105,10 +120,19 @@ size_t gate_mark_noisy(struct gate_run *runs, size_t n, bool have_reference, dou
  * returns how many. */
 size_t gate_clean_values(const struct gate_run *runs, size_t n, double *values);
 
+/* Why runs were noisy, in one clause for the log and JUnit: "3 of 8 runs
+ * here were noisy: other processes took 41% to 79% of the CPU during them,
+ * against a typical 12%" (what names the runs: "runs here", "baseline
+ * runs", "pairs"; reference < 0 when there is no typical share). Writes ""
+ * and returns 0 when none was noisy; returns the noisy count. */
+size_t gate_noise_text(const struct gate_run *runs, size_t n, const char *what,
+                       double reference, char *out, size_t cap);
+
 /* Fields of a job spec that never change what is timed: labels (tags),
  * repeat (how many runs, the gate chooses), capture_interval (captures are
- * read back outside the timed figures), reference and metrics (rendered and
- * scored after the timed run). Every other field must match. */
+ * read back outside the timed figures), reference, reference_look and
+ * metrics (rendered and scored after the timed run), timeout_s. Every other
+ * field must match. */
 bool gate_nonsemantic_field(const char *top_level_key);
 
 /* True when the specs differ in a field that matters; field gets its dotted

@@ -56,6 +56,19 @@ void junit_fail(struct junit_case *c, const char *fmt, ...)
     va_end(ap);
 }
 
+void junit_inconclusive(struct junit_case *c, bool fail, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    c->inconclusive = true;
+    char *dst = fail ? c->failure : c->skipped;
+    size_t cap = fail ? sizeof(c->failure) : sizeof(c->skipped);
+    if (dst[0] && strlen(dst) + 3 < cap)
+        strcat(dst, "; ");
+    vappend(dst, cap, fmt, ap);
+    va_end(ap);
+}
+
 void junit_out(struct junit_case *c, const char *fmt, ...)
 {
     va_list ap;
@@ -83,6 +96,30 @@ size_t junit_failures(const struct junit *j)
     size_t n = 0;
     for (size_t i = 0; i < j->count; i++)
         n += j->cases[i].failure[0] != '\0';
+    return n;
+}
+
+size_t junit_real_failures(const struct junit *j)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < j->count; i++)
+        n += j->cases[i].failure[0] != '\0' && !j->cases[i].inconclusive;
+    return n;
+}
+
+size_t junit_undecided(const struct junit *j)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < j->count; i++)
+        n += j->cases[i].inconclusive;
+    return n;
+}
+
+static size_t junit_skipped(const struct junit *j)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < j->count; i++)
+        n += j->cases[i].skipped[0] != '\0' && !j->cases[i].failure[0];
     return n;
 }
 
@@ -115,14 +152,14 @@ bool junit_write(const struct junit *j, const char *path, const char *suite, dou
     FILE *f = fopen(path, "w");
     if (!f)
         return false;
-    size_t failures = junit_failures(j);
+    size_t failures = junit_failures(j), skipped = junit_skipped(j);
     fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
-    fprintf(f, "<testsuites name=\"shadebench\" tests=\"%zu\" failures=\"%zu\" time=\"%.3f\">\n",
-            j->count, failures, time_s);
+    fprintf(f, "<testsuites name=\"shadebench\" tests=\"%zu\" failures=\"%zu\" skipped=\"%zu\" "
+            "time=\"%.3f\">\n", j->count, failures, skipped, time_s);
     fprintf(f, "  <testsuite name=\"");
     xml_escaped(f, suite);
-    fprintf(f, "\" tests=\"%zu\" failures=\"%zu\" errors=\"0\" skipped=\"0\" time=\"%.3f\">\n",
-            j->count, failures, time_s);
+    fprintf(f, "\" tests=\"%zu\" failures=\"%zu\" errors=\"0\" skipped=\"%zu\" time=\"%.3f\">\n",
+            j->count, failures, skipped, time_s);
     char text[256];
     for (size_t i = 0; i < j->count; i++) {
         const struct junit_case *c = &j->cases[i];
@@ -147,9 +184,13 @@ bool junit_write(const struct junit *j, const char *path, const char *suite, dou
         }
         if (c->failure[0]) {
             fprintf(f, "      <failure type=\"");
-            xml_escaped(f, c->classname);
+            xml_escaped(f, c->inconclusive ? "inconclusive" : c->classname);
             fprintf(f, "\" message=\"");
             xml_escaped(f, c->failure);
+            fprintf(f, "\"/>\n");
+        } else if (c->skipped[0]) {
+            fprintf(f, "      <skipped message=\"");
+            xml_escaped(f, c->skipped);
             fprintf(f, "\"/>\n");
         }
         if (c->output[0]) {
@@ -168,7 +209,8 @@ void junit_print(const struct junit *j, FILE *f)
     char text[256];
     for (size_t i = 0; i < j->count; i++) {
         const struct junit_case *c = &j->cases[i];
-        fprintf(f, "%s %s (%.2f s)", c->failure[0] ? "FAIL" : "PASS", c->name, c->time_s);
+        const char *tag = c->inconclusive ? "INCONCLUSIVE" : c->failure[0] ? "FAIL" : "PASS";
+        fprintf(f, "%s %s (%.2f s)", tag, c->name, c->time_s);
         const char *key;
         json_t *v;
         const char *sep = ": ";
@@ -180,6 +222,8 @@ void junit_print(const struct junit *j, FILE *f)
         fputc('\n', f);
         if (c->failure[0])
             fprintf(f, "    failure: %s\n", c->failure);
+        else if (c->skipped[0])
+            fprintf(f, "    not decided: %s\n", c->skipped);
         if (c->output[0])
             fprintf(f, "    %s\n", c->output);
     }
@@ -274,15 +318,24 @@ void junit_job_name(const json_t *spec, char *out, size_t cap)
     }
     free(keys);
     /* The scene by what shapes the work most: preset, size, lights, their
-     * motion and the camera's. */
+     * motion; each only when the spec names it, so that a name made from
+     * the spec as the user wrote it does not change when the daemon's
+     * defaults do. */
     json_t *scene = json_object_get(spec, "scene");
-    if (scene) {
+    if (json_is_object(scene)) {
         const char *preset = json_string_value(json_object_get(scene, "preset"));
-        put(name, ncap, " %s %lldx%lld %lld lights %s", preset ? preset : "scene",
-            (long long)json_integer_value(json_object_get(scene, "width")),
-            (long long)json_integer_value(json_object_get(scene, "height")),
-            (long long)json_integer_value(json_object_get(scene, "lights")),
-            json_is_true(json_object_get(scene, "dynamic")) ? "moving" : "still");
+        json_t *w = json_object_get(scene, "width"), *h = json_object_get(scene, "height");
+        json_t *lights = json_object_get(scene, "lights"), *dyn = json_object_get(scene, "dynamic");
+        if (preset)
+            put(name, ncap, " %s", preset);
+        if (json_is_number(w) && json_is_number(h))
+            put(name, ncap, " %gx%g", json_number_value(w), json_number_value(h));
+        else if (json_is_number(w) || json_is_number(h))
+            put(name, ncap, " %s %g", w ? "width" : "height", json_number_value(w ? w : h));
+        if (json_is_number(lights))
+            put(name, ncap, " %g lights", json_number_value(lights));
+        if (json_is_boolean(dyn))
+            put(name, ncap, " %s", json_is_true(dyn) ? "moving" : "still");
     }
     /* The rest of the scene (layout, camera, materials, ...) and the look
      * change the workload too, but spelled out they would bury the name:
@@ -305,7 +358,7 @@ void junit_job_name(const json_t *spec, char *out, size_t cap)
     free(text_rest);
     json_decref(rest);
     json_t *frames = json_object_get(spec, "frames");
-    if (json_is_integer(frames))
-        put(name, ncap, ", %lld frames", (long long)json_integer_value(frames));
+    if (json_is_number(frames))
+        put(name, ncap, ", %g frames", json_number_value(frames));
     snprintf(out, cap, "%s", name);
 }

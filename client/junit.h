@@ -13,10 +13,17 @@
 #include <stddef.h>
 #include <stdio.h>
 
+/* A case has one of three outcomes: passed, failed (failure set), or
+ * inconclusive (skipped set: the check ran but could not decide, written as
+ * <skipped message="..."> so that CI dashboards show it as not passed, with
+ * the reason). An inconclusive case that the user asked to fail
+ * (--fail-inconclusive) is a failure whose type is "inconclusive". */
 struct junit_case {
     char classname[96];
     char name[320];
     char failure[1024]; /* empty: passed */
+    char skipped[1024]; /* inconclusive: why it could not decide */
+    bool inconclusive;  /* failure or skipped comes from an undecided check */
     char output[2048];
     double time_s;
     json_t *properties; /* name -> string or number, in insertion order */
@@ -34,19 +41,30 @@ void junit_finish(struct junit *j);
 struct junit_case *junit_add(struct junit *j, const char *classname, const char *name);
 
 void junit_fail(struct junit_case *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* An undecided check: skipped with the reason, or with fail set a failure
+ * of type "inconclusive". */
+void junit_inconclusive(struct junit_case *c, bool fail, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
 void junit_out(struct junit_case *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 void junit_prop_num(struct junit_case *c, const char *name, double value);
 void junit_prop_str(struct junit_case *c, const char *name, const char *value);
 
 size_t junit_failures(const struct junit *j);
+/* Failures other than undecided checks, and undecided checks (skipped or
+ * failed on request). */
+size_t junit_real_failures(const struct junit *j);
+size_t junit_undecided(const struct junit *j);
 
 /* Writes the XML; false when the file cannot be written. */
 bool junit_write(const struct junit *j, const char *path, const char *suite, double time_s);
 
-/* The CI log: one line a case, PASS or FAIL, its properties and output. */
+/* The CI log: one line a case, PASS, FAIL or INCONCLUSIVE, its properties
+ * and output. */
 void junit_print(const struct junit *j, FILE *f);
 
-/* A stable name for a job from its spec as the daemon understood it:
+/* A stable name for a job from its spec, best the spec as the user wrote it
+ * (the job file: a new daemon default then renames nothing), else as the
+ * daemon understood it (fetch):
  * "osl async_distance=20 osl(reshade=touched resolution=auto texel_density=1)
  *  grid 160x120 10 lights moving #1a2b3c4d, 20 frames": the technique and
  * its options (top-level numbers that are set, and the object named after
@@ -55,7 +73,8 @@ void junit_print(const struct junit *j, FILE *f);
  * differ there get different names, without burying the name), and the
  * frames. Options of other techniques and the fields that do not change
  * what is measured (labels, repeat, captures, reference, metrics) are left
- * out. At most 240 characters. */
+ * out, and so are scene fields the spec does not name. At most 240
+ * characters. */
 void junit_job_name(const json_t *spec, char *out, size_t cap);
 
 #endif

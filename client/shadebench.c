@@ -5,14 +5,17 @@
  * error). This file reads the command line; the commands live in
  * cmd_*.c, the statistics in gate.c and stats_test.c. */
 #define _POSIX_C_SOURCE 200809L
+#include <errno.h>
 #include <getopt.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "client/client.h"
+#include "client/suggest.h"
 #include "common/fsutil.h"
 #include "config.h"
 #include "common/result_keys.h"
@@ -46,7 +49,8 @@ static void usage(FILE *f)
             "  list                every job, one a line\n"
             "  cancel ID           cancel a queued or running job\n"
             "  fetch ID            download a finished job (--out DIR) and judge it\n"
-            "  info                the daemon's version, device and techniques\n\n"
+            "  info                the daemon's version, device, techniques, effects and limits\n"
+            "                      (--json: the daemon's whole answer)\n\n"
             "Options:\n"
             "  --server URL        default $SHADEBENCH_SERVER, else http://127.0.0.1:8460\n"
             "  --token-file FILE   bearer token from a file (default $SHADEBENCH_TOKEN_FILE)\n"
@@ -61,12 +65,14 @@ static void usage(FILE *f)
             "  --max-flip X        a capture fails above this mean FLIP (needs a reference)\n\n"
             "Timing gate (submit --wait --baseline) and ab:\n"
             "  --baseline FILE     result.json (or job.json) of earlier runs to compare with\n"
-            "  --runs N            runs on each side (default: the job's repeat, else 5)\n"
+            "  --runs N            clean runs kept on each side (default: the job's repeat, else 5)\n"
             "  --max-slowdown P    the smallest slowdown that counts, e.g. 5%% or 0.05 (default 5%%)\n"
-            "  --max-reruns N      extra runs for noisy runs, unclear verdicts and confirming a\n"
-            "                      regression (default 10)\n"
-            "  --fail-inconclusive fail (exit 1) when still too noisy to tell; default: pass with\n"
-            "                      a warning\n"
+            "  --max-reruns N      at most N extra runs (ab: pairs) for noisy runs, unclear\n"
+            "                      verdicts and confirming a regression (default 10)\n"
+            "  --fail-inconclusive exit 3 when still too noisy to tell (default: exit 0 with a\n"
+            "                      warning; either way JUnit marks it skipped, not passed);\n"
+            "                      $SHADEBENCH_FAIL_INCONCLUSIVE=1 sets it for CI\n"
+            "  --no-fail-inconclusive  the default, over $SHADEBENCH_FAIL_INCONCLUSIVE\n"
             "  --allow-mismatch    compare with a baseline of another job or device\n"
             "  --series NAME       frame_ms, gpu_ms or cpu_ms (default: frame_ms on software\n"
             "                      renderers such as llvmpipe, gpu_ms on GPUs)\n"
@@ -83,16 +89,17 @@ static void usage(FILE *f)
             "  --timeout S         give up waiting after S seconds\n"
             "  --quiet             no progress or verdict lines on stderr\n\n"
             "Exit status: 0 pass, 1 regression or quality failure (or a failed job),\n"
-            "2 usage, server or baseline-mismatch error.\n");
+            "2 usage, server or baseline-mismatch error, 3 a timing verdict too noisy to\n"
+            "reach with --fail-inconclusive (and nothing failed).\n");
 }
 
 /* A token file: its first line, whitespace trimmed. */
-static char *read_token_file(const char *path)
+static char *read_token_file(const char *path, const char *source)
 {
     size_t len;
     char *text = fs_read_file(path, 64 * 1024, &len);
     if (!text)
-        die_usage("cannot read the token file %s", path);
+        die_usage("cannot read the token file %s (%s): %s", path, source, strerror(errno));
     text[strcspn(text, "\r\n")] = '\0';
     size_t n = strlen(text);
     while (n && (text[n - 1] == ' ' || text[n - 1] == '\t'))
@@ -132,6 +139,40 @@ static int count(const char *arg, const char *flag, int lo, int hi)
     return (int)v;
 }
 
+/* A yes/no environment variable: unset or empty is no. */
+static bool env_flag(const char *name)
+{
+    const char *v = getenv(name);
+    if (!v || !*v || !strcmp(v, "0") || !strcasecmp(v, "no") || !strcasecmp(v, "false"))
+        return false;
+    if (!strcmp(v, "1") || !strcasecmp(v, "yes") || !strcasecmp(v, "true"))
+        return true;
+    die_usage("$%s must be 1, yes or true (or 0, no, false, empty), got \"%s\"", name, v);
+}
+
+/* A mistyped option: a short error with the nearest option, not the whole
+ * usage. */
+static void die_option(const struct option *longopts, const char *arg, bool missing_value)
+    __attribute__((noreturn));
+static void die_option(const struct option *longopts, const char *arg, bool missing_value)
+{
+    char name[64];
+    const char *s = arg;
+    while (*s == '-')
+        s++;
+    snprintf(name, sizeof(name), "%.*s", (int)strcspn(s, "="), s);
+    if (missing_value)
+        die_usage("--%s needs a value (see --help)", name);
+    const char *names[64];
+    size_t n = 0;
+    for (const struct option *o = longopts; o->name && n < 64; o++)
+        names[n++] = o->name;
+    const char *near = suggest_nearest(name, names, n);
+    if (near)
+        die_usage("unknown option %s; did you mean --%s? (--help lists every option)", arg, near);
+    die_usage("unknown option %s (--help lists every option)", arg);
+}
+
 int main(int argc, char **argv)
 {
     struct options o = {.max_slowdown = 0.05, .min_ssim = NAN, .max_flip = NAN,
@@ -145,7 +186,7 @@ int main(int argc, char **argv)
     enum { O_SERVER = 256, O_TOKEN, O_TOKEN_FILE, O_WAIT, O_OUT, O_JUNIT, O_MIN_SSIM, O_MAX_FLIP,
            O_BASELINE, O_SLOWDOWN, O_SERIES, O_TIMEOUT, O_QUIET, O_HELP, O_VERSION, O_RUNS,
            O_RERUNS, O_FAIL_INC, O_ALLOW, O_CONFIDENCE, O_NOISE, O_LABEL, O_FILTER, O_SINCE,
-           O_FIGURE, O_SERVER_B };
+           O_FIGURE, O_SERVER_B, O_NO_FAIL_INC, O_JSON };
     static const struct option longopts[] = {
         {"server", required_argument, NULL, O_SERVER},
         {"token", required_argument, NULL, O_TOKEN},
@@ -173,11 +214,17 @@ int main(int argc, char **argv)
         {"since", required_argument, NULL, O_SINCE},
         {"figure", required_argument, NULL, O_FIGURE},
         {"server-b", required_argument, NULL, O_SERVER_B},
+        {"no-fail-inconclusive", no_argument, NULL, O_NO_FAIL_INC},
+        {"json", no_argument, NULL, O_JSON},
         {NULL, 0, NULL, 0},
     };
+    /* CI sets the default once for every command; the flags override it. */
+    o.fail_inconclusive = env_flag("SHADEBENCH_FAIL_INCONCLUSIVE");
+    bool raw_json = false;
     int opt;
     char *end;
-    while ((opt = getopt_long(argc, argv, "", longopts, NULL)) != -1) {
+    opterr = 0; /* errors are ours: short, with a suggestion */
+    while ((opt = getopt_long(argc, argv, ":", longopts, NULL)) != -1) {
         switch (opt) {
         case O_SERVER: server = optarg; break;
         case O_SERVER_B: server_b = optarg; break;
@@ -206,6 +253,8 @@ int main(int argc, char **argv)
         case O_RUNS: o.runs = count(optarg, "--runs", 1, 100); break;
         case O_RERUNS: o.max_reruns = count(optarg, "--max-reruns", 0, 1000); break;
         case O_FAIL_INC: o.fail_inconclusive = true; break;
+        case O_NO_FAIL_INC: o.fail_inconclusive = false; break;
+        case O_JSON: raw_json = true; break;
         case O_ALLOW: o.allow_mismatch = true; break;
         case O_LABEL: key_value(optarg, "--label", o.labels); break;
         case O_FILTER: key_value(optarg, "--filter", o.filters); break;
@@ -230,13 +279,13 @@ int main(int argc, char **argv)
         case O_QUIET: o.quiet = true; break;
         case O_HELP: usage(stdout); return EXIT_PASS;
         case O_VERSION: printf("shadebench %s\n", PACKAGE_VERSION); return EXIT_PASS;
-        default: usage(stderr); return EXIT_ERROR;
+        case ':': die_option(longopts, argv[optind - 1], true);
+        default: die_option(longopts, argv[optind - 1], false);
         }
     }
-    if (optind >= argc) {
-        usage(stderr);
-        return EXIT_ERROR;
-    }
+    if (optind >= argc)
+        die_usage("no command given (submit, ab, sweep, history, status, list, cancel, fetch, "
+                  "info; --help explains them)");
     const char *cmd = argv[optind];
     int nargs = argc - optind - 1;
     const char *arg = nargs > 0 ? argv[optind + 1] : NULL;
@@ -250,8 +299,16 @@ int main(int argc, char **argv)
     size_t k = 0;
     while (k < sizeof(commands) / sizeof(commands[0]) && strcmp(commands[k].name, cmd) != 0)
         k++;
-    if (k == sizeof(commands) / sizeof(commands[0]))
-        die_usage("unknown command %s (see --help)", cmd);
+    if (k == sizeof(commands) / sizeof(commands[0])) {
+        const char *names[sizeof(commands) / sizeof(commands[0])];
+        for (size_t i = 0; i < sizeof(commands) / sizeof(commands[0]); i++)
+            names[i] = commands[i].name;
+        const char *near = suggest_nearest(cmd, names, sizeof(names) / sizeof(names[0]));
+        if (near)
+            die_usage("unknown command %s; did you mean %s? (--help lists the commands)", cmd,
+                      near);
+        die_usage("unknown command %s (--help lists the commands)", cmd);
+    }
     if (nargs < commands[k].min || nargs > commands[k].max)
         die_usage("%s takes %s", cmd, commands[k].max == 0 ? "no argument"
                                       : commands[k].min == commands[k].max ? "one argument"
@@ -264,22 +321,28 @@ int main(int argc, char **argv)
         die_usage("sweep --out needs --wait: the table is complete once the sweep ends");
     if (strcmp(cmd, "history") != 0 && (json_object_size(o.filters) || o.since || o.figure))
         die_usage("--filter, --since and --figure belong to history");
+    if (raw_json && strcmp(cmd, "info") != 0)
+        die_usage("--json belongs to info");
 
     /* The token: a file or the environment, so that it need not show in
      * the process list; --token still works, with a warning. */
-    char *token_text = NULL;
+    char *token_text = NULL, token_source[1100] = "";
     const char *env_token = getenv("SHADEBENCH_TOKEN");
     const char *env_file = getenv("SHADEBENCH_TOKEN_FILE");
     if (argv_token) {
         token = argv_token;
+        snprintf(token_source, sizeof(token_source), "--token");
         fprintf(stderr, "shadebench: warning: --token shows the token to every user of this "
                 "machine (ps); prefer --token-file or $SHADEBENCH_TOKEN\n");
     } else if (token_file) {
-        token = token_text = read_token_file(token_file);
+        snprintf(token_source, sizeof(token_source), "--token-file %s", token_file);
+        token = token_text = read_token_file(token_file, "--token-file");
     } else if (env_token && *env_token) {
         token = env_token;
+        snprintf(token_source, sizeof(token_source), "$SHADEBENCH_TOKEN");
     } else if (env_file && *env_file) {
-        token = token_text = read_token_file(env_file);
+        snprintf(token_source, sizeof(token_source), "$SHADEBENCH_TOKEN_FILE=%s", env_file);
+        token = token_text = read_token_file(env_file, "$SHADEBENCH_TOKEN_FILE");
     }
 
     curl_global_init(CURL_GLOBAL_DEFAULT);
@@ -287,6 +350,7 @@ int main(int argc, char **argv)
     memset(&cb, 0, sizeof(cb));
     if (!conn_init(&c, server, token) || (server_b && !conn_init(&cb, server_b, token)))
         die_usage("cannot initialise libcurl");
+    c.token_source = cb.token_source = token_source;
     int rc;
     char path[256];
     if (!strcmp(cmd, "submit"))
@@ -301,7 +365,7 @@ int main(int argc, char **argv)
     } else if (!strcmp(cmd, "fetch"))
         rc = cmd_fetch(&c, &o, arg);
     else if (!strcmp(cmd, "info"))
-        rc = cmd_print(&c, "GET", "/v1/info");
+        rc = raw_json ? cmd_print(&c, "GET", "/v1/info") : cmd_info(&c);
     else if (!strcmp(cmd, "ab"))
         rc = cmd_ab(&c, server_b ? &cb : &c, &o, arg, nargs == 2 ? argv[optind + 2] : arg);
     else if (!strcmp(cmd, "sweep"))

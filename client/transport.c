@@ -90,7 +90,21 @@ json_t *conn_json(struct conn *c, const char *method, const char *path, const ch
     if (status_out)
         *status_out = status;
     json_t *j = status > 0 ? json_loads(b.data ? b.data : "", 0, NULL) : NULL;
-    if (status >= 400 || (status > 0 && !j)) {
+    if (status == 401) {
+        /* The daemon answers a missing and a wrong token alike; the client
+         * knows which it sent. */
+        if (c->token && *c->token)
+            fprintf(stderr, "shadebench: %s %s%s: HTTP 401: the daemon refused the token from "
+                    "%s: it is not the token the daemon was started with (shadebenchd "
+                    "--token FILE)\n", method, c->server, path,
+                    c->token_source && *c->token_source ? c->token_source : "the command line");
+        else
+            fprintf(stderr, "shadebench: %s %s%s: HTTP 401: the daemon needs a token and none "
+                    "was given: --token-file FILE, $SHADEBENCH_TOKEN or "
+                    "$SHADEBENCH_TOKEN_FILE\n", method, c->server, path);
+        json_decref(j);
+        j = NULL;
+    } else if (status >= 400 || (status > 0 && !j)) {
         json_t *e = json_object_get(j, "error");
         const char *field = json_string_value(json_object_get(e, "field"));
         const char *message = json_string_value(json_object_get(e, "message"));

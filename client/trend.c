@@ -8,8 +8,8 @@
 #include <string.h>
 #include <time.h>
 
-enum { W = 900, H = 520, MAX_SERIES = 8 };
-static const double L = 80, R = 180, T = 50, B = 70;
+enum { W = 900, PLOT_H = 520, MAX_SERIES = TREND_MAX_SERIES };
+static const double L = 80, R = 40, T = 50, B = 70, LEGEND_LINE = 18;
 static const char *const COLOURS[MAX_SERIES] = {"#0072b2", "#e69f00", "#009e73", "#cc79a7",
                                                 "#56b4e9", "#d55e00", "#f0e442", "#595959"};
 
@@ -69,14 +69,79 @@ static double tick_step(double span)
     return (f < 1.5 ? 1 : f < 3 ? 2 : f < 7 ? 5 : 10) * mag;
 }
 
+int trend_time_ticks(double tmin, double tmax, double *ticks, char (*labels)[24], int cap,
+                     double *step)
+{
+    static const double steps[] = {1,     2,     5,     10,     15,     30,     60,      120,
+                                   300,   600,   900,   1800,   3600,   7200,   10800,   21600,
+                                   43200, 86400, 172800, 604800, 1209600, 2419200};
+    double span = tmax - tmin, st = 0;
+    for (size_t i = 0; i < sizeof(steps) / sizeof(steps[0]) && !st; i++)
+        if (span / steps[i] <= 7.0)
+            st = steps[i];
+    if (!st) /* beyond 28-day steps: whole multiples of 28 days */
+        st = 2419200.0 * ceil(span / 7.0 / 2419200.0);
+    *step = st;
+    const char *fmt = st < 60 ? "%H:%M:%S" : st < 86400 ? (span > 86400 ? "%m-%d %H:%M" : "%H:%M")
+                                                       : "%Y-%m-%d";
+    int n = 0;
+    for (double t = ceil(tmin / st) * st; t <= tmax + 1e-6 && n < cap; t += st) {
+        time_t tt = (time_t)llround(t);
+        struct tm tm;
+        gmtime_r(&tt, &tm);
+        ticks[n] = (double)tt;
+        strftime(labels[n], sizeof(labels[0]), fmt, &tm);
+        n++;
+    }
+    return n;
+}
+
+/* The series of the points, in order of first appearance; past MAX_SERIES
+ * they are counted, not drawn. */
+struct series_list {
+    const char *key[MAX_SERIES];
+    const char *name[MAX_SERIES];
+    int n, left_out;
+};
+
+static int series_index(const struct series_list *sl, const char *key)
+{
+    for (int s = 0; s < sl->n; s++)
+        if (!strcmp(sl->key[s], key))
+            return s;
+    return -1;
+}
+
 char *trend_svg(const struct trend_point *pts, size_t n, const char *title, const char *ylabel)
 {
     struct out o = {0};
-    double x0 = L, x1 = W - R, y0 = H - B, y1 = T;
-    double tmin = INFINITY, tmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
-    char series[MAX_SERIES][48];
-    int nseries = 0;
+    struct series_list sl = {.n = 0};
+    const char *seen_extra[64];
+    int nextra = 0;
     for (size_t i = 0; i < n; i++) {
+        if (series_index(&sl, pts[i].series) >= 0)
+            continue;
+        if (sl.n < MAX_SERIES) {
+            sl.key[sl.n] = pts[i].series;
+            sl.name[sl.n++] = pts[i].name[0] ? pts[i].name : pts[i].series;
+            continue;
+        }
+        bool seen = false;
+        for (int k = 0; k < nextra && !seen; k++)
+            seen = !strcmp(seen_extra[k], pts[i].series);
+        if (!seen) {
+            if (nextra < 64)
+                seen_extra[nextra++] = pts[i].series;
+            sl.left_out++;
+        }
+    }
+    int legend_lines = sl.n + (sl.left_out > 0) + 1;
+    int H = PLOT_H + (int)(legend_lines * LEGEND_LINE);
+    double x0 = L, x1 = W - R, y0 = PLOT_H - B, y1 = T;
+    double tmin = INFINITY, tmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+    for (size_t i = 0; i < n; i++) {
+        if (series_index(&sl, pts[i].series) < 0)
+            continue;
         tmin = fmin(tmin, pts[i].t);
         tmax = fmax(tmax, pts[i].t);
         /* Intervals never cross zero: figures here are times and scores. */
@@ -84,16 +149,19 @@ char *trend_svg(const struct trend_point *pts, size_t n, const char *title, cons
         double hi = isnan(pts[i].hi) ? pts[i].y : pts[i].hi;
         ymin = fmin(ymin, fmin(pts[i].y, lo));
         ymax = fmax(ymax, fmax(pts[i].y, hi));
-        int s = 0;
-        while (s < nseries && strcmp(series[s], pts[i].series) != 0)
-            s++;
-        if (s == nseries && nseries < MAX_SERIES)
-            snprintf(series[nseries++], sizeof(series[0]), "%s", pts[i].series);
+    }
+    if (!(tmax >= tmin)) {
+        tmin = 0;
+        tmax = 1;
+        ymin = 0;
+        ymax = 1;
     }
     bool logy = trend_log_axis(ymin, ymax);
-    if (!(tmax > tmin)) {
-        tmin -= 60;
-        tmax += 60;
+    if (tmax - tmin < 60) {
+        /* Jobs within a minute: a minute's axis, so that it has ticks. */
+        double mid = (tmin + tmax) / 2;
+        tmin = mid - 30;
+        tmax = mid + 30;
     }
     double pad = (tmax - tmin) * 0.05;
     tmin -= pad;
@@ -139,38 +207,34 @@ char *trend_svg(const struct trend_point *pts, size_t n, const char *title, cons
                     "<text x=\"%g\" y=\"%.1f\" font-size=\"12\" text-anchor=\"end\">%g</text>\n",
                 x0, x1, MAPY(v), MAPY(v), x0 - 8, MAPY(v) + 4, fabs(v) < step * 1e-6 ? 0.0 : v);
     }
-    /* X ticks: dates, or times of day within a day. */
-    double tstep = tick_step(tmax - tmin);
-    bool same_day = tmax - tmin < 86400 * 2;
-    for (double t = ceil(tmin / tstep) * tstep; t <= tmax; t += tstep) {
-        time_t tt = (time_t)t;
-        struct tm tm;
-        gmtime_r(&tt, &tm);
-        char buf[32];
-        strftime(buf, sizeof(buf), same_day ? "%H:%M" : "%Y-%m-%d", &tm);
+    /* X ticks on round times, each labelled exactly. */
+    double ticks[16], tstep;
+    char labels[16][24];
+    int nt = trend_time_ticks(tmin, tmax, ticks, labels, 16, &tstep);
+    for (int k = 0; k < nt; k++)
         add(&o, "<line x1=\"%.1f\" x2=\"%.1f\" y1=\"%g\" y2=\"%g\" stroke=\"#e0e0e0\"/>"
-                "<text x=\"%.1f\" y=\"%g\" font-size=\"12\" text-anchor=\"middle\">%s</text>\n",
-            MAPX(t), MAPX(t), y0, y1, MAPX(t), y0 + 18, buf);
-    }
+                "<text class=\"tick\" data-t=\"%.0f\" x=\"%.1f\" y=\"%g\" font-size=\"12\" "
+                "text-anchor=\"middle\">%s</text>\n",
+            MAPX(ticks[k]), MAPX(ticks[k]), y0, y1, ticks[k], MAPX(ticks[k]), y0 + 18, labels[k]);
     add(&o, "<rect x=\"%g\" y=\"%g\" width=\"%g\" height=\"%g\" fill=\"none\" stroke=\"#222\"/>\n",
         x0, y1, x1 - x0, y0 - y1);
-    add(&o, "<text x=\"%g\" y=\"%d\" font-size=\"14\" text-anchor=\"middle\">job created (UTC)%s"
-            "</text>\n", (x0 + x1) / 2, H - 22, logy ? "" : "");
+    add(&o, "<text x=\"%g\" y=\"%g\" font-size=\"14\" text-anchor=\"middle\">job created (UTC)"
+            "</text>\n", (x0 + x1) / 2, y0 + 44);
     add(&o, "<text transform=\"translate(24 %g) rotate(-90)\" font-size=\"14\" "
             "text-anchor=\"middle\">", (y0 + y1) / 2);
     escaped(&o, ylabel);
     add(&o, "%s</text>\n", logy ? " (log scale)" : "");
     /* One line per series, in time order, then the points. */
-    for (int s = 0; s < nseries; s++) {
+    for (int s = 0; s < sl.n; s++) {
         add(&o, "<g class=\"series\" data-series=\"");
-        escaped(&o, series[s]);
+        escaped(&o, sl.key[s]);
         add(&o, "\" stroke=\"%s\" fill=\"%s\">\n<polyline fill=\"none\" stroke-width=\"2\" points=\"",
             COLOURS[s], COLOURS[s]);
         double last = -INFINITY;
         for (;;) {
             size_t best = n;
             for (size_t i = 0; i < n; i++)
-                if (!strcmp(pts[i].series, series[s]) && pts[i].t > last &&
+                if (!strcmp(pts[i].series, sl.key[s]) && pts[i].t > last &&
                     (best == n || pts[i].t < pts[best].t))
                     best = i;
             if (best == n)
@@ -181,7 +245,7 @@ char *trend_svg(const struct trend_point *pts, size_t n, const char *title, cons
         add(&o, "\"/>\n");
         for (size_t i = 0; i < n; i++) {
             const struct trend_point *p = &pts[i];
-            if (strcmp(p->series, series[s]) != 0)
+            if (strcmp(p->series, sl.key[s]) != 0)
                 continue;
             if (!isnan(p->lo) && !isnan(p->hi)) {
                 double lo = fmax(p->lo, logy ? ymin : 0.0);
@@ -189,17 +253,37 @@ char *trend_svg(const struct trend_point *pts, size_t n, const char *title, cons
                         "data-low=\"%g\" data-high=\"%g\"/>\n",
                     MAPX(p->t), MAPX(p->t), MAPY(lo), MAPY(p->hi), lo, p->hi);
             }
-            add(&o, "<circle class=\"point\" cx=\"%.1f\" cy=\"%.1f\" r=\"4\" data-value=\"%g\">"
-                    "<title>", MAPX(p->t), MAPY(p->y), p->y);
+            /* A noisy run: hollow, and the tooltip says what disturbed it. */
+            add(&o, "<circle class=\"point\" cx=\"%.1f\" cy=\"%.1f\" r=\"4\" data-value=\"%g\" "
+                    "data-t=\"%.0f\"%s><title>", MAPX(p->t), MAPY(p->y), p->y, p->t,
+                p->noisy ? " data-noisy=\"true\" fill=\"white\" stroke-width=\"2\"" : "");
             escaped(&o, p->label);
-            add(&o, ": %g</title></circle>\n", p->y);
+            add(&o, ": %g", p->y);
+            if (p->noisy && !isnan(p->other_share))
+                add(&o, " (noisy: other processes took %.0f%% of the CPU)", 100 * p->other_share);
+            else if (p->noisy)
+                add(&o, " (noisy)");
+            add(&o, "</title></circle>\n");
         }
-        add(&o, "</g>\n<circle cx=\"%g\" cy=\"%d\" r=\"5\" fill=\"%s\"/><text x=\"%g\" y=\"%d\" "
-                "font-size=\"12\">", x1 + 20, (int)T + 10 + 22 * s, COLOURS[s], x1 + 32,
-            (int)T + 14 + 22 * s);
-        escaped(&o, series[s]);
+        add(&o, "</g>\n");
+    }
+    /* The legend under the plot: every series by its full name. */
+    double ly = PLOT_H + 4;
+    for (int s = 0; s < sl.n; s++, ly += LEGEND_LINE) {
+        add(&o, "<circle cx=\"%g\" cy=\"%.1f\" r=\"5\" fill=\"%s\"/><text class=\"legend\" "
+                "x=\"%g\" y=\"%.1f\" font-size=\"12\">", x0 + 6, ly - 4, COLOURS[s], x0 + 18, ly);
+        escaped(&o, sl.name[s]);
         add(&o, "</text>\n");
     }
+    add(&o, "<circle cx=\"%g\" cy=\"%.1f\" r=\"4\" fill=\"white\" stroke=\"#222\" "
+            "stroke-width=\"2\"/><text x=\"%g\" y=\"%.1f\" font-size=\"12\">hollow: a run the "
+            "daemon found noisy (result.interference); hover for the CPU others took</text>\n",
+        x0 + 6, ly - 4, x0 + 18, ly);
+    ly += LEGEND_LINE;
+    if (sl.left_out)
+        add(&o, "<text class=\"left-out\" x=\"%g\" y=\"%.1f\" font-size=\"12\">%d more "
+                "workload%s not drawn (at most %d series): narrow the history with --filter</text>\n",
+            x0, ly, sl.left_out, sl.left_out == 1 ? "" : "s", MAX_SERIES);
     if (n == 0)
         add(&o, "<text x=\"%g\" y=\"%g\" font-size=\"14\" text-anchor=\"middle\">no matching "
                 "jobs</text>\n", (x0 + x1) / 2, (y0 + y1) / 2);

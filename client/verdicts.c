@@ -1,13 +1,28 @@
-#define _POSIX_C_SOURCE 200809L
+#define _DEFAULT_SOURCE /* timegm */
 #include "client/verdicts.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
+#include <unistd.h>
 
 #include "common/fsutil.h"
 #include "common/result_keys.h"
+
+double iso_unix_s(const char *s)
+{
+    struct tm tm;
+    memset(&tm, 0, sizeof(tm));
+    int ms = 0;
+    if (!s || sscanf(s, "%d-%d-%dT%d:%d:%d.%dZ", &tm.tm_year, &tm.tm_mon, &tm.tm_mday,
+                     &tm.tm_hour, &tm.tm_min, &tm.tm_sec, &ms) < 6)
+        return NAN;
+    tm.tm_year -= 1900;
+    tm.tm_mon -= 1;
+    return (double)timegm(&tm) + ms / 1000.0;
+}
 
 void job_classname(const json_t *spec, char *out, size_t cap)
 {
@@ -70,7 +85,10 @@ struct junit_case *job_case(struct junit *j, const char *classname, const char *
     struct junit_case *t = junit_add(j, classname, cname);
     if (!t)
         return NULL;
-    t->time_s = time_s;
+    /* Not timed here (fetch): the job's own span, from creation to its end. */
+    double span = iso_unix_s(json_string_value(json_object_get(job, "finished"))) -
+                  iso_unix_s(json_string_value(json_object_get(job, "created")));
+    t->time_s = time_s > 0 ? time_s : isfinite(span) && span > 0 ? span : 0;
     const char *status = json_string_value(json_object_get(job, "status"));
     const char *id = json_string_value(json_object_get(job, "id"));
     junit_prop_str(t, "job", id);
@@ -145,6 +163,9 @@ bool run_set_add(struct run_set *s, const struct options *o, const char *text,
     printf("%s\n", id);
     fflush(stdout);
     snprintf(path, sizeof(path), "/v1/jobs/%s", id);
+    /* A terminal gets the progress bar; a CI log gets one line a run, at
+     * its end, instead of progress lines that would bury it. */
+    bool bar = !o->quiet && isatty(STDERR_FILENO);
     if (check) {
         json_t *queued = conn_json(s->conn, "GET", path, NULL, NULL);
         bool ok = queued && check(json_object_get(queued, "spec"), ctx);
@@ -155,10 +176,11 @@ bool run_set_add(struct run_set *s, const struct options *o, const char *text,
         }
     }
     snprintf(what, sizeof(what), "%s %zu %s", s->what, s->n + 1, id);
-    json_t *job = conn_follow_job(s->conn, id, what, o->quiet, o->timeout_s);
+    json_t *job = conn_follow_job(s->conn, id, what, !bar, o->timeout_s);
     if (!job)
         return false;
-    s->elapsed_s += clock_mono_s() - start;
+    double took = clock_mono_s() - start;
+    s->elapsed_s += took;
     const char *status = json_string_value(json_object_get(job, "status"));
     if (!status || strcmp(status, "done") != 0) {
         json_decref(s->failed);
@@ -171,9 +193,39 @@ bool run_set_add(struct run_set *s, const struct options *o, const char *text,
         json_decref(job);
         return false;
     }
+    r->elapsed_s = took;
     s->n++;
     json_array_append_new(s->jobs, job);
+    if (!o->quiet) {
+        char line[512];
+        run_set_line(s, s->n - 1, series, line, sizeof(line));
+        fprintf(stderr, "%s\n", line);
+    }
     return true;
+}
+
+void run_set_line(const struct run_set *s, size_t i, const char *series, char *out, size_t cap)
+{
+    const struct gate_run *r = &s->runs[i];
+    int used;
+    if (s->planned && i >= s->planned)
+        used = snprintf(out, cap, "%s %zu (extra %zu of at most %d): job %s, %s %.3f ms", s->what,
+                        i + 1, i + 1 - s->planned, s->budget, r->job, series, r->ms);
+    else if (s->planned)
+        used = snprintf(out, cap, "%s %zu of %zu: job %s, %s %.3f ms", s->what, i + 1, s->planned,
+                        r->job, series, r->ms);
+    else
+        used = snprintf(out, cap, "%s %zu: job %s, %s %.3f ms", s->what, i + 1, r->job, series,
+                        r->ms);
+    if (used < 0 || (size_t)used >= cap)
+        return;
+    if (r->has_share)
+        used += snprintf(out + used, cap - (size_t)used, ", others took %.0f%% of the CPU",
+                         100 * r->other_share);
+    else if (r->daemon_noisy)
+        used += snprintf(out + used, cap - (size_t)used, ", flagged noisy by the daemon");
+    if ((size_t)used < cap && r->elapsed_s > 0)
+        snprintf(out + used, cap - (size_t)used, ", %.1f s", r->elapsed_s);
 }
 
 json_t *run_set_json(const struct run_set *s)
@@ -230,10 +282,19 @@ void run_set_print(const struct run_set *s, const char *series, FILE *f)
 
 int junit_conclude(const struct options *o, struct junit *j, const char *suite, double time_s)
 {
-    int rc = junit_failures(j) ? EXIT_FAIL : EXIT_PASS;
+    size_t failed = junit_real_failures(j), undecided = junit_undecided(j);
+    int rc = failed ? EXIT_FAIL : undecided && o->fail_inconclusive ? EXIT_INCONCLUSIVE : EXIT_PASS;
     if (!o->quiet) {
         junit_print(j, stderr);
-        fprintf(stderr, "%zu checks, %zu failed\n", j->count, junit_failures(j));
+        fprintf(stderr, "%zu checks: %zu passed, %zu failed, %zu inconclusive\n", j->count,
+                j->count - failed - undecided, failed, undecided);
+        if (undecided && !failed)
+            fprintf(stderr, "shadebench: warning: %zu check%s could not decide (too noisy to "
+                    "tell); %s\n", undecided, undecided == 1 ? "" : "s",
+                    o->fail_inconclusive
+                        ? "exit status 3 (--fail-inconclusive or SHADEBENCH_FAIL_INCONCLUSIVE=1)"
+                        : "exit status 0, but not a pass: JUnit marks it skipped "
+                          "(--fail-inconclusive or SHADEBENCH_FAIL_INCONCLUSIVE=1 exits 3)");
     }
     if (o->junit && !junit_write(j, o->junit, suite, time_s)) {
         fprintf(stderr, "shadebench: cannot write %s\n", o->junit);

@@ -18,7 +18,12 @@
 void quality_cases(const struct options *o, const json_t *result, const char *classname,
                    const char *name, struct junit *j);
 
-/* The job case: failed unless done; the figures as properties. */
+/* "2026-11-21T10:00:05.123Z" (the daemon's times) in seconds since 1970;
+ * NAN when it is not one. */
+double iso_unix_s(const char *s);
+
+/* The job case: failed unless done; the figures as properties. time_s 0:
+ * the job's span from creation to its end. */
 struct junit_case *job_case(struct junit *j, const char *classname, const char *name,
                             const json_t *job, double time_s);
 
@@ -29,6 +34,8 @@ void job_classname(const json_t *spec, char *out, size_t cap);
 struct run_set {
     struct conn *conn;
     const char *what;       /* progress prefix: "run", "A", "B" */
+    size_t planned;         /* the runs asked for (--runs): the log counts against it */
+    int budget;             /* extra runs allowed beyond them (--max-reruns) */
     struct gate_run *runs;
     json_t *jobs;           /* the final job JSON of each run, same order */
     size_t n, cap;
@@ -44,7 +51,9 @@ void run_set_finish(struct run_set *s);
  * spec as the daemon understood it; returning false cancels the job and
  * fails. Returns false on a server error, a refused check or a run without
  * the series (message printed); a job that failed is kept in s->failed and
- * returns true. */
+ * returns true. The job's id goes to stdout (one a line, for scripts); the
+ * log on stderr gets one line a run when it ends (run_set_line), with a
+ * progress bar before it on a terminal only. */
 typedef bool (*spec_check_fn)(const json_t *spec, void *ctx);
 bool run_set_add(struct run_set *s, const struct options *o, const char *text,
                  const char *series, spec_check_fn check, void *ctx);
@@ -59,9 +68,15 @@ bool run_set_write(const struct run_set *s, const char *dir);
 /* Prints one line a run (its median, other processes' CPU share, noise). */
 void run_set_print(const struct run_set *s, const char *series, FILE *f);
 
+/* One run for the log, as it ends: "run 6 (extra 1 of at most 10): job ID,
+ * frame_ms 12.345 ms, others took 45% of the CPU, 3.2 s". i counts from 0.
+ * Pure (no I/O); for the unit tests too. */
+void run_set_line(const struct run_set *s, size_t i, const char *series, char *out, size_t cap);
+
 /* Writes --junit, prints the cases to stderr (unless quiet), and returns
- * the exit status: 1 when a case failed, 2 when the file could not be
- * written, else 0. */
+ * the exit status: 1 when a case failed outright, 3 when a check could not
+ * decide and the user asked to fail on that, 2 when the file could not be
+ * written, else 0 (with a warning for undecided checks). */
 int junit_conclude(const struct options *o, struct junit *j, const char *suite, double time_s);
 
 #endif

@@ -2,16 +2,18 @@
 #define _POSIX_C_SOURCE 200809L
 #include "daemon/api/charts.h"
 #include "common/result_keys.h"
+#include "daemon/api/sweep_verdict.h"
 
 #include <cairo-svg.h>
 #include <cairo.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 enum { WIDTH = 900, HEIGHT = 560, MAX_SERIES = 8, MAX_WORKLOADS = 32, MAX_LEVELS = 16 };
-static const double LEFT = 90, RIGHT = 200, TOP = 62, BOTTOM = 70;
+static const double LEFT = 90, RIGHT = 200, TOP = 62, BOTTOM = 70, FOOTER_LINE = 15;
 
 /* Colour-blind-safe (Okabe-Ito). */
 static const double PALETTE[MAX_SERIES][3] = {
@@ -30,6 +32,13 @@ struct point {
     bool runs_median;  /* box[2] is the median of run medians, the box the first run's */
     bool placed;       /* label drawn at lx, ly (top-left) with size lw, lh */
     double lx, ly, lw, lh;
+    bool tied;         /* on the front, but its time overlaps another front point's */
+    bool judged, pdiff_pass; /* speed_accuracy: PerceptualDiff ran, and passed */
+    bool noisy;        /* the point's run was disturbed (sweep rows with interference) */
+    double other_share;
+    int tag;           /* label left out: its number in the key under the chart (0: none) */
+    char tagtext[32];  /* the numbers drawn next to this point ("3" or "3,4": near points) */
+    double tx, ty;     /* where tagtext is drawn (baseline start) */
 };
 
 /* A horizontal level: the reference where it has no x of its own. */
@@ -62,6 +71,16 @@ struct chart {
     int nlevels;
     int labels_left_out;
     struct axis ax, ay;
+    bool quality_y, flip;  /* speed_accuracy: y is worst SSIM (or FLIP) */
+    bool has_jnd;          /* PerceptualDiff's verdicts separate at jnd_y */
+    double jnd_y;
+    bool any_noisy, any_pdiff_fail, any_tied;
+    char pdiff_note[160];  /* how PerceptualDiff relates to the y axis */
+    /* Lines under the plot: the key of left-out labels, points not drawn,
+     * a partial sweep. */
+    char footer[96][160];
+    int nfooter, footer_left_out;
+    char partial[160];     /* "" or why the sweep is partial */
 };
 
 const char *charts_default_series(const json_t *device)
@@ -212,7 +231,9 @@ static void polyline_by_x(cairo_t *cr, const struct chart *c, int series, int w,
 }
 
 /* ---- label placement: greedy, first free spot among eight around the
- * point; a label that fits nowhere is left out (and counted). ---- */
+ * point; a label that fits nowhere gets a number instead, drawn next to the
+ * point (one tag for points that sit on top of each other), and its full
+ * label in the key under the chart: every point is named somewhere. ---- */
 
 struct rect {
     double x, y, w, h;
@@ -223,10 +244,46 @@ static bool overlaps(struct rect a, struct rect b)
     return a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h && b.y < a.y + a.h;
 }
 
+/* The first of eight spots around (x, y) for a w x h box inside the frame
+ * that overlaps nothing taken; false when none is free. */
+static bool free_spot(double x, double y, double w, double h, const struct frame *f,
+                      const struct rect *taken, int nt, struct rect *out)
+{
+    const double cand[8][2] = {
+        {x + 9, y - 7 - h},      {x + 9, y + 7},      {x - 9 - w, y - 7 - h}, {x - 9 - w, y + 7},
+        {x - w / 2, y - 9 - h},  {x - w / 2, y + 9},  {x + 9, y - h / 2},     {x - 9 - w, y - h / 2},
+    };
+    for (int k = 0; k < 8; k++) {
+        struct rect r = {cand[k][0], cand[k][1], w, h};
+        bool ok = r.x >= f->x0 + 1 && r.x + r.w <= f->x1 - 1 && r.y >= f->y1 + 1 &&
+                  r.y + r.h <= f->y0 - 1;
+        for (int t = 0; ok && t < nt; t++)
+            ok = !overlaps(r, taken[t]);
+        if (ok) {
+            *out = r;
+            return true;
+        }
+    }
+    return false;
+}
+
+static void add_footer(struct chart *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void add_footer(struct chart *c, const char *fmt, ...)
+{
+    if (c->nfooter == (int)(sizeof(c->footer) / sizeof(c->footer[0]))) {
+        c->footer_left_out++;
+        return;
+    }
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(c->footer[c->nfooter++], sizeof(c->footer[0]), fmt, ap);
+    va_end(ap);
+}
+
 static void place_labels(cairo_t *cr, struct chart *c, const struct frame *f)
 {
     cairo_set_font_size(cr, 11);
-    struct rect *taken = calloc((size_t)c->n * 4 + 1, sizeof(*taken));
+    struct rect *taken = calloc((size_t)c->n * 5 + 1, sizeof(*taken));
     if (!taken)
         return;
     int nt = 0;
@@ -250,24 +307,50 @@ static void place_labels(cairo_t *cr, struct chart *c, const struct frame *f)
             continue;
         cairo_text_extents_t e;
         cairo_text_extents(cr, p->label, &e);
-        double w = e.x_advance + 2, h = 13, x = px(c, f, p->x), y = py(c, f, p->y);
-        const double cand[8][2] = {
-            {x + 9, y - 7 - h},      {x + 9, y + 7},      {x - 9 - w, y - 7 - h}, {x - 9 - w, y + 7},
-            {x - w / 2, y - 9 - h},  {x - w / 2, y + 9},  {x + 9, y - h / 2},     {x - 9 - w, y - h / 2},
-        };
-        for (int k = 0; k < 8 && !p->placed; k++) {
-            struct rect r = {cand[k][0], cand[k][1], w, h};
-            bool ok = r.x >= f->x0 + 1 && r.x + r.w <= f->x1 - 1 && r.y >= f->y1 + 1 &&
-                      r.y + r.h <= f->y0 - 1;
-            for (int t = 0; ok && t < nt; t++)
-                ok = !overlaps(r, taken[t]);
-            if (ok) {
-                p->placed = true;
-                p->lx = r.x, p->ly = r.y, p->lw = r.w, p->lh = r.h;
-                taken[nt++] = r;
-            }
+        struct rect r;
+        if (free_spot(px(c, f, p->x), py(c, f, p->y), e.x_advance + 2, 13, f, taken, nt, &r)) {
+            p->placed = true;
+            p->lx = r.x, p->ly = r.y, p->lw = r.w, p->lh = r.h;
+            taken[nt++] = r;
         }
         c->labels_left_out += !p->placed;
+    }
+    /* Numbers for the rest; points within a marker of each other share one
+     * tag ("3,4"), drawn by the first of them. */
+    int next = 0;
+    for (int i = 0; i < c->n; i++) {
+        struct point *p = &c->pts[i];
+        if (!p->label[0] || p->placed)
+            continue;
+        p->tag = ++next;
+        double x = px(c, f, p->x), y = py(c, f, p->y);
+        struct point *lead = p;
+        for (int j = 0; j < i; j++) {
+            struct point *q = &c->pts[j];
+            if (q->tag && q->tagtext[0] && fabs(px(c, f, q->x) - x) < 10 &&
+                fabs(py(c, f, q->y) - y) < 10) {
+                lead = q;
+                break;
+            }
+        }
+        size_t used = strlen(lead->tagtext);
+        snprintf(lead->tagtext + used, sizeof(lead->tagtext) - used, "%s%d", used ? "," : "",
+                 p->tag);
+    }
+    cairo_set_font_size(cr, 10);
+    for (int i = 0; i < c->n; i++) {
+        struct point *p = &c->pts[i];
+        if (!p->tagtext[0])
+            continue;
+        cairo_text_extents_t e;
+        cairo_text_extents(cr, p->tagtext, &e);
+        double x = px(c, f, p->x), y = py(c, f, p->y);
+        struct rect r = {x + 7, y - 16, e.x_advance + 2, 11};
+        /* Where no spot is free the tag still goes next to its point: a
+         * number over something beats a point without a name. */
+        if (free_spot(x, y, e.x_advance + 2, 11, f, taken, nt, &r))
+            taken[nt++] = r;
+        p->tx = r.x + 1, p->ty = r.y + r.h - 2;
     }
     free(taken);
 }
@@ -281,14 +364,11 @@ static void diamond(cairo_t *cr, double x, double y, double r)
     cairo_close_path(cr);
 }
 
-static void draw(cairo_t *cr, struct chart *c)
+/* The plot's frame: with many categories, labels slanted, with room made
+ * for them below and to the left, so that they overlap neither each other
+ * nor the axis title nor the edge. */
+static struct frame frame_of(cairo_t *cr, const struct chart *c, double *angle_out)
 {
-    cairo_set_source_rgb(cr, 1, 1, 1);
-    cairo_paint(cr);
-    cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
-    /* Many categories: labels slanted, with room made for them below and
-     * to the left, so that they overlap neither each other nor the axis
-     * title nor the edge. */
     double left = LEFT, bottom = BOTTOM, angle = 0;
     if (c->categorical_x && c->ncategories > 4) {
         angle = 0.6;
@@ -303,7 +383,17 @@ static void draw(cairo_t *cr, struct chart *c)
         left = fmin(left, WIDTH / 3.0);
         bottom = fmin(bottom, HEIGHT / 2.0);
     }
-    const struct frame f = {left, WIDTH - RIGHT, HEIGHT - bottom, TOP};
+    *angle_out = angle;
+    return (struct frame){left, WIDTH - RIGHT, HEIGHT - bottom, TOP};
+}
+
+static void draw(cairo_t *cr, struct chart *c)
+{
+    cairo_set_source_rgb(cr, 1, 1, 1);
+    cairo_paint(cr);
+    cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+    double angle;
+    const struct frame f = frame_of(cr, c, &angle);
 
     char buf[64];
     double tv[64];
@@ -389,6 +479,24 @@ static void draw(cairo_t *cr, struct chart *c)
         text(cr, f.x1 - 4, y - 4, l->label, 11, 1.0);
     }
 
+    /* PerceptualDiff's just-noticeable difference, where its verdicts
+     * separate along y: every point on the passing side passed. */
+    if (c->has_jnd) {
+        double y = py(c, &f, c->jnd_y);
+        double dash[] = {3, 3};
+        cairo_set_source_rgb(cr, 0.0, 0.5, 0.2);
+        cairo_set_dash(cr, dash, 2, 0);
+        cairo_set_line_width(cr, 1.2);
+        cairo_move_to(cr, f.x0, y);
+        cairo_line_to(cr, f.x1, y);
+        cairo_stroke(cr);
+        cairo_set_dash(cr, NULL, 0, 0);
+        text(cr, f.x0 + 4, y + (c->flip ? -4 : 12),
+             c->flip ? "PerceptualDiff passes at and below this line (just-noticeable difference)"
+                     : "PerceptualDiff passes at and above this line (just-noticeable difference)",
+             10, 0.0);
+    }
+
     /* Pareto fronts first, under the points: one per workload, each with
      * a dash pattern of its own (named in the legend). */
     static const double DASHES[4][2] = {{6, 4}, {2, 3}, {10, 3}, {4, 2}};
@@ -409,8 +517,6 @@ static void draw(cairo_t *cr, struct chart *c)
         cairo_set_dash(cr, NULL, 0, 0);
     }
 
-    if (!c->boxes && !c->no_markers)
-        place_labels(cr, c, &f);
     for (int s = 0; s < c->nseries; s++) {
         const double *col = PALETTE[s % MAX_SERIES];
         if (c->lines) {
@@ -488,23 +594,52 @@ static void draw(cairo_t *cr, struct chart *c)
             }
             if (p->reference) {
                 diamond(cr, x, y, 6.5);
-                cairo_fill(cr);
             } else {
                 cairo_new_sub_path(cr);
                 cairo_arc(cr, x, y, 4.5, 0, 2 * M_PI);
+            }
+            if (p->judged && !p->pdiff_pass) {
+                /* Hollow: PerceptualDiff sees a difference. */
+                cairo_set_source_rgb(cr, 1, 1, 1);
+                cairo_fill_preserve(cr);
+                cairo_set_source_rgb(cr, col[0], col[1], col[2]);
+                cairo_set_line_width(cr, 2);
+                cairo_stroke(cr);
+            } else {
                 cairo_fill(cr);
             }
             if (p->pareto) {
+                /* On the front; dashed when tied with another front point. */
+                double dash[] = {3, 2};
                 cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
+                cairo_set_line_width(cr, 1.5);
+                cairo_set_dash(cr, dash, p->tied ? 2 : 0, 0);
                 cairo_new_sub_path(cr);
                 cairo_arc(cr, x, y, 9, 0, 2 * M_PI);
                 cairo_stroke(cr);
+                cairo_set_dash(cr, NULL, 0, 0);
+            }
+            if (p->noisy) {
+                double dot[] = {1.5, 2.5};
+                cairo_set_source_rgb(cr, 0.85, 0.35, 0.0);
+                cairo_set_line_width(cr, 1.5);
+                cairo_set_dash(cr, dot, 2, 0);
+                cairo_new_sub_path(cr);
+                cairo_arc(cr, x, y, 13, 0, 2 * M_PI);
+                cairo_stroke(cr);
+                cairo_set_dash(cr, NULL, 0, 0);
             }
             if (p->placed) {
                 cairo_set_source_rgb(cr, 0.15, 0.15, 0.15);
                 cairo_set_font_size(cr, 11);
                 cairo_move_to(cr, p->lx + 1, p->ly + p->lh - 3);
                 cairo_show_text(cr, p->label);
+            }
+            if (p->tagtext[0]) {
+                cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
+                cairo_set_font_size(cr, 10);
+                cairo_move_to(cr, p->tx, p->ty);
+                cairo_show_text(cr, p->tagtext);
             }
         }
     }
@@ -532,8 +667,12 @@ static void draw(cairo_t *cr, struct chart *c)
         cairo_new_sub_path(cr);
         cairo_arc(cr, f.x1 + 20, ly, 8, 0, 2 * M_PI);
         cairo_stroke(cr);
-        text(cr, f.x1 + 32, ly + 4, c->nworkloads > 1 ? "Pareto front, per workload:"
-                                                      : "Pareto front", 12, 0.0);
+        text(cr, f.x1 + 32, ly + 4, c->nworkloads > 1 ? "Pareto front, per workload"
+                                                      : "Pareto front (on", 12, 0.0);
+        if (c->nworkloads <= 1) {
+            ly += 14;
+            text(cr, f.x1 + 32, ly + 4, "intervals, see below)", 12, 0.0);
+        }
         ly += 20;
         for (int w = 0; c->nworkloads > 1 && w < c->nworkloads && w < 8; w++, ly += 18) {
             cairo_set_line_width(cr, 1.5);
@@ -549,12 +688,74 @@ static void draw(cairo_t *cr, struct chart *c)
         }
         ly += 4;
     }
+    /* What the marks mean, for the marks this chart uses. */
+    if (c->any_tied) {
+        double dash[] = {3, 2};
+        cairo_set_dash(cr, dash, 2, 0);
+        cairo_new_sub_path(cr);
+        cairo_arc(cr, f.x1 + 20, ly, 8, 0, 2 * M_PI);
+        cairo_stroke(cr);
+        cairo_set_dash(cr, NULL, 0, 0);
+        text(cr, f.x1 + 32, ly + 4, "tied on the front:", 11, 0.0);
+        text(cr, f.x1 + 32, ly + 17, "times not distinguishable", 11, 0.0);
+        ly += 34;
+    }
+    if (c->any_pdiff_fail) {
+        cairo_set_line_width(cr, 2);
+        cairo_new_sub_path(cr);
+        cairo_arc(cr, f.x1 + 20, ly, 4.5, 0, 2 * M_PI);
+        cairo_stroke(cr);
+        text(cr, f.x1 + 32, ly + 4, "hollow: fails PerceptualDiff", 11, 0.0);
+        ly += 20;
+    }
+    if (c->any_noisy) {
+        double dot[] = {1.5, 2.5};
+        cairo_set_source_rgb(cr, 0.85, 0.35, 0.0);
+        cairo_set_line_width(cr, 1.5);
+        cairo_set_dash(cr, dot, 2, 0);
+        cairo_new_sub_path(cr);
+        cairo_arc(cr, f.x1 + 20, ly, 9, 0, 2 * M_PI);
+        cairo_stroke(cr);
+        cairo_set_dash(cr, NULL, 0, 0);
+        cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
+        text(cr, f.x1 + 32, ly + 4, "dotted: a noisy run", 11, 0.0);
+        text(cr, f.x1 + 32, ly + 17, "(others took CPU)", 11, 0.0);
+        ly += 34;
+    }
     if (c->labels_left_out) {
-        snprintf(buf, sizeof(buf), "%d label%s left out", c->labels_left_out,
+        snprintf(buf, sizeof(buf), "%d label%s numbered:", c->labels_left_out,
                  c->labels_left_out > 1 ? "s" : "");
         text(cr, f.x1 + 12, ly + 4, buf, 11, 0.0);
-        text(cr, f.x1 + 12, ly + 18, "(no room without overlap)", 11, 0.0);
+        text(cr, f.x1 + 12, ly + 18, "the key is under the chart", 11, 0.0);
     }
+}
+
+/* Under the plot: the partial sweep, the key of numbered labels, the
+ * points not drawn; the canvas is made tall enough for them. */
+static void draw_footer(cairo_t *cr, const struct chart *c)
+{
+    double y = HEIGHT + 4;
+    cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+    for (int i = 0; i < c->nfooter; i++, y += FOOTER_LINE) {
+        bool warn = !strncmp(c->footer[i], "Not drawn", 9) || !strncmp(c->footer[i], "PARTIAL", 7);
+        if (warn)
+            cairo_set_source_rgb(cr, 0.7, 0.0, 0.0);
+        else
+            cairo_set_source_rgb(cr, 0.15, 0.15, 0.15);
+        text(cr, LEFT - 60, y, c->footer[i], 11, 0.0);
+    }
+    if (c->footer_left_out) {
+        char buf[96];
+        snprintf(buf, sizeof(buf), "... and %d more lines: see the report's table",
+                 c->footer_left_out);
+        text(cr, LEFT - 60, y, buf, 11, 0.0);
+    }
+}
+
+static int footer_height(const struct chart *c)
+{
+    int lines = c->nfooter + (c->footer_left_out > 0);
+    return lines ? (int)(lines * FOOTER_LINE + 10) : 0;
 }
 
 /* ---- output ---- */
@@ -593,6 +794,11 @@ static json_t *layout_json(const struct chart *c)
         json_object_set_new(o, "label_box", p->placed ? json_pack("[f, f, f, f]", p->lx, p->ly,
                                                                   p->lw, p->lh)
                                                       : json_null());
+        json_object_set_new(o, "tag", p->tag ? json_integer(p->tag) : json_null());
+        json_object_set_new(o, "tied", json_boolean(p->tied));
+        json_object_set_new(o, "noisy", json_boolean(p->noisy));
+        if (p->judged)
+            json_object_set_new(o, "pdiff_pass", json_boolean(p->pdiff_pass));
         json_array_append_new(pts, o);
     }
     for (int w = 0; w < c->nworkloads; w++) {
@@ -608,10 +814,18 @@ static json_t *layout_json(const struct chart *c)
         json_array_append_new(levels, json_pack("{s:s, s:f, s:f, s:f}", "label", c->levels[i].label,
                                                 "y", c->levels[i].y, "lo", c->levels[i].lo, "hi",
                                                 c->levels[i].hi));
-    return json_pack("{s:s, s:s, s:s, s:s, s:b, s:b, s:o, s:o, s:o, s:o, s:i}", "chart", c->name,
-                     "subtitle", c->subtitle, "xlabel", c->xlabel, "ylabel", c->ylabel, "x_log",
-                     c->ax.log, "y_log", c->ay.log, "points", pts, "workloads", workloads,
-                     "fronts", fronts, "levels", levels, "labels_left_out", c->labels_left_out);
+    json_t *footer = json_array();
+    for (int i = 0; i < c->nfooter; i++)
+        json_array_append_new(footer, json_string(c->footer[i]));
+    json_t *out = json_pack("{s:s, s:s, s:s, s:s, s:s, s:b, s:b, s:o, s:o, s:o, s:o, s:i, s:o, "
+                            "s:s, s:[f, f]}", "chart", c->name, "title", c->title,
+                            "subtitle", c->subtitle, "xlabel", c->xlabel, "ylabel", c->ylabel,
+                            "x_log", c->ax.log, "y_log", c->ay.log, "points", pts, "workloads",
+                            workloads, "fronts", fronts, "levels", levels, "labels_left_out",
+                            c->labels_left_out, "footer", footer, "partial", c->partial,
+                            "y_range", c->ay.lo, c->ay.hi);
+    json_object_set_new(out, "jnd", c->has_jnd ? json_real(c->jnd_y) : json_null());
+    return out;
 }
 
 /* The layout as JSON inside <metadata>, before the closing </svg>. */
@@ -697,17 +911,61 @@ static void fit_axes(struct chart *c)
     c->ax = c->categorical_x ? (struct axis){-0.5, c->ncategories - 0.5, false}
                              : make_axis(x_log_ok ? xpos : xl, xh, x_log_ok, sa);
     c->ay = make_axis(y_log_ok ? ypos : yl, yh, y_log_ok, !sa);
+    if (c->quality_y) {
+        /* From the worst score, or from 0.99 (FLIP 0.01) when every score is
+         * better, to exact: a difference of 1e-5 stays a hair, not a cliff. */
+        double lo = c->flip ? 0.0 : fmin(c->n ? yl : 1.0, 0.99);
+        double hi = c->flip ? fmax(c->n ? yh : 0.0, 0.01) : 1.0;
+        double pad = (hi - lo) * 0.06;
+        c->ay = (struct axis){lo - pad, hi + pad, false};
+    }
+}
+
+/* Before drawing, on a scratch surface: where the labels go and which
+ * get numbers, so that the key under the chart, and so its height, are
+ * known when the real surface is made. */
+static void layout(struct chart *c)
+{
+    if (c->boxes || c->no_markers)
+        return;
+    cairo_surface_t *scratch = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, 1, 1);
+    cairo_t *cr = cairo_create(scratch);
+    cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+    double angle;
+    struct frame f = frame_of(cr, c, &angle);
+    place_labels(cr, c, &f);
+    cairo_destroy(cr);
+    cairo_surface_destroy(scratch);
+    bool first = true;
+    for (int i = 0; i < c->n; i++) {
+        const struct point *p = &c->pts[i];
+        if (!p->tag)
+            continue;
+        char where[48];
+        if (c->boxes || c->categorical_x)
+            snprintf(where, sizeof(where), "%.4g ms", p->y);
+        else if (c->quality_y)
+            snprintf(where, sizeof(where), "%.4g ms, %s %.6g", p->x, c->flip ? "FLIP" : "SSIM", p->y);
+        else
+            snprintf(where, sizeof(where), "x %.4g, %.4g ms", p->x, p->y);
+        add_footer(c, "%s%d: %.20s%s%.80s (%s)", first ? "Key: " : "     ", p->tag,
+                   c->series[p->series], p->label[0] ? ", " : "", p->label, where);
+        first = false;
+    }
 }
 
 static char *render(struct chart *c, enum chart_format format, size_t *len)
 {
     fit_axes(c);
+    layout(c);
+    int height = HEIGHT + footer_height(c);
     struct sink sink = {0};
     cairo_surface_t *surface =
-        format == CHART_SVG ? cairo_svg_surface_create_for_stream(collect, &sink, WIDTH, HEIGHT)
-                            : cairo_image_surface_create(CAIRO_FORMAT_ARGB32, WIDTH, HEIGHT);
+        format == CHART_SVG ? cairo_svg_surface_create_for_stream(collect, &sink, WIDTH, height)
+                            : cairo_image_surface_create(CAIRO_FORMAT_ARGB32, WIDTH, height);
     cairo_t *cr = cairo_create(surface);
     draw(cr, c);
+    draw_footer(cr, c);
     cairo_destroy(cr);
     if (format == CHART_PNG)
         cairo_surface_write_to_png_stream(surface, collect, &sink);
@@ -735,35 +993,6 @@ static int series_of(struct chart *c, const char *name)
     return c->nseries++;
 }
 
-static bool workload_key(const char *path)
-{
-    return !strncmp(path, "scene.", 6) || !strcmp(path, "frames") || !strcmp(path, "warmup_frames");
-}
-
-/* The workload a row measures: its swept scene.*, frames and warmup_frames
- * values ("" when none is swept). Points are comparable only within one. */
-static int workload_of(struct chart *c, const json_t *values)
-{
-    char key[128] = "";
-    const char *k;
-    json_t *v;
-    json_object_foreach((json_t *)values, k, v) {
-        if (!workload_key(k))
-            continue;
-        char *t = json_dumps(v, JSON_ENCODE_ANY);
-        size_t used = strlen(key);
-        snprintf(key + used, sizeof(key) - used, "%s%s=%s", used ? ", " : "", k, t ? t : "?");
-        free(t);
-    }
-    for (int w = 0; w < c->nworkloads; w++)
-        if (!strcmp(c->workloads[w], key))
-            return w;
-    if (c->nworkloads == MAX_WORKLOADS)
-        return MAX_WORKLOADS - 1;
-    snprintf(c->workloads[c->nworkloads], sizeof(c->workloads[0]), "%s", key);
-    return c->nworkloads++;
-}
-
 /* "async_distance=5, lights=8" without the technique (it is the series). */
 static void values_label(const json_t *values, char *out, size_t cap)
 {
@@ -773,7 +1002,7 @@ static void values_label(const json_t *values, char *out, size_t cap)
     json_object_foreach((json_t *)values, key, v) {
         if (strcmp(key, "technique") == 0)
             continue;
-        char *t = json_dumps(v, JSON_ENCODE_ANY);
+        char *t = json_dumps(v, JSON_ENCODE_ANY | SV_DUMP_REALS);
         size_t used = strlen(out);
         const char *short_key = strrchr(key, '.') ? strrchr(key, '.') + 1 : key;
         snprintf(out + used, cap - used, "%s%s=%s", used ? ", " : "", short_key, t ? t : "?");
@@ -786,25 +1015,63 @@ static double num(const json_t *v, double fallback)
     return json_is_number(v) ? json_number_value(v) : fallback;
 }
 
-/* The sweep's reference technique: the base job's, else forward. */
-static const char *sweep_reference(const json_t *sweep)
+/* The quality axis and PerceptualDiff's line on it: y from the worst score
+ * (or 0.99 when every score is better, so that differences of 1e-5 are not
+ * drawn as a cliff) to exact; the line where PerceptualDiff's verdicts
+ * separate, when they do. */
+static void quality_axis(struct chart *c)
 {
-    const json_t *base = json_object_get(json_object_get(sweep, "spec"), "base");
-    const char *r = json_string_value(json_object_get(base, "reference"));
-    return r ? r : "forward";
+    double worst_pass = c->flip ? -INFINITY : INFINITY, best_fail = c->flip ? INFINITY : -INFINITY;
+    int pass = 0, fail = 0;
+    for (int i = 0; i < c->n; i++) {
+        const struct point *p = &c->pts[i];
+        if (!p->judged)
+            continue;
+        if (p->pdiff_pass) {
+            pass++;
+            worst_pass = c->flip ? fmax(worst_pass, p->y) : fmin(worst_pass, p->y);
+        } else {
+            fail++;
+            best_fail = c->flip ? fmin(best_fail, p->y) : fmax(best_fail, p->y);
+        }
+    }
+    c->any_pdiff_fail = fail > 0;
+    bool separate = pass && fail && (c->flip ? worst_pass < best_fail : worst_pass > best_fail);
+    if (separate) {
+        c->has_jnd = true;
+        c->jnd_y = worst_pass;
+        snprintf(c->pdiff_note, sizeof(c->pdiff_note), "PerceptualDiff passes from %s %.6g on",
+                 c->flip ? "FLIP" : "SSIM", worst_pass);
+    } else if (pass && fail) {
+        snprintf(c->pdiff_note, sizeof(c->pdiff_note), "PerceptualDiff's verdicts do not follow "
+                 "%s here: hollow points fail it", c->flip ? "FLIP" : "SSIM");
+    } else if (pass || fail) {
+        snprintf(c->pdiff_note, sizeof(c->pdiff_note), "every judged point %s PerceptualDiff",
+                 pass ? "passes" : "fails");
+    }
 }
 
-/* A time with its interval, cut at zero: times are never negative, and an
- * interval below zero (few runs, Student's t) says only "very uncertain". */
-static void time_interval(const json_t *cell, double *v, double *lo, double *hi, bool *clamped)
+/* What could not be drawn, and a partial sweep, under the chart. */
+static void missing_footer(struct chart *c, const struct sweep_view *v, bool sa, bool flip)
 {
-    *v = num(json_object_get(cell, RK_MEDIAN), NAN);
-    json_t *ci = json_object_get(cell, RK_CI95);
-    *lo = num(json_array_get(ci, 0), *v);
-    *hi = num(json_array_get(ci, 1), *v);
-    *clamped = *lo < 0;
-    if (*clamped)
-        *lo = 0;
+    if (v->partial) {
+        snprintf(c->partial, sizeof(c->partial), "partial sweep: %s, %lld of %lld points ran",
+                 v->status, (long long)(v->n - v->not_done), (long long)v->points_total);
+        add_footer(c, "PARTIAL sweep (%s): %d of %lld planned points finished; the chart shows "
+                   "only those", v->status, v->n - v->not_done, (long long)v->points_total);
+    }
+    for (int i = 0; i < v->n; i++) {
+        const struct sv_point *p = &v->pts[i];
+        bool no_quality = sa && p->timed && !(flip ? p->has_flip : p->has_ssim);
+        if (p->timed && !no_quality)
+            continue;
+        add_footer(c, "Not drawn: %.20s%s%.80s (%s)", p->technique, p->label[0] ? ", " : "",
+                   p->label, strcmp(p->status, "done") != 0 ? p->status
+                             : no_quality ? "not judged: no reference" : "no time");
+    }
+    if (v->not_run)
+        add_footer(c, "Not drawn: %d planned point%s not run", v->not_run,
+                   v->not_run == 1 ? "" : "s");
 }
 
 char *charts_sweep(const json_t *sweep, const char *name, enum chart_format format,
@@ -817,47 +1084,55 @@ char *charts_sweep(const json_t *sweep, const char *name, enum chart_format form
         return NULL;
     }
     const char *series = o->series ? o->series : charts_default_series(o->device);
-    const char *ref = sweep_reference(sweep);
-    json_t *points = json_object_get(sweep, "points");
+    /* The same reading of the table as the verdict's (sweep_verdict.h):
+     * workloads, intervals, the front. */
+    struct sweep_view v;
     struct chart c;
     memset(&c, 0, sizeof(c));
     c.name = name;
-    c.pts = calloc(json_array_size(points) + 1, sizeof(*c.pts));
-    if (!c.pts) {
+    if (!sweep_view_init(&v, sweep, series) ||
+        !(c.pts = calloc((size_t)v.n + 1, sizeof(*c.pts)))) {
+        sweep_view_finish(&v);
         snprintf(err, errlen, "out of memory");
         return NULL;
     }
-    /* The x axis: the first numeric swept parameter, as the report's
+    if (sa)
+        sweep_view_front(&v, o->flip);
+    c.nworkloads = v.nworkloads;
+    for (int w = 0; w < v.nworkloads; w++)
+        snprintf(c.workloads[w], sizeof(c.workloads[0]), "%s", v.workloads[w]);
+    /* The x axis: the first numeric swept parameter, as the verdict's
      * crossovers use (a sweep over technique and light count charts time
      * against the light count, a line per technique); with none, the first
      * swept parameter other than a timed reference point's technique. */
-    const char *param = NULL, *numeric = NULL;
-    size_t i;
-    json_t *row;
-    json_array_foreach(points, i, row) {
+    const char *param = v.param;
+    for (int i = 0; i < v.n && !param; i++) {
+        const json_t *values = json_object_get(v.pts[i].row, "values");
         const char *key;
-        json_t *v;
-        json_object_foreach(json_object_get(row, "values"), key, v) {
-            if (!param && !(strcmp(key, "technique") == 0 &&
-                            json_object_size(json_object_get(row, "values")) == 1))
+        json_t *val;
+        json_object_foreach((json_t *)values, key, val) {
+            if (!param && !(strcmp(key, "technique") == 0 && json_object_size(values) == 1))
                 param = key;
-            if (!numeric && json_is_number(v))
-                numeric = key;
         }
     }
-    if (numeric)
-        param = numeric;
     c.x_log_ok = sa;
     c.x_log_param = tvp;
+    c.quality_y = sa;
+    c.flip = o->flip;
+    missing_footer(&c, &v, sa, o->flip);
     bool any_runs = false;
-    json_array_foreach(points, i, row) {
-        json_t *t = json_object_get(row, series);
-        if (!t || !json_is_number(json_object_get(t, RK_MEDIAN)))
-            continue; /* a failed or cancelled point */
+    for (int k = 0; k < v.n; k++) {
+        const struct sv_point *sp = &v.pts[k];
+        if (!sp->timed)
+            continue; /* a failed or cancelled point: named under the chart */
+        const json_t *t = json_object_get(sp->row, series);
+        const char *tech = sp->technique;
+        const json_t *values = json_object_get(sp->row, "values");
         struct point *p = &c.pts[c.n];
-        const char *tech = json_string_value(json_object_get(row, "technique"));
-        json_t *values = json_object_get(row, "values");
-        p->reference = tech && !strcmp(tech, ref);
+        p->reference = sp->reference;
+        p->noisy = sp->noisy;
+        p->other_share = sp->other_share;
+        c.any_noisy = c.any_noisy || sp->noisy;
         char sname[96], others[64] = "";
         if (tvp) {
             /* A line per technique and per value of the other swept
@@ -868,22 +1143,24 @@ char *charts_sweep(const json_t *sweep, const char *name, enum chart_format form
             values_label(rest, others, sizeof(others));
             json_decref(rest);
         }
-        snprintf(sname, sizeof(sname), "%.20s%s%s%.24s", tech ? tech : "?",
-                 p->reference ? " (reference)" : "", others[0] ? " " : "", others);
-        p->workload = workload_of(&c, values);
-        double median, lo, hi;
-        time_interval(t, &median, &lo, &hi, &p->lo_clamped);
+        snprintf(sname, sizeof(sname), "%.20s%s%s%.24s", tech, p->reference ? " (reference)" : "",
+                 others[0] ? " " : "", others);
+        p->workload = sp->workload;
+        double median = sp->ms, lo = sp->lo, hi = sp->hi;
+        p->lo_clamped = sp->lo_clamped;
         if (!(tvp && p->reference && !(param && json_object_get(values, param))))
             p->series = series_of(&c, sname);
         if (sa) {
-            json_t *q = json_object_get(row, o->flip ? RK_WORST_FLIP : RK_WORST_SSIM);
-            if (!json_is_number(q) && !p->reference)
-                continue;
-            /* The reference against itself: SSIM 1, FLIP 0, exactly. */
-            double qv = json_is_number(q) ? json_number_value(q) : (o->flip ? 0.0 : 1.0);
+            if (!(o->flip ? sp->has_flip : sp->has_ssim))
+                continue; /* not judged: named under the chart */
             p->x = median, p->x_lo = lo, p->x_hi = hi;
-            p->y = p->y_lo = p->y_hi = qv;
-            values_label(values, p->label, sizeof(p->label));
+            p->y = p->y_lo = p->y_hi = o->flip ? sp->flip : sp->ssim;
+            p->pareto = sp->pareto;
+            p->tied = sp->tied;
+            c.any_tied = c.any_tied || sp->tied;
+            p->judged = sp->judged;
+            p->pdiff_pass = sp->pdiff_pass;
+            snprintf(p->label, sizeof(p->label), "%.63s", sp->label);
             if (p->reference) {
                 char wl[64];
                 snprintf(wl, sizeof(wl), "%s", p->label);
@@ -896,10 +1173,8 @@ char *charts_sweep(const json_t *sweep, const char *name, enum chart_format form
                 if (c.nlevels < MAX_LEVELS) {
                     struct level *l = &c.levels[c.nlevels++];
                     l->y = median, l->lo = lo, l->hi = hi;
-                    char wl[64];
-                    values_label(values, wl, sizeof(wl));
                     snprintf(l->label, sizeof(l->label), "%.20s (reference)%s%.30s", tech,
-                             wl[0] ? " " : "", wl);
+                             sp->label[0] ? " " : "", sp->label);
                 }
                 continue;
             }
@@ -907,29 +1182,27 @@ char *charts_sweep(const json_t *sweep, const char *name, enum chart_format form
                 p->x = p->x_lo = p->x_hi = json_number_value(pv);
             } else {
                 c.categorical_x = true;
-                char *text = json_dumps(pv, JSON_ENCODE_ANY);
-                int k = 0;
-                while (k < c.ncategories && strcmp(c.categories[k], text ? text : "?") != 0)
-                    k++;
-                if (k == c.ncategories && c.ncategories < 64)
+                char *text = json_dumps(pv, JSON_ENCODE_ANY | SV_DUMP_REALS);
+                int q = 0;
+                while (q < c.ncategories && strcmp(c.categories[q], text ? text : "?") != 0)
+                    q++;
+                if (q == c.ncategories && c.ncategories < 64)
                     snprintf(c.categories[c.ncategories++], sizeof(c.categories[0]), "%s", text ? text : "?");
                 free(text);
-                p->x = p->x_lo = p->x_hi = k;
+                p->x = p->x_lo = p->x_hi = q;
             }
             p->y = median, p->y_lo = lo, p->y_hi = hi;
         } else {
             c.boxes = c.categorical_x = true;
             static const char *const keys[6] = {RK_MIN, RK_P5, RK_MEDIAN, RK_P95, RK_P99, RK_MAX};
-            for (int k = 0; k < 6; k++)
-                p->box[k] = num(json_object_get(t, keys[k]), median);
+            for (int q = 0; q < 6; q++)
+                p->box[q] = num(json_object_get(t, keys[q]), median);
             const char *over = json_string_value(json_object_get(t, "over"));
             p->runs_median = over && !strcmp(over, "runs");
             any_runs = any_runs || p->runs_median;
             if (c.ncategories < 64) {
-                char label[64];
-                values_label(values, label, sizeof(label));
                 snprintf(c.categories[c.ncategories], sizeof(c.categories[0]), "%.48s %.60s",
-                         sname, label);
+                         sname, sp->label);
                 p->x = c.ncategories++;
             }
             p->y = median;
@@ -940,29 +1213,21 @@ char *charts_sweep(const json_t *sweep, const char *name, enum chart_format form
     series_note(series, o->device, !o->series, note, sizeof(note));
     snprintf(c.subtitle, sizeof(c.subtitle), "%s", note);
     if (sa) {
+        quality_axis(&c);
         snprintf(c.title, sizeof(c.title), "Speed against accuracy");
         snprintf(c.xlabel, sizeof(c.xlabel), "median %s, ms (95%% interval)", series);
         snprintf(c.ylabel, sizeof(c.ylabel), o->flip ? "worst mean FLIP (lower is better)"
                                                      : "worst SSIM (higher is better)");
-        /* Pareto within each workload only: nothing of the same workload
-         * both faster and at least as accurate. */
-        for (int a = 0; a < c.n; a++) {
-            c.pts[a].pareto = true;
-            for (int b = 0; b < c.n && c.pts[a].pareto; b++) {
-                if (a == b || c.pts[b].workload != c.pts[a].workload)
-                    continue;
-                bool better_q = o->flip ? c.pts[b].y <= c.pts[a].y : c.pts[b].y >= c.pts[a].y;
-                bool strictly = c.pts[b].x < c.pts[a].x ||
-                                (o->flip ? c.pts[b].y < c.pts[a].y : c.pts[b].y > c.pts[a].y);
-                if (c.pts[b].x <= c.pts[a].x && better_q && strictly)
-                    c.pts[a].pareto = false;
-            }
-        }
         if (c.nworkloads > 1) {
             size_t used = strlen(c.subtitle);
             snprintf(c.subtitle + used, sizeof(c.subtitle) - used, "; a front per workload (%d)",
                      c.nworkloads);
         }
+        if (c.pdiff_note[0])
+            add_footer(&c, "%s.", c.pdiff_note);
+        add_footer(&c, "Pareto front: nothing of the same workload is measurably faster (its "
+                   "95%% interval separate) and at least as accurate, or as fast and more "
+                   "accurate.");
     } else if (tvp) {
         c.lines = !c.categorical_x;
         snprintf(c.title, sizeof(c.title), "Frame time against %s", param ? param : "the parameter");
@@ -975,8 +1240,13 @@ char *charts_sweep(const json_t *sweep, const char *name, enum chart_format form
                  : "box p5-p95, line median, tick p99, whiskers min-max");
         snprintf(c.ylabel, sizeof(c.ylabel), "%s, ms", series);
     }
+    if (c.partial[0]) {
+        size_t used = strlen(c.title);
+        snprintf(c.title + used, sizeof(c.title) - used, " (%s)", c.partial);
+    }
     char *out = render(&c, format, len);
     free(c.pts);
+    sweep_view_finish(&v);
     if (!out)
         snprintf(err, errlen, "cairo could not draw the chart");
     return out;

@@ -10,6 +10,8 @@
 
 #include "config.h"
 #include "daemon/api/charts.h"
+#include "daemon/api/sweep_verdict.h"
+#include "daemon/harness/interference.h" /* INTERFERENCE_RULE */
 #include "common/job_files.h"
 #include "common/png_io.h"
 #include "common/result_keys.h"
@@ -132,7 +134,7 @@ static void chart(struct html *h, const json_t *subject, const char *name, bool 
 
 static void json_block(struct html *h, const json_t *v)
 {
-    char *text = json_dumps(v, JSON_INDENT(2) | JSON_PRESERVE_ORDER);
+    char *text = json_dumps(v, JSON_INDENT(2) | JSON_PRESERVE_ORDER | SV_DUMP_REALS);
     add(h, "<pre>");
     escaped(h, text);
     add(h, "</pre>");
@@ -156,6 +158,7 @@ static void head(struct html *h, const char *title, const json_t *device)
            "th,td{border:1px solid #ccc;padding:4px 8px;text-align:right}"
            "th{background:#f0f0f0}td.l,th.l{text-align:left}"
            ".fail{color:#b00;font-weight:bold}.pass{color:#070}"
+           ".noisy{color:#a50;font-weight:bold}.partial{background:#fff3cd;padding:0.5em}"
            "img.chart{max-width:100%%;border:1px solid #ddd;margin:0.5em 0}"
            "figure{display:inline-block;margin:4px;text-align:center;font-size:12px}"
            "img.thumb{display:block;border:1px solid #ccc}"
@@ -199,221 +202,138 @@ static void num_cell(struct html *h, const json_t *v, const char *fmt)
 
 /* ---- the verdict of a sweep ---- */
 
-static bool workload_key(const char *k)
+/* A swept value or a spec for people: reals to 9 significant digits (0.1,
+ * not 0.10000000000000001). */
+static char *dump(const json_t *v, size_t flags)
 {
-    return !strncmp(k, "scene.", 6) || !strcmp(k, "frames") || !strcmp(k, "warmup_frames");
+    return json_dumps(v, flags | JSON_ENCODE_ANY | SV_DUMP_REALS);
 }
 
-/* "key=value, ..." of the values that pass keep(key), in their order. */
-static void values_text(const json_t *values, bool (*keep)(const char *key, const char *skip),
-                        const char *skip, char *out, size_t cap)
+/* The first max names of a list, "a, b and 3 more", after lead. */
+static void name_list(struct html *h, const json_t *names, size_t max, const char *lead)
 {
-    out[0] = '\0';
-    const char *k;
-    json_t *v;
-    json_object_foreach((json_t *)values, k, v) {
-        if (!keep(k, skip))
-            continue;
-        char *t = json_dumps(v, JSON_ENCODE_ANY);
-        size_t used = strlen(out);
-        snprintf(out + used, cap - used, "%s%s=%s", used ? ", " : "", k, t ? t : "?");
-        free(t);
-    }
-}
-
-static bool keep_workload(const char *k, const char *skip)
-{
-    return workload_key(k) && (!skip || strcmp(k, skip) != 0);
-}
-
-static bool keep_variant(const char *k, const char *skip)
-{
-    return !workload_key(k) && strcmp(k, "technique") != 0 && (!skip || strcmp(k, skip) != 0);
-}
-
-static double row_ms(const json_t *row, const char *series)
-{
-    json_t *m = json_object_get(json_object_get(row, series), RK_MEDIAN);
-    return json_is_number(m) ? json_number_value(m) : NAN;
-}
-
-/* Adds crossovers between two curves {"name", "workload", "flat", "xs",
- * "ys"} to list. A flat curve (the reference, timed once per workload)
- * holds its value at every x of the other. */
-static void cross(const json_t *a, const json_t *b, const char *param, json_t *list)
-{
-    json_t *xa = json_object_get(a, "xs"), *ya = json_object_get(a, "ys");
-    json_t *xb = json_object_get(b, "xs"), *yb = json_object_get(b, "ys");
-    bool fa = json_is_true(json_object_get(a, "flat")), fb = json_is_true(json_object_get(b, "flat"));
-    if (fa && fb)
-        return;
-    const json_t *xs = fa ? xb : xa;
-    size_t n = json_array_size(xs);
-    double *x = malloc((n + 1) * sizeof(double)), *d = malloc((n + 1) * sizeof(double));
-    size_t k = 0;
-    for (size_t i = 0; x && d && i < n; i++) {
-        double xv = json_number_value(json_array_get(xs, i));
-        double va = NAN, vb = NAN;
-        for (size_t j = 0; j < json_array_size(xa); j++)
-            if (fa || json_number_value(json_array_get(xa, j)) == xv)
-                va = json_number_value(json_array_get(ya, j));
-        for (size_t j = 0; j < json_array_size(xb); j++)
-            if (fb || json_number_value(json_array_get(xb, j)) == xv)
-                vb = json_number_value(json_array_get(yb, j));
-        if (isnan(va) || isnan(vb))
-            continue;
-        /* Insert sorted by x. */
-        size_t at = k;
-        while (at > 0 && x[at - 1] > xv) {
-            x[at] = x[at - 1];
-            d[at] = d[at - 1];
-            at--;
-        }
-        x[at] = xv;
-        d[at] = va - vb;
-        k++;
-    }
-    for (size_t i = 0; i + 1 < k; i++) {
-        if (!(d[i] * d[i + 1] < 0))
-            continue;
-        double at = x[i] + (x[i + 1] - x[i]) * d[i] / (d[i] - d[i + 1]);
-        /* Below the crossing, the curve with the smaller time is faster. */
-        const json_t *below = d[i] < 0 ? a : b, *above = d[i] < 0 ? b : a;
-        json_array_append_new(list, json_pack("{s:O, s:O, s:s, s:[f, f], s:f, s:O}", "faster_below",
-                                              json_object_get(below, "name"), "faster_above",
-                                              json_object_get(above, "name"), "param", param,
-                                              "between", x[i], x[i + 1], "at", at, RK_WORKLOAD,
-                                              json_object_get(a, RK_WORKLOAD)));
-    }
-    free(x);
-    free(d);
-}
-
-json_t *report_sweep_verdict(const json_t *sweep, const char *series)
-{
-    json_t *v = json_pack("{s:s}", "series", series);
-    json_t *result = json_object_get(sweep, RK_RESULT);
-    static const char *const copied[] = {"largest_pdiff_pass", "breaking_point"};
-    for (int i = 0; i < 2; i++)
-        if (json_object_get(result, copied[i]))
-            json_object_set(v, copied[i], json_object_get(result, copied[i]));
-    const json_t *base = json_object_get(json_object_get(sweep, "spec"), "base");
-    const char *ref = json_string_value(json_object_get(base, "reference"));
-    ref = ref ? ref : "forward";
-    json_t *points = json_object_get(sweep, "points");
-    /* The first numeric parameter of the grid. */
-    const char *param = NULL;
     size_t i;
-    json_t *row;
-    json_array_foreach(points, i, row) {
-        const char *k;
-        json_t *val;
-        json_object_foreach(json_object_get(row, "values"), k, val) if (!param && json_is_number(val))
-            param = k;
+    json_t *name;
+    json_array_foreach(names, i, name) {
+        if (i == max) {
+            add(h, " and %zu more", json_array_size(names) - max);
+            break;
+        }
+        add(h, "%s", i ? ", " : lead);
+        escaped(h, json_string_value(name));
     }
-    /* Curves: one per technique and per value of the other parameters. */
-    json_t *curves = json_object();
-    json_t *by_workload = json_object();
-    char name[160], wl[160], key[400];
-    json_array_foreach(points, i, row) {
-        double ms = row_ms(row, series);
-        const char *tech = json_string_value(json_object_get(row, "technique"));
-        json_t *values = json_object_get(row, "values");
-        if (isnan(ms) || !tech)
-            continue;
-        bool is_ref = !strcmp(tech, ref);
-        /* Per workload: the reference against the fastest points. */
-        values_text(values, keep_workload, NULL, wl, sizeof(wl));
-        json_t *w = json_object_get(by_workload, wl);
-        if (!w) {
-            w = json_pack("{s:s, s:s}", RK_WORKLOAD, wl, "reference", ref);
-            json_object_set_new(by_workload, wl, w);
-        }
-        if (is_ref) {
-            json_object_set_new(w, RK_REFERENCE_MS, json_real(ms));
-        } else {
-            json_t *pt = json_pack("{s:s, s:O, s:f}", "technique", tech, "values", values, "ms", ms);
-            json_t *fastest = json_object_get(w, "fastest");
-            if (!fastest || ms < json_number_value(json_object_get(fastest, "ms")))
-                json_object_set(w, "fastest", pt);
-            json_t *pf = json_object_get(row, RK_PDIFF_FAILED_CAPTURES);
-            json_t *fp = json_object_get(w, "fastest_passing");
-            if (json_is_integer(pf) && json_integer_value(pf) == 0 &&
-                (!fp || ms < json_number_value(json_object_get(fp, "ms"))))
-                json_object_set(w, "fastest_passing", pt);
-            json_decref(pt);
-        }
-        if (!param)
-            continue;
-        json_t *pv = json_object_get(values, param);
-        if (pv && !json_is_number(pv))
-            continue;
-        values_text(values, keep_workload, param, wl, sizeof(wl));
-        values_text(values, keep_variant, param, name, sizeof(name));
-        char full[200];
-        snprintf(full, sizeof(full), "%s%s%s%s", tech, is_ref ? " (reference)" : "",
-                 name[0] ? " " : "", name);
-        snprintf(key, sizeof(key), "%s|%s", full, wl);
-        json_t *c = json_object_get(curves, key);
-        if (!c) {
-            c = json_pack("{s:s, s:s, s:b, s:[], s:[]}", "name", full, RK_WORKLOAD, wl, "flat",
-                          pv == NULL, "xs", "ys");
-            json_object_set_new(curves, key, c);
-        }
-        json_array_append_new(json_object_get(c, "xs"), json_real(pv ? json_number_value(pv) : 0));
-        json_array_append_new(json_object_get(c, "ys"), json_real(ms));
+}
+
+/* "x at 12.3 ms: 0.90x the reference (0.85x to 0.95x)", or not
+ * distinguishable when the intervals overlap. */
+static void against_html(struct html *h, const json_t *pt, const char *what)
+{
+    char *vals = dump(json_object_get(pt, "values"), JSON_COMPACT);
+    add(h, "; %s is ", what);
+    escaped(h, str(pt, "technique"));
+    add(h, " ");
+    escaped(h, vals);
+    free(vals);
+    add(h, " at %.3f ms", json_number_value(json_object_get(pt, "ms")));
+    json_t *ci = json_object_get(pt, "ratio_ci");
+    if (json_object_get(pt, "ratio")) {
+        double r = json_number_value(json_object_get(pt, "ratio"));
+        double lo = json_number_value(json_array_get(ci, 0)), hi = json_number_value(json_array_get(ci, 1));
+        char hi_text[32];
+        if (hi > 1e6)
+            snprintf(hi_text, sizeof(hi_text), "any ratio");
+        else
+            snprintf(hi_text, sizeof(hi_text), "%.2f&times;", hi);
+        if (json_is_true(json_object_get(pt, "distinguishable")))
+            add(h, " (<b>%.2f&times;</b> the reference; the intervals allow %.2f&times; to %s)", r,
+                lo, hi_text);
+        else
+            add(h, " (<b>not distinguishable from the reference at this noise</b>: %.2f&times; "
+                   "by the medians, but the intervals allow %.2f&times; to %s)", r, lo, hi_text);
     }
-    json_t *crossovers = json_array();
-    const char *ka, *kb;
-    json_t *a, *b;
-    json_object_foreach(curves, ka, a) {
-        bool after = false;
-        json_object_foreach(curves, kb, b) {
-            if (!strcmp(ka, kb)) {
-                after = true;
-                continue;
-            }
-            if (after && !strcmp(json_string_value(json_object_get(a, RK_WORKLOAD)),
-                                 json_string_value(json_object_get(b, RK_WORKLOAD))))
-                cross(a, b, param, crossovers);
-        }
+    json_t *tied = json_object_get(pt, "tied_with");
+    if (json_array_size(tied)) {
+        add(h, ", as fast as far as the intervals tell as ");
+        name_list(h, tied, 4, "");
     }
-    json_object_set_new(v, "crossovers", crossovers);
-    json_t *against = json_array();
-    const char *k;
-    json_t *w;
-    json_object_foreach(by_workload, k, w) {
-        json_t *rm = json_object_get(w, RK_REFERENCE_MS);
-        static const char *const which[] = {"fastest", "fastest_passing"};
-        for (int j = 0; j < 2 && rm; j++) {
-            json_t *pt = json_object_get(w, which[j]);
-            if (pt)
-                json_object_set_new(pt, "ratio", json_real(json_number_value(json_object_get(pt, "ms")) /
-                                                           json_number_value(rm)));
-        }
-        json_array_append(against, w);
-    }
-    json_object_set_new(v, "against_reference", against);
-    json_decref(curves);
-    json_decref(by_workload);
-    return v;
 }
 
 static void verdict_html(struct html *h, const json_t *v)
 {
-    add(h, "<h2>Verdict</h2><ul class=\"verdict\">");
+    add(h, "<h2>Verdict</h2>");
+    if (json_is_true(json_object_get(v, "partial"))) {
+        add(h, "<p class=\"partial\"><b>A partial sweep</b> (%s): %lld of %lld planned points "
+               "have rows",
+            str(v, "status"),
+            (long long)(json_integer_value(json_object_get(v, "points_total")) -
+                        json_integer_value(json_object_get(v, "not_run"))),
+            (long long)json_integer_value(json_object_get(v, "points_total")));
+        if (json_array_size(json_object_get(v, "missing")))
+            add(h, ", %zu of them did not finish", json_array_size(json_object_get(v, "missing")));
+        add(h, ". The verdict below covers only the points that ran.</p>");
+    }
+    add(h, "<ul class=\"verdict\">");
+    size_t i;
+    json_t *m;
+    json_array_foreach(json_object_get(v, "missing"), i, m) {
+        char *vals = dump(json_object_get(m, "values"), JSON_COMPACT);
+        add(h, "<li class=\"fail\">Not measured: ");
+        escaped(h, str(m, "technique"));
+        add(h, " ");
+        escaped(h, vals);
+        add(h, " (%s", str(m, "status"));
+        if (json_is_string(json_object_get(m, "error"))) {
+            add(h, ": ");
+            escaped(h, str(m, "error"));
+        }
+        add(h, ").</li>");
+        free(vals);
+    }
+    json_t *noisy = json_object_get(v, "noisy");
+    if (json_array_size(noisy)) {
+        double worst = 0;
+        json_array_foreach(noisy, i, m) worst = fmax(worst, json_number_value(json_object_get(m, "other_cpu_share")));
+        add(h, "<li class=\"noisy\"><b>Noise:</b> %zu point%s ran while other processes took CPU "
+               "time", json_array_size(noisy), json_array_size(noisy) == 1 ? "" : "s");
+        if (worst > 0)
+            add(h, " (up to %.0f%% of the machine)", 100 * worst);
+        add(h, "; their times may be inflated, and a comparison involving them is only as good "
+               "as their intervals: ");
+        json_array_foreach(noisy, i, m) {
+            char *vals = dump(json_object_get(m, "values"), JSON_COMPACT);
+            add(h, "%s", i ? ", " : "");
+            escaped(h, str(m, "technique"));
+            add(h, " ");
+            escaped(h, vals);
+            double share = json_number_value(json_object_get(m, "other_cpu_share"));
+            if (share >= 0)
+                add(h, " (%.0f%%)", 100 * share);
+            free(vals);
+        }
+        add(h, ".</li>");
+    }
+    long long judged = json_integer_value(json_object_get(v, "pdiff_judged"));
+    json_t *passing = json_object_get(v, "pdiff_passing");
     json_t *lp = json_object_get(v, "largest_pdiff_pass");
     if (lp) {
-        char *val = json_dumps(json_object_get(lp, "value"), JSON_ENCODE_ANY);
+        char *val = dump(json_object_get(lp, "value"), 0);
         add(h, "<li>Largest <b>");
         escaped(h, str(lp, "param"));
-        add(h, "</b> whose captures all pass PerceptualDiff: <b>%s</b>.</li>",
-            json_is_null(json_object_get(lp, "value")) ? "none passes" : (val ? val : "?"));
+        if (json_is_null(json_object_get(lp, "value")))
+            add(h, "</b> whose captures all pass PerceptualDiff: <b>none</b> of the %lld judged "
+                   "points passes.</li>", judged);
+        else
+            add(h, "</b> whose captures all pass PerceptualDiff: <b>%s</b>.</li>", val ? val : "?");
         free(val);
+    } else if (judged) {
+        add(h, "<li>Points whose captures all pass PerceptualDiff: <b>%zu of %lld</b> judged",
+            json_array_size(passing), judged);
+        name_list(h, passing, 12, ": ");
+        add(h, ".</li>");
     }
     json_t *bp = json_object_get(v, "breaking_point");
     if (bp) {
-        char *val = json_dumps(json_object_get(bp, "value"), JSON_ENCODE_ANY);
+        char *val = dump(json_object_get(bp, "value"), 0);
         add(h, "<li>Breaking point: the largest <b>");
         escaped(h, str(bp, "param"));
         add(h, "</b> at which <b>");
@@ -422,19 +342,57 @@ static void verdict_html(struct html *h, const json_t *v)
             str(bp, "outcome"), (long long)json_integer_value(json_object_get(bp, "probes")));
         free(val);
     }
-    size_t i;
+    json_t *f;
+    json_array_foreach(json_object_get(v, "front"), i, f) {
+        add(h, "<li>Pareto front of speed against worst SSIM");
+        if (str(f, RK_WORKLOAD)[0]) {
+            add(h, " (");
+            escaped(h, str(f, RK_WORKLOAD));
+            add(h, ")");
+        }
+        add(h, ", only where intervals separate: ");
+        size_t k;
+        json_t *p;
+        bool tied = false;
+        json_array_foreach(json_object_get(f, "points"), k, p) {
+            add(h, "%s", k ? ", " : "");
+            escaped(h, str(p, "name"));
+            add(h, " (%.3f ms, SSIM %.6f%s)", json_number_value(json_object_get(p, "ms")),
+                json_number_value(json_object_get(p, RK_WORST_SSIM)),
+                json_is_true(json_object_get(p, "tied")) ? ", tied" : "");
+            tied = tied || json_is_true(json_object_get(p, "tied"));
+        }
+        add(h, "%s.</li>", tied ? "; tied points are equally accurate and their times are not "
+                                  "distinguishable at this noise" : "");
+    }
     json_t *c;
+    size_t stated = 0;
     json_array_foreach(json_object_get(v, "crossovers"), i, c) {
-        add(h, "<li>Crossover on %s: <b>", str(v, "series"));
-        escaped(h, str(c, "faster_below"));
-        add(h, "</b> is faster below <b>");
-        escaped(h, str(c, "param"));
         json_t *bt = json_object_get(c, "between");
-        add(h, " &asymp; %.4g</b> (between %.4g and %.4g), <b>",
-            json_number_value(json_object_get(c, "at")), json_number_value(json_array_get(bt, 0)),
-            json_number_value(json_array_get(bt, 1)));
-        escaped(h, str(c, "faster_above"));
-        add(h, "</b> above it");
+        bool sure = json_is_true(json_object_get(c, "distinguishable"));
+        stated += sure;
+        if (sure) {
+            add(h, "<li>Crossover on %s: <b>", str(v, "series"));
+            escaped(h, str(c, "faster_below"));
+            add(h, "</b> is faster below <b>");
+            escaped(h, str(c, "param"));
+            add(h, " &asymp; %.4g</b> (between %.4g and %.4g, where the intervals separate on "
+                   "both sides), <b>",
+                json_number_value(json_object_get(c, "at")), json_number_value(json_array_get(bt, 0)),
+                json_number_value(json_array_get(bt, 1)));
+            escaped(h, str(c, "faster_above"));
+            add(h, "</b> above it");
+        } else {
+            add(h, "<li>By their medians ");
+            escaped(h, str(c, "faster_below"));
+            add(h, " and ");
+            escaped(h, str(c, "faster_above"));
+            add(h, " cross between ");
+            escaped(h, str(c, "param"));
+            add(h, " = %.4g and %.4g, but their intervals overlap on at least one side: <b>not "
+                   "distinguishable at this noise</b>",
+                json_number_value(json_array_get(bt, 0)), json_number_value(json_array_get(bt, 1)));
+        }
         if (str(c, RK_WORKLOAD)[0]) {
             add(h, " (");
             escaped(h, str(c, RK_WORKLOAD));
@@ -443,41 +401,59 @@ static void verdict_html(struct html *h, const json_t *v)
         add(h, ".</li>");
     }
     if (!json_array_size(json_object_get(v, "crossovers")))
-        add(h, "<li>No crossover: along the first swept parameter no technique overtakes "
+        add(h, "<li>No crossover: along the first swept numeric parameter no technique overtakes "
                "another on the same workload.</li>");
     json_t *w;
     json_array_foreach(json_object_get(v, "against_reference"), i, w) {
         json_t *rm = json_object_get(w, RK_REFERENCE_MS);
         if (!rm)
             continue;
+        json_t *rci = json_object_get(w, "reference_ci");
         add(h, "<li>");
         if (str(w, RK_WORKLOAD)[0]) {
             escaped(h, str(w, RK_WORKLOAD));
             add(h, ": ");
         }
         escaped(h, str(w, "reference"));
-        add(h, " (the reference) takes %.3f ms", json_number_value(rm));
-        static const char *const which[][2] = {{"fastest", "the fastest point"},
-                                               {"fastest_passing", "the fastest passing PerceptualDiff"}};
-        for (int k = 0; k < 2; k++) {
-            json_t *pt = json_object_get(w, which[k][0]);
-            if (!pt)
-                continue;
-            char *vals = json_dumps(json_object_get(pt, "values"), JSON_COMPACT);
-            add(h, "; %s is ", which[k][1]);
-            escaped(h, str(pt, "technique"));
-            add(h, " ");
-            escaped(h, vals);
-            add(h, " at %.3f ms (<b>%.2f&times;</b> the reference)",
-                json_number_value(json_object_get(pt, "ms")),
-                json_number_value(json_object_get(pt, "ratio")));
-            free(vals);
-        }
-        if (!json_object_get(w, "fastest_passing"))
+        add(h, " (the reference) takes %.3f ms [%.3f, %.3f]", json_number_value(rm),
+            json_number_value(json_array_get(rci, 0)), json_number_value(json_array_get(rci, 1)));
+        if (json_object_get(w, "fastest"))
+            against_html(h, json_object_get(w, "fastest"), "the fastest point");
+        if (json_object_get(w, "fastest_passing"))
+            against_html(h, json_object_get(w, "fastest_passing"),
+                         "the fastest passing PerceptualDiff");
+        else
             add(h, "; no point passes PerceptualDiff");
         add(h, ".</li>");
     }
     add(h, "</ul>");
+}
+
+/* The sweep with what its rows do not carry: each point job's interference
+ * figures (from its result.json), so that the verdict, the table and the
+ * charts mark the same noisy points. New reference. */
+static json_t *with_interference(const json_t *sweep, report_job_dir_fn job_dir, void *ctx)
+{
+    json_t *copy = json_deep_copy(sweep);
+    size_t i;
+    json_t *row;
+    json_array_foreach(json_object_get(copy, "points"), i, row) {
+        char dir[PATH_MAX], path[PATH_MAX + 16];
+        int frame = 0;
+        const char *job = json_string_value(json_object_get(row, "job"));
+        if (!job_dir || !job || !job_dir(ctx, job, dir, sizeof(dir), &frame) ||
+            !job_file_path(dir, JOB_FILE_RESULT, path, sizeof(path)))
+            continue;
+        json_t *result = json_load_file(path, 0, NULL);
+        json_t *inter = json_object_get(result, RK_INTERFERENCE);
+        if (inter)
+            json_object_set_new(row, RK_INTERFERENCE,
+                                json_pack("{s:O, s:O}", "other_cpu_share",
+                                          json_object_get(inter, "other_cpu_share"), "noisy",
+                                          json_object_get(inter, "noisy")));
+        json_decref(result);
+    }
+    return copy;
 }
 
 /* The thesis's chapter 4 for this device: execution time of the timed
@@ -529,9 +505,12 @@ static void thesis_tables(struct html *h, const json_t *points)
            "passing and SSIM from 0.99991 to 0.99994.</p>");
 }
 
-char *report_sweep_html(const json_t *sweep, const json_t *device, report_job_dir_fn job_dir,
+char *report_sweep_html(const json_t *posted, const json_t *device, report_job_dir_fn job_dir,
                         void *ctx, size_t *len)
 {
+    /* One copy of the table, with the points' noise, for the verdict, the
+     * table and the charts alike. */
+    json_t *sweep = with_interference(posted, job_dir, ctx);
     struct html h = {0};
     char title[128];
     snprintf(title, sizeof(title), "shadebench sweep %s", str(sweep, "id"));
@@ -545,7 +524,7 @@ char *report_sweep_html(const json_t *sweep, const json_t *device, report_job_di
     }
     add(&h, "</p>");
     const char *series = charts_default_series(device);
-    json_t *verdict = report_sweep_verdict(sweep, series);
+    json_t *verdict = sweep_verdict_json(sweep, series);
     verdict_html(&h, verdict);
     json_decref(verdict);
     json_t *points = json_object_get(sweep, "points");
@@ -556,18 +535,20 @@ char *report_sweep_html(const json_t *sweep, const json_t *device, report_job_di
     reference = reference ? reference : "forward";
     add(&h, "<h2>Table</h2><table><tr><th class=\"l\">parameters</th><th class=\"l\">technique</th>"
             "<th class=\"l\">job</th><th>frame_ms median [95%%]</th><th>gpu_ms median [95%%]</th>"
-            "<th>worst SSIM</th><th>worst FLIP</th><th>PerceptualDiff failures</th></tr>");
+            "<th>worst SSIM</th><th>worst FLIP</th><th>PerceptualDiff failures</th>"
+            "<th>others' CPU</th></tr>");
     size_t i;
     json_t *row;
     json_array_foreach(points, i, row) {
-        char *values = json_dumps(json_object_get(row, "values"), JSON_COMPACT);
-        add(&h, "<tr><td class=\"l\">");
+        char *values = dump(json_object_get(row, "values"), JSON_COMPACT);
+        bool done = !strcmp(str(row, "status"), "done");
+        add(&h, "<tr%s><td class=\"l\">", done ? "" : " class=\"fail\"");
         escaped(&h, values);
         add(&h, "</td><td class=\"l\">");
         escaped(&h, str(row, "technique"));
         add(&h, "</td><td class=\"l\">");
         escaped(&h, str(row, "job"));
-        add(&h, " (%s)%s</td>", str(row, "status"),
+        add(&h, " (%s)%s</td>", done ? "done" : str(row, "status"),
             !strcmp(str(row, "technique"), reference) ? " reference, timed" : "");
         free(values);
         ms_cell(&h, json_object_get(row, RK_FRAME_MS));
@@ -580,10 +561,26 @@ char *report_sweep_html(const json_t *sweep, const json_t *device, report_job_di
                 (long long)json_integer_value(pf));
         else
             add(&h, "<td>-</td>");
+        json_t *inter = json_object_get(row, RK_INTERFERENCE);
+        json_t *share = json_object_get(inter, "other_cpu_share");
+        if (json_is_number(share))
+            add(&h, "<td class=\"%s\">%s%.0f%%</td>", json_is_true(json_object_get(inter, "noisy"))
+                ? "noisy" : "", json_is_true(json_object_get(inter, "noisy")) ? "noisy: " : "",
+                100 * json_number_value(share));
+        else
+            add(&h, "<td>-</td>");
         add(&h, "</tr>");
     }
+    long long planned = json_integer_value(json_object_get(json_object_get(sweep, "progress"),
+                                                           "points_total"));
+    if (planned > (long long)json_array_size(points))
+        add(&h, "<tr class=\"fail\"><td class=\"l\" colspan=\"9\">%lld planned point%s not run "
+                "(the sweep is %s)</td></tr>", planned - (long long)json_array_size(points),
+            planned - (long long)json_array_size(points) == 1 ? "" : "s", str(sweep, "status"));
     add(&h, "</table><p>Intervals are 95%%; a lower end below zero is shown as 0 (times are "
-            "never negative).</p><h2>Charts</h2>");
+            "never negative). Others' CPU: the share of the machine's CPU time other processes "
+            "took during the point's timed frames; the daemon's rule: %s.</p><h2>Charts</h2>",
+        INTERFERENCE_RULE);
     struct chart_options o = {.device = device};
     chart(&h, sweep, "speed_accuracy", true, &o, "speed against accuracy (SSIM)");
     o.flip = true;
@@ -602,7 +599,7 @@ char *report_sweep_html(const json_t *sweep, const json_t *device, report_job_di
         int frame = 0;
         if (!job_dir || !job_dir(ctx, str(row, "job"), dir, sizeof(dir), &frame) || frame <= 0)
             continue;
-        char *values = json_dumps(json_object_get(row, "values"), JSON_COMPACT);
+        char *values = dump(json_object_get(row, "values"), JSON_COMPACT);
         add(&h, "<div><h3>");
         escaped(&h, str(row, "technique"));
         add(&h, " ");
@@ -618,6 +615,7 @@ char *report_sweep_html(const json_t *sweep, const json_t *device, report_job_di
     add(&h, "<h2>The sweep as posted</h2>");
     json_block(&h, json_object_get(sweep, "spec"));
     add(&h, "</body></html>\n");
+    json_decref(sweep);
     if (h.failed) {
         free(h.data);
         return NULL;
@@ -685,7 +683,7 @@ static void technique_figures(struct html *h, const json_t *r, const char *techn
     const char *key;
     json_t *v;
     json_object_foreach(own, key, v) {
-        char *text = json_is_string(v) ? NULL : json_dumps(v, JSON_ENCODE_ANY | JSON_COMPACT);
+        char *text = json_is_string(v) ? NULL : dump(v, JSON_COMPACT);
         add(h, "<tr><td class=\"l\">");
         escaped(h, key);
         add(h, "</td><td class=\"l\">");
@@ -728,6 +726,34 @@ static void runs_table(struct html *h, const json_t *r)
     add(h, "</table>");
 }
 
+/* What disturbed the run, where people look first: the CPU other processes
+ * took during the timed frames and the load, and whether that makes the
+ * run noisy by the daemon's rule. */
+static void noise_html(struct html *h, const json_t *inter)
+{
+    json_t *share = json_object_get(inter, "other_cpu_share");
+    if (!json_is_number(share)) {
+        if (inter && json_object_get(inter, "error")) {
+            add(h, "<p>Noise: not measured (");
+            escaped(h, str(inter, "error"));
+            add(h, ").</p>");
+        }
+        return;
+    }
+    bool noisy = json_is_true(json_object_get(inter, "noisy"));
+    json_t *ls = json_object_get(inter, "loadavg_start"), *le = json_object_get(inter, "loadavg_end");
+    add(h, "<p class=\"%s\">%s other processes took <b>%.0f%%</b> of the machine's CPU time "
+           "during the timed frames (1-minute load %.2f to %.2f on %lld CPUs)",
+        noisy ? "noisy" : "", noisy ? "<b>A noisy run:</b>" : "Quiet run:",
+        100 * json_number_value(share), json_number_value(json_array_get(ls, 0)),
+        json_number_value(json_array_get(le, 0)),
+        (long long)json_integer_value(json_object_get(inter, "cpus")));
+    add(h, noisy ? "; its times may be inflated by them, so compare them with care (the "
+                   "daemon's rule: %s).</p>"
+                 : " (the daemon's rule: %s).</p>",
+        INTERFERENCE_RULE);
+}
+
 char *report_job_html(const json_t *job, const char *dir, const json_t *device, size_t *len)
 {
     struct html h = {0};
@@ -741,6 +767,7 @@ char *report_job_html(const json_t *job, const char *dir, const json_t *device, 
         escaped(&h, str(job, "error"));
     }
     add(&h, ".</p>");
+    noise_html(&h, json_object_get(r, RK_INTERFERENCE));
     if (r) {
         add(&h, "<h2>Timings</h2><p>%lld timed frames after %lld warm-up, %.3f s, %.1f fps, "
                 "%lld triangles a frame.</p>",

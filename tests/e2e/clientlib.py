@@ -16,7 +16,9 @@ class Client:
 
     def run(self, *args, env_token=True, extra_env=None, timeout=900):
         env = dict(os.environ, SHADEBENCH_SERVER=self.d.base)
-        for k in ("SHADEBENCH_TOKEN", "SHADEBENCH_TOKEN_FILE"):
+        # The tests choose these themselves: a CI shell's own settings
+        # (SHADEBENCH_FAIL_INCONCLUSIVE=1, say) must not change them.
+        for k in ("SHADEBENCH_TOKEN", "SHADEBENCH_TOKEN_FILE", "SHADEBENCH_FAIL_INCONCLUSIVE"):
             env.pop(k, None)
         if env_token and self.token:
             env["SHADEBENCH_TOKEN"] = self.token

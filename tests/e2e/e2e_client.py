@@ -34,7 +34,7 @@ try:
     check(d.json("GET", "/v1/jobs", headers=auth)[0] == 200, "right token: 200")
     out = cl.run("list", env_token=False)
     check(out.returncode == 2 and "401" in out.stderr, "client without token exits 2: %s" % out.stderr)
-    out = cl.run("--token-file", tmp_token, "info", env_token=False)
+    out = cl.run("--token-file", tmp_token, "info", "--json", env_token=False)
     check(out.returncode == 0 and json.loads(out.stdout)["version"], "--token-file works")
     out = cl.run("info", env_token=False, extra_env={"SHADEBENCH_TOKEN_FILE": tmp_token})
     check(out.returncode == 0, "$SHADEBENCH_TOKEN_FILE works")

@@ -94,7 +94,7 @@ try:
     junit = cl.path("inc.xml")
     out = cl.run(*args, "--fail-inconclusive", "--junit", junit)
     fails = [c[0] for c in junit_cases(junit)[1].values() if c[0]]
-    check(out.returncode == 1 and fails and "inconclusive" in fails[0], "--fail-inconclusive fails it: %s" % fails)
+    check(out.returncode == 3 and fails and "inconclusive" in fails[0], "--fail-inconclusive fails it (exit 3): %s" % fails)
 finally:
     testlib.stop_and_check(d)
 testlib.finish("e2e_gate")

@@ -12,6 +12,7 @@
 
 #include "daemon/api/charts.h"
 #include "daemon/api/report.h"
+#include "daemon/api/sweep_verdict.h"
 #include "tests/unit/check.h"
 
 static json_t *row(const char *tech, double lights, double async, double ms, double lo, double hi,
@@ -73,6 +74,274 @@ static json_t *chart(const json_t *sweep, const char *name, const struct chart_o
     CHECK(l != NULL);
     free(svg);
     return l;
+}
+
+/* A row from its values (JSON text), a time with interval, quality (ssim
+ * < 0: not judged) and a status. */
+static json_t *trow(const char *tech, const char *values, double ms, double lo, double hi,
+                    double ssim, int pdiff_failed, const char *status)
+{
+    json_t *r = json_pack("{s:o, s:s, s:s, s:s}", "values", json_loads(values, 0, NULL),
+                          "technique", tech, "job", "j", "status", status);
+    if (!strcmp(status, "done")) {
+        json_t *cell = json_pack("{s:f, s:[f, f], s:f, s:f, s:f, s:f, s:f}", "median", ms, "ci95",
+                                 lo, hi, "min", ms * 0.9, "p5", ms * 0.95, "p95", ms * 1.1, "p99",
+                                 ms * 1.2, "max", ms * 1.3);
+        json_object_set(r, "frame_ms", cell);
+        json_object_set(r, "gpu_ms", cell);
+        json_object_set_new(r, "cpu_ms", cell);
+    }
+    if (ssim >= 0) {
+        json_object_set_new(r, "worst_ssim", json_real(ssim));
+        json_object_set_new(r, "worst_flip", json_real((1 - ssim) * 10));
+        json_object_set_new(r, "pdiff_failed_captures", json_integer(pdiff_failed));
+    }
+    return r;
+}
+
+static json_t *tsweep(json_t *points, const char *status, int total, const char *largest_param)
+{
+    json_t *sw = json_pack("{s:s, s:s, s:s, s:{s:{s:s, s:s}}, s:o, s:{s:i, s:i}}", "id", "s2",
+                           "kind", "vary", "status", status, "spec", "base", "technique", "forward",
+                           "reference", "forward", "points", points, "progress", "points_done",
+                           (int)json_array_size(points), "points_total", total);
+    if (largest_param)
+        json_object_set_new(sw, "result", json_pack("{s:{s:s, s:n}}", "largest_pdiff_pass",
+                                                    "param", largest_param, "value"));
+    return sw;
+}
+
+static bool point_is(const json_t *pts, size_t i, const char *key)
+{
+    return json_is_true(json_object_get(json_array_get(pts, i), key));
+}
+
+/* The issue's reproducer: a sweep over techniques, every point passing
+ * PerceptualDiff. Its verdict must not say "none passes" (the sweep's
+ * largest value is null only because techniques are not numbers); its
+ * front only separates points whose intervals do (tiled 53 [43, 60] is
+ * not better than clustered deferred 56 [34, 92]); and the chart draws the
+ * same front. */
+static void test_technique_sweep(const json_t *llvmpipe)
+{
+    json_t *points = json_array();
+    json_array_append_new(points, trow("tiled_deferred", "{\"technique\":\"tiled_deferred\"}", 53,
+                                       43, 60, 0.99998, 0, "done"));
+    json_array_append_new(points, trow("clustered_deferred",
+                                       "{\"technique\":\"clustered_deferred\"}", 56, 34, 92,
+                                       0.99998, 0, "done"));
+    json_array_append_new(points, trow("deferred", "{\"technique\":\"deferred\"}", 140, 130,
+                                       150, 0.99998, 0, "done"));
+    json_array_append_new(points, trow("forward_plus", "{\"technique\":\"forward_plus\"}", 58,
+                                       50, 66, 0.99997, 0, "done"));
+    json_array_append_new(points, trow("forward", "{\"technique\":\"forward\"}", 150, 140, 160,
+                                       -1, 0, "done"));
+    json_t *sw = tsweep(points, "done", 5, "technique");
+    json_t *v = sweep_verdict_json(sw, "frame_ms");
+    CHECK(!json_object_get(v, "largest_pdiff_pass"));
+    CHECK(json_array_size(json_object_get(v, "pdiff_passing")) == 4 &&
+          json_integer_value(json_object_get(v, "pdiff_judged")) == 4);
+    /* The front: tiled and clustered deferred tied (equal quality, times
+     * not distinguishable); deferred dominated by them (measurably slower);
+     * forward_plus overlaps both but is less accurate: dominated; forward,
+     * the reference, exact and slowest: on the front. */
+    json_t *front = json_object_get(json_array_get(json_object_get(v, "front"), 0), "points");
+    CHECK(json_array_size(front) == 3);
+    size_t i;
+    json_t *m;
+    int tied = 0;
+    json_array_foreach(front, i, m) {
+        const char *n = json_string_value(json_object_get(m, "name"));
+        CHECK(strstr(n, "tiled_deferred") || strstr(n, "clustered_deferred") ||
+              !strcmp(n, "forward"));
+        tied += json_is_true(json_object_get(m, "tied"));
+    }
+    CHECK(tied == 2);
+    /* The fastest is not distinguishable from its tied neighbours. */
+    json_t *fastest = json_object_get(json_array_get(json_object_get(v, "against_reference"), 0),
+                                      "fastest");
+    CHECK(json_array_size(json_object_get(fastest, "tied_with")) == 2 &&
+          json_is_true(json_object_get(fastest, "distinguishable")));
+    json_decref(v);
+    /* The chart draws that front: the same points, two tied. */
+    struct chart_options o = {.device = llvmpipe};
+    json_t *l = chart(sw, "speed_accuracy", &o);
+    json_t *pts = json_object_get(l, "points");
+    CHECK(json_array_size(pts) == 5);
+    CHECK(point_is(pts, 0, "pareto") && point_is(pts, 0, "tied") && point_is(pts, 1, "pareto") &&
+          point_is(pts, 1, "tied") && !point_is(pts, 2, "pareto") && !point_is(pts, 3, "pareto") &&
+          point_is(pts, 4, "pareto") && !point_is(pts, 4, "tied"));
+    /* SSIM 0.99997 to 1: the axis starts at 0.99 or below, so the
+     * difference is a hair, not a cliff. */
+    json_t *yr = json_object_get(l, "y_range");
+    CHECK(json_real_value(json_array_get(yr, 0)) <= 0.99 &&
+          json_real_value(json_array_get(yr, 1)) >= 1.0);
+    /* Every point is labelled, numbered with its label in the key, or the
+     * only point of its series (named in the legend). */
+    json_t *p, *q;
+    json_array_foreach(pts, i, p) {
+        size_t k, same = 0;
+        json_array_foreach(pts, k, q) same += json_equal(json_object_get(p, "series"),
+                                                         json_object_get(q, "series"));
+        CHECK(!json_is_null(json_object_get(p, "label_box")) ||
+              json_is_integer(json_object_get(p, "tag")) ||
+              (!json_string_length(json_object_get(p, "label")) && same == 1));
+    }
+    json_decref(l);
+    size_t hl = 0;
+    char *html = report_sweep_html(sw, llvmpipe, NULL, NULL, &hl);
+    CHECK(html && !strstr(html, "none passes") && !strstr(html, "none</b>") &&
+          strstr(html, "<b>4 of 4</b> judged") && strstr(html, ", tied"));
+    free(html);
+    json_decref(sw);
+}
+
+/* Crossovers and ratios stated only where the intervals support them. */
+static void test_noise_in_verdicts(const json_t *llvmpipe)
+{
+    json_t *points = json_array();
+    /* Along async_distance, osl and forward (timed once) cross near 14
+     * by their medians, with intervals overlapping at 20. */
+    json_array_append_new(points, trow("osl", "{\"async_distance\":5}", 40, 35, 45, 0.997, 1, "done"));
+    json_array_append_new(points, trow("osl", "{\"async_distance\":20}", 60, 40, 90, 0.9999, 0, "done"));
+    json_array_append_new(points, trow("forward", "{\"technique\":\"forward\"}", 55, 50, 60,
+                                       -1, 0, "done"));
+    json_t *sw = tsweep(points, "done", 3, "async_distance");
+    json_t *v = sweep_verdict_json(sw, "frame_ms");
+    json_t *cr = json_array_get(json_object_get(v, "crossovers"), 0);
+    CHECK(json_array_size(json_object_get(v, "crossovers")) == 1 &&
+          json_is_false(json_object_get(cr, "distinguishable")));
+    /* The fastest passing point (d 20, 60 [40, 90]) against the reference
+     * (55 [50, 60]): 1.09 by the medians, not distinguishable. */
+    json_t *w = json_array_get(json_object_get(v, "against_reference"), 0);
+    json_t *fp = json_object_get(w, "fastest_passing");
+    CHECK(fp && json_is_false(json_object_get(fp, "distinguishable")) &&
+          json_real_value(json_array_get(json_object_get(fp, "ratio_ci"), 0)) < 1 &&
+          json_real_value(json_array_get(json_object_get(fp, "ratio_ci"), 1)) > 1);
+    /* The fastest (d 5, 40 [35, 45]) is measurably faster: stated. */
+    CHECK(json_is_true(json_object_get(json_object_get(w, "fastest"), "distinguishable")));
+    CHECK(json_integer_value(json_object_get(json_object_get(v, "largest_pdiff_pass"), "value")) == 20);
+    json_decref(v);
+    /* Noisy points (the report adds each point job's interference). */
+    json_object_set_new(json_array_get(points, 1), "interference",
+                        json_pack("{s:f, s:b}", "other_cpu_share", 0.79, "noisy", 1));
+    v = sweep_verdict_json(sw, "frame_ms");
+    CHECK(json_array_size(json_object_get(v, "noisy")) == 1);
+    json_decref(v);
+    size_t hl = 0;
+    char *html = report_sweep_html(sw, llvmpipe, NULL, NULL, &hl);
+    CHECK(html && strstr(html, "not distinguishable at this noise") &&
+          strstr(html, "not distinguishable from the reference at this noise") &&
+          strstr(html, "<b>Noise:</b> 1 point ran") && strstr(html, "(79%)") &&
+          !strstr(html, "0.10000000"));
+    free(html);
+    struct chart_options o = {.device = llvmpipe};
+    json_t *l = chart(sw, "speed_accuracy", &o);
+    json_t *pts = json_object_get(l, "points");
+    CHECK(point_is(pts, 1, "noisy") && !point_is(pts, 0, "noisy"));
+    /* PerceptualDiff's verdicts separate at SSIM 0.9999: the line is there. */
+    CHECK(fabs(json_real_value(json_object_get(l, "jnd")) - 0.9999) < 1e-12);
+    CHECK(json_is_false(json_object_get(json_array_get(pts, 0), "pdiff_pass")));
+    json_decref(l);
+    json_decref(sw);
+}
+
+/* A cancelled sweep says so in its verdict and its charts, and names the
+ * points it could not draw. */
+static void test_partial_sweep(const json_t *llvmpipe)
+{
+    json_t *points = json_array();
+    json_array_append_new(points, trow("osl", "{\"async_distance\":0}", 30, 28, 32, 0.9999, 0, "done"));
+    json_array_append_new(points, trow("osl", "{\"async_distance\":5}", 0, 0, 0, -1, 0, "cancelled"));
+    json_t *sw = tsweep(points, "cancelled", 4, "async_distance");
+    json_t *v = sweep_verdict_json(sw, "frame_ms");
+    CHECK(json_is_true(json_object_get(v, "partial")) &&
+          json_integer_value(json_object_get(v, "not_run")) == 2 &&
+          json_array_size(json_object_get(v, "missing")) == 1);
+    json_decref(v);
+    struct chart_options o = {.device = llvmpipe};
+    static const char *const names[] = {"speed_accuracy", "time_vs_param", "distribution"};
+    for (int k = 0; k < 3; k++) {
+        json_t *l = chart(sw, names[k], &o);
+        json_t *footer = json_object_get(l, "footer");
+        char all[2048] = "";
+        size_t i;
+        json_t *line;
+        json_array_foreach(footer, i, line) {
+            strncat(all, json_string_value(line), sizeof(all) - strlen(all) - 2);
+            strcat(all, "\n");
+        }
+        CHECK(strstr(json_string_value(json_object_get(l, "title")), "partial sweep") &&
+              strstr(all, "PARTIAL") && strstr(all, "async_distance=5 (cancelled)") &&
+              strstr(all, "2 planned points not run"));
+        json_decref(l);
+    }
+    size_t hl = 0;
+    char *html = report_sweep_html(sw, llvmpipe, NULL, NULL, &hl);
+    CHECK(html && strstr(html, "A partial sweep") && strstr(html, "Not measured: osl") &&
+          strstr(html, "2 planned points not run"));
+    free(html);
+    json_decref(sw);
+}
+
+/* Points on top of each other: labels that do not fit become numbers, and
+ * the key under the chart names every one of them. */
+static void test_crowded_labels(const json_t *llvmpipe)
+{
+    json_t *points = json_array();
+    for (int i = 0; i < 12; i++) {
+        char values[64];
+        snprintf(values, sizeof(values), "{\"async_distance\":%d}", i);
+        json_array_append_new(points, trow("osl", values, 30 + 0.01 * i, 29, 31, 0.999, 0, "done"));
+    }
+    json_t *sw = tsweep(points, "done", 12, "async_distance");
+    struct chart_options o = {.device = llvmpipe};
+    json_t *l = chart(sw, "speed_accuracy", &o);
+    json_t *pts = json_object_get(l, "points");
+    int tagged = 0;
+    size_t i;
+    json_t *p;
+    json_array_foreach(pts, i, p) {
+        bool labelled = !json_is_null(json_object_get(p, "label_box"));
+        json_t *tag = json_object_get(p, "tag");
+        CHECK(labelled || json_is_integer(tag));
+        if (json_is_integer(tag)) {
+            tagged++;
+            char needle[64];
+            snprintf(needle, sizeof(needle), "%lld: osl, async_distance=%zu ",
+                     (long long)json_integer_value(tag), i);
+            bool keyed = false;
+            size_t k;
+            json_t *line;
+            json_array_foreach(json_object_get(l, "footer"), k, line)
+                keyed = keyed || strstr(json_string_value(line), needle);
+            CHECK(keyed);
+        }
+    }
+    CHECK(tagged > 0 && tagged == json_integer_value(json_object_get(l, "labels_left_out")));
+    json_decref(l);
+    json_decref(sw);
+}
+
+/* The job report: numbers for people, and the run's noise where people
+ * look. */
+static void test_job_report(const json_t *llvmpipe)
+{
+    json_t *job = json_loads(
+        "{\"id\":\"j9\",\"technique\":\"osl\",\"status\":\"done\","
+        "\"spec\":{\"technique\":\"osl\",\"metrics\":{\"pdiff\":{\"fov\":22.600000000000001}}},"
+        "\"result\":{\"frames\":4,\"frame_ms\":{\"median\":10.0},"
+        "\"osl\":{\"texels_shaded_per_frame\":{\"mean\":873813.33333333326}},"
+        "\"interference\":{\"other_cpu_share\":0.79,\"noisy\":true,\"cpus\":2,"
+        "\"loadavg_start\":[6.1,5,4],\"loadavg_end\":[8.9,6,5]}}}", 0, NULL);
+    size_t hl = 0;
+    char *html = report_job_html(job, "/nonexistent", llvmpipe, &hl);
+    CHECK(html && !strstr(html, "22.600000000000001") && strstr(html, "22.6") &&
+          !strstr(html, "873813.33333333326") && strstr(html, "873813.333"));
+    CHECK(html && strstr(html, "A noisy run:") && strstr(html, "<b>79%</b>") &&
+          strstr(html, "6.10 to 8.90 on 2 CPUs"));
+    free(html);
+    json_decref(job);
 }
 
 int main(void)
@@ -183,7 +452,7 @@ int main(void)
     /* The verdict: on 2 lights forward (20 ms) beats OSL at d 0 (30 ms);
      * on 40 lights OSL wins. Along lights, OSL at d 0 and forward cross
      * between 2 and 40. */
-    json_t *v = report_sweep_verdict(sweep, "frame_ms");
+    json_t *v = sweep_verdict_json(sweep, "frame_ms");
     json_t *cr = json_object_get(v, "crossovers");
     int found = 0;
     json_t *c;
@@ -236,6 +505,12 @@ int main(void)
                                sizeof(err)));
     json_decref(samples);
     json_decref(job);
+
+    test_technique_sweep(llvmpipe);
+    test_noise_in_verdicts(llvmpipe);
+    test_partial_sweep(llvmpipe);
+    test_crowded_labels(llvmpipe);
+    test_job_report(llvmpipe);
 
     json_decref(sweep);
     json_decref(points);

@@ -9,7 +9,9 @@
 #include <string.h>
 
 #include "client/junit.h"
+#include "client/suggest.h"
 #include "client/trend.h"
+#include "client/workload.h"
 #include "common/fsutil.h"
 #include "tests/unit/check.h"
 
@@ -21,8 +23,218 @@ static size_t count(const char *hay, const char *needle)
     return n;
 }
 
+/* An undecided check is never a plain pass: <skipped> with its reason, or
+ * a failure of type "inconclusive" when asked to fail; counted apart from
+ * real failures (which decide the exit status first). */
+static void test_inconclusive_junit(void)
+{
+    struct junit j;
+    junit_init(&j);
+    struct junit_case *job = junit_add(&j, "shadebench.forward", "forward: job");
+    struct junit_case *gate = junit_add(&j, "shadebench.forward", "forward: median frame_ms");
+    junit_inconclusive(gate, false, "inconclusive: interval reaches +30%%; 3 of 8 runs noisy");
+    CHECK(junit_failures(&j) == 0 && junit_real_failures(&j) == 0 && junit_undecided(&j) == 1);
+    const char *path = "test_client_inconclusive.xml";
+    CHECK(junit_write(&j, path, "s", 1.0));
+    size_t len;
+    char *xml = fs_read_file(path, 1 << 20, &len);
+    CHECK(xml && strstr(xml, "<skipped message=\"inconclusive: interval reaches +30%; 3 of 8 runs "
+                             "noisy\"/>") && strstr(xml, "skipped=\"1\"") &&
+          !strstr(xml, "<failure"));
+    free(xml);
+    /* Asked to fail: a failure of its own type, still not a real failure. */
+    struct junit_case *gate2 = junit_add(&j, "shadebench.forward", "again");
+    junit_inconclusive(gate2, true, "inconclusive (--fail-inconclusive): too noisy");
+    CHECK(junit_failures(&j) == 1 && junit_real_failures(&j) == 0 && junit_undecided(&j) == 2);
+    CHECK(junit_write(&j, path, "s", 1.0));
+    xml = fs_read_file(path, 1 << 20, &len);
+    CHECK(xml && strstr(xml, "<failure type=\"inconclusive\" message=\"inconclusive "
+                             "(--fail-inconclusive): too noisy\"/>"));
+    free(xml);
+    junit_fail(job, "job failed");
+    CHECK(junit_real_failures(&j) == 1);
+    /* The log names the outcome. */
+    FILE *f = fopen(path, "w+");
+    junit_print(&j, f);
+    rewind(f);
+    char buf[2048];
+    size_t got = fread(buf, 1, sizeof(buf) - 1, f);
+    buf[got] = '\0';
+    fclose(f);
+    CHECK(strstr(buf, "INCONCLUSIVE forward: median frame_ms") && strstr(buf, "not decided: ") &&
+          strstr(buf, "FAIL forward: job"));
+    remove(path);
+    junit_finish(&j);
+}
+
+/* Names from the spec as the user wrote it: fields the file does not name
+ * are left out (no "0x0 0 lights"), so a default the daemon adds later
+ * renames nothing. */
+static void test_names_as_written(void)
+{
+    json_t *spec = json_loads("{\"technique\":\"forward\",\"frames\":20,"
+                              "\"scene\":{\"width\":160,\"height\":120}}", 0, NULL);
+    char name[320], again[320];
+    junit_job_name(spec, name, sizeof(name));
+    CHECK(strncmp(name, "forward 160x120 #", 17) == 0 && strstr(name, ", 20 frames") &&
+          !strstr(name, "lights") && !strstr(name, "0x0"));
+    /* The daemon's filled-in spec names more; the file's name is the one CI
+     * keeps, whatever the daemon adds. */
+    json_t *filled = json_deep_copy(spec);
+    json_object_set_new(json_object_get(filled, "scene"), "lights", json_integer(10));
+    junit_job_name(filled, again, sizeof(again));
+    CHECK(strcmp(name, again) != 0);
+    junit_job_name(spec, again, sizeof(again));
+    CHECK(strcmp(name, again) == 0);
+    json_decref(filled);
+    json_decref(spec);
+    spec = json_loads("{\"technique\":\"unlit\"}", 0, NULL);
+    junit_job_name(spec, name, sizeof(name));
+    CHECK(strncmp(name, "unlit #", 7) == 0 && !strstr(name, "frames"));
+    json_decref(spec);
+}
+
+/* Workload identity: labels, repeat, captures, the reference and other
+ * techniques' options leave it alone; size, lights, frames, warm-up, look
+ * and the technique's own options change it; 20 and 20.0 are one value. */
+static void test_workload_identity(void)
+{
+    json_t *a = json_loads("{\"technique\":\"osl\",\"frames\":20,\"warmup_frames\":5,"
+                           "\"scene\":{\"width\":160,\"height\":120,\"lights\":10},"
+                           "\"osl\":{\"resolution\":256},\"labels\":{\"commit\":\"a\"},"
+                           "\"repeat\":1,\"reference\":\"forward\",\"forward\":{},"
+                           "\"capture_interval\":10}", 0, NULL);
+    json_t *b = json_deep_copy(a);
+    char ka[96], kb[96], da[240], db[240];
+    json_object_set_new(b, "labels", json_pack("{s:s}", "commit", "b"));
+    json_object_set_new(b, "repeat", json_integer(5));
+    json_object_set_new(b, "capture_interval", json_integer(0));
+    json_object_del(b, "reference");
+    json_object_del(b, "forward");
+    json_object_set_new(json_object_get(b, "scene"), "lights", json_real(10.0));
+    workload_key(a, ka, sizeof(ka));
+    workload_key(b, kb, sizeof(kb));
+    CHECK(strcmp(ka, kb) == 0 && strncmp(ka, "osl#", 4) == 0 && strlen(ka) == 4 + 16);
+    static const char *const changes[] = {
+        "{\"scene\":{\"width\":320}}", "{\"scene\":{\"lights\":14}}", "{\"frames\":40}",
+        "{\"warmup_frames\":0}", "{\"look\":{\"hdr\":\"rgba16f\"}}",
+        "{\"osl\":{\"resolution\":128}}"};
+    for (size_t i = 0; i < sizeof(changes) / sizeof(changes[0]); i++) {
+        json_t *c = json_deep_copy(a), *patch = json_loads(changes[i], 0, NULL);
+        const char *k;
+        json_t *v;
+        json_object_foreach(patch, k, v) {
+            if (json_is_object(v) && json_is_object(json_object_get(c, k)))
+                json_object_update(json_object_get(c, k), v);
+            else
+                json_object_set(c, k, v);
+        }
+        workload_key(c, kb, sizeof(kb));
+        CHECK(strcmp(ka, kb) != 0);
+        /* The description differs too, even where the name does not spell
+         * the field out (warm-up frames). */
+        workload_describe(a, da, sizeof(da));
+        workload_describe(c, db, sizeof(db));
+        CHECK(strcmp(da, db) != 0);
+        json_decref(patch);
+        json_decref(c);
+    }
+    workload_describe(a, da, sizeof(da));
+    static const char prefix[] = "osl osl(resolution=256) 160x120 10 lights #";
+    CHECK(strncmp(da, prefix, strlen(prefix)) == 0 &&
+          strncmp(da + strlen(prefix), ka + 4, 8) == 0 && strstr(da, ", 20 frames"));
+    json_decref(a);
+    json_decref(b);
+}
+
+static void test_suggest(void)
+{
+    static const char *const opts[] = {"runs", "max-reruns", "fail-inconclusive", "baseline",
+                                       "junit", "max-slowdown", "server", "server-b"};
+    size_t n = sizeof(opts) / sizeof(opts[0]);
+    CHECK(suggest_nearest("rnus", opts, n) && !strcmp(suggest_nearest("rnus", opts, n), "runs"));
+    CHECK(!strcmp(suggest_nearest("run", opts, n), "runs"));
+    CHECK(!strcmp(suggest_nearest("max-rerun", opts, n), "max-reruns"));
+    CHECK(!strcmp(suggest_nearest("fail-inconclusiv", opts, n), "fail-inconclusive"));
+    CHECK(!strcmp(suggest_nearest("basline", opts, n), "baseline"));
+    CHECK(suggest_nearest("colour", opts, n) == NULL);
+    CHECK(suggest_nearest("max", opts, n) == NULL); /* ambiguous and far */
+    CHECK(suggest_distance("ab", "ba") == 1 && suggest_distance("", "abc") == 3 &&
+          suggest_distance("kitten", "sitting") == 3);
+}
+
+/* Time ticks on round times, labelled exactly: the job at 03:26:06 lies
+ * right of the tick labelled 03:26, which is at 03:26:00. */
+static void test_time_ticks(void)
+{
+    double ticks[16], step;
+    char labels[16][24];
+    /* 2026-11-25 03:25:00 to 03:28:30 UTC */
+    double t0 = 1795564800.0 + 3 * 3600 + 25 * 60, t1 = t0 + 210;
+    int n = trend_time_ticks(t0, t1, ticks, labels, 16, &step);
+    CHECK(n >= 3 && n <= 8 && step == 30);
+    for (int i = 0; i < n; i++)
+        CHECK(fmod(ticks[i], step) == 0 && ticks[i] >= t0 && ticks[i] <= t1);
+    CHECK(!strcmp(labels[0], "03:25:00") && !strcmp(labels[2], "03:26:00"));
+    /* Over hours: labels in minutes, each at a whole minute. */
+    n = trend_time_ticks(t0, t0 + 5 * 3600, ticks, labels, 16, &step);
+    CHECK(n >= 3 && n <= 8 && step == 3600);
+    for (int i = 0; i < n; i++)
+        CHECK(fmod(ticks[i], 60) == 0 && strlen(labels[i]) == 5 && !strcmp(labels[i] + 2, ":00"));
+    /* Over days: dates, at midnight. */
+    n = trend_time_ticks(t0, t0 + 20 * 86400, ticks, labels, 16, &step);
+    CHECK(n >= 2 && n <= 8 && fmod(step, 86400) == 0);
+    for (int i = 0; i < n; i++)
+        CHECK(fmod(ticks[i], 86400) == 0 && strlen(labels[i]) == 10);
+    /* An odd span (100 s: the old step) gets a round step, not 100 s. */
+    n = trend_time_ticks(t0 + 6, t0 + 106, ticks, labels, 16, &step);
+    CHECK(step == 15 || step == 30);
+}
+
+/* The trend chart: one series per workload with its full name in the
+ * legend, noisy runs hollow with the CPU others took, series beyond the
+ * eighth counted rather than silently dropped. */
+static void test_trend_workloads(void)
+{
+    struct trend_point pts[12];
+    memset(pts, 0, sizeof(pts));
+    for (int i = 0; i < 12; i++) {
+        pts[i].t = 1795576800.0 + 60 * i;
+        pts[i].y = 10 + i;
+        pts[i].lo = pts[i].hi = NAN;
+        pts[i].other_share = NAN;
+        snprintf(pts[i].series, sizeof(pts[i].series), "forward#%016d", i < 4 ? i % 2 : i);
+        snprintf(pts[i].name, sizeof(pts[i].name), "forward 320x240 workload %d", i < 4 ? i % 2 : i);
+        snprintf(pts[i].label, sizeof(pts[i].label), "job%d", i);
+    }
+    pts[1].noisy = true;
+    pts[1].other_share = 0.79;
+    /* Jobs within two seconds still get an axis with ticks. */
+    struct trend_point close[2] = {pts[0], pts[1]};
+    close[1].t = close[0].t + 1.5;
+    char *svg = trend_svg(close, 2, "t", "ms");
+    CHECK(svg && count(svg, "class=\"tick\"") >= 3);
+    free(svg);
+    svg = trend_svg(pts, 4, "t", "ms");
+    CHECK(svg && count(svg, "class=\"series\"") == 2 && strstr(svg, "forward 320x240 workload 0") &&
+          strstr(svg, "forward 320x240 workload 1"));
+    CHECK(svg && count(svg, "data-noisy=\"true\"") == 1 && strstr(svg, "took 79% of the CPU"));
+    free(svg);
+    svg = trend_svg(pts, 12, "t", "ms");
+    /* 2 + 8 workloads: 8 drawn, 2 said to be left out. */
+    CHECK(svg && count(svg, "class=\"series\"") == 8 && strstr(svg, "2 more workloads not drawn"));
+    free(svg);
+}
+
 int main(void)
 {
+    test_inconclusive_junit();
+    test_names_as_written();
+    test_workload_identity();
+    test_suggest();
+    test_time_ticks();
+    test_trend_workloads();
+
     json_t *osl = json_loads(
         "{\"technique\":\"osl\",\"frames\":20,\"warmup_frames\":5,\"capture_interval\":10,"
         "\"async_distance\":20,\"scene\":{\"preset\":\"grid\",\"lights\":10,\"dynamic\":true,"

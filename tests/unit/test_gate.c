@@ -46,8 +46,52 @@ static void rates(double slowdown, double cv, int trials, int counts[3])
     }
 }
 
+/* ab's sentences speak of A and B, never of a baseline it does not have;
+ * the gate's keep "the baseline". */
+static void test_sides(void)
+{
+    struct ratio_interval r = {.na = 5, .nb = 5, .ratio = 0.953, .lo = 0.737, .hi = 1.233,
+                               .cv_a = 0.2, .cv_b = 0.25, .confidence = 0.95};
+    struct gate_verdict v;
+    gate_decide_sides(&r, 0.05, &GATE_SIDES_AB, &v);
+    CHECK(v.outcome == GATE_INCONCLUSIVE && !strstr(v.why, "baseline") && strstr(v.why, "in A") &&
+          strstr(v.why, "in B"));
+    gate_decide(&r, 0.05, &v);
+    CHECK(v.outcome == GATE_INCONCLUSIVE && strstr(v.why, "in the baseline"));
+    r.ratio = 1.4, r.lo = 0.98, r.hi = 2.0;
+    gate_decide_sides(&r, 0.05, &GATE_SIDES_AB, &v);
+    CHECK(v.outcome == GATE_INCONCLUSIVE && !strstr(v.why, "baseline"));
+}
+
+/* The log and JUnit say why a verdict could not be reached: how many runs
+ * were noisy and how much CPU the others took. */
+static void test_noise_text(void)
+{
+    struct gate_run runs[4] = {
+        {.ms = 10, .has_share = true, .other_share = 0.12},
+        {.ms = 10, .has_share = true, .other_share = 0.41, .noisy = true},
+        {.ms = 10, .has_share = true, .other_share = 0.79, .noisy = true},
+        {.ms = 10, .daemon_noisy = true, .noisy = true},
+    };
+    char out[320];
+    CHECK(gate_noise_text(runs, 4, "runs here", 0.12, out, sizeof(out)) == 3);
+    CHECK(!strcmp(out, "3 of 4 runs here were noisy: other processes took 41% to 79% of the CPU "
+                       "during them, against a typical 12%"));
+    CHECK(gate_noise_text(runs, 2, "runs", -1, out, sizeof(out)) == 1);
+    CHECK(!strcmp(out, "1 of 2 runs was noisy: other processes took 41% of the CPU during it"));
+    CHECK(gate_noise_text(runs + 3, 1, "pairs", -1, out, sizeof(out)) == 1 &&
+          strstr(out, "flagged it (no CPU figures)"));
+    CHECK(gate_noise_text(runs, 1, "runs", 0.1, out, sizeof(out)) == 0 && out[0] == '\0');
+    /* Truncation never overruns. */
+    char tiny[12];
+    gate_noise_text(runs, 4, "runs here", 0.12, tiny, sizeof(tiny));
+    CHECK(strlen(tiny) < sizeof(tiny));
+}
+
 int main(void)
 {
+    test_sides();
+    test_noise_text();
     /* Student's t against the tables. */
     CHECK_NEAR(student_t_quantile(0.975, 1), 12.706, 1e-3);
     CHECK_NEAR(student_t_quantile(0.975, 4), 2.776, 1e-3);

@@ -7,6 +7,7 @@
  * fuzzed on its own. GL-free; any thread. */
 
 #include <stdbool.h>
+#include <stddef.h>
 
 enum route_kind {
     ROUTE_NONE, /* no such route or resource: 404 */
@@ -62,5 +63,11 @@ const char *route_image_prefix(enum route_image image);
 void route_job_url(const char *id, char out[ROUTE_URL_MAX]);
 void route_sweep_url(const char *id, char out[ROUTE_URL_MAX]);
 void route_image_url(const char *id, enum route_image image, int frame, char out[ROUTE_URL_MAX]);
+
+/* A page of a list (kind ROUTE_JOBS or ROUTE_SWEEPS) with its n query
+ * arguments, each key and value percent-encoded. malloc'ed (the query can
+ * be long), NULL when out of memory. */
+char *route_list_url(enum route_kind kind, size_t n, const char *const keys[],
+                     const char *const values[]);
 
 #endif

@@ -61,7 +61,9 @@ static void labels_text(const json_t *labels, char *out, size_t cap)
 
 int cmd_history(struct conn *c, const struct options *o)
 {
-    char err[600], query[4096] = "";
+    /* The whole history, in the largest pages the daemon gives (a
+     * --filter limit=N given later in the query wins). */
+    char err[600], query[4096] = "?limit=1000";
     if (o->out_dir && !out_dir_claim(o->out_dir, "history.json", NULL, err, sizeof(err))) {
         fprintf(stderr, "shadebench: %s\n", err);
         return EXIT_ERROR;
@@ -73,14 +75,13 @@ int cmd_history(struct conn *c, const struct options *o)
     json_object_foreach(o->filters, key, v) {
         char *k = curl_easy_escape(c->curl, key, 0), *val = curl_easy_escape(c->curl, json_string_value(v), 0);
         size_t used = strlen(query);
-        snprintf(query + used, sizeof(query) - used, "%c%s=%s", used ? '&' : '?', k ? k : "",
-                 val ? val : "");
+        snprintf(query + used, sizeof(query) - used, "&%s=%s", k ? k : "", val ? val : "");
         curl_free(k);
         curl_free(val);
     }
     if (!has_status) {
         size_t used = strlen(query);
-        snprintf(query + used, sizeof(query) - used, "%cstatus=done", used ? '&' : '?');
+        snprintf(query + used, sizeof(query) - used, "&status=done");
     }
     if (o->since) {
         char *val = curl_easy_escape(c->curl, o->since, 0);
@@ -90,7 +91,7 @@ int cmd_history(struct conn *c, const struct options *o)
     }
     char path[4200];
     snprintf(path, sizeof(path), "/v1/jobs%s", query);
-    json_t *list = conn_json(c, "GET", path, NULL, NULL);
+    json_t *list = conn_list(c, path, "jobs");
     if (!list)
         return EXIT_ERROR;
     json_t *jobs = json_object_get(list, "jobs");

@@ -106,6 +106,15 @@ static json_t *labels_json(const struct job_spec *spec)
     return o;
 }
 
+/* A finished job's spec is its spec.json, written when it was accepted and
+ * never changed: its row keeps the spec only while the job may still run
+ * (to queue it again after a restart), or where there is no spec.json
+ * (--once). Rows stay small: about 1 KB a job rather than 5. */
+static bool row_keeps_spec(enum job_status status, bool dir_given)
+{
+    return !job_status_finished(status) || dir_given;
+}
+
 /* The job's row in the store for state st; figures from result once done. */
 static void row_of(const struct job *job, const struct job_state *st, const json_t *result,
                    struct store_row *row)
@@ -126,7 +135,7 @@ static void row_of(const struct job *job, const struct job_state *st, const json
     }
     row->labels = labels_json(&job->spec);
     row->figures = st->status == JOB_DONE ? job_figures(result) : NULL;
-    row->spec = job_spec_to_json(&job->spec);
+    row->spec = row_keeps_spec(st->status, job->dir_given) ? job_spec_to_json(&job->spec) : NULL;
 }
 
 /* Under the lock: the job's state changed; number it and copy it. */
@@ -608,6 +617,20 @@ static void fail_damaged_result(struct queue *q, struct store_row *row, const ch
         LOG(LOG_ERROR, "job %s: %s", row->id, err);
 }
 
+/* A finished job's spec, from its spec.json; NULL (logged) when it cannot
+ * be read. */
+static json_t *read_spec(const struct store_row *row)
+{
+    char path[PATH_MAX + 16], why[600] = "";
+    snprintf(path, sizeof(path), "%s/spec.json", row->dir);
+    json_t *rec = record_read(path, why, sizeof(why));
+    json_t *spec = json_incref(json_object_get(rec, "spec"));
+    if (!spec)
+        LOG(LOG_WARN, "job %s: %s: %s", row->id, path, rec ? "no spec in it" : why);
+    json_decref(rec);
+    return spec;
+}
+
 /* A stored (finished) job as GET /v1/jobs/ID shows it; NULL when there is
  * no such job. A done job's result comes from its result.json. */
 static json_t *stored_job_json(struct queue *q, const char *id)
@@ -632,6 +655,8 @@ static json_t *stored_job_json(struct queue *q, const char *id)
             pthread_mutex_unlock(&q->repair);
         }
     }
+    if (!row.spec)
+        row.spec = read_spec(&row);
     struct job_state st = row_state(&row);
     json_t *o = state_json(row.id, row.technique, row.created, &st, row.total);
     if (o) {
@@ -889,6 +914,10 @@ static bool import_job(void *ctx, const char *id, const char *dir, struct store_
         if (!why[0]) {
             row_from_legacy(q, id, dir, o, status, &spec, row);
             json_decref(o);
+            if (job_status_finished(row->status)) {
+                json_decref(row->spec); /* its spec.json has it */
+                row->spec = NULL;
+            }
             return true;
         }
         json_decref(o);
@@ -900,6 +929,10 @@ static bool import_job(void *ctx, const char *id, const char *dir, struct store_
                  legacy ? why : "no row in the store and no job.json", rebuilt);
         record_quarantine(store_record_kind(q->store, STORE_JOBS), id, dir, reason, NULL, 0);
         return false;
+    }
+    if (job_status_finished(row->status)) {
+        json_decref(row->spec);
+        row->spec = NULL;
     }
     if (legacy) {
         snprintf(reason, sizeof(reason), "job.json: %s; job %s", why, rebuilt);
@@ -922,7 +955,12 @@ static void load_unfinished(void *ctx, const struct store_row *stored)
     struct job_spec spec;
     struct job_error jerr;
     char err[PATH_MAX + 300];
-    if (!job_spec_parse(row.spec, q->techniques, &spec, &jerr)) {
+    /* An unfinished row has its spec; should it not, spec.json has. */
+    json_t *read = row.spec ? NULL : read_spec(&row);
+    bool parsed = job_spec_parse(row.spec ? row.spec : read, q->techniques, &spec, &jerr);
+    json_decref(read);
+    if (!parsed) {
+        row.spec = NULL; /* finished: its spec.json has it */
         row.status = JOB_FAILED;
         row.finished = clock_unix_s();
         snprintf(row.error, sizeof(row.error), "not a job this daemon can run (%s: %s)",
@@ -958,6 +996,8 @@ static void load_unfinished(void *ctx, const struct store_row *stored)
     }
     /* Running when the daemon died: what an interrupted write left goes. */
     record_remove_tmp_files(row.dir);
+    if (!row.dir_given)
+        row.spec = NULL; /* finished now: its spec.json has it */
     char why[300] = "";
     json_t *figures = NULL;
     if (done_from_result(&row, &spec, row.dir, why, sizeof(why))) {

@@ -30,7 +30,7 @@ static const char SCHEMA[] =
     " kind INTEGER NOT NULL, id TEXT NOT NULL, status TEXT NOT NULL,"
     " technique TEXT NOT NULL, created REAL NOT NULL, started REAL NOT NULL,"
     " finished REAL NOT NULL, done INTEGER NOT NULL, total INTEGER NOT NULL,"
-    " error TEXT, labels TEXT, figures TEXT, spec TEXT NOT NULL, extra TEXT, dir TEXT,"
+    " error TEXT, labels TEXT, figures TEXT, spec TEXT, extra TEXT, dir TEXT,"
     " PRIMARY KEY (kind, id)) WITHOUT ROWID;"
     "CREATE INDEX IF NOT EXISTS records_status ON records (kind, status, id);"
     "CREATE INDEX IF NOT EXISTS records_technique ON records (kind, technique, id);"
@@ -509,10 +509,7 @@ static bool put_locked(struct store *s, const struct store_row *r)
         sqlite3_bind_null(st, 10);
     bind_json(st, 11, r->labels);
     bind_json(st, 12, r->figures);
-    if (r->spec)
-        bind_json(st, 13, r->spec);
-    else
-        sqlite3_bind_text(st, 13, "{}", -1, SQLITE_STATIC);
+    bind_json(st, 13, r->spec);
     bind_json(st, 14, r->extra);
     if (!r->dir_given)
         sqlite3_bind_null(st, 15);

@@ -6,7 +6,8 @@
  * a write that returned survives kill -9 and a power cut. One row per record
  * holds what lists show and filters read (status, technique, times,
  * progress, labels, a job's headline figures, the error) and what its owner
- * needs to bring it back (the spec; a sweep's table), with indexes for the
+ * needs to bring it back (an unfinished job's spec; a sweep's table), with
+ * indexes for the
  * list filters; labels have a table of their own. Everything else a record
  * owns stays in its directory, STATE_DIR/<kind>/<ID>/ (records.h): its
  * spec.json, written once when it is accepted, and a job's result.json,
@@ -64,7 +65,7 @@ struct store_row {
     bool dir_given;
     json_t *labels;  /* object of strings, or NULL */
     json_t *figures; /* a job's headline figures (job_figures.h), or NULL */
-    json_t *spec;    /* a job's spec; a sweep's body as posted */
+    json_t *spec;    /* a job's spec (NULL once finished: see queue.c); a sweep's body */
     json_t *extra;   /* a sweep's table and result; NULL for jobs */
 };
 

@@ -84,7 +84,8 @@ write(os.path.join(jd["bad_result"], "result.json"), "{\"frames\": ")
 # Killed between writing result.json and storing the job done: complete, so
 # done; killed before the metrics completed it: interrupted.
 for name in ("died_after_result", "died_before_metrics"):
-    storelib.set_status(state, storelib.JOBS, ids[name], "running", finished=0)
+    spec = json.loads(read(os.path.join(jd[name], "spec.json")))["spec"]
+    storelib.set_status(state, storelib.JOBS, ids[name], "running", finished=0, spec=json.dumps(spec))
 result = json.loads(read(os.path.join(jd["died_before_metrics"], "result.json")))
 del result["quality"]
 write(os.path.join(jd["died_before_metrics"], "result.json"), json.dumps(result))

@@ -61,9 +61,10 @@ static void labels_text(const json_t *labels, char *out, size_t cap)
 
 int cmd_history(struct conn *c, const struct options *o)
 {
-    /* The whole history, in the largest pages the daemon gives (a
-     * --filter limit=N given later in the query wins). */
-    char err[600], query[4096] = "?limit=1000";
+    /* The whole history, page after page (the daemon's pages unless
+     * --filter limit=N; no limit of our own, which a daemon from before
+     * pages would refuse). */
+    char err[600], query[4096] = "";
     if (o->out_dir && !out_dir_claim(o->out_dir, "history.json", NULL, err, sizeof(err))) {
         fprintf(stderr, "shadebench: %s\n", err);
         return EXIT_ERROR;
@@ -75,13 +76,14 @@ int cmd_history(struct conn *c, const struct options *o)
     json_object_foreach(o->filters, key, v) {
         char *k = curl_easy_escape(c->curl, key, 0), *val = curl_easy_escape(c->curl, json_string_value(v), 0);
         size_t used = strlen(query);
-        snprintf(query + used, sizeof(query) - used, "&%s=%s", k ? k : "", val ? val : "");
+        snprintf(query + used, sizeof(query) - used, "%c%s=%s", used ? '&' : '?', k ? k : "",
+                 val ? val : "");
         curl_free(k);
         curl_free(val);
     }
     if (!has_status) {
         size_t used = strlen(query);
-        snprintf(query + used, sizeof(query) - used, "&status=done");
+        snprintf(query + used, sizeof(query) - used, "%cstatus=done", used ? '&' : '?');
     }
     if (o->since) {
         char *val = curl_easy_escape(c->curl, o->since, 0);

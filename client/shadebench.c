@@ -77,7 +77,7 @@ static void usage(FILE *f)
             "  --server-b URL      ab: the second daemon\n\n"
             "History:\n"
             "  --filter KEY=VALUE  technique=, status=, label.NAME= (repeatable); limit=N: pages\n"
-            "                      of N jobs (default 1000), followed to the end\n"
+            "                      of N jobs (default: the daemon's, 100), read to the end\n"
             "  --since TIME        jobs created since TIME (2026-11-21, 2026-11-21T10:00:00Z, or\n"
             "                      seconds since 1970)\n"
             "  --figure NAME       frame_ms, gpu_ms, cpu_ms or worst_ssim (default as --series)\n\n"

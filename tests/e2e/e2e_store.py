@@ -2,7 +2,7 @@
 every job exactly once, in submission order, with filters kept and a job
 submitted meanwhile coming at the end; a bad limit or cursor gets 400 naming
 it; the sweep list pages too; the client's history and list follow next to
-the end. kill -9 in the middle of a stream of submissions loses no job that
+the end. Retention keeps a running sweep's point jobs. kill -9 in the middle of a stream of submissions loses no job that
 was answered 202. A state directory of the earlier version (job.json and
 sweep.json files, tests/e2e/fixtures/legacy-state, made by
 make_legacy_state.py with that version) is imported on first start:
@@ -123,6 +123,28 @@ try:
     check(out.returncode == 0 and all_ids + [late] == [i for i in listed if i in all_ids + [late]]
           and len(listed) == len(all_ids) + 1 + 2,  # and the sweeps' point jobs
           "list reads every page: %d jobs" % len(listed))
+finally:
+    testlib.stop_and_check(d)
+
+# --- Retention keeps what a running sweep needs -------------------------------
+d = testlib.Daemon("--keep-jobs", "1")
+try:
+    status, reply = d.json("POST", "/v1/sweeps", {"base": TINY, "vary": {"scene.lights": [1, 2, 3]},
+                                                 "time_reference": False})
+    sweep = d.wait_sweep(reply["id"])
+    points = [p["job"] for p in sweep.get("points", [])]
+    check(sweep["status"] == "done" and len(points) == 3, "a sweep of 3 points under --keep-jobs 1")
+    check(all(d.json("GET", "/v1/jobs/" + job_id)[0] == 200 for job_id in points),
+          "its point jobs all stayed while it ran, though only 1 finished job is kept")
+    last = d.run(TINY)
+    deadline = time.time() + 10
+    jobs_dir = os.path.join(d.state, "jobs")
+    while time.time() < deadline and (len(storelib.ids(d.state)) > 1 or len(os.listdir(jobs_dir)) > 1):
+        time.sleep(0.05)
+    check(storelib.ids(d.state) == [last["id"]] and os.listdir(jobs_dir) == [last["id"]],
+          "once it is done, retention removes them, rows and directories: %s, %s"
+          % (storelib.ids(d.state), os.listdir(jobs_dir)))
+    check(d.json("GET", "/v1/sweeps/" + reply["id"])[0] == 200, "the sweep, the newest finished one, stays")
 finally:
     testlib.stop_and_check(d)
 

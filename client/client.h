@@ -67,6 +67,11 @@ long conn_request(struct conn *c, const char *method, const char *path, const ch
 json_t *conn_json(struct conn *c, const char *method, const char *path, const char *body,
                   long *status);
 
+/* A list that comes in pages (GET /v1/jobs, /v1/sweeps): path's first page,
+ * then each "next" link until the last; {key: [every item]}. NULL (the
+ * error printed) when a page cannot be had. */
+json_t *conn_list(struct conn *c, const char *path, const char *key);
+
 bool conn_download(struct conn *c, const char *path, const char *file);
 
 /* Follows a job until it ends (a bar on a terminal, plain lines otherwise,

@@ -219,6 +219,9 @@ static bool history_render(struct conn *c, const struct options *o, json_t *jobs
 
 int cmd_history(struct conn *c, const struct options *o)
 {
+    /* The whole history, page after page (the daemon's pages unless
+     * --filter limit=N; no limit of our own, which a daemon from before
+     * pages would refuse). */
     char err[600], query[4096] = "";
     if (o->out_dir && !out_dir_claim(o->out_dir, "history.json", NULL, err, sizeof(err))) {
         fprintf(stderr, "shadebench: %s\n", err);
@@ -248,7 +251,7 @@ int cmd_history(struct conn *c, const struct options *o)
     }
     char path[4200];
     snprintf(path, sizeof(path), "/v1/jobs%s", query);
-    json_t *list = conn_json(c, "GET", path, NULL, NULL);
+    json_t *list = conn_list(c, path, "jobs");
     if (!list)
         return EXIT_ERROR;
     json_t *jobs = json_object_get(list, "jobs");

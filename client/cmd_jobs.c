@@ -646,7 +646,7 @@ int cmd_status(struct conn *c, const char *id)
 
 int cmd_list(struct conn *c)
 {
-    json_t *list = conn_json(c, "GET", "/v1/jobs", NULL, NULL);
+    json_t *list = conn_list(c, "/v1/jobs", "jobs");
     if (!list)
         return EXIT_ERROR;
     size_t i;

@@ -117,6 +117,29 @@ json_t *conn_json(struct conn *c, const char *method, const char *path, const ch
     return j;
 }
 
+json_t *conn_list(struct conn *c, const char *path, const char *key)
+{
+    json_t *all = json_array();
+    char *at = strdup(path);
+    /* Each page names the next (a path on this server) until the last. */
+    while (at && all) {
+        json_t *page = conn_json(c, "GET", at, NULL, NULL);
+        if (!page) {
+            json_decref(all);
+            all = NULL;
+            break;
+        }
+        json_array_extend(all, json_object_get(page, key));
+        const char *next = json_string_value(json_object_get(page, "next"));
+        char *follow = next && next[0] == '/' && strcmp(next, at) != 0 ? strdup(next) : NULL;
+        free(at);
+        at = follow;
+        json_decref(page);
+    }
+    free(at);
+    return all ? json_pack("{s:o}", key, all) : NULL;
+}
+
 bool conn_download(struct conn *c, const char *path, const char *file)
 {
     struct buffer b;

@@ -50,7 +50,9 @@ bool fs_write_atomic(const char *path, const void *data, size_t len)
 
 bool fs_write_json_atomic(const char *path, const json_t *value)
 {
-    char *text = json_dumps(value, JSON_INDENT(2) | JSON_SORT_KEYS);
+    /* Keys in the writer's order: a result's passes are in frame order, and
+     * a finished job is served from its file. */
+    char *text = json_dumps(value, JSON_INDENT(2));
     if (!text) {
         errno = ENOMEM;
         return false;

@@ -10,7 +10,8 @@
 #include <stdbool.h>
 #include <stddef.h>
 
-#define JOB_FILE_RESULT "result.json"
+#define JOB_FILE_SPEC "spec.json"     /* the job as accepted (the store's) */
+#define JOB_FILE_RESULT "result.json" /* the harness's */
 #define JOB_FILE_TIMINGS "timings.csv"
 
 /* The per-capture images of a job, one PNG per captured frame each. */

@@ -44,6 +44,13 @@ struct options {
 };
 
 #define DEFAULT_CONFIG "/etc/shadebench/shadebenchd.conf"
+/* Retention by default, so that a box left alone keeps its disk and memory
+ * bounded: at about 2 MB of files a small job, 10,000 jobs are a few GB
+ * (docs/store.md). */
+#define KEEP_JOBS_DEFAULT 10000
+#define KEEP_JOBS_TEXT "10000"
+#define KEEP_DAYS_DEFAULT 90
+#define KEEP_DAYS_TEXT "90"
 
 static void usage(FILE *f)
 {
@@ -58,8 +65,10 @@ static void usage(FILE *f)
             "  --queue-size N       jobs that may wait at once (default 64)\n"
             "  --token FILE         require \"Authorization: Bearer <token>\" with the token in\n"
             "                       FILE on every endpoint but /healthz (SIGHUP rereads it)\n"
-            "  --keep-jobs N        keep the newest N finished jobs, remove older ones' files\n"
-            "  --keep-days D        remove finished jobs older than D days\n"
+            "  --keep-jobs N        keep the newest N finished jobs (and sweeps), remove older\n"
+            "                       ones and their files (default " KEEP_JOBS_TEXT "; 0: keep all)\n"
+            "  --keep-days D        remove finished jobs (and sweeps) older than D days\n"
+            "                       (default " KEEP_DAYS_TEXT "; 0: keep all)\n"
             "  --job-timeout S      running time a job may take when it gives no timeout_s\n"
             "                       (default 86400; 0: no limit)\n"
             "  --max-connections N  HTTP connections open at once, in total (default 4096)\n"
@@ -332,12 +341,15 @@ static int run_once(const struct options *o)
         fprintf(stderr, "shadebenchd: cannot create %s\n", o->out);
         return 2;
     }
-    char err[512];
-    struct queue *q = queue_create(NULL, 1);
+    char err[PATH_MAX + 300];
+    /* One job, no state directory: its record lives in memory. */
+    struct store *store = store_open(NULL, err, sizeof(err));
+    struct queue *q = store ? queue_create(store, 1) : NULL;
     struct runner *r = q ? runner_create(q, o->device, o->gl_debug, err, sizeof(err)) : NULL;
     if (!r) {
-        fprintf(stderr, "shadebenchd: %s\n", q ? err : "out of memory");
+        fprintf(stderr, "shadebenchd: %s\n", q || !store ? err : "out of memory");
         queue_destroy(q);
+        store_close(store);
         return 1;
     }
     pin_loaded_modules();
@@ -362,6 +374,7 @@ static int run_once(const struct options *o)
     }
     runner_destroy(r);
     queue_destroy(q);
+    store_close(store);
     return rc;
 }
 
@@ -399,26 +412,35 @@ static int serve(const struct options *o)
     pthread_sigmask(SIG_BLOCK, &set, NULL);
     signal(SIGPIPE, SIG_IGN);
 
-    char err[512];
-    struct queue *q = queue_create(state_dir, o->queue_size);
+    char err[PATH_MAX + 300];
+    struct store *store = store_open(state_dir, err, sizeof(err));
+    if (!store) {
+        LOG(LOG_ERROR, "%s", err);
+        return 1;
+    }
+    struct queue *q = queue_create(store, o->queue_size);
     if (!q) {
         LOG(LOG_ERROR, "out of memory");
+        store_close(store);
         return 1;
     }
     queue_set_retention(q, o->keep_jobs, o->keep_days);
-    /* Earlier jobs first: finished ones are served again, queued ones run. */
+    /* Earlier jobs first: finished ones are served from the store, queued
+     * ones run. */
     int loaded = queue_load(q, technique_catalog(), err, sizeof(err));
     if (loaded < 0) {
         LOG(LOG_ERROR, "%s", err);
         queue_destroy(q);
+        store_close(store);
         return 1;
     }
     if (loaded > 0)
-        LOG(LOG_INFO, "loaded %d job(s) from %s", loaded, state_dir);
+        LOG(LOG_INFO, "%d job(s) in %s/%s", loaded, state_dir, STORE_FILE);
     struct runner *r = runner_create(q, o->device, o->gl_debug, err, sizeof(err));
     if (!r) {
         LOG(LOG_ERROR, "%s", err);
         queue_destroy(q);
+        store_close(store);
         return 1;
     }
     pin_loaded_modules();
@@ -430,6 +452,7 @@ static int serve(const struct options *o)
         sweeps_destroy(sweeps);
         runner_destroy(r);
         queue_destroy(q);
+        store_close(store);
         return 1;
     }
     LOG(LOG_INFO, "shadebenchd %s listening on %s (port %d), state in %s", PACKAGE_VERSION,
@@ -462,6 +485,7 @@ static int serve(const struct options *o)
     sweeps_destroy(sweeps);
     runner_destroy(r);
     queue_destroy(q);
+    store_close(store);
     return 0;
 }
 
@@ -480,7 +504,8 @@ int main(int argc, char **argv)
      * jobs before it, for at most 128 MiB of free heap kept. */
     mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
     mallopt(M_TRIM_THRESHOLD, 128 * 1024 * 1024);
-    struct options o = {.device = -1, .queue_size = 64, .job_timeout = 86400};
+    struct options o = {.device = -1, .queue_size = 64, .job_timeout = 86400,
+                        .keep_jobs = KEEP_JOBS_DEFAULT, .keep_days = KEEP_DAYS_DEFAULT};
     snprintf(o.listen, sizeof(o.listen), "127.0.0.1:8460");
     enum { OPT_LISTEN = 256, OPT_STATE, OPT_DEVICE, OPT_QUEUE, OPT_TOKEN, OPT_KEEP_JOBS,
            OPT_KEEP_DAYS, OPT_JOB_TIMEOUT, OPT_MAX_CONN, OPT_MAX_CONN_IP, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_ONCE, OPT_OUT, OPT_DEBUG,

@@ -278,17 +278,13 @@ static enum MHD_Result respond_metrics(struct http_server *s, struct MHD_Connect
     FILE *f = open_memstream(&text, &len);
     if (!f)
         return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "metrics", "out of memory");
-    json_t *list = queue_list_json(s->queue);
-    size_t counts[JOB_INTERRUPTED + 1] = {0};
-    size_t i;
-    json_t *job;
-    json_array_foreach(json_object_get(list, "jobs"), i, job) {
-        const char *st = json_string_value(json_object_get(job, "status"));
-        for (int k = JOB_QUEUED; st && k <= JOB_INTERRUPTED; k++)
-            if (strcmp(st, job_status_name((enum job_status)k)) == 0)
-                counts[k]++;
+    size_t counts[JOB_STATUS_COUNT];
+    if (!queue_counts(s->queue, counts)) {
+        fclose(f);
+        free(text);
+        return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "metrics",
+                             "cannot read the store (see the log)");
     }
-    json_decref(list);
     fprintf(f, "# HELP shadebench_jobs Jobs in the store, by status.\n"
                "# TYPE shadebench_jobs gauge\n");
     for (int k = JOB_QUEUED; k <= JOB_INTERRUPTED; k++)
@@ -422,7 +418,7 @@ static enum MHD_Result respond_chart(struct MHD_Connection *c, const json_t *sub
 }
 
 struct list_args {
-    struct job_filter filter;
+    struct store_query query;
     struct job_error err;
     bool ok;
 };
@@ -432,8 +428,43 @@ static enum MHD_Result list_arg(void *cls, enum MHD_ValueKind kind, const char *
 {
     (void)kind;
     struct list_args *a = cls;
-    a->ok = a->ok && job_filter_add(&a->filter, key, value, &a->err);
+    a->ok = a->ok && job_filter_add(&a->query, key, value, &a->err);
     return a->ok ? MHD_YES : MHD_NO;
+}
+
+/* GET /v1/jobs and GET /v1/sweeps: a page, with the link to the next one.
+ * Jobs take filters (?technique=&status=&label.KEY=VALUE&since=), both
+ * take ?limit=&cursor= (daemon/api/job_filter.h). */
+static enum MHD_Result respond_list(struct http_server *s, struct MHD_Connection *c,
+                                    enum route_kind route)
+{
+    struct list_args *a = calloc(1, sizeof(*a));
+    if (!a)
+        return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "url", "out of memory");
+    a->ok = true;
+    job_filter_init(&a->query, route == ROUTE_SWEEPS ? STORE_SWEEPS : STORE_JOBS);
+    MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, list_arg, a);
+    if (!a->ok) {
+        json_t *body = job_error_to_json(&a->err);
+        free(a);
+        return respond_json(c, MHD_HTTP_BAD_REQUEST, body);
+    }
+    /* The error goes in a 256-byte message (respond_error): logged whole. */
+    char next[RECORD_ID_LEN], err[240];
+    json_t *list = route == ROUTE_SWEEPS
+                       ? sweeps_list_page(s->sweeps, &a->query, next, err, sizeof(err))
+                       : queue_list_page(s->queue, &a->query, next, err, sizeof(err));
+    if (!list) {
+        free(a);
+        return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "store", err);
+    }
+    if (route == ROUTE_SWEEPS)
+        links_add_sweep_list(list);
+    else
+        links_add_job_list(list);
+    links_add_next(list, route, &a->query, next);
+    free(a);
+    return respond_json(c, MHD_HTTP_OK, list);
 }
 
 static bool point_job_dir(void *ctx, const char *job_id, char *dir, size_t cap, int *last_frame)
@@ -719,18 +750,8 @@ static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
                                      "the job must be at most 65536 bytes");
             return submit_job(s, c, req);
         }
-        {
-            /* The route allows only POST, GET and HEAD here. Filters:
-             * ?technique=&status=&label.KEY=VALUE&since= (daemon/api/job_filter.h) */
-            struct list_args a = {.ok = true};
-            job_filter_init(&a.filter);
-            MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, list_arg, &a);
-            if (!a.ok)
-                return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&a.err));
-            json_t *list = queue_list_json_with(s->queue, job_filter_visit, &a.filter);
-            links_add_job_list(list);
-            return respond_json(c, MHD_HTTP_OK, list);
-        }
+        /* The route allows only POST, GET and HEAD here. */
+        return respond_list(s, c, ROUTE_JOBS);
     case ROUTE_SWEEPS:
         if (post) {
             if (req->too_large)
@@ -738,9 +759,7 @@ static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
                                      "the sweep must be at most 65536 bytes");
             return post_sweep(s, c, req);
         }
-        json_t *list = sweeps_list_json(s->sweeps);
-        links_add_sweep_list(list);
-        return respond_json(c, MHD_HTTP_OK, list);
+        return respond_list(s, c, ROUTE_SWEEPS);
     case ROUTE_JOB:
     case ROUTE_JOB_REPORT:
     case ROUTE_JOB_CHART:

@@ -1,7 +1,11 @@
 #include "daemon/api/links.h"
 
+#include "daemon/api/job_filter.h"
 #include "daemon/api/routes.h"
 #include "common/result_keys.h"
+
+#include <stdio.h>
+#include <stdlib.h>
 
 /* The images a capture entry of result.captures may name. */
 static const enum job_image CAPTURE_IMAGES[] = {JOB_IMAGE_FRAME, JOB_IMAGE_REFERENCE,
@@ -81,4 +85,39 @@ void links_add_sweep_list(json_t *list)
     json_t *sweep;
     json_array_foreach(json_object_get(list, "sweeps"), i, sweep)
         links_add_sweep(sweep);
+}
+
+void links_add_next(json_t *list, enum route_kind kind, const struct store_query *q,
+                    const char *next)
+{
+    if (!next || !next[0])
+        return;
+    /* The question as job_filter_add reads it: filters, since, limit, cursor. */
+    const char *keys[STORE_MAX_TERMS + 3], *values[STORE_MAX_TERMS + 3];
+    char names[STORE_MAX_TERMS][48], since[32], limit[16];
+    size_t n = 0;
+    for (size_t i = 0; i < q->nterms; i++) {
+        const struct store_term *t = &q->terms[i];
+        if (t->kind == STORE_TERM_LABEL)
+            snprintf(names[i], sizeof(names[i]), "label.%s", t->label);
+        else
+            snprintf(names[i], sizeof(names[i]), "%s",
+                     t->kind == STORE_TERM_TECHNIQUE ? "technique" : "status");
+        keys[n] = names[i];
+        values[n++] = t->value;
+    }
+    if (q->since_ms > 0) {
+        job_filter_format_time(q->since_ms, since);
+        keys[n] = "since";
+        values[n++] = since;
+    }
+    snprintf(limit, sizeof(limit), "%d", q->limit);
+    keys[n] = "limit";
+    values[n++] = limit;
+    keys[n] = "cursor";
+    values[n++] = next;
+    char *url = route_list_url(kind, n, keys, values);
+    if (url)
+        json_object_set_new(list, "next", json_string(url));
+    free(url);
 }

@@ -8,6 +8,9 @@
 
 #include <jansson.h>
 
+#include "daemon/api/routes.h"
+#include "daemon/jobs/store.h"
+
 /* job.url; per capture (result.captures) url from its frame, and
  * reference_url, ssim_map_url and flip_map_url where the capture names
  * that file; each heat map capture's url. Takes a job as GET /v1/jobs/ID
@@ -20,5 +23,11 @@ void links_add_sweep(json_t *sweep);
 /* Each item of {"jobs": [...]} or {"sweeps": [...]}. */
 void links_add_job_list(json_t *list);
 void links_add_sweep_list(json_t *list);
+
+/* list.next: the URL of the page after this one, the same question (kind
+ * ROUTE_JOBS or ROUTE_SWEEPS, q's filters and limit) from cursor next;
+ * nothing when next is "" (this page is the last). */
+void links_add_next(json_t *list, enum route_kind kind, const struct store_query *q,
+                    const char *next);
 
 #endif

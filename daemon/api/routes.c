@@ -2,6 +2,7 @@
 #include "daemon/api/routes.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static const struct {
@@ -202,4 +203,49 @@ void route_sweep_url(const char *id, char out[ROUTE_URL_MAX])
 void route_image_url(const char *id, enum job_image image, int frame, char out[ROUTE_URL_MAX])
 {
     snprintf(out, ROUTE_URL_MAX, "/v1/jobs/%s/%s/%d.png", id, job_image_kind(image)->folder, frame);
+}
+
+/* Query arguments keep the unreserved characters of RFC 3986 and escape
+ * every other byte. */
+static size_t encode(const char *s, char *out)
+{
+    static const char hex[] = "0123456789ABCDEF";
+    size_t n = 0;
+    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+        if ((*p >= 'A' && *p <= 'Z') || (*p >= 'a' && *p <= 'z') || (*p >= '0' && *p <= '9') ||
+            *p == '-' || *p == '_' || *p == '.' || *p == '~') {
+            if (out)
+                out[n] = (char)*p;
+            n++;
+        } else {
+            if (out) {
+                out[n] = '%';
+                out[n + 1] = hex[*p >> 4];
+                out[n + 2] = hex[*p & 15];
+            }
+            n += 3;
+        }
+    }
+    return n;
+}
+
+char *route_list_url(enum route_kind kind, size_t n, const char *const keys[],
+                     const char *const values[])
+{
+    const char *path = kind == ROUTE_SWEEPS ? "/v1/sweeps" : "/v1/jobs";
+    size_t len = strlen(path) + 1;
+    for (size_t i = 0; i < n; i++)
+        len += encode(keys[i], NULL) + encode(values[i], NULL) + 2;
+    char *url = malloc(len);
+    if (!url)
+        return NULL;
+    size_t at = (size_t)sprintf(url, "%s", path);
+    for (size_t i = 0; i < n; i++) {
+        url[at++] = i ? '&' : '?';
+        at += encode(keys[i], url + at);
+        url[at++] = '=';
+        at += encode(values[i], url + at);
+    }
+    url[at] = '\0';
+    return url;
 }

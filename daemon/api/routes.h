@@ -7,6 +7,7 @@
  * fuzzed on its own. GL-free; any thread. */
 
 #include <stdbool.h>
+#include <stddef.h>
 
 #include "common/job_files.h"
 
@@ -61,5 +62,11 @@ void route_sweep_url(const char *id, char out[ROUTE_URL_MAX]);
 /* A finished job's per-frame figures (timings.csv). */
 void route_timings_url(const char *id, char out[ROUTE_URL_MAX]);
 void route_image_url(const char *id, enum job_image image, int frame, char out[ROUTE_URL_MAX]);
+
+/* A page of a list (kind ROUTE_JOBS or ROUTE_SWEEPS) with its n query
+ * arguments, each key and value percent-encoded. malloc'ed (the query can
+ * be long), NULL when out of memory. */
+char *route_list_url(enum route_kind kind, size_t n, const char *const keys[],
+                     const char *const values[]);
 
 #endif

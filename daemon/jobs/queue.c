@@ -1,60 +1,58 @@
 #define _POSIX_C_SOURCE 200809L
 #include "daemon/jobs/queue.h"
 
-#include "common/fsutil.h"
+#include "common/job_files.h"
 #include "common/clock.h"
 #include "common/log.h"
 #include "common/result_keys.h"
+#include "daemon/jobs/job_figures.h"
+#include "daemon/jobs/job_dir.h"
 
-#include <dirent.h>
 #include <errno.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
+/* Retention removes at most a batch at a time: after a job finishes (so
+ * between jobs, never in a timed region), and at startup for at most
+ * RETENTION_START_S, so that a large backlog (a lowered --keep-jobs) never
+ * holds up the start; the rest goes a batch per finished job. */
+#define RETENTION_BATCH 256
+#define RETENTION_START_S 2.0
+
 struct queue {
-    /* Guards everything below and the jobs' store-owned fields. Never held
-     * across file I/O: see struct snapshot. */
+    /* Guards everything below and the live jobs' queue-owned fields. Never
+     * held across file I/O or a store write: see struct snapshot. */
     pthread_mutex_t lock;
     pthread_cond_t changed;
-    struct job **jobs; /* sorted by id: submission order */
-    size_t count, cap;
+    struct store_live live; /* struct job: queued, running, or not yet stored */
     int queued, max_queued; /* queued counts submissions in progress too */
     bool stopping;
     int keep_jobs;
     double keep_days;
-    struct record_kind kind; /* STATE_DIR/jobs/ID/job.json */
+    struct store *store;
     const struct technique_catalog *techniques; /* for queue_load */
     void (*listener)(void *ctx);
     void *listener_ctx;
+    /* The retention guard; its lock is held while it is asked, so that it
+     * is never asked once unset. */
+    pthread_mutex_t guard;
+    bool (*needed)(void *ctx, const char *id);
+    void *needed_ctx;
+    pthread_mutex_t repair;    /* one repair of a damaged result.json at a time */
+    pthread_mutex_t retention; /* one retention pass at a time */
 };
 
-/* A job's state as taken under the store lock, written after it is
- * released. The job stays alive until then (pending). */
+/* A job's state as taken under the lock, written after it is released. The
+ * job stays in memory until then (pending). */
 struct snapshot {
     struct job *job;
     uint64_t seq;
-    json_t *json;
+    struct store_row row;
 };
-
-void queue_set_listener(struct queue *q, void (*fn)(void *ctx), void *ctx)
-{
-    q->listener = fn;
-    q->listener_ctx = ctx;
-}
-
-#define NOTIFY_LISTENER(q) ((q)->listener ? (q)->listener((q)->listener_ctx) : (void)0)
-
-const char *job_status_name(enum job_status s)
-{
-    static const char *const names[] = {"queued",    "running",  "done",
-                                        "failed",    "cancelled", "interrupted"};
-    return names[s];
-}
 
 /* The parts of a job's state that its JSON shows and that change. */
 struct job_state {
@@ -65,64 +63,85 @@ struct job_state {
     int frames_done;
 };
 
-static struct job_state state_of(const struct job *job);
-static json_t *state_json(const struct job *job, const struct job_state *st, bool full);
-static json_t *state_record(const struct job *job, const struct job_state *st);
-static json_t *job_json_locked(const struct job *job, bool full);
-static json_t *job_record_locked(const struct job *job);
-static void apply_retention(struct queue *q);
+static void apply_retention(struct queue *q, bool startup);
 
-static bool finished(const struct job *job)
+void queue_set_listener(struct queue *q, void (*fn)(void *ctx), void *ctx)
 {
-    return job->status != JOB_QUEUED && job->status != JOB_RUNNING;
+    q->listener = fn;
+    q->listener_ctx = ctx;
+}
+
+void queue_set_retention_guard(struct queue *q, bool (*needed)(void *ctx, const char *id),
+                               void *ctx)
+{
+    pthread_mutex_lock(&q->guard);
+    q->needed = needed;
+    q->needed_ctx = ctx;
+    pthread_mutex_unlock(&q->guard);
+}
+
+static bool needed_elsewhere(struct queue *q, const char *id)
+{
+    pthread_mutex_lock(&q->guard);
+    bool needed = q->needed && q->needed(q->needed_ctx, id);
+    pthread_mutex_unlock(&q->guard);
+    return needed;
+}
+
+#define NOTIFY_LISTENER(q) ((q)->listener ? (q)->listener((q)->listener_ctx) : (void)0)
+
+static bool finished(const struct job *job) { return job_status_finished(job->status); }
+
+static struct job_state state_of(const struct job *job)
+{
+    return (struct job_state){job->status, job->phase, job->started, job->finished, job->error,
+                              atomic_load_explicit(&job->frames_done, memory_order_relaxed)};
+}
+
+/* A finished job's spec is its spec.json, written when it was accepted and
+ * never changed: its row keeps the spec only while the job may still run
+ * (to queue it again after a restart), or where there is no spec.json
+ * (--once). Rows stay small: about 1 KB a job rather than 5. */
+static bool row_keeps_spec(enum job_status status, bool dir_given)
+{
+    return !job_status_finished(status) || dir_given;
+}
+
+/* The job's row in the store for state st; figures from result once done. */
+static void row_of(const struct job *job, const struct job_state *st, const json_t *result,
+                   struct store_row *row)
+{
+    store_row_init(row, STORE_JOBS);
+    snprintf(row->id, sizeof(row->id), "%s", job->id);
+    row->status = st->status;
+    snprintf(row->technique, sizeof(row->technique), "%s", job->spec.technique);
+    row->created = job->created;
+    row->started = st->started;
+    row->finished = st->finished;
+    row->done = st->frames_done;
+    row->total = job->frames_total;
+    snprintf(row->error, sizeof(row->error), "%s", st->error ? st->error : "");
+    if (job->dir_given) {
+        snprintf(row->dir, sizeof(row->dir), "%s", job->dir);
+        row->dir_given = true;
+    }
+    row->labels = job_dir_labels(&job->spec);
+    row->figures = st->status == JOB_DONE ? job_figures(result) : NULL;
+    row->spec = row_keeps_spec(st->status, job->dir_given) ? job_spec_to_json(&job->spec) : NULL;
 }
 
 /* Under the lock: the job's state changed; number it and copy it. */
 static void snapshot_locked(struct job *job, struct snapshot *snap)
 {
+    struct job_state st = state_of(job);
     snap->job = job;
-    snap->seq = ++job->seq;
-    snap->json = job_record_locked(job);
-    job->pending++;
+    snap->seq = store_version_take(&job->version);
+    row_of(job, &st, job->result, &snap->row);
 }
 
-/* Without the lock: writes the snapshot unless a newer one is on disk, and
- * releases the job. Failures are logged with the file and errno. */
-static bool write_snapshot(struct queue *q, struct snapshot *snap, char *err, size_t errlen)
+static struct job *find_locked(struct queue *q, const char *id)
 {
-    struct job *job = snap->job;
-    char path[PATH_MAX + 16], why[PATH_MAX + 128] = "";
-    bool ok = true;
-    snprintf(path, sizeof(path), "%s/job.json", job->dir);
-    if (!snap->json) {
-        ok = false;
-        snprintf(why, sizeof(why), "cannot write %s: out of memory", path);
-    } else {
-        ok = record_writer_write(&job->writer, snap->seq, path, snap->json, why, sizeof(why));
-    }
-    if (!ok)
-        LOG(LOG_ERROR, "job %s: %s (its state in memory stays right; written again at exit)",
-            job->id, why);
-    if (err)
-        snprintf(err, errlen, "%s", why);
-    json_decref(snap->json);
-    snap->json = NULL;
-    pthread_mutex_lock(&q->lock);
-    job->pending--;
-    pthread_mutex_unlock(&q->lock);
-    return ok;
-}
-
-struct queue *queue_create(const char *state_dir, int max_queued)
-{
-    struct queue *q = calloc(1, sizeof(*q));
-    if (!q)
-        return NULL;
-    pthread_mutex_init(&q->lock, NULL);
-    pthread_cond_init(&q->changed, NULL);
-    q->max_queued = max_queued;
-    record_kind_init(&q->kind, state_dir, "jobs", "job.json");
-    return q;
+    return store_live_find(&q->live, id);
 }
 
 static void job_free(struct job *job)
@@ -130,9 +149,58 @@ static void job_free(struct job *job)
     if (!job)
         return;
     json_decref(job->result);
-    record_writer_finish(&job->writer);
     free(job);
 }
+
+/* A finished job whose newest state is stored leaves memory: from then on
+ * it is read from the store. Returns the job to free once the lock is
+ * released, or NULL. */
+static struct job *evict_locked(struct queue *q, struct job *job)
+{
+    if (!finished(job) || !store_version_stored(&job->version))
+        return NULL;
+    store_live_remove(&q->live, job);
+    return job;
+}
+
+/* Without the lock: stores the snapshot unless a newer one is stored, and
+ * releases the job (which may then leave memory). Failures are logged with
+ * the database and the system's reason. */
+static bool write_snapshot(struct queue *q, struct snapshot *snap, char *err, size_t errlen)
+{
+    struct job *job = snap->job;
+    char why[PATH_MAX + 300] = "";
+    bool ok = store_put(q->store, &snap->row, snap->seq, &job->version.written, why, sizeof(why));
+    if (!ok)
+        LOG(LOG_ERROR, "job %s: %s (its state in memory stays right; written again at exit)",
+            job->id, why);
+    if (err)
+        snprintf(err, errlen, "%s", why);
+    store_row_finish(&snap->row);
+    pthread_mutex_lock(&q->lock);
+    store_version_back(&job->version, snap->seq, ok);
+    struct job *gone = evict_locked(q, job);
+    pthread_mutex_unlock(&q->lock);
+    job_free(gone);
+    return ok;
+}
+
+struct queue *queue_create(struct store *store, int max_queued)
+{
+    struct queue *q = calloc(1, sizeof(*q));
+    if (!q)
+        return NULL;
+    pthread_mutex_init(&q->lock, NULL);
+    pthread_cond_init(&q->changed, NULL);
+    pthread_mutex_init(&q->guard, NULL);
+    pthread_mutex_init(&q->repair, NULL);
+    pthread_mutex_init(&q->retention, NULL);
+    q->max_queued = max_queued;
+    q->store = store;
+    return q;
+}
+
+struct store *queue_store(const struct queue *q) { return q->store; }
 
 void queue_destroy(struct queue *q)
 {
@@ -140,30 +208,31 @@ void queue_destroy(struct queue *q)
         return;
     /* Every other thread is gone: state a full disk held back gets one more
      * try, so that a restart does not find it stale. */
-    for (size_t i = 0; i < q->count; i++) {
-        struct job *job = q->jobs[i];
-        if (job->writer.written < job->seq) {
+    for (size_t i = 0; i < q->live.count;) {
+        struct job *job = q->live.items[i];
+        size_t before = q->live.count;
+        if (job->version.saved < job->version.seq) {
             struct snapshot snap;
             pthread_mutex_lock(&q->lock);
-            snap.job = job;
-            snap.seq = job->seq;
-            snap.json = job_record_locked(job);
-            job->pending++;
+            snapshot_locked(job, &snap);
             pthread_mutex_unlock(&q->lock);
-            write_snapshot(q, &snap, NULL, 0);
+            write_snapshot(q, &snap, NULL, 0); /* a finished one leaves the list */
         }
+        if (q->live.count == before)
+            i++;
     }
-    for (size_t i = 0; i < q->count; i++)
-        job_free(q->jobs[i]);
-    free(q->jobs);
+    for (size_t i = 0; i < q->live.count; i++)
+        job_free(q->live.items[i]);
+    store_live_finish(&q->live);
+    pthread_mutex_destroy(&q->retention);
+    pthread_mutex_destroy(&q->repair);
+    pthread_mutex_destroy(&q->guard);
     pthread_cond_destroy(&q->changed);
     pthread_mutex_destroy(&q->lock);
     free(q);
 }
 
 int queue_max_queued(const struct queue *q) { return q->max_queued; }
-
-const char *queue_state_dir(const struct queue *q) { return q->kind.state_dir; }
 
 void queue_retention(struct queue *q, int *keep_jobs, double *keep_days)
 {
@@ -175,34 +244,6 @@ void queue_retention(struct queue *q, int *keep_jobs, double *keep_days)
 
 const char *queue_submit_error(void) { return records_submit_error(); }
 
-static struct job *find_locked(struct queue *q, const char *id)
-{
-    for (size_t i = 0; i < q->count; i++)
-        if (strcmp(q->jobs[i]->id, id) == 0)
-            return q->jobs[i];
-    return NULL;
-}
-
-/* Keeps the array in id order, which is submission order. */
-static bool insert_locked(struct queue *q, struct job *job)
-{
-    if (q->count == q->cap) {
-        size_t cap = q->cap ? q->cap * 2 : 64;
-        struct job **jobs = realloc(q->jobs, cap * sizeof(*jobs));
-        if (!jobs)
-            return false;
-        q->jobs = jobs;
-        q->cap = cap;
-    }
-    size_t at = q->count;
-    while (at > 0 && strcmp(q->jobs[at - 1]->id, job->id) > 0)
-        at--;
-    memmove(q->jobs + at + 1, q->jobs + at, (q->count - at) * sizeof(*q->jobs));
-    q->jobs[at] = job;
-    q->count++;
-    return true;
-}
-
 static struct job *job_new(void)
 {
     struct job *job = calloc(1, sizeof(*job));
@@ -210,29 +251,13 @@ static struct job *job_new(void)
         return NULL;
     atomic_init(&job->cancel, false);
     atomic_init(&job->frames_done, 0);
-    record_writer_init(&job->writer);
     return job;
-}
-
-/* spec.json: the job as accepted, written once. A damaged job.json is
- * rebuilt from it and result.json. */
-static bool write_spec_record(const struct job *job, char *err, size_t errlen)
-{
-    char path[PATH_MAX + 16];
-    snprintf(path, sizeof(path), "%s/spec.json", job->dir);
-    json_t *o = json_pack("{s:s, s:f, s:o}", "id", job->id, "created_unix", job->created, "spec",
-                          job_spec_to_json(&job->spec));
-    bool ok = o && fs_write_json_atomic(path, o);
-    if (!ok)
-        snprintf(err, errlen, "cannot write %s: %s", path, o ? strerror(errno) : "out of memory");
-    json_decref(o);
-    return ok;
 }
 
 enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *spec,
                                       const char *dir_override, char id_out[24])
 {
-    char why[PATH_MAX + 200] = "";
+    char why[PATH_MAX + 300] = "";
     records_set_submit_error("%s", "");
     pthread_mutex_lock(&q->lock);
     enum queue_submit_result res = q->stopping                  ? QUEUE_STOPPING
@@ -244,42 +269,43 @@ enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *sp
     if (res != QUEUE_OK)
         return res;
 
-    /* The directory and both records are written with no lock held; the job
-     * joins the store only once they are on disk, so a job that cannot be
-     * persisted is refused and nothing of it is left behind. */
+    /* The directory, spec.json and the row are written with no lock held;
+     * the job joins the queue only once they are stored, so a job that
+     * cannot be persisted is refused and nothing of it is left behind. */
     struct job *job = job_new();
     bool made_dir = false;
     if (!job) {
         snprintf(why, sizeof(why), "out of memory");
         goto fail;
     }
-    if (!record_create_dir(&q->kind, dir_override, job->id, job->dir, sizeof(job->dir), why,
-                           sizeof(why)))
+    if (!record_create_dir(store_record_kind(q->store, STORE_JOBS), dir_override, job->id,
+                           job->dir, sizeof(job->dir), why, sizeof(why)))
         goto fail;
     made_dir = !dir_override;
+    job->dir_given = dir_override != NULL;
     job->spec = *spec;
     job->status = JOB_QUEUED;
     job->frames_total = spec->frames * job_spec_runs(spec);
     job->created = clock_unix_s();
-    if (!dir_override && !write_spec_record(job, why, sizeof(why)))
+    if (!dir_override && !job_dir_write_spec(job->dir, job->id, job->created, spec, why, sizeof(why)))
         goto fail;
-    json_t *first = job_record_locked(job); /* not shared yet: no lock needed */
-    char path[PATH_MAX + 16];
-    snprintf(path, sizeof(path), "%s/job.json", job->dir);
-    job->seq = 1;
-    bool written = first && record_writer_write(&job->writer, 1, path, first, why, sizeof(why));
-    if (!first)
-        snprintf(why, sizeof(why), "out of memory");
-    json_decref(first);
-    if (!written)
+    struct snapshot first;
+    snapshot_locked(job, &first); /* not shared yet: no lock needed */
+    bool stored = store_put(q->store, &first.row, first.seq, &job->version.written, why,
+                            sizeof(why));
+    store_row_finish(&first.row);
+    store_version_back(&job->version, first.seq, stored);
+    if (!stored)
         goto fail;
     pthread_mutex_lock(&q->lock);
-    bool inserted = insert_locked(q, job);
+    bool inserted = store_live_insert(&q->live, job);
     if (inserted)
         pthread_cond_broadcast(&q->changed);
     pthread_mutex_unlock(&q->lock);
     if (!inserted) {
+        /* Stored but not queued: it runs on the next start. */
         snprintf(why, sizeof(why), "out of memory");
+        made_dir = false;
         goto fail;
     }
     snprintf(id_out, 24, "%s", job->id);
@@ -287,15 +313,14 @@ enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *sp
 
 fail:
     records_set_submit_error("the job cannot be persisted in the state directory %s: %s",
-                             q->kind.state_dir[0] ? q->kind.state_dir
-                             : dir_override       ? dir_override
-                                                  : "(none)",
+                             store_state_dir(q->store)[0] ? store_state_dir(q->store)
+                             : dir_override               ? dir_override
+                                                          : "(none)",
                              why);
     LOG(LOG_ERROR, "job refused: %s", records_submit_error());
     if (made_dir) {
         /* Never accepted, so not a record: remove what was made of it. */
-        static const char *const files[] = {"job.json", "job.json.tmp", "spec.json",
-                                            "spec.json.tmp"};
+        static const char *const files[] = {JOB_FILE_SPEC, JOB_FILE_SPEC ".tmp"};
         char path2[PATH_MAX + 32];
         for (size_t i = 0; i < sizeof(files) / sizeof(files[0]); i++) {
             snprintf(path2, sizeof(path2), "%s/%s", job->dir, files[i]);
@@ -317,9 +342,9 @@ struct job *queue_next(struct queue *q)
     struct snapshot snap;
     pthread_mutex_lock(&q->lock);
     while (!q->stopping) {
-        for (size_t i = 0; i < q->count && !job; i++)
-            if (q->jobs[i]->status == JOB_QUEUED)
-                job = q->jobs[i];
+        for (size_t i = 0; i < q->live.count && !job; i++)
+            if (((struct job *)q->live.items[i])->status == JOB_QUEUED)
+                job = q->live.items[i];
         if (job)
             break;
         pthread_cond_wait(&q->changed, &q->lock);
@@ -373,13 +398,12 @@ void queue_finish(struct queue *q, struct job *job, enum job_status status,
             next.error = error;
     }
     snap.job = job;
-    snap.seq = ++job->seq;
-    snap.json = state_record(job, &next);
-    job->pending++;
+    snap.seq = store_version_take(&job->version);
+    row_of(job, &next, result, &snap.row);
     pthread_mutex_unlock(&q->lock);
-    /* Written before anyone can see it (the job is running, so only this
-     * thread changes its state): a job shown finished is finished on disk,
-     * unless the write failed, which is logged. */
+    /* Stored before anyone can see it (the job is running, so only this
+     * thread changes its state): a job shown finished is finished in the
+     * store, unless the write failed, which is logged. */
     write_snapshot(q, &snap, NULL, 0);
 
     pthread_mutex_lock(&q->lock);
@@ -401,10 +425,12 @@ void queue_finish(struct queue *q, struct job *job, enum job_status status,
         json_decref(job->result);
         job->result = result;
     }
-    /* Had anyone written an older view meanwhile, the newest goes last. */
-    bool again = job->seq != snap.seq;
+    /* Had anyone taken a newer view meanwhile, the newest goes last. */
+    bool again = job->version.seq != snap.seq;
     if (again)
         snapshot_locked(job, &snap);
+    /* The caller's last touch of the job: it may leave memory now. */
+    struct job *gone = again ? NULL : evict_locked(q, job);
     pthread_cond_broadcast(&q->changed);
     NOTIFY_LISTENER(q);
     pthread_mutex_unlock(&q->lock);
@@ -413,7 +439,8 @@ void queue_finish(struct queue *q, struct job *job, enum job_status status,
     if (requeue)
         LOG(LOG_INFO, "job %s: stopped by the daemon's exit; back to the head of the queue",
             job->id);
-    apply_retention(q);
+    job_free(gone);
+    apply_retention(q, false);
 }
 
 void queue_stop(struct queue *q)
@@ -422,11 +449,13 @@ void queue_stop(struct queue *q)
     q->stopping = true;
     /* A running job stops at its next frame rather than holding up the exit,
      * and goes back to the queue: the stop is not its fault. */
-    for (size_t i = 0; i < q->count; i++)
-        if (q->jobs[i]->status == JOB_RUNNING) {
-            q->jobs[i]->requeue_on_stop = !q->jobs[i]->user_cancel;
-            atomic_store(&q->jobs[i]->cancel, true);
+    for (size_t i = 0; i < q->live.count; i++) {
+        struct job *job = q->live.items[i];
+        if (job->status == JOB_RUNNING) {
+            job->requeue_on_stop = !job->user_cancel;
+            atomic_store(&job->cancel, true);
         }
+    }
     pthread_cond_broadcast(&q->changed);
     NOTIFY_LISTENER(q);
     pthread_mutex_unlock(&q->lock);
@@ -438,8 +467,14 @@ enum queue_cancel_result queue_cancel(struct queue *q, const char *id)
     struct snapshot snap = {0};
     pthread_mutex_lock(&q->lock);
     struct job *job = find_locked(q, id);
-    if (!job)
-        goto out;
+    if (!job) {
+        pthread_mutex_unlock(&q->lock);
+        /* Not live: finished (only live jobs can change), or no such job. */
+        struct store_row row;
+        enum store_found found = store_get(q->store, STORE_JOBS, id, false, &row);
+        store_row_finish(&row);
+        return found == STORE_FOUND ? CANCEL_FINISHED : CANCEL_NOT_FOUND;
+    }
     switch (job->status) {
     case JOB_QUEUED:
         job->status = JOB_CANCELLED;
@@ -460,7 +495,6 @@ enum queue_cancel_result queue_cancel(struct queue *q, const char *id)
     default:
         res = CANCEL_FINISHED;
     }
-out:
     pthread_mutex_unlock(&q->lock);
     if (snap.job)
         write_snapshot(q, &snap, NULL, 0);
@@ -481,27 +515,29 @@ static json_t *iso_time(double t)
     return json_string(buf);
 }
 
-static struct job_state state_of(const struct job *job)
+/* What a job's JSON shows of its state, live or stored alike. */
+static json_t *state_json(const char *id, const char *technique, double created,
+                          const struct job_state *st, int frames_total)
 {
-    return (struct job_state){job->status, job->phase, job->started, job->finished, job->error,
-                              atomic_load_explicit(&job->frames_done, memory_order_relaxed)};
-}
-
-static json_t *state_json(const struct job *job, const struct job_state *st, bool full)
-{
-    json_t *o = json_pack("{s:s, s:s, s:s, s:{s:i, s:i}, s:o, s:o, s:o}",
-                          "id", job->id, "status", job_status_name(st->status),
-                          "technique", job->spec.technique, "progress", "frames_done",
-                          st->frames_done, "frames_total", job->frames_total, "created",
-                          iso_time(job->created), "started", iso_time(st->started),
-                          "finished", iso_time(st->finished));
+    json_t *o = json_pack("{s:s, s:s, s:s, s:{s:i, s:i}, s:o, s:o, s:o}", "id", id, "status",
+                          job_status_name(st->status), "technique", technique, "progress",
+                          "frames_done", st->frames_done, "frames_total", frames_total, "created",
+                          iso_time(created), "started", iso_time(st->started), "finished",
+                          iso_time(st->finished));
     if (!o)
         return NULL;
     if (st->status == JOB_RUNNING && st->phase)
         json_object_set_new(o, "phase", json_string(st->phase));
     if (st->error && st->error[0])
         json_object_set_new(o, "error", json_string(st->error));
-    if (full) {
+    return o;
+}
+
+static json_t *live_json_locked(const struct job *job, bool full)
+{
+    struct job_state st = state_of(job);
+    json_t *o = state_json(job->id, job->spec.technique, job->created, &st, job->frames_total);
+    if (o && full) {
         json_object_set_new(o, "spec", job_spec_to_json(&job->spec));
         if (job->result)
             json_object_set_new(o, RK_RESULT, json_deep_copy(job->result));
@@ -509,294 +545,48 @@ static json_t *state_json(const struct job *job, const struct job_state *st, boo
     return o;
 }
 
-/* job.json: the job's state, written whenever it changes (the result lives
- * in result.json beside it, written before the job is marked done). */
-static json_t *state_record(const struct job *job, const struct job_state *st)
+static struct job_state row_state(const struct store_row *row)
 {
-    json_t *o = state_json(job, st, false);
-    if (!o)
+    return (struct job_state){row->status, NULL, row->started, row->finished, row->error,
+                              row->done};
+}
+
+/* A stored (finished) job as GET /v1/jobs/ID shows it; NULL when there is
+ * no such job. A done job's result comes from its result.json. */
+static json_t *stored_job_json(struct queue *q, const char *id)
+{
+    struct store_row row;
+    if (store_get(q->store, STORE_JOBS, id, true, &row) != STORE_FOUND) {
+        store_row_finish(&row);
         return NULL;
-    json_object_set_new(o, "spec", job_spec_to_json(&job->spec));
-    json_object_set_new(o, "times_unix",
-                        json_pack("[f, f, f]", job->created, st->started, st->finished));
-    return o;
-}
-
-static json_t *job_json_locked(const struct job *job, bool full)
-{
-    struct job_state st = state_of(job);
-    return state_json(job, &st, full);
-}
-
-static json_t *job_record_locked(const struct job *job)
-{
-    struct job_state st = state_of(job);
-    return state_record(job, &st);
-}
-
-static bool status_from_name(const char *name, enum job_status *out)
-{
-    for (int s = JOB_QUEUED; s <= JOB_INTERRUPTED; s++)
-        if (name && strcmp(name, job_status_name((enum job_status)s)) == 0) {
-            *out = (enum job_status)s;
-            return true;
+    }
+    json_t *result = NULL;
+    if (row.status == JOB_DONE) {
+        char path[PATH_MAX + 16], why[600] = "";
+        snprintf(path, sizeof(path), "%s/result.json", row.dir);
+        result = record_read(path, why, sizeof(why));
+        if (!result) {
+            pthread_mutex_lock(&q->repair);
+            /* Another reader may have repaired it meanwhile. */
+            store_row_finish(&row);
+            if (store_get(q->store, STORE_JOBS, id, true, &row) == STORE_FOUND &&
+                row.status == JOB_DONE && !(result = record_read(path, why, sizeof(why))))
+                job_dir_fail_result(q->store, &row, path, why);
+            pthread_mutex_unlock(&q->repair);
         }
-    return false;
-}
-
-/* A result.json is complete once nothing more would have been added to it:
- * the metrics stage adds "quality" for jobs with a reference, the repeats
- * add "repeat". An earlier version means the job never finished. */
-static bool result_complete(const struct job_spec *spec, const json_t *result)
-{
-    if (spec->reference[0] && !json_object_get(result, RK_QUALITY))
-        return false;
-    if (job_spec_runs(spec) > 1 && !json_object_get(result, "repeat"))
-        return false;
-    return true;
-}
-
-static double file_mtime(const char *path)
-{
-    struct stat st;
-    return stat(path, &st) == 0 ? (double)st.st_mtim.tv_sec + st.st_mtim.tv_nsec / 1e9 : 0;
-}
-
-/* Rebuilds a job whose job.json cannot be read from spec.json (written once
- * at submission) and result.json. NULL, with why, when they do not allow it. */
-static struct job *rebuild_job(struct queue *q, const char *id, const char *dir, char *why,
-                               size_t whylen)
-{
-    char path[PATH_MAX + 16], rwhy[300] = "", swhy[700] = "";
-    snprintf(path, sizeof(path), "%s/spec.json", dir);
-    json_t *rec = record_read(path, swhy, sizeof(swhy));
-    struct job_spec spec;
-    struct job_error jerr;
-    const char *rid = json_string_value(json_object_get(rec, "id"));
-    if (rec && (!rid || strcmp(rid, id) != 0))
-        snprintf(swhy, sizeof(swhy), "its id does not match its directory");
-    else if (rec && !job_spec_parse(json_object_get(rec, "spec"), q->techniques, &spec, &jerr))
-        snprintf(swhy, sizeof(swhy), "not a job this daemon can run (%s: %s)", jerr.field,
-                 jerr.message);
-    if (swhy[0]) {
-        snprintf(why, whylen, "spec.json: %s", swhy);
-        json_decref(rec);
-        return NULL;
     }
-    struct job *job = job_new();
-    if (!job) {
-        snprintf(why, whylen, "out of memory");
-        json_decref(rec);
-        return NULL;
-    }
-    snprintf(job->id, sizeof(job->id), "%s", id);
-    snprintf(job->dir, sizeof(job->dir), "%s", dir);
-    job->spec = spec;
-    job->frames_total = spec.frames * job_spec_runs(&spec);
-    job->created = json_number_value(json_object_get(rec, "created_unix"));
-    json_decref(rec);
-    snprintf(path, sizeof(path), "%s/result.json", dir);
-    json_t *result = record_read(path, rwhy, sizeof(rwhy));
-    if (result && result_complete(&job->spec, result)) {
-        job->status = JOB_DONE;
-        job->result = result;
-        job->finished = file_mtime(path);
-        atomic_store(&job->frames_done, job->frames_total);
-        snprintf(why, whylen, "rebuilt as done from spec.json and result.json");
-    } else {
-        /* Its state is unknown: it may have been queued, running or failed.
-         * Interrupted says so, and nothing is run twice behind anyone's back. */
-        json_decref(result);
-        job->status = JOB_INTERRUPTED;
-        job->finished = clock_unix_s();
-        snprintf(job->error, sizeof(job->error),
-                 "interrupted: its job.json was damaged and its result.json is %s; "
-                 "submit it again to measure it", result ? "incomplete" : "missing or damaged");
-        snprintf(why, whylen, "rebuilt as interrupted from spec.json (result.json %s)",
-                 result ? "incomplete" : rwhy);
-    }
-    return job;
-}
-
-/* Reads one job's directory (startup: no lock is needed to read files, and
- * none is held). Whatever cannot be read is quarantined, never skipped
- * silently. */
-static void load_job(void *ctx, const char *id, const char *dir)
-{
-    struct queue *q = ctx;
-    char path[PATH_MAX + 16], why[600] = "", quarantined[PATH_MAX] = "";
-    snprintf(path, sizeof(path), "%s/job.json", dir);
-    json_t *o = record_read(path, why, sizeof(why));
-    struct job_spec spec;
-    struct job_error jerr;
-    enum job_status status = JOB_INTERRUPTED;
+    if (!row.spec)
+        row.spec = job_dir_read_spec(&row);
+    struct job_state st = row_state(&row);
+    json_t *o = state_json(row.id, row.technique, row.created, &st, row.total);
     if (o) {
-        const char *jid = json_string_value(json_object_get(o, "id"));
-        if (!jid || strcmp(jid, id) != 0)
-            snprintf(why, sizeof(why), "its id %.40s does not match its directory",
-                     jid ? jid : "(none)");
-        else if (!status_from_name(json_string_value(json_object_get(o, "status")), &status))
-            snprintf(why, sizeof(why), "no valid status");
-        else if (!job_spec_parse(json_object_get(o, "spec"), q->techniques, &spec, &jerr))
-            snprintf(why, sizeof(why), "not a job this daemon can read (%s: %s)", jerr.field,
-                     jerr.message);
+        json_object_set_new(o, "spec", row.spec ? json_incref(row.spec) : json_object());
+        if (result && row.status == JOB_DONE)
+            json_object_set(o, RK_RESULT, result);
     }
-    struct job *job = NULL;
-    bool changed = false;
-    if (why[0]) {
-        json_decref(o);
-        char rebuilt[800];
-        job = rebuild_job(q, id, dir, rebuilt, sizeof(rebuilt));
-        if (!job) {
-            char reason[1600];
-            snprintf(reason, sizeof(reason), "job.json: %s; cannot be rebuilt: %s", why, rebuilt);
-            record_quarantine(&q->kind, id, dir, reason, NULL, 0);
-            return;
-        }
-        char reason[1600];
-        snprintf(reason, sizeof(reason), "job.json: %s; job %s", why, rebuilt);
-        if (access(path, F_OK) == 0)
-            record_quarantine(&q->kind, id, path, reason, quarantined, sizeof(quarantined));
-        LOG(LOG_WARN, "job %s: %s", id, reason);
-        changed = true;
-    } else {
-        if (!(job = job_new())) {
-            LOG(LOG_ERROR, "job %s: out of memory loading it", id);
-            json_decref(o);
-            return;
-        }
-        snprintf(job->id, sizeof(job->id), "%s", id);
-        snprintf(job->dir, sizeof(job->dir), "%s", dir);
-        job->spec = spec;
-        job->status = status;
-        json_t *progress = json_object_get(o, "progress");
-        job->frames_total = spec.frames * job_spec_runs(&spec);
-        atomic_store(&job->frames_done,
-                     (int)json_integer_value(json_object_get(progress, "frames_done")));
-        json_t *times = json_object_get(o, "times_unix");
-        job->created = json_number_value(json_array_get(times, 0));
-        job->started = json_number_value(json_array_get(times, 1));
-        job->finished = json_number_value(json_array_get(times, 2));
-        const char *error = json_string_value(json_object_get(o, "error"));
-        if (error)
-            snprintf(job->error, sizeof(job->error), "%s", error);
-        json_decref(o);
-
-        if (job->status == JOB_RUNNING) {
-            /* A complete result.json is the last thing a job writes before it
-             * is done: the daemon died (or the disk was full) between that
-             * and writing job.json. Anything less was cut short. */
-            snprintf(path, sizeof(path), "%s/result.json", dir);
-            json_t *result = access(path, F_OK) == 0 ? record_read(path, why, sizeof(why)) : NULL;
-            if (result && result_complete(&job->spec, result)) {
-                job->status = JOB_DONE;
-                job->result = result;
-                job->finished = file_mtime(path);
-                atomic_store(&job->frames_done, job->frames_total);
-                LOG(LOG_WARN, "job %s: job.json says running, but its result.json is complete: "
-                    "done", id);
-            } else {
-                json_decref(result);
-                job->status = JOB_INTERRUPTED;
-                job->finished = clock_unix_s();
-                snprintf(job->error, sizeof(job->error),
-                         "interrupted: the daemon stopped (killed or crashed) while this job ran; "
-                         "its files may be incomplete, submit it again to measure it");
-            }
-            changed = true;
-        } else if (job->status == JOB_DONE) {
-            snprintf(path, sizeof(path), "%s/result.json", dir);
-            job->result = record_read(path, why, sizeof(why));
-            if (!job->result) {
-                bool present = access(path, F_OK) == 0;
-                char reason[800];
-                snprintf(reason, sizeof(reason), "result.json of a finished job: %s", why);
-                if (present)
-                    record_quarantine(&q->kind, id, path, reason, quarantined,
-                                      sizeof(quarantined));
-                else
-                    LOG(LOG_WARN, "job %s: %s", id, reason);
-                job->status = JOB_FAILED;
-                snprintf(job->error, sizeof(job->error), "result.json is missing or damaged: %s%s%s",
-                         why, quarantined[0] ? "; moved to " : "", quarantined);
-                changed = true;
-            }
-        }
-    }
-    record_note_id(&q->kind, id);
-    struct snapshot snap = {0};
-    pthread_mutex_lock(&q->lock);
-    bool inserted = insert_locked(q, job);
-    if (inserted && job->status == JOB_QUEUED)
-        q->queued++;
-    if (inserted && changed)
-        snapshot_locked(job, &snap);
-    pthread_mutex_unlock(&q->lock);
-    if (!inserted) {
-        LOG(LOG_ERROR, "job %s: out of memory loading it", id);
-        job_free(job);
-        return;
-    }
-    if (snap.job)
-        write_snapshot(q, &snap, NULL, 0);
-}
-
-int queue_load(struct queue *q, const struct technique_catalog *techniques, char *err, size_t errlen)
-{
-    q->techniques = techniques;
-    size_t before = q->count;
-    if (record_scan(&q->kind, load_job, q, err, errlen) < 0)
-        return -1;
-    pthread_mutex_lock(&q->lock);
-    int loaded = (int)(q->count - before);
-    pthread_cond_broadcast(&q->changed);
-    pthread_mutex_unlock(&q->lock);
-    apply_retention(q);
-    return loaded;
-}
-
-void queue_set_retention(struct queue *q, int keep_jobs, double keep_days)
-{
-    pthread_mutex_lock(&q->lock);
-    q->keep_jobs = keep_jobs;
-    q->keep_days = keep_days;
-    pthread_mutex_unlock(&q->lock);
-}
-
-static void apply_retention(struct queue *q)
-{
-    pthread_mutex_lock(&q->lock);
-    if (!q->kind.state_dir[0] || (q->keep_jobs <= 0 && q->keep_days <= 0) || !q->count) {
-        pthread_mutex_unlock(&q->lock);
-        return;
-    }
-    double *times = malloc(q->count * sizeof(double));
-    bool *victim = malloc(q->count * sizeof(bool));
-    struct job **victims = malloc(q->count * sizeof(*victims));
-    size_t nv = 0, kept = 0;
-    if (times && victim && victims) {
-        /* A job with a write in flight is not finished for retention yet. */
-        for (size_t i = 0; i < q->count; i++)
-            times[i] = finished(q->jobs[i]) && !q->jobs[i]->pending ? q->jobs[i]->finished : -1;
-        record_retention(times, q->count, q->keep_jobs, q->keep_days, clock_unix_s(), victim);
-        for (size_t i = 0; i < q->count; i++) {
-            if (victim[i])
-                victims[nv++] = q->jobs[i];
-            else
-                q->jobs[kept++] = q->jobs[i];
-        }
-        q->count = kept;
-    }
-    pthread_mutex_unlock(&q->lock);
-    /* Files are removed with no lock held. */
-    for (size_t i = 0; i < nv; i++) {
-        LOG(LOG_INFO, "retention: removing job %s", victims[i]->id);
-        record_remove_dir(victims[i]->dir);
-        job_free(victims[i]);
-    }
-    free(times);
-    free(victim);
-    free(victims);
+    json_decref(result);
+    store_row_finish(&row);
+    return o;
 }
 
 json_t *queue_job_json(struct queue *q, const char *id, double wait_s)
@@ -807,43 +597,64 @@ json_t *queue_job_json(struct queue *q, const char *id, double wait_s)
     struct job *job = find_locked(q, id);
     while (job && wait_s > 0 && !finished(job) && !q->stopping) {
         int rc = pthread_cond_timedwait(&q->changed, &q->lock, &deadline);
-        /* Look it up again: retention may have removed it meanwhile. */
+        /* Look it up again: once finished and stored, it leaves memory. */
         job = find_locked(q, id);
         if (rc == ETIMEDOUT)
             break;
     }
     if (job)
-        out = job_json_locked(job, true);
+        out = live_json_locked(job, true);
     pthread_mutex_unlock(&q->lock);
-    return out;
+    return job ? out : stored_job_json(q, id);
 }
 
-json_t *queue_list_json(struct queue *q)
+struct page {
+    json_t *jobs;
+};
+
+static void page_row(void *ctx, const struct store_row *row)
 {
-    json_t *list = json_array();
-    pthread_mutex_lock(&q->lock);
-    for (size_t i = 0; i < q->count; i++)
-        json_array_append_new(list, job_json_locked(q->jobs[i], false));
-    pthread_mutex_unlock(&q->lock);
-    return json_pack("{s:o}", "jobs", list);
+    struct page *p = ctx;
+    struct job_state st = row_state(row);
+    json_t *entry = state_json(row->id, row->technique, row->created, &st, row->total);
+    if (!entry)
+        return;
+    json_object_set_new(entry, "labels", row->labels ? json_incref(row->labels) : json_object());
+    if (row->figures)
+        json_object_set(entry, "figures", row->figures);
+    json_array_append_new(p->jobs, entry);
 }
 
-json_t *queue_list_json_with(struct queue *q, queue_list_fn fn, void *ctx)
+json_t *queue_list_page(struct queue *q, const struct store_query *query,
+                        char next[RECORD_ID_LEN], char *err, size_t errlen)
 {
-    json_t *list = json_array();
+    struct page p = {.jobs = json_array()};
+    if (!p.jobs || !store_list(q->store, query, page_row, &p, next, err, errlen)) {
+        json_decref(p.jobs);
+        return NULL;
+    }
+    /* Queued and running jobs: their state in memory is the newest
+     * (progress and phase are never stored while they run). */
+    size_t i;
+    json_t *entry;
     pthread_mutex_lock(&q->lock);
-    for (size_t i = 0; i < q->count; i++) {
-        const struct job *job = q->jobs[i];
-        json_t *entry = job_json_locked(job, false), *labels = json_object();
-        for (int k = 0; k < job->spec.nlabels; k++)
-            json_object_set_new(labels, job->spec.labels[k].key,
-                                json_string(job->spec.labels[k].value));
-        json_object_set_new(entry, "labels", labels);
-        if ((entry = fn(entry, job->result, ctx)))
-            json_array_append_new(list, entry);
+    json_array_foreach(p.jobs, i, entry) {
+        const struct job *job = find_locked(q, json_string_value(json_object_get(entry, "id")));
+        if (!job)
+            continue;
+        json_t *live = live_json_locked(job, false);
+        json_object_del(entry, "phase");
+        json_object_del(entry, "error");
+        json_object_update(entry, live);
+        json_decref(live);
     }
     pthread_mutex_unlock(&q->lock);
-    return json_pack("{s:o}", "jobs", list);
+    return json_pack("{s:o}", "jobs", p.jobs);
+}
+
+bool queue_counts(struct queue *q, size_t counts[JOB_STATUS_COUNT])
+{
+    return store_count(q->store, STORE_JOBS, counts);
 }
 
 bool queue_job_dir(struct queue *q, const char *id, char *dir, size_t cap,
@@ -856,5 +667,168 @@ bool queue_job_dir(struct queue *q, const char *id, char *dir, size_t cap,
         *status = job->status;
     }
     pthread_mutex_unlock(&q->lock);
-    return job != NULL;
+    if (job)
+        return true;
+    struct store_row row;
+    bool found = store_get(q->store, STORE_JOBS, id, false, &row) == STORE_FOUND;
+    if (found) {
+        snprintf(dir, cap, "%s", row.dir);
+        *status = row.status;
+    }
+    store_row_finish(&row);
+    return found;
+}
+
+/* --- Loading -------------------------------------------------------------- */
+
+/* store_import: a job directory the store has no row for (job_dir.h). */
+static bool import_job(void *ctx, const char *id, const char *dir, struct store_row *row)
+{
+    struct queue *q = ctx;
+    return job_dir_import(q->store, q->techniques, id, dir, row);
+}
+
+/* Startup: a queued job joins the queue; one that was running when the
+ * daemon died is interrupted, or done when its result.json is complete. */
+static void load_unfinished(void *ctx, const struct store_row *stored)
+{
+    struct queue *q = ctx;
+    struct store_row row = *stored; /* its JSON stays the store's */
+    row.figures = NULL;             /* an unfinished job has none */
+    struct job_spec spec;
+    struct job_error jerr;
+    char err[PATH_MAX + 300];
+    /* An unfinished row has its spec; should it not, spec.json has. */
+    json_t *read = row.spec ? NULL : job_dir_read_spec(&row);
+    bool parsed = job_spec_parse(row.spec ? row.spec : read, q->techniques, &spec, &jerr);
+    json_decref(read);
+    if (!parsed) {
+        row.spec = NULL; /* finished: its spec.json has it */
+        row.status = JOB_FAILED;
+        row.finished = clock_unix_s();
+        snprintf(row.error, sizeof(row.error), "not a job this daemon can run (%s: %s)",
+                 jerr.field, jerr.message);
+        LOG(LOG_WARN, "job %s: %s", row.id, row.error);
+        if (!store_put(q->store, &row, 0, NULL, err, sizeof(err)))
+            LOG(LOG_ERROR, "job %s: %s", row.id, err);
+        return;
+    }
+    if (row.status == JOB_QUEUED) {
+        struct job *job = job_new();
+        if (!job) {
+            LOG(LOG_ERROR, "job %s: out of memory loading it; it runs on the next start", row.id);
+            return;
+        }
+        snprintf(job->id, sizeof(job->id), "%s", row.id);
+        snprintf(job->dir, sizeof(job->dir), "%s", row.dir);
+        job->dir_given = row.dir_given;
+        job->spec = spec;
+        job->status = JOB_QUEUED;
+        job->frames_total = row.total;
+        job->created = row.created;
+        pthread_mutex_lock(&q->lock);
+        bool inserted = store_live_insert(&q->live, job);
+        if (inserted)
+            q->queued++;
+        pthread_mutex_unlock(&q->lock);
+        if (!inserted) {
+            LOG(LOG_ERROR, "job %s: out of memory loading it; it runs on the next start", row.id);
+            job_free(job);
+        }
+        return;
+    }
+    /* Running when the daemon died: what an interrupted write left goes. */
+    record_remove_tmp_files(row.dir);
+    if (!row.dir_given)
+        row.spec = NULL; /* finished now: its spec.json has it */
+    char why[300] = "";
+    json_t *figures = NULL;
+    if (job_dir_done_from_result(&row, &spec, row.dir, why, sizeof(why))) {
+        figures = row.figures; /* ours, not the store's */
+        LOG(LOG_WARN, "job %s: stored as running, but its result.json is complete: done", row.id);
+    } else {
+        row.status = JOB_INTERRUPTED;
+        row.finished = clock_unix_s();
+        snprintf(row.error, sizeof(row.error),
+                 "interrupted: the daemon stopped (killed or crashed) while this job ran; "
+                 "its files may be incomplete, submit it again to measure it");
+    }
+    if (!store_put(q->store, &row, 0, NULL, err, sizeof(err)))
+        LOG(LOG_ERROR, "job %s: %s", row.id, err);
+    json_decref(figures);
+}
+
+int queue_load(struct queue *q, const struct technique_catalog *techniques, char *err, size_t errlen)
+{
+    q->techniques = techniques;
+    int imported = store_import(q->store, STORE_JOBS, "job.json", import_job, q, err, errlen);
+    if (imported < 0)
+        return -1;
+    if (imported > 0)
+        LOG(LOG_INFO, "imported %d job(s) from their directories into %s/%s", imported,
+            store_state_dir(q->store), STORE_FILE);
+    if (!store_each_unfinished(q->store, STORE_JOBS, load_unfinished, q)) {
+        snprintf(err, errlen, "cannot read the unfinished jobs from %s/%s",
+                 store_state_dir(q->store), STORE_FILE);
+        return -1;
+    }
+    pthread_mutex_lock(&q->lock);
+    pthread_cond_broadcast(&q->changed);
+    pthread_mutex_unlock(&q->lock);
+    apply_retention(q, true);
+    size_t counts[JOB_STATUS_COUNT];
+    if (!store_count(q->store, STORE_JOBS, counts)) {
+        snprintf(err, errlen, "cannot count the jobs in %s/%s", store_state_dir(q->store),
+                 STORE_FILE);
+        return -1;
+    }
+    size_t total = 0;
+    for (int k = 0; k < JOB_STATUS_COUNT; k++)
+        total += counts[k];
+    return (int)total;
+}
+
+void queue_set_retention(struct queue *q, int keep_jobs, double keep_days)
+{
+    pthread_mutex_lock(&q->lock);
+    q->keep_jobs = keep_jobs;
+    q->keep_days = keep_days;
+    pthread_mutex_unlock(&q->lock);
+}
+
+static void apply_retention(struct queue *q, bool startup)
+{
+    int keep;
+    double days;
+    queue_retention(q, &keep, &days);
+    if (!store_state_dir(q->store)[0] || (keep <= 0 && days <= 0))
+        return;
+    char(*ids)[RECORD_ID_LEN] = malloc(RETENTION_BATCH * RECORD_ID_LEN);
+    if (!ids)
+        return;
+    pthread_mutex_lock(&q->retention);
+    double t0 = clock_mono_s();
+    for (;;) {
+        int n = store_retention_victims(q->store, STORE_JOBS, keep, days, clock_unix_s(), ids,
+                                        RETENTION_BATCH);
+        /* A job still in memory, or one a sweep still needs, stays for now. */
+        int m = 0;
+        for (int i = 0; i < n; i++) {
+            pthread_mutex_lock(&q->lock);
+            bool live = find_locked(q, ids[i]) != NULL;
+            pthread_mutex_unlock(&q->lock);
+            if (!live && !needed_elsewhere(q, ids[i]))
+                memmove(ids[m++], ids[i], RECORD_ID_LEN);
+        }
+        if (m > 0 && m <= 8)
+            for (int i = 0; i < m; i++)
+                LOG(LOG_INFO, "retention: removing job %s", ids[i]);
+        else if (m > 8)
+            LOG(LOG_INFO, "retention: removing %d jobs, %s to %s", m, ids[0], ids[m - 1]);
+        store_remove(q->store, STORE_JOBS, ids, m);
+        if (!startup || n < RETENTION_BATCH || m < n || clock_mono_s() - t0 > RETENTION_START_S)
+            break;
+    }
+    pthread_mutex_unlock(&q->retention);
+    free(ids);
 }

@@ -1,18 +1,24 @@
 #ifndef SHADEBENCH_QUEUE_H
 #define SHADEBENCH_QUEUE_H
 
-/* The job store and the queue between HTTP threads and the render thread.
- * GL-free. Every change of a job's state is written to its directory
- * (job.json: temporary file, fsync, rename; records.h) so that a restarted
- * daemon finds every job again. Only finished jobs are ever freed (by
- * retention), so a job pointer handed to the render or metrics thread stays
- * valid.
+/* The jobs: the queue between HTTP threads and the render thread, on top of
+ * the record store (store.h). GL-free. Every change of a job's state is
+ * written to the store before it is shown, so that a restarted daemon
+ * finds every job again; a job is accepted only once it is stored.
  *
- * Locking, for timings nothing disturbs: the store lock guards the jobs'
- * state and is never held across file I/O (a snapshot of the job is taken
- * under it and written after it is released, in order per job). The render
- * thread's timed loop takes no lock at all: progress is an atomic. Any
- * thread may call any function unless its comment says otherwise. */
+ * Only the jobs that can still change live in memory as struct job: queued
+ * and running ones (and a finished one while its last write is in flight).
+ * A finished job leaves memory once stored, and is read back from the store
+ * (its row) and its directory (result.json) when asked for; so a box with
+ * 100,000 finished jobs holds none of them. A job pointer handed to the
+ * render or metrics thread stays valid until queue_finish returns.
+ *
+ * Locking, for timings nothing disturbs: the queue's lock guards the live
+ * jobs and is never held across file I/O or a store write (a snapshot of
+ * the job is taken under it and written after it is released, in order per
+ * job). The render thread's timed loop takes no lock at all: progress is an
+ * atomic. Any thread may call any function unless its comment says
+ * otherwise. */
 
 #include <jansson.h>
 #include <limits.h>
@@ -21,10 +27,10 @@
 
 #include "daemon/jobs/job_spec.h"
 #include "daemon/jobs/records.h"
+#include "daemon/jobs/store.h"
 
-enum job_status { JOB_QUEUED, JOB_RUNNING, JOB_DONE, JOB_FAILED, JOB_CANCELLED, JOB_INTERRUPTED };
-
-/* id, spec, dir and frames_total never change once the job is accepted;
+/* id (first: store_live), spec, dir and frames_total never change once the
+ * job is accepted;
  * frames_done and cancel are atomics; the rest is the store's, read through
  * queue_job_json. */
 struct job {
@@ -39,12 +45,11 @@ struct job {
     json_t *result;
     char dir[PATH_MAX]; /* result.json, timings.csv and frames live here */
     double created, started, finished;
-    /* The store's own, under its lock. */
-    uint64_t seq;         /* number of the newest state, for ordered writes */
-    unsigned pending;     /* snapshots not yet written: retention waits */
+    /* The queue's own, under its lock. */
+    struct store_version version; /* ordered writes; it stays in memory until stored */
     bool user_cancel;     /* DELETE asked for it: a stop then does not requeue */
     bool requeue_on_stop; /* cancelled by a stop: back to the queue, not failed */
-    struct record_writer writer;
+    bool dir_given;       /* --once: dir is the caller's */
 };
 
 struct queue;
@@ -53,26 +58,37 @@ struct queue;
  * (nothing of it is left behind); queue_submit_error says why. */
 enum queue_submit_result { QUEUE_OK, QUEUE_FULL, QUEUE_STOPPING, QUEUE_IO_ERROR };
 
-/* state_dir may be NULL for --once, where out_dir names the single job's dir. */
-struct queue *queue_create(const char *state_dir, int max_queued);
+/* On store (a store in memory for --once, where queue_submit's dir_override
+ * names the single job's directory); the store outlives the queue. */
+struct queue *queue_create(struct store *store, int max_queued);
+struct store *queue_store(const struct queue *q);
 
 /* Retention of finished jobs: keep at most keep_jobs of them (0: all) and
- * none finished more than keep_days ago (0: forever). Their directories are
- * removed; nothing else is ever deleted. */
+ * none finished more than keep_days ago (0: forever). Their rows and
+ * directories are removed, the earliest finished first; nothing else is
+ * ever deleted. It runs at startup and after each job finishes, a batch at
+ * a time, between jobs. */
 void queue_set_retention(struct queue *q, int keep_jobs, double keep_days);
 
 /* Retention settings, for the sweeps that share them. */
 void queue_retention(struct queue *q, int *keep_jobs, double *keep_days);
-/* "" for --once. */
-const char *queue_state_dir(const struct queue *q);
 
-/* Startup, before other threads use the store. Reloads the jobs under
- * state_dir/jobs: finished ones are served as before, queued ones run
- * (a job SIGTERM stopped is queued), and one that was running when the
- * daemon died is marked interrupted. Leftover *.tmp files are removed; a
- * record that cannot be read is logged and quarantined (records.h); a
- * damaged job.json is rebuilt from spec.json and result.json where they are
- * intact. Returns the number of jobs loaded, or -1 with err filled. */
+/* Retention asks needed(ctx, id) before it removes a finished job, and
+ * keeps it while the answer is true (the sweeps: a point of a queued or
+ * running sweep). needed is called with no lock of the queue held. Set
+ * once, before serving. */
+void queue_set_retention_guard(struct queue *q, bool (*needed)(void *ctx, const char *id),
+                               void *ctx);
+
+/* Startup, before other threads use the queue. Imports the job directories
+ * the store has no row for (a state directory of an earlier version, with
+ * job.json files; a submission cut short; every job after a damaged
+ * database was recovered): a damaged job.json is quarantined and the job
+ * rebuilt from spec.json and result.json where they are intact, a record
+ * that cannot be read is logged and quarantined (records.h). Then queued
+ * jobs run (a job SIGTERM stopped is queued), and one that was running when
+ * the daemon died is marked interrupted, or done when its result.json is
+ * complete. Returns the number of jobs in the store, or -1 with err. */
 int queue_load(struct queue *q, const struct technique_catalog *techniques, char *err, size_t errlen);
 /* After every thread using it has stopped: writes any state a full disk
  * held back, then frees. Accepts NULL. */
@@ -105,24 +121,25 @@ void queue_stop(struct queue *q);
 enum queue_cancel_result { CANCEL_DONE, CANCEL_REQUESTED, CANCEL_FINISHED, CANCEL_NOT_FOUND };
 enum queue_cancel_result queue_cancel(struct queue *q, const char *id);
 
-/* Snapshot of the job as JSON; with wait_s > 0, first waits until it ends
- * or wait_s pass. NULL when there is no such job. */
+/* Snapshot of the job as JSON, with its spec and, once done, its result
+ * (read from result.json: a damaged one is quarantined and the job marked
+ * failed, naming where the file went); with wait_s > 0, first waits until
+ * it ends or wait_s pass. NULL when there is no such job. */
 json_t *queue_job_json(struct queue *q, const char *id, double wait_s);
-json_t *queue_list_json(struct queue *q);
 
-/* The list with a say per job, for filters and figures: fn gets the job's
- * list entry with its "labels" (its own reference) and its result
- * (borrowed, NULL until done), under the store's lock, so it must be quick
- * and must not keep result. It returns the entry to list (it may add to it)
- * or NULL to leave the job out (releasing the entry). */
-typedef json_t *(*queue_list_fn)(json_t *entry, const json_t *result, void *ctx);
-json_t *queue_list_json_with(struct queue *q, queue_list_fn fn, void *ctx);
+/* One page of the job list, {"jobs": [...]}: each job's state, "labels"
+ * and, once done, "figures" (job_figures.h), never its result; query says
+ * which jobs (filters) and where the page starts. next gets the cursor of
+ * the next page, "" after the last. NULL with err on a store error. */
+json_t *queue_list_page(struct queue *q, const struct store_query *query,
+                        char next[RECORD_ID_LEN], char *err, size_t errlen);
+
+/* Jobs in the store by status, for /metrics. */
+bool queue_counts(struct queue *q, size_t counts[JOB_STATUS_COUNT]);
 
 /* Copies the job's directory; false when there is no such job. */
 bool queue_job_dir(struct queue *q, const char *id, char *dir, size_t cap,
                    enum job_status *status);
-
-const char *job_status_name(enum job_status s);
 
 /* fn(ctx) is called whenever a job finishes or is cancelled, and when the
  * queue stops, with the queue's lock held: it must return at once and take

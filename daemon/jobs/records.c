@@ -26,12 +26,10 @@ void records_set_submit_error(const char *fmt, ...)
     va_end(ap);
 }
 
-void record_kind_init(struct record_kind *k, const char *state_dir, const char *name,
-                      const char *file)
+void record_kind_init(struct record_kind *k, const char *state_dir, const char *name)
 {
     memset(k, 0, sizeof(*k));
     snprintf(k->name, sizeof(k->name), "%s", name);
-    snprintf(k->file, sizeof(k->file), "%s", file);
     if (state_dir && *state_dir) {
         snprintf(k->state_dir, sizeof(k->state_dir), "%s", state_dir);
         snprintf(k->root, sizeof(k->root), "%.*s/%s", (int)(sizeof(k->root) - sizeof(k->name) - 2),
@@ -99,32 +97,6 @@ void record_note_id(struct record_kind *k, const char *id)
     unsigned cur = atomic_load(&k->serial);
     while (serial > cur && !atomic_compare_exchange_weak(&k->serial, &cur, serial))
         ;
-}
-
-void record_writer_init(struct record_writer *w)
-{
-    pthread_mutex_init(&w->lock, NULL);
-    w->written = 0;
-}
-
-void record_writer_finish(struct record_writer *w) { pthread_mutex_destroy(&w->lock); }
-
-bool record_writer_write(struct record_writer *w, uint64_t seq, const char *path,
-                         const json_t *snapshot, char *err, size_t errlen)
-{
-    bool ok = true;
-    pthread_mutex_lock(&w->lock);
-    /* A newer snapshot got here first: this one is stale and must not
-     * replace it. */
-    if (seq > w->written) {
-        ok = fs_write_json_atomic(path, snapshot);
-        if (ok)
-            w->written = seq;
-        else
-            snprintf(err, errlen, "cannot write %s: %s", path, strerror(errno));
-    }
-    pthread_mutex_unlock(&w->lock);
-    return ok;
 }
 
 json_t *record_read(const char *path, char *why, size_t whylen)
@@ -224,7 +196,7 @@ static bool ends_with(const char *s, const char *suffix)
 }
 
 /* Temporary files are what an interrupted atomic write leaves: never a record. */
-static void remove_tmp_files(const char *dir)
+void record_remove_tmp_files(const char *dir)
 {
     DIR *d = opendir(dir);
     if (!d)
@@ -249,7 +221,8 @@ static int by_name(const void *a, const void *b)
     return strcmp(*(char *const *)a, *(char *const *)b);
 }
 
-int record_scan(struct record_kind *k, record_load_fn load, void *ctx, char *err, size_t errlen)
+int record_scan(struct record_kind *k, record_known_fn known, record_load_fn load, void *ctx,
+                char *err, size_t errlen)
 {
     if (!k->root[0])
         return 0;
@@ -299,6 +272,8 @@ int record_scan(struct record_kind *k, record_load_fn load, void *ctx, char *err
                 LOG(LOG_INFO, "removed the leftover temporary file %s", path);
             continue;
         }
+        if (known && record_id_valid(names[i]) && known(ctx, names[i]))
+            continue;
         if (lstat(path, &st) != 0)
             continue; /* gone meanwhile */
         if (!S_ISDIR(st.st_mode) || !record_id_valid(names[i])) {
@@ -308,7 +283,7 @@ int record_scan(struct record_kind *k, record_load_fn load, void *ctx, char *err
                               NULL, 0);
             continue;
         }
-        remove_tmp_files(path);
+        record_remove_tmp_files(path);
         load(ctx, names[i], path);
         rc++;
     }
@@ -317,55 +292,6 @@ out:
         free(names[i]);
     free(names);
     return rc;
-}
-
-static int by_time(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-size_t record_retention(const double *finished, size_t n, int keep, double keep_days, double now,
-                        bool *victim)
-{
-    size_t finished_count = 0, nv = 0;
-    for (size_t i = 0; i < n; i++) {
-        victim[i] = false;
-        finished_count += finished[i] >= 0;
-    }
-    /* Over the count limit: the records that finished earliest go first. */
-    if (keep > 0 && finished_count > (size_t)keep) {
-        size_t excess = finished_count - (size_t)keep, nt = 0;
-        double *times = malloc(finished_count * sizeof(double));
-        if (times) {
-            for (size_t i = 0; i < n; i++)
-                if (finished[i] >= 0)
-                    times[nt++] = finished[i];
-            qsort(times, nt, sizeof(double), by_time);
-            double cutoff = times[excess - 1];
-            free(times);
-            /* Strictly earlier ones first, then ties at the cutoff in order. */
-            for (size_t i = 0; i < n; i++)
-                if (finished[i] >= 0 && finished[i] < cutoff) {
-                    victim[i] = true;
-                    nv++;
-                }
-            for (size_t i = 0; i < n && nv < excess; i++)
-                if (finished[i] == cutoff && !victim[i]) {
-                    victim[i] = true;
-                    nv++;
-                }
-        }
-    }
-    if (keep_days > 0) {
-        double cutoff = now - keep_days * 86400.0;
-        for (size_t i = 0; i < n; i++)
-            if (finished[i] >= 0 && finished[i] < cutoff && !victim[i]) {
-                victim[i] = true;
-                nv++;
-            }
-    }
-    return nv;
 }
 
 bool record_remove_dir(const char *dir)

@@ -11,14 +11,19 @@
 #include <unistd.h>
 
 #include "common/clock.h"
+#include "common/fsutil.h"
 #include "common/log.h"
 #include "common/stats.h"
 #include "daemon/jobs/records.h"
+#include "daemon/jobs/store.h"
 #include "common/result_keys.h"
 
+/* At most this many finished sweeps go at a time (retention). */
+#define RETENTION_BATCH 64
+
 struct sweep {
-    char id[RECORD_ID_LEN];
-    char dir[PATH_MAX]; /* STATE_DIR/sweeps/ID: sweep.json */
+    char id[RECORD_ID_LEN]; /* first: store_live */
+    char dir[PATH_MAX]; /* STATE_DIR/sweeps/ID: spec.json */
     struct sweep_spec spec;
     json_t *body;    /* as posted */
     json_t *points;  /* the table, one object per point */
@@ -31,81 +36,143 @@ struct sweep {
      * point twice. Sweep thread only. */
     char adopt_job[RECORD_ID_LEN];
     atomic_bool cancel; /* DELETE */
-    double created, finished;
-    /* Under the sweeps' lock: ordered writes, as for jobs (records.h). */
-    uint64_t seq;
-    unsigned pending;
-    struct record_writer writer;
+    double created, started, finished;
+    /* Under the sweeps' lock: ordered writes, as for jobs (queue.h). */
+    struct store_version version;
 };
 
 struct sweeps {
     struct queue *queue;
+    struct store *store;
     const struct technique_catalog *techniques;
     pthread_t thread;
-    /* Guards the list and the sweeps' state; never held across file I/O. */
+    /* Guards the list and the sweeps' state; never held across file I/O or
+     * a store write, and never while calling into the queue. */
     pthread_mutex_t lock;
     pthread_cond_t changed;
-    struct sweep **all; /* in id order */
-    size_t count, cap;
+    struct store_live live; /* struct sweep: queued, running, or not yet stored */
     int reserved; /* submissions writing their first record */
     atomic_bool stopping;
-    struct record_kind kind; /* STATE_DIR/sweeps/ID/sweep.json */
 };
 
 /* A sweep's state taken under the lock, written after it. */
 struct snapshot {
     struct sweep *sw;
     uint64_t seq;
-    json_t *json;
+    struct store_row row;
 };
 
-static json_t *sweep_json_locked(const struct sweep *sw, bool full);
 static void apply_retention(struct sweeps *s);
 
-static bool sweep_finished(const struct sweep *sw)
+static bool sweep_finished(const struct sweep *sw) { return job_status_finished(sw->status); }
+
+/* What GET /v1/sweeps/ID shows of a sweep, live or stored alike; the table
+ * and result are the caller's to copy. */
+static json_t *sweep_json(const char *id, const char *kind, enum job_status status, size_t done,
+                          size_t total, const char *current_job, bool thesis, const char *error,
+                          json_t *body, json_t *points, json_t *result, bool full)
 {
-    return sw->status != JOB_QUEUED && sw->status != JOB_RUNNING;
+    json_t *o = json_pack("{s:s, s:s, s:s, s:{s:I, s:I}}", "id", id, "kind", kind, "status",
+                          job_status_name(status), "progress", "points_done", (json_int_t)done,
+                          "points_total", (json_int_t)total);
+    if (!o)
+        return NULL;
+    if (current_job && current_job[0])
+        json_object_set_new(o, "current_job", json_string(current_job));
+    if (thesis)
+        json_object_set_new(o, "preset", json_string("thesis"));
+    if (error && error[0])
+        json_object_set_new(o, "error", json_string(error));
+    if (full) {
+        json_object_set(o, "spec", body ? body : json_null());
+        json_object_set_new(o, "points", points ? json_deep_copy(points) : json_array());
+        if (result)
+            json_object_set_new(o, RK_RESULT, json_deep_copy(result));
+    }
+    return o;
 }
 
-/* sweep.json: what GET /v1/sweeps/ID shows, plus the times. A deep copy:
- * the sweep thread keeps appending to the live table. */
-static json_t *sweep_record_locked(const struct sweep *sw)
+static const char *kind_name(const struct sweep *sw)
 {
-    json_t *live = sweep_json_locked(sw, true);
-    json_t *o = live ? json_deep_copy(live) : NULL;
-    json_decref(live);
-    if (o)
-        json_object_set_new(o, "times_unix", json_pack("[f, f]", sw->created, sw->finished));
-    return o;
+    return sw->spec.kind == SWEEP_VARY ? "vary" : "find";
+}
+
+/* A deep copy: the sweep thread keeps appending to the live table. */
+static json_t *live_json_locked(const struct sweep *sw, bool full)
+{
+    return sweep_json(sw->id, kind_name(sw), sw->status, json_array_size(sw->points),
+                      sw->spec.npoints, sw->current_job, sw->spec.thesis, sw->error, sw->body,
+                      sw->points, sw->result, full);
+}
+
+/* The sweep's row: its table and result in extra, copied (the sweep thread
+ * goes on appending once the lock is released). */
+static void row_of_locked(const struct sweep *sw, struct store_row *row)
+{
+    store_row_init(row, STORE_SWEEPS);
+    snprintf(row->id, sizeof(row->id), "%s", sw->id);
+    row->status = sw->status;
+    snprintf(row->technique, sizeof(row->technique), "%s", kind_name(sw));
+    row->created = sw->created;
+    row->started = sw->started;
+    row->finished = sw->finished;
+    row->done = (int)json_array_size(sw->points);
+    row->total = (int)sw->spec.npoints;
+    snprintf(row->error, sizeof(row->error), "%s", sw->error);
+    row->spec = json_deep_copy(sw->body);
+    row->extra = json_pack("{s:o}", "points", json_deep_copy(sw->points));
+    if (sw->result)
+        json_object_set_new(row->extra, RK_RESULT, json_deep_copy(sw->result));
+    if (sw->current_job[0])
+        json_object_set_new(row->extra, "current_job", json_string(sw->current_job));
+    if (sw->spec.thesis)
+        json_object_set_new(row->extra, "preset", json_string("thesis"));
 }
 
 static void snapshot_locked(struct sweep *sw, struct snapshot *snap)
 {
     snap->sw = sw;
-    snap->seq = ++sw->seq;
-    snap->json = sweep_record_locked(sw);
-    sw->pending++;
+    snap->seq = store_version_take(&sw->version);
+    row_of_locked(sw, &snap->row);
+}
+
+static void sweep_free(struct sweep *sw)
+{
+    if (!sw)
+        return;
+    sweep_spec_finish(&sw->spec);
+    json_decref(sw->body);
+    json_decref(sw->points);
+    json_decref(sw->result);
+    free(sw);
+}
+
+/* A finished sweep whose last state is stored leaves memory; returns it to
+ * free once the lock is released, or NULL. */
+static struct sweep *evict_locked(struct sweeps *s, struct sweep *sw)
+{
+    if (!sweep_finished(sw) || !store_version_stored(&sw->version))
+        return NULL;
+    store_live_remove(&s->live, sw);
+    return sw;
 }
 
 static bool write_snapshot(struct sweeps *s, struct snapshot *snap, char *err, size_t errlen)
 {
     struct sweep *sw = snap->sw;
-    char path[PATH_MAX + 16], why[PATH_MAX + 128] = "";
-    snprintf(path, sizeof(path), "%s/sweep.json", sw->dir);
-    bool ok = snap->json && record_writer_write(&sw->writer, snap->seq, path, snap->json, why,
-                                                sizeof(why));
-    if (!snap->json)
-        snprintf(why, sizeof(why), "cannot write %s: out of memory", path);
+    char why[PATH_MAX + 300] = "";
+    bool ok = store_put(s->store, &snap->row, snap->seq, &sw->version.written, why, sizeof(why));
     if (!ok)
         LOG(LOG_ERROR, "sweep %s: %s (its state in memory stays right; written again at exit)",
             sw->id, why);
     if (err)
         snprintf(err, errlen, "%s", why);
-    json_decref(snap->json);
-    snap->json = NULL;
+    store_row_finish(&snap->row);
     pthread_mutex_lock(&s->lock);
-    sw->pending--;
+    store_version_back(&sw->version, snap->seq, ok);
+    struct sweep *gone = evict_locked(s, sw);
     pthread_mutex_unlock(&s->lock);
+    sweep_free(gone);
     return ok;
 }
 
@@ -122,42 +189,14 @@ static struct sweep *sweep_new(void)
     if (!sw)
         return NULL;
     atomic_init(&sw->cancel, false);
-    record_writer_init(&sw->writer);
     return sw;
 }
 
-static void sweep_free(struct sweep *sw)
+static struct sweep *find_locked(struct sweeps *s, const char *id)
 {
-    if (!sw)
-        return;
-    sweep_spec_finish(&sw->spec);
-    json_decref(sw->body);
-    json_decref(sw->points);
-    json_decref(sw->result);
-    record_writer_finish(&sw->writer);
-    free(sw);
+    return store_live_find(&s->live, id);
 }
 
-static bool insert_locked(struct sweeps *s, struct sweep *sw)
-{
-    if (s->count == s->cap) {
-        size_t cap = s->cap ? s->cap * 2 : 16;
-        struct sweep **all = realloc(s->all, cap * sizeof(*all));
-        if (!all)
-            return false;
-        s->all = all;
-        s->cap = cap;
-    }
-    size_t at = s->count;
-    while (at > 0 && strcmp(s->all[at - 1]->id, sw->id) > 0)
-        at--;
-    memmove(s->all + at + 1, s->all + at, (s->count - at) * sizeof(*s->all));
-    s->all[at] = sw;
-    s->count++;
-    return true;
-}
-
-/* One row of the table from a finished point job. */
 static json_t *point_row(const json_t *job, json_t *values)
 {
     json_t *r = json_object_get(job, RK_RESULT);
@@ -390,6 +429,7 @@ static json_t *vary_result(const struct sweep *sw)
     return res;
 }
 
+
 static void run_sweep(struct sweeps *s, struct sweep *sw)
 {
     bool ok = true;
@@ -446,15 +486,16 @@ static void run_sweep(struct sweeps *s, struct sweep *sw)
         sw->finished = clock_unix_s();
         sw->current_job[0] = '\0';
     }
-    changed_locked(s, sw, &snap);
-    pthread_mutex_unlock(&s->lock);
-    write_snapshot(s, &snap, NULL, 0);
+    /* Logged before the write: once stored, a finished sweep leaves memory. */
     if (stopped)
         LOG(LOG_INFO, "sweep %s: stopped with the daemon after %zu points; resumes on the next start",
             sw->id, json_array_size(sw->points));
     else
         LOG(LOG_INFO, "sweep %s %s (%zu points)", sw->id, job_status_name(sw->status),
             json_array_size(sw->points));
+    changed_locked(s, sw, &snap);
+    pthread_mutex_unlock(&s->lock);
+    write_snapshot(s, &snap, NULL, 0);
     apply_retention(s);
 }
 
@@ -464,9 +505,9 @@ static void *sweeps_main(void *arg)
     pthread_mutex_lock(&s->lock);
     for (;;) {
         struct sweep *next = NULL;
-        for (size_t i = 0; i < s->count && !next; i++)
-            if (s->all[i]->status == JOB_QUEUED)
-                next = s->all[i];
+        for (size_t i = 0; i < s->live.count && !next; i++)
+            if (((struct sweep *)s->live.items[i])->status == JOB_QUEUED)
+                next = s->live.items[i];
         if (atomic_load(&s->stopping))
             break;
         if (!next) {
@@ -475,6 +516,7 @@ static void *sweeps_main(void *arg)
         }
         struct snapshot snap;
         next->status = JOB_RUNNING;
+        next->started = clock_unix_s();
         changed_locked(s, next, &snap);
         pthread_mutex_unlock(&s->lock);
         write_snapshot(s, &snap, NULL, 0);
@@ -485,93 +527,225 @@ static void *sweeps_main(void *arg)
     return NULL;
 }
 
-static bool status_from_name(const char *name, enum job_status *out)
+/* --- Loading -------------------------------------------------------------- */
+
+/* spec.json: the sweep as posted, written once; enough to rebuild its row. */
+static bool write_spec_record(const char *dir, const char *id, double created, const json_t *body,
+                              char *err, size_t errlen)
 {
-    for (int st = JOB_QUEUED; st <= JOB_INTERRUPTED; st++)
-        if (name && strcmp(name, job_status_name((enum job_status)st)) == 0) {
-            *out = (enum job_status)st;
-            return true;
-        }
-    return false;
+    char path[PATH_MAX + 16];
+    snprintf(path, sizeof(path), "%s/spec.json", dir);
+    json_t *o = json_pack("{s:s, s:f, s:O}", "id", id, "created_unix", created, "spec", body);
+    bool ok = o && fs_write_json_atomic(path, o);
+    if (!ok)
+        snprintf(err, errlen, "cannot write %s: %s", path, o ? strerror(errno) : "out of memory");
+    json_decref(o);
+    return ok;
 }
 
-/* Startup: one sweep's record. Whatever cannot be read is quarantined. */
-static void load_sweep(void *ctx, const char *id, const char *dir)
+/* The row of a sweep.json of an earlier version; false with why. */
+static bool row_from_legacy(struct sweeps *s, const char *id, const char *dir, json_t *o,
+                            struct store_row *row, char *why, size_t whylen)
 {
-    struct sweeps *s = ctx;
-    char path[PATH_MAX + 16], why[600] = "";
-    snprintf(path, sizeof(path), "%s/sweep.json", dir);
-    json_t *o = record_read(path, why, sizeof(why));
-    struct sweep *sw = NULL;
-    enum job_status status = JOB_FAILED;
+    const char *rid = json_string_value(json_object_get(o, "id"));
+    json_t *points = json_object_get(o, "points");
+    json_t *body = json_object_get(o, "spec");
+    struct sweep_spec spec;
     struct job_error jerr;
-    if (o) {
-        const char *rid = json_string_value(json_object_get(o, "id"));
-        json_t *points = json_object_get(o, "points");
-        if (!rid || strcmp(rid, id) != 0)
-            snprintf(why, sizeof(why), "its id does not match its directory");
-        else if (!status_from_name(json_string_value(json_object_get(o, "status")), &status))
-            snprintf(why, sizeof(why), "no valid status");
-        else if (!json_is_array(points))
-            snprintf(why, sizeof(why), "no points table");
-        else if (!(sw = sweep_new()))
-            snprintf(why, sizeof(why), "out of memory");
-        else if (!sweep_spec_parse(json_object_get(o, "spec"), s->techniques, &sw->spec, &jerr))
-            snprintf(why, sizeof(why), "not a sweep this daemon can read (%s: %s)", jerr.field,
-                     jerr.message);
+    if (!rid || strcmp(rid, id) != 0) {
+        snprintf(why, whylen, "its id does not match its directory");
+        return false;
     }
-    if (why[0]) {
-        json_decref(o);
-        sweep_free(sw);
-        char reason[800];
-        snprintf(reason, sizeof(reason), "sweep.json: %s", why);
-        record_quarantine(&s->kind, id, dir, reason, NULL, 0);
-        return;
+    if (!job_status_parse(json_string_value(json_object_get(o, "status")), &row->status)) {
+        snprintf(why, whylen, "no valid status");
+        return false;
     }
-    snprintf(sw->id, sizeof(sw->id), "%s", id);
-    snprintf(sw->dir, sizeof(sw->dir), "%s", dir);
-    sw->body = json_incref(json_object_get(o, "spec"));
-    sw->points = json_incref(json_object_get(o, "points"));
-    sw->result = json_incref(json_object_get(o, RK_RESULT));
-    sw->status = status;
+    if (!json_is_array(points)) {
+        snprintf(why, whylen, "no points table");
+        return false;
+    }
+    if (!sweep_spec_parse(body, s->techniques, &spec, &jerr)) {
+        sweep_spec_finish(&spec);
+        snprintf(why, whylen, "not a sweep this daemon can read (%s: %s)", jerr.field,
+                 jerr.message);
+        return false;
+    }
     json_t *times = json_object_get(o, "times_unix");
-    sw->created = json_number_value(json_array_get(times, 0));
-    sw->finished = json_number_value(json_array_get(times, 1));
+    snprintf(row->technique, sizeof(row->technique), "%s",
+             spec.kind == SWEEP_VARY ? "vary" : "find");
+    row->created = json_number_value(json_array_get(times, 0));
+    row->finished = json_number_value(json_array_get(times, 1));
+    row->done = (int)json_array_size(points);
+    row->total = (int)spec.npoints;
     const char *error = json_string_value(json_object_get(o, "error"));
     const char *current = json_string_value(json_object_get(o, "current_job"));
-    if (error)
-        snprintf(sw->error, sizeof(sw->error), "%s", error);
+    snprintf(row->error, sizeof(row->error), "%s", error ? error : "");
+    row->spec = json_incref(body);
+    row->extra = json_pack("{s:O}", "points", points);
+    if (json_object_get(o, RK_RESULT))
+        json_object_set(row->extra, RK_RESULT, json_object_get(o, RK_RESULT));
     if (current && record_id_valid(current))
-        snprintf(sw->current_job, sizeof(sw->current_job), "%s", current);
-    json_decref(o);
-    bool changed = false;
-    if (sw->status == JOB_RUNNING) {
-        /* Killed or crashed: its point job is interrupted too (queue.c). */
-        sw->status = JOB_INTERRUPTED;
-        sw->finished = clock_unix_s();
-        sw->current_job[0] = '\0';
-        snprintf(sw->error, sizeof(sw->error),
-                 "interrupted: the daemon stopped (killed or crashed) while this sweep ran; "
-                 "its %zu finished points stay, submit it again to run the rest",
-                 json_array_size(sw->points));
-        changed = true;
-    } else if (sw->status == JOB_QUEUED && sw->current_job[0]) {
-        snprintf(sw->adopt_job, sizeof(sw->adopt_job), "%s", sw->current_job);
+        json_object_set_new(row->extra, "current_job", json_string(current));
+    if (spec.thesis)
+        json_object_set_new(row->extra, "preset", json_string("thesis"));
+    char path[PATH_MAX + 16], err[PATH_MAX + 200];
+    snprintf(path, sizeof(path), "%s/spec.json", dir);
+    if (access(path, F_OK) != 0 && !write_spec_record(dir, id, row->created, body, err, sizeof(err)))
+        LOG(LOG_WARN, "sweep %s: %s", id, err);
+    sweep_spec_finish(&spec);
+    return true;
+}
+
+/* store_import: a sweep directory the store has no row for. An earlier
+ * version's sweep.json is imported (a running one is then interrupted by
+ * load_unfinished); with spec.json alone, the sweep is rebuilt as
+ * interrupted, its table lost; what cannot be read is quarantined whole. */
+static bool import_sweep(void *ctx, const char *id, const char *dir, struct store_row *row)
+{
+    struct sweeps *s = ctx;
+    char path[PATH_MAX + 16], why[600] = "", reason[800];
+    snprintf(path, sizeof(path), "%s/sweep.json", dir);
+    if (access(path, F_OK) == 0) {
+        json_t *o = record_read(path, why, sizeof(why));
+        bool ok = o && row_from_legacy(s, id, dir, o, row, why, sizeof(why));
+        json_decref(o);
+        if (ok)
+            return true;
+        snprintf(reason, sizeof(reason), "sweep.json: %s", why);
+        record_quarantine(store_record_kind(s->store, STORE_SWEEPS), id, dir, reason, NULL, 0);
+        return false;
     }
-    record_note_id(&s->kind, id);
-    struct snapshot snap = {0};
-    pthread_mutex_lock(&s->lock);
-    bool inserted = insert_locked(s, sw);
-    if (inserted && changed)
-        snapshot_locked(sw, &snap);
-    pthread_mutex_unlock(&s->lock);
-    if (!inserted) {
-        LOG(LOG_ERROR, "sweep %s: out of memory loading it", id);
+    snprintf(path, sizeof(path), "%s/spec.json", dir);
+    json_t *rec = record_read(path, why, sizeof(why));
+    const char *rid = json_string_value(json_object_get(rec, "id"));
+    struct sweep_spec spec;
+    struct job_error jerr;
+    bool parsed = false;
+    if (rec && (!rid || strcmp(rid, id) != 0))
+        snprintf(why, sizeof(why), "its id does not match its directory");
+    else if (rec && !(parsed = sweep_spec_parse(json_object_get(rec, "spec"), s->techniques,
+                                                &spec, &jerr)))
+        snprintf(why, sizeof(why), "not a sweep this daemon can read (%s: %s)", jerr.field,
+                 jerr.message);
+    if (!parsed) {
+        if (rec)
+            sweep_spec_finish(&spec);
+        json_decref(rec);
+        snprintf(reason, sizeof(reason), "no row in the store and no sweep.json; spec.json: %s",
+                 why);
+        record_quarantine(store_record_kind(s->store, STORE_SWEEPS), id, dir, reason, NULL, 0);
+        return false;
+    }
+    snprintf(row->technique, sizeof(row->technique), "%s",
+             spec.kind == SWEEP_VARY ? "vary" : "find");
+    row->created = json_number_value(json_object_get(rec, "created_unix"));
+    row->total = (int)spec.npoints;
+    row->status = JOB_INTERRUPTED;
+    row->finished = clock_unix_s();
+    snprintf(row->error, sizeof(row->error),
+             "interrupted: its state was not in the store (a submission cut short, or the store "
+             "was rebuilt), so its table is lost; submit it again to run it");
+    row->spec = json_incref(json_object_get(rec, "spec"));
+    row->extra = json_pack("{s:[]}", "points");
+    if (spec.thesis)
+        json_object_set_new(row->extra, "preset", json_string("thesis"));
+    sweep_spec_finish(&spec);
+    json_decref(rec);
+    LOG(LOG_WARN, "sweep %s: no row in the store; rebuilt from spec.json as interrupted", id);
+    return true;
+}
+
+/* Startup: a queued sweep joins the queue (resuming after its points); one
+ * that was running when the daemon died is interrupted, its points kept. */
+static void load_unfinished(void *ctx, const struct store_row *stored)
+{
+    struct sweeps *s = ctx;
+    struct store_row row = *stored; /* its JSON stays the store's */
+    struct job_error jerr;
+    char err[PATH_MAX + 300];
+    json_t *points = json_object_get(row.extra, "points");
+    const char *current = json_string_value(json_object_get(row.extra, "current_job"));
+    struct sweep *sw = sweep_new();
+    if (!sw) {
+        LOG(LOG_ERROR, "sweep %s: out of memory loading it", row.id);
+        return;
+    }
+    if (!json_is_array(points) ||
+        !sweep_spec_parse(row.spec, s->techniques, &sw->spec, &jerr)) {
+        row.status = JOB_FAILED;
+        row.finished = clock_unix_s();
+        snprintf(row.error, sizeof(row.error), "not a sweep this daemon can run (%s: %s)",
+                 json_is_array(points) ? jerr.field : "points",
+                 json_is_array(points) ? jerr.message : "no table");
+        LOG(LOG_WARN, "sweep %s: %s", row.id, row.error);
+        if (!store_put(s->store, &row, 0, NULL, err, sizeof(err)))
+            LOG(LOG_ERROR, "sweep %s: %s", row.id, err);
         sweep_free(sw);
         return;
     }
-    if (snap.sw)
-        write_snapshot(s, &snap, NULL, 0);
+    if (row.status == JOB_RUNNING) {
+        /* Killed or crashed: its point job is interrupted too (queue.c). */
+        json_t *extra = json_deep_copy(row.extra);
+        json_object_del(extra, "current_job");
+        row.extra = extra;
+        row.status = JOB_INTERRUPTED;
+        row.finished = clock_unix_s();
+        snprintf(row.error, sizeof(row.error),
+                 "interrupted: the daemon stopped (killed or crashed) while this sweep ran; "
+                 "its %zu finished points stay, submit it again to run the rest",
+                 json_array_size(points));
+        if (!store_put(s->store, &row, 0, NULL, err, sizeof(err)))
+            LOG(LOG_ERROR, "sweep %s: %s", row.id, err);
+        json_decref(extra);
+        sweep_free(sw);
+        return;
+    }
+    snprintf(sw->id, sizeof(sw->id), "%s", row.id);
+    snprintf(sw->dir, sizeof(sw->dir), "%s", row.dir);
+    sw->body = json_incref(row.spec);
+    sw->points = json_deep_copy(points);
+    sw->result = json_deep_copy(json_object_get(row.extra, RK_RESULT));
+    sw->status = JOB_QUEUED;
+    sw->created = row.created;
+    snprintf(sw->error, sizeof(sw->error), "%.511s", row.error);
+    if (current && record_id_valid(current)) {
+        snprintf(sw->current_job, sizeof(sw->current_job), "%s", current);
+        snprintf(sw->adopt_job, sizeof(sw->adopt_job), "%s", current);
+    }
+    pthread_mutex_lock(&s->lock);
+    bool inserted = store_live_insert(&s->live, sw);
+    pthread_mutex_unlock(&s->lock);
+    if (!inserted) {
+        LOG(LOG_ERROR, "sweep %s: out of memory loading it; it resumes on the next start", row.id);
+        sweep_free(sw);
+    }
+}
+
+/* The queue's retention guard: a point job of a queued or running sweep
+ * stays (the one it waits for, the one it adopts, and those in its table,
+ * which its report shows). */
+static bool needs_job(void *ctx, const char *id)
+{
+    struct sweeps *s = ctx;
+    bool needed = false;
+    pthread_mutex_lock(&s->lock);
+    for (size_t i = 0; i < s->live.count && !needed; i++) {
+        const struct sweep *sw = s->live.items[i];
+        if (sweep_finished(sw))
+            continue;
+        needed = strcmp(sw->current_job, id) == 0 || strcmp(sw->adopt_job, id) == 0;
+        size_t k;
+        json_t *row;
+        json_array_foreach(sw->points, k, row) {
+            const char *job = json_string_value(json_object_get(row, "job"));
+            if (needed || (job && strcmp(job, id) == 0)) {
+                needed = true;
+                break;
+            }
+        }
+    }
+    pthread_mutex_unlock(&s->lock);
+    return needed;
 }
 
 struct sweeps *sweeps_create(struct queue *q, const struct technique_catalog *techniques)
@@ -580,22 +754,27 @@ struct sweeps *sweeps_create(struct queue *q, const struct technique_catalog *te
     if (!s)
         return NULL;
     s->queue = q;
+    s->store = queue_store(q);
     s->techniques = techniques;
     atomic_init(&s->stopping, false);
     pthread_mutex_init(&s->lock, NULL);
     pthread_cond_init(&s->changed, NULL);
-    record_kind_init(&s->kind, queue_state_dir(q), "sweeps", "sweep.json");
-    char err[PATH_MAX + 64];
-    int loaded = record_scan(&s->kind, load_sweep, s, err, sizeof(err));
-    if (loaded < 0)
-        LOG(LOG_ERROR, "sweeps: %s; none reloaded", err);
-    else if (loaded > 0)
-        LOG(LOG_INFO, "loaded %d sweep(s) from %s", loaded, s->kind.root);
+    char err[PATH_MAX + 300];
+    int imported = store_import(s->store, STORE_SWEEPS, "sweep.json", import_sweep, s, err,
+                                sizeof(err));
+    if (imported < 0)
+        LOG(LOG_ERROR, "sweeps: %s; none imported", err);
+    else if (imported > 0)
+        LOG(LOG_INFO, "imported %d sweep(s) from their directories", imported);
+    if (!store_each_unfinished(s->store, STORE_SWEEPS, load_unfinished, s))
+        LOG(LOG_ERROR, "sweeps: cannot read the unfinished sweeps; none resumed");
     apply_retention(s);
+    queue_set_retention_guard(q, needs_job, s);
     if (pthread_create(&s->thread, NULL, sweeps_main, s) != 0) {
-        for (size_t i = 0; i < s->count; i++)
-            sweep_free(s->all[i]);
-        free(s->all);
+        queue_set_retention_guard(q, NULL, NULL);
+        for (size_t i = 0; i < s->live.count; i++)
+            sweep_free(s->live.items[i]);
+        store_live_finish(&s->live);
         pthread_cond_destroy(&s->changed);
         pthread_mutex_destroy(&s->lock);
         free(s);
@@ -608,6 +787,9 @@ void sweeps_destroy(struct sweeps *s)
 {
     if (!s)
         return;
+    /* The render thread may still finish a job: its retention must not ask
+     * a freed guard. */
+    queue_set_retention_guard(s->queue, NULL, NULL);
     /* A stop, not a cancel: the running sweep returns to the queue and its
      * point job is left to the store, which requeues it. */
     pthread_mutex_lock(&s->lock);
@@ -615,21 +797,22 @@ void sweeps_destroy(struct sweeps *s)
     pthread_cond_broadcast(&s->changed);
     pthread_mutex_unlock(&s->lock);
     pthread_join(s->thread, NULL);
-    for (size_t i = 0; i < s->count; i++) {
-        struct sweep *sw = s->all[i];
-        if (sw->writer.written < sw->seq) { /* a full disk held it back: one more try */
+    for (size_t i = 0; i < s->live.count;) {
+        struct sweep *sw = s->live.items[i];
+        size_t before = s->live.count;
+        if (sw->version.saved < sw->version.seq) { /* a full disk held it back: one more try */
             struct snapshot snap;
             pthread_mutex_lock(&s->lock);
-            snap.sw = sw;
-            snap.seq = sw->seq;
-            snap.json = sweep_record_locked(sw);
-            sw->pending++;
+            snapshot_locked(sw, &snap);
             pthread_mutex_unlock(&s->lock);
-            write_snapshot(s, &snap, NULL, 0);
+            write_snapshot(s, &snap, NULL, 0); /* a finished one leaves the list */
         }
-        sweep_free(sw);
+        if (s->live.count == before)
+            i++;
     }
-    free(s->all);
+    for (size_t i = 0; i < s->live.count; i++)
+        sweep_free(s->live.items[i]);
+    store_live_finish(&s->live);
     pthread_cond_destroy(&s->changed);
     pthread_mutex_destroy(&s->lock);
     free(s);
@@ -641,8 +824,8 @@ enum queue_submit_result sweeps_submit(struct sweeps *s, struct sweep_spec *spec
     records_set_submit_error("%s", "");
     pthread_mutex_lock(&s->lock);
     size_t waiting = (size_t)s->reserved;
-    for (size_t i = 0; i < s->count; i++)
-        waiting += s->all[i]->status == JOB_QUEUED;
+    for (size_t i = 0; i < s->live.count; i++)
+        waiting += ((struct sweep *)s->live.items[i])->status == JOB_QUEUED;
     enum queue_submit_result res = atomic_load(&s->stopping)     ? QUEUE_STOPPING
                                    : waiting >= SWEEPS_MAX_WAITING ? QUEUE_FULL
                                                                    : QUEUE_OK;
@@ -652,40 +835,45 @@ enum queue_submit_result sweeps_submit(struct sweeps *s, struct sweep_spec *spec
     if (res != QUEUE_OK)
         return res;
 
-    /* Accepted only once sweep.json is on disk, written with no lock held. */
-    char why[PATH_MAX + 200] = "out of memory";
+    /* Accepted only once spec.json and the row are stored, with no lock held. */
+    char why[PATH_MAX + 300] = "out of memory";
     struct sweep *sw = sweep_new();
     bool made_dir = false, inserted = false;
     if (!sw || !(sw->body = json_deep_copy(body)) || !(sw->points = json_array()))
         goto fail;
-    if (!record_create_dir(&s->kind, NULL, sw->id, sw->dir, sizeof(sw->dir), why, sizeof(why)))
+    if (!record_create_dir(store_record_kind(s->store, STORE_SWEEPS), NULL, sw->id, sw->dir,
+                           sizeof(sw->dir), why, sizeof(why)))
         goto fail;
     made_dir = true;
     sw->spec = *spec;
     sw->status = JOB_QUEUED;
     sw->created = clock_unix_s();
-    json_t *first = sweep_record_locked(sw); /* not shared yet: no lock needed */
-    char path[PATH_MAX + 16];
-    snprintf(path, sizeof(path), "%s/sweep.json", sw->dir);
-    sw->seq = 1;
-    snprintf(why, sizeof(why), "out of memory");
-    bool written = first && record_writer_write(&sw->writer, 1, path, first, why, sizeof(why));
-    json_decref(first);
+    bool written = write_spec_record(sw->dir, sw->id, sw->created, sw->body, why, sizeof(why));
+    if (written) {
+        struct snapshot first;
+        snapshot_locked(sw, &first); /* not shared yet: no lock needed */
+        written = store_put(s->store, &first.row, first.seq, &sw->version.written, why,
+                            sizeof(why));
+        store_row_finish(&first.row);
+        store_version_back(&sw->version, first.seq, written);
+    }
     if (!written) {
         memset(&sw->spec, 0, sizeof(sw->spec)); /* still the caller's */
         goto fail;
     }
     pthread_mutex_lock(&s->lock);
     s->reserved--;
-    inserted = insert_locked(s, sw);
+    inserted = store_live_insert(&s->live, sw);
     if (inserted)
         pthread_cond_broadcast(&s->changed);
     else
         s->reserved++; /* given back below */
     pthread_mutex_unlock(&s->lock);
     if (!inserted) {
+        /* Stored but not queued: it runs on the next start. */
         memset(&sw->spec, 0, sizeof(sw->spec));
         snprintf(why, sizeof(why), "out of memory");
+        made_dir = false;
         goto fail;
     }
     memset(spec, 0, sizeof(*spec)); /* ours now */
@@ -694,14 +882,14 @@ enum queue_submit_result sweeps_submit(struct sweeps *s, struct sweep_spec *spec
 
 fail:
     records_set_submit_error("the sweep cannot be persisted in the state directory %s: %s",
-                             s->kind.state_dir, why);
+                             store_state_dir(s->store), why);
     LOG(LOG_ERROR, "sweep refused: %s", records_submit_error());
     if (made_dir) {
         /* Never accepted, so not a record: remove what was made of it. */
         char p2[PATH_MAX + 32];
-        snprintf(p2, sizeof(p2), "%s/sweep.json", sw->dir);
+        snprintf(p2, sizeof(p2), "%s/spec.json", sw->dir);
         unlink(p2);
-        snprintf(p2, sizeof(p2), "%s/sweep.json.tmp", sw->dir);
+        snprintf(p2, sizeof(p2), "%s/spec.json.tmp", sw->dir);
         unlink(p2);
         if (rmdir(sw->dir) != 0)
             LOG(LOG_WARN, "cannot remove %s: %s", sw->dir, strerror(errno));
@@ -713,36 +901,13 @@ fail:
     return QUEUE_IO_ERROR;
 }
 
-static struct sweep *find_locked(struct sweeps *s, const char *id)
+static json_t *row_json(const struct store_row *row, bool full)
 {
-    for (size_t i = 0; i < s->count; i++)
-        if (strcmp(s->all[i]->id, id) == 0)
-            return s->all[i];
-    return NULL;
-}
-
-static json_t *sweep_json_locked(const struct sweep *sw, bool full)
-{
-    json_t *o = json_pack("{s:s, s:s, s:s, s:{s:I, s:I}}", "id", sw->id, "kind",
-                          sw->spec.kind == SWEEP_VARY ? "vary" : "find", "status",
-                          job_status_name(sw->status), "progress", "points_done",
-                          (json_int_t)json_array_size(sw->points), "points_total",
-                          (json_int_t)sw->spec.npoints);
-    if (!o)
-        return NULL;
-    if (sw->current_job[0])
-        json_object_set_new(o, "current_job", json_string(sw->current_job));
-    if (sw->spec.thesis)
-        json_object_set_new(o, "preset", json_string("thesis"));
-    if (sw->error[0])
-        json_object_set_new(o, "error", json_string(sw->error));
-    if (full) {
-        json_object_set(o, "spec", sw->body);
-        json_object_set(o, "points", sw->points);
-        if (sw->result)
-            json_object_set(o, RK_RESULT, sw->result);
-    }
-    return o;
+    const json_t *extra = row->extra;
+    return sweep_json(row->id, row->technique, row->status, (size_t)row->done, (size_t)row->total,
+                      json_string_value(json_object_get(extra, "current_job")),
+                      json_object_get(extra, "preset") != NULL, row->error, row->spec,
+                      json_object_get(extra, "points"), json_object_get(extra, RK_RESULT), full);
 }
 
 json_t *sweeps_json(struct sweeps *s, const char *id, double wait_s)
@@ -752,26 +917,52 @@ json_t *sweeps_json(struct sweeps *s, const char *id, double wait_s)
     struct sweep *sw = find_locked(s, id);
     while (sw && wait_s > 0 && !sweep_finished(sw) && !atomic_load(&s->stopping)) {
         int rc = pthread_cond_timedwait(&s->changed, &s->lock, &deadline);
-        sw = find_locked(s, id); /* retention may have removed it meanwhile */
+        sw = find_locked(s, id); /* once finished and stored, it leaves memory */
         if (rc == ETIMEDOUT)
             break;
     }
-    /* A deep copy: the sweep thread keeps appending to the live table. */
-    json_t *live = sw ? sweep_json_locked(sw, true) : NULL;
-    json_t *o = live ? json_deep_copy(live) : NULL;
-    json_decref(live);
+    json_t *o = sw ? live_json_locked(sw, true) : NULL;
     pthread_mutex_unlock(&s->lock);
+    if (sw)
+        return o;
+    struct store_row row;
+    if (store_get(s->store, STORE_SWEEPS, id, true, &row) == STORE_FOUND)
+        o = row_json(&row, true);
+    store_row_finish(&row);
     return o;
 }
 
-json_t *sweeps_list_json(struct sweeps *s)
+struct page {
+    json_t *sweeps;
+};
+
+static void page_row(void *ctx, const struct store_row *row)
 {
-    json_t *list = json_array();
+    struct page *p = ctx;
+    json_t *entry = row_json(row, false);
+    if (entry)
+        json_array_append_new(p->sweeps, entry);
+}
+
+json_t *sweeps_list_page(struct sweeps *s, const struct store_query *query,
+                         char next[RECORD_ID_LEN], char *err, size_t errlen)
+{
+    struct page p = {.sweeps = json_array()};
+    if (!p.sweeps || !store_list(s->store, query, page_row, &p, next, err, errlen)) {
+        json_decref(p.sweeps);
+        return NULL;
+    }
+    /* Live sweeps: their state in memory is the newest. */
+    size_t i;
+    json_t *entry;
     pthread_mutex_lock(&s->lock);
-    for (size_t i = 0; i < s->count; i++)
-        json_array_append_new(list, sweep_json_locked(s->all[i], false));
+    json_array_foreach(p.sweeps, i, entry) {
+        const struct sweep *sw = find_locked(s, json_string_value(json_object_get(entry, "id")));
+        if (sw)
+            json_array_set_new(p.sweeps, i, live_json_locked(sw, false));
+    }
     pthread_mutex_unlock(&s->lock);
-    return json_pack("{s:o}", "sweeps", list);
+    return json_pack("{s:o}", "sweeps", p.sweeps);
 }
 
 enum queue_cancel_result sweeps_cancel(struct sweeps *s, const char *id)
@@ -797,6 +988,13 @@ enum queue_cancel_result sweeps_cancel(struct sweeps *s, const char *id)
     pthread_mutex_unlock(&s->lock);
     if (snap.sw)
         write_snapshot(s, &snap, NULL, 0);
+    if (!sw) {
+        /* Not live: finished, or no such sweep. */
+        struct store_row row;
+        if (store_get(s->store, STORE_SWEEPS, id, false, &row) == STORE_FOUND)
+            r = CANCEL_FINISHED;
+        store_row_finish(&row);
+    }
     return r;
 }
 
@@ -807,34 +1005,20 @@ static void apply_retention(struct sweeps *s)
     int keep = 0;
     double days = 0;
     queue_retention(s->queue, &keep, &days);
-    pthread_mutex_lock(&s->lock);
-    if (!s->kind.state_dir[0] || (keep <= 0 && days <= 0) || !s->count) {
-        pthread_mutex_unlock(&s->lock);
+    if (!store_state_dir(s->store)[0] || (keep <= 0 && days <= 0))
         return;
-    }
-    double *times = malloc(s->count * sizeof(double));
-    bool *victim = malloc(s->count * sizeof(bool));
-    struct sweep **victims = malloc(s->count * sizeof(*victims));
-    size_t nv = 0, kept = 0;
-    if (times && victim && victims) {
-        for (size_t i = 0; i < s->count; i++)
-            times[i] = sweep_finished(s->all[i]) && !s->all[i]->pending ? s->all[i]->finished : -1;
-        record_retention(times, s->count, keep, days, clock_unix_s(), victim);
-        for (size_t i = 0; i < s->count; i++) {
-            if (victim[i])
-                victims[nv++] = s->all[i];
-            else
-                s->all[kept++] = s->all[i];
+    char ids[RETENTION_BATCH][RECORD_ID_LEN];
+    int n = store_retention_victims(s->store, STORE_SWEEPS, keep, days, clock_unix_s(), ids,
+                                    RETENTION_BATCH);
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+        pthread_mutex_lock(&s->lock);
+        bool live = find_locked(s, ids[i]) != NULL;
+        pthread_mutex_unlock(&s->lock);
+        if (!live) {
+            LOG(LOG_INFO, "retention: removing sweep %s", ids[i]);
+            memmove(ids[m++], ids[i], RECORD_ID_LEN);
         }
-        s->count = kept;
     }
-    pthread_mutex_unlock(&s->lock);
-    for (size_t i = 0; i < nv; i++) {
-        LOG(LOG_INFO, "retention: removing sweep %s", victims[i]->id);
-        record_remove_dir(victims[i]->dir);
-        sweep_free(victims[i]);
-    }
-    free(times);
-    free(victim);
-    free(victims);
+    store_remove(s->store, STORE_SWEEPS, ids, m);
 }

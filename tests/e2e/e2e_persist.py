@@ -1,16 +1,16 @@
 """Results survive the daemon: kill -9 it mid-job, restart on the same state
 directory, and every finished job is served byte for byte as before, the
 killed job is "interrupted" with a message, a queued job runs; SIGTERM
-puts the running job back at the head of the queue (persisted as queued,
-run again on the next start) and exits 0; retention removes only the oldest
-finished jobs' directories."""
+puts the running job back at the head of the queue (stored as queued, run
+again on the next start) and exits 0; retention removes only the oldest
+finished jobs, their rows and directories."""
 
 import hashlib
-import json
 import os
 import signal
 import time
 
+import storelib
 import testlib
 from testlib import check
 
@@ -23,8 +23,6 @@ LONG = {"frames": 1000000, "warmup_frames": 0, "scene": {"width": 32, "height": 
 def digest_dir(path):
     out = {}
     for name in sorted(os.listdir(path)):
-        if name == "job.json":
-            continue  # rewritten on purpose when the state changes
         with open(os.path.join(path, name), "rb") as f:
             out[name] = hashlib.sha256(f.read()).hexdigest()
     return out
@@ -81,12 +79,11 @@ try:
 finally:
     code = second.stop()
 check(code == 0 and time.time() - t0 < 30, "SIGTERM mid-job exits 0 quickly (%s)" % code)
-with open(os.path.join(state, "jobs", term_id, "job.json")) as f:
-    on_disk = json.load(f)
-check(on_disk["status"] == "queued" and "error" not in on_disk and on_disk["times_unix"][1] == 0,
-      "the SIGTERMed job is persisted as queued, not failed: %s" % on_disk.get("status"))
-with open(os.path.join(state, "jobs", after_id, "job.json")) as f:
-    check(json.load(f)["status"] == "queued", "the job behind it stays queued")
+on_disk = storelib.row(state, storelib.JOBS, term_id) or {}
+check(on_disk.get("status") == "queued" and on_disk.get("error") is None and on_disk.get("started") == 0,
+      "the SIGTERMed job is stored as queued, not failed: %s" % on_disk.get("status"))
+check((storelib.row(state, storelib.JOBS, after_id) or {}).get("status") == "queued",
+      "the job behind it stays queued")
 
 third = testlib.Daemon("--state-dir", state, "--keep-jobs", "2")
 try:
@@ -108,6 +105,9 @@ try:
           "--keep-jobs 2 keeps the newest two finished (%s, %s): %s; statuses %s"
           % (term_id, after_id, remaining,
              [(j["id"], j["status"]) for j in third.json("GET", "/v1/jobs")[1]["jobs"]]))
+    check(storelib.ids(state) == sorted([term_id, after_id]) and
+          [j["id"] for j in third.json("GET", "/v1/jobs")[1]["jobs"]] == sorted([term_id, after_id]),
+          "and their rows: the store and the list hold the same two: %s" % storelib.ids(state))
     check(third.json("GET", "/v1/jobs/" + done_id)[0] == 404, "a removed job is gone from the API")
     check(os.path.isdir(state), "the state directory itself stays")
 finally:

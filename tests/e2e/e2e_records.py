@@ -1,11 +1,14 @@
-"""No record is lost silently. Damaged job.json files (empty, garbage,
-truncated) are quarantined with a log line and the jobs rebuilt from
-spec.json and result.json; a damaged result.json is quarantined and its job
-marked failed; what cannot be rebuilt is moved aside whole; leftover *.tmp
-files go. Sweeps survive a restart: a finished one is served as before, one
-stopped by SIGTERM resumes without running a point twice, one killed is
-interrupted with its points kept. A full or read-only state directory
-answers 507 naming it, and loses nothing."""
+"""No record is lost silently. A damaged result.json is quarantined and its
+job marked failed, naming where the file went; a job the store had as
+running is done when its result.json is complete, interrupted otherwise; odd
+entries in jobs/ and sweeps/ are quarantined; leftover *.tmp files go. A
+damaged store (store.db) is quarantined with its reason and every job
+rebuilt from its directory (spec.json and result.json), results and specs
+as before; what cannot be rebuilt is moved aside whole. Sweeps survive a
+restart: a finished one is served as before, one stopped by SIGTERM resumes
+without running a point twice, one killed is interrupted with its points
+kept. A full or read-only state directory answers 507 naming it, and loses
+nothing."""
 
 import json
 import os
@@ -14,12 +17,13 @@ import subprocess
 import tempfile
 import time
 
+import storelib
 import testlib
 from testlib import check
 
 testlib.skip_without_egl()
-SMALL = {"frames": 5, "warmup_frames": 1, "scene": {"width": 64, "height": 48}}
-WITH_REF = dict(SMALL, capture_interval=5, reference="forward")
+SMALL = {"frames": 2, "warmup_frames": 0, "scene": {"width": 32, "height": 32}}
+WITH_REF = dict(SMALL, capture_interval=2, reference="forward")
 SLOW_BASE = {"frames": 100, "warmup_frames": 0, "scene": {"width": 64, "height": 48}}
 
 
@@ -54,12 +58,16 @@ def wait_for(pred, timeout=60):
     return False
 
 
+def quarantined(state):
+    qdir = os.path.join(state, "quarantine")
+    return sorted(os.listdir(qdir)) if os.path.isdir(qdir) else []
+
+
 # --- Damaged records -------------------------------------------------------
 first = testlib.Daemon()
 state = first.state
 jobs_dir = os.path.join(state, "jobs")
-names = ["empty", "garbage", "truncated", "with_ref", "bad_result", "nothing_left",
-         "died_after_result", "died_before_metrics"]
+names = ["plain", "with_ref", "bad_result", "nothing_left", "died_after_result", "died_before_metrics"]
 ids, before = {}, {}
 for name in names:
     ids[name] = first.submit(WITH_REF if name in ("with_ref", "died_before_metrics") else SMALL)
@@ -70,27 +78,23 @@ check(first.stop() == 0, "first daemon exits 0")
 
 jd = {n: os.path.join(jobs_dir, ids[n]) for n in names}
 check(all(os.path.exists(os.path.join(jd[n], "spec.json")) for n in names), "every job has spec.json")
-write(os.path.join(jd["empty"], "job.json"), "")
-write(os.path.join(jd["garbage"], "job.json"), b"\x00\xff\xfe garbage \x01", "wb")
-text = read(os.path.join(jd["truncated"], "job.json"))
-write(os.path.join(jd["truncated"], "job.json"), text[: len(text) // 2])
-text = read(os.path.join(jd["with_ref"], "job.json"))
-write(os.path.join(jd["with_ref"], "job.json"), text[: len(text) // 3])
+check(not any(os.path.exists(os.path.join(jd[n], "job.json")) for n in names),
+      "and no job.json: its state is in the store")
 write(os.path.join(jd["bad_result"], "result.json"), "{\"frames\": ")
-os.remove(os.path.join(jd["nothing_left"], "job.json"))
-os.remove(os.path.join(jd["nothing_left"], "spec.json"))
-# Killed between writing result.json and job.json: complete, so done; killed
-# before the metrics completed it: interrupted.
+# Killed between writing result.json and storing the job done: complete, so
+# done; killed before the metrics completed it: interrupted.
 for name in ("died_after_result", "died_before_metrics"):
-    record = json.loads(read(os.path.join(jd[name], "job.json")))
-    record["status"] = "running"
-    write(os.path.join(jd[name], "job.json"), json.dumps(record))
+    spec = json.loads(read(os.path.join(jd[name], "spec.json")))["spec"]
+    storelib.set_status(state, storelib.JOBS, ids[name], "running", finished=0, spec=json.dumps(spec))
 result = json.loads(read(os.path.join(jd["died_before_metrics"], "result.json")))
 del result["quality"]
 write(os.path.join(jd["died_before_metrics"], "result.json"), json.dumps(result))
 os.mkdir(os.path.join(jobs_dir, "not-a-job"))
-os.mkdir(os.path.join(jobs_dir, "20990101-000000-0042"))  # an id, but empty
-tmp_files = [os.path.join(jd["empty"], "job.json.tmp"), os.path.join(jd["garbage"], "timings.csv.tmp"),
+os.mkdir(os.path.join(jobs_dir, "20990101-000000-0042"))  # an id, but empty and unknown
+# What an interrupted atomic write leaves: in a job that was running, and
+# beside the records.
+tmp_files = [os.path.join(jd["died_after_result"], "timings.csv.tmp"),
+             os.path.join(jd["died_before_metrics"], "result.json.tmp"),
              os.path.join(jobs_dir, "stray.tmp")]
 for p in tmp_files:
     write(p, "half")
@@ -98,56 +102,80 @@ bad_sweep = os.path.join(state, "sweeps", "20261122-000000-0009")
 os.makedirs(bad_sweep)
 write(os.path.join(bad_sweep, "sweep.json"), "nonsense")
 
-second = testlib.Daemon("--state-dir", state)
+reloaded = testlib.Daemon("--state-dir", state)
 try:
-    log = log_text(second)
-    for name in ("empty", "garbage", "truncated", "with_ref"):
-        status, job = second.json("GET", "/v1/jobs/" + ids[name])
-        check(status == 200 and job["status"] == "done", "%s job.json: rebuilt as done (%s)" % (name, job.get("status")))
-        check(job.get("result") == before[name]["result"], "%s: its result is served as before" % name)
-        check(job.get("spec") == before[name]["spec"], "%s: its spec is as before" % name)
-        check(("job.json" in log and ids[name] in log and "quarantined" in log), "%s: logged" % name)
-        on_disk = json.loads(read(os.path.join(jd[name], "job.json")))
-        check(on_disk["status"] == "done", "%s: a good job.json is written back" % name)
-    check("empty file" in log and "not JSON" in log, "the log says why each record was unreadable")
-    quarantine = os.path.join(state, "quarantine")
-    q = sorted(os.listdir(quarantine)) if os.path.isdir(quarantine) else []
-    for name in ("empty", "garbage", "truncated", "with_ref"):
-        copies = [e for e in q if e.startswith("jobs-%s-job.json-" % ids[name]) and not e.endswith(".reason")]
-        check(len(copies) == 1, "%s: the damaged job.json is kept in quarantine: %s" % (name, q))
-        check(any(e.startswith(copies[0] if copies else "?") and e.endswith(".reason") for e in q),
-              "%s: with a .reason beside it" % name)
-    garbage_copy = [e for e in q if ids["garbage"] in e and not e.endswith(".reason")]
-    check(garbage_copy and read(os.path.join(quarantine, garbage_copy[0]), "rb").startswith(b"\x00\xff\xfe"),
-          "the quarantined copy holds the damaged bytes")
-
-    status, job = second.json("GET", "/v1/jobs/" + ids["bad_result"])
+    log = log_text(reloaded)
+    status, job = reloaded.json("GET", "/v1/jobs/" + ids["bad_result"])
     check(status == 200 and job["status"] == "failed" and "result.json" in job.get("error", "")
           and "quarantine" in job.get("error", ""),
           "a damaged result.json: job failed, saying where the file went: %s" % job.get("error"))
-    check(any(ids["bad_result"] in e and "result.json" in e for e in q), "the damaged result.json is quarantined")
+    q = quarantined(state)
+    check(any(ids["bad_result"] in e and "result.json" in e and not e.endswith(".reason") for e in q)
+          and any(ids["bad_result"] in e and e.endswith(".reason") for e in q),
+          "the damaged result.json is quarantined, with a .reason: %s" % q)
+    check((storelib.row(state, storelib.JOBS, ids["bad_result"]) or {}).get("status") == "failed",
+          "and the store says failed")
+    check("not JSON" in log_text(reloaded), "the log says why it was unreadable")
 
-    job = second.json("GET", "/v1/jobs/" + ids["died_after_result"])[1]
+    job = reloaded.json("GET", "/v1/jobs/" + ids["died_after_result"])[1]
     check(job.get("status") == "done" and job.get("result") == before["died_after_result"]["result"],
-          "running on disk with a complete result.json: done (%s)" % job.get("status"))
-    job = second.json("GET", "/v1/jobs/" + ids["died_before_metrics"])[1]
-    check(job.get("status") == "interrupted", "running on disk, metrics missing: interrupted (%s)" % job.get("status"))
-    check(second.json("GET", "/v1/jobs/" + ids["nothing_left"])[0] == 404, "a job that cannot be rebuilt is not served")
-    moved = [e for e in q if e.startswith("jobs-" + ids["nothing_left"]) and not e.endswith(".reason")]
-    check(len(moved) == 1 and os.path.exists(os.path.join(quarantine, moved[0], "result.json")),
-          "but its whole directory is kept in quarantine: %s" % q)
-    check(not os.path.exists(jd["nothing_left"]), "and moved out of jobs/")
+          "running in the store with a complete result.json: done (%s)" % job.get("status"))
+    job = reloaded.json("GET", "/v1/jobs/" + ids["died_before_metrics"])[1]
+    check(job.get("status") == "interrupted" and "interrupted" in job.get("error", ""),
+          "running in the store, metrics missing: interrupted (%s)" % job.get("status"))
+    check(reloaded.json("GET", "/v1/jobs/" + ids["plain"])[1].get("result") == before["plain"]["result"],
+          "the others are served as before")
     check(any("not-a-job" in e for e in q) and any("20990101-000000-0042" in e for e in q),
           "odd entries in jobs/ are quarantined: %s" % q)
+    check(reloaded.json("GET", "/v1/jobs/20990101-000000-0042")[0] == 404, "and not served")
     check(not any(os.path.exists(p) for p in tmp_files), "leftover *.tmp files are removed at start")
     check(any(e.startswith("sweeps-20261122-000000-0009") for e in q) and "sweep.json" in log,
-          "a damaged sweep.json is quarantined, with a log line")
-    check(second.wait(second.submit(SMALL))["status"] == "done", "the daemon works on")
+          "a damaged sweep.json (of an earlier version) is quarantined, with a log line")
+finally:
+    code = reloaded.stop()
+check(code == 0, "the second daemon exits 0")
 
+# A damaged store: quarantined, every job rebuilt from its directory.
+write(os.path.join(state, "store.db"), b"\x00\xff\xfe not a database \x01" * 64, "wb")
+os.remove(os.path.join(jd["nothing_left"], "spec.json"))
+rebuilt = testlib.Daemon("--state-dir", state)
+try:
+    log = log_text(rebuilt)
+    q = quarantined(state)
+    copies = [e for e in q if e.startswith("store-store.db-") and not e.endswith(".reason")]
+    check(len(copies) == 1 and any(e == copies[0] + ".reason" for e in q),
+          "the damaged store.db is kept in quarantine with its .reason: %s" % q)
+    check(copies and read(os.path.join(state, "quarantine", copies[0]), "rb").startswith(b"\x00\xff\xfe"),
+          "holding the damaged bytes")
+    check("store.db" in log and "rebuilt" in log, "the log says what happened")
+    for name in ("plain", "with_ref", "died_after_result"):
+        status, job = rebuilt.json("GET", "/v1/jobs/" + ids[name])
+        check(status == 200 and job["status"] == "done", "%s: rebuilt as done (%s)" % (name, job.get("status")))
+        check(job.get("result") == before[name]["result"], "%s: its result is served as before" % name)
+        check(job.get("spec") == before[name]["spec"], "%s: its spec is as before" % name)
+    check(rebuilt.json("GET", "/v1/jobs/" + ids["died_before_metrics"])[1].get("status") == "interrupted",
+          "an incomplete result.json: interrupted")
+    check(rebuilt.json("GET", "/v1/jobs/" + ids["nothing_left"])[0] == 404, "a job that cannot be rebuilt is not served")
+    moved = [e for e in q if e.startswith("jobs-" + ids["nothing_left"]) and not e.endswith(".reason")]
+    check(len(moved) == 1 and os.path.exists(os.path.join(state, "quarantine", moved[0], "result.json")),
+          "but its whole directory is kept in quarantine: %s" % q)
+    check(not os.path.exists(jd["nothing_left"]), "and moved out of jobs/")
+    listed = [j["id"] for j in rebuilt.json("GET", "/v1/jobs")[1]["jobs"]]
+    check(listed == sorted(ids[n] for n in names if n != "nothing_left"),
+          "the list has every rebuilt job: %s" % listed)
+    check(rebuilt.wait(rebuilt.submit(SMALL))["status"] == "done", "the daemon works on")
+finally:
+    code = rebuilt.stop()
+check(code == 0, "the third daemon exits 0")
+
+second = testlib.Daemon("--state-dir", state)
+try:
     # --- Sweeps survive a restart ----------------------------------------------
     done_sweep = second.wait_sweep(post_sweep(second, {"base": SMALL, "vary": {"scene.lights": [1, 2]}}))
     check(done_sweep["status"] == "done" and len(done_sweep["points"]) == 2, "a small sweep done")
-    check(os.path.exists(os.path.join(state, "sweeps", done_sweep["id"], "sweep.json")), "it is on disk")
+    check(os.path.exists(os.path.join(state, "sweeps", done_sweep["id"], "spec.json")) and
+          (storelib.row(state, storelib.SWEEPS, done_sweep["id"]) or {}).get("status") == "done",
+          "it is stored")
     jobs_before = len(second.json("GET", "/v1/jobs")[1]["jobs"])
     resumed_id = post_sweep(second, {"base": SLOW_BASE, "vary": {"scene.lights": [1, 2, 3]}})
     check(wait_for(lambda: second.json("GET", "/v1/sweeps/" + resumed_id)[1].get("current_job")
@@ -157,11 +185,12 @@ try:
 finally:
     code = second.stop()
 check(code == 0, "SIGTERM mid-sweep exits 0")
-on_disk = json.loads(read(os.path.join(state, "sweeps", resumed_id, "sweep.json")))
+stored = storelib.row(state, storelib.SWEEPS, resumed_id) or {}
+on_disk = dict(stored.get("extra") or {}, status=stored.get("status"))
 # Stopped mid-point (the usual case), it names the point job to adopt; stopped
 # between points, it has none and resumes with the next point.
 check(on_disk["status"] == "queued",
-      "the sweep stopped by SIGTERM is persisted as queued: %s" % on_disk.get("status"))
+      "the sweep stopped by SIGTERM is stored as queued: %s" % on_disk.get("status"))
 
 third = testlib.Daemon("--state-dir", state)
 try:
@@ -180,10 +209,10 @@ try:
         check(on_disk["current_job"] in {r["job"] for r in rows}, "the requeued point job was adopted")
 
     killed_id = post_sweep(third, {"base": SLOW_BASE, "vary": {"scene.lights": [4, 5]}})
-    killed_file = os.path.join(state, "sweeps", killed_id, "sweep.json")
     check(wait_for(lambda: third.json("GET", "/v1/sweeps/" + killed_id)[1].get("current_job")
-                   and json.loads(read(killed_file)).get("current_job")),
-          "another sweep running, and on disk as running")
+                   and ((storelib.row(state, storelib.SWEEPS, killed_id) or {}).get("extra") or {})
+                   .get("current_job")),
+          "another sweep running, and stored as running")
     third.proc.send_signal(signal.SIGKILL)
     third.proc.wait()
     third.log.close()
@@ -199,7 +228,7 @@ try:
     check(fourth.json("GET", "/v1/sweeps/" + resumed_id)[1].get("status") == "done", "the others stay done")
 finally:
     testlib.stop_and_check(fourth)
-for dd in (first, second, third):
+for dd in (first, reloaded, rebuilt, second, third):
     dd.cleanup(keep=testlib.failures > 0)
 
 
@@ -256,13 +285,20 @@ try:
             check("cannot be persisted" in log_text(full), "the refusal is logged")
             if mounted:
                 os.remove(filler)
-                # Read-only: the same answer, with the errno saying so.
-                ro = subprocess.run(["mount", "-o", "remount,ro", mnt], capture_output=True).returncode == 0
-                if check(ro, "remount read-only"):
+                # Read-only: the same answer, with the errno saying so. The
+                # store's database is open for writing, so the kernel refuses
+                # to remount the whole state directory read-only under it;
+                # jobs/ (a read-only bind mount over itself) is where a new
+                # job would go.
+                jobs_mnt = os.path.join(mnt, "jobs")
+                ro = (subprocess.run(["mount", "--bind", jobs_mnt, jobs_mnt], capture_output=True).returncode == 0
+                      and subprocess.run(["mount", "-o", "remount,bind,ro", jobs_mnt],
+                                         capture_output=True).returncode == 0)
+                if check(ro, "jobs/ mounted read-only"):
                     status, reply = full.json("POST", "/v1/jobs", SMALL)
                     check(status == 507 and "Read-only file system" in reply.get("error", {}).get("message", ""),
                           "a read-only state directory gets 507 too: %d %s" % (status, reply))
-                    subprocess.run(["mount", "-o", "remount,rw", mnt], capture_output=True)
+                subprocess.run(["umount", jobs_mnt], capture_output=True)
             else:
                 os.chmod(os.path.join(mnt, "jobs"), 0o755)
                 os.chmod(os.path.join(mnt, "sweeps"), 0o755)
@@ -281,6 +317,7 @@ try:
         full.cleanup()
 finally:
     if mounted:  # never leave a mount behind, whatever failed
+        subprocess.run(["umount", os.path.join(mnt, "jobs")], capture_output=True)
         subprocess.run(["umount", mnt], capture_output=True)
 for leftover in (mnt, base):
     if os.path.isdir(leftover) and not os.listdir(leftover):

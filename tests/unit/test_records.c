@@ -1,7 +1,7 @@
-/* The records shared by jobs and sweeps: ids that never clash, ordered
- * writes where a stale snapshot never replaces a newer one, quarantine that
- * moves and never deletes, leftover temporary files removed at load, and
- * retention's choice of victims. Runs in a fresh temporary directory. */
+/* The records' directories shared by jobs and sweeps: ids that never
+ * clash, quarantine that moves and never deletes, leftover temporary files
+ * removed at load, directories the store knows left unopened. Runs in a
+ * fresh temporary directory. */
 #define _POSIX_C_SOURCE 200809L
 #include <dirent.h>
 #include <stdio.h>
@@ -37,7 +37,14 @@ static int count_entries(const char *dir, const char *containing)
 struct seen {
     char ids[8][RECORD_ID_LEN];
     int n;
+    char known[RECORD_ID_LEN];
 };
+
+static bool is_known(void *ctx, const char *id)
+{
+    const struct seen *s = ctx;
+    return strcmp(s->known, id) == 0;
+}
 
 static void collect(void *ctx, const char *id, const char *dir)
 {
@@ -72,39 +79,19 @@ int main(void)
 
     /* Ids: fresh directories in order; a restart continues after loaded ids. */
     struct record_kind k;
-    record_kind_init(&k, state, "jobs", "job.json");
+    record_kind_init(&k, state, "jobs");
     char id1[RECORD_ID_LEN], id2[RECORD_ID_LEN], dir1[PATH_MAX], dir2[PATH_MAX], err[512];
     CHECK(record_create_dir(&k, NULL, id1, dir1, sizeof(dir1), err, sizeof(err)));
     CHECK(record_create_dir(&k, NULL, id2, dir2, sizeof(dir2), err, sizeof(err)));
     CHECK(strcmp(id1, id2) < 0 && exists(dir1) && exists(dir2));
     struct record_kind again;
-    record_kind_init(&again, state, "jobs", "job.json");
+    record_kind_init(&again, state, "jobs");
     record_note_id(&again, id2);
     char id3[RECORD_ID_LEN], dir3[PATH_MAX];
     CHECK(record_create_dir(&again, NULL, id3, dir3, sizeof(dir3), err, sizeof(err)));
     CHECK(strcmp(id3, id2) > 0);
 
-    /* Ordered writes: the newer snapshot wins whatever the order of arrival. */
-    struct record_writer w;
-    record_writer_init(&w);
-    char path[PATH_MAX + 32];
-    snprintf(path, sizeof(path), "%s/job.json", dir1);
-    json_t *newer = json_pack("{s:i}", "n", 2), *older = json_pack("{s:i}", "n", 1);
-    CHECK(record_writer_write(&w, 2, path, newer, err, sizeof(err)));
-    CHECK(record_writer_write(&w, 1, path, older, err, sizeof(err)));
-    char why[256];
-    json_t *back = record_read(path, why, sizeof(why));
-    CHECK(back && json_integer_value(json_object_get(back, "n")) == 2);
-    json_decref(back);
-    /* A write that fails names the file and the errno text. */
-    char missing[PATH_MAX + 32];
-    snprintf(missing, sizeof(missing), "%s/no-such-dir/job.json", state);
-    CHECK(!record_writer_write(&w, 3, missing, newer, err, sizeof(err)));
-    CHECK(strstr(err, missing) && strstr(err, "No such file or directory"));
-    json_decref(newer);
-    json_decref(older);
-    record_writer_finish(&w);
-
+    char path[PATH_MAX + 32], why[256];
     /* Reading says why it cannot. */
     snprintf(path, sizeof(path), "%s/empty.json", dir2);
     write_text(path, "");
@@ -127,12 +114,21 @@ int main(void)
     mkdir(notid, 0755);
     snprintf(top_tmp, sizeof(top_tmp), "%s/jobs/x.tmp", state);
     write_text(top_tmp, "");
+    /* A directory the store knows is left unopened: its *.tmp stays. */
+    char known_tmp[PATH_MAX + 32];
+    snprintf(known_tmp, sizeof(known_tmp), "%s/result.json.tmp", dir2);
+    write_text(known_tmp, "half");
     struct seen seen = {0};
-    int n = record_scan(&again, collect, &seen, err, sizeof(err));
-    CHECK(n == 3 && seen.n == 3);
-    CHECK(strcmp(seen.ids[0], id1) == 0 && strcmp(seen.ids[1], id2) == 0 &&
-          strcmp(seen.ids[2], id3) == 0);
-    CHECK(!exists(path) && !exists(top_tmp));
+    snprintf(seen.known, sizeof(seen.known), "%s", id2);
+    int n = record_scan(&again, is_known, collect, &seen, err, sizeof(err));
+    CHECK(n == 2 && seen.n == 2);
+    CHECK(strcmp(seen.ids[0], id1) == 0 && strcmp(seen.ids[1], id3) == 0);
+    CHECK(!exists(path) && !exists(top_tmp) && exists(known_tmp));
+    unlink(known_tmp);
+    /* Without the store's say, every directory is handed over. */
+    struct seen all = {0};
+    CHECK(record_scan(&again, NULL, collect, &all, err, sizeof(err)) == 3 && all.n == 3 &&
+          strcmp(all.ids[1], id2) == 0);
     CHECK(!exists(stray) && !exists(notid));
     char qdir[PATH_MAX + 32];
     snprintf(qdir, sizeof(qdir), "%s/quarantine", state);
@@ -155,24 +151,8 @@ int main(void)
     CHECK(record_quarantine(&again, id2, dir2, "again", moved2, sizeof(moved2)));
     CHECK(strcmp(moved, moved2) != 0 && exists(moved) && exists(moved2));
     struct record_kind none;
-    record_kind_init(&none, NULL, "jobs", "job.json");
+    record_kind_init(&none, NULL, "jobs");
     CHECK(!record_quarantine(&none, id1, dir1, "no state dir", NULL, 0) && exists(dir1));
-
-    /* Retention: the earliest finished beyond keep, and those too old. */
-    double fin[6] = {100, -1, 50, 300, 200, -1};
-    bool victim[6];
-    CHECK(record_retention(fin, 6, 2, 0, 1000, victim) == 2);
-    CHECK(victim[0] && victim[2] && !victim[1] && !victim[3] && !victim[4] && !victim[5]);
-    CHECK(record_retention(fin, 6, 0, 0, 1000, victim) == 0);
-    /* keep_days: 1 day = 86400 s; "now" is 86400 + 150: 50 and 100 are too old. */
-    CHECK(record_retention(fin, 6, 0, 1, 86400 + 150, victim) == 2 && victim[0] && victim[2]);
-    /* Ties at the cutoff: exactly the excess goes. */
-    double ties[4] = {10, 10, 10, 20};
-    CHECK(record_retention(ties, 4, 2, 0, 1000, victim) == 2 && victim[0] && victim[1] &&
-          !victim[2] && !victim[3]);
-    /* Both rules: the union. */
-    CHECK(record_retention(fin, 6, 3, 1, 86400 + 75, victim) == 1 && victim[2]);
-    CHECK(record_retention(fin, 6, 3, 1, 86400 + 150, victim) == 2 && victim[0] && victim[2]);
 
     /* Removing a finished record's directory. */
     CHECK(record_remove_dir(dir3) && !exists(dir3));

@@ -1,5 +1,6 @@
 /* The URL space: which resource a path names, its id and sub-resource, and
  * the methods each takes. */
+#include <stdlib.h>
 #include <string.h>
 
 #include "daemon/api/routes.h"
@@ -72,5 +73,19 @@ int main(void)
               back.image == (enum job_image)image && back.frame == 999999999 &&
               strcmp(back.id, "1-2") == 0);
     }
+    /* A list's next page: each key and value percent-encoded, in order. */
+    const char *keys[] = {"label.branch", "since", "limit", "cursor"};
+    const char *values[] = {"feature/a b&c=d", "2026-11-21T10:00:00.000Z", "100", "1-2"};
+    char *next = route_list_url(ROUTE_JOBS, 4, keys, values);
+    CHECK(next && !strcmp(next, "/v1/jobs?label.branch=feature%2Fa%20b%26c%3Dd&since=2026-11-21T10%3A"
+                                "00%3A00.000Z&limit=100&cursor=1-2"));
+    free(next);
+    next = route_list_url(ROUTE_SWEEPS, 0, keys, values);
+    CHECK(next && !strcmp(next, "/v1/sweeps"));
+    free(next);
+    const char *utf8[] = {"\xc3\xa9"};
+    next = route_list_url(ROUTE_SWEEPS, 1, keys, utf8);
+    CHECK(next && !strcmp(next, "/v1/sweeps?label.branch=%C3%A9"));
+    free(next);
     return check_finish("test_routes");
 }

@@ -1,0 +1,1243 @@
+#define _POSIX_C_SOURCE 200809L
+#include "daemon/jobs/store.h"
+
+#include <errno.h>
+#include <pthread.h>
+#include <sqlite3.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "common/log.h"
+
+/* Read connections open at once: more than the HTTP pool, the sweep thread
+ * and the watcher ask at the same moment, each holding one for a page. */
+#define STORE_READERS 8
+/* Rows per transaction when importing directories. */
+#define STORE_BATCH 256
+#define STORE_SCHEMA_VERSION 1
+
+/* The schema. Status is text, so that the database reads plainly in the
+ * sqlite3 shell and in the tests. Rows are WITHOUT ROWID, keyed by (kind,
+ * id): ids are time-ordered, so the key is also submission order, which is
+ * the list's order and its cursor. finished is 0 until a record finishes,
+ * so that retention reads the finished ones from its index alone. */
+static const char SCHEMA[] =
+    "CREATE TABLE IF NOT EXISTS records ("
+    " kind INTEGER NOT NULL, id TEXT NOT NULL, status TEXT NOT NULL,"
+    " technique TEXT NOT NULL, created REAL NOT NULL, started REAL NOT NULL,"
+    " finished REAL NOT NULL, done INTEGER NOT NULL, total INTEGER NOT NULL,"
+    " error TEXT, labels TEXT, figures TEXT, spec TEXT, extra TEXT, dir TEXT,"
+    " PRIMARY KEY (kind, id)) WITHOUT ROWID;"
+    "CREATE INDEX IF NOT EXISTS records_status ON records (kind, status, id);"
+    "CREATE INDEX IF NOT EXISTS records_technique ON records (kind, technique, id);"
+    "CREATE INDEX IF NOT EXISTS records_finished ON records (kind, finished);"
+    "CREATE TABLE IF NOT EXISTS labels ("
+    " kind INTEGER NOT NULL, id TEXT NOT NULL, key TEXT NOT NULL, value TEXT NOT NULL,"
+    " PRIMARY KEY (kind, id, key)) WITHOUT ROWID;"
+    "CREATE INDEX IF NOT EXISTS labels_value ON labels (kind, key, value, id);"
+    /* Records whose rows are gone and whose directories may not be yet. */
+    "CREATE TABLE IF NOT EXISTS removals ("
+    " kind INTEGER NOT NULL, id TEXT NOT NULL, PRIMARY KEY (kind, id)) WITHOUT ROWID;";
+
+static const char PUT_ROW[] =
+    "INSERT INTO records (kind, id, status, technique, created, started, finished, done, total,"
+    " error, labels, figures, spec, extra, dir)"
+    " VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15)"
+    " ON CONFLICT (kind, id) DO UPDATE SET status = excluded.status,"
+    " technique = excluded.technique, created = excluded.created, started = excluded.started,"
+    " finished = excluded.finished, done = excluded.done, total = excluded.total,"
+    " error = excluded.error, labels = excluded.labels, figures = excluded.figures,"
+    " spec = excluded.spec, extra = excluded.extra, dir = excluded.dir";
+static const char PUT_LABEL[] = "INSERT OR IGNORE INTO labels (kind, id, key, value) VALUES (?, ?, ?, ?)";
+
+/* The columns every read takes, in this order; full reads add the JSON. */
+#define ROW_COLUMNS "id, status, technique, created, started, finished, done, total, error, dir"
+#define ROW_JSON_COLUMNS ", labels, figures, spec, extra"
+
+struct reader {
+    sqlite3 *db;
+    struct reader *next;
+};
+
+struct store {
+    char state_dir[PATH_MAX];
+    char path[PATH_MAX + 16];
+    bool memory; /* one connection, no file: --once */
+    struct record_kind kinds[STORE_KINDS];
+    /* The write connection and its statements; held across each commit. */
+    pthread_mutex_t write_lock;
+    sqlite3 *writer;
+    sqlite3_stmt *put_row, *put_label;
+    bool batch; /* store_import: puts join the open transaction */
+    pthread_mutex_t pool_lock;
+    pthread_cond_t pool_free;
+    struct reader *idle;
+    int readers; /* open, idle or lent */
+};
+
+static const char *const KIND_DIRS[STORE_KINDS] = {"jobs", "sweeps"};
+
+const char *job_status_name(enum job_status s)
+{
+    static const char *const names[JOB_STATUS_COUNT] = {"queued", "running", "done",
+                                                        "failed", "cancelled", "interrupted"};
+    return (unsigned)s < JOB_STATUS_COUNT ? names[s] : "failed";
+}
+
+bool job_status_parse(const char *name, enum job_status *out)
+{
+    for (int s = 0; s < JOB_STATUS_COUNT; s++)
+        if (name && strcmp(name, job_status_name((enum job_status)s)) == 0) {
+            *out = (enum job_status)s;
+            return true;
+        }
+    return false;
+}
+
+void store_row_init(struct store_row *r, enum store_kind kind)
+{
+    memset(r, 0, sizeof(*r));
+    r->kind = kind;
+}
+
+void store_row_finish(struct store_row *r)
+{
+    json_decref(r->labels);
+    json_decref(r->figures);
+    json_decref(r->spec);
+    json_decref(r->extra);
+    r->labels = r->figures = r->spec = r->extra = NULL;
+}
+
+bool store_live_insert(struct store_live *l, void *item)
+{
+    if (l->count == l->cap) {
+        size_t cap = l->cap ? l->cap * 2 : 16;
+        void **items = realloc(l->items, cap * sizeof(*items));
+        if (!items)
+            return false;
+        l->items = items;
+        l->cap = cap;
+    }
+    /* New records have the newest ids: the end, almost always. */
+    const char *id = item;
+    size_t at = l->count;
+    while (at > 0 && strcmp(l->items[at - 1], id) > 0)
+        at--;
+    memmove(l->items + at + 1, l->items + at, (l->count - at) * sizeof(*l->items));
+    l->items[at] = item;
+    l->count++;
+    return true;
+}
+
+void *store_live_find(const struct store_live *l, const char *id)
+{
+    size_t lo = 0, hi = l->count;
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        int c = strcmp(l->items[mid], id);
+        if (c == 0)
+            return l->items[mid];
+        if (c < 0)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return NULL;
+}
+
+void store_live_remove(struct store_live *l, const void *item)
+{
+    for (size_t i = 0; i < l->count; i++)
+        if (l->items[i] == item) {
+            memmove(l->items + i, l->items + i + 1, (l->count - i - 1) * sizeof(*l->items));
+            l->count--;
+            return;
+        }
+}
+
+void store_live_finish(struct store_live *l)
+{
+    free(l->items);
+    memset(l, 0, sizeof(*l));
+}
+
+uint64_t store_version_take(struct store_version *v)
+{
+    v->pending++;
+    return ++v->seq;
+}
+
+bool store_version_back(struct store_version *v, uint64_t seq, bool ok)
+{
+    v->pending--;
+    if (ok && seq > v->saved)
+        v->saved = seq;
+    return store_version_stored(v);
+}
+
+const char *store_state_dir(const struct store *s) { return s->state_dir; }
+
+struct record_kind *store_record_kind(struct store *s, enum store_kind kind)
+{
+    return &s->kinds[kind];
+}
+
+/* "cannot WHAT STATE_DIR/store.db: SQLite's message (the system's)". */
+static void db_error(const struct store *s, sqlite3 *db, const char *what, char *err,
+                     size_t errlen)
+{
+    int sys = db ? sqlite3_system_errno(db) : 0;
+    snprintf(err, errlen, "cannot %s %s: %s%s%s%s", what,
+             s->memory ? "the store in memory" : s->path, db ? sqlite3_errmsg(db) : "out of memory",
+             sys ? " (" : "", sys ? strerror(sys) : "", sys ? ")" : "");
+}
+
+static bool exec(struct store *s, sqlite3 *db, const char *sql, char *err, size_t errlen)
+{
+    if (sqlite3_exec(db, sql, NULL, NULL, NULL) == SQLITE_OK)
+        return true;
+    db_error(s, db, "write", err, errlen);
+    return false;
+}
+
+/* Is this error a database that cannot be read (rather than one that
+ * cannot be reached: permissions, a full disk)? */
+static bool damaged_code(int code)
+{
+    code &= 0xff;
+    return code == SQLITE_NOTADB || code == SQLITE_CORRUPT;
+}
+
+static sqlite3 *open_connection(struct store *s, bool create, bool *damaged, char *err,
+                                size_t errlen)
+{
+    sqlite3 *db = NULL;
+    int flags = SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX | (create ? SQLITE_OPEN_CREATE : 0);
+    int rc = sqlite3_open_v2(s->memory ? ":memory:" : s->path, &db, flags, NULL);
+    if (damaged)
+        *damaged = false;
+    if (rc != SQLITE_OK) {
+        db_error(s, db, "open", err, errlen);
+        if (damaged)
+            *damaged = damaged_code(sqlite3_extended_errcode(db));
+        sqlite3_close_v2(db);
+        return NULL;
+    }
+    /* A checkpoint can hold a reader back for a moment; never an error. */
+    sqlite3_busy_timeout(db, 10000);
+    sqlite3_extended_result_codes(db, 1);
+    /* Every commit reaches the disk before it returns: kill -9 or a power
+     * cut loses nothing a client was told is stored. */
+    if (!exec(s, db, "PRAGMA synchronous = FULL", err, errlen)) {
+        if (damaged)
+            *damaged = damaged_code(sqlite3_extended_errcode(db));
+        sqlite3_close_v2(db);
+        return NULL;
+    }
+    return db;
+}
+
+/* The first question of a database that may be damaged: its answer, or
+ * NULL with why. */
+static char *pragma_text(sqlite3 *db, const char *sql)
+{
+    sqlite3_stmt *st = NULL;
+    char *out = NULL;
+    if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) == SQLITE_OK && sqlite3_step(st) == SQLITE_ROW) {
+        const char *t = (const char *)sqlite3_column_text(st, 0);
+        out = strdup(t ? t : "");
+    }
+    sqlite3_finalize(st);
+    return out;
+}
+
+/* Opens the writer and readies the schema. *damaged tells a database that
+ * cannot be read (moved to quarantine by the caller) from one that cannot
+ * be opened at all (an error for the operator: permissions, a full disk). */
+static bool open_writer(struct store *s, bool *damaged, char *err, size_t errlen)
+{
+    s->writer = open_connection(s, true, damaged, err, errlen);
+    if (!s->writer)
+        return false;
+    char *mode = pragma_text(s->writer, s->memory ? "PRAGMA journal_mode = MEMORY"
+                                                  : "PRAGMA journal_mode = WAL");
+    if (!mode) {
+        *damaged = damaged_code(sqlite3_extended_errcode(s->writer));
+        db_error(s, s->writer, "read", err, errlen);
+        return false;
+    }
+    bool wal = strcmp(mode, "wal") == 0 || s->memory;
+    free(mode);
+    if (!wal) {
+        snprintf(err, errlen, "cannot put %s in write-ahead-log mode", s->path);
+        return false;
+    }
+    char *version = pragma_text(s->writer, "PRAGMA user_version");
+    int v = version ? atoi(version) : 0;
+    free(version);
+    if (v > STORE_SCHEMA_VERSION) {
+        snprintf(err, errlen, "%s was written by a newer shadebenchd (schema %d; this one reads %d)",
+                 s->path, v, STORE_SCHEMA_VERSION);
+        return false;
+    }
+    if (!s->memory) {
+        char *check = pragma_text(s->writer, "PRAGMA quick_check");
+        if (!check || strcmp(check, "ok") != 0) {
+            *damaged = true;
+            if (check)
+                snprintf(err, errlen, "%s fails its integrity check: %.300s", s->path, check);
+            else
+                db_error(s, s->writer, "check", err, errlen);
+            free(check);
+            return false;
+        }
+        free(check);
+    }
+    char sql[sizeof(SCHEMA) + 64];
+    snprintf(sql, sizeof(sql), "BEGIN IMMEDIATE;%sPRAGMA user_version = %d;COMMIT",
+             SCHEMA, STORE_SCHEMA_VERSION);
+    if (!exec(s, s->writer, sql, err, errlen)) {
+        *damaged = damaged_code(sqlite3_extended_errcode(s->writer));
+        sqlite3_exec(s->writer, "ROLLBACK", NULL, NULL, NULL);
+        return false;
+    }
+    if (sqlite3_prepare_v3(s->writer, PUT_ROW, -1, SQLITE_PREPARE_PERSISTENT, &s->put_row, NULL) !=
+            SQLITE_OK ||
+        sqlite3_prepare_v3(s->writer, PUT_LABEL, -1, SQLITE_PREPARE_PERSISTENT, &s->put_label,
+                           NULL) != SQLITE_OK) {
+        db_error(s, s->writer, "prepare statements on", err, errlen);
+        return false;
+    }
+    return true;
+}
+
+static void close_writer(struct store *s)
+{
+    sqlite3_finalize(s->put_row);
+    sqlite3_finalize(s->put_label);
+    s->put_row = s->put_label = NULL;
+    sqlite3_close_v2(s->writer);
+    s->writer = NULL;
+}
+
+/* A damaged database goes to quarantine with its log, never deleted: the
+ * rows come back from the directories (store_import). */
+static void quarantine_database(struct store *s, const char *reason)
+{
+    struct record_kind k;
+    record_kind_init(&k, s->state_dir, "store");
+    static const char *const suffixes[] = {"", "-wal", "-shm"};
+    for (int i = 0; i < 3; i++) {
+        char path[PATH_MAX + 32], name[32];
+        snprintf(path, sizeof(path), "%s%s", s->path, suffixes[i]);
+        snprintf(name, sizeof(name), "%s%s", STORE_FILE, suffixes[i]);
+        if (access(path, F_OK) == 0)
+            record_quarantine(&k, name, path, reason, NULL, 0);
+    }
+}
+
+/* Lends a read connection: the writer itself for a store in memory (held
+ * under the write lock), else one of the pool, opened when none is idle. */
+static sqlite3 *reader_take(struct store *s)
+{
+    if (s->memory) {
+        pthread_mutex_lock(&s->write_lock);
+        return s->writer;
+    }
+    pthread_mutex_lock(&s->pool_lock);
+    while (!s->idle && s->readers >= STORE_READERS)
+        pthread_cond_wait(&s->pool_free, &s->pool_lock);
+    struct reader *r = s->idle;
+    if (r) {
+        s->idle = r->next;
+        pthread_mutex_unlock(&s->pool_lock);
+        sqlite3 *db = r->db;
+        free(r);
+        return db;
+    }
+    s->readers++;
+    pthread_mutex_unlock(&s->pool_lock);
+    char err[PATH_MAX + 200];
+    sqlite3 *db = open_connection(s, false, NULL, err, sizeof(err));
+    if (!db) {
+        LOG(LOG_ERROR, "store: %s", err);
+        pthread_mutex_lock(&s->pool_lock);
+        s->readers--;
+        pthread_cond_signal(&s->pool_free);
+        pthread_mutex_unlock(&s->pool_lock);
+    }
+    return db;
+}
+
+static void reader_give(struct store *s, sqlite3 *db)
+{
+    if (s->memory) {
+        pthread_mutex_unlock(&s->write_lock);
+        return;
+    }
+    struct reader *r = malloc(sizeof(*r));
+    pthread_mutex_lock(&s->pool_lock);
+    if (r) {
+        r->db = db;
+        r->next = s->idle;
+        s->idle = r;
+    } else {
+        sqlite3_close_v2(db);
+        s->readers--;
+    }
+    pthread_cond_signal(&s->pool_free);
+    pthread_mutex_unlock(&s->pool_lock);
+}
+
+static void note_last_ids(struct store *s)
+{
+    sqlite3 *db = reader_take(s);
+    sqlite3_stmt *st = NULL;
+    if (db && sqlite3_prepare_v2(db, "SELECT max(id) FROM records WHERE kind = ?", -1, &st, NULL) ==
+                  SQLITE_OK) {
+        for (int k = 0; k < STORE_KINDS; k++) {
+            sqlite3_bind_int(st, 1, k);
+            if (sqlite3_step(st) == SQLITE_ROW && sqlite3_column_text(st, 0))
+                record_note_id(&s->kinds[k], (const char *)sqlite3_column_text(st, 0));
+            sqlite3_reset(st);
+        }
+    }
+    sqlite3_finalize(st);
+    if (db)
+        reader_give(s, db);
+}
+
+static void reap_noted(struct store *s);
+
+struct store *store_open(const char *state_dir, char *err, size_t errlen)
+{
+    struct store *s = calloc(1, sizeof(*s));
+    if (!s) {
+        snprintf(err, errlen, "out of memory");
+        return NULL;
+    }
+    s->memory = !state_dir || !*state_dir;
+    if (!s->memory) {
+        snprintf(s->state_dir, sizeof(s->state_dir), "%s", state_dir);
+        snprintf(s->path, sizeof(s->path), "%s/%s", s->state_dir, STORE_FILE);
+    }
+    for (int k = 0; k < STORE_KINDS; k++)
+        record_kind_init(&s->kinds[k], s->state_dir, KIND_DIRS[k]);
+    pthread_mutex_init(&s->write_lock, NULL);
+    pthread_mutex_init(&s->pool_lock, NULL);
+    pthread_cond_init(&s->pool_free, NULL);
+    bool damaged;
+    if (!open_writer(s, &damaged, err, errlen)) {
+        close_writer(s);
+        if (!damaged)
+            goto fail;
+        /* Nothing is lost by starting afresh: the directories hold every
+         * record's spec and results, and store_import rebuilds the rows. */
+        LOG(LOG_ERROR, "store: %s; it goes to quarantine and the records are rebuilt from "
+            "their directories", err);
+        quarantine_database(s, err);
+        if (!open_writer(s, &damaged, err, errlen)) {
+            close_writer(s);
+            goto fail;
+        }
+    }
+    note_last_ids(s);
+    reap_noted(s);
+    return s;
+
+fail:
+    pthread_cond_destroy(&s->pool_free);
+    pthread_mutex_destroy(&s->pool_lock);
+    pthread_mutex_destroy(&s->write_lock);
+    free(s);
+    return NULL;
+}
+
+void store_close(struct store *s)
+{
+    if (!s)
+        return;
+    while (s->idle) {
+        struct reader *r = s->idle;
+        s->idle = r->next;
+        sqlite3_close_v2(r->db);
+        free(r);
+    }
+    close_writer(s);
+    pthread_cond_destroy(&s->pool_free);
+    pthread_mutex_destroy(&s->pool_lock);
+    pthread_mutex_destroy(&s->write_lock);
+    free(s);
+}
+
+/* SQLite frees the text once the statement is done with it. */
+static void bind_json(sqlite3_stmt *st, int i, const json_t *v)
+{
+    char *text = v ? json_dumps(v, JSON_COMPACT) : NULL;
+    if (text)
+        sqlite3_bind_text(st, i, text, -1, free);
+    else
+        sqlite3_bind_null(st, i);
+}
+
+/* Under the write lock, inside a transaction. */
+static bool put_locked(struct store *s, const struct store_row *r)
+{
+    sqlite3_stmt *st = s->put_row;
+    sqlite3_bind_int(st, 1, r->kind);
+    sqlite3_bind_text(st, 2, r->id, -1, SQLITE_STATIC);
+    sqlite3_bind_text(st, 3, job_status_name(r->status), -1, SQLITE_STATIC);
+    sqlite3_bind_text(st, 4, r->technique, -1, SQLITE_STATIC);
+    sqlite3_bind_double(st, 5, r->created);
+    sqlite3_bind_double(st, 6, r->started);
+    /* Retention reads finished > 0 as finished: a finished row always has
+     * a time. */
+    double finished = r->finished > 0 || !job_status_finished(r->status) ? r->finished
+                      : r->created > 0                                    ? r->created
+                                                                          : 1;
+    sqlite3_bind_double(st, 7, job_status_finished(r->status) ? finished : 0);
+    sqlite3_bind_int(st, 8, r->done);
+    sqlite3_bind_int(st, 9, r->total);
+    if (r->error[0])
+        sqlite3_bind_text(st, 10, r->error, -1, SQLITE_STATIC);
+    else
+        sqlite3_bind_null(st, 10);
+    bind_json(st, 11, r->labels);
+    bind_json(st, 12, r->figures);
+    bind_json(st, 13, r->spec);
+    bind_json(st, 14, r->extra);
+    if (!r->dir_given)
+        sqlite3_bind_null(st, 15);
+    else
+        sqlite3_bind_text(st, 15, r->dir, -1, SQLITE_STATIC);
+    int rc = sqlite3_step(st);
+    sqlite3_reset(st);
+    sqlite3_clear_bindings(st);
+    if (rc != SQLITE_DONE)
+        return false;
+    const char *key;
+    json_t *value;
+    json_object_foreach(r->labels, key, value) {
+        if (!json_is_string(value))
+            continue;
+        sqlite3_stmt *lb = s->put_label;
+        sqlite3_bind_int(lb, 1, r->kind);
+        sqlite3_bind_text(lb, 2, r->id, -1, SQLITE_STATIC);
+        sqlite3_bind_text(lb, 3, key, -1, SQLITE_STATIC);
+        sqlite3_bind_text(lb, 4, json_string_value(value), -1, SQLITE_STATIC);
+        rc = sqlite3_step(lb);
+        sqlite3_reset(lb);
+        if (rc != SQLITE_DONE)
+            return false;
+    }
+    return true;
+}
+
+bool store_put(struct store *s, const struct store_row *r, uint64_t seq, uint64_t *written,
+               char *err, size_t errlen)
+{
+    bool ok = true;
+    pthread_mutex_lock(&s->write_lock);
+    /* A newer state got here first: this one is stale. */
+    if (written && *written >= seq)
+        goto out;
+    if (s->batch) {
+        ok = put_locked(s, r);
+    } else {
+        ok = sqlite3_exec(s->writer, "BEGIN IMMEDIATE", NULL, NULL, NULL) == SQLITE_OK &&
+             put_locked(s, r) && sqlite3_exec(s->writer, "COMMIT", NULL, NULL, NULL) == SQLITE_OK;
+    }
+    if (!ok) {
+        db_error(s, s->writer, "write", err, errlen);
+        if (!s->batch && !sqlite3_get_autocommit(s->writer))
+            sqlite3_exec(s->writer, "ROLLBACK", NULL, NULL, NULL);
+    } else if (written) {
+        *written = seq;
+    }
+out:
+    pthread_mutex_unlock(&s->write_lock);
+    return ok;
+}
+
+static json_t *column_json(sqlite3_stmt *st, int col)
+{
+    const char *text = (const char *)sqlite3_column_text(st, col);
+    return text ? json_loads(text, 0, NULL) : NULL;
+}
+
+static void column_copy(sqlite3_stmt *st, int col, char *out, size_t cap)
+{
+    const char *text = (const char *)sqlite3_column_text(st, col);
+    snprintf(out, cap, "%s", text ? text : "");
+}
+
+/* Reads ROW_COLUMNS (and, with json, ROW_JSON_COLUMNS) from the statement's
+ * current row. */
+static void read_row(struct store *s, sqlite3_stmt *st, bool json, struct store_row *r)
+{
+    column_copy(st, 0, r->id, sizeof(r->id));
+    const char *status = (const char *)sqlite3_column_text(st, 1);
+    if (!job_status_parse(status, &r->status))
+        r->status = JOB_FAILED;
+    column_copy(st, 2, r->technique, sizeof(r->technique));
+    r->created = sqlite3_column_double(st, 3);
+    r->started = sqlite3_column_double(st, 4);
+    r->finished = sqlite3_column_double(st, 5);
+    r->done = sqlite3_column_int(st, 6);
+    r->total = sqlite3_column_int(st, 7);
+    column_copy(st, 8, r->error, sizeof(r->error));
+    r->dir_given = sqlite3_column_type(st, 9) != SQLITE_NULL;
+    if (r->dir_given)
+        column_copy(st, 9, r->dir, sizeof(r->dir));
+    else
+        snprintf(r->dir, sizeof(r->dir), "%.*s/%s", (int)(sizeof(r->dir) - RECORD_ID_LEN - 2),
+                 s->kinds[r->kind].root, r->id);
+    if (json) {
+        r->labels = column_json(st, 10);
+        r->figures = column_json(st, 11);
+        r->spec = column_json(st, 12);
+        r->extra = column_json(st, 13);
+    }
+}
+
+enum store_found store_get(struct store *s, enum store_kind kind, const char *id, bool full,
+                           struct store_row *out)
+{
+    store_row_init(out, kind);
+    sqlite3 *db = reader_take(s);
+    if (!db)
+        return STORE_ERROR;
+    sqlite3_stmt *st = NULL;
+    enum store_found found = STORE_ERROR;
+    const char *sql = full ? "SELECT " ROW_COLUMNS ROW_JSON_COLUMNS
+                             " FROM records WHERE kind = ? AND id = ?"
+                           : "SELECT " ROW_COLUMNS " FROM records WHERE kind = ? AND id = ?";
+    if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) == SQLITE_OK) {
+        sqlite3_bind_int(st, 1, kind);
+        sqlite3_bind_text(st, 2, id, -1, SQLITE_STATIC);
+        int rc = sqlite3_step(st);
+        if (rc == SQLITE_ROW) {
+            read_row(s, st, full, out);
+            found = STORE_FOUND;
+        } else if (rc == SQLITE_DONE) {
+            found = STORE_MISSING;
+        }
+    }
+    if (found == STORE_ERROR) {
+        char err[PATH_MAX + 300];
+        db_error(s, db, "read", err, sizeof(err));
+        LOG(LOG_ERROR, "store: %s %s: %s", KIND_DIRS[kind], id, err);
+    }
+    sqlite3_finalize(st);
+    reader_give(s, db);
+    return found;
+}
+
+/* A statement built piece by piece, with its parameters in order. */
+struct sql {
+    char text[12288];
+    size_t len;
+    bool overflow;
+    int n;
+    struct {
+        enum { P_INT, P_DOUBLE, P_TEXT } type;
+        int64_t i;
+        double d;
+        const char *t;
+    } params[2 * STORE_MAX_TERMS + 16];
+};
+
+__attribute__((format(printf, 2, 3))) static void sql_add(struct sql *q, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(q->text + q->len, sizeof(q->text) - q->len, fmt, ap);
+    va_end(ap);
+    if (n < 0 || (size_t)n >= sizeof(q->text) - q->len)
+        q->overflow = true;
+    else
+        q->len += (size_t)n;
+}
+
+static void sql_text(struct sql *q, const char *t)
+{
+    if (q->n < (int)(sizeof(q->params) / sizeof(q->params[0])))
+        q->params[q->n].type = P_TEXT, q->params[q->n++].t = t;
+    else
+        q->overflow = true;
+}
+
+static void sql_int(struct sql *q, int64_t i)
+{
+    if (q->n < (int)(sizeof(q->params) / sizeof(q->params[0])))
+        q->params[q->n].type = P_INT, q->params[q->n++].i = i;
+    else
+        q->overflow = true;
+}
+
+static void sql_double(struct sql *q, double d)
+{
+    if (q->n < (int)(sizeof(q->params) / sizeof(q->params[0])))
+        q->params[q->n].type = P_DOUBLE, q->params[q->n++].d = d;
+    else
+        q->overflow = true;
+}
+
+static void sql_bind(const struct sql *q, sqlite3_stmt *st)
+{
+    for (int i = 0; i < q->n; i++) {
+        if (q->params[i].type == P_INT)
+            sqlite3_bind_int64(st, i + 1, q->params[i].i);
+        else if (q->params[i].type == P_DOUBLE)
+            sqlite3_bind_double(st, i + 1, q->params[i].d);
+        else
+            sqlite3_bind_text(st, i + 1, q->params[i].t, -1, SQLITE_STATIC);
+    }
+}
+
+static bool same_group(const struct store_term *a, const struct store_term *b)
+{
+    return a->kind == b->kind && strcmp(a->label, b->label) == 0;
+}
+
+static bool first_of_group(const struct store_query *q, size_t i)
+{
+    for (size_t k = 0; k < i; k++)
+        if (same_group(&q->terms[k], &q->terms[i]))
+            return false;
+    return true;
+}
+
+/* "(?, ?, ?)": the values of the group that starts at term i. */
+static void add_values(struct sql *sql, const struct store_query *q, size_t i)
+{
+    sql_add(sql, "(");
+    bool first = true;
+    for (size_t k = i; k < q->nterms; k++)
+        if (same_group(&q->terms[k], &q->terms[i])) {
+            sql_add(sql, first ? "?" : ", ?");
+            sql_text(sql, q->terms[k].value);
+            first = false;
+        }
+    sql_add(sql, ")");
+}
+
+/* The lower bound on ids: the cursor, or what since allows. Ids are
+ * stamped with the second of their submission before created is taken,
+ * so a record created at or after since has an id at or after since's
+ * stamp; an hour's margin keeps it true whatever happened between the two
+ * clock reads. The bound only narrows the scan: created is still compared. */
+static void id_bound(const struct store_query *q, char bound[RECORD_ID_LEN], bool *strict)
+{
+    bound[0] = '\0';
+    *strict = false;
+    char prefix[32] = "";
+    if (q->since_ms > 0) {
+        time_t t = (time_t)(q->since_ms / 1000) - 3600;
+        struct tm tm;
+        if (t > 0 && gmtime_r(&t, &tm))
+            strftime(prefix, sizeof(prefix), "%Y%m%d-%H%M%S", &tm);
+    }
+    if (q->after[0] && strcmp(q->after, prefix) >= 0) {
+        snprintf(bound, RECORD_ID_LEN, "%s", q->after);
+        *strict = true;
+    } else if (prefix[0]) {
+        snprintf(bound, RECORD_ID_LEN, "%s", prefix);
+    }
+}
+
+/* Of the label groups, the one with the fewest rows past the bound (counted
+ * up to a cap, so that asking costs little) drives the query: its index
+ * gives ids in order, and the others are checked per row. -1: no label. */
+static int driving_label(sqlite3 *db, const struct store_query *q, const char *bound, bool strict)
+{
+    int best = -1;
+    long best_count = 0;
+    int groups = 0;
+    for (size_t i = 0; i < q->nterms; i++)
+        groups += q->terms[i].kind == STORE_TERM_LABEL && first_of_group(q, i);
+    for (size_t i = 0; i < q->nterms; i++) {
+        if (q->terms[i].kind != STORE_TERM_LABEL || !first_of_group(q, i))
+            continue;
+        if (groups == 1)
+            return (int)i;
+        struct sql sql = {.n = 0};
+        sql_add(&sql, "SELECT count(*) FROM (SELECT 1 FROM labels WHERE kind = ? AND key = ? "
+                      "AND value IN ");
+        sql_int(&sql, q->kind);
+        sql_text(&sql, q->terms[i].label);
+        add_values(&sql, q, i);
+        if (bound[0]) {
+            sql_add(&sql, strict ? " AND id > ?" : " AND id >= ?");
+            sql_text(&sql, bound);
+        }
+        sql_add(&sql, " LIMIT 5000)");
+        sqlite3_stmt *st = NULL;
+        long count = 5000;
+        if (!sql.overflow && sqlite3_prepare_v2(db, sql.text, -1, &st, NULL) == SQLITE_OK) {
+            sql_bind(&sql, st);
+            if (sqlite3_step(st) == SQLITE_ROW)
+                count = (long)sqlite3_column_int64(st, 0);
+        }
+        sqlite3_finalize(st);
+        if (best < 0 || count < best_count) {
+            best = (int)i;
+            best_count = count;
+        }
+    }
+    return best;
+}
+
+bool store_list(struct store *s, const struct store_query *q, store_row_fn fn, void *ctx,
+                char next[RECORD_ID_LEN], char *err, size_t errlen)
+{
+    next[0] = '\0';
+    int limit = q->limit > 0 && q->limit <= STORE_LIMIT_MAX ? q->limit : STORE_LIMIT_DEFAULT;
+    sqlite3 *db = reader_take(s);
+    if (!db) {
+        snprintf(err, errlen, "cannot open %s to read", s->path);
+        return false;
+    }
+    char bound[RECORD_ID_LEN];
+    bool strict;
+    id_bound(q, bound, &strict);
+    int driver = driving_label(db, q, bound, strict);
+    struct sql *sql = calloc(1, sizeof(*sql));
+    bool ok = false;
+    sqlite3_stmt *st = NULL;
+    if (!sql) {
+        snprintf(err, errlen, "out of memory");
+        goto out;
+    }
+    const char *columns = "r.id, r.status, r.technique, r.created, r.started, r.finished, r.done,"
+                          " r.total, r.error, r.dir, r.labels, r.figures, NULL, ";
+    const char *extra = q->kind == STORE_SWEEPS ? "r.extra" : "NULL";
+    /* r stands for the row, k for the table whose id the order follows. */
+    const char *k = driver >= 0 ? "l" : "r";
+    if (driver >= 0) {
+        sql_add(sql, "SELECT %s%s FROM labels l CROSS JOIN records r ON r.kind = l.kind "
+                     "AND r.id = l.id WHERE l.kind = ? AND l.key = ? AND l.value IN ",
+                columns, extra);
+        sql_int(sql, q->kind);
+        sql_text(sql, q->terms[driver].label);
+        add_values(sql, q, (size_t)driver);
+    } else {
+        sql_add(sql, "SELECT %s%s FROM records r WHERE r.kind = ?", columns, extra);
+        sql_int(sql, q->kind);
+    }
+    if (bound[0]) {
+        sql_add(sql, strict ? " AND %s.id > ?" : " AND %s.id >= ?", k);
+        sql_text(sql, bound);
+    }
+    for (size_t i = 0; i < q->nterms; i++) {
+        if ((int)i == driver || !first_of_group(q, i))
+            continue;
+        const struct store_term *t = &q->terms[i];
+        if (t->kind == STORE_TERM_LABEL) {
+            sql_add(sql, " AND EXISTS (SELECT 1 FROM labels x WHERE x.kind = r.kind AND "
+                         "x.id = r.id AND x.key = ? AND x.value IN ");
+            sql_text(sql, t->label);
+            add_values(sql, q, i);
+            sql_add(sql, ")");
+        } else {
+            sql_add(sql, t->kind == STORE_TERM_TECHNIQUE ? " AND r.technique IN "
+                                                         : " AND r.status IN ");
+            add_values(sql, q, i);
+        }
+    }
+    if (q->since_ms > 0) {
+        sql_add(sql, " AND r.created >= ?");
+        sql_double(sql, (double)q->since_ms / 1000.0);
+    }
+    sql_add(sql, " ORDER BY %s.id LIMIT ?", k);
+    sql_int(sql, limit + 1); /* one more tells whether a next page exists */
+    if (sql->overflow) {
+        snprintf(err, errlen, "the list's question is too long");
+        goto out;
+    }
+    if (sqlite3_prepare_v2(db, sql->text, -1, &st, NULL) != SQLITE_OK) {
+        db_error(s, db, "read", err, errlen);
+        goto out;
+    }
+    sql_bind(sql, st);
+    int rows = 0, rc;
+    char last[RECORD_ID_LEN] = "";
+    struct store_row row;
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+        if (rows == limit) {
+            snprintf(next, RECORD_ID_LEN, "%s", last);
+            break;
+        }
+        store_row_init(&row, q->kind);
+        read_row(s, st, false, &row);
+        row.labels = column_json(st, 10);
+        row.figures = column_json(st, 11);
+        row.extra = column_json(st, 13);
+        snprintf(last, sizeof(last), "%s", row.id);
+        fn(ctx, &row);
+        store_row_finish(&row);
+        rows++;
+    }
+    ok = rc == SQLITE_ROW || rc == SQLITE_DONE;
+    if (!ok)
+        db_error(s, db, "read", err, errlen);
+out:
+    if (!ok)
+        LOG(LOG_ERROR, "store: list of %s: %s", KIND_DIRS[q->kind], err);
+    sqlite3_finalize(st);
+    free(sql);
+    reader_give(s, db);
+    return ok;
+}
+
+bool store_count(struct store *s, enum store_kind kind, size_t counts[JOB_STATUS_COUNT])
+{
+    memset(counts, 0, JOB_STATUS_COUNT * sizeof(counts[0]));
+    sqlite3 *db = reader_take(s);
+    if (!db)
+        return false;
+    sqlite3_stmt *st = NULL;
+    int rc = SQLITE_ERROR;
+    if (sqlite3_prepare_v2(db, "SELECT status, count(*) FROM records WHERE kind = ? GROUP BY status",
+                           -1, &st, NULL) == SQLITE_OK) {
+        sqlite3_bind_int(st, 1, kind);
+        while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+            enum job_status status;
+            if (job_status_parse((const char *)sqlite3_column_text(st, 0), &status))
+                counts[status] = (size_t)sqlite3_column_int64(st, 1);
+        }
+    }
+    sqlite3_finalize(st);
+    reader_give(s, db);
+    return rc == SQLITE_DONE;
+}
+
+bool store_each_unfinished(struct store *s, enum store_kind kind, store_row_fn fn, void *ctx)
+{
+    sqlite3 *db = reader_take(s);
+    if (!db)
+        return false;
+    sqlite3_stmt *st = NULL;
+    struct store_row *rows = NULL;
+    size_t n = 0, cap = 0;
+    int rc = SQLITE_ERROR;
+    /* Read them all first: fn may write, which a store in memory (one
+     * connection) cannot do while this read is open. */
+    if (sqlite3_prepare_v2(db, "SELECT " ROW_COLUMNS ROW_JSON_COLUMNS " FROM records WHERE "
+                           "kind = ? AND status IN ('queued', 'running') ORDER BY id",
+                           -1, &st, NULL) == SQLITE_OK) {
+        sqlite3_bind_int(st, 1, kind);
+        while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+            if (n == cap) {
+                size_t grown = cap ? cap * 2 : 16;
+                struct store_row *more = realloc(rows, grown * sizeof(*rows));
+                if (!more) {
+                    rc = SQLITE_NOMEM;
+                    break;
+                }
+                rows = more;
+                cap = grown;
+            }
+            store_row_init(&rows[n], kind);
+            read_row(s, st, true, &rows[n]);
+            n++;
+        }
+    }
+    if (rc != SQLITE_DONE) {
+        char err[PATH_MAX + 300];
+        db_error(s, db, "read", err, sizeof(err));
+        LOG(LOG_ERROR, "store: unfinished %s: %s", KIND_DIRS[kind], err);
+    }
+    sqlite3_finalize(st);
+    reader_give(s, db);
+    for (size_t i = 0; i < n; i++) {
+        if (rc == SQLITE_DONE)
+            fn(ctx, &rows[i]);
+        store_row_finish(&rows[i]);
+    }
+    free(rows);
+    return rc == SQLITE_DONE;
+}
+
+int store_retention_victims(struct store *s, enum store_kind kind, int keep, double keep_days,
+                            double now, char (*ids)[RECORD_ID_LEN], int max)
+{
+    if ((keep <= 0 && keep_days <= 0) || max <= 0)
+        return 0;
+    struct sql sql = {.n = 0};
+    /* Both rules read the index on (kind, finished) alone. */
+    sql_add(&sql, "SELECT id, finished FROM (");
+    if (keep > 0) {
+        sql_add(&sql, "SELECT id, finished FROM (SELECT id, finished FROM records WHERE kind = ? "
+                      "AND finished > 0 ORDER BY finished DESC, id DESC LIMIT -1 OFFSET ?)");
+        sql_int(&sql, kind);
+        sql_int(&sql, keep);
+    }
+    if (keep_days > 0) {
+        sql_add(&sql, "%sSELECT id, finished FROM records WHERE kind = ? AND finished > 0 AND "
+                      "finished < ?", keep > 0 ? " UNION " : "");
+        sql_int(&sql, kind);
+        sql_double(&sql, now - keep_days * 86400.0);
+    }
+    sql_add(&sql, ") ORDER BY finished, id LIMIT ?");
+    sql_int(&sql, max);
+    sqlite3 *db = reader_take(s);
+    if (!db)
+        return -1;
+    sqlite3_stmt *st = NULL;
+    int n = 0, rc = SQLITE_ERROR;
+    if (sqlite3_prepare_v2(db, sql.text, -1, &st, NULL) == SQLITE_OK) {
+        sql_bind(&sql, st);
+        while (n < max && (rc = sqlite3_step(st)) == SQLITE_ROW)
+            column_copy(st, 0, ids[n++], RECORD_ID_LEN);
+        if (rc == SQLITE_ROW)
+            rc = SQLITE_DONE;
+    }
+    if (rc != SQLITE_DONE) {
+        char err[PATH_MAX + 300];
+        db_error(s, db, "read", err, sizeof(err));
+        LOG(LOG_ERROR, "store: retention of %s: %s", KIND_DIRS[kind], err);
+        n = -1;
+    }
+    sqlite3_finalize(st);
+    reader_give(s, db);
+    return n;
+}
+
+/* Under the write lock. */
+static bool run_each(struct store *s, const char *sql, enum store_kind kind,
+                     char (*ids)[RECORD_ID_LEN], int n)
+{
+    sqlite3_stmt *st = NULL;
+    bool ok = sqlite3_prepare_v2(s->writer, sql, -1, &st, NULL) == SQLITE_OK;
+    for (int i = 0; ok && i < n; i++) {
+        sqlite3_bind_int(st, 1, kind);
+        sqlite3_bind_text(st, 2, ids[i], -1, SQLITE_STATIC);
+        ok = sqlite3_step(st) == SQLITE_DONE;
+        sqlite3_reset(st);
+    }
+    sqlite3_finalize(st);
+    return ok;
+}
+
+static bool clear_notes(struct store *s, enum store_kind kind, char (*ids)[RECORD_ID_LEN], int n)
+{
+    pthread_mutex_lock(&s->write_lock);
+    bool ok = sqlite3_exec(s->writer, "BEGIN IMMEDIATE", NULL, NULL, NULL) == SQLITE_OK &&
+              run_each(s, "DELETE FROM removals WHERE kind = ? AND id = ?", kind, ids, n) &&
+              sqlite3_exec(s->writer, "COMMIT", NULL, NULL, NULL) == SQLITE_OK;
+    if (!ok && !sqlite3_get_autocommit(s->writer))
+        sqlite3_exec(s->writer, "ROLLBACK", NULL, NULL, NULL);
+    pthread_mutex_unlock(&s->write_lock);
+    return ok;
+}
+
+static void remove_dirs(struct store *s, enum store_kind kind, char (*ids)[RECORD_ID_LEN], int n)
+{
+    for (int i = 0; i < n && !s->memory; i++) {
+        char dir[PATH_MAX + RECORD_ID_LEN + 2];
+        snprintf(dir, sizeof(dir), "%s/%s", s->kinds[kind].root, ids[i]);
+        if (access(dir, F_OK) == 0)
+            record_remove_dir(dir);
+    }
+}
+
+bool store_remove(struct store *s, enum store_kind kind, char (*ids)[RECORD_ID_LEN], int n)
+{
+    if (n <= 0)
+        return true;
+    pthread_mutex_lock(&s->write_lock);
+    bool ok = sqlite3_exec(s->writer, "BEGIN IMMEDIATE", NULL, NULL, NULL) == SQLITE_OK &&
+              run_each(s, "INSERT OR IGNORE INTO removals (kind, id) VALUES (?, ?)", kind, ids,
+                       n) &&
+              run_each(s, "DELETE FROM records WHERE kind = ? AND id = ?", kind, ids, n) &&
+              run_each(s, "DELETE FROM labels WHERE kind = ? AND id = ?", kind, ids, n) &&
+              sqlite3_exec(s->writer, "COMMIT", NULL, NULL, NULL) == SQLITE_OK;
+    if (!ok) {
+        char err[PATH_MAX + 300];
+        db_error(s, s->writer, "write", err, sizeof(err));
+        LOG(LOG_ERROR, "retention: %s; nothing removed", err);
+        if (!sqlite3_get_autocommit(s->writer))
+            sqlite3_exec(s->writer, "ROLLBACK", NULL, NULL, NULL);
+    }
+    pthread_mutex_unlock(&s->write_lock);
+    if (!ok)
+        return false;
+    /* Files are removed with no lock held. */
+    remove_dirs(s, kind, ids, n);
+    return clear_notes(s, kind, ids, n);
+}
+
+/* store_open: removals a stop cut short between the rows and the files. */
+static void reap_noted(struct store *s)
+{
+    for (int kind = 0; kind < STORE_KINDS; kind++) {
+        char(*ids)[RECORD_ID_LEN] = NULL;
+        int n = 0, cap = 0;
+        sqlite3 *db = reader_take(s);
+        sqlite3_stmt *st = NULL;
+        if (db && sqlite3_prepare_v2(db, "SELECT id FROM removals WHERE kind = ?", -1, &st, NULL) ==
+                      SQLITE_OK) {
+            sqlite3_bind_int(st, 1, kind);
+            while (sqlite3_step(st) == SQLITE_ROW) {
+                if (n == cap) {
+                    int grown = cap ? cap * 2 : 64;
+                    char(*more)[RECORD_ID_LEN] = realloc(ids, (size_t)grown * RECORD_ID_LEN);
+                    if (!more)
+                        break;
+                    ids = more;
+                    cap = grown;
+                }
+                column_copy(st, 0, ids[n++], RECORD_ID_LEN);
+            }
+        }
+        sqlite3_finalize(st);
+        if (db)
+            reader_give(s, db);
+        if (n) {
+            LOG(LOG_INFO, "store: finishing the removal of %d %s", n, KIND_DIRS[kind]);
+            remove_dirs(s, (enum store_kind)kind, ids, n);
+            clear_notes(s, (enum store_kind)kind, ids, n);
+        }
+        free(ids);
+    }
+}
+
+/* store_import's scan: which directories have rows, and the batch. */
+struct import {
+    struct store *s;
+    enum store_kind kind;
+    const char *legacy_file;
+    store_import_fn fn;
+    void *ctx;
+    char (*known)[RECORD_ID_LEN];
+    size_t nknown;
+    struct store_row *batch;
+    size_t nbatch;
+    int imported;
+    bool failed;
+    char err[PATH_MAX + 300];
+};
+
+static int by_id(const void *a, const void *b) { return strcmp(a, b); }
+
+static bool import_known(void *ctx, const char *id)
+{
+    struct import *im = ctx;
+    return im->nknown && bsearch(id, im->known, im->nknown, RECORD_ID_LEN, by_id) != NULL;
+}
+
+/* Commits the batch, then removes the legacy state files it replaced. */
+static void import_flush(struct import *im)
+{
+    struct store *s = im->s;
+    if (!im->nbatch)
+        return;
+    pthread_mutex_lock(&s->write_lock);
+    bool ok = sqlite3_exec(s->writer, "BEGIN IMMEDIATE", NULL, NULL, NULL) == SQLITE_OK;
+    for (size_t i = 0; ok && i < im->nbatch; i++)
+        ok = put_locked(s, &im->batch[i]);
+    ok = ok && sqlite3_exec(s->writer, "COMMIT", NULL, NULL, NULL) == SQLITE_OK;
+    if (!ok) {
+        db_error(s, s->writer, "write", im->err, sizeof(im->err));
+        if (!sqlite3_get_autocommit(s->writer))
+            sqlite3_exec(s->writer, "ROLLBACK", NULL, NULL, NULL);
+        im->failed = true;
+    }
+    pthread_mutex_unlock(&s->write_lock);
+    for (size_t i = 0; i < im->nbatch; i++) {
+        if (ok && im->legacy_file && !im->batch[i].dir_given) {
+            char path[PATH_MAX + 64];
+            snprintf(path, sizeof(path), "%s/%s", im->batch[i].dir, im->legacy_file);
+            if (unlink(path) != 0 && errno != ENOENT)
+                LOG(LOG_WARN, "store: cannot remove the imported %s: %s", path, strerror(errno));
+        }
+        store_row_finish(&im->batch[i]);
+    }
+    if (ok)
+        im->imported += (int)im->nbatch;
+    im->nbatch = 0;
+}
+
+static void import_one(void *ctx, const char *id, const char *dir)
+{
+    struct import *im = ctx;
+    if (im->failed)
+        return;
+    struct store_row *row = &im->batch[im->nbatch];
+    store_row_init(row, im->kind);
+    snprintf(row->id, sizeof(row->id), "%s", id);
+    snprintf(row->dir, sizeof(row->dir), "%s", dir);
+    if (!im->fn(im->ctx, id, dir, row)) {
+        store_row_finish(row);
+        return;
+    }
+    /* The import names the record by its directory, whatever it set. */
+    snprintf(row->id, sizeof(row->id), "%s", id);
+    snprintf(row->dir, sizeof(row->dir), "%s", dir);
+    row->dir_given = false;
+    record_note_id(&im->s->kinds[im->kind], id);
+    if (++im->nbatch == STORE_BATCH)
+        import_flush(im);
+}
+
+int store_import(struct store *s, enum store_kind kind, const char *legacy_file,
+                 store_import_fn import, void *ctx, char *err, size_t errlen)
+{
+    if (s->memory)
+        return 0;
+    struct import im = {.s = s, .kind = kind, .legacy_file = legacy_file, .fn = import, .ctx = ctx};
+    im.batch = calloc(STORE_BATCH, sizeof(*im.batch));
+    if (!im.batch) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    /* The ids with rows, sorted, so that each directory is looked up
+     * without a query and a known one is never opened. */
+    sqlite3 *db = reader_take(s);
+    sqlite3_stmt *st = NULL;
+    size_t cap = 0;
+    int rc = SQLITE_ERROR;
+    if (db && sqlite3_prepare_v2(db, "SELECT id FROM records WHERE kind = ? ORDER BY id", -1, &st,
+                                 NULL) == SQLITE_OK) {
+        sqlite3_bind_int(st, 1, kind);
+        while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+            if (im.nknown == cap) {
+                size_t grown = cap ? cap * 2 : 1024;
+                char(*more)[RECORD_ID_LEN] = realloc(im.known, grown * RECORD_ID_LEN);
+                if (!more) {
+                    rc = SQLITE_NOMEM;
+                    break;
+                }
+                im.known = more;
+                cap = grown;
+            }
+            column_copy(st, 0, im.known[im.nknown++], RECORD_ID_LEN);
+        }
+    }
+    if (rc != SQLITE_DONE)
+        db_error(s, db, "read", err, errlen);
+    sqlite3_finalize(st);
+    if (db)
+        reader_give(s, db);
+    int n = -1;
+    if (rc == SQLITE_DONE) {
+        /* SQLite's order is memcmp's, as strcmp's: bsearch agrees with it. */
+        n = record_scan(&s->kinds[kind], import_known, import_one, &im, err, errlen);
+        import_flush(&im);
+        if (im.failed) {
+            snprintf(err, errlen, "%s", im.err);
+            n = -1;
+        } else if (n >= 0) {
+            n = im.imported;
+        }
+    }
+    free(im.known);
+    free(im.batch);
+    return n;
+}

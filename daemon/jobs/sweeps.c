@@ -66,6 +66,19 @@ static void apply_retention(struct sweeps *s);
 
 static bool sweep_finished(const struct sweep *sw) { return job_status_finished(sw->status); }
 
+/* Points that ran to an end of their own: a point the sweep's cancel
+ * stopped has a row (status "cancelled") but is not done. */
+static size_t points_done(const struct sweep *sw)
+{
+    size_t i, done = 0;
+    json_t *row;
+    json_array_foreach(sw->points, i, row) {
+        const char *status = json_string_value(json_object_get(row, "status"));
+        done += !status || strcmp(status, "cancelled") != 0;
+    }
+    return done;
+}
+
 /* What GET /v1/sweeps/ID shows of a sweep, live or stored alike; the table
  * and result are the caller's to copy. */
 static json_t *sweep_json(const char *id, const char *kind, enum job_status status, size_t done,
@@ -100,7 +113,7 @@ static const char *kind_name(const struct sweep *sw)
 /* A deep copy: the sweep thread keeps appending to the live table. */
 static json_t *live_json_locked(const struct sweep *sw, bool full)
 {
-    return sweep_json(sw->id, kind_name(sw), sw->status, json_array_size(sw->points),
+    return sweep_json(sw->id, kind_name(sw), sw->status, points_done(sw),
                       sw->spec.npoints, sw->current_job, sw->spec.thesis, sw->error, sw->body,
                       sw->points, sw->result, full);
 }
@@ -116,7 +129,7 @@ static void row_of_locked(const struct sweep *sw, struct store_row *row)
     row->created = sw->created;
     row->started = sw->started;
     row->finished = sw->finished;
-    row->done = (int)json_array_size(sw->points);
+    row->done = (int)points_done(sw);
     row->total = (int)sw->spec.npoints;
     snprintf(row->error, sizeof(row->error), "%s", sw->error);
     row->spec = json_deep_copy(sw->body);
@@ -447,6 +460,10 @@ static void run_sweep(struct sweeps *s, struct sweep *sw)
             }
             add_row(s, sw, point_row(job, values));
             json_decref(job);
+            /* Cancelled while its last point ran: the point is in the table,
+             * cancelled, and the sweep is not done. */
+            if (atomic_load(&sw->cancel))
+                ok = false;
         }
         if (ok)
             result = vary_result(sw);

@@ -164,10 +164,14 @@ try:
     check(api("DELETE", "/v1/sweeps/%s" % sid)[0] in (200, 202), "the sweep is cancelled")
     s = wait_sweep(sid)
     html = d.request("GET", "/v1/sweeps/%s/report.html" % sid, headers=AUTH)[2].decode()
-    # (The sweep's own status may read "done" when the cancel lands on its
-    # last point: sweeps.c counts the cancelled point job as finished. The
-    # report goes by its rows, so it is partial either way.)
-    check(s.get("status") in ("cancelled", "done") and "A partial sweep" in html and
+    # The cancel lands on the sweep's last point (one of a million frames):
+    # the sweep is cancelled, not done, and that point is not counted done.
+    ran = [p for p in s.get("points", []) if p.get("status") != "cancelled"]
+    check(s.get("status") == "cancelled" and
+          s.get("progress", {}).get("points_done") == len(ran) == 1,
+          "a sweep cancelled during its last point is cancelled, its cancelled point not done: "
+          "%s %s" % (s.get("status"), s.get("progress")))
+    check("A partial sweep" in html and
           "Not measured" in html,
           "a cancelled sweep's report says it is partial and names the point it lacks: %s %s"
           % (s.get("status"), [(p.get("values"), p.get("status")) for p in s.get("points", [])]))

@@ -24,6 +24,8 @@
 #include "daemon/service.h"
 #include "daemon/jobs/sweeps.h"
 #include "daemon/techniques/catalog.h"
+#include "daemon/techniques/technique.h"
+#include "daemon/effects/effect_info.h"
 
 struct options {
     char listen[256];
@@ -317,7 +319,7 @@ static int list_devices(void)
     return 0;
 }
 
-static int run_once(const struct options *o)
+static int run_once(const struct options *o, const struct technique_catalog *catalog)
 {
     size_t len = 0;
     char *text = fs_read_file(o->once, JOB_MAX_BODY_BYTES + 1, &len);
@@ -328,7 +330,7 @@ static int run_once(const struct options *o)
     struct job_spec spec;
     struct job_error jerr;
     bool ok = len <= JOB_MAX_BODY_BYTES &&
-              job_spec_parse_text(text, len, technique_catalog(), &spec, &jerr);
+              job_spec_parse_text(text, len, catalog, &spec, &jerr);
     free(text);
     if (!ok) {
         if (len > JOB_MAX_BODY_BYTES)
@@ -378,7 +380,11 @@ static int run_once(const struct options *o)
     return rc;
 }
 
-static int serve(const struct options *o)
+/* The render thread as the HTTP layer sees it (http.h). */
+static bool render_alive(void *r) { return runner_alive(r); }
+static json_t *render_device_json(void *r) { return runner_device_json(r); }
+
+static int serve(const struct options *o, const struct technique_catalog *catalog)
 {
     char state_dir[PATH_MAX], token[HTTP_MAX_TOKEN_BYTES + 1] = "";
     const char *env = getenv("STATE_DIRECTORY");
@@ -427,7 +433,7 @@ static int serve(const struct options *o)
     queue_set_retention(q, o->keep_jobs, o->keep_days);
     /* Earlier jobs first: finished ones are served from the store, queued
      * ones run. */
-    int loaded = queue_load(q, technique_catalog(), err, sizeof(err));
+    int loaded = queue_load(q, catalog, err, sizeof(err));
     if (loaded < 0) {
         LOG(LOG_ERROR, "%s", err);
         queue_destroy(q);
@@ -444,9 +450,12 @@ static int serve(const struct options *o)
         return 1;
     }
     pin_loaded_modules();
-    struct sweeps *sweeps = sweeps_create(q, technique_catalog());
+    struct sweeps *sweeps = sweeps_create(q, catalog);
+    const struct http_context http_ctx = {.catalog = catalog, .queue = q, .sweeps = sweeps,
+                                          .render_alive = render_alive,
+                                          .device_json = render_device_json, .render = r};
     struct http_server *http =
-        sweeps ? http_server_create(o->listen, &limits, q, r, sweeps, err, sizeof(err)) : NULL;
+        sweeps ? http_server_create(o->listen, &limits, &http_ctx, err, sizeof(err)) : NULL;
     if (!http) {
         LOG(LOG_ERROR, "%s", sweeps ? err : "cannot start the sweep thread");
         sweeps_destroy(sweeps);
@@ -492,9 +501,13 @@ static int serve(const struct options *o)
 int main(int argc, char **argv)
 {
     /* Built before any thread starts, then read-only: every registered
-     * technique checked once. */
-    if (!technique_catalog()) {
-        fprintf(stderr, "shadebenchd: %s\n", technique_catalog_error());
+     * technique and effect checked once. */
+    static struct technique_catalog catalog;
+    char catalog_err[256];
+    if (!technique_catalog_init(&catalog, catalog_err, sizeof(catalog_err)) ||
+        !technique_registry_check(catalog_err, sizeof(catalog_err)) ||
+        !effect_registry_check(catalog_err, sizeof(catalog_err))) {
+        fprintf(stderr, "shadebenchd: %s\n", catalog_err);
         return 1;
     }
     /* Measurement integrity: glibc raises its mmap and trim thresholds as it
@@ -588,7 +601,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "shadebenchd: --once needs --out DIR\n");
             return 2;
         }
-        return run_once(&o);
+        return run_once(&o, &catalog);
     }
-    return serve(&o);
+    return serve(&o, &catalog);
 }

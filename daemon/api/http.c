@@ -28,7 +28,6 @@
 #include "daemon/quality/metrics.h"
 #include "daemon/api/job_filter.h"
 #include "daemon/jobs/sweep_spec.h"
-#include "daemon/techniques/catalog.h"
 #include "common/result_keys.h"
 
 #ifndef MHD_HTTP_CONTENT_TOO_LARGE
@@ -60,8 +59,8 @@ enum { NCODES = sizeof(COUNTED_CODES) / sizeof(COUNTED_CODES[0]) };
 struct http_server {
     struct MHD_Daemon *mhd;
     struct connections *conns;
-    struct queue *queue;
-    struct runner *runner;
+    struct http_context ctx;
+    struct queue *queue; /* ctx.queue and ctx.sweeps, the handlers' most used */
     struct sweeps *sweeps;
     struct http_limits limits;
     int port;
@@ -251,15 +250,15 @@ static json_t *info_json(struct http_server *s)
     double total;
     json_t *memory = memory_json(s, &total);
     /* From the GL-free catalogue: HTTP threads never touch GL. */
-    json_t *techs = technique_catalog_json(technique_catalog());
+    json_t *techs = technique_catalog_json(s->ctx.catalog);
     const struct http_limits *l = &s->limits;
     return json_pack("{s:s, s:s, s:s, s:o, s:o, s:o, s:o, s:o, s:{s:i, s:i, s:i, s:I, s:I, s:f, "
                      "s:f, s:I, s:f, s:I, s:I}}",
                      "name", "shadebenchd", "version", PACKAGE_VERSION, "api", "v1", "memory",
                      memory, "device",
-                     runner_device_json(s->runner), "techniques", techs,
+                     s->ctx.device_json(s->ctx.render), "techniques", techs,
                      "effects", effect_catalog_json(), /* post hook: look.post's effects */
-                     "sweepable", sweep_params_json(technique_catalog()), "limits",
+                     "sweepable", sweep_params_json(s->ctx.catalog), "limits",
                      "max_body_bytes", JOB_MAX_BODY_BYTES, "max_queued_jobs",
                      queue_max_queued(s->queue), "max_wait_s", MAX_WAIT_S, "max_connections",
                      (json_int_t)l->max_connections, "max_connections_per_ip",
@@ -356,7 +355,7 @@ static enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *
 {
     struct job_spec spec;
     struct job_error err;
-    if (!job_spec_parse_text(req->body ? req->body : "", req->len, technique_catalog(),
+    if (!job_spec_parse_text(req->body ? req->body : "", req->len, s->ctx.catalog,
                              &spec, &err))
         return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
     char id[24];
@@ -608,7 +607,7 @@ static enum MHD_Result job_resource(struct http_server *s, struct MHD_Connection
             json_decref(job);
             return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
         }
-        json_t *device = runner_device_json(s->runner);
+        json_t *device = s->ctx.device_json(s->ctx.render);
         size_t len = 0;
         char *html = report_job_html(job, dir, device, &len);
         json_decref(device);
@@ -657,7 +656,7 @@ static enum MHD_Result post_sweep(struct http_server *s, struct MHD_Connection *
     }
     struct sweep_spec spec;
     struct job_error err;
-    if (!sweep_spec_parse(body, technique_catalog(), &spec, &err)) {
+    if (!sweep_spec_parse(body, s->ctx.catalog, &spec, &err)) {
         sweep_spec_finish(&spec);
         json_decref(body);
         return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
@@ -715,11 +714,11 @@ static enum MHD_Result sweep_resource(struct http_server *s, struct MHD_Connecti
         return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such sweep");
     enum MHD_Result ret;
     if (r->kind == ROUTE_SWEEP_CHART) {
-        json_t *device = runner_device_json(s->runner);
+        json_t *device = s->ctx.device_json(s->ctx.render);
         ret = respond_chart(c, sw, r, true, device);
         json_decref(device);
     } else {
-        json_t *device = runner_device_json(s->runner);
+        json_t *device = s->ctx.device_json(s->ctx.render);
         size_t len = 0;
         char *html = report_sweep_html(sw, device, point_job_dir, s, &len);
         json_decref(device);
@@ -735,7 +734,7 @@ static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
     bool post = strcmp(method, "POST") == 0;
     switch (req->route.kind) {
     case ROUTE_HEALTHZ:
-        if (!runner_alive(s->runner))
+        if (!s->ctx.render_alive(s->ctx.render))
             return respond_json(c, MHD_HTTP_SERVICE_UNAVAILABLE,
                                 json_pack("{s:s}", "status", "render thread is not running"));
         return respond_json(c, MHD_HTTP_OK, json_pack("{s:s}", "status", "ok"));
@@ -929,8 +928,8 @@ static void on_mhd_log(void *cls, const char *fmt, va_list ap)
 }
 
 struct http_server *http_server_create(const char *listen, const struct http_limits *limits,
-                                       struct queue *q, struct runner *r,
-                                       struct sweeps *sweeps, char *err, size_t errlen)
+                                       const struct http_context *ctx, char *err,
+                                       size_t errlen)
 {
     char host[256];
     const char *colon = strrchr(listen, ':');
@@ -968,9 +967,9 @@ struct http_server *http_server_create(const char *listen, const struct http_lim
         snprintf(err, errlen, "out of memory");
         return NULL;
     }
-    s->queue = q;
-    s->runner = r;
-    s->sweeps = sweeps;
+    s->ctx = *ctx;
+    s->queue = ctx->queue;
+    s->sweeps = ctx->sweeps;
     s->limits = *limits;
     pthread_mutex_init(&s->token_lock, NULL);
     struct connections_config cc = {.header_s = limits->header_timeout_s,
@@ -1004,16 +1003,10 @@ struct http_server *http_server_create(const char *listen, const struct http_lim
         free(s);
         return NULL;
     }
-    queue_set_listener(q, on_queue_change, s->conns);
+    queue_set_listener(s->queue, on_queue_change, s->conns);
     const union MHD_DaemonInfo *info = MHD_get_daemon_info(s->mhd, MHD_DAEMON_INFO_BIND_PORT);
     s->port = info ? info->port : (int)port;
     return s;
-}
-
-void http_server_stop_waits(struct http_server *s)
-{
-    if (s)
-        connections_stop(s->conns, STOP_GRACE_S);
 }
 
 void http_server_destroy(struct http_server *s)

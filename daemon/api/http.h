@@ -9,9 +9,11 @@
 #include <stdbool.h>
 #include <stddef.h>
 
-#include "daemon/harness/runner.h"
+#include <jansson.h>
+
 #include "daemon/jobs/queue.h"
 #include "daemon/jobs/sweeps.h"
+#include "daemon/techniques/catalog.h"
 
 /* The longest bearer token accepted (a longer one is refused at load). */
 #define HTTP_MAX_TOKEN_BYTES 4096
@@ -27,17 +29,29 @@ struct http_limits {
 
 void http_limits_defaults(struct http_limits *l);
 
+/* What the API serves, handed in by its owner (main, or a unit test with a
+ * render thread of its own making): everything outlives the server. */
+struct http_context {
+    const struct technique_catalog *catalog; /* jobs and sweeps are parsed against it */
+    struct queue *queue;
+    struct sweeps *sweeps;
+    /* The render thread as the API sees it, without GL: whether it still
+     * runs (/healthz) and its device strings (/v1/info, reports; a new
+     * reference). Called from the HTTP threads. */
+    bool (*render_alive)(void *render);
+    json_t *(*device_json)(void *render);
+    void *render;
+};
+
 struct http_server;
 
 /* listen is "HOST:PORT" or "[V6]:PORT"; port 0 picks a free one. */
 struct http_server *http_server_create(const char *listen, const struct http_limits *limits,
-                                       struct queue *q, struct runner *r,
-                                       struct sweeps *sweeps, char *err, size_t errlen);
+                                       const struct http_context *ctx, char *err,
+                                       size_t errlen);
 /* Ends every wait at once with a "stopping" answer (new waits are refused)
  * and gives those answers a moment to go out; then MHD stops. Accepts NULL. */
 void http_server_destroy(struct http_server *s);
-/* Only the first half of destroy: waits end, serving goes on. Accepts NULL. */
-void http_server_stop_waits(struct http_server *s);
 
 /* When token is non-empty, every endpoint but /healthz needs
  * "Authorization: Bearer <token>". Safe to call while serving (SIGHUP).

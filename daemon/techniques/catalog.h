@@ -5,8 +5,8 @@
  * registered techniques, for the job parser, sweeps, reports and /v1/info,
  * which take it as a parameter and never name a technique. main builds it
  * once with technique_catalog_init before any thread starts and hands it
- * to the HTTP server and the store; a unit test builds the same one without
- * GL. Read-only once built: any thread. */
+ * to the HTTP server, the queue and the sweeps; a unit test builds the same
+ * one without GL. Read-only once built: any thread. */
 
 #include <jansson.h>
 #include <stdbool.h>
@@ -46,14 +46,5 @@ json_t *technique_catalog_json(const struct technique_catalog *c);
  * the path names no option of a catalogued technique. */
 const struct opt_field *technique_catalog_option(const struct technique_catalog *c,
                                                  const char *path);
-
-/* The daemon's catalogue, built on the first call (which main makes before
- * any thread starts) and checked against the GL registries; NULL when a
- * registered technique or effect fails its checks (err says which). Defined
- * by the GL registry: only for main and http.c, until main builds the
- * catalogue itself with technique_catalog_init and hands it over. */
-const struct technique_catalog *technique_catalog(void);
-/* Why technique_catalog() returned NULL. */
-const char *technique_catalog_error(void);
 
 #endif

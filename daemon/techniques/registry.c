@@ -70,21 +70,3 @@ bool technique_registry_check(char *err, size_t errlen)
     }
     return true;
 }
-
-static struct technique_catalog catalog;
-static bool catalog_built;
-static char catalog_error[256];
-
-const struct technique_catalog *technique_catalog(void)
-{
-    if (!catalog_built) {
-        catalog_built = true;
-        if (!technique_catalog_init(&catalog, catalog_error, sizeof(catalog_error)) ||
-            !technique_registry_check(catalog_error, sizeof(catalog_error)) ||
-            !effect_registry_check(catalog_error, sizeof(catalog_error)))
-            return NULL;
-    }
-    return catalog_error[0] ? NULL : &catalog;
-}
-
-const char *technique_catalog_error(void) { return catalog_error; }

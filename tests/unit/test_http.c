@@ -1,0 +1,300 @@
+/* The HTTP layer without GL: a real server on a loopback port over a real
+ * store in a temporary directory, handed the real technique catalogue and a
+ * render thread of the test's own (which takes jobs from the queue and
+ * finishes them with a made-up result), asked with plain sockets. */
+#define _POSIX_C_SOURCE 200809L
+#include <arpa/inet.h>
+#include <jansson.h>
+#include <limits.h>
+#include <netinet/in.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include "check.h"
+#include "common/fsutil.h"
+#include "common/job_files.h"
+#include "common/log.h"
+#include "daemon/api/http.h"
+#include "daemon/jobs/store.h"
+
+static atomic_bool render_up = true;
+
+static bool fake_alive(void *render)
+{
+    (void)render;
+    return atomic_load(&render_up);
+}
+
+static json_t *fake_device(void *render)
+{
+    (void)render;
+    return json_pack("{s:s}", "gl_renderer", "test renderer");
+}
+
+struct reply {
+    int status;
+    char *body; /* NUL-terminated */
+    json_t *json;
+};
+
+static void reply_finish(struct reply *r)
+{
+    free(r->body);
+    json_decref(r->json);
+    memset(r, 0, sizeof(*r));
+}
+
+/* One request on a fresh connection; extra: more header lines, each ending
+ * in \r\n. */
+static struct reply request(int port, const char *method, const char *path, const char *body,
+                            const char *extra)
+{
+    struct reply r = {0};
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (fd < 0 || connect(fd, (struct sockaddr *)&a, sizeof(a)) != 0) {
+        if (fd >= 0)
+            close(fd);
+        return r;
+    }
+    size_t blen = body ? strlen(body) : 0;
+    char head[1024];
+    int n = snprintf(head, sizeof(head),
+                     "%s %s HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n"
+                     "Content-Length: %zu\r\n%s\r\n",
+                     method, path, blen, extra ? extra : "");
+    if (write(fd, head, (size_t)n) != n || (blen && write(fd, body, blen) != (ssize_t)blen)) {
+        close(fd);
+        return r;
+    }
+    size_t cap = 1 << 16, used = 0;
+    char *buf = malloc(cap);
+    ssize_t got;
+    while (buf && (got = read(fd, buf + used, cap - used - 1)) > 0) {
+        used += (size_t)got;
+        if (cap - used < 4096) {
+            char *more = realloc(buf, cap *= 2);
+            if (!more)
+                break;
+            buf = more;
+        }
+    }
+    close(fd);
+    if (!buf)
+        return r;
+    buf[used] = '\0';
+    sscanf(buf, "HTTP/1.%*d %d", &r.status);
+    char *sep = strstr(buf, "\r\n\r\n");
+    r.body = strdup(sep ? sep + 4 : "");
+    r.json = json_loads(r.body, 0, NULL);
+    free(buf);
+    return r;
+}
+
+static const char *error_field(const struct reply *r)
+{
+    return json_string_value(json_object_get(json_object_get(r->json, "error"), "field"));
+}
+
+static const char *str(const json_t *o, const char *key)
+{
+    return json_string_value(json_object_get(o, key));
+}
+
+static const char *JOB = "{\"technique\":\"unlit\",\"frames\":2,\"warmup_frames\":0,"
+                         "\"capture_interval\":2,\"scene\":{\"width\":16,\"height\":16}}";
+
+/* The test's render thread: one job from the queue, finished with a result
+ * naming one capture, as the harness would leave it. */
+static void finish_next(struct queue *q, const char *expect_id)
+{
+    struct job *job = queue_next(q);
+    CHECK(job && strcmp(job->id, expect_id) == 0);
+    if (!job)
+        return;
+    json_t *result = json_pack("{s:s, s:i, s:[{s:i, s:s}]}", "technique", "unlit", "frames", 2,
+                               "captures", "frame", 2, "file", "frame-000002.png");
+    char path[PATH_MAX + 32];
+    job_file_path(job->dir, JOB_FILE_RESULT, path, sizeof(path));
+    CHECK(fs_write_json_atomic(path, result));
+    job_file_path(job->dir, JOB_FILE_TIMINGS, path, sizeof(path));
+    CHECK(fs_write_atomic(path, "frame,gpu_ms\n1,1.0\n2,1.0\n", 25));
+    queue_finish(q, job, JOB_DONE, NULL, result);
+}
+
+int main(void)
+{
+    log_set_level(LOG_WARN);
+    char state[] = "/tmp/test_http-XXXXXX";
+    CHECK(mkdtemp(state) != NULL);
+    char err[PATH_MAX + 300];
+    struct technique_catalog catalog;
+    CHECK(technique_catalog_init(&catalog, err, sizeof(err)));
+    struct store *store = store_open(state, err, sizeof(err));
+    struct queue *q = store ? queue_create(store, 4) : NULL;
+    CHECK(q && queue_load(q, &catalog, err, sizeof(err)) == 0);
+    struct sweeps *sweeps = q ? sweeps_create(q, &catalog) : NULL;
+    CHECK(sweeps != NULL);
+    struct http_limits limits;
+    http_limits_defaults(&limits);
+    const struct http_context ctx = {.catalog = &catalog, .queue = q, .sweeps = sweeps,
+                                     .render_alive = fake_alive, .device_json = fake_device};
+    struct http_server *http = sweeps ? http_server_create("127.0.0.1:0", &limits, &ctx, err,
+                                                           sizeof(err))
+                                      : NULL;
+    CHECK(http != NULL);
+    if (!http)
+        return check_finish("test_http");
+    int port = http_server_port(http);
+    struct reply r;
+
+    /* /healthz follows the render thread. */
+    r = request(port, "GET", "/healthz", NULL, NULL);
+    CHECK(r.status == 200);
+    reply_finish(&r);
+    atomic_store(&render_up, false);
+    r = request(port, "GET", "/healthz", NULL, NULL);
+    CHECK(r.status == 503);
+    reply_finish(&r);
+    atomic_store(&render_up, true);
+
+    /* /v1/info: the catalogue handed in, every technique of it, and the device. */
+    r = request(port, "GET", "/v1/info", NULL, NULL);
+    json_t *techs = json_object_get(r.json, "techniques");
+    CHECK(r.status == 200 && json_array_size(techs) == (size_t)catalog.count);
+    for (int i = 0; i < catalog.count; i++)
+        CHECK(strcmp(str(json_array_get(techs, (size_t)i), "name"), catalog.infos[i]->name) == 0);
+    CHECK(strcmp(str(json_object_get(r.json, "device"), "gl_renderer"), "test renderer") == 0);
+    reply_finish(&r);
+
+    /* Rejections are JSON naming the field and the rule. */
+    r = request(port, "POST", "/v1/jobs", "{\"technique\":\"nope\"}", NULL);
+    CHECK(r.status == 400 && error_field(&r) && strcmp(error_field(&r), "technique") == 0);
+    CHECK(strstr(r.body, "unlit") != NULL); /* the rule lists the catalogue */
+    reply_finish(&r);
+    r = request(port, "POST", "/v1/jobs", "{\"technique\":", NULL);
+    CHECK(r.status == 400 && error_field(&r) != NULL);
+    reply_finish(&r);
+    r = request(port, "GET", "/v1/nothing", NULL, NULL);
+    CHECK(r.status == 404 && error_field(&r) != NULL);
+    reply_finish(&r);
+    r = request(port, "PUT", "/v1/jobs", JOB, NULL);
+    CHECK(r.status == 405 && error_field(&r) != NULL);
+    reply_finish(&r);
+    char *big = malloc(70 * 1024);
+    memset(big, ' ', 70 * 1024 - 1);
+    big[70 * 1024 - 1] = '\0';
+    r = request(port, "POST", "/v1/jobs", big, NULL);
+    CHECK(r.status == 413 && error_field(&r) != NULL);
+    reply_finish(&r);
+    free(big);
+    r = request(port, "POST", "/v1/sweeps", "{\"base\":{}, \"vary\":{\"frames\":[]}}", NULL);
+    CHECK(r.status == 400 && error_field(&r) != NULL);
+    reply_finish(&r);
+
+    /* Accepted jobs wait in the queue: nothing takes them until the test does. */
+    char ids[3][32] = {{0}};
+    for (int i = 0; i < 3; i++) {
+        r = request(port, "POST", "/v1/jobs", JOB, NULL);
+        CHECK(r.status == 202 && str(r.json, "id") && strcmp(str(r.json, "status"), "queued") == 0);
+        snprintf(ids[i], sizeof(ids[i]), "%s", str(r.json, "id") ? str(r.json, "id") : "");
+        reply_finish(&r);
+    }
+    char path[128];
+    snprintf(path, sizeof(path), "/v1/jobs/%s", ids[0]);
+    r = request(port, "GET", path, NULL, NULL);
+    CHECK(r.status == 200 && strcmp(str(r.json, "status"), "queued") == 0 &&
+          strcmp(str(r.json, "url"), path) == 0);
+    reply_finish(&r);
+    snprintf(path, sizeof(path), "/v1/jobs/%s/frames/2.png", ids[0]);
+    r = request(port, "GET", path, NULL, NULL);
+    CHECK(r.status == 409); /* files exist once the job is done */
+    reply_finish(&r);
+
+    /* A page of two, then the rest through next. */
+    r = request(port, "GET", "/v1/jobs?limit=2", NULL, NULL);
+    json_t *jobs = json_object_get(r.json, "jobs");
+    const char *next = str(r.json, "next");
+    CHECK(r.status == 200 && json_array_size(jobs) == 2 && next != NULL);
+    CHECK(json_array_size(jobs) == 2 && strcmp(str(json_array_get(jobs, 0), "id"), ids[0]) == 0 &&
+          strcmp(str(json_array_get(jobs, 1), "id"), ids[1]) == 0);
+    char next_path[512];
+    snprintf(next_path, sizeof(next_path), "%s", next ? next : "/");
+    reply_finish(&r);
+    r = request(port, "GET", next_path, NULL, NULL);
+    jobs = json_object_get(r.json, "jobs");
+    CHECK(r.status == 200 && json_array_size(jobs) == 1 && !json_object_get(r.json, "next") &&
+          json_array_size(jobs) == 1 && strcmp(str(json_array_get(jobs, 0), "id"), ids[2]) == 0);
+    reply_finish(&r);
+    r = request(port, "GET", "/v1/jobs?limit=0", NULL, NULL);
+    CHECK(r.status == 400 && error_field(&r) && strcmp(error_field(&r), "limit") == 0);
+    reply_finish(&r);
+    r = request(port, "GET", "/v1/jobs?colour=red", NULL, NULL);
+    CHECK(r.status == 400 && error_field(&r) != NULL);
+    reply_finish(&r);
+
+    /* The first job runs and finishes: its result, its links and its files. */
+    finish_next(q, ids[0]);
+    snprintf(path, sizeof(path), "/v1/jobs/%s?wait=5", ids[0]);
+    r = request(port, "GET", path, NULL, NULL);
+    json_t *capture = json_array_get(json_object_get(json_object_get(r.json, "result"), "captures"), 0);
+    char frame_url[128];
+    snprintf(frame_url, sizeof(frame_url), "/v1/jobs/%s/frames/2.png", ids[0]);
+    CHECK(r.status == 200 && strcmp(str(r.json, "status"), "done") == 0);
+    CHECK(str(capture, "url") && strcmp(str(capture, "url"), frame_url) == 0);
+    char timings_url[128];
+    snprintf(timings_url, sizeof(timings_url), "/v1/jobs/%s/%s", ids[0], JOB_FILE_TIMINGS);
+    CHECK(str(r.json, "timings_url") && strcmp(str(r.json, "timings_url"), timings_url) == 0);
+    reply_finish(&r);
+    r = request(port, "GET", timings_url, NULL, NULL);
+    CHECK(r.status == 200 && strncmp(r.body, "frame,gpu_ms", 12) == 0);
+    reply_finish(&r);
+    r = request(port, "GET", frame_url, NULL, NULL);
+    CHECK(r.status == 404 && error_field(&r) && strcmp(error_field(&r), "frame") == 0);
+    reply_finish(&r);
+
+    /* DELETE: a queued job is cancelled at once; a finished one is 409. */
+    snprintf(path, sizeof(path), "/v1/jobs/%s", ids[1]);
+    r = request(port, "DELETE", path, NULL, NULL);
+    CHECK(r.status == 200 && strcmp(str(r.json, "status"), "cancelled") == 0);
+    reply_finish(&r);
+    snprintf(path, sizeof(path), "/v1/jobs/%s", ids[0]);
+    r = request(port, "DELETE", path, NULL, NULL);
+    CHECK(r.status == 409);
+    reply_finish(&r);
+
+    /* /metrics counts the store's jobs by status, in Prometheus' text form. */
+    r = request(port, "GET", "/metrics", NULL, NULL);
+    CHECK(r.status == 200 && strstr(r.body, "# TYPE ") && strstr(r.body, "shadebench_"));
+    reply_finish(&r);
+
+    /* With a token, everything but /healthz needs it. */
+    CHECK(http_server_set_token(http, "s3cret"));
+    r = request(port, "GET", "/v1/info", NULL, NULL);
+    CHECK(r.status == 401 && error_field(&r) != NULL);
+    reply_finish(&r);
+    r = request(port, "GET", "/v1/info", NULL, "Authorization: Bearer wrong\r\n");
+    CHECK(r.status == 401);
+    reply_finish(&r);
+    r = request(port, "GET", "/v1/info", NULL, "Authorization: Bearer s3cret\r\n");
+    CHECK(r.status == 200);
+    reply_finish(&r);
+    r = request(port, "GET", "/healthz", NULL, NULL);
+    CHECK(r.status == 200);
+    reply_finish(&r);
+
+    http_server_destroy(http);
+    sweeps_destroy(sweeps);
+    queue_stop(q);
+    queue_destroy(q);
+    store_close(store);
+    char cmd[PATH_MAX + 16];
+    snprintf(cmd, sizeof(cmd), "rm -rf %s", state);
+    CHECK(system(cmd) == 0);
+    return check_finish("test_http");
+}

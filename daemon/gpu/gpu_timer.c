@@ -2,6 +2,8 @@
 
 #include <stdlib.h>
 
+#include "common/clock.h"
+
 struct ring_slot {
     GLuint queries[GPU_TIMER_MAX_SECTIONS];
     bool issued[GPU_TIMER_MAX_SECTIONS];
@@ -14,7 +16,8 @@ struct gpu_timer {
     int current; /* running section, -1 when none */
     struct ring_slot ring[GPU_TIMER_RING];
     double *ms; /* frames * sections */
-    int64_t stalls;
+    int64_t stalls, implausible;
+    double created_s; /* clock_mono_s */
 };
 
 struct gpu_timer *gpu_timer_create(int sections, int64_t frames)
@@ -31,6 +34,7 @@ struct gpu_timer *gpu_timer_create(int sections, int64_t frames)
     }
     t->sections = sections;
     t->frames = frames;
+    t->created_s = clock_mono_s();
     t->current = -1;
     for (int i = 0; i < GPU_TIMER_RING; i++) {
         glGenQueries(sections, t->ring[i].queries);
@@ -62,7 +66,12 @@ static void read_slot(struct gpu_timer *t, struct ring_slot *slot)
             t->stalls++;
         GLuint64 ns = 0;
         glGetQueryObjectui64v(slot->queries[s], GL_QUERY_RESULT, &ns);
-        t->ms[slot->frame * t->sections + s] = (double)ns / 1e6;
+        double ms = (double)ns / 1e6;
+        if (ms > (clock_mono_s() - t->created_s) * 1e3) {
+            t->implausible++;
+            ms = 0.0;
+        }
+        t->ms[slot->frame * t->sections + s] = ms;
     }
     slot->frame = -1;
 }
@@ -123,3 +132,29 @@ double gpu_timer_ms(const struct gpu_timer *t, int64_t f, int s)
 }
 
 int64_t gpu_timer_stalls(const struct gpu_timer *t) { return t->stalls; }
+
+int64_t gpu_timer_implausible(const struct gpu_timer *t) { return t->implausible; }
+
+void gpu_timer_prime(void)
+{
+    /* The query must enclose work: llvmpipe starts its clock at the first
+     * rendering it times. */
+    GLuint q, tex, fbo;
+    GLuint64 ns;
+    glGenQueries(1, &q);
+    glGenTextures(1, &tex);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA8, 4, 4);
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex, 0);
+    glBeginQuery(GL_TIME_ELAPSED, q);
+    glClear(GL_COLOR_BUFFER_BIT);
+    glEndQuery(GL_TIME_ELAPSED);
+    glGetQueryObjectui64v(q, GL_QUERY_RESULT, &ns);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteTextures(1, &tex);
+    glDeleteQueries(1, &q);
+}

@@ -266,6 +266,8 @@ json_t *outputs_write(struct harness_run *run)
                             outputs_stats_json(sec, (size_t)n));
     }
     json_object_set_new(result, "gpu_sections_ms", by_section);
+    json_object_set_new(result, "timer_query_implausible",
+                        json_integer((json_int_t)gpu_timer_implausible(run->timer)));
     json_object_set_new(result, "look", look_spec_to_json(&spec->look));
     json_object_set_new(result, RK_NONFINITE, nonfinite_summary(run));
     look_stages_describe(&run->stages, result);

@@ -12,6 +12,7 @@ bool harness_gl_init(struct harness_gl *g, char *err, size_t errlen)
 {
     gl_debug_install();
     gpu_caps_query(&g->caps);
+    gpu_timer_prime();
     const struct gl_stage stages[] = {
         {GL_VERTEX_SHADER, {"fullscreen.vert"}},
         {GL_FRAGMENT_SHADER, {"resolve.frag"}},

@@ -152,4 +152,19 @@ try:
     check(d.json("GET", "/healthz")[0] == 200, "daemon healthy after a GL failure")
 finally:
     testlib.stop_and_check(d)
+# The first timed frame of a fresh daemon, with no warm-up before it: its
+# GPU time is a real one (llvmpipe answered a context's first timer query
+# with the time since boot, 86 minutes into a frame of 30 ms).
+d = testlib.Daemon()
+try:
+    first = d.run({"technique": "forward", "frames": 3, "warmup_frames": 0,
+                   "scene": {"width": 32, "height": 32}})
+    r = first.get("result", {})
+    check(first["status"] == "done" and r.get("timer_query_implausible") == 0 and
+          r["gpu_ms"]["max"] <= r["wall_s_including_captures"] * 1e3,
+          "a fresh daemon's first frame has a plausible GPU time: %s ms in %s s, %s implausible"
+          % (r.get("gpu_ms", {}).get("max"), r.get("wall_s_including_captures"),
+             r.get("timer_query_implausible")))
+finally:
+    testlib.stop_and_check(d)
 testlib.finish("e2e_http")

@@ -6,9 +6,9 @@
 //     sqrt(1 - x² - y²), which loses its sign: seed 004's packing);
 //   GBUFFER_ALBEDO_RGBA8 (rgb, 8 bits a channel),
 //   GBUFFER_ALBEDO_PACK_SHIFT (r: seed 001's first packing of a colour into one
-//     float, channels scaled by powers of 1/255 and unpacked with fract),
-//   GBUFFER_ALBEDO_PACK_BASE10 (r: seed 001's second, three decimal digits a
-//     channel in one float).
+//     float, bytes shifted by powers of 255; a byte of 255 is kept to 254),
+//   GBUFFER_ALBEDO_PACK_BASE10 (r: seed 001's second, decimal digits a
+//     channel in one float: two, 100 levels, the most that fit a float).
 // A third plane holds the material: specular weight and exponent (rg), and
 // under LIGHTING_PBR metallic and roughness (ba), 32-bit floats: exact. Position is never stored: it is rebuilt from the
 // depth texture with the frame block's inverse view-projection.
@@ -52,12 +52,22 @@ vec3 gbuffer_decode_normal(vec4 g)
 vec4 gbuffer_encode_albedo(vec3 c)
 {
 #if defined(GBUFFER_ALBEDO_PACK_SHIFT)
-    // The seed's colours came from 8-bit textures: quantise as they were.
-    vec4 q = vec4(round(clamp(c, 0.0, 1.0) * 255.0) / 255.0, 1.0);
-    return vec4(dot(q, vec4(1.0, 1.0 / 255.0, 1.0 / 65025.0, 1.0 / 16581375.0)), 0.0, 0.0, 0.0);
+    // Seed 001's first packing: the channels' bytes "shifted" into one float
+    // by multiplication, r·255² + g·255 + b. As base-255 digits a byte can
+    // be 254 at most (a channel of 1.0 carried into the next digit, which
+    // the seed's fract() unpacking turned into 0: white came out black), and
+    // the sum is an integer below 2²⁴, which a float holds exactly (the
+    // seed's fractions of 1/255 powers, with alpha as a fourth byte, did
+    // not).
+    vec3 q = min(round(clamp(c, 0.0, 1.0) * 255.0), 254.0);
+    return vec4(q.r * 65025.0 + q.g * 255.0 + q.b, 0.0, 0.0, 0.0);
 #elif defined(GBUFFER_ALBEDO_PACK_BASE10)
-    vec3 d = round(clamp(c, 0.0, 1.0) * 999.0);
-    return vec4(d.r * 1000000.0 + d.g * 1000.0 + d.b, 0.0, 0.0, 0.0);
+    // Seed 001's second packing: decimal digits a channel in one float. The
+    // seed's three digits a channel need 30 bits, so wherever red was large
+    // the float's 24-bit mantissa dropped blue and carried into green (white
+    // came out red); two digits a channel (100 levels) fit it exactly.
+    vec3 d = round(clamp(c, 0.0, 1.0) * 99.0);
+    return vec4(d.r * 10000.0 + d.g * 100.0 + d.b, 0.0, 0.0, 0.0);
 #else
     return vec4(c, 1.0);
 #endif
@@ -66,15 +76,11 @@ vec4 gbuffer_encode_albedo(vec3 c)
 vec3 gbuffer_decode_albedo(vec4 g)
 {
 #if defined(GBUFFER_ALBEDO_PACK_SHIFT)
-    vec4 e = fract(vec4(1.0, 255.0, 65025.0, 16581375.0) * g.r);
-    e -= e.yzww * vec4(1.0 / 255.0, 1.0 / 255.0, 1.0 / 255.0, 0.0);
-    return e.rgb;
+    uint n = uint(round(g.r));
+    return vec3(float(n / 65025u), float((n / 255u) % 255u), float(n % 255u)) / 255.0;
 #elif defined(GBUFFER_ALBEDO_PACK_BASE10)
-    float v = g.r;
-    float r = floor(v / 1000000.0);
-    float gg = floor((v - r * 1000000.0) / 1000.0);
-    float b = v - r * 1000000.0 - gg * 1000.0;
-    return clamp(vec3(r, gg, b) / 999.0, 0.0, 1.0);
+    uint n = uint(round(g.r));
+    return vec3(float(n / 10000u), float((n / 100u) % 100u), float(n % 100u)) / 99.0;
 #else
     return g.rgb;
 #endif

@@ -4,9 +4,10 @@ e2e_techniques.py:
   passes PerceptualDiff, on the thesis grid (10 and 256 lights) and the
   lights preset (16, 256 and 1,024 lights), and with an orbiting camera;
   every lossless non-default option does too;
-- lossy layouts show their loss: xy_reconstruct_z, pack_shift and
-  pack_base10 score a higher FLIP than the default layout (and no better
-  SSIM);
+- lossy layouts show their loss: xy_reconstruct_z scores a higher FLIP
+  than the default layout (and no better SSIM); the colour packings stay
+  within 1 (pack_shift) and 2 (pack_base10) levels of the default layout,
+  saturated white included, and each differs somewhere;
 - overflow is never silent: a tiny max_lights_per_cluster with many lights
   is counted per frame; under "fallback" the image still matches, under
   "fail" the job fails naming the option and the overflow; a sweep's
@@ -109,16 +110,38 @@ try:
     # Lossy layouts show their loss against the default layout.
     for tech in ("deferred", "clustered_deferred"):
         _, base_ssim, base_flip = matches(d, job(tech, 64), "%s default layout" % tech)
-        for layout in ({"normal": "xy_reconstruct_z"}, {"albedo": "pack_shift"},
-                       {"albedo": "pack_base10"}):
-            done = d.run(job(tech, 64, {"gbuffer": layout}))
-            ssim, flip, pdiff = quality(done)
-            print("  %-60s SSIM %.6f  FLIP %.5f  PerceptualDiff %s" % ("%s %s" % (tech, layout), ssim, flip, pdiff))
-            # FLIP sees every packing's loss; SSIM (luma structure) barely
-            # moves for the colour packings, so it only must not improve.
-            check(done.get("status") == "done" and flip > base_flip and ssim <= base_ssim + 1e-5,
-                  "%s gbuffer %s shows its loss: FLIP %.5f > %.5f, SSIM %.6f vs %.6f"
-                  % (tech, layout, flip, base_flip, ssim, base_ssim))
+        done = d.run(job(tech, 64, {"gbuffer": {"normal": "xy_reconstruct_z"}}))
+        ssim, flip, pdiff = quality(done)
+        print("  %-60s SSIM %.6f  FLIP %.5f  PerceptualDiff %s" % ("%s xy_reconstruct_z" % tech, ssim, flip, pdiff))
+        check(done.get("status") == "done" and flip > base_flip and ssim <= base_ssim + 1e-5,
+              "%s gbuffer xy_reconstruct_z shows its loss: FLIP %.5f > %.5f, SSIM %.6f vs %.6f"
+              % (tech, flip, base_flip, ssim, base_ssim))
+
+    # The colour packings' loss is a few levels, never a wrong hue: against
+    # the default layout's frame, on the grid and on the sphere preset's
+    # white (saturated: every channel 1.0, where the seed's layouts turned
+    # white black and red), pack_shift is at most 1 level off (a byte of 255
+    # is kept to 254) and pack_base10 at most 2 (100 levels a channel), and
+    # each differs somewhere (its loss stays visible).
+    bound = {"pack_shift": 1, "pack_base10": 2}
+    for tech in ("deferred", "clustered_deferred"):
+        for preset in ("grid", "sphere"):
+            plain = d.run(job(tech, 16, preset=preset, reference=None))
+            base = os.path.join(d.state, "jobs", plain["id"], "frame-000004.png")
+            for layout in ("pack_shift", "pack_base10"):
+                packed = d.run(job(tech, 16, {"gbuffer": {"albedo": layout}}, preset=preset,
+                                   reference=None))
+                diff = testlib.png_diff(base, os.path.join(d.state, "jobs", packed["id"],
+                                                           "frame-000004.png"))
+                differs = (diff or {}).get("differing_pixels", 0)
+                print("  %-60s %s" % ("%s %s %s" % (tech, layout, preset), diff))
+                check(packed.get("status") == "done" and diff is not None and
+                      diff["max_abs"] <= bound[layout],
+                      "%s %s on %s stays within %d level(s) of rgba8: %s"
+                      % (tech, layout, preset, bound[layout], diff))
+                if (layout, preset) in (("pack_shift", "sphere"), ("pack_base10", "grid")):
+                    check(differs > 0, "%s %s on %s shows its loss: %d pixels differ"
+                          % (tech, layout, preset, differs))
 
     # Overflow, forced: 256 lights, at most 4 a cluster.
     tiny = {"max_lights_per_cluster": 4}

@@ -18,8 +18,9 @@ static const struct opt_field options[] = {
      .offset = offsetof(struct osl_options, texel_density)},
     {.name = "reshade", .type = OPT_CHOICE, .def = OSL_RESHADE_TOUCHED,
      .choices = reshade_choices,
-     .summary = "touched reshades only objects a moving light reaches; all reshades every "
-                "due object, as the thesis measured",
+     .summary = "touched reshades only the objects a moving light reaches, as the thesis "
+                "did (3.1.2.3: objects go to the lighting shader only if a dynamic light "
+                "affects them); all reshades every due object, lit by a moving light or not",
      .offset = offsetof(struct osl_options, reshade)},
     {.name = "async_distance", .type = OPT_NUMBER, .def = 0.0, .min = 0.0, .max = 1e6,
      .summary = "async shading (thesis 3.1.2.3): an object at camera distance r is reshaded "

@@ -8,7 +8,7 @@
 
 enum osl_reshade {
     OSL_RESHADE_TOUCHED, /* only objects a moving light reaches */
-    OSL_RESHADE_ALL,     /* every due object, as the thesis measured */
+    OSL_RESHADE_ALL,     /* every due object, lit by a moving light or not */
 };
 
 struct osl_options {

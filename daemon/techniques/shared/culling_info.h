@@ -21,8 +21,8 @@ enum gbuffer_normal {
 };
 enum gbuffer_albedo {
     GBUFFER_ALBEDO_RGBA8,       /* 8 bits a channel (default) */
-    GBUFFER_ALBEDO_PACK_SHIFT,  /* seed 001: channels in one float by multiplied "shifts" */
-    GBUFFER_ALBEDO_PACK_BASE10, /* seed 001's fix: three decimal digits a channel in one float */
+    GBUFFER_ALBEDO_PACK_SHIFT,  /* seed 001: bytes in one float by multiplied "shifts" (255 -> 254) */
+    GBUFFER_ALBEDO_PACK_BASE10, /* seed 001's fix: decimal digits a channel in one float (100 levels) */
 };
 extern const char *const gbuffer_normal_choices[];
 extern const char *const gbuffer_albedo_choices[];
@@ -42,8 +42,9 @@ struct gbuffer_options {
      .offset = offsetof(opts_type, member.normal)},                                               \
     {.name = "gbuffer.albedo", .type = OPT_CHOICE, .def = GBUFFER_ALBEDO_RGBA8,                  \
      .choices = gbuffer_albedo_choices,                                                           \
-     .summary = "albedo layout: rgba8 (default), pack_shift (seed 001: channels in one "          \
-                "float by multiplied shifts) or pack_base10 (three decimal digits a channel)",    \
+     .summary = "albedo layout: rgba8 (default), pack_shift (seed 001: the bytes in one float "   \
+                "by multiplied shifts, a byte of 255 kept to 254) or pack_base10 (seed 001's "    \
+                "decimal digits: two a channel, 100 levels, what fits a float)",                  \
      .offset = offsetof(opts_type, member.albedo)}
 
 /* How the deferred technique bounds the pixels each light shades. */

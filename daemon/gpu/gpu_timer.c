@@ -16,7 +16,8 @@ struct gpu_timer {
     int current; /* running section, -1 when none */
     struct ring_slot ring[GPU_TIMER_RING];
     double *ms; /* frames * sections */
-    int64_t stalls, implausible;
+    unsigned char *implausible; /* per frame: sections whose answer was impossible */
+    int64_t stalls;
     double created_s; /* clock_mono_s */
 };
 
@@ -28,7 +29,10 @@ struct gpu_timer *gpu_timer_create(int sections, int64_t frames)
     if (!t)
         return NULL;
     t->ms = calloc((size_t)frames * (size_t)sections, sizeof(double));
-    if (!t->ms) {
+    t->implausible = calloc((size_t)frames, 1);
+    if (!t->ms || !t->implausible) {
+        free(t->ms);
+        free(t->implausible);
         free(t);
         return NULL;
     }
@@ -50,6 +54,7 @@ void gpu_timer_destroy(struct gpu_timer *t)
     for (int i = 0; i < GPU_TIMER_RING; i++)
         glDeleteQueries(t->sections, t->ring[i].queries);
     free(t->ms);
+    free(t->implausible);
     free(t);
 }
 
@@ -68,7 +73,7 @@ static void read_slot(struct gpu_timer *t, struct ring_slot *slot)
         glGetQueryObjectui64v(slot->queries[s], GL_QUERY_RESULT, &ns);
         double ms = (double)ns / 1e6;
         if (ms > (clock_mono_s() - t->created_s) * 1e3) {
-            t->implausible++;
+            t->implausible[slot->frame]++;
             ms = 0.0;
         }
         t->ms[slot->frame * t->sections + s] = ms;
@@ -133,7 +138,13 @@ double gpu_timer_ms(const struct gpu_timer *t, int64_t f, int s)
 
 int64_t gpu_timer_stalls(const struct gpu_timer *t) { return t->stalls; }
 
-int64_t gpu_timer_implausible(const struct gpu_timer *t) { return t->implausible; }
+int64_t gpu_timer_implausible(const struct gpu_timer *t, int64_t from_frame)
+{
+    int64_t n = 0;
+    for (int64_t f = from_frame < 0 ? 0 : from_frame; f < t->frames; f++)
+        n += t->implausible[f];
+    return n;
+}
 
 void gpu_timer_prime(void)
 {

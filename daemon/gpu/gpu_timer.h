@@ -32,10 +32,11 @@ void gpu_timer_drain(struct gpu_timer *t);
  * whole frame with s < 0. */
 double gpu_timer_ms(const struct gpu_timer *t, int64_t f, int s);
 int64_t gpu_timer_stalls(const struct gpu_timer *t);
-/* Sections whose elapsed time exceeded the time since the timer was
- * created: impossible, so a driver's fault (llvmpipe answers the first
- * query of a context with the time since boot). Recorded as 0 ms. */
-int64_t gpu_timer_implausible(const struct gpu_timer *t);
+/* Sections of frames from_frame on whose elapsed time exceeded the time
+ * since the timer was created: impossible, so a driver's fault (llvmpipe
+ * answers the first query of a context, and OSL's first raster pass after
+ * its compute work, with the time since boot). Recorded as 0 ms. */
+int64_t gpu_timer_implausible(const struct gpu_timer *t, int64_t from_frame);
 
 /* Once per context, before any timer: runs and reads one query, so that a
  * driver whose first answer is wrong gives it here. */

@@ -267,7 +267,7 @@ json_t *outputs_write(struct harness_run *run)
     }
     json_object_set_new(result, "gpu_sections_ms", by_section);
     json_object_set_new(result, "timer_query_implausible",
-                        json_integer((json_int_t)gpu_timer_implausible(run->timer)));
+                        json_integer((json_int_t)gpu_timer_implausible(run->timer, w0)));
     json_object_set_new(result, "look", look_spec_to_json(&spec->look));
     json_object_set_new(result, RK_NONFINITE, nonfinite_summary(run));
     look_stages_describe(&run->stages, result);

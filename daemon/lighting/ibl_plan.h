@@ -2,7 +2,7 @@
 #define SHADEBENCH_IBL_PLAN_H
 
 /* Where the light probes stand and which of them light a frame (GL-free;
- * the harness captures and filters them, daemon/harness/ibl.c).
+ * the harness captures and filters them, daemon/look/ibl.c).
  *
  * Placement: the spec's list, or n probes on a grid over the objects'
  * footprint, just above the tallest object (so no probe starts inside an

@@ -3,7 +3,7 @@
 
 /* The look's image-based lighting ("look.ibl") and shadows ("look.shadows"):
  * options, defaults, parsing with field-naming errors and the JSON written
- * back. The harness renders both for every technique (daemon/harness/ibl.c,
+ * back. The harness renders both for every technique (daemon/look/ibl.c,
  * shadows.c); the lighting library applies them in light_ambient and
  * light_contribution. GL-free; any thread. */
 

@@ -3,7 +3,7 @@
 
 /* Which lights get omni shadow maps this frame, at what size, and where
  * their faces lie in the atlas (GL-free: the harness's shadow pass renders
- * what the plan says, daemon/harness/shadows.c).
+ * what the plan says, daemon/look/shadows.c).
  *
  * A light needs a map only when its sphere of influence reaches the view
  * frustum and holds a caster (an object other than the ground). Its

@@ -81,32 +81,33 @@ tests_tools_sandbox_run_CFLAGS = $(AM_CFLAGS) $(SECCOMP_CFLAGS)
 tests_tools_sandbox_run_LDADD = $(SECCOMP_LIBS)
 endif
 
-# Longest first: make -j starts them in this order, so the short ones fill
-# in beside the long ones instead of one long test running alone at the end.
+# Longest first (tools/check prints each test's time): make -j starts them
+# in this order, so the short ones fill in beside the long ones instead of
+# one long test running alone at the end.
 E2E_TESTS = \
-	tests/e2e/e2e_hardening.py \
-	tests/e2e/e2e_load.py \
-	tests/e2e/e2e_techniques.py \
 	tests/e2e/e2e_report.py \
-	tests/e2e/e2e_osl.py \
+	tests/e2e/e2e_hardening.py \
 	tests/e2e/e2e_many_lights.py \
-	tests/e2e/e2e_client.py \
+	tests/e2e/e2e_techniques.py \
+	tests/e2e/e2e_load.py \
+	tests/e2e/e2e_osl.py \
 	tests/e2e/e2e_ab.py \
-	tests/e2e/e2e_gate.py \
-	tests/e2e/systemd_sandbox.py \
-	tests/e2e/e2e_metrics.py \
-	tests/e2e/e2e_records.py \
-	tests/e2e/e2e_post.py \
-	tests/e2e/e2e_history.py \
-	tests/e2e/e2e_integrity.py \
 	tests/e2e/e2e_sweep.py \
+	tests/e2e/e2e_records.py \
+	tests/e2e/e2e_integrity.py \
+	tests/e2e/e2e_gate.py \
 	tests/e2e/e2e_charts.py \
-	tests/e2e/e2e_scene.py \
-	tests/e2e/e2e_persist.py \
-	tests/e2e/e2e_pbr.py \
 	tests/e2e/e2e_http.py \
+	tests/e2e/e2e_scene.py \
+	tests/e2e/e2e_post.py \
 	tests/e2e/e2e_badinput.py \
+	tests/e2e/e2e_pbr.py \
+	tests/e2e/e2e_client.py \
+	tests/e2e/e2e_metrics.py \
+	tests/e2e/e2e_persist.py \
 	tests/e2e/ssim_skimage.py \
+	tests/e2e/e2e_history.py \
+	tests/e2e/systemd_sandbox.py \
 	tests/e2e/systemd_unit.sh
 
 TESTS = $(UNIT_TESTS) \
@@ -121,10 +122,10 @@ TESTS = $(UNIT_TESTS) \
 SANITIZER_TESTS = $(UNIT_TESTS) \
 	tests/fuzz/replay.sh \
 	tests/e2e/e2e_hardening.py \
-	tests/e2e/e2e_load.py \
 	tests/e2e/e2e_records.py \
-	tests/e2e/e2e_persist.py \
+	tests/e2e/e2e_load.py \
 	tests/e2e/e2e_http.py \
+	tests/e2e/e2e_persist.py \
 	tests/e2e/e2e_badinput.py
 check-sanitizers:
 if SANITIZERS

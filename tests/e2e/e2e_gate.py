@@ -2,11 +2,13 @@
 recorded in result.json), the same job against it passes, a job with many
 more lights fails (compared with --allow-mismatch), a mismatched job or
 device exits 2 before measuring, and a verdict that cannot be reached is
-a warning or, with --fail-inconclusive, a failure. Jobs stay tiny: CI has
-two cores and runs other tests beside this one, which is also why the
-"same job" check allows 60%: it must pass whatever the neighbours do,
-while 1000 lights (tens of times slower on llvmpipe, and still several
-times slower when the neighbours take most of the CPU) must still fail."""
+a warning or, with --fail-inconclusive, a failure. Jobs stay tiny (96x72,
+spheres of 8 segments, 30 frames: a few milliseconds a frame): the gate's
+statistics are under test, not the renderer. CI has two cores and runs
+other tests beside this one, which is also why the "same job" check allows
+60%: it must pass whatever the neighbours do, while 250 lights (7 times
+slower on llvmpipe here, and still several times slower when the
+neighbours take most of the CPU) must still fail."""
 
 import json
 import os
@@ -16,8 +18,8 @@ from testlib import check
 from clientlib import Client, junit_cases
 
 testlib.skip_without_egl()
-JOB = {"technique": "forward", "frames": 20, "warmup_frames": 5,
-       "scene": {"width": 160, "height": 120, "dynamic": True}}
+JOB = {"technique": "forward", "frames": 30, "warmup_frames": 3,
+       "scene": {"width": 96, "height": 72, "dynamic": True, "sphere_segments": 8}}
 
 d = testlib.Daemon()
 cl = Client(d)
@@ -53,10 +55,10 @@ try:
     check("baseline runs:" in out.stderr and "gate:" in out.stderr, "the runs and the verdict are in the log")
 
     # Many more lights: a different job, refused unless --allow-mismatch...
-    slow = cl.write("slow", dict(JOB, scene=dict(JOB["scene"], lights=1000)))
+    slow = cl.write("slow", dict(JOB, scene=dict(JOB["scene"], lights=250)))
     n_before = len(d.json("GET", "/v1/jobs")[1]["jobs"])
     out = cl.run("submit", slow, "--wait", "--baseline", baseline)
-    check(out.returncode == 2 and "scene.lights: 10 in the baseline, 1000 here" in out.stderr,
+    check(out.returncode == 2 and "scene.lights: 10 in the baseline, 250 here" in out.stderr,
           "a mismatched baseline exits 2 naming the field: %s" % out.stderr[-300:])
     listed = d.json("GET", "/v1/jobs")[1]["jobs"]
     check(len(listed) == n_before + 1 and listed[-1]["status"] == "cancelled",
@@ -68,7 +70,7 @@ try:
     out = cl.run("submit", slow, "--wait", "--baseline", baseline, "--allow-mismatch", "--runs", "3",
                  "--max-reruns", "6", "--max-slowdown", "60%", "--noise-tolerance", "off",
                  "--junit", junit)
-    check(out.returncode == 1 and "REGRESSION" in out.stderr, "1000 lights is a regression: %s" % out.stderr[-600:])
+    check(out.returncode == 1 and "REGRESSION" in out.stderr, "250 lights is a regression: %s" % out.stderr[-600:])
     fails = [c[0] for c in junit_cases(junit)[1].values() if c[0]]
     check(len(fails) == 1 and "slower by" in fails[0], "JUnit explains the regression: %s" % fails)
     check("confirming" in out.stderr, "a regression is confirmed on fresh runs before it fails")

@@ -30,7 +30,7 @@ try:
     a = d.run(dict(JOB, labels={"branch": "main", "commit": "aaa"}))
     b = d.run(dict(JOB, labels={"branch": "main", "commit": "bbb"}))
     o = d.run(dict(JOB, technique="osl", capture_interval=6, reference="forward",
-                   labels={"branch": "topic", "commit": "ccc"}))
+                   osl={"resolution": "auto"}, labels={"branch": "topic", "commit": "ccc"}))
     check(a["spec"]["labels"] == {"branch": "main", "commit": "aaa"}, "the spec keeps the labels")
     long_id = d.submit({"frames": 1000000, "warmup_frames": 0, "scene": {"width": 32, "height": 32}})
     d.json("DELETE", "/v1/jobs/" + long_id)

@@ -70,8 +70,12 @@ try:
     check(q["pdiff_failed_captures"] == 2 and q["pdiff_failed_frames"] == [3, 6], "both captures fail")
     check(q["worst_flip"]["mean"] >= m["flip"]["mean"], "worst FLIP is the worst")
 
-    # OSL against forward (still lights): passes, SSIM near 1 (the thesis: 0.9999).
-    job = d.run(dict(JOB, technique="osl", scene=dict(SCENE, width=320, height=240)))
+    # OSL against forward (still lights): passes, SSIM near 1 (the thesis:
+    # 0.9999). 64 texels an object show it as well as the thesis's 256
+    # (0.99997 against 0.99999), in a seventh of the time; e2e_osl.py holds
+    # 256 texels to their stated bound.
+    job = d.run(dict(JOB, technique="osl", osl={"resolution": 64},
+                     scene=dict(SCENE, width=320, height=240)))
     check(job["status"] == "done", "osl vs forward done: %s" % job.get("error"))
     q = job["result"]["quality"]
     check(q["worst_ssim"]["value"] > 0.999 and q["pdiff_failed_captures"] == 0,

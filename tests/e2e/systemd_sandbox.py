@@ -82,7 +82,8 @@ with open(job_path, "w") as f:
 full_job_path = os.path.join(tmp, "full.json")
 with open(full_job_path, "w") as f:
     f.write('{"technique": "osl", "frames": 4, "warmup_frames": 1, "capture_interval": 2, '
-            '"reference": "forward", "scene": {"width": 96, "height": 64}}')
+            '"osl": {"resolution": "auto"}, "reference": "forward", '
+            '"scene": {"width": 96, "height": 64}}')
 
 OPTIONS = []
 if "SystemCallFilter" in settings:

@@ -380,6 +380,9 @@ static int run_once(const struct options *o, const struct technique_catalog *cat
     return rc;
 }
 
+/* SIGTERM waits this long for the render thread, then exits without it. */
+#define STOP_RENDER_WAIT_S 2
+
 /* The render thread as the HTTP layer sees it (http.h). */
 static bool render_alive(void *r) { return runner_alive(r); }
 static json_t *render_device_json(void *r) { return runner_device_json(r); }
@@ -492,6 +495,14 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
     service_stopping();
     http_server_destroy(http);
     sweeps_destroy(sweeps);
+    /* Within a few seconds whatever runs (systemd's stop timeout is longer):
+     * the running job is back in the queue once the render thread stops
+     * it, and a frame still draining on the GPU is not waited for. */
+    if (!runner_stop(r, STOP_RENDER_WAIT_S)) {
+        LOG(LOG_WARN, "the render thread is still draining GPU work after %d s; exiting without "
+            "it (every job's state is stored)", STOP_RENDER_WAIT_S);
+        _exit(0);
+    }
     runner_destroy(r);
     queue_destroy(q);
     store_close(store);

@@ -98,6 +98,7 @@ endif
 # one long test running alone at the end.
 E2E_TESTS = \
 	tests/e2e/e2e_report.py \
+	tests/e2e/e2e_runaway.py \
 	tests/e2e/e2e_hardening.py \
 	tests/e2e/e2e_many_lights.py \
 	tests/e2e/e2e_techniques.py \

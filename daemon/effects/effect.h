@@ -14,6 +14,7 @@
 #include <stddef.h>
 
 #include "daemon/effects/effect_info.h"
+#include "daemon/gpu/budget.h"
 #include "daemon/gpu/pass.h"
 #include "daemon/gpu/targets.h"
 
@@ -35,6 +36,8 @@ struct effect_env {
     /* "#define HAVE_NORMAL_TEX 1" and its encoding when the technique
      * publishes normals, for programs that include post_common.glsl. */
     const char *normal_defines;
+    /* Bounded submissions: effect_draw_fullscreen draws in tiles. */
+    struct gpu_budget *budget;
 };
 
 struct effect {

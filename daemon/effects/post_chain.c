@@ -35,7 +35,11 @@ void effect_draw_fullscreen(const struct effect_env *env, GLuint prog)
     glDisable(GL_CULL_FACE);
     glUseProgram(prog);
     glBindVertexArray(env->empty_vao);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    GLint vp[4];
+    glGetIntegerv(GL_VIEWPORT, vp); /* the effect drew its plane's size: tile that */
+    struct gpu_tiles t;
+    for (gpu_tiles_begin(env->budget, vp[2], vp[3], &t); gpu_tiles_next(env->budget, &t);)
+        glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindVertexArray(0);
 }
 
@@ -148,6 +152,7 @@ bool post_chain_build(struct post_chain *c, GLuint normal_tex, bool normal_octah
             .first_pass = first,
             .label = c->fx[i].label,
             .hdr_format = frame->hdr_format,
+            .budget = frame->budget,
             .empty_vao = c->empty_vao,
             .linear_sampler = c->linear_sampler,
             .normal_defines = c->normal_defines,

@@ -14,6 +14,7 @@
 #include <stdint.h>
 
 #include "daemon/effects/post_spec.h"
+#include "daemon/gpu/budget.h"
 #include "daemon/gpu/pass.h"
 #include "daemon/gpu/targets.h"
 
@@ -26,6 +27,7 @@ struct post_frame {
     GLenum hdr_format;           /* of color, and of the chain's planes */
     GLuint color, depth;         /* the technique's HDR output and depth texture */
     struct gpu_targets *targets; /* the pool the chain and its effects take planes from */
+    struct gpu_budget *budget;   /* bounded submissions (daemon/gpu/budget.h) */
 };
 
 /* NaN and infinite pixels (any of R, G, B) in one frame's HDR colour. */

@@ -14,6 +14,7 @@ struct gpu_timer {
     int sections;
     int64_t frames, next_frame;
     int current; /* running section, -1 when none */
+    int last;    /* the section begun last, -1 before any */
     struct ring_slot ring[GPU_TIMER_RING];
     double *ms; /* frames * sections */
     unsigned char *implausible; /* per frame: sections whose answer was impossible */
@@ -40,6 +41,7 @@ struct gpu_timer *gpu_timer_create(int sections, int64_t frames)
     t->frames = frames;
     t->created_s = clock_mono_s();
     t->current = -1;
+    t->last = -1;
     for (int i = 0; i < GPU_TIMER_RING; i++) {
         glGenQueries(sections, t->ring[i].queries);
         t->ring[i].frame = -1;
@@ -96,6 +98,7 @@ void gpu_timer_section(struct gpu_timer *t, int s)
 {
     if (s == t->current || s < 0 || s >= t->sections)
         return;
+    t->last = s;
     struct ring_slot *slot = &t->ring[t->next_frame % GPU_TIMER_RING];
     if (t->current >= 0)
         glEndQuery(GL_TIME_ELAPSED);
@@ -137,6 +140,8 @@ double gpu_timer_ms(const struct gpu_timer *t, int64_t f, int s)
 }
 
 int64_t gpu_timer_stalls(const struct gpu_timer *t) { return t->stalls; }
+
+int gpu_timer_last_section(const struct gpu_timer *t) { return t->last; }
 
 int64_t gpu_timer_implausible(const struct gpu_timer *t, int64_t from_frame)
 {

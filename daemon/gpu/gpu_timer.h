@@ -32,6 +32,8 @@ void gpu_timer_drain(struct gpu_timer *t);
  * whole frame with s < 0. */
 double gpu_timer_ms(const struct gpu_timer *t, int64_t f, int s);
 int64_t gpu_timer_stalls(const struct gpu_timer *t);
+/* The section begun last (-1 before any): where a frame was abandoned. */
+int gpu_timer_last_section(const struct gpu_timer *t);
 /* Sections of frames from_frame on whose elapsed time exceeded the time
  * since the timer was created: impossible, so a driver's fault (llvmpipe
  * answers the first query of a context, and OSL's first raster pass after

@@ -17,12 +17,13 @@ static inline bool job_timed_out(const struct job *job)
            clock_unix_s() - job->started > job->spec.timeout_s;
 }
 
-/* The failure message, naming the phase the job was in. */
-static inline void job_timeout_message(const struct job *job, const char *phase, char *out,
-                                       size_t cap)
+/* The failure message, naming the phase the job was in and, where known,
+ * more of where (detail: "" or " at frame 3, in the shading pass"). */
+static inline void job_timeout_message(const struct job *job, const char *phase,
+                                       const char *detail, char *out, size_t cap)
 {
     snprintf(out, cap, "timeout: the job ran longer than its timeout_s of %g s and was stopped "
-                       "in the %s phase", job->spec.timeout_s, phase);
+                       "in the %s phase%s", job->spec.timeout_s, phase, detail);
 }
 
 #endif

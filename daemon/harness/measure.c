@@ -10,31 +10,48 @@
 #include "daemon/harness/outputs.h"
 #include "daemon/harness/telemetry.h"
 
-/* Between frames: a DELETE or a stop sets the job's cancel flag, and the
- * job's timeout_s may run out. */
+/* The pass a stopped frame was in, for the message: ", in the X pass". */
+static void where(const struct harness_run *run, char *out, size_t cap)
+{
+    int s = gpu_timer_last_section(run->timer);
+    if (s >= 0 && s < run->passes.count)
+        snprintf(out, cap, ", in the %s pass", run->passes.names[s]);
+    else
+        out[0] = '\0';
+}
+
+/* A DELETE or a stop sets the job's cancel flag, and the job's timeout_s
+ * may run out: between frames, and (through the budget) inside them. */
 static bool keep_going(struct harness_run *run, int64_t k, int run_index, enum job_status *status)
 {
+    char in[96] = "";
+    if (gpu_budget_stopped(&run->budget))
+        where(run, in, sizeof(in));
     if (atomic_load(&run->job->cancel)) {
         *status = JOB_CANCELLED;
         if (k >= 1)
-            snprintf(run->err, sizeof(run->err), "cancelled at frame %" PRId64 " of run %d", k,
-                     run_index + 1);
+            snprintf(run->err, sizeof(run->err), "cancelled at frame %" PRId64 " of run %d%s", k,
+                     run_index + 1, in);
         else
             snprintf(run->err, sizeof(run->err), "cancelled during warm-up frame %" PRId64
-                     " of %d, run %d", k + run->spec->warmup_frames, run->spec->warmup_frames,
-                     run_index + 1);
+                     " of %d, run %d%s", k + run->spec->warmup_frames, run->spec->warmup_frames,
+                     run_index + 1, in);
         return false;
     }
     if (job_timed_out(run->job)) {
-        job_timeout_message(run->job, "rendering", run->err, sizeof(run->err));
+        char detail[160];
+        snprintf(detail, sizeof(detail), " at %sframe %" PRId64 "%s", k >= 1 ? "" : "warm-up ",
+                 k >= 1 ? k : k + run->spec->warmup_frames, in);
+        job_timeout_message(run->job, "rendering", detail, run->err, sizeof(run->err));
         return false;
     }
-    return true;
+    return !gpu_budget_stopped(&run->budget);
 }
 
 bool measure_run(struct harness_run *run, int run_index, enum job_status *status)
 {
     const struct job_spec *spec = run->spec;
+    struct gpu_budget *budget = &run->budget;
     int w0 = spec->warmup_frames, n = spec->frames;
     double wall_start = 0, frame_begin = 0;
     run->capture_s = 0;
@@ -45,7 +62,8 @@ bool measure_run(struct harness_run *run, int run_index, enum job_status *status
             return false;
         if (k == 1) {
             /* Warm-up work still queued must not be billed to the timed frames. */
-            glFinish();
+            if (!gpu_budget_sync(budget))
+                return keep_going(run, k, run_index, status);
             interference_sample(&run->interference[0]);
             wall_start = clock_mono_s();
         }
@@ -53,9 +71,10 @@ bool measure_run(struct harness_run *run, int run_index, enum job_status *status
          * of the frame interval, never of the CPU submit time. */
         GLsync *fence = &run->fences[seq % RUN_FRAMES_IN_FLIGHT];
         if (*fence) {
-            glClientWaitSync(*fence, GL_SYNC_FLUSH_COMMANDS_BIT, UINT64_MAX);
-            glDeleteSync(*fence);
+            bool go = gpu_budget_wait(budget, *fence);
             *fence = NULL;
+            if (!go)
+                return keep_going(run, k, run_index, status);
         }
         double t0 = clock_mono_s();
         if (k >= 2)
@@ -66,11 +85,14 @@ bool measure_run(struct harness_run *run, int run_index, enum job_status *status
         double t1 = clock_mono_s();
         *fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
         if (!ok)
-            return false;
+            return gpu_budget_stopped(budget) ? keep_going(run, k, run_index, status) : false;
         if (k >= 1)
             run->cpu_ms[k - 1] = (t1 - t0) * 1e3;
         if (run->capture_count && job_spec_is_capture_frame(spec, (int)k)) {
             double c0 = clock_mono_s();
+            /* The readback waits for the frame: let the wait ask. */
+            if (!gpu_budget_sync(budget))
+                return keep_going(run, k, run_index, status);
             if (!outputs_read_capture(run, (int)k))
                 return false;
             double c = clock_mono_s() - c0;
@@ -82,7 +104,8 @@ bool measure_run(struct harness_run *run, int run_index, enum job_status *status
         queue_progress(run->queue, run->job, run_index * n + (k > 0 ? (int)k : 0));
         telemetry_frames(1);
     }
-    glFinish();
+    if (!gpu_budget_sync(budget))
+        return keep_going(run, n, run_index, status);
     double wall_end = clock_mono_s();
     interference_sample(&run->interference[1]);
     run->frame_ms[n - 1] += (wall_end - frame_begin) * 1e3;

@@ -158,7 +158,7 @@ static void run_task(struct metrics_worker *w, struct task *t)
         queue_finish(w->queue, job, JOB_DONE, NULL, t->result);
     } else if (timed_out) {
         char msg[200];
-        job_timeout_message(job, "metrics", msg, sizeof(msg));
+        job_timeout_message(job, "metrics", "", msg, sizeof(msg));
         LOG(LOG_WARN, "job %s failed: %s", job->id, msg);
         queue_finish(w->queue, job, JOB_FAILED, msg, NULL);
         json_decref(t->result);

@@ -266,6 +266,19 @@ json_t *outputs_write(struct harness_run *run)
                             outputs_stats_json(sec, (size_t)n));
     }
     json_object_set_new(result, "gpu_sections_ms", by_section);
+    double slice_s, free_s;
+    gpu_budget_limits(&slice_s, &free_s);
+    json_object_set_new(result, "gpu_budget",
+                        json_pack("{s:f, s:f, s:I, s:I, s:s}", "slice_s", slice_s,
+                                  "whole_below_s", free_s, "pieces_sliced",
+                                  (json_int_t)run->budget.pieces_sliced, "waits",
+                                  (json_int_t)run->budget.waits, "rule",
+                                  "a pass's work (or a loop of draws) that measured whole_below_s "
+                                  "or more runs in tiles of about slice_s, waited for in turn, so "
+                                  "that a cancel, a timeout or a stop acts within about a slice; "
+                                  "each piece is measured in tiles in its first run (the first "
+                                  "warm-up frame); pieces_sliced counts the runs drawn in more "
+                                  "than one tile, warm-up frames included"));
     json_object_set_new(result, "timer_query_implausible",
                         json_integer((json_int_t)gpu_timer_implausible(run->timer, w0)));
     json_object_set_new(result, "look", look_spec_to_json(&spec->look));

@@ -26,6 +26,7 @@ bool reference_render(struct harness_run *run, enum job_status *status)
                      .tech = ref, .look = &spec->reference_look, .stages = run->stages,
                      .shadow_pass = -1, .sky_pass = -1};
     bool ok = false;
+    run_budget_init(&rr);
     if (!ref || !pixels || !run_setup_targets(&rr)) {
         snprintf(run->err, sizeof(run->err), "reference %s: cannot prepare it: %.900s",
                  spec->reference, rr.err);
@@ -45,7 +46,7 @@ bool reference_render(struct harness_run *run, enum job_status *status)
             goto out;
         }
         if (job_timed_out(run->job)) {
-            job_timeout_message(run->job, "reference", run->err, sizeof(run->err));
+            job_timeout_message(run->job, "reference", "", run->err, sizeof(run->err));
             goto out;
         }
         rr.err[0] = '\0';
@@ -58,6 +59,20 @@ bool reference_render(struct harness_run *run, enum job_status *status)
             goto out;
         }
         bool drawn = run_frame(&rr, k, false);
+        if (!drawn && gpu_budget_stopped(&rr.budget)) {
+            ref->destroy(rr.state);
+            rr.state = NULL;
+            if (atomic_load(&run->job->cancel)) {
+                *status = JOB_CANCELLED;
+                snprintf(run->err, sizeof(run->err),
+                         "cancelled while rendering the reference (frame %d)", k);
+            } else {
+                char detail[64];
+                snprintf(detail, sizeof(detail), " at frame %d", k);
+                job_timeout_message(run->job, "reference", detail, run->err, sizeof(run->err));
+            }
+            goto out;
+        }
         if (drawn) {
             glBindFramebuffer(GL_READ_FRAMEBUFFER, rr.ldr_fbo);
             glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, pixels);

@@ -7,6 +7,7 @@
 
 #include "daemon/gpu/bindings.h"
 #include "daemon/gpu/glutil.h"
+#include "daemon/harness/deadline.h"
 
 bool harness_gl_init(struct harness_gl *g, char *err, size_t errlen)
 {
@@ -95,6 +96,7 @@ bool run_setup_targets(struct harness_run *run)
         .height = h,
         .defines = run->defines,
         .products = &run->products,
+        .budget = &run->budget,
     };
     return true;
 }
@@ -130,6 +132,7 @@ bool run_setup_passes(struct harness_run *run, const void *options, int64_t time
         .color = run->env.output_color,
         .depth = run->env.output_depth,
         .targets = run->env.targets,
+        .budget = &run->budget,
     };
     if (fits && !(run->post = post_chain_create(&frame, &run->look->post, &run->passes, run->err,
                                                 sizeof(run->err))))
@@ -166,12 +169,24 @@ static bool alloc_captures(struct harness_run *run)
     return true;
 }
 
+static bool job_stop_requested(void *ctx)
+{
+    const struct job *job = ctx;
+    return atomic_load(&job->cancel) || job_timed_out(job);
+}
+
+void run_budget_init(struct harness_run *run)
+{
+    gpu_budget_init(&run->budget, job_stop_requested, run->job);
+}
+
 bool run_prepare(struct harness_run *run, bool capture)
 {
     const struct job_spec *spec = run->spec;
     int n = spec->frames;
     run->look = &spec->look;
     run->shadow_pass = run->sky_pass = -1;
+    run_budget_init(run);
     run->scene_ok = scene_init(&run->scene, &spec->scene);
     run->capture_count = capture ? job_spec_capture_count(spec) : 0;
     run->cpu_ms = calloc((size_t)n, sizeof(double));
@@ -183,8 +198,8 @@ bool run_prepare(struct harness_run *run, bool capture)
     if (!gpu_scene_init(&run->gpu, &run->scene, run->err, sizeof(run->err)) ||
         !run_setup_targets(run) ||
         !look_stages_init(&run->stages, &spec->look, &run->scene, &run->gpu,
-                          &run->gl->frame_block, &run->gl->caps, run->defines, run->err,
-                          sizeof(run->err)) ||
+                          &run->gl->frame_block, &run->gl->caps, &run->budget, run->defines,
+                          run->err, sizeof(run->err)) ||
         !run_setup_passes(run, job_spec_technique_options(spec),
                           (int64_t)spec->warmup_frames + n))
         return false;
@@ -278,12 +293,18 @@ static void resolve(const struct harness_run *run)
 
 bool run_frame(struct harness_run *run, int64_t k, bool timed)
 {
+    gpu_budget_frame(&run->budget);
     run_frame_data(run, k, &run->frame_data);
     gpu_frame_block_update(&run->gl->frame_block, &run->frame_data);
     gpu_timer_begin_frame(run->timer);
     bool ok = look_stages_before(&run->stages, &run->passes, run->shadow_pass, k, timed, run->err,
                                  sizeof(run->err)) &&
               run->tech->render(run->state, &run->env, k, run->err, sizeof(run->err));
+    if (!ok && gpu_budget_stopped(&run->budget)) {
+        /* Abandoned where it was told to stop: nothing more is drawn. */
+        gpu_timer_end_frame(run->timer);
+        return false;
+    }
     look_stages_after(&run->stages, &run->passes, run->sky_pass, run->env.output_fbo,
                       run->env.width, run->env.height);
     run->hdr_resolved = post_chain_run(run->post);

@@ -82,6 +82,8 @@ struct harness_run {
     int shadow_pass, sky_pass; /* -1 when the look has none */
     struct post_chain *post;
     GLuint hdr_resolved; /* the HDR colour the resolve reads this frame */
+    /* Bounded submissions: asks the job's cancel flag and timeout. */
+    struct gpu_budget budget;
     /* Zeroed with the run, so that a still camera's block is built once. */
     struct gpu_frame_data frame_data;
     GLuint ldr_fbo;
@@ -121,6 +123,10 @@ bool run_setup_passes(struct harness_run *run, const void *options, int64_t time
 /* Builds the post chain's effects once the technique was created: the
  * normals it publishes (if any) choose their programs. */
 bool run_build_post_chain(struct harness_run *run);
+
+/* Starts the run's budget: its waits ask whether the job was cancelled (a
+ * DELETE, or the daemon stopping) or ran out of time. */
+void run_budget_init(struct harness_run *run);
 
 /* The per-frame block for frame k: camera, viewport and counts. */
 void run_frame_data(const struct harness_run *run, int64_t k, struct gpu_frame_data *d);

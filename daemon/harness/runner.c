@@ -4,6 +4,7 @@
 #include <epoxy/gl.h>
 #include <errno.h>
 #include <pthread.h>
+#include <time.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,6 +18,7 @@
 #include "common/stats.h"
 #include "daemon/gpu/egl.h"
 #include "daemon/gpu/glutil.h"
+#include "daemon/harness/deadline.h"
 #include "daemon/harness/measure.h"
 #include "daemon/harness/metrics_stage.h"
 #include "daemon/harness/outputs.h"
@@ -33,7 +35,7 @@ struct runner {
     pthread_t thread;
     pthread_mutex_t lock;
     pthread_cond_t ready_cond;
-    int ready; /* 0 starting, 1 up, -1 failed */
+    int ready; /* 0 starting, 1 up, -1 failed, 2 its loop has ended */
     atomic_bool alive;
     char error[512];
     /* The render thread's own; device_json is immutable once ready. */
@@ -64,7 +66,25 @@ static json_t *collect_device(struct egl_context *egl, const struct gpu_caps *ca
 static bool prepare_and_measure(struct harness_run *run, bool capture, int run_index,
                                 enum job_status *status)
 {
-    return run_prepare(run, capture) && measure_run(run, run_index, status);
+    if (run_prepare(run, capture))
+        return measure_run(run, run_index, status);
+    /* Told to stop while the look's set-up (image-based lighting's probes)
+     * ran: say why, as the timed loop would. */
+    bool cancelled = atomic_load(&run->job->cancel);
+    if (cancelled || job_timed_out(run->job)) {
+        char what[512];
+        snprintf(what, sizeof(what), "%.500s", run->err);
+        if (cancelled) {
+            *status = JOB_CANCELLED;
+            snprintf(run->err, sizeof(run->err), "cancelled during the set-up of run %d (%s)",
+                     run_index + 1, what);
+        } else {
+            char detail[540];
+            snprintf(detail, sizeof(detail), " (%s)", what);
+            job_timeout_message(run->job, "set-up", detail, run->err, sizeof(run->err));
+        }
+    }
+    return false;
 }
 
 static json_t *run_summary(int index, double wall_s, json_t *frame, json_t *gpu, json_t *cpu)
@@ -198,19 +218,27 @@ static void run_job(struct runner *r, struct job *job)
     }
     if (result)
         status = JOB_DONE;
-done:
-    if (status != JOB_DONE)
-        LOG(LOG_WARN, "job %s %s: %s", job->id, job_status_name(status), run.err);
-    else
-        LOG(LOG_INFO, "job %s rendered", job->id);
-    run_finish(&run);
-    service_status("idle; last job %s %s", job->id, job_status_name(status));
-    if (status == JOB_DONE && spec->reference[0]) {
-        queue_set_phase(r->queue, job, "metrics");
-        metrics_worker_submit(r->metrics, job, result);
-        return;
+done:;
+    char id[RECORD_ID_LEN];
+    snprintf(id, sizeof(id), "%s", job->id);
+    if (status != JOB_DONE) {
+        /* The job ends now; what the GPU still has of it (a tile or two of
+         * an abandoned frame) drains in the tear-down below, before the
+         * next job starts. */
+        LOG(LOG_WARN, "job %s %s: %s", id, job_status_name(status), run.err);
+        queue_finish(r->queue, job, status, run.err, result);
+        run_finish(&run);
+    } else {
+        LOG(LOG_INFO, "job %s rendered", id);
+        run_finish(&run);
+        if (spec->reference[0]) {
+            queue_set_phase(r->queue, job, "metrics");
+            metrics_worker_submit(r->metrics, job, result);
+        } else {
+            queue_finish(r->queue, job, status, NULL, result);
+        }
     }
-    queue_finish(r->queue, job, status, status == JOB_DONE ? NULL : run.err, result);
+    service_status("idle; last job %s %s", id, job_status_name(status));
 }
 
 static void *runner_main(void *arg)
@@ -248,6 +276,10 @@ static void *runner_main(void *arg)
     atomic_store(&r->alive, false);
     harness_gl_finish(&r->gl);
     egl_context_destroy(egl);
+    pthread_mutex_lock(&r->lock);
+    r->ready = 2;
+    pthread_cond_broadcast(&r->ready_cond);
+    pthread_mutex_unlock(&r->lock);
     return NULL;
 }
 
@@ -268,6 +300,11 @@ struct runner *runner_create(struct queue *q, int device, bool gl_debug,
     }
     r->device = device;
     r->gl_debug = gl_debug;
+    /* Tests draw everything in tiles of a tiny slice, however cheap: the
+     * pixels must not change. */
+    const char *slice_ms = getenv("SHADEBENCH_SLICE_MS");
+    if (slice_ms && atof(slice_ms) > 0)
+        gpu_budget_configure(atof(slice_ms) / 1e3, 0.0, 0.25);
     atomic_init(&r->alive, false);
     pthread_mutex_init(&r->lock, NULL);
     pthread_cond_init(&r->ready_cond, NULL);
@@ -289,6 +326,24 @@ struct runner *runner_create(struct queue *q, int device, bool gl_debug,
         return NULL;
     }
     return r;
+}
+
+bool runner_stop(struct runner *r, double wait_s)
+{
+    queue_stop(r->queue);
+    struct timespec until;
+    clock_gettime(CLOCK_REALTIME, &until);
+    until.tv_sec += (time_t)wait_s;
+    until.tv_nsec += (long)((wait_s - (double)(time_t)wait_s) * 1e9);
+    if (until.tv_nsec >= 1000000000L)
+        until.tv_sec++, until.tv_nsec -= 1000000000L;
+    pthread_mutex_lock(&r->lock);
+    while (r->ready != 2 &&
+           pthread_cond_timedwait(&r->ready_cond, &r->lock, &until) == 0)
+        ;
+    bool ended = r->ready == 2;
+    pthread_mutex_unlock(&r->lock);
+    return ended;
 }
 
 void runner_destroy(struct runner *r)

@@ -16,6 +16,11 @@ struct runner;
 /* Starts the render thread and waits until its context is up (or failed). */
 struct runner *runner_create(struct queue *q, int device, bool gl_debug,
                              char *err, size_t errlen);
+/* Stops the queue and waits up to wait_s for the render thread to end: the
+ * running job stops at once and is put back in the queue, but what the GPU
+ * still has of its frame drains first. False when the thread has not ended
+ * by then (the owner may exit without it: the job's state is on disk). */
+bool runner_stop(struct runner *r, double wait_s);
 /* Stops the queue, lets the running job see it, joins. Accepts NULL. */
 void runner_destroy(struct runner *r);
 

@@ -148,7 +148,7 @@ static bool filters_init(struct filters *f, struct look_ibl *ibl, const struct g
 /* Layer `layer`'s source: the environment alone (probe NULL) or the scene
  * from the probe, into the source cube map with its mip chain. */
 static bool capture(struct look_ibl *ibl, struct filters *f, const struct look_ibl_env *env,
-                    const struct ibl_probe *probe)
+                    const struct ibl_probe *probe, struct gpu_budget *budget)
 {
     const struct scene *s = env->scene;
     int res = ibl->resolution;
@@ -163,7 +163,8 @@ static bool capture(struct look_ibl *ibl, struct filters *f, const struct look_i
     glViewport(0, 0, res, res);
     glDisable(GL_SCISSOR_TEST);
     glDisable(GL_BLEND);
-    for (int face = 0; face < 6; face++) {
+    gpu_loop_begin(budget);
+    for (int face = 0; face < 6 && !gpu_budget_stopped(budget); face++) {
         glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0,
                                GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)face, f->source, 0);
         if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
@@ -197,21 +198,29 @@ static bool capture(struct look_ibl *ibl, struct filters *f, const struct look_i
         }
         glEnable(GL_DEPTH_TEST);
         look_sky_draw(env->sky);
+        gpu_loop_step(budget);
     }
+    gpu_loop_end(budget);
+    if (gpu_budget_stopped(budget))
+        return false;
     glBindTexture(GL_TEXTURE_CUBE_MAP, f->source);
     glGenerateMipmap(GL_TEXTURE_CUBE_MAP);
     return true;
 }
 
-static void draw_face(struct filters *f, GLuint target, int level, int layer_face, int size)
+/* A face of a filtered map: samples x texels can take long, so in tiles. */
+static void draw_face(struct filters *f, GLuint target, int level, int layer_face, int size,
+                      struct gpu_budget *b)
 {
     glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, target, level, layer_face);
     glViewport(0, 0, size, size);
     glBindVertexArray(f->vao);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+    struct gpu_tiles t;
+    for (gpu_tiles_begin(b, size, size, &t); gpu_tiles_next(b, &t);)
+        glDrawArrays(GL_TRIANGLES, 0, 3);
 }
 
-static bool filter(struct look_ibl *ibl, struct filters *f, int layer)
+static bool filter(struct look_ibl *ibl, struct filters *f, int layer, struct gpu_budget *b)
 {
     int res = ibl->resolution;
     glBindFramebuffer(GL_FRAMEBUFFER, f->fbo);
@@ -228,7 +237,7 @@ static bool filter(struct look_ibl *ibl, struct filters *f, int layer)
                 (float)res);
     for (int face = 0; face < 6; face++) {
         glUniform1i(SB_LOC_IBL_FACE, face);
-        draw_face(f, ibl->irradiance, 0, layer * 6 + face, IRRADIANCE_SIZE);
+        draw_face(f, ibl->irradiance, 0, layer * 6 + face, IRRADIANCE_SIZE, b);
     }
     /* Prefiltered: level l at roughness l / (levels - 1). */
     glUseProgram(f->prefilter_prog);
@@ -239,11 +248,12 @@ static bool filter(struct look_ibl *ibl, struct filters *f, int layer)
                     (float)res);
         for (int face = 0; face < 6; face++) {
             glUniform1i(SB_LOC_IBL_FACE, face);
-            draw_face(f, ibl->prefiltered, l, layer * 6 + face, size);
+            draw_face(f, ibl->prefiltered, l, layer * 6 + face, size, b);
         }
     }
     glBindVertexArray(0);
-    return glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    return !gpu_budget_stopped(b) &&
+           glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
 }
 
 struct look_ibl *look_ibl_create(const struct look_ibl_env *env, char *err, size_t errlen)
@@ -302,15 +312,23 @@ struct look_ibl *look_ibl_create(const struct look_ibl_env *env, char *err, size
     int64_t first = 1;
     gpu_scene_set_light_rows(env->gpu, &first, 1);
     glGenQueries(1, &phase.query);
+    /* The set-up's pieces are measured apart from the frames'. */
+    struct gpu_budget budget;
+    gpu_budget_init(&budget, env->budget ? env->budget->stop : NULL,
+                    env->budget ? env->budget->ctx : NULL);
     for (int layer = 0; layer < layers; layer++) {
         phase_begin(&phase);
-        bool captured = capture(ibl, &f, env, layer ? &ibl->probe[layer - 1] : NULL);
+        bool captured = capture(ibl, &f, env, layer ? &ibl->probe[layer - 1] : NULL, &budget);
         phase_end(&phase, &ibl->capture_ms, &ibl->gpu_capture_ms);
         phase_begin(&phase);
-        bool filtered = captured && filter(ibl, &f, layer);
+        bool filtered = captured && filter(ibl, &f, layer, &budget);
         phase_end(&phase, &ibl->filter_ms, &ibl->gpu_filter_ms);
         if (!filtered) {
-            snprintf(err, errlen, "look.ibl: the capture framebuffer is incomplete");
+            if (gpu_budget_stopped(&budget))
+                snprintf(err, errlen, "stopped while look.ibl captured and filtered probe %d of %d",
+                         layer, layers - 1);
+            else
+                snprintf(err, errlen, "look.ibl: the capture framebuffer is incomplete");
             goto out;
         }
     }

@@ -16,6 +16,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "daemon/gpu/budget.h"
 #include "daemon/gpu/gpu_scene.h"
 #include "daemon/gpu/pass.h"
 #include "daemon/look/sky.h"
@@ -30,6 +31,9 @@ struct look_ibl_env {
     struct gpu_scene *gpu;
     struct gpu_frame_block *frame_block; /* overwritten by the captures */
     const struct look_sky *sky;
+    /* Whose stop predicate the captures and filters ask (NULL: none); they
+     * measure their pieces in a budget of their own. */
+    const struct gpu_budget *budget;
 };
 
 /* Captures and filters everything (outside the timed frames; leaves the

@@ -47,9 +47,11 @@ void look_defines(const struct look_spec *look, char *out, size_t cap)
 bool look_stages_init(struct look_stages *l, const struct look_spec *look,
                        const struct scene *scene, struct gpu_scene *gpu,
                        struct gpu_frame_block *frame_block, const struct gpu_caps *caps,
-                       const char *defines, char *err, size_t errlen)
+                       struct gpu_budget *budget, const char *defines, char *err,
+                       size_t errlen)
 {
     memset(l, 0, sizeof(*l));
+    l->budget = budget;
     l->look = look;
     l->scene = scene;
     double t0 = clock_mono_s();
@@ -57,7 +59,7 @@ bool look_stages_init(struct look_stages *l, const struct look_spec *look,
     if ((l->sky_on || look->ibl.enabled) && !look_sky_init(&l->sky, defines, err, errlen))
         goto fail;
     if (look->ibl.enabled) {
-        struct look_ibl_env env = {&look->ibl, scene, gpu, frame_block, &l->sky};
+        struct look_ibl_env env = {&look->ibl, scene, gpu, frame_block, &l->sky, budget};
         if (!(l->ibl = look_ibl_create(&env, err, errlen)))
             goto fail;
     }
@@ -98,7 +100,8 @@ bool look_stages_before(struct look_stages *l, const struct gpu_passes *passes, 
     if (l->ibl)
         look_ibl_frame(l->ibl, frame);
     if (l->shadows && shadow_pass >= 0)
-        return look_shadows_render(l->shadows, passes, shadow_pass, frame, timed, err, errlen);
+        return look_shadows_render(l->shadows, passes, shadow_pass, frame, timed, l->budget, err,
+                                   errlen);
     return true;
 }
 

@@ -28,6 +28,7 @@
 void look_defines(const struct look_spec *look, char *out, size_t cap);
 
 struct look_stages {
+    struct gpu_budget *budget;
     const struct look_spec *look;
     const struct scene *scene;
     bool sky_on;
@@ -43,7 +44,8 @@ struct look_stages {
 bool look_stages_init(struct look_stages *l, const struct look_spec *look,
                        const struct scene *scene, struct gpu_scene *gpu,
                        struct gpu_frame_block *frame_block, const struct gpu_caps *caps,
-                       const char *defines, char *err, size_t errlen);
+                       struct gpu_budget *budget, const char *defines, char *err,
+                       size_t errlen);
 /* Takes a zeroed or initialised look. */
 void look_stages_finish(struct look_stages *l);
 

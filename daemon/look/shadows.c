@@ -168,7 +168,8 @@ static void draw_casters(struct look_shadows *sh, int ncasters, const float ligh
 }
 
 bool look_shadows_render(struct look_shadows *sh, const struct gpu_passes *passes, int pass,
-                            int64_t frame, bool timed, char *err, size_t errlen)
+                            int64_t frame, bool timed, struct gpu_budget *budget, char *err,
+                            size_t errlen)
 {
     const struct scene *s = sh->scene;
     const struct shadow_spec *spec = &sh->spec;
@@ -184,7 +185,8 @@ bool look_shadows_render(struct look_shadows *sh, const struct gpu_passes *passe
     if (atlas)
         glEnable(GL_SCISSOR_TEST);
     double draws_before = sh->draws_sum;
-    for (int i = 0; i < p->lights; i++) {
+    gpu_loop_begin(budget);
+    for (int i = 0; i < p->lights && gpu_loop_step(budget); i++) {
         const struct shadow_light_plan *l = &p->light[i];
         struct shadow_light_gpu *row = &sh->rows[i];
         memset(row, 0, sizeof(*row));
@@ -226,9 +228,15 @@ bool look_shadows_render(struct look_shadows *sh, const struct gpu_passes *passe
             draw_casters(sh, ncasters, l->pos, f, widen);
         }
     }
+    gpu_loop_end(budget);
     glBindVertexArray(0);
     glDisable(GL_SCISSOR_TEST);
     glCullFace(GL_BACK);
+    if (gpu_budget_stopped(budget)) {
+        gpu_pass_end(passes);
+        snprintf(err, errlen, "stopped");
+        return false;
+    }
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, sh->ssbo);
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0,
                     (GLsizeiptr)((size_t)p->lights * sizeof(*sh->rows)), sh->rows);

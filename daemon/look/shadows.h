@@ -15,6 +15,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "daemon/gpu/budget.h"
 #include "daemon/gpu/caps.h"
 #include "daemon/gpu/gpu_scene.h"
 #include "daemon/gpu/pass.h"
@@ -33,7 +34,8 @@ struct look_shadows *look_shadows_create(const struct shadow_spec *spec,
  * allocation, no lookups. False (err set) only when overflow is "fail"
  * and a light lost its shadow. `timed` counts the frame in the figures. */
 bool look_shadows_render(struct look_shadows *sh, const struct gpu_passes *passes, int pass,
-                            int64_t frame, bool timed, char *err, size_t errlen);
+                            int64_t frame, bool timed, struct gpu_budget *budget, char *err,
+                            size_t errlen);
 /* Atlas use and lights per timed frame, the lights that lost shadows. New
  * reference. */
 json_t *look_shadows_describe(const struct look_shadows *sh);

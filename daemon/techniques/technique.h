@@ -11,7 +11,9 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
+#include "daemon/gpu/budget.h"
 #include "daemon/gpu/caps.h"
 #include "daemon/gpu/gpu_scene.h"
 #include "daemon/gpu/pass.h"
@@ -62,7 +64,23 @@ struct technique_env {
     const char *defines;
     /* Zeroed by the harness before create; the technique fills what it has. */
     struct technique_products *products;
+    /* Bounded submissions (daemon/gpu/budget.h): a pass whose work may be
+     * large draws it in tiles (gpu_tiles_*) or takes checkpoints in its
+     * loops (gpu_loop_*), and render returns false, err "stopped", once
+     * gpu_budget_stopped. */
+    struct gpu_budget *budget;
 };
+
+/* After a pass drew in tiles or took checkpoints: false, err "stopped",
+ * once the budget was told to stop (the harness then says why). */
+static inline bool technique_keep_going(const struct technique_env *env, char *err,
+                                        size_t errlen)
+{
+    if (!gpu_budget_stopped(env->budget))
+        return true;
+    snprintf(err, errlen, "stopped");
+    return false;
+}
 
 struct technique {
     const struct technique_info *info;

@@ -88,7 +88,6 @@ fail:
 static bool deferred_render(void *state, const struct technique_env *env, int64_t frame,
                             char *err, size_t errlen)
 {
-    (void)err, (void)errlen;
     struct deferred *d = state;
     bool heat = heat_wanted(env, frame);
     gpu_scene_set_light_rows(env->gpu, &frame, 1);
@@ -103,9 +102,16 @@ static bool deferred_render(void *state, const struct technique_env *env, int64_
     if (heat)
         heat_bind(&d->heat); /* the ambient pass zeroes every pixel's count */
     glBindVertexArray(d->empty_vao);
-    gpu_scene_bind(env->gpu, &d->ambient);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    if (env->scene->light_count > 0) {
+    /* Each tile gets the ambient term, then every light in index order:
+     * what each pixel sums is the same as in one draw of each. */
+    struct gpu_tiles t;
+    for (gpu_tiles_begin(env->budget, env->width, env->height, &t); gpu_tiles_next(env->budget, &t);) {
+        glDisable(GL_BLEND);
+        glDisable(GL_CULL_FACE);
+        gpu_scene_bind(env->gpu, &d->ambient);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        if (env->scene->light_count == 0)
+            continue;
         if (heat)
             glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         glEnable(GL_BLEND);
@@ -125,7 +131,7 @@ static bool deferred_render(void *state, const struct technique_env *env, int64_
     if (heat)
         heat_done();
     gpu_pass_end(env->passes);
-    return true;
+    return technique_keep_going(env, err, errlen);
 }
 
 static json_t *deferred_describe(void *state)

@@ -34,6 +34,7 @@ struct osl {
     GLuint texgen_prog;
     struct scene_program light, draw;
     GLint work_count_loc, groups_x_loc; /* the lighting pass's per-frame uniforms */
+    GLint group_base_loc, group_end_loc;
     GLuint position_tex[SCENE_MESH_COUNT], normal_tex[SCENE_MESH_COUNT];
     int base_size[SCENE_MESH_COUNT]; /* level 0 edge of each mesh's textures */
     GLuint atlas, tile_buffer, work_buffer;
@@ -241,6 +242,8 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
     o->draw = gpu_scene_program(env->gpu, draw_prog);
     o->work_count_loc = glGetUniformLocation(light_prog, "u_work_count");
     o->groups_x_loc = glGetUniformLocation(light_prog, "u_groups_x");
+    o->group_base_loc = glGetUniformLocation(light_prog, "u_group_base");
+    o->group_end_loc = glGetUniformLocation(light_prog, "u_group_end");
     /* Texture units never change: position and normal of mesh m on units
      * 1 + 2m and 2 + 2m for the lighting pass, the atlas on unit 0. */
     for (int m = 0; m < SCENE_MESH_COUNT; m++) {
@@ -334,11 +337,19 @@ static double light_pass(struct osl *o, const struct technique_env *env, int64_t
         glBindTexture(GL_TEXTURE_2D, o->normal_tex[m]);
     }
     glActiveTexture(GL_TEXTURE0);
-    uint32_t gx = blocks < (uint32_t)o->groups_x_max ? blocks : (uint32_t)o->groups_x_max;
-    uint32_t gy = (blocks + gx - 1) / gx;
     glUniform1i(o->work_count_loc, count);
-    glUniform1i(o->groups_x_loc, (GLint)gx);
-    glDispatchCompute(gx, gy, 1);
+    /* The blocks in ranges of bounded cost (all at once unless that is
+     * costly): each a dispatch of its own. */
+    struct gpu_tiles t;
+    for (gpu_range_begin(env->budget, (int)blocks, &t); gpu_tiles_next(env->budget, &t);) {
+        uint32_t n = (uint32_t)t.tw;
+        uint32_t gx = n < (uint32_t)o->groups_x_max ? n : (uint32_t)o->groups_x_max;
+        uint32_t gy = (n + gx - 1) / gx;
+        glUniform1i(o->groups_x_loc, (GLint)gx);
+        glUniform1ui(o->group_base_loc, (GLuint)t.tx);
+        glUniform1ui(o->group_end_loc, (GLuint)(t.tx + t.tw));
+        glDispatchCompute(gx, gy, 1);
+    }
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
     return texels;
 }
@@ -346,7 +357,6 @@ static double light_pass(struct osl *o, const struct technique_env *env, int64_t
 static bool osl_render(void *state, const struct technique_env *env, int64_t frame,
                        char *err, size_t errlen)
 {
-    (void)err, (void)errlen;
     struct osl *o = state;
     int count = osl_schedule_plan(&o->schedule, env->scene, frame, !o->shaded_once,
                                   ((const struct osl_options *)env->options)->reshade, o->plan);
@@ -375,9 +385,11 @@ static bool osl_render(void *state, const struct technique_env *env, int64_t fra
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_TILES, o->tile_buffer);
     glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_ATLAS);
     glBindTexture(GL_TEXTURE_2D, o->atlas);
-    gpu_scene_draw(env->gpu, &o->draw);
+    struct gpu_tiles t;
+    for (gpu_tiles_begin(env->budget, env->width, env->height, &t); gpu_tiles_next(env->budget, &t);)
+        gpu_scene_draw(env->gpu, &o->draw);
     gpu_pass_end(env->passes);
-    return true;
+    return technique_keep_going(env, err, errlen);
 }
 
 static json_t *osl_describe(void *state)

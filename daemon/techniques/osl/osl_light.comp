@@ -15,12 +15,17 @@ uniform sampler2D u_position[4];
 uniform sampler2D u_normal[4];
 uniform int u_work_count;
 uniform int u_groups_x;
+// The dispatch may cover a range of the blocks only (bounded submissions,
+// daemon/gpu/budget.h): groups [u_group_base, u_group_end).
+uniform uint u_group_base;
+uniform uint u_group_end;
 
 void main()
 {
-    uint group = gl_WorkGroupID.y * uint(u_groups_x) + gl_WorkGroupID.x;
+    uint group = u_group_base + gl_WorkGroupID.y * uint(u_groups_x) + gl_WorkGroupID.x;
     int lo = 0, hi = u_work_count - 1;
-    if (u_work_count == 0 || group >= work[hi].z + work[hi].w * work[hi].w)
+    if (u_work_count == 0 || group >= u_group_end ||
+        group >= work[hi].z + work[hi].w * work[hi].w)
         return;
     while (lo < hi) {
         int mid = (lo + hi + 1) / 2;

@@ -81,7 +81,6 @@ static void binning(struct culled *c, const struct technique_env *env, int64_t f
 bool culled_render(void *state, const struct technique_env *env, int64_t frame, char *err,
                    size_t errlen)
 {
-    (void)err, (void)errlen;
     struct culled *c = state;
     bool tiles = c->cfg.grid.kind == LIGHT_GRID_TILES;
     bool heat = heat_wanted(env, frame);
@@ -106,7 +105,10 @@ bool culled_render(void *state, const struct technique_env *env, int64_t frame, 
         gpu_scene_bind(env->gpu, &c->shade);
         light_grid_bind(&c->grid);
         glBindVertexArray(c->empty_vao);
-        glDrawArrays(GL_TRIANGLES, 0, 3);
+        struct gpu_tiles t;
+        for (gpu_tiles_begin(env->budget, env->width, env->height, &t);
+             gpu_tiles_next(env->budget, &t);)
+            glDrawArrays(GL_TRIANGLES, 0, 3);
         glBindVertexArray(0);
     } else {
         gpu_pass_begin(env->passes, c->pass_shading, env->output_fbo, env->width, env->height);
@@ -115,12 +117,15 @@ bool culled_render(void *state, const struct technique_env *env, int64_t frame, 
             heat_clear(&c->heat, env->output_fbo);
         gpu_scene_bind(env->gpu, &c->shade);
         light_grid_bind(&c->grid);
-        gpu_scene_draw(env->gpu, &c->shade);
+        struct gpu_tiles t;
+        for (gpu_tiles_begin(env->budget, env->width, env->height, &t);
+             gpu_tiles_next(env->budget, &t);)
+            gpu_scene_draw(env->gpu, &c->shade);
     }
     if (heat)
         heat_done();
     gpu_pass_end(env->passes);
-    return true;
+    return technique_keep_going(env, err, errlen);
 }
 
 json_t *culled_describe(void *state)

@@ -34,16 +34,17 @@ bool single_pass_create(const struct technique_env *env, const char *label, cons
 bool single_pass_render(void *state, const struct technique_env *env, int64_t frame, char *err,
                         size_t errlen)
 {
-    (void)err, (void)errlen;
     struct single_pass *sp = state;
     gpu_scene_set_light_rows(env->gpu, &frame, 1);
     gpu_pass_begin(env->passes, 0, env->output_fbo, env->width, env->height);
     glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     gpu_scene_bind(env->gpu, &sp->program);
-    gpu_scene_draw(env->gpu, &sp->program);
+    struct gpu_tiles t;
+    for (gpu_tiles_begin(env->budget, env->width, env->height, &t); gpu_tiles_next(env->budget, &t);)
+        gpu_scene_draw(env->gpu, &sp->program);
     gpu_pass_end(env->passes);
-    return true;
+    return technique_keep_going(env, err, errlen);
 }
 
 void single_pass_destroy(void *state)

@@ -1,0 +1,169 @@
+"""No job can hold the render thread (issue #26): whatever a frame costs,
+cancel, timeout and SIGTERM act within about a second.
+- a frame of many seconds (forward, 16,384 lights at 128x128, about 15 s
+  unsliced on a 2-core llvmpipe box; 65,536 lights at 256x256 took 241 s)
+  fails at its timeout_s of 1 s, naming the phase, frame and pass, within a
+  second of it;
+- a DELETE during such a frame ends the job cancelled within a second;
+- a DELETE during image-based lighting's set-up (32 probes of 512 texels,
+  4,096 samples) ends it cancelled, naming the set-up;
+- SIGTERM during such a frame: the daemon exits 0 within 5 s, and after a
+  restart the job is queued again;
+- the next job runs after each (once the abandoned frame's last tiles
+  have drained);
+- drawing in tiles changes no pixel: a daemon that slices everything into
+  pieces of 2 ms (SHADEBENCH_SLICE_MS=2) renders every technique,
+  the post effects and the look byte for byte as one that does not, and says
+  so in result.gpu_budget."""
+
+import calendar
+import os
+import time
+
+import testlib
+from testlib import check
+
+testlib.skip_without_egl()
+S = testlib.TIME_SCALE
+
+HEAVY = {"technique": "forward", "scene": {"width": 128, "height": 128, "lights": 16384},
+         "frames": 3, "warmup_frames": 0}
+IBL = {"technique": "forward", "frames": 2, "scene": {"width": 64, "height": 48},
+       "look": {"lighting": "pbr", "ibl": {"probes": 32, "resolution": 512, "samples": 4096}}}
+TINY = {"technique": "unlit", "frames": 1, "warmup_frames": 0, "scene": {"width": 32, "height": 32}}
+
+
+def parse_time(text):
+    """The store's "2026-11-25T06:42:56.523Z" in seconds since 1970."""
+    if not text:
+        return float("nan")
+    whole, _, frac = text.rstrip("Z").partition(".")
+    return calendar.timegm(time.strptime(whole, "%Y-%m-%dT%H:%M:%S")) + float("0." + (frac or "0"))
+
+
+def wait_running(d, job_id):
+    """Until the job runs."""
+    deadline = time.time() + 60 * S
+    while time.time() < deadline:
+        job = d.json("GET", "/v1/jobs/" + job_id)[1]
+        if job.get("status") == "running":
+            return job
+        time.sleep(0.05)
+    return None
+
+
+def cancel_running(d, job, what):
+    """Submits job, and a second after it runs, DELETEs it: (status, the job
+    as the DELETE answered it, seconds the DELETE took)."""
+    job_id = d.submit(job)
+    check(wait_running(d, job_id) is not None, "%s runs" % what)
+    time.sleep(1.0)
+    t0 = time.time()
+    status, answer = d.json("DELETE", "/v1/jobs/" + job_id)
+    return status, answer, time.time() - t0
+
+
+def next_job_is_quick(d, what):
+    """The next job runs once the abandoned frame's last tiles have drained
+    (in the frame where each piece is first measured, a tile can overshoot
+    its slice where cheap pixels give way to dear ones)."""
+    t0 = time.time()
+    done = d.run(TINY)
+    check(done.get("status") == "done" and time.time() - t0 < 20 * S,
+          "after %s, the next job runs (%.2f s)" % (what, time.time() - t0))
+
+
+d = testlib.Daemon()
+try:
+    # timeout_s acts inside a frame of minutes.
+    job_id = d.submit(dict(HEAVY, frames=1, timeout_s=1))
+    done = d.wait(job_id)
+    took = parse_time(done.get("finished")) - parse_time(done.get("started"))
+    err = done.get("error") or ""
+    check(done.get("status") == "failed" and "timeout" in err and "rendering phase" in err and
+          "frame 1" in err and "shading pass" in err and took < 1 + 1.0 * S,
+          "timeout_s 1 stops a frame of seconds %.2f s after the job started: %s" % (took, err))
+    next_job_is_quick(d, "a timeout")
+
+    # DELETE acts inside a frame of seconds.
+    status, job, took = cancel_running(d, HEAVY, "the heavy job")
+    err = job.get("error") or ""
+    check(status in (200, 202) and job.get("status") == "cancelled" and took < 1.0 * S and
+          "frame 1" in err and "pass" in err,
+          "DELETE ends a job in a frame of seconds within a second (%.2f s): %s %s"
+          % (took, job.get("status"), err))
+    next_job_is_quick(d, "a cancel")
+
+    # DELETE acts inside image-based lighting's set-up.
+    status, job, took = cancel_running(d, IBL, "the IBL job")
+    err = job.get("error") or ""
+    check(job.get("status") == "cancelled" and "set-up" in err and "look.ibl" in err and
+          took < 1.5 * S,
+          "DELETE ends a job in image-based lighting's set-up (%.2f s): %s" % (took, err))
+    next_job_is_quick(d, "a cancel in the set-up")
+
+    # SIGTERM: out within 5 s, the job queued again for the next start.
+    job_id = d.submit(HEAVY)
+    check(wait_running(d, job_id) is not None, "the heavy job runs before SIGTERM")
+    time.sleep(1.0)
+    t0 = time.time()
+    code = d.stop()
+    took = time.time() - t0
+    check(code == 0 and took < 5 * S, "SIGTERM during a frame of seconds exits 0 in %.2f s" % took)
+    state = d.state
+finally:
+    if d.alive():
+        d.stop()
+
+# A fresh daemon over the stopped one's state: the job comes back queued.
+first = d
+d = testlib.Daemon("--state-dir", state)
+try:
+    job = d.json("GET", "/v1/jobs/" + job_id)[1]
+    check(job.get("status") in ("queued", "running"),
+          "after a restart the stopped job is queued again: %s" % job.get("status"))
+    status, job = d.json("DELETE", "/v1/jobs/" + job_id)
+    check(job.get("status") == "cancelled", "and can be cancelled there: %s" % job.get("status"))
+finally:
+    testlib.stop_and_check(d)
+    first.cleanup(keep=testlib.failures > 0)
+
+# Tiles change no pixel: every technique, the post chain and the look, drawn
+# with pieces of 2 ms, against a daemon that draws them whole.
+JOBS = [{"technique": t, "frames": 2, "warmup_frames": 1, "capture_interval": 2,
+         "osl": {"resolution": "auto"},
+         "scene": {"preset": "grid", "width": 64, "height": 48, "dynamic": True}}
+        for t in ("forward", "osl", "deferred", "tiled_deferred", "forward_plus",
+                  "clustered_forward", "clustered_deferred")]
+JOBS += [
+    {"technique": "deferred", "deferred": {"light_bounds": "volume"}, "frames": 2,
+     "warmup_frames": 1, "capture_interval": 2,
+     "scene": {"preset": "lights", "lights": 64, "width": 64, "height": 48}},
+    {"technique": "forward", "frames": 2, "warmup_frames": 1, "capture_interval": 2,
+     "scene": {"preset": "grid", "width": 64, "height": 48},
+     "look": {"hdr": "rgba16f", "tonemap": "aces", "post": ["bloom", "toon", "ssao"]}},
+    {"technique": "forward", "frames": 2, "warmup_frames": 1, "capture_interval": 2,
+     "scene": {"preset": "teapots", "lights": 4, "width": 64, "height": 48},
+     "look": {"lighting": "pbr", "ibl": {"probes": 1, "resolution": 32, "samples": 16},
+              "shadows": {"atlas": 512}}},
+]
+whole = testlib.Daemon()
+tiled = testlib.Daemon(env={"SHADEBENCH_SLICE_MS": "2"})
+try:
+    for job in JOBS:
+        a, b = whole.run(job), tiled.run(job)
+        what = "%s %s" % (job["technique"], job.get("look") or job.get(job["technique"]) or "")
+        sliced = b.get("result", {}).get("gpu_budget", {}).get("pieces_sliced", 0)
+        check(a.get("status") == "done" and b.get("status") == "done" and sliced > 0,
+              "%s runs whole and in tiles (%d pieces sliced): %s %s"
+              % (what, sliced, a.get("error"), b.get("error")))
+        if a.get("status") != "done" or b.get("status") != "done":
+            continue
+        diff = testlib.png_diff(os.path.join(whole.state, "jobs", a["id"], "frame-000002.png"),
+                                os.path.join(tiled.state, "jobs", b["id"], "frame-000002.png"))
+        check(diff is not None and diff["differing_pixels"] == 0,
+              "%s in tiles gives the same pixels: %s" % (what, diff))
+finally:
+    testlib.stop_and_check(whole)
+    testlib.stop_and_check(tiled)
+testlib.finish("e2e_runaway")

@@ -122,10 +122,21 @@ struct request {
     struct route route;
     char *body;
     size_t len;
+    bool started;         /* the access handler has seen its headers */
     bool too_large;
     bool waiting;         /* suspended; the next call is the resume */
     unsigned wait_status; /* 200 for ?wait=, 202 for a DELETE that waits */
+    /* What the raw request target showed (on_uri): a refusal to answer
+     * once the headers are in, and the query's size. */
+    const char *target_field, *target_rule;
+    size_t query_args;
 };
+
+/* Set by answer_waited just before it closes the connection of a client
+ * that hung up, and read by on_mhd_log, which libmicrohttpd calls at once
+ * on the same thread: its "internal error" line is then the expected end
+ * of a wait, not an error (2,000 waits hung up made 2,000 warnings). */
+static _Thread_local bool closing_gone_client;
 
 static enum MHD_Result respond_text(struct MHD_Connection *c, unsigned status,
                                     char *text, size_t len, const char *type)
@@ -551,8 +562,12 @@ static enum MHD_Result answer_waited(struct http_server *s, struct MHD_Connectio
 {
     req->waiting = false;
     enum wake why = connections_wake(req->conn);
-    if (why == WAKE_GONE)
-        return MHD_NO; /* nobody to answer: close */
+    if (why == WAKE_GONE) {
+        /* Nobody to answer: close. Counted in /metrics
+         * (shadebench_http_waits_abandoned_total), logged at debug. */
+        closing_gone_client = true;
+        return MHD_NO;
+    }
     if (why == WAKE_STOPPING && req->wait_status == MHD_HTTP_OK)
         return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "wait",
                              "the daemon is stopping: the wait ended early; ask again once it "
@@ -797,7 +812,7 @@ static enum MHD_Result scan_header(void *cls, enum MHD_ValueKind kind, const cha
 /* Checks made as soon as the headers are in, before any body is read:
  * answers the request (returns true) when it must be refused. */
 static bool refuse_early(struct http_server *s, struct MHD_Connection *c, const char *method,
-                         struct request *req, enum MHD_Result *ret)
+                         const char *version, struct request *req, enum MHD_Result *ret)
 {
     struct header_scan h = {0};
     MHD_get_connection_values_n(c, MHD_HEADER_KIND, scan_header, &h);
@@ -818,6 +833,24 @@ static bool refuse_early(struct http_server *s, struct MHD_Connection *c, const 
         (te && strcasecmp(te, "chunked") != 0)) {
         *ret = respond_error(c, MHD_HTTP_BAD_REQUEST, "Transfer-Encoding",
                              "must be \"chunked\" alone, once, and without Content-Length");
+        return true;
+    }
+    /* RFC 9112: an HTTP/1.1 request without Host is a 400 (a proxy's
+     * host-based rules cannot apply to it). */
+    if (strcmp(version, MHD_HTTP_VERSION_1_1) == 0 &&
+        !MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_HOST)) {
+        *ret = respond_error(c, MHD_HTTP_BAD_REQUEST, "Host",
+                             "an HTTP/1.1 request must have a Host header");
+        return true;
+    }
+    if (req->target_field) {
+        char rule[200] = "";
+        if (strcmp(req->target_field, "query") == 0)
+            snprintf(rule, sizeof(rule), "%s; this one has %zu", req->target_rule,
+                     req->query_args);
+        else
+            snprintf(rule, sizeof(rule), "%s", req->target_rule);
+        *ret = respond_error(c, MHD_HTTP_BAD_REQUEST, req->target_field, rule);
         return true;
     }
     if (req->route.kind != ROUTE_HEALTHZ && !authorized(s, c)) {
@@ -850,20 +883,20 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
                                   const char *upload_data, size_t *upload_data_size,
                                   void **con_cls)
 {
-    (void)version;
     struct http_server *s = cls;
     struct request *req = *con_cls;
-    if (!req) {
+    closing_gone_client = false; /* a close that logged nothing */
+    if (!req || !req->started) {
         /* The headers are in; nothing of the body has been read. */
-        req = calloc(1, sizeof(*req));
-        if (!req)
+        if (!req && !(req = calloc(1, sizeof(*req))))
             return MHD_NO;
         *con_cls = req;
+        req->started = true;
         req->conn = connections_of(c);
         connections_headers_in(s->conns, req->conn);
         route_parse(url, &req->route);
         enum MHD_Result ret;
-        if (refuse_early(s, c, method, req, &ret)) {
+        if (refuse_early(s, c, method, version, req, &ret)) {
             connections_answering(s->conns, req->conn);
             return ret;
         }
@@ -887,7 +920,40 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
     if (req->waiting)
         return answer_waited(s, c, req);
     connections_answering(s->conns, req->conn);
+    /* Jansson reads a NUL byte as the end of the text, so that what follows
+     * it would go unread: a body is JSON text, which has none. */
+    const char *nul = req->body ? memchr(req->body, '\0', req->len) : NULL;
+    if (nul) {
+        char rule[96];
+        snprintf(rule, sizeof(rule), "must be JSON text, which has no NUL byte (one at byte %zu)",
+                 (size_t)(nul - req->body));
+        return respond_error(c, MHD_HTTP_BAD_REQUEST, "body", rule);
+    }
     return dispatch(s, c, method, req);
+}
+
+/* MHD_OPTION_URI_LOG_CALLBACK: the request target exactly as sent, before
+ * libmicrohttpd splits off the query, stores the arguments in the
+ * connection's pool and decodes them (route_check_target says why that
+ * matters). What it returns is the request's *con_cls. */
+static void *on_uri(void *cls, const char *uri, struct MHD_Connection *c)
+{
+    (void)cls, (void)c;
+    struct request *req = calloc(1, sizeof(*req));
+    if (!req)
+        return NULL; /* on_request allocates it, unchecked */
+    if (!route_check_target(uri, &req->query_args, &req->target_field, &req->target_rule) &&
+        strcmp(req->target_field, "query") == 0) {
+        /* Refused anyway: keep libmicrohttpd from filling the pool with the
+         * arguments (it then answered nothing). The target is its own
+         * writable read buffer, which it cuts at the '?' right after this
+         * call and parses the arguments from the byte after; ending the
+         * query there leaves it none to parse (libmicrohttpd 0.9.75 to
+         * 1.0). */
+        char *query = strchr((char *)uri, '?');
+        query[1] = '\0';
+    }
+    return req;
 }
 
 static size_t code_index(unsigned status)
@@ -924,7 +990,10 @@ static void on_mhd_log(void *cls, const char *fmt, va_list ap)
     size_t n = strlen(msg);
     while (n && msg[n - 1] == '\n')
         msg[--n] = '\0';
-    LOG(LOG_WARN, "libmicrohttpd: %s", msg);
+    bool expected = closing_gone_client && strstr(msg, "internal error");
+    closing_gone_client = false;
+    LOG(expected ? LOG_DEBUG : LOG_WARN, "libmicrohttpd: %s%s", msg,
+        expected ? " (a waiting client hung up)" : "");
 }
 
 struct http_server *http_server_create(const char *listen, const struct http_limits *limits,
@@ -994,7 +1063,8 @@ struct http_server *http_server_create(const char *listen, const struct http_lim
         (unsigned)limits->max_connections_per_ip, MHD_OPTION_CONNECTION_TIMEOUT,
         (unsigned)limits->idle_timeout_s, MHD_OPTION_CONNECTION_MEMORY_LIMIT,
         (size_t)CONNECTION_MEMORY, MHD_OPTION_NOTIFY_CONNECTION, connections_notify, s->conns,
-        MHD_OPTION_NOTIFY_COMPLETED, on_completed, s, MHD_OPTION_END);
+        MHD_OPTION_NOTIFY_COMPLETED, on_completed, s, MHD_OPTION_URI_LOG_CALLBACK, on_uri, s,
+        MHD_OPTION_END);
     freeaddrinfo(ai);
     if (!s->mhd) {
         snprintf(err, errlen, "cannot listen on %s (address in use or not allowed?)", listen);

@@ -423,6 +423,14 @@ bool job_spec_parse_text(const char *text, size_t len,
                          struct job_error *err)
 {
     json_error_t jerr;
+    /* Jansson stops at a NUL byte as at the end of the text: whatever
+     * follows one would go unread. JSON text has none. */
+    const char *nul = memchr(text, '\0', len);
+    if (nul) {
+        job_spec_defaults(out, techniques);
+        return job_error_set(err, "body", "must be JSON text, which has no NUL byte (one at "
+                             "byte %zu)", (size_t)(nul - text));
+    }
     json_t *body = json_loadb(text, len, JSON_REJECT_DUPLICATES, &jerr);
     if (!body) {
         job_spec_defaults(out, techniques);

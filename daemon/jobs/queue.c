@@ -741,17 +741,13 @@ static void load_unfinished(void *ctx, const struct store_row *stored)
     record_remove_tmp_files(row.dir);
     if (!row.dir_given)
         row.spec = NULL; /* finished now: its spec.json has it */
-    char why[300] = "";
+    char why[800] = "";
     json_t *figures = NULL;
-    if (job_dir_done_from_result(&row, &spec, row.dir, why, sizeof(why))) {
+    if (job_dir_done_from_result(q->store, &row, &spec, row.dir, why, sizeof(why))) {
         figures = row.figures; /* ours, not the store's */
         LOG(LOG_WARN, "job %s: stored as running, but its result.json is complete: done", row.id);
     } else {
-        row.status = JOB_INTERRUPTED;
-        row.finished = clock_unix_s();
-        snprintf(row.error, sizeof(row.error),
-                 "interrupted: the daemon stopped (killed or crashed) while this job ran; "
-                 "its files may be incomplete, submit it again to measure it");
+        job_dir_interrupted(&row, why);
     }
     if (!store_put(q->store, &row, 0, NULL, err, sizeof(err)))
         LOG(LOG_ERROR, "job %s: %s", row.id, err);

@@ -726,6 +726,51 @@ static void test_migration(void)
     remove_state(state);
 }
 
+/* Damaged records (issue 26): a result.json that cannot be read is
+ * quarantined wherever it is found, at start-up too (it was left in place
+ * when its job was rebuilt or found running), and a job rebuilt from its
+ * directory keeps the start time its result.json carries. */
+static void test_rebuilt_records(void)
+{
+    char *state = make_state();
+    char err[PATH_MAX + 300];
+    const char *result = "{\"frame_ms\": {\"median\": 3.5}, \"started_unix\": 1900000001.0}";
+    /* A damaged job.json, rebuilt from spec.json and result.json: done. */
+    legacy_job(state, "20291231-235900-0001", NULL, "{\"id\": \"2029", true, result);
+    /* Running when the daemon died, its result.json damaged. */
+    legacy_job(state, "20291231-235900-0002", "running", NULL, true, "{\"frame_ms\": ");
+    /* No row and no job.json (the store was rebuilt), result.json damaged. */
+    legacy_job(state, "20291231-235900-0003", NULL, NULL, true, "[1, 2]");
+    struct store *s = store_open(state, err, sizeof(err));
+    struct queue *q = s ? queue_create(s, 8) : NULL;
+    CHECK(q && queue_load(q, fixture_catalog(), err, sizeof(err)) == 3);
+    if (!q)
+        return;
+    json_t *job = queue_job_json(q, "20291231-235900-0001", 0);
+    const char *started = json_string_value(json_object_get(job, "started"));
+    CHECK(!strcmp(json_string_value(json_object_get(job, "status")), "done") && started &&
+          !strncmp(started, "2030-03-17T17:46:41", 19));
+    json_decref(job);
+    for (int i = 2; i <= 3; i++) {
+        char id[RECORD_ID_LEN], prefix[64];
+        snprintf(id, sizeof(id), "20291231-235900-000%d", i);
+        job = queue_job_json(q, id, 0);
+        const char *error = json_string_value(json_object_get(job, "error"));
+        CHECK(!strcmp(json_string_value(json_object_get(job, "status")), "interrupted") && error &&
+              strstr(error, "damaged") && strstr(error, "moved to") && strstr(error, "quarantine"));
+        json_decref(job);
+        char qdir[PATH_MAX + 32], path[PATH_MAX + 96];
+        snprintf(qdir, sizeof(qdir), "%s/quarantine", state);
+        snprintf(prefix, sizeof(prefix), "%s-result.json", id);
+        CHECK(count_entries(qdir, prefix) == 2); /* the file and its .reason */
+        snprintf(path, sizeof(path), "%s/jobs/%s/result.json", state, id);
+        CHECK(!exists(path));
+    }
+    queue_destroy(q);
+    store_close(s);
+    remove_state(state);
+}
+
 /* The live set keeps id order whatever the order of insertion; the
  * version says stored only when no state is left to write. */
 static void test_live_and_version(void)
@@ -765,5 +810,6 @@ int main(void)
     test_figures();
     test_live_and_version();
     test_migration();
+    test_rebuilt_records();
     return check_finish("test_store");
 }

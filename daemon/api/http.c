@@ -149,6 +149,8 @@ static enum MHD_Result respond_text(struct MHD_Connection *c, unsigned status,
     }
     MHD_add_response_header(resp, "Content-Type", type);
     MHD_add_response_header(resp, "Cache-Control", "no-store");
+    if (connections_is_reserve(connections_of(c)))
+        MHD_add_response_header(resp, "Connection", "close"); /* gives the reserve slot back */
     if (status == MHD_HTTP_UNAUTHORIZED)
         MHD_add_response_header(resp, "WWW-Authenticate", "Bearer realm=\"shadebench\"");
     connections_set_status(connections_of(c), status);
@@ -207,6 +209,8 @@ static enum MHD_Result respond_405(struct MHD_Connection *c, const char *allow, 
     }
     MHD_add_response_header(resp, "Content-Type", "application/json");
     MHD_add_response_header(resp, "Allow", allow);
+    if (connections_is_reserve(connections_of(c)))
+        MHD_add_response_header(resp, "Connection", "close");
     connections_set_status(connections_of(c), MHD_HTTP_METHOD_NOT_ALLOWED);
     enum MHD_Result ret = MHD_queue_response(c, MHD_HTTP_METHOD_NOT_ALLOWED, resp);
     MHD_destroy_response(resp);
@@ -280,6 +284,94 @@ static json_t *info_json(struct http_server *s)
                      (json_int_t)JOB_MAX_CAPTURES, "max_image_pixels", (json_int_t)IMAGE_MAX_PIXELS);
 }
 
+/* The render thread's state as /healthz shows it. */
+static json_t *render_json(const struct render_state *st, double stall_s)
+{
+    if (!st->alive)
+        return json_pack("{s:s}", "state", "stopped");
+    if (!st->busy)
+        return json_pack("{s:s, s:f}", "state", "idle", "idle_s", st->since_progress_s);
+    return json_pack("{s:s, s:s, s:s, s:f, s:f, s:f}", "state",
+                     render_state_stalled(st, stall_s) ? "stalled" : "busy", "job", st->job,
+                     "phase", st->phase, "busy_s", st->busy_s, "since_progress_s",
+                     st->since_progress_s, "stall_seconds", stall_s);
+}
+
+/* GET /healthz: cheap (no store, no lock), and true: 503 when the render
+ * thread has stopped, or has made no progress for longer than the bound
+ * while a job is on it, which no other endpoint would show (a job that
+ * holds the GPU for minutes still left every other answer quick). */
+static enum MHD_Result respond_healthz(struct http_server *s, struct MHD_Connection *c)
+{
+    struct render_state st;
+    s->ctx.render_state(s->ctx.render, &st);
+    json_t *render = render_json(&st, s->ctx.stall_s);
+    if (!st.alive)
+        return respond_json(c, MHD_HTTP_SERVICE_UNAVAILABLE,
+                            json_pack("{s:s, s:o}", "status", "render thread is not running",
+                                      "render", render));
+    if (render_state_stalled(&st, s->ctx.stall_s)) {
+        char msg[256];
+        snprintf(msg, sizeof(msg), "the render thread has made no progress for %.0f s (more "
+                 "than --stall-seconds %g) on job %s, phase %s", st.since_progress_s,
+                 s->ctx.stall_s, st.job, st.phase);
+        return respond_json(c, MHD_HTTP_SERVICE_UNAVAILABLE,
+                            json_pack("{s:s, s:s, s:o}", "status", "stalled", "message", msg,
+                                      "render", render));
+    }
+    return respond_json(c, MHD_HTTP_OK, json_pack("{s:s, s:o}", "status", "ok", "render", render));
+}
+
+/* Label values in the text format: a backslash, a quote and a newline are
+ * escaped. A job id and a phase have none, but say so in one place. */
+static void prometheus_label(FILE *f, const char *v)
+{
+    for (; v && *v; v++) {
+        if (*v == '\\' || *v == '"')
+            fputc('\\', f);
+        if (*v == '\n')
+            fputs("\\n", f);
+        else
+            fputc(*v, f);
+    }
+}
+
+static void render_metrics(struct http_server *s, FILE *f)
+{
+    struct render_state st;
+    s->ctx.render_state(s->ctx.render, &st);
+    fprintf(f, "# HELP shadebench_render_up Whether the render thread runs.\n"
+               "# TYPE shadebench_render_up gauge\n"
+               "shadebench_render_up %d\n", st.alive);
+    fprintf(f, "# HELP shadebench_render_busy Whether a job is on the render thread.\n"
+               "# TYPE shadebench_render_busy gauge\n"
+               "shadebench_render_busy %d\n", st.busy);
+    fprintf(f, "# HELP shadebench_render_seconds_since_progress Seconds since the render thread "
+               "last made progress (a frame, a slice of GPU work, a metric tile, a phase); 0 "
+               "while idle.\n"
+               "# TYPE shadebench_render_seconds_since_progress gauge\n"
+               "shadebench_render_seconds_since_progress %.3f\n",
+            st.busy ? st.since_progress_s : 0.0);
+    fprintf(f, "# HELP shadebench_render_stalled Whether /healthz reports the render thread "
+               "stalled (busy, no progress for longer than shadebench_render_stall_seconds).\n"
+               "# TYPE shadebench_render_stalled gauge\n"
+               "shadebench_render_stalled %d\n"
+               "# HELP shadebench_render_stall_seconds The stall bound (--stall-seconds; 0: "
+               "none).\n"
+               "# TYPE shadebench_render_stall_seconds gauge\n"
+               "shadebench_render_stall_seconds %g\n",
+            render_state_stalled(&st, s->ctx.stall_s), s->ctx.stall_s);
+    if (st.busy) {
+        fprintf(f, "# HELP shadebench_render_job The job on the render thread and its phase.\n"
+                   "# TYPE shadebench_render_job gauge\n"
+                   "shadebench_render_job{job=\"");
+        prometheus_label(f, st.job);
+        fprintf(f, "\",phase=\"");
+        prometheus_label(f, st.phase);
+        fprintf(f, "\"} 1\n");
+    }
+}
+
 /* GET /metrics: Prometheus text format 0.0.4. */
 static enum MHD_Result respond_metrics(struct http_server *s, struct MHD_Connection *c)
 {
@@ -311,6 +403,7 @@ static enum MHD_Result respond_metrics(struct http_server *s, struct MHD_Connect
     fprintf(f, "# HELP shadebench_frames_rendered_total Frames rendered for jobs (warm-up and timed).\n"
                "# TYPE shadebench_frames_rendered_total counter\n"
                "shadebench_frames_rendered_total %llu\n", t.frames);
+    render_metrics(s, f);
     fprintf(f, "# HELP shadebench_render_busy_seconds_total Seconds the render thread spent on jobs.\n"
                "# TYPE shadebench_render_busy_seconds_total counter\n"
                "shadebench_render_busy_seconds_total %.6f\n", t.render_busy_s);
@@ -749,10 +842,7 @@ static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
     bool post = strcmp(method, "POST") == 0;
     switch (req->route.kind) {
     case ROUTE_HEALTHZ:
-        if (!s->ctx.render_alive(s->ctx.render))
-            return respond_json(c, MHD_HTTP_SERVICE_UNAVAILABLE,
-                                json_pack("{s:s}", "status", "render thread is not running"));
-        return respond_json(c, MHD_HTTP_OK, json_pack("{s:s}", "status", "ok"));
+        return respond_healthz(s, c);
     case ROUTE_INFO:
         return respond_json(c, MHD_HTTP_OK, info_json(s));
     case ROUTE_METRICS:
@@ -851,6 +941,15 @@ static bool refuse_early(struct http_server *s, struct MHD_Connection *c, const 
         else
             snprintf(rule, sizeof(rule), "%s", req->target_rule);
         *ret = respond_error(c, MHD_HTTP_BAD_REQUEST, req->target_field, rule);
+        return true;
+    }
+    if (connections_is_reserve(req->conn) && req->route.kind != ROUTE_HEALTHZ &&
+        req->route.kind != ROUTE_METRICS) {
+        char rule[200];
+        snprintf(rule, sizeof(rule), "this address has its %u connections open "
+                 "(--max-connections-per-ip); the %d beyond them serve /healthz and /metrics only",
+                 s->limits.max_connections_per_ip, CONNECTIONS_HEALTH_RESERVE);
+        *ret = respond_error(c, MHD_HTTP_TOO_MANY_REQUESTS, "connections", rule);
         return true;
     }
     if (req->route.kind != ROUTE_HEALTHZ && !authorized(s, c)) {
@@ -1042,7 +1141,8 @@ struct http_server *http_server_create(const char *listen, const struct http_lim
     s->limits = *limits;
     pthread_mutex_init(&s->token_lock, NULL);
     struct connections_config cc = {.header_s = limits->header_timeout_s,
-                                    .body_s = limits->body_timeout_s};
+                                    .body_s = limits->body_timeout_s,
+                                    .per_ip = limits->max_connections_per_ip};
     s->conns = connections_create(&cc, wait_done, s, err, errlen);
     if (!s->conns) {
         freeaddrinfo(ai);
@@ -1060,7 +1160,8 @@ struct http_server *http_server_create(const char *listen, const struct http_lim
         s, MHD_OPTION_SOCK_ADDR, ai->ai_addr, MHD_OPTION_THREAD_POOL_SIZE,
         (unsigned)(limits->threads ? limits->threads : 1), MHD_OPTION_CONNECTION_LIMIT,
         (unsigned)limits->max_connections, MHD_OPTION_PER_IP_CONNECTION_LIMIT,
-        (unsigned)limits->max_connections_per_ip, MHD_OPTION_CONNECTION_TIMEOUT,
+        (unsigned)(limits->max_connections_per_ip + CONNECTIONS_HEALTH_RESERVE),
+        MHD_OPTION_CONNECTION_TIMEOUT,
         (unsigned)limits->idle_timeout_s, MHD_OPTION_CONNECTION_MEMORY_LIMIT,
         (size_t)CONNECTION_MEMORY, MHD_OPTION_NOTIFY_CONNECTION, connections_notify, s->conns,
         MHD_OPTION_NOTIFY_COMPLETED, on_completed, s, MHD_OPTION_URI_LOG_CALLBACK, on_uri, s,

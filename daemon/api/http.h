@@ -11,6 +11,7 @@
 
 #include <jansson.h>
 
+#include "daemon/harness/render_state.h"
 #include "daemon/jobs/queue.h"
 #include "daemon/jobs/sweeps.h"
 #include "daemon/techniques/catalog.h"
@@ -35,12 +36,17 @@ struct http_context {
     const struct technique_catalog *catalog; /* jobs and sweeps are parsed against it */
     struct queue *queue;
     struct sweeps *sweeps;
-    /* The render thread as the API sees it, without GL: whether it still
-     * runs (/healthz) and its device strings (/v1/info, reports; a new
-     * reference). Called from the HTTP threads. */
-    bool (*render_alive)(void *render);
+    /* The render thread as the API sees it, without GL: what it is doing
+     * (render_state.h: whether it runs, its job and phase, its last
+     * progress), for /healthz and /metrics, which must stay cheap (the
+     * state is read lock-free); and its device strings (/v1/info, reports;
+     * a new reference). Called from the HTTP threads. */
+    void (*render_state)(void *render, struct render_state *out);
     json_t *(*device_json)(void *render);
     void *render;
+    /* /healthz answers 503 when the render thread, busy with a job, has
+     * made no progress for longer than this (--stall-seconds); 0: never. */
+    double stall_s;
 };
 
 struct http_server;

@@ -21,6 +21,7 @@
 #include "daemon/harness/metrics_stage.h"
 #include "daemon/harness/outputs.h"
 #include "daemon/harness/reference.h"
+#include "daemon/harness/render_state.h"
 #include "daemon/harness/run.h"
 #include "daemon/harness/telemetry.h"
 #include "daemon/service.h"
@@ -64,7 +65,11 @@ static json_t *collect_device(struct egl_context *egl, const struct gpu_caps *ca
 static bool prepare_and_measure(struct harness_run *run, bool capture, int run_index,
                                 enum job_status *status)
 {
-    return run_prepare(run, capture) && measure_run(run, run_index, status);
+    render_state_phase("setup");
+    if (!run_prepare(run, capture))
+        return false;
+    render_state_phase("rendering");
+    return measure_run(run, run_index, status);
 }
 
 static json_t *run_summary(int index, double wall_s, json_t *frame, json_t *gpu, json_t *cpu)
@@ -180,6 +185,7 @@ static void run_job(struct runner *r, struct job *job)
     }
     if (!prepare_and_measure(&run, true, 0, &status))
         goto done;
+    render_state_phase("writing results");
     result = outputs_write(&run);
     /* The first run's technique is done with: free it before more runs or the
      * reference claim the device's memory. */
@@ -191,6 +197,7 @@ static void run_job(struct runner *r, struct job *job)
     }
     if (result && spec->reference[0]) {
         queue_set_phase(r->queue, job, "reference");
+        render_state_phase("reference");
         if (!reference_render(&run, &status)) {
             json_decref(result);
             result = NULL;
@@ -207,6 +214,9 @@ done:
     service_status("idle; last job %s %s", job->id, job_status_name(status));
     if (status == JOB_DONE && spec->reference[0]) {
         queue_set_phase(r->queue, job, "metrics");
+        /* Still this job's until the metrics thread is done with it: the
+         * render thread waits for that before the next job. */
+        render_state_phase("metrics");
         metrics_worker_submit(r->metrics, job, result);
         return;
     }
@@ -225,6 +235,7 @@ static void *runner_main(void *arg)
     }
     if (egl) {
         r->gl.device_json = collect_device(egl, &r->gl.caps);
+        render_state_end(); /* idle from now */
         r->ready = 1;
         atomic_store(&r->alive, true);
     } else {
@@ -238,9 +249,14 @@ static void *runner_main(void *arg)
     LOG(LOG_INFO, "GL context on %s (%s): %s, %s", egl_context_device(egl),
         egl_context_platform(egl), gl_str(GL_RENDERER), gl_str(GL_VERSION));
 
-    struct job *job;
-    /* The metrics and files of earlier jobs finish before the next job is timed. */
-    while ((metrics_worker_wait_idle(r->metrics), job = queue_next(r->queue))) {
+    for (;;) {
+        /* The metrics and files of earlier jobs finish before the next job is timed. */
+        metrics_worker_wait_idle(r->metrics);
+        render_state_end();
+        struct job *job = queue_next(r->queue);
+        if (!job)
+            break;
+        render_state_begin(job->id, "setup");
         double busy_from = clock_mono_s();
         run_job(r, job);
         telemetry_render_busy(clock_mono_s() - busy_from);
@@ -306,5 +322,11 @@ void runner_destroy(struct runner *r)
 }
 
 bool runner_alive(struct runner *r) { return atomic_load(&r->alive); }
+
+void runner_state(struct runner *r, struct render_state *out)
+{
+    render_state_read(out);
+    out->alive = runner_alive(r);
+}
 
 json_t *runner_device_json(struct runner *r) { return json_incref(r->gl.device_json); }

@@ -13,21 +13,26 @@
 #include <string.h>
 #include <sys/socket.h>
 #include <sys/time.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "check.h"
 #include "common/fsutil.h"
 #include "common/job_files.h"
 #include "common/log.h"
+#include "daemon/api/connections.h"
 #include "daemon/api/http.h"
 #include "daemon/jobs/store.h"
 
 static atomic_bool render_up = true;
 
-static bool fake_alive(void *render)
+/* The real render state (render_state.c), which the test drives as the
+ * render thread would. */
+static void fake_state(void *render, struct render_state *out)
 {
     (void)render;
-    return atomic_load(&render_up);
+    render_state_read(out);
+    out->alive = atomic_load(&render_up);
 }
 
 static json_t *fake_device(void *render)
@@ -47,6 +52,12 @@ static void reply_finish(struct reply *r)
     free(r->body);
     json_decref(r->json);
     memset(r, 0, sizeof(*r));
+}
+
+static void sleep_ms(long ms)
+{
+    struct timespec t = {.tv_sec = ms / 1000, .tv_nsec = (ms % 1000) * 1000000L};
+    nanosleep(&t, NULL);
 }
 
 static int connect_to(int port)
@@ -180,8 +191,10 @@ int main(void)
     CHECK(sweeps != NULL);
     struct http_limits limits;
     http_limits_defaults(&limits);
+    limits.max_connections_per_ip = 3;
     const struct http_context ctx = {.catalog = &catalog, .queue = q, .sweeps = sweeps,
-                                     .render_alive = fake_alive, .device_json = fake_device};
+                                     .render_state = fake_state, .device_json = fake_device,
+                                     .stall_s = 0.3};
     struct http_server *http = sweeps ? http_server_create("127.0.0.1:0", &limits, &ctx, err,
                                                            sizeof(err))
                                       : NULL;
@@ -191,9 +204,50 @@ int main(void)
     int port = http_server_port(http);
     struct reply r;
 
-    /* /healthz follows the render thread. */
+    /* /healthz follows the render thread: idle, busy with a job (which and
+     * in what phase), stalled once it makes no progress for longer than
+     * stall_s, healthy again with progress, and 503 once it has stopped. */
+    render_state_end();
+    r = request(port, "GET", "/healthz", NULL, NULL);
+    json_t *render = json_object_get(r.json, "render");
+    CHECK(r.status == 200 && !strcmp(str(r.json, "status"), "ok") &&
+          !strcmp(str(render, "state"), "idle"));
+    reply_finish(&r);
+    render_state_begin("20260101-000000-0042", "setup");
+    render_state_phase("rendering");
+    r = request(port, "GET", "/healthz", NULL, NULL);
+    render = json_object_get(r.json, "render");
+    CHECK(r.status == 200 && !strcmp(str(render, "state"), "busy") &&
+          !strcmp(str(render, "job"), "20260101-000000-0042") &&
+          !strcmp(str(render, "phase"), "rendering") &&
+          json_real_value(json_object_get(render, "since_progress_s")) < 0.3);
+    reply_finish(&r);
+    sleep_ms(400);
+    r = request(port, "GET", "/healthz", NULL, NULL);
+    render = json_object_get(r.json, "render");
+    CHECK(r.status == 503 && !strcmp(str(r.json, "status"), "stalled") &&
+          strstr(str(r.json, "message"), "20260101-000000-0042") &&
+          !strcmp(str(render, "state"), "stalled") &&
+          json_real_value(json_object_get(render, "since_progress_s")) > 0.3);
+    reply_finish(&r);
+    r = request(port, "GET", "/metrics", NULL, NULL);
+    CHECK(r.status == 200 && strstr(r.body, "shadebench_render_stalled 1\n") &&
+          strstr(r.body, "shadebench_render_busy 1\n") &&
+          strstr(r.body, "shadebench_render_job{job=\"20260101-000000-0042\",phase=\"rendering\"} 1"));
+    reply_finish(&r);
+    render_progress(); /* a frame went round */
     r = request(port, "GET", "/healthz", NULL, NULL);
     CHECK(r.status == 200);
+    reply_finish(&r);
+    sleep_ms(400);
+    render_state_end(); /* idle is never stalled, however long */
+    sleep_ms(400);
+    r = request(port, "GET", "/healthz", NULL, NULL);
+    CHECK(r.status == 200 && !strcmp(str(json_object_get(r.json, "render"), "state"), "idle"));
+    reply_finish(&r);
+    r = request(port, "GET", "/metrics", NULL, NULL);
+    CHECK(r.status == 200 && strstr(r.body, "shadebench_render_stalled 0\n") &&
+          strstr(r.body, "shadebench_render_busy 0\n") && !strstr(r.body, "render_job{"));
     reply_finish(&r);
     atomic_store(&render_up, false);
     r = request(port, "GET", "/healthz", NULL, NULL);
@@ -357,6 +411,37 @@ int main(void)
     /* /metrics counts the store's jobs by status, in Prometheus' text form. */
     r = request(port, "GET", "/metrics", NULL, NULL);
     CHECK(r.status == 200 && strstr(r.body, "# TYPE ") && strstr(r.body, "shadebench_"));
+    reply_finish(&r);
+
+    /* A health check has connections of its own: past an address's 3, the
+     * next CONNECTIONS_HEALTH_RESERVE serve /healthz and /metrics only (and
+     * close after one answer); past those, libmicrohttpd refuses. */
+    int hogs[3 + CONNECTIONS_HEALTH_RESERVE];
+    for (int i = 0; i < 3; i++)
+        hogs[i] = connect_to(port); /* open, and silent: each holds its slot */
+    sleep_ms(200);
+    r = request(port, "GET", "/v1/info", NULL, NULL);
+    CHECK(r.status == 429 && error_field(&r) && strcmp(error_field(&r), "connections") == 0 &&
+          strstr(r.body, "/healthz"));
+    reply_finish(&r);
+    r = request(port, "GET", "/healthz", NULL, NULL);
+    CHECK(r.status == 200);
+    reply_finish(&r);
+    r = request(port, "GET", "/metrics", NULL, NULL);
+    CHECK(r.status == 200 && strstr(r.body, "shadebench_render_up 1"));
+    reply_finish(&r);
+    for (int i = 3; i < 3 + CONNECTIONS_HEALTH_RESERVE; i++)
+        hogs[i] = connect_to(port);
+    sleep_ms(200);
+    r = request(port, "GET", "/healthz", NULL, NULL);
+    CHECK(r.status == 0); /* closed unanswered */
+    reply_finish(&r);
+    for (int i = 0; i < 3 + CONNECTIONS_HEALTH_RESERVE; i++)
+        if (hogs[i] >= 0)
+            close(hogs[i]);
+    sleep_ms(200);
+    r = request(port, "GET", "/v1/info", NULL, NULL);
+    CHECK(r.status == 200);
     reply_finish(&r);
 
     /* With a token, everything but /healthz needs it. */

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "config.h"
+#include "common/clock.h"
 #include "common/job_files.h"
 #include "common/log.h"
 #include "daemon/api/charts.h"
@@ -398,6 +399,10 @@ static enum MHD_Result respond_metrics(struct http_server *s, struct MHD_Connect
     fprintf(f, "# HELP shadebench_queue_capacity Jobs that may wait at once.\n"
                "# TYPE shadebench_queue_capacity gauge\n"
                "shadebench_queue_capacity %d\n", queue_max_queued(s->queue));
+    fprintf(f, "# HELP shadebench_state_disk_full Whether the state directory's disk is full: "
+               "no job starts and none is accepted until there is room (docs/store.md).\n"
+               "# TYPE shadebench_state_disk_full gauge\n"
+               "shadebench_state_disk_full %d\n", store_disk_full(queue_store(s->queue)));
     struct telemetry t;
     telemetry_read(&t);
     fprintf(f, "# HELP shadebench_frames_rendered_total Frames rendered for jobs (warm-up and timed).\n"
@@ -1081,6 +1086,33 @@ static void on_completed(void *cls, struct MHD_Connection *c, void **con_cls,
     connections_request_done(s->conns, k);
 }
 
+/* libmicrohttpd logs per connection (one refused for the per-address
+ * limit, one that failed to send): a client could write the log full. At
+ * most MHD_LOG_BURST of its warnings go out each MHD_LOG_WINDOW_S; the rest
+ * are counted, and the count logged when the next window opens. */
+enum { MHD_LOG_BURST = 20, MHD_LOG_WINDOW_S = 10 };
+static pthread_mutex_t mhd_log_lock = PTHREAD_MUTEX_INITIALIZER;
+static double mhd_log_window;
+static unsigned mhd_log_count;
+
+static bool mhd_log_allowed(void)
+{
+    double now = clock_mono_s();
+    unsigned suppressed = 0;
+    pthread_mutex_lock(&mhd_log_lock);
+    if (now - mhd_log_window >= MHD_LOG_WINDOW_S) {
+        suppressed = mhd_log_count > MHD_LOG_BURST ? mhd_log_count - MHD_LOG_BURST : 0;
+        mhd_log_window = now;
+        mhd_log_count = 0;
+    }
+    bool allowed = ++mhd_log_count <= MHD_LOG_BURST;
+    pthread_mutex_unlock(&mhd_log_lock);
+    if (suppressed)
+        LOG(LOG_WARN, "libmicrohttpd: %u more messages in %d s were not logged", suppressed,
+            MHD_LOG_WINDOW_S);
+    return allowed;
+}
+
 static void on_mhd_log(void *cls, const char *fmt, va_list ap)
 {
     (void)cls;
@@ -1091,8 +1123,10 @@ static void on_mhd_log(void *cls, const char *fmt, va_list ap)
         msg[--n] = '\0';
     bool expected = closing_gone_client && strstr(msg, "internal error");
     closing_gone_client = false;
-    LOG(expected ? LOG_DEBUG : LOG_WARN, "libmicrohttpd: %s%s", msg,
-        expected ? " (a waiting client hung up)" : "");
+    if (expected)
+        LOG(LOG_DEBUG, "libmicrohttpd: %s (a waiting client hung up)", msg);
+    else if (mhd_log_allowed())
+        LOG(LOG_WARN, "libmicrohttpd: %s", msg);
 }
 
 struct http_server *http_server_create(const char *listen, const struct http_limits *limits,

@@ -21,6 +21,7 @@
 #include "daemon/jobs/job_figures.h"
 #include "daemon/jobs/queue.h"
 #include "daemon/jobs/store.h"
+#include "daemon/jobs/store_reserve.h"
 #include "tests/unit/catalog_fixture.h"
 #include "tests/unit/check.h"
 
@@ -771,6 +772,60 @@ static void test_rebuilt_records(void)
     remove_state(state);
 }
 
+static long long file_size(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 ? (long long)st.st_size : -1;
+}
+
+/* The reserve a full disk draws on (store_reserve.h): its room is taken at
+ * open and given back on release; a state noted and not stored is found by
+ * the next open (the newest note of a record wins, a stored one goes), and
+ * goes once applied. */
+static void test_reserve(void)
+{
+    char *state = make_state();
+    char path[PATH_MAX + 32], status[32], error[512];
+    snprintf(path, sizeof(path), "%s/%s", state, STORE_RESERVE_FILE);
+    struct store_reserve *r = store_reserve_open(state);
+    CHECK(r && file_size(path) == STORE_RESERVE_BYTES && store_reserve_ready(r) &&
+          !store_reserve_released(r));
+    CHECK(!store_reserve_found(r, 0, "20260101-000000-0001", status, sizeof(status), error,
+                               sizeof(error)));
+    CHECK(store_reserve_note(r, 0, "20260101-000000-0001", "running", ""));
+    CHECK(store_reserve_note(r, 0, "20260101-000000-0001", "failed", "cannot write\tit:\nfull"));
+    CHECK(store_reserve_note(r, 0, "20260101-000000-0002", "failed", "stored after all"));
+    CHECK(store_reserve_note(r, 1, "20260101-000000-0003", "cancelled", "a sweep"));
+    store_reserve_unnote(r, 0, "20260101-000000-0002");
+    CHECK(store_reserve_release(r) && file_size(path) == STORE_RESERVE_NOTES_BYTES &&
+          store_reserve_released(r) && !store_reserve_release(r));
+    store_reserve_close(r);
+
+    r = store_reserve_open(state); /* the next start: room again, and the notes */
+    CHECK(r && file_size(path) == STORE_RESERVE_BYTES && store_reserve_ready(r));
+    CHECK(store_reserve_found(r, 0, "20260101-000000-0001", status, sizeof(status), error,
+                              sizeof(error)) &&
+          !strcmp(status, "failed") && !strcmp(error, "cannot write it: full"));
+    CHECK(!store_reserve_found(r, 0, "20260101-000000-0002", status, sizeof(status), error,
+                               sizeof(error)));
+    CHECK(store_reserve_found(r, 1, "20260101-000000-0003", status, sizeof(status), error,
+                              sizeof(error)) && !strcmp(status, "cancelled"));
+    CHECK(!store_reserve_found(r, 1, "20260101-000000-0001", status, sizeof(status), error,
+                               sizeof(error))); /* kinds apart */
+    /* A state noted now, then the earlier notes applied: only the new one
+     * is left for the next start. */
+    CHECK(store_reserve_note(r, 0, "20260101-000000-0004", "queued", ""));
+    store_reserve_found_done(r);
+    store_reserve_close(r);
+    r = store_reserve_open(state);
+    CHECK(r && !store_reserve_found(r, 0, "20260101-000000-0001", status, sizeof(status), error,
+                                    sizeof(error)) &&
+          store_reserve_found(r, 0, "20260101-000000-0004", status, sizeof(status), error,
+                              sizeof(error)));
+    store_reserve_close(r);
+    remove_state(state);
+}
+
 /* The live set keeps id order whatever the order of insertion; the
  * version says stored only when no state is left to write. */
 static void test_live_and_version(void)
@@ -811,5 +866,6 @@ int main(void)
     test_live_and_version();
     test_migration();
     test_rebuilt_records();
+    test_reserve();
     return check_finish("test_store");
 }

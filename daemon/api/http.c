@@ -25,6 +25,7 @@
 #include "daemon/api/report.h"
 #include "daemon/api/routes.h"
 #include "daemon/harness/telemetry.h"
+#include "daemon/jobs/job_cost.h"
 #include "daemon/jobs/job_spec.h"
 #include "daemon/quality/metrics.h"
 #include "daemon/api/job_filter.h"
@@ -240,25 +241,36 @@ static enum MHD_Result respond_file(struct MHD_Connection *c, const char *path,
     return ret;
 }
 
-/* The daemon's memory budget: what its own buffers can reach at the limits
- * the API accepts, by part. The GL driver's memory (framebuffers, textures,
- * compiled shaders) is the driver's and not counted. */
+double http_memory_bytes(const struct http_limits *l)
+{
+    /* libmicrohttpd's per-connection pool plus a body buffer, per
+     * connection, at the connection limit (a health check's reserve too). */
+    return (double)l->max_connections * (CONNECTION_MEMORY + JOB_MAX_BODY_BYTES);
+}
+
+/* The daemon's memory budget (--memory-budget), by part: the driver and
+ * libraries as measured at start, the connections at their limit, and what
+ * is left for one job, which each job's estimate must fit (job_cost.h);
+ * rss_bytes is the resident set now, the driver's allocations included. */
 static json_t *memory_json(const struct http_server *s, double *total)
 {
     const double side = 8192.0, frame = side * side * 4.0;
-    /* The render thread's captures (bounded per job) and one read-back frame
-     * for the reference; its per-frame series (3 doubles a frame, 1,000,000
-     * frames at most). */
+    double http = http_memory_bytes(&s->limits), job = job_cost_memory_limit();
+    *total = s->ctx.memory_budget_bytes > 0 ? s->ctx.memory_budget_bytes
+                                            : s->ctx.driver_bytes + http + job;
+    /* What the API's own limits let a job's buffers reach, for scale: its
+     * captures (bounded per job), a read-back frame and its per-frame
+     * series, and the metrics stage at the largest image. */
     double captures = JOB_MAX_CAPTURE_BYTES, render = frame + 1e6 * 3 * sizeof(double);
-    /* The metrics thread scores the previous job while the next renders: its
-     * bound at the largest image and the widest FLIP filter. */
     double metrics = metrics_memory_bytes(8192, 8192, 1000.0);
-    /* libmicrohttpd's per-connection pool plus a body buffer, per connection. */
-    double http = (double)s->limits.max_connections * (CONNECTION_MEMORY + JOB_MAX_BODY_BYTES);
-    *total = captures + render + metrics + http;
-    return json_pack("{s:f, s:f, s:f, s:f, s:f, s:s}", "budget_bytes", *total, "captures_bytes",
-                     captures, "render_bytes", render, "metrics_bytes", metrics, "http_bytes",
-                     http, "excludes", "the GL driver's own memory");
+    return json_pack("{s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:s}", "budget_bytes", *total,
+                     "driver_bytes", s->ctx.driver_bytes, "http_bytes", http, "job_bytes", job,
+                     "rss_bytes", telemetry_rss_bytes(), "captures_bytes", captures,
+                     "render_bytes", render, "metrics_bytes", metrics, "rule",
+                     "budget_bytes = driver_bytes (the daemon's resident set at start, the GL "
+                     "context up: driver, shader compiler, libraries) + http_bytes (every "
+                     "connection's buffers) + job_bytes (what one job may take: a job whose "
+                     "estimate, its answer's cost.memory_bytes, is over it is refused)");
 }
 
 static json_t *info_json(struct http_server *s)
@@ -451,7 +463,11 @@ static enum MHD_Result respond_metrics(struct http_server *s, struct MHD_Connect
     json_decref(memory_json(s, &budget));
     fprintf(f, "# HELP shadebench_memory_budget_bytes The daemon's memory budget (parts in /v1/info).\n"
                "# TYPE shadebench_memory_budget_bytes gauge\n"
-               "shadebench_memory_budget_bytes %.0f\n", budget);
+               "shadebench_memory_budget_bytes %.0f\n"
+               "# HELP shadebench_memory_rss_bytes The daemon's resident set (the GL driver's "
+               "allocations included).\n"
+               "# TYPE shadebench_memory_rss_bytes gauge\n"
+               "shadebench_memory_rss_bytes %.0f\n", budget, telemetry_rss_bytes());
     if (fclose(f) != 0 || !text) {
         free(text);
         return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "metrics", "out of memory");
@@ -485,8 +501,11 @@ static enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *
     char url[ROUTE_URL_MAX];
     route_job_url(id, url);
     LOG(LOG_INFO, "queued job %s (%s)", id, spec.technique);
+    struct job_cost cost;
+    job_cost_estimate(&spec, &cost);
     return respond_json(c, MHD_HTTP_ACCEPTED,
-                        json_pack("{s:s, s:s, s:s}", "id", id, "status", "queued", "url", url));
+                        json_pack("{s:s, s:s, s:s, s:o}", "id", id, "status", "queued", "url", url,
+                                  "cost", job_cost_json(&cost)));
 }
 
 static bool parse_wait(struct MHD_Connection *c, double *wait)

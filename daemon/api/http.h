@@ -30,6 +30,10 @@ struct http_limits {
 
 void http_limits_defaults(struct http_limits *l);
 
+/* What the connections' buffers can reach at these limits (bytes): a part
+ * of the memory budget. */
+double http_memory_bytes(const struct http_limits *l);
+
 /* What the API serves, handed in by its owner (main, or a unit test with a
  * render thread of its own making): everything outlives the server. */
 struct http_context {
@@ -47,6 +51,11 @@ struct http_context {
     /* /healthz answers 503 when the render thread, busy with a job, has
      * made no progress for longer than this (--stall-seconds); 0: never. */
     double stall_s;
+    /* The memory budget (/v1/info): in all (--memory-budget; 0: the sum of
+     * its parts), and the driver's part, the daemon's resident set measured
+     * at start with the GL context up. What a job may take is
+     * job_cost_memory_limit(). */
+    double memory_budget_bytes, driver_bytes;
 };
 
 struct http_server;

@@ -251,4 +251,75 @@ finally:
         os.rmdir(mnt)
         os.rmdir(base)
 
+# --- Memory: within the stated budget, and given back after a large job -----
+def rss_kb(pid, key="VmRSS"):
+    with open("/proc/%d/status" % pid) as f:
+        for line in f:
+            if line.startswith(key + ":"):
+                return int(line.split()[1])
+    return 0
+
+
+d = testlib.Daemon()
+try:
+    pid = d.proc.pid
+    info = d.json("GET", "/v1/info")[1].get("memory", {})
+    check(info.get("driver_bytes", 0) > 0 and info.get("rss_bytes", 0) > 0 and
+          abs(info.get("budget_bytes", 0) - info.get("driver_bytes", 0) - info.get("http_bytes", 0)
+              - info.get("job_bytes", 0)) < 1e6,
+          "/v1/info's budget includes the driver (measured) and what a job may take: %s"
+          % {k: v for k, v in info.items() if k != "rule"})
+    # Idle: after a small job of the same technique, so that what its first
+    # run leaves for good (compiled shaders) counts as idle.
+    warm = dict(TINY, technique="forward", capture_interval=1)
+    warm["scene"] = {"width": 64, "height": 64, "lights": 1}
+    check(d.run(warm).get("status") == "done", "a small job first")
+    time.sleep(0.5)
+    idle = rss_kb(pid)
+    large = dict(warm, scene={"width": 4096, "height": 4096, "lights": 1})
+    status, reply = d.json("POST", "/v1/jobs", large)
+    check(status == 202 and reply.get("cost", {}).get("memory_bytes", 0) > 4096 * 4096 * 24,
+          "the accepted answer states the job's memory estimate: %s" % reply.get("cost"))
+    job = d.wait(reply.get("id", ""))
+    check(job.get("status") == "done", "a 4096x4096 job: %s %s" % (job.get("status"), job.get("error")))
+    peak = rss_kb(pid, "VmHWM")
+    bound = idle + (peak - idle) / 4
+    deadline = time.time() + 10 * S
+    now = rss_kb(pid)
+    while now > bound and time.time() < deadline:
+        time.sleep(0.2)
+        now = rss_kb(pid)
+    print("memory: idle %.0f MiB, peak %.0f MiB, after the job %.0f MiB (bound %.0f)"
+          % (idle / 1024, peak / 1024, now / 1024, bound / 1024))
+    check(peak > idle + 200 * 1024, "the large job took memory (peak %d kB, idle %d kB)" % (peak, idle))
+    check(now <= bound, "and gave it back: %.0f MiB resident, at most idle + a quarter of the "
+          "peak's rise, %.0f MiB" % (now / 1024, bound / 1024))
+    check("given back" in log_text(d), "the log says what it gave back")
+finally:
+    testlib.stop_and_check(d)
+
+# A budget: a job whose estimate does not fit what it leaves a job is
+# refused naming the field, a sweep with such a point too; a budget that
+# leaves a job nothing stops the daemon at start.
+d = testlib.Daemon("--memory-budget", "200", "--max-connections", "16")
+try:
+    info = d.json("GET", "/v1/info")[1].get("memory", {})
+    check(info.get("budget_bytes") == 200 * 1048576 and 0 < info.get("job_bytes", 0) < 200 * 1048576,
+          "--memory-budget 200 is the stated budget: %s" % {k: v for k, v in info.items() if k != "rule"})
+    testlib.rejects(d, dict(TINY, scene={"width": 2048, "height": 2048}), "scene.width",
+                    what="a 2048x2048 job under a 200 MiB budget")
+    check(d.run(TINY).get("status") == "done", "a small one runs")
+    tall = dict(TINY, scene={"width": 32, "height": 2048})
+    status, reply = d.json("POST", "/v1/sweeps", {"base": tall, "vary": {"scene.width": [32, 2048]}})
+    check(status == 400 and reply.get("error", {}).get("field", "").startswith("vary") and
+          "MiB" in reply.get("error", {}).get("message", ""),
+          "a sweep with a point over it is refused: %d %s" % (status, reply))
+finally:
+    testlib.stop_and_check(d)
+out = subprocess.run([testlib.SHADEBENCHD, "--listen", "127.0.0.1:0", "--memory-budget", "64",
+                      "--state-dir", tempfile.mkdtemp(prefix="shadebench-budget-")],
+                     capture_output=True, text=True, timeout=60 * S)
+check(out.returncode == 1 and "--memory-budget" in out.stderr + out.stdout,
+      "a budget that leaves a job nothing stops the start, saying so (%d)" % out.returncode)
+
 testlib.finish("e2e_faults")

@@ -22,6 +22,7 @@
 #include "common/log.h"
 #include "daemon/api/connections.h"
 #include "daemon/api/http.h"
+#include "daemon/jobs/job_cost.h"
 #include "daemon/jobs/store.h"
 
 static atomic_bool render_up = true;
@@ -337,11 +338,28 @@ int main(void)
     CHECK(!job_spec_parse_text("{\"frames\":1\0}", 13, &catalog, &nul_spec, &nul_err) &&
           strcmp(nul_err.field, "body") == 0);
 
+    /* Memory: /v1/info states the budget with the resident set; a job over
+     * what a job may take is refused naming the field that drives it. */
+    r = request(port, "GET", "/v1/info", NULL, NULL);
+    json_t *memory = json_object_get(r.json, "memory");
+    CHECK(r.status == 200 && json_real_value(json_object_get(memory, "rss_bytes")) > 0 &&
+          json_real_value(json_object_get(memory, "budget_bytes")) > 0 &&
+          json_object_get(memory, "job_bytes") && json_object_get(memory, "driver_bytes"));
+    reply_finish(&r);
+    job_cost_set_memory_limit(1048576.0);
+    r = request(port, "POST", "/v1/jobs", "{\"technique\":\"unlit\",\"scene\":{\"width\":1024,"
+                "\"height\":1024}}", NULL);
+    CHECK(r.status == 400 && error_field(&r) && strcmp(error_field(&r), "scene.width") == 0 &&
+          strstr(r.body, "MiB"));
+    reply_finish(&r);
+    job_cost_set_memory_limit(0);
+
     /* Accepted jobs wait in the queue: nothing takes them until the test does. */
     char ids[3][32] = {{0}};
     for (int i = 0; i < 3; i++) {
         r = request(port, "POST", "/v1/jobs", JOB, NULL);
         CHECK(r.status == 202 && str(r.json, "id") && strcmp(str(r.json, "status"), "queued") == 0);
+        CHECK(json_real_value(json_object_get(json_object_get(r.json, "cost"), "memory_bytes")) > 0);
         snprintf(ids[i], sizeof(ids[i]), "%s", str(r.json, "id") ? str(r.json, "id") : "");
         reply_finish(&r);
     }

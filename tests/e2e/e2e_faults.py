@@ -284,7 +284,7 @@ try:
     check(job.get("status") == "done", "a 4096x4096 job: %s %s" % (job.get("status"), job.get("error")))
     peak = rss_kb(pid, "VmHWM")
     bound = idle + (peak - idle) / 4
-    deadline = time.time() + 10 * S
+    deadline = time.time() + (1 if os.environ.get("SHADEBENCH_SANITIZERS") else 10)
     now = rss_kb(pid)
     while now > bound and time.time() < deadline:
         time.sleep(0.2)
@@ -292,8 +292,14 @@ try:
     print("memory: idle %.0f MiB, peak %.0f MiB, after the job %.0f MiB (bound %.0f)"
           % (idle / 1024, peak / 1024, now / 1024, bound / 1024))
     check(peak > idle + 200 * 1024, "the large job took memory (peak %d kB, idle %d kB)" % (peak, idle))
-    check(now <= bound, "and gave it back: %.0f MiB resident, at most idle + a quarter of the "
-          "peak's rise, %.0f MiB" % (now / 1024, bound / 1024))
+    if os.environ.get("SHADEBENCH_SANITIZERS"):
+        # AddressSanitizer's allocator keeps what is freed in its own
+        # quarantine and caches, and malloc_trim is glibc's: the resident
+        # set says nothing of the daemon's there.
+        print("memory: not bounded under the sanitizers (their allocator keeps freed memory)")
+    else:
+        check(now <= bound, "and gave it back: %.0f MiB resident, at most idle + a quarter of "
+              "the peak's rise, %.0f MiB" % (now / 1024, bound / 1024))
     check("given back" in log_text(d), "the log says what it gave back")
 finally:
     testlib.stop_and_check(d)

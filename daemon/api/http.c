@@ -1064,9 +1064,9 @@ static void *on_uri(void *cls, const char *uri, struct MHD_Connection *c)
     (void)cls, (void)c;
     struct request *req = calloc(1, sizeof(*req));
     if (!req)
-        return NULL; /* on_request allocates it, unchecked */
-    if (!route_check_target(uri, &req->query_args, &req->target_field, &req->target_rule) &&
-        strcmp(req->target_field, "query") == 0) {
+        return NULL; /* on_request allocates it then, without these checks */
+    route_check_target(uri, &req->query_args, &req->target_field, &req->target_rule);
+    if (req->query_args > ROUTE_MAX_QUERY_ARGS) {
         /* Refused anyway: keep libmicrohttpd from filling the pool with the
          * arguments (it then answered nothing). The target is its own
          * writable read buffer, which it cuts at the '?' right after this

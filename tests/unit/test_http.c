@@ -319,6 +319,10 @@ int main(void)
     CHECK(r.status == 400 && error_field(&r) && strcmp(error_field(&r), "query") == 0 &&
           strstr(r.body, "500"));
     reply_finish(&r);
+    memcpy(many + strlen("/v1/jobs?label.k0="), "%00", 3); /* and an encoded NUL: still answered */
+    r = request(port, "GET", many, NULL, NULL);
+    CHECK(r.status == 400 && error_field(&r) && strcmp(error_field(&r), "url") == 0);
+    reply_finish(&r);
     at = sprintf(many, "/v1/jobs");
     for (int i = 0; i < 40; i++)
         at += sprintf(many + at, "%clabel.k%d=v", i ? '&' : '?', i);

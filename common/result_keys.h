@@ -21,6 +21,9 @@
 #define RK_REPEAT "repeat" /* the repeat's outcome: runs, stable, ... */
 #define RK_STABLE "stable"
 #define RK_WALL_S "wall_s"
+/* When the job started running (unix seconds): with spec.json, what a row
+ * rebuilt from the job's directory takes its start time from. */
+#define RK_STARTED_UNIX "started_unix"
 #define RK_REFERENCE_MS "reference_ms"
 #define RK_WORKLOAD "workload"
 #define RK_INTERFERENCE "interference"

@@ -17,6 +17,8 @@
 #include "daemon/gpu/egl.h"
 #include "common/fsutil.h"
 #include "daemon/api/http.h"
+#include "daemon/harness/telemetry.h"
+#include "daemon/jobs/job_cost.h"
 #include "daemon/jobs/job_spec.h"
 #include "common/log.h"
 #include "daemon/jobs/queue.h"
@@ -41,6 +43,8 @@ struct options {
     int max_connections;
     int max_connections_per_ip;
     double job_timeout;
+    double stall_s;
+    double memory_budget_mib; /* 0: the driver, the connections, and half the RAM for a job */
     bool list_devices;
     bool gl_debug;
 };
@@ -53,6 +57,11 @@ struct options {
 #define KEEP_JOBS_TEXT "10000"
 #define KEEP_DAYS_DEFAULT 90
 #define KEEP_DAYS_TEXT "90"
+/* /healthz's bound on a busy render thread without progress: far above any
+ * step the harness takes between two progress marks (a frame, a slice of
+ * GPU work, a metric tile), far below what an operator would wait. */
+#define STALL_SECONDS_DEFAULT 60
+#define STALL_SECONDS_TEXT "60"
 
 static void usage(FILE *f)
 {
@@ -73,6 +82,13 @@ static void usage(FILE *f)
             "                       (default " KEEP_DAYS_TEXT "; 0: keep all)\n"
             "  --job-timeout S      running time a job may take when it gives no timeout_s\n"
             "                       (default 86400; 0: no limit)\n"
+            "  --stall-seconds S    /healthz answers 503 when the render thread, busy with a\n"
+            "                       job, has made no progress for S seconds (default "
+            STALL_SECONDS_TEXT "; 0: never)\n"
+            "  --memory-budget MIB  the daemon's memory budget: a job whose estimate does not fit\n"
+            "                       what the driver (measured at start) and the connections\n"
+            "                       leave of it is refused (default: those two and half the\n"
+            "                       machine's memory for a job)\n"
             "  --max-connections N  HTTP connections open at once, in total (default 4096)\n"
             "  --max-connections-per-ip N\n"
             "                       HTTP connections open at once from one address (default 64)\n"
@@ -86,10 +102,11 @@ static void usage(FILE *f)
             "  --version, --help\n\n"
             "Settings come from, in rising order: defaults, the config file (lines of\n"
             "\"key = value\": listen, state-dir, device, queue-size, token, keep-jobs,\n"
-            "keep-days, job-timeout, max-connections, max-connections-per-ip, log-level),\n"
-            "the environment (SHADEBENCH_LISTEN, SHADEBENCH_STATE_DIR,\n"
-            "SHADEBENCH_DEVICE, SHADEBENCH_QUEUE_SIZE, SHADEBENCH_TOKEN_FILE,\n"
-            "SHADEBENCH_KEEP_JOBS, SHADEBENCH_KEEP_DAYS, SHADEBENCH_JOB_TIMEOUT,\n"
+            "keep-days, job-timeout, stall-seconds, memory-budget, max-connections,\n"
+            "max-connections-per-ip, log-level), the environment (SHADEBENCH_LISTEN,\n"
+            "SHADEBENCH_STATE_DIR, SHADEBENCH_DEVICE, SHADEBENCH_QUEUE_SIZE,\n"
+            "SHADEBENCH_TOKEN_FILE, SHADEBENCH_KEEP_JOBS, SHADEBENCH_KEEP_DAYS,\n"
+            "SHADEBENCH_JOB_TIMEOUT, SHADEBENCH_STALL_SECONDS, SHADEBENCH_MEMORY_BUDGET,\n"
             "SHADEBENCH_MAX_CONNECTIONS, SHADEBENCH_MAX_CONNECTIONS_PER_IP,\n"
             "SHADEBENCH_LOG_LEVEL), the flags.\n");
 }
@@ -140,6 +157,12 @@ static bool apply_setting(struct options *o, const char *key, const char *value,
     } else if (strcmp(key, "job-timeout") == 0) {
         if (!parse_number(value, 0, 1e7, &o->job_timeout))
             rule = "must be a number of seconds from 0 (no limit) to 10000000";
+    } else if (strcmp(key, "stall-seconds") == 0) {
+        if (!parse_number(value, 0, 1e6, &o->stall_s))
+            rule = "must be a number of seconds from 0 (never stalled) to 1000000";
+    } else if (strcmp(key, "memory-budget") == 0) {
+        if (!parse_number(value, 0, 1e9, &o->memory_budget_mib))
+            rule = "must be a number of MiB from 0 (the default) to 1000000000";
     } else if (strcmp(key, "max-connections") == 0) {
         if (!parse_int(value, 16, 1000000, &o->max_connections))
             rule = "must be an integer from 16 to 1000000";
@@ -205,7 +228,7 @@ static bool load_environment(struct options *o)
 {
     static const char *const keys[] = {"listen", "state-dir", "device", "queue-size",
                                        "token-file", "keep-jobs", "keep-days", "job-timeout",
-                                       "max-connections",
+                                       "stall-seconds", "memory-budget", "max-connections",
                                        "max-connections-per-ip", "log-level", NULL};
     for (const char *const *k = keys; *k; k++) {
         char name[64] = "SHADEBENCH_";
@@ -383,8 +406,39 @@ static int run_once(const struct options *o, const struct technique_catalog *cat
 /* SIGTERM waits this long for the render thread, then exits without it. */
 #define STOP_RENDER_WAIT_S 2
 
+/* The memory budget (/v1/info): the driver's part is the resident set now,
+ * with the GL context up; what the driver and the connections leave is
+ * what one job may take (job_cost.h), and job_spec_parse refuses a job
+ * whose estimate is over it. false with err when --memory-budget leaves a
+ * job less than 64 MiB. */
+static bool set_memory_budget(const struct options *o, const struct http_limits *limits,
+                              double *budget, double *driver, char *err, size_t errlen)
+{
+    *driver = telemetry_rss_bytes();
+    double http = http_memory_bytes(limits), job;
+    if (o->memory_budget_mib > 0) {
+        *budget = o->memory_budget_mib * 1048576.0;
+        job = *budget - *driver - http;
+        if (job < 64.0 * 1048576.0) {
+            snprintf(err, errlen, "--memory-budget %.0f MiB leaves %.0f MiB for a job once the "
+                     "driver (%.0f MiB measured) and %u connections (%.0f MiB) have theirs; a "
+                     "job needs at least 64", o->memory_budget_mib, job / 1048576.0,
+                     *driver / 1048576.0, limits->max_connections, http / 1048576.0);
+            return false;
+        }
+    } else {
+        job = (double)sysconf(_SC_PHYS_PAGES) * (double)sysconf(_SC_PAGESIZE) / 2;
+        *budget = *driver + http + job;
+    }
+    job_cost_set_memory_limit(job);
+    LOG(LOG_INFO, "memory budget %.0f MiB: the driver %.0f (measured), connections %.0f, a job "
+        "up to %.0f", *budget / 1048576.0, *driver / 1048576.0, http / 1048576.0,
+        job / 1048576.0);
+    return true;
+}
+
 /* The render thread as the HTTP layer sees it (http.h). */
-static bool render_alive(void *r) { return runner_alive(r); }
+static void render_state(void *r, struct render_state *out) { runner_state(r, out); }
 static json_t *render_device_json(void *r) { return runner_device_json(r); }
 
 static int serve(const struct options *o, const struct technique_catalog *catalog)
@@ -453,10 +507,20 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
         return 1;
     }
     pin_loaded_modules();
+    double budget, driver;
+    if (!set_memory_budget(o, &limits, &budget, &driver, err, sizeof(err))) {
+        LOG(LOG_ERROR, "%s", err);
+        runner_destroy(r);
+        queue_destroy(q);
+        store_close(store);
+        return 1;
+    }
     struct sweeps *sweeps = sweeps_create(q, catalog);
     const struct http_context http_ctx = {.catalog = catalog, .queue = q, .sweeps = sweeps,
-                                          .render_alive = render_alive,
-                                          .device_json = render_device_json, .render = r};
+                                          .render_state = render_state,
+                                          .device_json = render_device_json, .render = r,
+                                          .stall_s = o->stall_s, .memory_budget_bytes = budget,
+                                          .driver_bytes = driver};
     struct http_server *http =
         sweeps ? http_server_create(o->listen, &limits, &http_ctx, err, sizeof(err)) : NULL;
     if (!http) {
@@ -529,10 +593,11 @@ int main(int argc, char **argv)
     mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
     mallopt(M_TRIM_THRESHOLD, 128 * 1024 * 1024);
     struct options o = {.device = -1, .queue_size = 64, .job_timeout = 86400,
+                        .stall_s = STALL_SECONDS_DEFAULT,
                         .keep_jobs = KEEP_JOBS_DEFAULT, .keep_days = KEEP_DAYS_DEFAULT};
     snprintf(o.listen, sizeof(o.listen), "127.0.0.1:8460");
     enum { OPT_LISTEN = 256, OPT_STATE, OPT_DEVICE, OPT_QUEUE, OPT_TOKEN, OPT_KEEP_JOBS,
-           OPT_KEEP_DAYS, OPT_JOB_TIMEOUT, OPT_MAX_CONN, OPT_MAX_CONN_IP, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_ONCE, OPT_OUT, OPT_DEBUG,
+           OPT_KEEP_DAYS, OPT_JOB_TIMEOUT, OPT_STALL, OPT_MEMORY, OPT_MAX_CONN, OPT_MAX_CONN_IP, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_ONCE, OPT_OUT, OPT_DEBUG,
            OPT_LOG, OPT_VERSION, OPT_HELP };
     static const struct option longopts[] = {
         {"listen", required_argument, NULL, OPT_LISTEN},
@@ -543,6 +608,8 @@ int main(int argc, char **argv)
         {"keep-jobs", required_argument, NULL, OPT_KEEP_JOBS},
         {"keep-days", required_argument, NULL, OPT_KEEP_DAYS},
         {"job-timeout", required_argument, NULL, OPT_JOB_TIMEOUT},
+        {"stall-seconds", required_argument, NULL, OPT_STALL},
+        {"memory-budget", required_argument, NULL, OPT_MEMORY},
         {"max-connections", required_argument, NULL, OPT_MAX_CONN},
         {"max-connections-per-ip", required_argument, NULL, OPT_MAX_CONN_IP},
         {"config", required_argument, NULL, OPT_CONFIG},
@@ -573,6 +640,8 @@ int main(int argc, char **argv)
         case OPT_KEEP_JOBS: key = "keep-jobs"; break;
         case OPT_KEEP_DAYS: key = "keep-days"; break;
         case OPT_JOB_TIMEOUT: key = "job-timeout"; break;
+        case OPT_STALL: key = "stall-seconds"; break;
+        case OPT_MEMORY: key = "memory-budget"; break;
         case OPT_MAX_CONN: key = "max-connections"; break;
         case OPT_MAX_CONN_IP: key = "max-connections-per-ip"; break;
         case OPT_LOG: key = "log-level"; break;

@@ -74,7 +74,8 @@ tests_unit_test_routes_LDADD = $(CORE_LIBS)
 # catalogue, with the test as the render thread.
 tests_unit_test_http_SOURCES = tests/unit/test_http.c $(API_SOURCES) \
 	daemon/jobs/sweeps.c daemon/jobs/sweeps.h \
-	daemon/harness/telemetry.c daemon/harness/telemetry.h
+	daemon/harness/telemetry.c daemon/harness/telemetry.h \
+	daemon/harness/render_state.c daemon/harness/render_state.h
 tests_unit_test_http_LDADD = $(CORE_LIBS) $(MHD_LIBS) $(CAIRO_LIBS) -lm
 # The fuzz targets, replayed over their corpora in make check (tests/fuzz/run.sh
 # builds them with clang and libFuzzer instead).
@@ -98,6 +99,7 @@ endif
 # one long test running alone at the end.
 E2E_TESTS = \
 	tests/e2e/e2e_report.py \
+	tests/e2e/e2e_faults.py \
 	tests/e2e/e2e_runaway.py \
 	tests/e2e/e2e_hardening.py \
 	tests/e2e/e2e_many_lights.py \
@@ -136,6 +138,7 @@ TESTS = $(UNIT_TESTS) \
 # several times slower, and the rendering paths they add are the driver's.
 SANITIZER_TESTS = $(UNIT_TESTS) \
 	tests/fuzz/replay.sh \
+	tests/e2e/e2e_faults.py \
 	tests/e2e/e2e_hardening.py \
 	tests/e2e/e2e_records.py \
 	tests/e2e/e2e_store.py \

@@ -9,6 +9,7 @@
 #include <string.h>
 #include <sys/epoll.h>
 #include <sys/eventfd.h>
+#include <netinet/in.h>
 #include <sys/socket.h>
 #include <time.h>
 #include <unistd.h>
@@ -32,6 +33,8 @@ struct conn {
     struct conn *prev, *next;
     struct MHD_Connection *mhd;
     int fd;
+    struct sockaddr_storage addr; /* the client's; family 0 when unknown */
+    bool reserve;                 /* past its address's per-IP limit */
     uint64_t serial; /* epoll's key: a freed conn is never looked up by pointer */
     enum conn_state state;
     double deadline; /* K_HEADERS and K_BODY, monotonic seconds */
@@ -256,6 +259,32 @@ void connections_destroy(struct connections *cs)
     free(cs);
 }
 
+/* The same client address (the port aside)? */
+static bool same_address(const struct sockaddr_storage *a, const struct sockaddr_storage *b)
+{
+    if (a->ss_family != b->ss_family)
+        return false;
+    if (a->ss_family == AF_INET)
+        return memcmp(&((const struct sockaddr_in *)a)->sin_addr,
+                      &((const struct sockaddr_in *)b)->sin_addr, sizeof(struct in_addr)) == 0;
+    if (a->ss_family == AF_INET6)
+        return memcmp(&((const struct sockaddr_in6 *)a)->sin6_addr,
+                      &((const struct sockaddr_in6 *)b)->sin6_addr, sizeof(struct in6_addr)) == 0;
+    return false;
+}
+
+/* Under the lock: does k's address already have its per-IP connections? */
+static bool over_per_ip_locked(struct connections *cs, const struct conn *k)
+{
+    if (!cs->cfg.per_ip || !k->addr.ss_family)
+        return false;
+    unsigned n = 0;
+    for (const struct conn *o = cs->head; o; o = o->next)
+        if (same_address(&o->addr, &k->addr) && ++n >= cs->cfg.per_ip)
+            return true;
+    return false;
+}
+
 void connections_notify(void *cls, struct MHD_Connection *c, void **socket_context,
                         enum MHD_ConnectionNotificationCode code)
 {
@@ -269,9 +298,23 @@ void connections_notify(void *cls, struct MHD_Connection *c, void **socket_conte
             return;
         k->mhd = c;
         k->fd = info->connect_fd;
+        const union MHD_ConnectionInfo *peer =
+            MHD_get_connection_info(c, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
+        if (peer && peer->client_addr) {
+            size_t len = peer->client_addr->sa_family == AF_INET6 ? sizeof(struct sockaddr_in6)
+                         : peer->client_addr->sa_family == AF_INET ? sizeof(struct sockaddr_in)
+                                                                   : 0;
+            memcpy(&k->addr, peer->client_addr, len);
+        }
         k->state = K_HEADERS;
-        k->deadline = clock_mono_s() + cs->cfg.header_s;
         pthread_mutex_lock(&cs->lock);
+        k->reserve = over_per_ip_locked(cs, k);
+        /* A reserve connection is for a health checker, which sends its
+         * request at once: one that does not gives its slot back soon. */
+        double header_s = cs->cfg.header_s;
+        if (k->reserve && header_s > CONNECTIONS_RESERVE_HEADER_S)
+            header_s = CONNECTIONS_RESERVE_HEADER_S;
+        k->deadline = clock_mono_s() + header_s;
         k->serial = cs->next_serial++;
         k->next = cs->head;
         if (cs->head)
@@ -352,6 +395,8 @@ void connections_request_done(struct connections *cs, struct conn *k)
     }
     pthread_mutex_unlock(&cs->lock);
 }
+
+bool connections_is_reserve(const struct conn *k) { return k && k->reserve; }
 
 void connections_set_status(struct conn *k, unsigned status)
 {

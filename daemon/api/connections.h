@@ -7,6 +7,12 @@
  *    in within header_s of the accept (or of the previous request on the
  *    connection), its body within body_s of the headers; a late connection
  *    is shut down (libmicrohttpd's own timeout restarts on every byte);
+ *  - a health check has an allowance of its own: past its address's
+ *    per_ip connections, the next CONNECTIONS_HEALTH_RESERVE are reserve
+ *    connections, which may ask /healthz and /metrics only, must send
+ *    their request within CONNECTIONS_RESERVE_HEADER_S and are closed after
+ *    one answer, so that other clients of the same address (waits held
+ *    open, a local load test) cannot lock a local monitor out;
  *  - long-polls (?wait=) hold no thread: the connection is suspended
  *    (MHD_suspend_connection) and one watcher thread resumes it when its job
  *    or sweep has finished, its time is up, its client has gone away
@@ -31,9 +37,15 @@ enum wait_kind { WAIT_JOB, WAIT_SWEEP };
  * Called on the watcher thread, which holds no lock of the caller's. */
 typedef bool (*wait_done_fn)(void *ctx, enum wait_kind kind, const char *id);
 
+/* Connections an address may open past its per-IP limit for /healthz and
+ * /metrics (libmicrohttpd's own per-IP limit is set to per_ip plus these). */
+#define CONNECTIONS_HEALTH_RESERVE 4
+#define CONNECTIONS_RESERVE_HEADER_S 2.0
+
 struct connections_config {
     double header_s; /* accept (or the previous request) to complete headers */
     double body_s;   /* complete headers to complete body */
+    unsigned per_ip; /* an address's connections before reserve ones (0: no limit) */
 };
 
 struct connections *connections_create(const struct connections_config *cfg, wait_done_fn done,
@@ -55,6 +67,10 @@ void connections_headers_in(struct connections *cs, struct conn *k);
 void connections_answering(struct connections *cs, struct conn *k);
 /* The answer is sent: the next request's header deadline starts. */
 void connections_request_done(struct connections *cs, struct conn *k);
+/* A connection past its address's per-IP limit (see above): it serves a
+ * health check and closes. */
+bool connections_is_reserve(const struct conn *k);
+
 /* The answer's status, for the request counters. */
 void connections_set_status(struct conn *k, unsigned status);
 unsigned connections_status(const struct conn *k);

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "config.h"
+#include "common/clock.h"
 #include "common/job_files.h"
 #include "common/log.h"
 #include "daemon/api/charts.h"
@@ -24,6 +25,7 @@
 #include "daemon/api/report.h"
 #include "daemon/api/routes.h"
 #include "daemon/harness/telemetry.h"
+#include "daemon/jobs/job_cost.h"
 #include "daemon/jobs/job_spec.h"
 #include "daemon/quality/metrics.h"
 #include "daemon/api/job_filter.h"
@@ -122,10 +124,21 @@ struct request {
     struct route route;
     char *body;
     size_t len;
+    bool started;         /* the access handler has seen its headers */
     bool too_large;
     bool waiting;         /* suspended; the next call is the resume */
     unsigned wait_status; /* 200 for ?wait=, 202 for a DELETE that waits */
+    /* What the raw request target showed (on_uri): a refusal to answer
+     * once the headers are in, and the query's size. */
+    const char *target_field, *target_rule;
+    size_t query_args;
 };
+
+/* Set by answer_waited just before it closes the connection of a client
+ * that hung up, and read by on_mhd_log, which libmicrohttpd calls at once
+ * on the same thread: its "internal error" line is then the expected end
+ * of a wait, not an error (2,000 waits hung up made 2,000 warnings). */
+static _Thread_local bool closing_gone_client;
 
 static enum MHD_Result respond_text(struct MHD_Connection *c, unsigned status,
                                     char *text, size_t len, const char *type)
@@ -138,6 +151,8 @@ static enum MHD_Result respond_text(struct MHD_Connection *c, unsigned status,
     }
     MHD_add_response_header(resp, "Content-Type", type);
     MHD_add_response_header(resp, "Cache-Control", "no-store");
+    if (connections_is_reserve(connections_of(c)))
+        MHD_add_response_header(resp, "Connection", "close"); /* gives the reserve slot back */
     if (status == MHD_HTTP_UNAUTHORIZED)
         MHD_add_response_header(resp, "WWW-Authenticate", "Bearer realm=\"shadebench\"");
     connections_set_status(connections_of(c), status);
@@ -196,6 +211,8 @@ static enum MHD_Result respond_405(struct MHD_Connection *c, const char *allow, 
     }
     MHD_add_response_header(resp, "Content-Type", "application/json");
     MHD_add_response_header(resp, "Allow", allow);
+    if (connections_is_reserve(connections_of(c)))
+        MHD_add_response_header(resp, "Connection", "close");
     connections_set_status(connections_of(c), MHD_HTTP_METHOD_NOT_ALLOWED);
     enum MHD_Result ret = MHD_queue_response(c, MHD_HTTP_METHOD_NOT_ALLOWED, resp);
     MHD_destroy_response(resp);
@@ -224,25 +241,36 @@ static enum MHD_Result respond_file(struct MHD_Connection *c, const char *path,
     return ret;
 }
 
-/* The daemon's memory budget: what its own buffers can reach at the limits
- * the API accepts, by part. The GL driver's memory (framebuffers, textures,
- * compiled shaders) is the driver's and not counted. */
+double http_memory_bytes(const struct http_limits *l)
+{
+    /* libmicrohttpd's per-connection pool plus a body buffer, per
+     * connection, at the connection limit (a health check's reserve too). */
+    return (double)l->max_connections * (CONNECTION_MEMORY + JOB_MAX_BODY_BYTES);
+}
+
+/* The daemon's memory budget (--memory-budget), by part: the driver and
+ * libraries as measured at start, the connections at their limit, and what
+ * is left for one job, which each job's estimate must fit (job_cost.h);
+ * rss_bytes is the resident set now, the driver's allocations included. */
 static json_t *memory_json(const struct http_server *s, double *total)
 {
     const double side = 8192.0, frame = side * side * 4.0;
-    /* The render thread's captures (bounded per job) and one read-back frame
-     * for the reference; its per-frame series (3 doubles a frame, 1,000,000
-     * frames at most). */
+    double http = http_memory_bytes(&s->limits), job = job_cost_memory_limit();
+    *total = s->ctx.memory_budget_bytes > 0 ? s->ctx.memory_budget_bytes
+                                            : s->ctx.driver_bytes + http + job;
+    /* What the API's own limits let a job's buffers reach, for scale: its
+     * captures (bounded per job), a read-back frame and its per-frame
+     * series, and the metrics stage at the largest image. */
     double captures = JOB_MAX_CAPTURE_BYTES, render = frame + 1e6 * 3 * sizeof(double);
-    /* The metrics thread scores the previous job while the next renders: its
-     * bound at the largest image and the widest FLIP filter. */
     double metrics = metrics_memory_bytes(8192, 8192, 1000.0);
-    /* libmicrohttpd's per-connection pool plus a body buffer, per connection. */
-    double http = (double)s->limits.max_connections * (CONNECTION_MEMORY + JOB_MAX_BODY_BYTES);
-    *total = captures + render + metrics + http;
-    return json_pack("{s:f, s:f, s:f, s:f, s:f, s:s}", "budget_bytes", *total, "captures_bytes",
-                     captures, "render_bytes", render, "metrics_bytes", metrics, "http_bytes",
-                     http, "excludes", "the GL driver's own memory");
+    return json_pack("{s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:s}", "budget_bytes", *total,
+                     "driver_bytes", s->ctx.driver_bytes, "http_bytes", http, "job_bytes", job,
+                     "rss_bytes", telemetry_rss_bytes(), "captures_bytes", captures,
+                     "render_bytes", render, "metrics_bytes", metrics, "rule",
+                     "budget_bytes = driver_bytes (the daemon's resident set at start, the GL "
+                     "context up: driver, shader compiler, libraries) + http_bytes (every "
+                     "connection's buffers) + job_bytes (what one job may take: a job whose "
+                     "estimate, its answer's cost.memory_bytes, is over it is refused)");
 }
 
 static json_t *info_json(struct http_server *s)
@@ -267,6 +295,94 @@ static json_t *info_json(struct http_server *s)
                      "max_token_bytes", (json_int_t)HTTP_MAX_TOKEN_BYTES, "default_job_timeout_s",
                      job_spec_default_timeout(), "max_captures",
                      (json_int_t)JOB_MAX_CAPTURES, "max_image_pixels", (json_int_t)IMAGE_MAX_PIXELS);
+}
+
+/* The render thread's state as /healthz shows it. */
+static json_t *render_json(const struct render_state *st, double stall_s)
+{
+    if (!st->alive)
+        return json_pack("{s:s}", "state", "stopped");
+    if (!st->busy)
+        return json_pack("{s:s, s:f}", "state", "idle", "idle_s", st->since_progress_s);
+    return json_pack("{s:s, s:s, s:s, s:f, s:f, s:f}", "state",
+                     render_state_stalled(st, stall_s) ? "stalled" : "busy", "job", st->job,
+                     "phase", st->phase, "busy_s", st->busy_s, "since_progress_s",
+                     st->since_progress_s, "stall_seconds", stall_s);
+}
+
+/* GET /healthz: cheap (no store, no lock), and true: 503 when the render
+ * thread has stopped, or has made no progress for longer than the bound
+ * while a job is on it, which no other endpoint would show (a job that
+ * holds the GPU for minutes still left every other answer quick). */
+static enum MHD_Result respond_healthz(struct http_server *s, struct MHD_Connection *c)
+{
+    struct render_state st;
+    s->ctx.render_state(s->ctx.render, &st);
+    json_t *render = render_json(&st, s->ctx.stall_s);
+    if (!st.alive)
+        return respond_json(c, MHD_HTTP_SERVICE_UNAVAILABLE,
+                            json_pack("{s:s, s:o}", "status", "render thread is not running",
+                                      "render", render));
+    if (render_state_stalled(&st, s->ctx.stall_s)) {
+        char msg[256];
+        snprintf(msg, sizeof(msg), "the render thread has made no progress for %.0f s (more "
+                 "than --stall-seconds %g) on job %s, phase %s", st.since_progress_s,
+                 s->ctx.stall_s, st.job, st.phase);
+        return respond_json(c, MHD_HTTP_SERVICE_UNAVAILABLE,
+                            json_pack("{s:s, s:s, s:o}", "status", "stalled", "message", msg,
+                                      "render", render));
+    }
+    return respond_json(c, MHD_HTTP_OK, json_pack("{s:s, s:o}", "status", "ok", "render", render));
+}
+
+/* Label values in the text format: a backslash, a quote and a newline are
+ * escaped. A job id and a phase have none, but say so in one place. */
+static void prometheus_label(FILE *f, const char *v)
+{
+    for (; v && *v; v++) {
+        if (*v == '\\' || *v == '"')
+            fputc('\\', f);
+        if (*v == '\n')
+            fputs("\\n", f);
+        else
+            fputc(*v, f);
+    }
+}
+
+static void render_metrics(struct http_server *s, FILE *f)
+{
+    struct render_state st;
+    s->ctx.render_state(s->ctx.render, &st);
+    fprintf(f, "# HELP shadebench_render_up Whether the render thread runs.\n"
+               "# TYPE shadebench_render_up gauge\n"
+               "shadebench_render_up %d\n", st.alive);
+    fprintf(f, "# HELP shadebench_render_busy Whether a job is on the render thread.\n"
+               "# TYPE shadebench_render_busy gauge\n"
+               "shadebench_render_busy %d\n", st.busy);
+    fprintf(f, "# HELP shadebench_render_seconds_since_progress Seconds since the render thread "
+               "last made progress (a frame, a slice of GPU work, a metric tile, a phase); 0 "
+               "while idle.\n"
+               "# TYPE shadebench_render_seconds_since_progress gauge\n"
+               "shadebench_render_seconds_since_progress %.3f\n",
+            st.busy ? st.since_progress_s : 0.0);
+    fprintf(f, "# HELP shadebench_render_stalled Whether /healthz reports the render thread "
+               "stalled (busy, no progress for longer than shadebench_render_stall_seconds).\n"
+               "# TYPE shadebench_render_stalled gauge\n"
+               "shadebench_render_stalled %d\n"
+               "# HELP shadebench_render_stall_seconds The stall bound (--stall-seconds; 0: "
+               "none).\n"
+               "# TYPE shadebench_render_stall_seconds gauge\n"
+               "shadebench_render_stall_seconds %g\n",
+            render_state_stalled(&st, s->ctx.stall_s), s->ctx.stall_s);
+    if (st.busy) {
+        fprintf(f, "# HELP shadebench_render_job The job on the render thread and its phase.\n"
+                   "# TYPE shadebench_render_job gauge\n"
+                   "shadebench_render_job{job=\"");
+        prometheus_label(f, st.job);
+        fprintf(f, "\",phase=\"");
+        prometheus_label(f, st.phase);
+        fprintf(f, "\"} 1\n");
+    }
 }
 
 /* GET /metrics: Prometheus text format 0.0.4. */
@@ -295,11 +411,16 @@ static enum MHD_Result respond_metrics(struct http_server *s, struct MHD_Connect
     fprintf(f, "# HELP shadebench_queue_capacity Jobs that may wait at once.\n"
                "# TYPE shadebench_queue_capacity gauge\n"
                "shadebench_queue_capacity %d\n", queue_max_queued(s->queue));
+    fprintf(f, "# HELP shadebench_state_disk_full Whether the state directory's disk is full: "
+               "no job starts and none is accepted until there is room (docs/store.md).\n"
+               "# TYPE shadebench_state_disk_full gauge\n"
+               "shadebench_state_disk_full %d\n", store_disk_full(queue_store(s->queue)));
     struct telemetry t;
     telemetry_read(&t);
     fprintf(f, "# HELP shadebench_frames_rendered_total Frames rendered for jobs (warm-up and timed).\n"
                "# TYPE shadebench_frames_rendered_total counter\n"
                "shadebench_frames_rendered_total %llu\n", t.frames);
+    render_metrics(s, f);
     fprintf(f, "# HELP shadebench_render_busy_seconds_total Seconds the render thread spent on jobs.\n"
                "# TYPE shadebench_render_busy_seconds_total counter\n"
                "shadebench_render_busy_seconds_total %.6f\n", t.render_busy_s);
@@ -342,7 +463,11 @@ static enum MHD_Result respond_metrics(struct http_server *s, struct MHD_Connect
     json_decref(memory_json(s, &budget));
     fprintf(f, "# HELP shadebench_memory_budget_bytes The daemon's memory budget (parts in /v1/info).\n"
                "# TYPE shadebench_memory_budget_bytes gauge\n"
-               "shadebench_memory_budget_bytes %.0f\n", budget);
+               "shadebench_memory_budget_bytes %.0f\n"
+               "# HELP shadebench_memory_rss_bytes The daemon's resident set (the GL driver's "
+               "allocations included).\n"
+               "# TYPE shadebench_memory_rss_bytes gauge\n"
+               "shadebench_memory_rss_bytes %.0f\n", budget, telemetry_rss_bytes());
     if (fclose(f) != 0 || !text) {
         free(text);
         return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "metrics", "out of memory");
@@ -376,8 +501,11 @@ static enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *
     char url[ROUTE_URL_MAX];
     route_job_url(id, url);
     LOG(LOG_INFO, "queued job %s (%s)", id, spec.technique);
+    struct job_cost cost;
+    job_cost_estimate(&spec, &cost);
     return respond_json(c, MHD_HTTP_ACCEPTED,
-                        json_pack("{s:s, s:s, s:s}", "id", id, "status", "queued", "url", url));
+                        json_pack("{s:s, s:s, s:s, s:o}", "id", id, "status", "queued", "url", url,
+                                  "cost", job_cost_json(&cost)));
 }
 
 static bool parse_wait(struct MHD_Connection *c, double *wait)
@@ -551,8 +679,12 @@ static enum MHD_Result answer_waited(struct http_server *s, struct MHD_Connectio
 {
     req->waiting = false;
     enum wake why = connections_wake(req->conn);
-    if (why == WAKE_GONE)
-        return MHD_NO; /* nobody to answer: close */
+    if (why == WAKE_GONE) {
+        /* Nobody to answer: close. Counted in /metrics
+         * (shadebench_http_waits_abandoned_total), logged at debug. */
+        closing_gone_client = true;
+        return MHD_NO;
+    }
     if (why == WAKE_STOPPING && req->wait_status == MHD_HTTP_OK)
         return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "wait",
                              "the daemon is stopping: the wait ended early; ask again once it "
@@ -734,10 +866,7 @@ static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
     bool post = strcmp(method, "POST") == 0;
     switch (req->route.kind) {
     case ROUTE_HEALTHZ:
-        if (!s->ctx.render_alive(s->ctx.render))
-            return respond_json(c, MHD_HTTP_SERVICE_UNAVAILABLE,
-                                json_pack("{s:s}", "status", "render thread is not running"));
-        return respond_json(c, MHD_HTTP_OK, json_pack("{s:s}", "status", "ok"));
+        return respond_healthz(s, c);
     case ROUTE_INFO:
         return respond_json(c, MHD_HTTP_OK, info_json(s));
     case ROUTE_METRICS:
@@ -797,7 +926,7 @@ static enum MHD_Result scan_header(void *cls, enum MHD_ValueKind kind, const cha
 /* Checks made as soon as the headers are in, before any body is read:
  * answers the request (returns true) when it must be refused. */
 static bool refuse_early(struct http_server *s, struct MHD_Connection *c, const char *method,
-                         struct request *req, enum MHD_Result *ret)
+                         const char *version, struct request *req, enum MHD_Result *ret)
 {
     struct header_scan h = {0};
     MHD_get_connection_values_n(c, MHD_HEADER_KIND, scan_header, &h);
@@ -818,6 +947,33 @@ static bool refuse_early(struct http_server *s, struct MHD_Connection *c, const 
         (te && strcasecmp(te, "chunked") != 0)) {
         *ret = respond_error(c, MHD_HTTP_BAD_REQUEST, "Transfer-Encoding",
                              "must be \"chunked\" alone, once, and without Content-Length");
+        return true;
+    }
+    /* RFC 9112: an HTTP/1.1 request without Host is a 400 (a proxy's
+     * host-based rules cannot apply to it). */
+    if (strcmp(version, MHD_HTTP_VERSION_1_1) == 0 &&
+        !MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_HOST)) {
+        *ret = respond_error(c, MHD_HTTP_BAD_REQUEST, "Host",
+                             "an HTTP/1.1 request must have a Host header");
+        return true;
+    }
+    if (req->target_field) {
+        char rule[200] = "";
+        if (strcmp(req->target_field, "query") == 0)
+            snprintf(rule, sizeof(rule), "%s; this one has %zu", req->target_rule,
+                     req->query_args);
+        else
+            snprintf(rule, sizeof(rule), "%s", req->target_rule);
+        *ret = respond_error(c, MHD_HTTP_BAD_REQUEST, req->target_field, rule);
+        return true;
+    }
+    if (connections_is_reserve(req->conn) && req->route.kind != ROUTE_HEALTHZ &&
+        req->route.kind != ROUTE_METRICS) {
+        char rule[200];
+        snprintf(rule, sizeof(rule), "this address has its %u connections open "
+                 "(--max-connections-per-ip); the %d beyond them serve /healthz and /metrics only",
+                 s->limits.max_connections_per_ip, CONNECTIONS_HEALTH_RESERVE);
+        *ret = respond_error(c, MHD_HTTP_TOO_MANY_REQUESTS, "connections", rule);
         return true;
     }
     if (req->route.kind != ROUTE_HEALTHZ && !authorized(s, c)) {
@@ -850,20 +1006,20 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
                                   const char *upload_data, size_t *upload_data_size,
                                   void **con_cls)
 {
-    (void)version;
     struct http_server *s = cls;
     struct request *req = *con_cls;
-    if (!req) {
+    closing_gone_client = false; /* a close that logged nothing */
+    if (!req || !req->started) {
         /* The headers are in; nothing of the body has been read. */
-        req = calloc(1, sizeof(*req));
-        if (!req)
+        if (!req && !(req = calloc(1, sizeof(*req))))
             return MHD_NO;
         *con_cls = req;
+        req->started = true;
         req->conn = connections_of(c);
         connections_headers_in(s->conns, req->conn);
         route_parse(url, &req->route);
         enum MHD_Result ret;
-        if (refuse_early(s, c, method, req, &ret)) {
+        if (refuse_early(s, c, method, version, req, &ret)) {
             connections_answering(s->conns, req->conn);
             return ret;
         }
@@ -887,7 +1043,40 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
     if (req->waiting)
         return answer_waited(s, c, req);
     connections_answering(s->conns, req->conn);
+    /* Jansson reads a NUL byte as the end of the text, so that what follows
+     * it would go unread: a body is JSON text, which has none. */
+    const char *nul = req->body ? memchr(req->body, '\0', req->len) : NULL;
+    if (nul) {
+        char rule[96];
+        snprintf(rule, sizeof(rule), "must be JSON text, which has no NUL byte (one at byte %zu)",
+                 (size_t)(nul - req->body));
+        return respond_error(c, MHD_HTTP_BAD_REQUEST, "body", rule);
+    }
     return dispatch(s, c, method, req);
+}
+
+/* MHD_OPTION_URI_LOG_CALLBACK: the request target exactly as sent, before
+ * libmicrohttpd splits off the query, stores the arguments in the
+ * connection's pool and decodes them (route_check_target says why that
+ * matters). What it returns is the request's *con_cls. */
+static void *on_uri(void *cls, const char *uri, struct MHD_Connection *c)
+{
+    (void)cls, (void)c;
+    struct request *req = calloc(1, sizeof(*req));
+    if (!req)
+        return NULL; /* on_request allocates it then, without these checks */
+    route_check_target(uri, &req->query_args, &req->target_field, &req->target_rule);
+    if (req->query_args > ROUTE_MAX_QUERY_ARGS) {
+        /* Refused anyway: keep libmicrohttpd from filling the pool with the
+         * arguments (it then answered nothing). The target is its own
+         * writable read buffer, which it cuts at the '?' right after this
+         * call and parses the arguments from the byte after; ending the
+         * query there leaves it none to parse (libmicrohttpd 0.9.75 to
+         * 1.0). */
+        char *query = strchr((char *)uri, '?');
+        query[1] = '\0';
+    }
+    return req;
 }
 
 static size_t code_index(unsigned status)
@@ -916,6 +1105,33 @@ static void on_completed(void *cls, struct MHD_Connection *c, void **con_cls,
     connections_request_done(s->conns, k);
 }
 
+/* libmicrohttpd logs per connection (one refused for the per-address
+ * limit, one that failed to send): a client could write the log full. At
+ * most MHD_LOG_BURST of its warnings go out each MHD_LOG_WINDOW_S; the rest
+ * are counted, and the count logged when the next window opens. */
+enum { MHD_LOG_BURST = 20, MHD_LOG_WINDOW_S = 10 };
+static pthread_mutex_t mhd_log_lock = PTHREAD_MUTEX_INITIALIZER;
+static double mhd_log_window;
+static unsigned mhd_log_count;
+
+static bool mhd_log_allowed(void)
+{
+    double now = clock_mono_s();
+    unsigned suppressed = 0;
+    pthread_mutex_lock(&mhd_log_lock);
+    if (now - mhd_log_window >= MHD_LOG_WINDOW_S) {
+        suppressed = mhd_log_count > MHD_LOG_BURST ? mhd_log_count - MHD_LOG_BURST : 0;
+        mhd_log_window = now;
+        mhd_log_count = 0;
+    }
+    bool allowed = ++mhd_log_count <= MHD_LOG_BURST;
+    pthread_mutex_unlock(&mhd_log_lock);
+    if (suppressed)
+        LOG(LOG_WARN, "libmicrohttpd: %u more messages in %d s were not logged", suppressed,
+            MHD_LOG_WINDOW_S);
+    return allowed;
+}
+
 static void on_mhd_log(void *cls, const char *fmt, va_list ap)
 {
     (void)cls;
@@ -924,7 +1140,12 @@ static void on_mhd_log(void *cls, const char *fmt, va_list ap)
     size_t n = strlen(msg);
     while (n && msg[n - 1] == '\n')
         msg[--n] = '\0';
-    LOG(LOG_WARN, "libmicrohttpd: %s", msg);
+    bool expected = closing_gone_client && strstr(msg, "internal error");
+    closing_gone_client = false;
+    if (expected)
+        LOG(LOG_DEBUG, "libmicrohttpd: %s (a waiting client hung up)", msg);
+    else if (mhd_log_allowed())
+        LOG(LOG_WARN, "libmicrohttpd: %s", msg);
 }
 
 struct http_server *http_server_create(const char *listen, const struct http_limits *limits,
@@ -973,7 +1194,8 @@ struct http_server *http_server_create(const char *listen, const struct http_lim
     s->limits = *limits;
     pthread_mutex_init(&s->token_lock, NULL);
     struct connections_config cc = {.header_s = limits->header_timeout_s,
-                                    .body_s = limits->body_timeout_s};
+                                    .body_s = limits->body_timeout_s,
+                                    .per_ip = limits->max_connections_per_ip};
     s->conns = connections_create(&cc, wait_done, s, err, errlen);
     if (!s->conns) {
         freeaddrinfo(ai);
@@ -991,10 +1213,12 @@ struct http_server *http_server_create(const char *listen, const struct http_lim
         s, MHD_OPTION_SOCK_ADDR, ai->ai_addr, MHD_OPTION_THREAD_POOL_SIZE,
         (unsigned)(limits->threads ? limits->threads : 1), MHD_OPTION_CONNECTION_LIMIT,
         (unsigned)limits->max_connections, MHD_OPTION_PER_IP_CONNECTION_LIMIT,
-        (unsigned)limits->max_connections_per_ip, MHD_OPTION_CONNECTION_TIMEOUT,
+        (unsigned)(limits->max_connections_per_ip + CONNECTIONS_HEALTH_RESERVE),
+        MHD_OPTION_CONNECTION_TIMEOUT,
         (unsigned)limits->idle_timeout_s, MHD_OPTION_CONNECTION_MEMORY_LIMIT,
         (size_t)CONNECTION_MEMORY, MHD_OPTION_NOTIFY_CONNECTION, connections_notify, s->conns,
-        MHD_OPTION_NOTIFY_COMPLETED, on_completed, s, MHD_OPTION_END);
+        MHD_OPTION_NOTIFY_COMPLETED, on_completed, s, MHD_OPTION_URI_LOG_CALLBACK, on_uri, s,
+        MHD_OPTION_END);
     freeaddrinfo(ai);
     if (!s->mhd) {
         snprintf(err, errlen, "cannot listen on %s (address in use or not allowed?)", listen);

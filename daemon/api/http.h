@@ -11,6 +11,7 @@
 
 #include <jansson.h>
 
+#include "daemon/harness/render_state.h"
 #include "daemon/jobs/queue.h"
 #include "daemon/jobs/sweeps.h"
 #include "daemon/techniques/catalog.h"
@@ -29,18 +30,32 @@ struct http_limits {
 
 void http_limits_defaults(struct http_limits *l);
 
+/* What the connections' buffers can reach at these limits (bytes): a part
+ * of the memory budget. */
+double http_memory_bytes(const struct http_limits *l);
+
 /* What the API serves, handed in by its owner (main, or a unit test with a
  * render thread of its own making): everything outlives the server. */
 struct http_context {
     const struct technique_catalog *catalog; /* jobs and sweeps are parsed against it */
     struct queue *queue;
     struct sweeps *sweeps;
-    /* The render thread as the API sees it, without GL: whether it still
-     * runs (/healthz) and its device strings (/v1/info, reports; a new
-     * reference). Called from the HTTP threads. */
-    bool (*render_alive)(void *render);
+    /* The render thread as the API sees it, without GL: what it is doing
+     * (render_state.h: whether it runs, its job and phase, its last
+     * progress), for /healthz and /metrics, which must stay cheap (the
+     * state is read lock-free); and its device strings (/v1/info, reports;
+     * a new reference). Called from the HTTP threads. */
+    void (*render_state)(void *render, struct render_state *out);
     json_t *(*device_json)(void *render);
     void *render;
+    /* /healthz answers 503 when the render thread, busy with a job, has
+     * made no progress for longer than this (--stall-seconds); 0: never. */
+    double stall_s;
+    /* The memory budget (/v1/info): in all (--memory-budget; 0: the sum of
+     * its parts), and the driver's part, the daemon's resident set measured
+     * at start with the GL context up. What a job may take is
+     * job_cost_memory_limit(). */
+    double memory_budget_bytes, driver_bytes;
 };
 
 struct http_server;

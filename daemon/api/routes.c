@@ -164,6 +164,30 @@ bool route_parse(const char *url, struct route *r)
     return true;
 }
 
+bool route_check_target(const char *target, size_t *args, const char **field,
+                        const char **message)
+{
+    const char *query = strchr(target, '?');
+    *args = 0;
+    if (query && query[1]) {
+        *args = 1;
+        for (const char *p = query + 1; *p; p++)
+            *args += *p == '&';
+    }
+    for (const char *p = strchr(target, '%'); p; p = strchr(p + 1, '%'))
+        if (p[1] == '0' && p[2] == '0') {
+            *field = "url";
+            *message = "must not contain an encoded NUL byte (%00), which would cut it short";
+            return false;
+        }
+    if (*args > ROUTE_MAX_QUERY_ARGS) {
+        *field = "query";
+        *message = "at most 64 query arguments (filters, limit, cursor, wait, ...)";
+        return false;
+    }
+    return true;
+}
+
 bool route_method_ok(enum route_kind kind, const char *method, const char **allow,
                      const char **rule)
 {

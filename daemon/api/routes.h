@@ -45,6 +45,21 @@ struct route {
  * false for ROUTE_NONE. */
 bool route_parse(const char *url, struct route *out);
 
+/* Query arguments a request may carry: the lists take at most
+ * STORE_MAX_TERMS (32) filters with limit, cursor and since; anything far
+ * beyond is not a question the API can answer. */
+#define ROUTE_MAX_QUERY_ARGS 64
+
+/* Checks the request target as the client sent it, before libmicrohttpd
+ * splits off the query and decodes it: an encoded NUL (%00) anywhere would
+ * cut the decoded path or argument short (".../1.png%00.txt" served the
+ * PNG), and libmicrohttpd keeps every argument in the connection's small
+ * memory pool (500 of them left the client without an answer). False, with
+ * the field ("url" or "query") and the rule of a 400, when it must be
+ * refused; *args gets the number of query arguments either way. */
+bool route_check_target(const char *target, size_t *args, const char **field,
+                        const char **message);
+
 /* Does kind take method (GET and HEAD alike)? If not, *allow is the Allow
  * header and *rule the message of the 405. */
 bool route_method_ok(enum route_kind kind, const char *method, const char **allow,

@@ -55,8 +55,11 @@ bool gpu_budget_wait(struct gpu_budget *b, GLsync fence)
             break;
     }
     glDeleteSync(fence);
-    if (b)
+    if (b) {
         b->waits++;
+        if (b->progress && !b->stopped)
+            b->progress();
+    }
     return !gpu_budget_stopped(b);
 }
 

@@ -40,6 +40,9 @@ struct gpu_budget_piece {
 struct gpu_budget {
     bool (*stop)(void *ctx);
     void *ctx;
+    /* Called when a wait has seen the GPU finish what it waited for (the
+     * daemon's health check counts it as progress); may be NULL. */
+    void (*progress)(void);
     bool stopped;
     int64_t waits;  /* fences waited for, in all */
     int64_t pieces_sliced; /* runs of a piece drawn in more than one tile or chunk */

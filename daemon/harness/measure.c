@@ -8,6 +8,7 @@
 #include "daemon/gpu/glutil.h"
 #include "daemon/harness/deadline.h"
 #include "daemon/harness/outputs.h"
+#include "daemon/harness/render_state.h"
 #include "daemon/harness/telemetry.h"
 
 /* The pass a stopped frame was in, for the message: ", in the X pass". */
@@ -102,6 +103,7 @@ bool measure_run(struct harness_run *run, int run_index, enum job_status *status
         if ((seq & 15) == 15 && gl_error_take("rendering", run->err, sizeof(run->err)))
             return false;
         queue_progress(run->queue, run->job, run_index * n + (k > 0 ? (int)k : 0));
+        render_progress_at(t1); /* for /healthz: one atomic store of a time already read */
         telemetry_frames(1);
     }
     if (!gpu_budget_sync(budget))

@@ -17,6 +17,7 @@
 #include "daemon/quality/metrics.h"
 #include "common/png_io.h"
 #include "daemon/harness/deadline.h"
+#include "daemon/harness/render_state.h"
 #include "daemon/harness/telemetry.h"
 #include "common/result_keys.h"
 
@@ -42,6 +43,7 @@ struct metrics_worker {
 static bool cancel_requested(void *ctx)
 {
     const struct job *job = ctx;
+    render_progress(); /* a tile scored: the render thread waits on this (/healthz) */
     return atomic_load(&job->cancel) || job_timed_out(job);
 }
 

@@ -285,6 +285,7 @@ json_t *outputs_write(struct harness_run *run)
     json_object_set_new(result, RK_NONFINITE, nonfinite_summary(run));
     look_stages_describe(&run->stages, result);
     json_object_set_new(result, "targets_bytes", json_real(gpu_targets_bytes(run->gl->targets)));
+    json_object_set_new(result, RK_STARTED_UNIX, json_real(run->job->started));
     if (heatmap)
         json_object_set(result, RK_HEATMAP, heatmap);
     json_object_set_new(result, "scene", scene_describe(&run->scene));

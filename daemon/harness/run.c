@@ -8,6 +8,7 @@
 #include "daemon/gpu/bindings.h"
 #include "daemon/gpu/glutil.h"
 #include "daemon/harness/deadline.h"
+#include "daemon/harness/render_state.h"
 
 bool harness_gl_init(struct harness_gl *g, char *err, size_t errlen)
 {
@@ -178,6 +179,7 @@ static bool job_stop_requested(void *ctx)
 void run_budget_init(struct harness_run *run)
 {
     gpu_budget_init(&run->budget, job_stop_requested, run->job);
+    run->budget.progress = render_progress;
 }
 
 bool run_prepare(struct harness_run *run, bool capture)

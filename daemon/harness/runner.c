@@ -3,6 +3,7 @@
 
 #include <epoxy/gl.h>
 #include <errno.h>
+#include <malloc.h>
 #include <pthread.h>
 #include <time.h>
 #include <stdatomic.h>
@@ -18,14 +19,22 @@
 #include "common/stats.h"
 #include "daemon/gpu/egl.h"
 #include "daemon/gpu/glutil.h"
+#include "daemon/gpu/targets.h"
 #include "daemon/harness/deadline.h"
 #include "daemon/harness/measure.h"
 #include "daemon/harness/metrics_stage.h"
 #include "daemon/harness/outputs.h"
 #include "daemon/harness/reference.h"
+#include "daemon/harness/render_state.h"
 #include "daemon/harness/run.h"
 #include "daemon/harness/telemetry.h"
 #include "daemon/service.h"
+
+/* After a job, a resident set this far above the idle one is given back
+ * (give_back_memory); the target pool is emptied when it holds more than
+ * RUNNER_KEEP_TARGETS_BYTES. */
+#define RUNNER_TRIM_ABOVE_BYTES (64.0 * 1024 * 1024)
+#define RUNNER_KEEP_TARGETS_BYTES (256.0 * 1024 * 1024)
 
 struct runner {
     struct queue *queue;
@@ -40,6 +49,7 @@ struct runner {
     char error[512];
     /* The render thread's own; device_json is immutable once ready. */
     struct harness_gl gl;
+    double idle_rss; /* the resident set once the context was up */
 };
 
 static const char *gl_str(GLenum name)
@@ -66,8 +76,11 @@ static json_t *collect_device(struct egl_context *egl, const struct gpu_caps *ca
 static bool prepare_and_measure(struct harness_run *run, bool capture, int run_index,
                                 enum job_status *status)
 {
-    if (run_prepare(run, capture))
+    render_state_phase("setup");
+    if (run_prepare(run, capture)) {
+        render_state_phase("rendering");
         return measure_run(run, run_index, status);
+    }
     /* Told to stop while the look's set-up (image-based lighting's probes)
      * ran: say why, as the timed loop would. */
     bool cancelled = atomic_load(&run->job->cancel);
@@ -200,6 +213,7 @@ static void run_job(struct runner *r, struct job *job)
     }
     if (!prepare_and_measure(&run, true, 0, &status))
         goto done;
+    render_state_phase("writing results");
     result = outputs_write(&run);
     /* The first run's technique is done with: free it before more runs or the
      * reference claim the device's memory. */
@@ -211,6 +225,7 @@ static void run_job(struct runner *r, struct job *job)
     }
     if (result && spec->reference[0]) {
         queue_set_phase(r->queue, job, "reference");
+        render_state_phase("reference");
         if (!reference_render(&run, &status)) {
             json_decref(result);
             result = NULL;
@@ -233,12 +248,52 @@ done:;
         run_finish(&run);
         if (spec->reference[0]) {
             queue_set_phase(r->queue, job, "metrics");
+            /* Still this job's until the metrics thread is done with it: the
+             * render thread waits for that before the next job. */
+            render_state_phase("metrics");
             metrics_worker_submit(r->metrics, job, result);
         } else {
             queue_finish(r->queue, job, status, NULL, result);
         }
     }
     service_status("idle; last job %s %s", id, job_status_name(status));
+}
+
+/* Between jobs, outside every timed region: what a large job took goes
+ * back to the system. The target pool keeps a size's framebuffers for the
+ * next job at that size, so that it allocates nothing; but llvmpipe keeps
+ * the framebuffers in the daemon's own memory, and it keeps the last
+ * output's colour and depth alive after they are deleted (an 8192x8192 job
+ * left 1.89 GB resident until a restart; a 4096x4096 one 440 MB). So once
+ * the pool holds more than RUNNER_KEEP_TARGETS_BYTES, the context is made
+ * anew, which frees everything the driver held; then malloc_trim returns
+ * what the freed buffers left in the heap (main.c's fixed M_TRIM_THRESHOLD
+ * and M_MMAP_THRESHOLD, which keep a job's timings independent of the jobs
+ * before it, stay as they are). false when no context could be made again
+ * (err says why): the render thread then stops. */
+static bool give_back_memory(struct runner *r, struct egl_context **egl, char *err, size_t errlen)
+{
+    double before = telemetry_rss_bytes();
+    if (before < r->idle_rss + RUNNER_TRIM_ABOVE_BYTES)
+        return true;
+    double renew_s = 0;
+    if (gpu_targets_bytes(r->gl.targets) > RUNNER_KEEP_TARGETS_BYTES) {
+        double t0 = clock_mono_s();
+        harness_gl_finish(&r->gl);
+        egl_context_destroy(*egl);
+        *egl = egl_context_create(r->device, r->gl_debug, err, errlen);
+        if (!*egl || !harness_gl_init(&r->gl, err, errlen))
+            return false;
+        renew_s = clock_mono_s() - t0;
+    }
+    malloc_trim(0);
+    double after = telemetry_rss_bytes();
+    LOG(LOG_INFO, "after the job: %.0f MiB given back (%s), %.0f MiB resident (%.0f when idle)",
+        (before - after) / 1048576.0, renew_s > 0 ? "a new GL context" : "the heap trimmed",
+        after / 1048576.0, r->idle_rss / 1048576.0);
+    if (renew_s > 0)
+        LOG(LOG_DEBUG, "the new GL context took %.0f ms", renew_s * 1e3);
+    return true;
 }
 
 static void *runner_main(void *arg)
@@ -253,6 +308,8 @@ static void *runner_main(void *arg)
     }
     if (egl) {
         r->gl.device_json = collect_device(egl, &r->gl.caps);
+        r->idle_rss = telemetry_rss_bytes();
+        render_state_end(); /* idle from now */
         r->ready = 1;
         atomic_store(&r->alive, true);
     } else {
@@ -266,15 +323,25 @@ static void *runner_main(void *arg)
     LOG(LOG_INFO, "GL context on %s (%s): %s, %s", egl_context_device(egl),
         egl_context_platform(egl), gl_str(GL_RENDERER), gl_str(GL_VERSION));
 
-    struct job *job;
-    /* The metrics and files of earlier jobs finish before the next job is timed. */
-    while ((metrics_worker_wait_idle(r->metrics), job = queue_next(r->queue))) {
+    for (;;) {
+        /* The metrics and files of earlier jobs finish before the next job is timed. */
+        metrics_worker_wait_idle(r->metrics);
+        if (!give_back_memory(r, &egl, err, sizeof(err))) {
+            LOG(LOG_ERROR, "the render thread stops: no GL context after a large job: %s", err);
+            break;
+        }
+        render_state_end();
+        struct job *job = queue_next(r->queue);
+        if (!job)
+            break;
+        render_state_begin(job->id, "setup");
         double busy_from = clock_mono_s();
         run_job(r, job);
         telemetry_render_busy(clock_mono_s() - busy_from);
     }
     atomic_store(&r->alive, false);
-    harness_gl_finish(&r->gl);
+    if (egl)
+        harness_gl_finish(&r->gl);
     egl_context_destroy(egl);
     pthread_mutex_lock(&r->lock);
     r->ready = 2;
@@ -361,5 +428,11 @@ void runner_destroy(struct runner *r)
 }
 
 bool runner_alive(struct runner *r) { return atomic_load(&r->alive); }
+
+void runner_state(struct runner *r, struct render_state *out)
+{
+    render_state_read(out);
+    out->alive = runner_alive(r);
+}
 
 json_t *runner_device_json(struct runner *r) { return json_incref(r->gl.device_json); }

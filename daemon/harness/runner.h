@@ -9,6 +9,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "daemon/harness/render_state.h"
 #include "daemon/jobs/queue.h"
 
 struct runner;
@@ -25,6 +26,9 @@ bool runner_stop(struct runner *r, double wait_s);
 void runner_destroy(struct runner *r);
 
 bool runner_alive(struct runner *r);
+/* What the render thread is doing (render_state.h), alive included; cheap
+ * and lock-free, for /healthz. Any thread. */
+void runner_state(struct runner *r, struct render_state *out);
 /* Device and driver strings, as reported in every result. New reference. */
 json_t *runner_device_json(struct runner *r);
 

@@ -2,7 +2,10 @@
 #include "daemon/harness/telemetry.h"
 
 #include <stdatomic.h>
+#include <stdbool.h>
+#include <stdio.h>
 #include <time.h>
+#include <unistd.h>
 
 /* Seconds are kept as nanoseconds so that they add up atomically. */
 static atomic_ullong frames, render_ns, metrics_ns, captures;
@@ -28,4 +31,14 @@ void telemetry_read(struct telemetry *out)
     out->render_busy_s = (double)atomic_load(&render_ns) / 1e9;
     out->metrics_s = (double)atomic_load(&metrics_ns) / 1e9;
     out->captures_scored = atomic_load(&captures);
+}
+
+double telemetry_rss_bytes(void)
+{
+    FILE *f = fopen("/proc/self/statm", "r");
+    unsigned long long size = 0, resident = 0;
+    bool ok = f && fscanf(f, "%llu %llu", &size, &resident) == 2;
+    if (f)
+        fclose(f);
+    return ok ? (double)resident * (double)sysconf(_SC_PAGESIZE) : 0;
 }

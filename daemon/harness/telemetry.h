@@ -17,4 +17,9 @@ void telemetry_render_busy(double seconds);
 void telemetry_metrics(double seconds, unsigned captures);
 void telemetry_read(struct telemetry *out);
 
+/* The process's resident set now (bytes, from /proc/self/statm; 0 when it
+ * cannot be read): the driver's allocations included, which llvmpipe makes
+ * in the daemon's own memory. */
+double telemetry_rss_bytes(void);
+
 #endif

@@ -89,6 +89,15 @@ void job_dir_fail_result(struct store *store, struct store_row *row, const char 
         LOG(LOG_ERROR, "job %s: %s", row->id, err);
 }
 
+void job_dir_interrupted(struct store_row *row, const char *result_why)
+{
+    row->status = JOB_INTERRUPTED;
+    row->finished = clock_unix_s();
+    snprintf(row->error, sizeof(row->error),
+             "interrupted: the daemon stopped (killed or crashed) while this job ran; its files "
+             "may be incomplete (result.json %.700s), submit it again to measure it", result_why);
+}
+
 /* The row of a job known from its parsed spec. */
 static void row_from_spec(struct store_row *row, const struct job_spec *spec, double created)
 {
@@ -101,19 +110,33 @@ static void row_from_spec(struct store_row *row, const struct job_spec *spec, do
     row->spec = job_spec_to_json(spec);
 }
 
-bool job_dir_done_from_result(struct store_row *row, const struct job_spec *spec,
-                                const char *dir, char *why, size_t whylen)
+bool job_dir_done_from_result(struct store *store, struct store_row *row,
+                              const struct job_spec *spec, const char *dir, char *why,
+                              size_t whylen)
 {
     char path[PATH_MAX + 16];
     job_file_path(dir, JOB_FILE_RESULT, path, sizeof(path));
-    json_t *result = access(path, F_OK) == 0 ? record_read(path, why, whylen) : NULL;
-    if (!result && access(path, F_OK) != 0)
+    bool present = access(path, F_OK) == 0;
+    char read_why[600] = "";
+    json_t *result = present ? record_read(path, read_why, sizeof(read_why)) : NULL;
+    if (!present) {
         snprintf(why, whylen, "missing");
+    } else if (!result) {
+        char reason[800], moved[PATH_MAX] = "";
+        snprintf(reason, sizeof(reason), "result.json of job %s: %s", row->id, read_why);
+        record_quarantine(store_record_kind(store, STORE_JOBS), row->id, path, reason, moved,
+                          sizeof(moved));
+        snprintf(why, whylen, "damaged (%.300s)%s%.400s", read_why,
+                 moved[0] ? " and moved to " : "", moved);
+    }
     bool complete = result && result_complete(spec, result);
     if (result && !complete)
         snprintf(why, whylen, "incomplete");
     if (complete) {
         row->status = JOB_DONE;
+        double started = json_number_value(json_object_get(result, RK_STARTED_UNIX));
+        if (row->started <= 0 && started > 0)
+            row->started = started;
         row->finished = file_mtime(path);
         row->done = row->total;
         row->error[0] = '\0';
@@ -127,9 +150,9 @@ bool job_dir_done_from_result(struct store_row *row, const struct job_spec *spec
 /* Rebuilds a job's row from spec.json (written once at submission) and
  * result.json. false, with why, when they do not allow it. lost says what
  * became of its state, for the message of an interrupted one. */
-static bool rebuild_row(const struct technique_catalog *techniques, const char *id,
-                        const char *dir, const char *lost, struct store_row *row, char *why,
-                        size_t whylen)
+static bool rebuild_row(struct store *store, const struct technique_catalog *techniques,
+                        const char *id, const char *dir, const char *lost, struct store_row *row,
+                        char *why, size_t whylen)
 {
     char path[PATH_MAX + 16], swhy[700] = "";
     job_file_path(dir, JOB_FILE_SPEC, path, sizeof(path));
@@ -149,8 +172,9 @@ static bool rebuild_row(const struct technique_catalog *techniques, const char *
     }
     row_from_spec(row, &spec, json_number_value(json_object_get(rec, "created_unix")));
     json_decref(rec);
-    char rwhy[300] = "";
-    if (job_dir_done_from_result(row, &spec, dir, rwhy, sizeof(rwhy))) {
+    char rwhy[800] = "";
+    snprintf(row->id, sizeof(row->id), "%s", id);
+    if (job_dir_done_from_result(store, row, &spec, dir, rwhy, sizeof(rwhy))) {
         snprintf(why, whylen, "rebuilt as done from spec.json and result.json");
         return true;
     }
@@ -159,8 +183,8 @@ static bool rebuild_row(const struct technique_catalog *techniques, const char *
     row->status = JOB_INTERRUPTED;
     row->finished = clock_unix_s();
     snprintf(row->error, sizeof(row->error),
-             "interrupted: %s and its result.json is %s; submit it again to measure it", lost,
-             strcmp(rwhy, "incomplete") == 0 ? "incomplete" : "missing or damaged");
+             "interrupted: %s and its result.json is %.700s; submit it again to measure it",
+             lost, rwhy);
     snprintf(why, whylen, "rebuilt as interrupted from spec.json (result.json %s)", rwhy);
     return true;
 }
@@ -179,7 +203,7 @@ static void row_from_legacy(struct store *store, const char *id, const char *dir
                                                         "frames_done"));
     const char *error = json_string_value(json_object_get(o, "error"));
     snprintf(row->error, sizeof(row->error), "%s", error ? error : "");
-    char why[600] = "", path[PATH_MAX + 16];
+    char why[800] = "", path[PATH_MAX + 16];
     job_file_path(dir, JOB_FILE_SPEC, path, sizeof(path));
     /* Earlier versions may not have written it: the directory must be
      * enough to rebuild the row from now on. */
@@ -189,15 +213,12 @@ static void row_from_legacy(struct store *store, const char *id, const char *dir
         /* A complete result.json is the last thing a job writes before it
          * is done: the daemon died (or the disk was full) between that and
          * writing job.json. Anything less was cut short. */
-        if (job_dir_done_from_result(row, spec, dir, why, sizeof(why))) {
+        snprintf(row->id, sizeof(row->id), "%s", id);
+        if (job_dir_done_from_result(store, row, spec, dir, why, sizeof(why))) {
             LOG(LOG_WARN, "job %s: job.json says running, but its result.json is complete: done",
                 id);
         } else {
-            row->status = JOB_INTERRUPTED;
-            row->finished = clock_unix_s();
-            snprintf(row->error, sizeof(row->error),
-                     "interrupted: the daemon stopped (killed or crashed) while this job ran; "
-                     "its files may be incomplete, submit it again to measure it");
+            job_dir_interrupted(row, why);
         }
     } else if (status == JOB_DONE) {
         job_file_path(dir, JOB_FILE_RESULT, path, sizeof(path));
@@ -247,7 +268,7 @@ bool job_dir_import(struct store *store, const struct technique_catalog *techniq
     }
     char rebuilt[800], reason[1600];
     const char *lost = legacy ? "its job.json was damaged" : "its state was not in the store";
-    if (!rebuild_row(techniques, id, dir, lost, row, rebuilt, sizeof(rebuilt))) {
+    if (!rebuild_row(store, techniques, id, dir, lost, row, rebuilt, sizeof(rebuilt))) {
         snprintf(reason, sizeof(reason), "%s%s; cannot be rebuilt: %s", legacy ? "job.json: " : "",
                  legacy ? why : "no row in the store and no job.json", rebuilt);
         record_quarantine(store_record_kind(store, STORE_JOBS), id, dir, reason, NULL, 0);

@@ -28,10 +28,19 @@ bool job_dir_write_spec(const char *dir, const char *id, double created,
 json_t *job_dir_read_spec(const struct store_row *row);
 
 /* A complete result.json in dir makes the row done (finish time, progress,
- * figures); false (why: "missing", "incomplete" or the read error) leaves
- * the row as it was. */
-bool job_dir_done_from_result(struct store_row *row, const struct job_spec *spec,
-                                const char *dir, char *why, size_t whylen);
+ * figures, and the start time the harness wrote into it, so that a row
+ * rebuilt from the directory keeps it); false leaves the row as it was,
+ * with why "missing", "incomplete", or, for a file that cannot be read,
+ * the reason and where it went: a damaged one is quarantined (records.h)
+ * rather than left for the next reader to trip on. */
+bool job_dir_done_from_result(struct store *store, struct store_row *row,
+                              const struct job_spec *spec, const char *dir, char *why,
+                              size_t whylen);
+
+/* A job that was running when the daemon died, without a complete
+ * result.json (result_why: job_dir_done_from_result's why): interrupted,
+ * saying so. */
+void job_dir_interrupted(struct store_row *row, const char *result_why);
 
 /* A done job whose result.json at path cannot be read (why): the file goes
  * to quarantine (when it is there at all), the row becomes failed, naming

@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "daemon/jobs/job_cost.h"
+
 
 /* A technique name from the catalogue; null gives "" (index -1) where allowed. */
 static bool get_technique(const json_t *v, const char *field,
@@ -415,7 +417,11 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
                     job_spec_capture_count(out), out->scene.width,
                     out->scene.height, bytes / 1048576.0,
                     JOB_MAX_CAPTURE_BYTES / 1048576.0);
-    return true;
+    /* Admission: the estimate of the memory it holds, against what a job
+     * may take (job_cost.h; no limit unless the daemon set one). */
+    struct job_cost cost;
+    job_cost_estimate(out, &cost);
+    return job_cost_admit(&cost, err);
 }
 
 bool job_spec_parse_text(const char *text, size_t len,
@@ -423,6 +429,14 @@ bool job_spec_parse_text(const char *text, size_t len,
                          struct job_error *err)
 {
     json_error_t jerr;
+    /* Jansson stops at a NUL byte as at the end of the text: whatever
+     * follows one would go unread. JSON text has none. */
+    const char *nul = memchr(text, '\0', len);
+    if (nul) {
+        job_spec_defaults(out, techniques);
+        return job_error_set(err, "body", "must be JSON text, which has no NUL byte (one at "
+                             "byte %zu)", (size_t)(nul - text));
+    }
     json_t *body = json_loadb(text, len, JSON_REJECT_DUPLICATES, &jerr);
     if (!body) {
         job_spec_defaults(out, techniques);

@@ -7,6 +7,7 @@
 #include "common/result_keys.h"
 #include "daemon/jobs/job_figures.h"
 #include "daemon/jobs/job_dir.h"
+#include "daemon/jobs/store_reserve.h"
 
 #include <errno.h>
 #include <pthread.h>
@@ -22,6 +23,9 @@
  * holds up the start; the rest goes a batch per finished job. */
 #define RETENTION_BATCH 256
 #define RETENTION_START_S 2.0
+/* While the disk is full, the render thread asks this often whether there
+ * is room again (store_has_room) before it starts a job. */
+#define ROOM_POLL_S 1.0
 
 struct queue {
     /* Guards everything below and the live jobs' queue-owned fields. Never
@@ -172,8 +176,9 @@ static bool write_snapshot(struct queue *q, struct snapshot *snap, char *err, si
     char why[PATH_MAX + 300] = "";
     bool ok = store_put(q->store, &snap->row, snap->seq, &job->version.written, why, sizeof(why));
     if (!ok)
-        LOG(LOG_ERROR, "job %s: %s (its state in memory stays right; written again at exit)",
-            job->id, why);
+        LOG(LOG_ERROR, "job %s: its state (%s%s%s) cannot be stored: %s; it is tried again with "
+            "the job's next change and at exit", job->id, job_status_name(snap->row.status),
+            snap->row.error[0] ? ": " : "", snap->row.error, why);
     if (err)
         snprintf(err, errlen, "%s", why);
     store_row_finish(&snap->row);
@@ -207,7 +212,8 @@ void queue_destroy(struct queue *q)
     if (!q)
         return;
     /* Every other thread is gone: state a full disk held back gets one more
-     * try, so that a restart does not find it stale. */
+     * try, so that a restart does not find it stale; the log says which
+     * state made it and which did not, and what the next start will do. */
     for (size_t i = 0; i < q->live.count;) {
         struct job *job = q->live.items[i];
         size_t before = q->live.count;
@@ -216,7 +222,16 @@ void queue_destroy(struct queue *q)
             pthread_mutex_lock(&q->lock);
             snapshot_locked(job, &snap);
             pthread_mutex_unlock(&q->lock);
-            write_snapshot(q, &snap, NULL, 0); /* a finished one leaves the list */
+            char id[RECORD_ID_LEN], why[PATH_MAX + 300];
+            enum job_status status = snap.row.status;
+            snprintf(id, sizeof(id), "%s", job->id);
+            if (write_snapshot(q, &snap, why, sizeof(why))) /* a finished one leaves the list */
+                LOG(LOG_INFO, "job %s: its state (%s) was stored at exit", id,
+                    job_status_name(status));
+            else
+                LOG(LOG_ERROR, "job %s: its state (%s) could not be stored at exit either (%s); "
+                    "it is noted in %s/%s, from which the next start records it", id,
+                    job_status_name(status), why, store_state_dir(q->store), STORE_RESERVE_FILE);
         }
         if (q->live.count == before)
             i++;
@@ -244,6 +259,24 @@ void queue_retention(struct queue *q, int *keep_jobs, double *keep_days)
 
 const char *queue_submit_error(void) { return records_submit_error(); }
 
+bool queue_room_to_accept(struct queue *q, const char *what)
+{
+    if (store_has_room(q->store))
+        return true;
+    records_set_submit_error("the %s cannot be persisted in the state directory %s: %s (its disk "
+                             "is full, but for the reserve kept for recording how the jobs "
+                             "accepted end, %s); free some space", what,
+                             store_state_dir(q->store), strerror(ENOSPC), STORE_RESERVE_FILE);
+    /* Once every 10 s: each refusal is answered, a full disk's log need not
+     * grow by one line per submission. */
+    static _Atomic double last_logged = -1e9;
+    double now = clock_mono_s(), then = atomic_load(&last_logged);
+    if (now - then >= 10 && atomic_compare_exchange_strong(&last_logged, &then, now))
+        LOG(LOG_ERROR, "%s refused (and any more in the next 10 s): %s", what,
+            records_submit_error());
+    return false;
+}
+
 static struct job *job_new(void)
 {
     struct job *job = calloc(1, sizeof(*job));
@@ -259,6 +292,8 @@ enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *sp
 {
     char why[PATH_MAX + 300] = "";
     records_set_submit_error("%s", "");
+    if (!queue_room_to_accept(q, "job"))
+        return QUEUE_IO_ERROR;
     pthread_mutex_lock(&q->lock);
     enum queue_submit_result res = q->stopping                  ? QUEUE_STOPPING
                                    : q->queued >= q->max_queued ? QUEUE_FULL
@@ -336,31 +371,75 @@ fail:
     return QUEUE_IO_ERROR;
 }
 
+/* Under the lock: the first queued job, or NULL. */
+static struct job *first_queued_locked(struct queue *q)
+{
+    for (size_t i = 0; i < q->live.count; i++)
+        if (((struct job *)q->live.items[i])->status == JOB_QUEUED)
+            return q->live.items[i];
+    return NULL;
+}
+
+/* Under the lock: waits up to seconds for a change (a stop, a new job). */
+static void wait_locked(struct queue *q, double seconds)
+{
+    struct timespec until = clock_deadline(seconds);
+    pthread_cond_timedwait(&q->changed, &q->lock, &until);
+}
+
 struct job *queue_next(struct queue *q)
 {
-    struct job *job = NULL;
-    struct snapshot snap;
+    /* A job starts only once the store has recorded that it runs: one that
+     * ran unrecorded would run again after a restart, as if it had never
+     * run. So while the disk is full (no room in the store's reserve, or
+     * the write fails) the queued jobs wait, and say why in the log. */
+    bool told = false;
     pthread_mutex_lock(&q->lock);
     while (!q->stopping) {
-        for (size_t i = 0; i < q->live.count && !job; i++)
-            if (((struct job *)q->live.items[i])->status == JOB_QUEUED)
-                job = q->live.items[i];
-        if (job)
-            break;
-        pthread_cond_wait(&q->changed, &q->lock);
-    }
-    if (job) {
+        struct job *job = first_queued_locked(q);
+        if (!job) {
+            pthread_cond_wait(&q->changed, &q->lock);
+            continue;
+        }
+        pthread_mutex_unlock(&q->lock);
+        bool room = store_has_room(q->store);
+        pthread_mutex_lock(&q->lock);
+        if (q->stopping || job != first_queued_locked(q))
+            continue; /* cancelled meanwhile, or stopping */
+        if (!room) {
+            if (!told)
+                LOG(LOG_ERROR, "job %s waits: the disk of the state directory %s is full, and a "
+                    "job starts only once the store can record how it ends",
+                    job->id, store_state_dir(q->store));
+            told = true;
+            wait_locked(q, ROOM_POLL_S);
+            continue;
+        }
+        struct snapshot snap;
         job->status = JOB_RUNNING;
         job->phase = "rendering";
         job->started = clock_unix_s();
         q->queued--;
         snapshot_locked(job, &snap);
         pthread_cond_broadcast(&q->changed);
+        pthread_mutex_unlock(&q->lock);
+        if (write_snapshot(q, &snap, NULL, 0)) {
+            if (told)
+                LOG(LOG_INFO, "job %s starts: the store has room again", job->id);
+            return job;
+        }
+        /* Not recorded as running: back to the head of the queue (which the
+         * store still says it is in), to start once it can be. */
+        pthread_mutex_lock(&q->lock);
+        job->status = JOB_QUEUED;
+        job->phase = NULL;
+        job->started = 0;
+        q->queued++;
+        told = true;
+        wait_locked(q, ROOM_POLL_S);
     }
     pthread_mutex_unlock(&q->lock);
-    if (job)
-        write_snapshot(q, &snap, NULL, 0);
-    return job;
+    return NULL;
 }
 
 void queue_progress(struct queue *q, struct job *job, int frames_done)
@@ -713,7 +792,25 @@ static void load_unfinished(void *ctx, const struct store_row *stored)
             LOG(LOG_ERROR, "job %s: %s", row.id, err);
         return;
     }
-    if (row.status == JOB_QUEUED) {
+    /* A state the last run could not store, for want of space, is in the
+     * store's reserve (store_reserve.h): it is newer than the row. */
+    enum job_status noted = row.status;
+    char noted_error[sizeof(row.error)] = "";
+    bool note = store_unrecorded(q->store, STORE_JOBS, row.id, &noted, noted_error,
+                                 sizeof(noted_error));
+    if (note)
+        LOG(LOG_WARN, "job %s: stored as %s, but the last run noted it %s (the disk was full)",
+            row.id, job_status_name(row.status), job_status_name(noted));
+    if (note && noted == JOB_QUEUED && row.status == JOB_RUNNING) {
+        /* Stopped by SIGTERM and sent back to the queue, unrecorded. */
+        row.status = JOB_QUEUED;
+        row.started = 0;
+        row.done = 0;
+        if (!store_put(q->store, &row, 0, NULL, err, sizeof(err)))
+            LOG(LOG_ERROR, "job %s: %s", row.id, err);
+    }
+    bool noted_end = note && job_status_finished(noted) && noted != JOB_DONE;
+    if (row.status == JOB_QUEUED && !noted_end) {
         struct job *job = job_new();
         if (!job) {
             LOG(LOG_ERROR, "job %s: out of memory loading it; it runs on the next start", row.id);
@@ -741,17 +838,24 @@ static void load_unfinished(void *ctx, const struct store_row *stored)
     record_remove_tmp_files(row.dir);
     if (!row.dir_given)
         row.spec = NULL; /* finished now: its spec.json has it */
-    char why[300] = "";
+    char why[800] = "";
     json_t *figures = NULL;
-    if (job_dir_done_from_result(&row, &spec, row.dir, why, sizeof(why))) {
+    if (noted_end) {
+        row.status = noted;
+        row.finished = clock_unix_s();
+        snprintf(row.error, sizeof(row.error), "%.700s (stored at the next start: the disk was "
+                 "full when the job ended)", noted_error);
+    } else if (job_dir_done_from_result(q->store, &row, &spec, row.dir, why, sizeof(why))) {
         figures = row.figures; /* ours, not the store's */
         LOG(LOG_WARN, "job %s: stored as running, but its result.json is complete: done", row.id);
-    } else {
+    } else if (note) {
         row.status = JOB_INTERRUPTED;
         row.finished = clock_unix_s();
-        snprintf(row.error, sizeof(row.error),
-                 "interrupted: the daemon stopped (killed or crashed) while this job ran; "
-                 "its files may be incomplete, submit it again to measure it");
+        snprintf(row.error, sizeof(row.error), "interrupted: the disk was full when this job "
+                 "ended %s, which could not be stored, and its result.json is %.400s; submit it "
+                 "again to measure it", job_status_name(noted), why);
+    } else {
+        job_dir_interrupted(&row, why);
     }
     if (!store_put(q->store, &row, 0, NULL, err, sizeof(err)))
         LOG(LOG_ERROR, "job %s: %s", row.id, err);
@@ -772,6 +876,7 @@ int queue_load(struct queue *q, const struct technique_catalog *techniques, char
                  store_state_dir(q->store), STORE_FILE);
         return -1;
     }
+    store_unrecorded_done(q->store);
     pthread_mutex_lock(&q->lock);
     pthread_cond_broadcast(&q->changed);
     pthread_mutex_unlock(&q->lock);

@@ -102,6 +102,12 @@ enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *sp
  * QUEUE_IO_ERROR: names the state directory, the file and the errno text. */
 const char *queue_submit_error(void);
 
+/* While the state directory's disk is full (store_has_room), its reserve
+ * is for recording how the jobs already accepted end: nothing new (what: a
+ * "job" or a "sweep") is accepted. false, with queue_submit_error's text
+ * set, when it must be refused. */
+bool queue_room_to_accept(struct queue *q, const char *what);
+
 /* Render thread: blocks until a job is queued (marks it running) or the
  * queue is stopping (returns NULL). */
 struct job *queue_next(struct queue *q);

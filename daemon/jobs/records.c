@@ -142,9 +142,8 @@ bool record_quarantine(const struct record_kind *k, const char *id, const char *
             path, qdir, strerror(errno), reason);
         return false;
     }
-    /* A file keeps its name in the quarantined one; a directory is the record. */
-    struct stat st;
-    bool is_dir = stat(path, &st) == 0 && S_ISDIR(st.st_mode);
+    /* A file keeps its name in the quarantined one; a record's directory
+     * (named by its id) is the record. */
     const char *base = strrchr(path, '/');
     base = base ? base + 1 : path;
     char stamp[32];
@@ -157,7 +156,7 @@ bool record_quarantine(const struct record_kind *k, const char *id, const char *
         char suffix[16] = "";
         if (n)
             snprintf(suffix, sizeof(suffix), ".%d", n);
-        bool named = is_dir || strcmp(base, id) == 0; /* the id says it all */
+        bool named = strcmp(base, id) == 0; /* the id says it all */
         if (snprintf(dest, sizeof(dest), "%s/%s-%.64s%s%.200s-%s%s", qdir, k->name, id,
                      named ? "" : "-", named ? "" : base, stamp, suffix) >= (int)sizeof(dest)) {
             LOG(LOG_ERROR, "cannot quarantine %s: the state directory's path is too long (%s)",

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "common/log.h"
+#include "daemon/jobs/store_reserve.h"
 
 /* Read connections open at once: more than the HTTP pool, the sweep thread
  * and the watcher ask at the same moment, each holding one for a page. */
@@ -77,6 +78,7 @@ struct store {
     pthread_cond_t pool_free;
     struct reader *idle;
     int readers; /* open, idle or lent */
+    struct store_reserve *reserve; /* NULL in memory, or when it cannot be opened */
 };
 
 static const char *const KIND_DIRS[STORE_KINDS] = {"jobs", "sweeps"};
@@ -448,6 +450,8 @@ struct store *store_open(const char *state_dir, char *err, size_t errlen)
     }
     note_last_ids(s);
     reap_noted(s);
+    if (!s->memory)
+        s->reserve = store_reserve_open(s->state_dir);
     return s;
 
 fail:
@@ -469,6 +473,7 @@ void store_close(struct store *s)
         free(r);
     }
     close_writer(s);
+    store_reserve_close(s->reserve);
     pthread_cond_destroy(&s->pool_free);
     pthread_mutex_destroy(&s->pool_lock);
     pthread_mutex_destroy(&s->write_lock);
@@ -538,31 +543,79 @@ static bool put_locked(struct store *s, const struct store_row *r)
     return true;
 }
 
+/* Under the write lock: the row in a transaction of its own. On failure,
+ * err says why and *full whether the disk had no room. */
+static bool put_transaction(struct store *s, const struct store_row *r, bool *full, char *err,
+                            size_t errlen)
+{
+    bool ok = sqlite3_exec(s->writer, "BEGIN IMMEDIATE", NULL, NULL, NULL) == SQLITE_OK &&
+              put_locked(s, r) && sqlite3_exec(s->writer, "COMMIT", NULL, NULL, NULL) == SQLITE_OK;
+    if (!ok) {
+        int sys = sqlite3_system_errno(s->writer);
+        *full = (sqlite3_extended_errcode(s->writer) & 0xff) == SQLITE_FULL || sys == ENOSPC ||
+                sys == EDQUOT;
+        db_error(s, s->writer, "write", err, errlen);
+        if (!sqlite3_get_autocommit(s->writer))
+            sqlite3_exec(s->writer, "ROLLBACK", NULL, NULL, NULL);
+    }
+    return ok;
+}
+
 bool store_put(struct store *s, const struct store_row *r, uint64_t seq, uint64_t *written,
                char *err, size_t errlen)
 {
-    bool ok = true;
+    bool ok = true, full = false;
     pthread_mutex_lock(&s->write_lock);
     /* A newer state got here first: this one is stale. */
-    if (written && *written >= seq)
-        goto out;
+    if (written && *written >= seq) {
+        pthread_mutex_unlock(&s->write_lock);
+        return true;
+    }
     if (s->batch) {
         ok = put_locked(s, r);
-    } else {
-        ok = sqlite3_exec(s->writer, "BEGIN IMMEDIATE", NULL, NULL, NULL) == SQLITE_OK &&
-             put_locked(s, r) && sqlite3_exec(s->writer, "COMMIT", NULL, NULL, NULL) == SQLITE_OK;
+        if (!ok)
+            db_error(s, s->writer, "write", err, errlen);
+        goto out;
     }
+    ok = put_transaction(s, r, &full, err, errlen);
     if (!ok) {
-        db_error(s, s->writer, "write", err, errlen);
-        if (!s->batch && !sqlite3_get_autocommit(s->writer))
-            sqlite3_exec(s->writer, "ROLLBACK", NULL, NULL, NULL);
-    } else if (written) {
-        *written = seq;
+        /* Noted in place first (store_reserve.h): should the retry fail
+         * too, the next start still learns what this state was. */
+        bool noted = store_reserve_note(s->reserve, (int)r->kind, r->id,
+                                        job_status_name(r->status), r->error);
+        if (full && store_reserve_release(s->reserve)) {
+            LOG(LOG_ERROR, "store: the disk of %s is full: its reserve (%s, %d bytes) is "
+                "released to store %s %s as %s; no job starts and none is accepted until there "
+                "is room again", s->state_dir, STORE_RESERVE_FILE, STORE_RESERVE_BYTES,
+                r->kind == STORE_JOBS ? "job" : "sweep", r->id, job_status_name(r->status));
+            ok = put_transaction(s, r, &full, err, errlen);
+        }
+        if (ok && noted)
+            store_reserve_unnote(s->reserve, (int)r->kind, r->id);
+    } else {
+        /* An older state of the record noted earlier is stale now. */
+        store_reserve_unnote(s->reserve, (int)r->kind, r->id);
     }
 out:
+    if (ok && written)
+        *written = seq;
     pthread_mutex_unlock(&s->write_lock);
     return ok;
 }
+
+bool store_has_room(struct store *s) { return store_reserve_ready(s->reserve); }
+
+bool store_disk_full(struct store *s) { return store_reserve_released(s->reserve); }
+
+bool store_unrecorded(struct store *s, enum store_kind kind, const char *id,
+                      enum job_status *status, char *error, size_t cap)
+{
+    char name[32];
+    return store_reserve_found(s->reserve, (int)kind, id, name, sizeof(name), error, cap) &&
+           job_status_parse(name, status);
+}
+
+void store_unrecorded_done(struct store *s) { store_reserve_found_done(s->reserve); }
 
 static json_t *column_json(sqlite3_stmt *st, int col)
 {

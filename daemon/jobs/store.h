@@ -134,6 +134,22 @@ struct record_kind *store_record_kind(struct store *s, enum store_kind kind);
 bool store_put(struct store *s, const struct store_row *r, uint64_t seq, uint64_t *written,
                char *err, size_t errlen);
 
+/* A full disk (store_reserve.h): when a write fails for want of space,
+ * the state it could not store is noted in STATE_DIR/store.reserve and the
+ * reserve's room released for one more try. store_has_room is false from
+ * then until the room can be taken back (tried at most once a second) with
+ * some free space beside it (STORE_RESERVE_HEADROOM): no job should start
+ * or be accepted meanwhile. A store in memory always has room. Any thread. */
+bool store_has_room(struct store *s);
+/* The reserve is released (no attempt to take it back). Any thread. */
+bool store_disk_full(struct store *s);
+/* Startup: the state an earlier run could not store for kind/id, even
+ * with the reserve's room (its status and error); false when none. */
+bool store_unrecorded(struct store *s, enum store_kind kind, const char *id,
+                      enum job_status *status, char *error, size_t cap);
+/* Startup: those states are stored now; their notes go. */
+void store_unrecorded_done(struct store *s);
+
 enum store_found { STORE_FOUND, STORE_MISSING, STORE_ERROR };
 /* One row; with full false, without labels, figures, spec and extra (for
  * the cheap questions: status, directory). STORE_ERROR is logged. out is

@@ -2,6 +2,8 @@
 #include "daemon/jobs/sweep_spec.h"
 #include "common/result_keys.h"
 
+#include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -318,11 +320,70 @@ static bool add_reference_points(struct sweep_spec *out, const json_t *body,
     return true;
 }
 
-static bool parse_criterion(const char *text, struct sweep_spec *s)
+/* "NAME OP X" with spaces or none around OP, X a plain decimal number
+ * (digits with an optional fraction and exponent: no hexadecimal, inf or
+ * nan, which strtod alone takes) that a double holds (no underflow to 0 or
+ * a denormal) and that lies in [lo, hi]. -1: not of this form; 0: of it,
+ * but X is refused (why says by which rule); 1: *x read. */
+static int parse_threshold(const char *text, const char *name, const char *op, double lo,
+                           double hi, const char *range, double *x, char *why, size_t whylen)
 {
-    double x;
-    char tail[2];
+    size_t n = strlen(name), m = strlen(op);
+    if (strncmp(text, name, n) != 0)
+        return -1;
+    const char *p = text + n;
+    while (*p == ' ')
+        p++;
+    if (strncmp(p, op, m) != 0)
+        return -1;
+    p += m;
+    while (*p == ' ')
+        p++;
+    const char *num = p;
+    p += *p == '-' || *p == '+';
+    size_t digits = strspn(p, "0123456789");
+    p += digits;
+    if (*p == '.') {
+        size_t frac = strspn(p + 1, "0123456789");
+        digits += frac;
+        p += 1 + frac;
+    }
+    if (digits && (*p == 'e' || *p == 'E')) {
+        const char *e = p + 1 + (p[1] == '-' || p[1] == '+');
+        size_t exp = strspn(e, "0123456789");
+        p = exp ? e + exp : p;
+    }
+    if (!digits || *p) {
+        snprintf(why, whylen, "\"%s %s X\" needs X a decimal number like 0.95 (digits, an "
+                 "optional fraction and exponent: no hexadecimal, inf or nan)", name, op);
+        return 0;
+    }
+    errno = 0;
+    char *end;
+    double v = strtod(num, &end);
+    if (errno == ERANGE || (v != 0 && fabs(v) < DBL_MIN)) {
+        snprintf(why, whylen, "\"%s %s X\": %.40s %s", name, op, num,
+                 fabs(v) < 1 ? "underflows (closer to 0 than a double holds at full precision)"
+                             : "overflows a double");
+        return 0;
+    }
+    if (!(v >= lo && v <= hi)) {
+        snprintf(why, whylen, "\"%s %s X\" needs X from %g to %g (%s); %.40s is outside", name,
+                 op, lo, hi, range, num);
+        return 0;
+    }
+    *x = v;
+    return 1;
+}
+
+/* false with why naming the rule broken. */
+static bool parse_criterion(const char *text, struct sweep_spec *s, char *why, size_t whylen)
+{
     snprintf(s->criterion_text, sizeof(s->criterion_text), "%s", text);
+    snprintf(why, whylen, "must be one of \"pdiff_pass\", \"stable\", \"finite\", "
+             "\"no_overflow\", \"ssim_min >= X\", \"flip_max <= X\"");
+    int r;
+    double x;
     if (strcmp(text, "pdiff_pass") == 0)
         s->criterion = CRITERION_PDIFF_PASS;
     else if (strcmp(text, "stable") == 0)
@@ -331,12 +392,19 @@ static bool parse_criterion(const char *text, struct sweep_spec *s)
         s->criterion = CRITERION_FINITE;
     else if (strcmp(text, "no_overflow") == 0)
         s->criterion = CRITERION_NO_OVERFLOW;
-    else if (sscanf(text, "ssim_min >= %lf%1s", &x, tail) == 1 && x >= -1 && x <= 1)
+    else if ((r = parse_threshold(text, "ssim_min", ">=", -1, 1, "SSIM's range", &x, why,
+                                  whylen)) >= 0) {
+        if (r == 0)
+            return false;
         s->criterion = CRITERION_SSIM_MIN, s->threshold = x;
-    else if (sscanf(text, "flip_max <= %lf%1s", &x, tail) == 1 && x >= 0 && x <= 1)
+    } else if ((r = parse_threshold(text, "flip_max", "<=", 0, 1, "FLIP's range", &x, why,
+                                    whylen)) >= 0) {
+        if (r == 0)
+            return false;
         s->criterion = CRITERION_FLIP_MAX, s->threshold = x;
-    else
+    } else {
         return false;
+    }
     return true;
 }
 
@@ -487,9 +555,9 @@ static bool parse_into(const json_t *body, const struct technique_catalog *techn
         return job_error_set(err, out->from != floor(out->from) ? "find.from" : "find.to",
                     "must be an integer: %s is an integer parameter", param);
     const char *crit = json_string_value(json_object_get(find, "while"));
-    if (!crit || !parse_criterion(crit, out))
-        return job_error_set(err, "find.while", "must be one of \"pdiff_pass\", \"stable\", "
-                    "\"finite\", \"no_overflow\", \"ssim_min >= X\", \"flip_max <= X\"");
+    char why[200];
+    if (!parse_criterion(crit ? crit : "", out, why, sizeof(why)))
+        return job_error_set(err, "find.while", "%s", why);
     if (out->criterion == CRITERION_NO_OVERFLOW) {
         char list[200];
         technique_catalog_list(techniques, TECHNIQUE_BOUNDED_LIGHT_LISTS, list, sizeof(list));

@@ -839,6 +839,8 @@ enum queue_submit_result sweeps_submit(struct sweeps *s, struct sweep_spec *spec
                                        const json_t *body, char id_out[24])
 {
     records_set_submit_error("%s", "");
+    if (!queue_room_to_accept(s->queue, "sweep"))
+        return QUEUE_IO_ERROR;
     pthread_mutex_lock(&s->lock);
     size_t waiting = (size_t)s->reserved;
     for (size_t i = 0; i < s->live.count; i++)

@@ -316,6 +316,7 @@ struct look_ibl *look_ibl_create(const struct look_ibl_env *env, char *err, size
     struct gpu_budget budget;
     gpu_budget_init(&budget, env->budget ? env->budget->stop : NULL,
                     env->budget ? env->budget->ctx : NULL);
+    budget.progress = env->budget ? env->budget->progress : NULL;
     for (int layer = 0; layer < layers; layer++) {
         phase_begin(&phase);
         bool captured = capture(ibl, &f, env, layer ? &ibl->probe[layer - 1] : NULL, &budget);

@@ -256,13 +256,7 @@ try:
             if mounted:
                 # Fill it up.
                 filler = os.path.join(mnt, "filler")
-                try:
-                    with open(filler, "wb") as f:
-                        while True:
-                            f.write(b"\0" * 65536)
-                            f.flush()
-                except OSError:
-                    pass
+                testlib.fill_disk(filler)
                 reason = "No space left on device"
             else:
                 os.chmod(os.path.join(mnt, "jobs"), 0o555)

@@ -152,6 +152,17 @@ class Daemon:
         return status
 
 
+def fill_disk(path):
+    """Appends zeros to path until its disk is full."""
+    try:
+        with open(path, "ab") as f:
+            while True:
+                f.write(b"\0" * 65536)
+                f.flush()
+    except OSError:
+        pass
+
+
 def rejects(d, body, field, status=400, what=None):
     """POST body as a job; it must be refused with status, naming field."""
     code, reply = d.json("POST", "/v1/jobs", body)

@@ -12,21 +12,28 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/time.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "check.h"
 #include "common/fsutil.h"
 #include "common/job_files.h"
 #include "common/log.h"
+#include "daemon/api/connections.h"
 #include "daemon/api/http.h"
+#include "daemon/jobs/job_cost.h"
 #include "daemon/jobs/store.h"
 
 static atomic_bool render_up = true;
 
-static bool fake_alive(void *render)
+/* The real render state (render_state.c), which the test drives as the
+ * render thread would. */
+static void fake_state(void *render, struct render_state *out)
 {
     (void)render;
-    return atomic_load(&render_up);
+    render_state_read(out);
+    out->alive = atomic_load(&render_up);
 }
 
 static json_t *fake_device(void *render)
@@ -48,30 +55,73 @@ static void reply_finish(struct reply *r)
     memset(r, 0, sizeof(*r));
 }
 
+static void sleep_ms(long ms)
+{
+    struct timespec t = {.tv_sec = ms / 1000, .tv_nsec = (ms % 1000) * 1000000L};
+    nanosleep(&t, NULL);
+}
+
+static int connect_to(int port)
+{
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    /* A server that never answers fails the check rather than hanging. */
+    struct timeval tv = {.tv_sec = 10};
+    if (fd >= 0 && (setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv)) != 0 ||
+                    connect(fd, (struct sockaddr *)&a, sizeof(a)) != 0)) {
+        close(fd);
+        fd = -1;
+    }
+    return fd;
+}
+
+static struct reply read_reply(int fd);
+
+/* Sends len bytes as they are (the request line and headers included) on
+ * a fresh connection and reads the answer until the server closes. */
+static struct reply raw_request(int port, const char *data, size_t len)
+{
+    struct reply r = {0};
+    int fd = connect_to(port);
+    if (fd < 0)
+        return r;
+    if (write(fd, data, len) != (ssize_t)len) {
+        close(fd);
+        return r;
+    }
+    return read_reply(fd);
+}
+
 /* One request on a fresh connection; extra: more header lines, each ending
  * in \r\n. */
 static struct reply request(int port, const char *method, const char *path, const char *body,
                             const char *extra)
 {
     struct reply r = {0};
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in a = {.sin_family = AF_INET, .sin_port = htons((uint16_t)port)};
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (fd < 0 || connect(fd, (struct sockaddr *)&a, sizeof(a)) != 0) {
+    size_t blen = body ? strlen(body) : 0;
+    char *head = malloc(strlen(path) + 1024);
+    if (!head)
+        return r;
+    int n = sprintf(head, "%s %s HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n"
+                    "Content-Length: %zu\r\n%s\r\n",
+                    method, path, blen, extra ? extra : "");
+    int fd = connect_to(port);
+    bool sent = fd >= 0 && write(fd, head, (size_t)n) == n &&
+                (!blen || write(fd, body, blen) == (ssize_t)blen);
+    free(head);
+    if (!sent) {
         if (fd >= 0)
             close(fd);
         return r;
     }
-    size_t blen = body ? strlen(body) : 0;
-    char head[1024];
-    int n = snprintf(head, sizeof(head),
-                     "%s %s HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n"
-                     "Content-Length: %zu\r\n%s\r\n",
-                     method, path, blen, extra ? extra : "");
-    if (write(fd, head, (size_t)n) != n || (blen && write(fd, body, blen) != (ssize_t)blen)) {
-        close(fd);
-        return r;
-    }
+    return read_reply(fd);
+}
+
+/* Reads an answer until the server closes fd, then closes it. */
+static struct reply read_reply(int fd)
+{
+    struct reply r = {0};
     size_t cap = 1 << 16, used = 0;
     char *buf = malloc(cap);
     ssize_t got;
@@ -142,8 +192,10 @@ int main(void)
     CHECK(sweeps != NULL);
     struct http_limits limits;
     http_limits_defaults(&limits);
+    limits.max_connections_per_ip = 3;
     const struct http_context ctx = {.catalog = &catalog, .queue = q, .sweeps = sweeps,
-                                     .render_alive = fake_alive, .device_json = fake_device};
+                                     .render_state = fake_state, .device_json = fake_device,
+                                     .stall_s = 0.3};
     struct http_server *http = sweeps ? http_server_create("127.0.0.1:0", &limits, &ctx, err,
                                                            sizeof(err))
                                       : NULL;
@@ -153,9 +205,50 @@ int main(void)
     int port = http_server_port(http);
     struct reply r;
 
-    /* /healthz follows the render thread. */
+    /* /healthz follows the render thread: idle, busy with a job (which and
+     * in what phase), stalled once it makes no progress for longer than
+     * stall_s, healthy again with progress, and 503 once it has stopped. */
+    render_state_end();
+    r = request(port, "GET", "/healthz", NULL, NULL);
+    json_t *render = json_object_get(r.json, "render");
+    CHECK(r.status == 200 && !strcmp(str(r.json, "status"), "ok") &&
+          !strcmp(str(render, "state"), "idle"));
+    reply_finish(&r);
+    render_state_begin("20260101-000000-0042", "setup");
+    render_state_phase("rendering");
+    r = request(port, "GET", "/healthz", NULL, NULL);
+    render = json_object_get(r.json, "render");
+    CHECK(r.status == 200 && !strcmp(str(render, "state"), "busy") &&
+          !strcmp(str(render, "job"), "20260101-000000-0042") &&
+          !strcmp(str(render, "phase"), "rendering") &&
+          json_real_value(json_object_get(render, "since_progress_s")) < 0.3);
+    reply_finish(&r);
+    sleep_ms(400);
+    r = request(port, "GET", "/healthz", NULL, NULL);
+    render = json_object_get(r.json, "render");
+    CHECK(r.status == 503 && !strcmp(str(r.json, "status"), "stalled") &&
+          strstr(str(r.json, "message"), "20260101-000000-0042") &&
+          !strcmp(str(render, "state"), "stalled") &&
+          json_real_value(json_object_get(render, "since_progress_s")) > 0.3);
+    reply_finish(&r);
+    r = request(port, "GET", "/metrics", NULL, NULL);
+    CHECK(r.status == 200 && strstr(r.body, "shadebench_render_stalled 1\n") &&
+          strstr(r.body, "shadebench_render_busy 1\n") &&
+          strstr(r.body, "shadebench_render_job{job=\"20260101-000000-0042\",phase=\"rendering\"} 1"));
+    reply_finish(&r);
+    render_progress(); /* a frame went round */
     r = request(port, "GET", "/healthz", NULL, NULL);
     CHECK(r.status == 200);
+    reply_finish(&r);
+    sleep_ms(400);
+    render_state_end(); /* idle is never stalled, however long */
+    sleep_ms(400);
+    r = request(port, "GET", "/healthz", NULL, NULL);
+    CHECK(r.status == 200 && !strcmp(str(json_object_get(r.json, "render"), "state"), "idle"));
+    reply_finish(&r);
+    r = request(port, "GET", "/metrics", NULL, NULL);
+    CHECK(r.status == 200 && strstr(r.body, "shadebench_render_stalled 0\n") &&
+          strstr(r.body, "shadebench_render_busy 0\n") && !strstr(r.body, "render_job{"));
     reply_finish(&r);
     atomic_store(&render_up, false);
     r = request(port, "GET", "/healthz", NULL, NULL);
@@ -197,11 +290,80 @@ int main(void)
     CHECK(r.status == 400 && error_field(&r) != NULL);
     reply_finish(&r);
 
+    /* The request itself (issue 26): every refusal JSON naming what is wrong. */
+    static const char no_host[] = "GET /v1/info HTTP/1.1\r\nConnection: close\r\n\r\n";
+    r = raw_request(port, no_host, sizeof(no_host) - 1);
+    CHECK(r.status == 400 && error_field(&r) && strcmp(error_field(&r), "Host") == 0);
+    reply_finish(&r);
+    static const char old_http[] = "GET /healthz HTTP/1.0\r\n\r\n"; /* Host is 1.1's */
+    r = raw_request(port, old_http, sizeof(old_http) - 1);
+    CHECK(r.status == 200);
+    reply_finish(&r);
+    /* %00 would cut the decoded path: 1.png%00.txt must not serve 1.png. */
+    r = request(port, "GET", "/v1/jobs/1/frames/1.png%00.txt", NULL, NULL);
+    CHECK(r.status == 400 && error_field(&r) && strcmp(error_field(&r), "url") == 0);
+    reply_finish(&r);
+    r = request(port, "GET", "/v1/jobs?label.a=x%00y", NULL, NULL);
+    CHECK(r.status == 400 && error_field(&r) && strcmp(error_field(&r), "url") == 0);
+    reply_finish(&r);
+    r = request(port, "GET", "/v1/jobs?label.a=100%25", NULL, NULL); /* an encoded '%' is fine */
+    CHECK(r.status == 200);
+    reply_finish(&r);
+    /* 500 filters: refused as JSON (libmicrohttpd's pool ran out and nobody
+     * answered); 40 are past the store's 32 and refused by the filter. */
+    char *many = malloc(16 * 1024);
+    int at = sprintf(many, "/v1/jobs");
+    for (int i = 0; i < 500; i++)
+        at += sprintf(many + at, "%clabel.k%d=v", i ? '&' : '?', i);
+    r = request(port, "GET", many, NULL, NULL);
+    CHECK(r.status == 400 && error_field(&r) && strcmp(error_field(&r), "query") == 0 &&
+          strstr(r.body, "500"));
+    reply_finish(&r);
+    memcpy(many + strlen("/v1/jobs?label.k0="), "%00", 3); /* and an encoded NUL: still answered */
+    r = request(port, "GET", many, NULL, NULL);
+    CHECK(r.status == 400 && error_field(&r) && strcmp(error_field(&r), "url") == 0);
+    reply_finish(&r);
+    at = sprintf(many, "/v1/jobs");
+    for (int i = 0; i < 40; i++)
+        at += sprintf(many + at, "%clabel.k%d=v", i ? '&' : '?', i);
+    r = request(port, "GET", many, NULL, NULL);
+    CHECK(r.status == 400 && error_field(&r) && strncmp(error_field(&r), "label.", 6) == 0);
+    reply_finish(&r);
+    free(many);
+    /* A NUL byte in a body: Jansson would stop reading at it. */
+    static const char nul_body[] = "POST /v1/jobs HTTP/1.1\r\nHost: x\r\nConnection: close\r\n"
+                                   "Content-Length: 33\r\n\r\n{\"technique\":\"unlit\",\"frames\":1\0}";
+    r = raw_request(port, nul_body, sizeof(nul_body) - 1);
+    CHECK(r.status == 400 && error_field(&r) && strcmp(error_field(&r), "body") == 0 &&
+          strstr(r.body, "NUL"));
+    reply_finish(&r);
+    struct job_spec nul_spec;
+    struct job_error nul_err;
+    CHECK(!job_spec_parse_text("{\"frames\":1\0}", 13, &catalog, &nul_spec, &nul_err) &&
+          strcmp(nul_err.field, "body") == 0);
+
+    /* Memory: /v1/info states the budget with the resident set; a job over
+     * what a job may take is refused naming the field that drives it. */
+    r = request(port, "GET", "/v1/info", NULL, NULL);
+    json_t *memory = json_object_get(r.json, "memory");
+    CHECK(r.status == 200 && json_real_value(json_object_get(memory, "rss_bytes")) > 0 &&
+          json_real_value(json_object_get(memory, "budget_bytes")) > 0 &&
+          json_object_get(memory, "job_bytes") && json_object_get(memory, "driver_bytes"));
+    reply_finish(&r);
+    job_cost_set_memory_limit(1048576.0);
+    r = request(port, "POST", "/v1/jobs", "{\"technique\":\"unlit\",\"scene\":{\"width\":1024,"
+                "\"height\":1024}}", NULL);
+    CHECK(r.status == 400 && error_field(&r) && strcmp(error_field(&r), "scene.width") == 0 &&
+          strstr(r.body, "MiB"));
+    reply_finish(&r);
+    job_cost_set_memory_limit(0);
+
     /* Accepted jobs wait in the queue: nothing takes them until the test does. */
     char ids[3][32] = {{0}};
     for (int i = 0; i < 3; i++) {
         r = request(port, "POST", "/v1/jobs", JOB, NULL);
         CHECK(r.status == 202 && str(r.json, "id") && strcmp(str(r.json, "status"), "queued") == 0);
+        CHECK(json_real_value(json_object_get(json_object_get(r.json, "cost"), "memory_bytes")) > 0);
         snprintf(ids[i], sizeof(ids[i]), "%s", str(r.json, "id") ? str(r.json, "id") : "");
         reply_finish(&r);
     }
@@ -271,6 +433,37 @@ int main(void)
     /* /metrics counts the store's jobs by status, in Prometheus' text form. */
     r = request(port, "GET", "/metrics", NULL, NULL);
     CHECK(r.status == 200 && strstr(r.body, "# TYPE ") && strstr(r.body, "shadebench_"));
+    reply_finish(&r);
+
+    /* A health check has connections of its own: past an address's 3, the
+     * next CONNECTIONS_HEALTH_RESERVE serve /healthz and /metrics only (and
+     * close after one answer); past those, libmicrohttpd refuses. */
+    int hogs[3 + CONNECTIONS_HEALTH_RESERVE];
+    for (int i = 0; i < 3; i++)
+        hogs[i] = connect_to(port); /* open, and silent: each holds its slot */
+    sleep_ms(200);
+    r = request(port, "GET", "/v1/info", NULL, NULL);
+    CHECK(r.status == 429 && error_field(&r) && strcmp(error_field(&r), "connections") == 0 &&
+          strstr(r.body, "/healthz"));
+    reply_finish(&r);
+    r = request(port, "GET", "/healthz", NULL, NULL);
+    CHECK(r.status == 200);
+    reply_finish(&r);
+    r = request(port, "GET", "/metrics", NULL, NULL);
+    CHECK(r.status == 200 && strstr(r.body, "shadebench_render_up 1"));
+    reply_finish(&r);
+    for (int i = 3; i < 3 + CONNECTIONS_HEALTH_RESERVE; i++)
+        hogs[i] = connect_to(port);
+    sleep_ms(200);
+    r = request(port, "GET", "/healthz", NULL, NULL);
+    CHECK(r.status == 0); /* closed unanswered */
+    reply_finish(&r);
+    for (int i = 0; i < 3 + CONNECTIONS_HEALTH_RESERVE; i++)
+        if (hogs[i] >= 0)
+            close(hogs[i]);
+    sleep_ms(200);
+    r = request(port, "GET", "/v1/info", NULL, NULL);
+    CHECK(r.status == 200);
     reply_finish(&r);
 
     /* With a token, everything but /healthz needs it. */

@@ -1,6 +1,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "daemon/jobs/job_cost.h"
 #include "daemon/jobs/job_spec.h"
 #include "tests/unit/catalog_fixture.h"
 #include "tests/unit/check.h"
@@ -23,6 +24,55 @@ static void rejects(const char *text, const char *field)
     CHECK(err.message[0] != '\0');
     if (ok || strcmp(err.field, field) != 0)
         fprintf(stderr, "  for %s: got field '%s' (%s)\n", text, err.field, err.message);
+}
+
+/* The cost estimate (job_cost.h): each part grows with what drives it, the
+ * largest names its field, and admission holds a job to the limit. */
+static void test_cost(void)
+{
+    struct job_spec spec;
+    struct job_error err;
+    struct job_cost small, big, cost;
+    CHECK(parse("{\"technique\":\"unlit\",\"frames\":1,\"warmup_frames\":0,"
+                "\"scene\":{\"width\":32,\"height\":32}}", &spec, &err));
+    job_cost_estimate(&spec, &small);
+    /* 24 bytes a pixel of the harness's (rgba32f), 32 of a technique's planes. */
+    CHECK(small.targets_bytes == 32.0 * 32 * (24 + 32) && small.captures_bytes == 0 &&
+          small.reference_bytes == 0 && small.metrics_bytes == 0 && small.look_bytes == 0);
+    CHECK(small.memory_bytes > small.targets_bytes && strcmp(small.memory_field, "scene.width") == 0);
+    CHECK(parse("{\"technique\":\"unlit\",\"frames\":1,\"warmup_frames\":0,"
+                "\"scene\":{\"width\":4096,\"height\":4096}}", &spec, &err));
+    job_cost_estimate(&spec, &big);
+    CHECK(big.targets_bytes == small.targets_bytes * 16384);
+    CHECK(parse("{\"technique\":\"unlit\",\"frames\":64,\"warmup_frames\":0,"
+                "\"capture_interval\":1,\"reference\":\"forward\","
+                "\"look\":{\"hdr\":\"rgba16f\",\"post\":[\"bloom\"]},"
+                "\"scene\":{\"width\":256,\"height\":256}}", &spec, &err));
+    job_cost_estimate(&spec, &cost);
+    CHECK(cost.targets_bytes == 256.0 * 256 * (16 + 32 + 32) && cost.captures_bytes > 0 &&
+          cost.reference_bytes > 0 && cost.metrics_bytes > 0);
+    CHECK(strcmp(cost.memory_field, "capture_interval") == 0); /* 64 captures lead */
+    json_t *j = job_cost_json(&cost);
+    CHECK(json_real_value(json_object_get(j, "memory_bytes")) == cost.memory_bytes);
+    json_decref(j);
+    CHECK(parse("{\"technique\":\"unlit\",\"frames\":1,\"warmup_frames\":0,"
+                "\"look\":{\"lighting\":\"pbr\",\"ibl\":{\"probes\":32,\"resolution\":512}},"
+                "\"scene\":{\"width\":64,\"height\":64}}", &spec, &err));
+    job_cost_estimate(&spec, &cost);
+    CHECK(cost.look_bytes > 5e8 && strcmp(cost.memory_field, "look.ibl.resolution") == 0);
+
+    /* Admission: no limit by default; over the limit, refused naming the
+     * field, and job_spec_parse does it for every caller. */
+    CHECK(job_cost_memory_limit() == 0 && job_cost_admit(&big, &err));
+    job_cost_set_memory_limit(64.0 * 1048576);
+    CHECK(job_cost_admit(&small, &err) && !job_cost_admit(&big, &err) &&
+          strcmp(err.field, "scene.width") == 0 && strstr(err.message, "MiB"));
+    rejects("{\"technique\":\"unlit\",\"scene\":{\"width\":4096,\"height\":4096}}",
+            "scene.width");
+    rejects("{\"look\":{\"lighting\":\"pbr\",\"ibl\":{\"probes\":32,\"resolution\":512}},"
+            "\"scene\":{\"width\":64,\"height\":64}}", "look.ibl.resolution");
+    CHECK(parse("{\"scene\":{\"width\":64,\"height\":64}}", &spec, &err));
+    job_cost_set_memory_limit(0);
 }
 
 int main(void)
@@ -291,5 +341,6 @@ int main(void)
     e = job_error_to_json(&raw);
     CHECK(e != NULL);
     json_decref(e);
+    test_cost();
     return check_finish("test_job");
 }

@@ -33,6 +33,25 @@ int main(void)
     CHECK(kind_of("/v1/sweeps/5/charts/speed_accuracy.png", &r) == ROUTE_SWEEP_CHART && r.chart_png);
     CHECK(kind_of("/v1/sweeps/5/report.html", &r) == ROUTE_SWEEP_REPORT);
 
+    /* The raw target: an encoded NUL anywhere, or a query of more than
+     * ROUTE_MAX_QUERY_ARGS arguments, is refused naming it. */
+    size_t args;
+    const char *field = NULL, *why = NULL;
+    CHECK(route_check_target("/v1/jobs?a=1&b=2", &args, &field, &why) && args == 2);
+    CHECK(route_check_target("/v1/jobs?", &args, &field, &why) && args == 0);
+    CHECK(route_check_target("/v1/jobs/1/frames/1.png%2500", &args, &field, &why));
+    CHECK(!route_check_target("/v1/jobs/1/frames/1.png%00.txt", &args, &field, &why) &&
+          strcmp(field, "url") == 0 && why);
+    CHECK(!route_check_target("/v1/jobs?label.a=%00", &args, &field, &why) &&
+          strcmp(field, "url") == 0);
+    char many[1024] = "/v1/jobs?a";
+    for (int i = 0; i < ROUTE_MAX_QUERY_ARGS; i++)
+        strcat(many, "&a");
+    CHECK(!route_check_target(many, &args, &field, &why) && strcmp(field, "query") == 0 &&
+          args == ROUTE_MAX_QUERY_ARGS + 1);
+    many[strlen(many) - 2] = '\0';
+    CHECK(route_check_target(many, &args, &field, &why) && args == ROUTE_MAX_QUERY_ARGS);
+
     /* Refusals name what is wrong. */
     CHECK(kind_of("/v1/jobs/../../etc/passwd", &r) == ROUTE_NONE && strcmp(r.field, "id") == 0);
     CHECK(kind_of("/v1/jobs/1/frames/0.png", &r) == ROUTE_NONE && strcmp(r.field, "frame") == 0);

@@ -21,6 +21,7 @@
 #include "daemon/jobs/job_figures.h"
 #include "daemon/jobs/queue.h"
 #include "daemon/jobs/store.h"
+#include "daemon/jobs/store_reserve.h"
 #include "tests/unit/catalog_fixture.h"
 #include "tests/unit/check.h"
 
@@ -726,6 +727,105 @@ static void test_migration(void)
     remove_state(state);
 }
 
+/* Damaged records (issue 26): a result.json that cannot be read is
+ * quarantined wherever it is found, at start-up too (it was left in place
+ * when its job was rebuilt or found running), and a job rebuilt from its
+ * directory keeps the start time its result.json carries. */
+static void test_rebuilt_records(void)
+{
+    char *state = make_state();
+    char err[PATH_MAX + 300];
+    const char *result = "{\"frame_ms\": {\"median\": 3.5}, \"started_unix\": 1900000001.0}";
+    /* A damaged job.json, rebuilt from spec.json and result.json: done. */
+    legacy_job(state, "20291231-235900-0001", NULL, "{\"id\": \"2029", true, result);
+    /* Running when the daemon died, its result.json damaged. */
+    legacy_job(state, "20291231-235900-0002", "running", NULL, true, "{\"frame_ms\": ");
+    /* No row and no job.json (the store was rebuilt), result.json damaged. */
+    legacy_job(state, "20291231-235900-0003", NULL, NULL, true, "[1, 2]");
+    struct store *s = store_open(state, err, sizeof(err));
+    struct queue *q = s ? queue_create(s, 8) : NULL;
+    CHECK(q && queue_load(q, fixture_catalog(), err, sizeof(err)) == 3);
+    if (!q)
+        return;
+    json_t *job = queue_job_json(q, "20291231-235900-0001", 0);
+    const char *started = json_string_value(json_object_get(job, "started"));
+    CHECK(!strcmp(json_string_value(json_object_get(job, "status")), "done") && started &&
+          !strncmp(started, "2030-03-17T17:46:41", 19));
+    json_decref(job);
+    for (int i = 2; i <= 3; i++) {
+        char id[RECORD_ID_LEN], prefix[64];
+        snprintf(id, sizeof(id), "20291231-235900-000%d", i);
+        job = queue_job_json(q, id, 0);
+        const char *error = json_string_value(json_object_get(job, "error"));
+        CHECK(!strcmp(json_string_value(json_object_get(job, "status")), "interrupted") && error &&
+              strstr(error, "damaged") && strstr(error, "moved to") && strstr(error, "quarantine"));
+        json_decref(job);
+        char qdir[PATH_MAX + 32], path[PATH_MAX + 96];
+        snprintf(qdir, sizeof(qdir), "%s/quarantine", state);
+        snprintf(prefix, sizeof(prefix), "%s-result.json", id);
+        CHECK(count_entries(qdir, prefix) == 2); /* the file and its .reason */
+        snprintf(path, sizeof(path), "%s/jobs/%s/result.json", state, id);
+        CHECK(!exists(path));
+    }
+    queue_destroy(q);
+    store_close(s);
+    remove_state(state);
+}
+
+static long long file_size(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 ? (long long)st.st_size : -1;
+}
+
+/* The reserve a full disk draws on (store_reserve.h): its room is taken at
+ * open and given back on release; a state noted and not stored is found by
+ * the next open (the newest note of a record wins, a stored one goes), and
+ * goes once applied. */
+static void test_reserve(void)
+{
+    char *state = make_state();
+    char path[PATH_MAX + 32], status[32], error[512];
+    snprintf(path, sizeof(path), "%s/%s", state, STORE_RESERVE_FILE);
+    struct store_reserve *r = store_reserve_open(state);
+    CHECK(r && file_size(path) == STORE_RESERVE_BYTES && store_reserve_ready(r) &&
+          !store_reserve_released(r));
+    CHECK(!store_reserve_found(r, 0, "20260101-000000-0001", status, sizeof(status), error,
+                               sizeof(error)));
+    CHECK(store_reserve_note(r, 0, "20260101-000000-0001", "running", ""));
+    CHECK(store_reserve_note(r, 0, "20260101-000000-0001", "failed", "cannot write\tit:\nfull"));
+    CHECK(store_reserve_note(r, 0, "20260101-000000-0002", "failed", "stored after all"));
+    CHECK(store_reserve_note(r, 1, "20260101-000000-0003", "cancelled", "a sweep"));
+    store_reserve_unnote(r, 0, "20260101-000000-0002");
+    CHECK(store_reserve_release(r) && file_size(path) == STORE_RESERVE_NOTES_BYTES &&
+          store_reserve_released(r) && !store_reserve_release(r));
+    store_reserve_close(r);
+
+    r = store_reserve_open(state); /* the next start: room again, and the notes */
+    CHECK(r && file_size(path) == STORE_RESERVE_BYTES && store_reserve_ready(r));
+    CHECK(store_reserve_found(r, 0, "20260101-000000-0001", status, sizeof(status), error,
+                              sizeof(error)) &&
+          !strcmp(status, "failed") && !strcmp(error, "cannot write it: full"));
+    CHECK(!store_reserve_found(r, 0, "20260101-000000-0002", status, sizeof(status), error,
+                               sizeof(error)));
+    CHECK(store_reserve_found(r, 1, "20260101-000000-0003", status, sizeof(status), error,
+                              sizeof(error)) && !strcmp(status, "cancelled"));
+    CHECK(!store_reserve_found(r, 1, "20260101-000000-0001", status, sizeof(status), error,
+                               sizeof(error))); /* kinds apart */
+    /* A state noted now, then the earlier notes applied: only the new one
+     * is left for the next start. */
+    CHECK(store_reserve_note(r, 0, "20260101-000000-0004", "queued", ""));
+    store_reserve_found_done(r);
+    store_reserve_close(r);
+    r = store_reserve_open(state);
+    CHECK(r && !store_reserve_found(r, 0, "20260101-000000-0001", status, sizeof(status), error,
+                                    sizeof(error)) &&
+          store_reserve_found(r, 0, "20260101-000000-0004", status, sizeof(status), error,
+                              sizeof(error)));
+    store_reserve_close(r);
+    remove_state(state);
+}
+
 /* The live set keeps id order whatever the order of insertion; the
  * version says stored only when no state is left to write. */
 static void test_live_and_version(void)
@@ -765,5 +865,7 @@ int main(void)
     test_figures();
     test_live_and_version();
     test_migration();
+    test_rebuilt_records();
+    test_reserve();
     return check_finish("test_store");
 }

@@ -235,5 +235,36 @@ int main(void)
     rejects("{\"base\":{},\"find\":{\"param\":\"async_distance\",\"from\":0,\"to\":9,\"while\":\"pretty\"}}", "find.while");
     rejects("{\"base\":{},\"find\":{\"param\":\"scene.lights\",\"from\":0,\"to\":70000,\"while\":\"stable\"}}", "find.to");
     rejects("{\"base\":{},\"vary\":{\"frames\":[1]},\"extra\":1}", "extra");
+
+    /* find.while's threshold: a plain decimal in the metric's range, and
+     * the message names the rule broken (issue 26). */
+    static const struct {
+        const char *crit, *rule; /* rule: a word of the message; NULL: accepted */
+        double x;
+    } whiles[] = {
+        {"ssim_min >= 0.95", NULL, 0.95}, {"ssim_min>=1", NULL, 1}, {"ssim_min >= -1", NULL, -1},
+        {"flip_max <= 5e-2", NULL, 0.05}, {"flip_max <=0.1", NULL, 0.1},
+        {"ssim_min >= 2", "from -1 to 1", 0}, {"flip_max <= -0.1", "from 0 to 1", 0},
+        {"ssim_min >= 0x1p-1", "decimal", 0}, {"ssim_min >= inf", "decimal", 0},
+        {"ssim_min >= nan", "decimal", 0}, {"ssim_min >= 1e-400", "closer to 0", 0},
+        {"ssim_min >= 1e-310", "closer to 0", 0}, {"ssim_min >= 0.9x", "decimal", 0},
+        {"ssim_min >= ", "decimal", 0}, {"ssim_min >= .", "decimal", 0},
+        {"ssim_max >= 0.9", "one of", 0}, {"flip_max >= 0.1", "one of", 0},
+    };
+    for (size_t i = 0; i < sizeof(whiles) / sizeof(whiles[0]); i++) {
+        char text[256];
+        snprintf(text, sizeof(text), "{\"base\":{},\"find\":{\"param\":\"async_distance\","
+                 "\"from\":0,\"to\":9,\"while\":\"%s\"}}", whiles[i].crit);
+        struct sweep_spec s;
+        struct job_error err;
+        bool ok = parse(text, &s, &err);
+        if (whiles[i].rule)
+            CHECK(!ok && strcmp(err.field, "find.while") == 0 && strstr(err.message, whiles[i].rule));
+        else
+            CHECK(ok && s.threshold == whiles[i].x);
+        if (ok != !whiles[i].rule || (!ok && !strstr(err.message, whiles[i].rule)))
+            fprintf(stderr, "  for %s: %s\n", whiles[i].crit, ok ? "accepted" : err.message);
+        sweep_spec_finish(&s);
+    }
     return check_finish("test_sweep");
 }

@@ -1246,4 +1246,11 @@ void http_server_destroy(struct http_server *s)
     free(s);
 }
 
+size_t http_server_open_connections(struct http_server *s)
+{
+    struct connections_stats cs;
+    connections_stats(s->conns, &cs);
+    return cs.open;
+}
+
 int http_server_port(const struct http_server *s) { return s->port; }

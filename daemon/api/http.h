@@ -73,5 +73,7 @@ void http_server_destroy(struct http_server *s);
  * false (token unchanged) when it is over HTTP_MAX_TOKEN_BYTES. */
 bool http_server_set_token(struct http_server *s, const char *token);
 int http_server_port(const struct http_server *s);
+/* HTTP connections open now (as /metrics counts them). Any thread. */
+size_t http_server_open_connections(struct http_server *s);
 
 #endif

@@ -61,6 +61,15 @@ static void sleep_ms(long ms)
     nanosleep(&t, NULL);
 }
 
+/* Until the server holds exactly n connections (at most 10 s): a
+ * connection is counted once the server has taken it, which a loaded
+ * machine may do late. */
+static void wait_connections(struct http_server *http, size_t n)
+{
+    for (int i = 0; i < 1000 && http_server_open_connections(http) != n; i++)
+        sleep_ms(10);
+}
+
 static int connect_to(int port)
 {
     int fd = socket(AF_INET, SOCK_STREAM, 0);
@@ -441,7 +450,7 @@ int main(void)
     int hogs[3 + CONNECTIONS_HEALTH_RESERVE];
     for (int i = 0; i < 3; i++)
         hogs[i] = connect_to(port); /* open, and silent: each holds its slot */
-    sleep_ms(200);
+    wait_connections(http, 3);
     r = request(port, "GET", "/v1/info", NULL, NULL);
     CHECK(r.status == 429 && error_field(&r) && strcmp(error_field(&r), "connections") == 0 &&
           strstr(r.body, "/healthz"));
@@ -454,14 +463,14 @@ int main(void)
     reply_finish(&r);
     for (int i = 3; i < 3 + CONNECTIONS_HEALTH_RESERVE; i++)
         hogs[i] = connect_to(port);
-    sleep_ms(200);
+    wait_connections(http, 3 + CONNECTIONS_HEALTH_RESERVE);
     r = request(port, "GET", "/healthz", NULL, NULL);
     CHECK(r.status == 0); /* closed unanswered */
     reply_finish(&r);
     for (int i = 0; i < 3 + CONNECTIONS_HEALTH_RESERVE; i++)
         if (hogs[i] >= 0)
             close(hogs[i]);
-    sleep_ms(200);
+    wait_connections(http, 0);
     r = request(port, "GET", "/v1/info", NULL, NULL);
     CHECK(r.status == 200);
     reply_finish(&r);

@@ -50,6 +50,7 @@ static double format_bytes(GLenum format)
         return 8;
     case GL_DEPTH_COMPONENT32F:
     case GL_DEPTH_COMPONENT24:
+    case GL_DEPTH24_STENCIL8:
     case GL_RGBA8:
     case GL_R32F:
     case GL_RG16F:
@@ -105,6 +106,14 @@ GLuint gpu_targets_texture(struct gpu_targets *t, const char *name, GLenum forma
     return slot->tex;
 }
 
+static bool has_stencil(const struct gpu_targets *t, GLuint tex)
+{
+    for (int i = 0; tex && i < GPU_TARGETS_MAX; i++)
+        if (t->targets[i].tex == tex)
+            return t->targets[i].format == GL_DEPTH24_STENCIL8;
+    return false;
+}
+
 GLuint gpu_targets_fbo(struct gpu_targets *t, const char *name, const GLuint *colors, int ncolors,
                        GLuint depth, char *err, size_t errlen)
 {
@@ -133,7 +142,12 @@ GLuint gpu_targets_fbo(struct gpu_targets *t, const char *name, const GLuint *co
                                tex, 0);
         bufs[i] = GL_COLOR_ATTACHMENT0 + (GLenum)i;
     }
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, depth, 0);
+    /* Detach both first: the attachment point follows the format, and a
+     * slot may have held the other kind. */
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_TEXTURE_2D, 0, 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER,
+                           has_stencil(t, depth) ? GL_DEPTH_STENCIL_ATTACHMENT : GL_DEPTH_ATTACHMENT,
+                           GL_TEXTURE_2D, depth, 0);
     if (ncolors)
         glDrawBuffers(ncolors, bufs);
     else

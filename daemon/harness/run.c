@@ -66,7 +66,7 @@ bool run_setup_targets(struct harness_run *run)
     GLenum hdr_format = run->look->hdr == LOOK_HDR_RGBA16F ? GL_RGBA16F : GL_RGBA32F;
     GLuint color = gpu_targets_texture(pool, "output.hdr", hdr_format, w, h, run->err,
                                        sizeof(run->err));
-    GLuint depth = color ? gpu_targets_texture(pool, "output.depth", GL_DEPTH_COMPONENT24, w, h,
+    GLuint depth = color ? gpu_targets_texture(pool, "output.depth", GL_DEPTH24_STENCIL8, w, h,
                                                run->err, sizeof(run->err))
                          : 0;
     GLuint ldr = depth ? gpu_targets_texture(pool, "output.ldr", GL_RGBA8, w, h, run->err,

@@ -43,6 +43,7 @@ struct options {
     int max_connections;
     int max_connections_per_ip;
     double job_timeout;
+    double max_job_s;
     double stall_s;
     double memory_budget_mib; /* 0: the driver, the connections, and half the RAM for a job */
     bool list_devices;
@@ -82,6 +83,9 @@ static void usage(FILE *f)
             "                       (default " KEEP_DAYS_TEXT "; 0: keep all)\n"
             "  --job-timeout S      running time a job may take when it gives no timeout_s\n"
             "                       (default 86400; 0: no limit)\n"
+            "  --max-job-seconds S  running time any job may take: a larger timeout_s is\n"
+            "                       refused, and the default is capped to it (default 0: no\n"
+            "                       limit but each job's timeout_s)\n"
             "  --stall-seconds S    /healthz answers 503 when the render thread, busy with a\n"
             "                       job, has made no progress for S seconds (default "
             STALL_SECONDS_TEXT "; 0: never)\n"
@@ -102,11 +106,12 @@ static void usage(FILE *f)
             "  --version, --help\n\n"
             "Settings come from, in rising order: defaults, the config file (lines of\n"
             "\"key = value\": listen, state-dir, device, queue-size, token, keep-jobs,\n"
-            "keep-days, job-timeout, stall-seconds, memory-budget, max-connections,\n"
-            "max-connections-per-ip, log-level), the environment (SHADEBENCH_LISTEN,\n"
-            "SHADEBENCH_STATE_DIR, SHADEBENCH_DEVICE, SHADEBENCH_QUEUE_SIZE,\n"
-            "SHADEBENCH_TOKEN_FILE, SHADEBENCH_KEEP_JOBS, SHADEBENCH_KEEP_DAYS,\n"
-            "SHADEBENCH_JOB_TIMEOUT, SHADEBENCH_STALL_SECONDS, SHADEBENCH_MEMORY_BUDGET,\n"
+            "keep-days, job-timeout, max-job-seconds, stall-seconds, memory-budget,\n"
+            "max-connections, max-connections-per-ip, log-level), the environment\n"
+            "(SHADEBENCH_LISTEN, SHADEBENCH_STATE_DIR, SHADEBENCH_DEVICE,\n"
+            "SHADEBENCH_QUEUE_SIZE, SHADEBENCH_TOKEN_FILE, SHADEBENCH_KEEP_JOBS,\n"
+            "SHADEBENCH_KEEP_DAYS, SHADEBENCH_JOB_TIMEOUT, SHADEBENCH_MAX_JOB_SECONDS,\n"
+            "SHADEBENCH_STALL_SECONDS, SHADEBENCH_MEMORY_BUDGET,\n"
             "SHADEBENCH_MAX_CONNECTIONS, SHADEBENCH_MAX_CONNECTIONS_PER_IP,\n"
             "SHADEBENCH_LOG_LEVEL), the flags.\n");
 }
@@ -156,6 +161,9 @@ static bool apply_setting(struct options *o, const char *key, const char *value,
             rule = "must be a number of days from 0 (keep all)";
     } else if (strcmp(key, "job-timeout") == 0) {
         if (!parse_number(value, 0, 1e7, &o->job_timeout))
+            rule = "must be a number of seconds from 0 (no limit) to 10000000";
+    } else if (strcmp(key, "max-job-seconds") == 0) {
+        if (!parse_number(value, 0, 1e7, &o->max_job_s))
             rule = "must be a number of seconds from 0 (no limit) to 10000000";
     } else if (strcmp(key, "stall-seconds") == 0) {
         if (!parse_number(value, 0, 1e6, &o->stall_s))
@@ -228,7 +236,7 @@ static bool load_environment(struct options *o)
 {
     static const char *const keys[] = {"listen", "state-dir", "device", "queue-size",
                                        "token-file", "keep-jobs", "keep-days", "job-timeout",
-                                       "stall-seconds", "memory-budget", "max-connections",
+                                       "max-job-seconds", "stall-seconds", "memory-budget", "max-connections",
                                        "max-connections-per-ip", "log-level", NULL};
     for (const char *const *k = keys; *k; k++) {
         char name[64] = "SHADEBENCH_";
@@ -597,7 +605,7 @@ int main(int argc, char **argv)
                         .keep_jobs = KEEP_JOBS_DEFAULT, .keep_days = KEEP_DAYS_DEFAULT};
     snprintf(o.listen, sizeof(o.listen), "127.0.0.1:8460");
     enum { OPT_LISTEN = 256, OPT_STATE, OPT_DEVICE, OPT_QUEUE, OPT_TOKEN, OPT_KEEP_JOBS,
-           OPT_KEEP_DAYS, OPT_JOB_TIMEOUT, OPT_STALL, OPT_MEMORY, OPT_MAX_CONN, OPT_MAX_CONN_IP, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_ONCE, OPT_OUT, OPT_DEBUG,
+           OPT_KEEP_DAYS, OPT_JOB_TIMEOUT, OPT_MAX_JOB, OPT_STALL, OPT_MEMORY, OPT_MAX_CONN, OPT_MAX_CONN_IP, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_ONCE, OPT_OUT, OPT_DEBUG,
            OPT_LOG, OPT_VERSION, OPT_HELP };
     static const struct option longopts[] = {
         {"listen", required_argument, NULL, OPT_LISTEN},
@@ -608,6 +616,7 @@ int main(int argc, char **argv)
         {"keep-jobs", required_argument, NULL, OPT_KEEP_JOBS},
         {"keep-days", required_argument, NULL, OPT_KEEP_DAYS},
         {"job-timeout", required_argument, NULL, OPT_JOB_TIMEOUT},
+        {"max-job-seconds", required_argument, NULL, OPT_MAX_JOB},
         {"stall-seconds", required_argument, NULL, OPT_STALL},
         {"memory-budget", required_argument, NULL, OPT_MEMORY},
         {"max-connections", required_argument, NULL, OPT_MAX_CONN},
@@ -640,6 +649,7 @@ int main(int argc, char **argv)
         case OPT_KEEP_JOBS: key = "keep-jobs"; break;
         case OPT_KEEP_DAYS: key = "keep-days"; break;
         case OPT_JOB_TIMEOUT: key = "job-timeout"; break;
+        case OPT_MAX_JOB: key = "max-job-seconds"; break;
         case OPT_STALL: key = "stall-seconds"; break;
         case OPT_MEMORY: key = "memory-budget"; break;
         case OPT_MAX_CONN: key = "max-connections"; break;
@@ -674,6 +684,7 @@ int main(int argc, char **argv)
             return 2;
     }
     job_spec_set_default_timeout(o.job_timeout);
+    job_spec_set_max_seconds(o.max_job_s);
     if (o.list_devices)
         return list_devices();
     if (o.once) {

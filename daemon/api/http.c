@@ -281,7 +281,7 @@ static json_t *info_json(struct http_server *s)
     json_t *techs = technique_catalog_json(s->ctx.catalog);
     const struct http_limits *l = &s->limits;
     return json_pack("{s:s, s:s, s:s, s:o, s:o, s:o, s:o, s:o, s:{s:i, s:i, s:i, s:I, s:I, s:f, "
-                     "s:f, s:I, s:f, s:I, s:I}}",
+                     "s:f, s:I, s:f, s:f, s:I, s:I}}",
                      "name", "shadebenchd", "version", PACKAGE_VERSION, "api", "v1", "memory",
                      memory, "device",
                      s->ctx.device_json(s->ctx.render), "techniques", techs,
@@ -293,7 +293,8 @@ static json_t *info_json(struct http_server *s)
                      (json_int_t)l->max_connections_per_ip, "header_timeout_s",
                      l->header_timeout_s, "body_timeout_s", l->body_timeout_s,
                      "max_token_bytes", (json_int_t)HTTP_MAX_TOKEN_BYTES, "default_job_timeout_s",
-                     job_spec_default_timeout(), "max_captures",
+                     job_spec_default_timeout(), "max_job_seconds", job_spec_max_seconds(),
+                     "max_captures",
                      (json_int_t)JOB_MAX_CAPTURES, "max_image_pixels", (json_int_t)IMAGE_MAX_PIXELS);
 }
 

@@ -2,6 +2,7 @@
 #include "daemon/harness/measure.h"
 
 #include <inttypes.h>
+#include <math.h>
 #include <stdio.h>
 
 #include "common/clock.h"
@@ -49,12 +50,35 @@ static bool keep_going(struct harness_run *run, int64_t k, int run_index, enum j
     return !gpu_budget_stopped(&run->budget);
 }
 
+/* A job that cannot finish within its timeout_s fails as soon as that is
+ * clear, not when the time has run out: once even its fastest frame so far,
+ * times the frames left in this run, would take it past the limit (a lower
+ * bound: later runs, the reference and the metrics come on top). Only
+ * worth it where the time saved is more than a second. */
+static bool out_of_time(struct harness_run *run, int seq, double fastest_s)
+{
+    const struct job *job = run->job;
+    int left = run->spec->warmup_frames + run->spec->frames - seq - 1;
+    double more = fastest_s * left, ran = clock_unix_s() - job->started;
+    if (job->spec.timeout_s <= 0 || job->started <= 0 || !isfinite(fastest_s) || more < 1.0 ||
+        ran + more <= job->spec.timeout_s)
+        return false;
+    snprintf(run->err, sizeof(run->err),
+             "timeout: the job cannot finish within its timeout_s of %g s: after %.1f s, "
+             "%d frames are left and its fastest frame took %.1f ms, so at least %.1f s more; "
+             "stopped at frame %d of %d in the rendering phase (fewer frames, a smaller "
+             "scene, or a larger timeout_s)",
+             job->spec.timeout_s, ran, left, fastest_s * 1e3, more, seq + 1,
+             run->spec->warmup_frames + run->spec->frames);
+    return true;
+}
+
 bool measure_run(struct harness_run *run, int run_index, enum job_status *status)
 {
     const struct job_spec *spec = run->spec;
     struct gpu_budget *budget = &run->budget;
     int w0 = spec->warmup_frames, n = spec->frames;
-    double wall_start = 0, frame_begin = 0;
+    double wall_start = 0, frame_begin = 0, fastest_s = INFINITY;
     run->capture_s = 0;
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     for (int seq = 0; seq < w0 + n; seq++) {
@@ -80,6 +104,11 @@ bool measure_run(struct harness_run *run, int run_index, enum job_status *status
         double t0 = clock_mono_s();
         if (k >= 2)
             run->frame_ms[k - 2] += (t0 - frame_begin) * 1e3;
+        /* From the fourth frame on, an interval includes the wait for a frame
+         * in flight, so it is what a frame costs (the first ones are only
+         * submissions, or shader compilation). */
+        if (seq >= 3)
+            fastest_s = fmin(fastest_s, t0 - frame_begin);
         frame_begin = t0;
         bool ok = run_frame(run, k, k >= 1);
         glFlush(); /* where a swap would hand the frame to the GPU */
@@ -101,6 +130,8 @@ bool measure_run(struct harness_run *run, int run_index, enum job_status *status
             run->frame_ms[k - 1] -= c * 1e3;
         }
         if ((seq & 15) == 15 && gl_error_take("rendering", run->err, sizeof(run->err)))
+            return false;
+        if (out_of_time(run, seq, fastest_s))
             return false;
         queue_progress(run->queue, run->job, run_index * n + (k > 0 ? (int)k : 0));
         render_progress_at(t1); /* for /healthz: one atomic store of a time already read */

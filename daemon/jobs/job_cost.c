@@ -80,6 +80,15 @@ void job_cost_estimate(const struct job_spec *spec, struct job_cost *out)
                         sizeof(double);
     out->memory_bytes = out->targets_bytes + out->look_bytes + out->captures_bytes +
                         out->reference_bytes + out->metrics_bytes + out->series_bytes;
+    out->frames_total = (double)(spec->frames + spec->warmup_frames) * job_spec_runs(spec);
+    out->pixel_frames = pixels * out->frames_total;
+    out->pixel_light_evaluations = out->pixel_frames * spec->scene.lights;
+    const struct ibl_spec *ibl = &spec->look.ibl;
+    out->ibl_samples = ibl->enabled ? (ibl->probes + 1) * 6.0 * ibl->resolution *
+                                          ibl->resolution * ibl->samples
+                                    : 0;
+    out->shadow_texels = shadow_bytes(&spec->look.shadows) / 4.0 * out->frames_total;
+    out->metric_pixels = reference ? captures * pixels : 0;
     /* The field to change, by the largest part. */
     struct {
         double bytes;
@@ -103,10 +112,14 @@ void job_cost_estimate(const struct job_spec *spec, struct job_cost *out)
 
 json_t *job_cost_json(const struct job_cost *c)
 {
-    return json_pack("{s:f, s:f, s:f, s:f, s:f, s:f, s:f}", "memory_bytes", c->memory_bytes,
-                     "targets_bytes", c->targets_bytes, "look_bytes", c->look_bytes,
-                     "captures_bytes", c->captures_bytes, "reference_bytes", c->reference_bytes,
-                     "metrics_bytes", c->metrics_bytes, "series_bytes", c->series_bytes);
+    return json_pack("{s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:{s:f, s:f, s:f, s:f, s:f, s:f}}",
+                     "memory_bytes", c->memory_bytes, "targets_bytes", c->targets_bytes,
+                     "look_bytes", c->look_bytes, "captures_bytes", c->captures_bytes,
+                     "reference_bytes", c->reference_bytes, "metrics_bytes", c->metrics_bytes,
+                     "series_bytes", c->series_bytes, "work", "frames", c->frames_total,
+                     "pixel_frames", c->pixel_frames, "pixel_light_evaluations",
+                     c->pixel_light_evaluations, "ibl_samples", c->ibl_samples, "shadow_texels",
+                     c->shadow_texels, "metric_pixels", c->metric_pixels);
 }
 
 bool job_cost_admit(const struct job_cost *c, struct job_error *err)

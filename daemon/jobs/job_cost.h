@@ -33,15 +33,22 @@ struct job_cost {
     double series_bytes;    /* per-frame figures: CPU, frame and GPU times of every pass */
     double memory_bytes;    /* their sum */
     const char *memory_field; /* the job field that drives the largest part */
-    /* The render thread's time, once the harness estimates it (issue 26's
-     * admission by cost): its parts go here. */
+    /* Work, in units no rate turns into seconds without the device: the
+     * render thread's time is judged on the device, from a job's first
+     * frames (a job that cannot finish within its timeout_s fails there). */
+    double frames_total;          /* warm-up and timed frames of every run */
+    double pixel_frames;          /* pixels x frames_total */
+    double pixel_light_evaluations; /* x lights: forward's loop, the most any technique does */
+    double ibl_samples;           /* probes' cube faces' texels x samples, once */
+    double shadow_texels;         /* shadow atlas texels x frames_total */
+    double metric_pixels;         /* captures x pixels scored against the reference */
 };
 
 /* Fills out from spec (which must be valid: job_spec_parse's). */
 void job_cost_estimate(const struct job_spec *spec, struct job_cost *out);
 
-/* {"memory_bytes", "targets_bytes", ...}: the estimate as the API states
- * it. New reference. */
+/* {"memory_bytes", "targets_bytes", ..., "work": {...}}: the estimate as
+ * the API states it. New reference. */
 json_t *job_cost_json(const struct job_cost *c);
 
 /* The most memory one job may take (bytes; 0: no limit, the default, as

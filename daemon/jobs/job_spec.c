@@ -69,10 +69,27 @@ static bool alias_target(const struct technique_catalog *c, int alias, int *tech
     return *technique >= 0 && *opt;
 }
 
-static double default_timeout_s;
+static double default_timeout_s, max_job_s;
 
 void job_spec_set_default_timeout(double seconds) { default_timeout_s = seconds; }
 double job_spec_default_timeout(void) { return default_timeout_s; }
+void job_spec_set_max_seconds(double seconds) { max_job_s = seconds > 0 ? seconds : 0; }
+double job_spec_max_seconds(void) { return max_job_s; }
+
+/* timeout_s within the daemon's limit: a job's own is refused above it, the
+ * default is capped to it. */
+static bool apply_max_seconds(const json_t *body, struct job_spec *out, struct job_error *err)
+{
+    if (max_job_s <= 0 || (out->timeout_s > 0 && out->timeout_s <= max_job_s))
+        return true;
+    if (json_object_get(body, "timeout_s"))
+        return job_error_set(err, "timeout_s",
+                             "%g s (0 is no limit) is more than this daemon lets a job run "
+                             "(--max-job-seconds %g; /v1/info: limits.max_job_seconds)",
+                             out->timeout_s, max_job_s);
+    out->timeout_s = max_job_s;
+    return true;
+}
 
 void job_spec_defaults(struct job_spec *out, const struct technique_catalog *techniques)
 {
@@ -381,7 +398,8 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
                  &out->warmup_frames, err) ||
         !jf_get_int(body, "capture_interval", "capture_interval", 0, 1000000,
                  &out->capture_interval, err) ||
-        !jf_get_number(body, "timeout_s", "timeout_s", 0.0, 1e7, &out->timeout_s, err))
+        !jf_get_number(body, "timeout_s", "timeout_s", 0.0, 1e7, &out->timeout_s, err) ||
+        !apply_max_seconds(body, out, err))
         return false;
 
     json_t *scene;

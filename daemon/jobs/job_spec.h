@@ -65,6 +65,13 @@ struct job_spec {
 void job_spec_set_default_timeout(double seconds);
 double job_spec_default_timeout(void);
 
+/* The most running time any job may take (--max-job-seconds; 0: no limit,
+ * the default). A job's own timeout_s may be lower, never higher or 0; one
+ * that names none gets the default, capped by this. Set once at start-up,
+ * before any thread parses jobs. */
+void job_spec_set_max_seconds(double seconds);
+double job_spec_max_seconds(void);
+
 
 /* Fills defaults, then applies and validates the body. techniques is the
  * catalogue of accepted techniques; it must outlive the spec. */

@@ -11,6 +11,10 @@ cancel, timeout and SIGTERM act within about a second.
   restart the job is queued again;
 - the next job runs after each (once the abandoned frame's last tiles
   have drained);
+- a job that cannot finish within its timeout_s fails within its first
+  frames, saying why, not when the time has run out; the 202 states the
+  work a job asks for; --max-job-seconds refuses a larger timeout_s naming
+  it and caps the default;
 - drawing in tiles changes no pixel: a daemon that slices everything into
   pieces of 2 ms (SHADEBENCH_SLICE_MS=2) renders every technique,
   the post effects and the look byte for byte as one that does not, and says
@@ -85,6 +89,23 @@ try:
           "timeout_s 1 stops a frame of seconds %.2f s after the job started: %s" % (took, err))
     next_job_is_quick(d, "a timeout")
 
+    # A job that cannot finish in time fails at once: 1,000 frames of about
+    # 0.2 s each (0.7 s under load) against 30 s.
+    status, answer = d.json("POST", "/v1/jobs", dict(HEAVY, frames=1000, warmup_frames=1,
+                                                      timeout_s=30, scene={"width": 128, "height": 128,
+                                                                           "lights": 2048}))
+    work = (answer.get("cost") or {}).get("work") or {}
+    check(status == 202 and work.get("frames") == 1001 and
+          work.get("pixel_light_evaluations") == 1001 * 128 * 128 * 2048.0,
+          "the 202 states the work asked for: %s %s" % (status, work))
+    done = d.wait(answer.get("id"))
+    took = parse_time(done.get("finished")) - parse_time(done.get("started"))
+    err = done.get("error") or ""
+    print("cannot finish: %s after %.1f s: %s" % (done.get("status"), took, err))
+    check(done.get("status") == "failed" and "cannot finish within its timeout_s of 30 s" in err
+          and "rendering phase" in err and took < 10 * S,
+          "a job that cannot finish in time fails after %.1f s, not 30: %s" % (took, err))
+
     # DELETE acts inside a frame of seconds.
     status, job, took = cancel_running(d, HEAVY, "the heavy job")
     err = job.get("error") or ""
@@ -127,6 +148,20 @@ try:
 finally:
     testlib.stop_and_check(d)
     first.cleanup(keep=testlib.failures > 0)
+
+# --max-job-seconds: the most any job may run.
+d = testlib.Daemon("--max-job-seconds", "100")
+try:
+    info = d.json("GET", "/v1/info")[1]
+    check(info.get("limits", {}).get("max_job_seconds") == 100,
+          "/v1/info states max_job_seconds: %s" % info.get("limits", {}).get("max_job_seconds"))
+    for timeout in (101, 0):
+        testlib.rejects(d, dict(TINY, timeout_s=timeout), "timeout_s")
+    done = d.run(TINY)
+    check(done.get("status") == "done" and done.get("spec", {}).get("timeout_s") == 100,
+          "a job that names no timeout_s gets --max-job-seconds: %s" % done.get("spec", {}).get("timeout_s"))
+finally:
+    testlib.stop_and_check(d)
 
 # Tiles change no pixel: every technique, the post chain and the look, drawn
 # with pieces of 2 ms, against a daemon that draws them whole.

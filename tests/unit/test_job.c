@@ -60,6 +60,20 @@ static void test_cost(void)
                 "\"scene\":{\"width\":64,\"height\":64}}", &spec, &err));
     job_cost_estimate(&spec, &cost);
     CHECK(cost.look_bytes > 5e8 && strcmp(cost.memory_field, "look.ibl.resolution") == 0);
+    /* Work: 33 cubes (32 probes and the environment) of 512x512 faces. */
+    CHECK(cost.frames_total == 1 && cost.pixel_frames == 64.0 * 64 &&
+          cost.ibl_samples == 33 * 6.0 * 512 * 512 * spec.look.ibl.samples &&
+          cost.shadow_texels == 0 && cost.metric_pixels == 0);
+    CHECK(parse("{\"technique\":\"clustered_deferred\",\"frames\":10,\"warmup_frames\":2,"
+                "\"capture_interval\":5,\"reference\":\"forward\","
+                "\"scene\":{\"width\":100,\"height\":50,\"lights\":1000}}", &spec, &err));
+    job_cost_estimate(&spec, &cost);
+    CHECK(cost.frames_total == 12 && cost.pixel_light_evaluations == 12 * 5000.0 * 1000 &&
+          cost.metric_pixels == 2 * 5000.0);
+    j = job_cost_json(&cost);
+    CHECK(json_real_value(json_object_get(json_object_get(j, "work"), "pixel_frames")) ==
+          12 * 5000.0);
+    json_decref(j);
 
     /* Admission: no limit by default; over the limit, refused naming the
      * field, and job_spec_parse does it for every caller. */
@@ -73,6 +87,30 @@ static void test_cost(void)
             "\"scene\":{\"width\":64,\"height\":64}}", "look.ibl.resolution");
     CHECK(parse("{\"scene\":{\"width\":64,\"height\":64}}", &spec, &err));
     job_cost_set_memory_limit(0);
+}
+
+/* --max-job-seconds: a job's own timeout_s above it (or 0, no limit) is
+ * refused naming timeout_s; one that names none gets the default capped. */
+static void test_max_seconds(void)
+{
+    struct job_spec spec;
+    struct job_error err;
+    double saved = job_spec_default_timeout();
+    CHECK(job_spec_max_seconds() == 0);
+    CHECK(parse("{\"timeout_s\":0}", &spec, &err) && spec.timeout_s == 0);
+    job_spec_set_max_seconds(600);
+    CHECK(parse("{}", &spec, &err) && spec.timeout_s == 600);
+    CHECK(parse("{\"timeout_s\":30}", &spec, &err) && spec.timeout_s == 30);
+    CHECK(parse("{\"timeout_s\":600}", &spec, &err) && spec.timeout_s == 600);
+    rejects("{\"timeout_s\":601}", "timeout_s");
+    rejects("{\"timeout_s\":0}", "timeout_s");
+    job_spec_set_default_timeout(60);
+    CHECK(parse("{}", &spec, &err) && spec.timeout_s == 60);
+    job_spec_set_default_timeout(0);
+    CHECK(parse("{}", &spec, &err) && spec.timeout_s == 600);
+    job_spec_set_max_seconds(0);
+    job_spec_set_default_timeout(saved);
+    CHECK(parse("{\"timeout_s\":601}", &spec, &err) && spec.timeout_s == 601);
 }
 
 int main(void)
@@ -342,5 +380,6 @@ int main(void)
     CHECK(e != NULL);
     json_decref(e);
     test_cost();
+    test_max_seconds();
     return check_finish("test_job");
 }

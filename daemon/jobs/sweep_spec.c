@@ -244,6 +244,25 @@ static bool check_point(const json_t *job, const struct technique_catalog *techn
     return job_error_set(err, field, "%s: %s", inner.field, inner.message);
 }
 
+/* A base job, or one with a swept value, checked as its points will run:
+ * with the baseline as the reference when it names none and captures at
+ * its last frame at least (point_defaults), so that fields needing a
+ * reference (temporal, metrics) may be given. */
+static bool check_as_point(const json_t *job, const struct technique_catalog *techniques,
+                           const char *field, struct job_error *err)
+{
+    json_t *point = json_deep_copy(job);
+    if (!json_object_get(point, "reference") || json_is_null(json_object_get(point, "reference")))
+        json_object_set_new(point, "reference", json_string(baseline(techniques)));
+    json_t *ci = json_object_get(point, "capture_interval"), *nf = json_object_get(point, "frames");
+    if (!ci || (json_is_integer(ci) && json_integer_value(ci) == 0))
+        json_object_set_new(point, "capture_interval",
+                            json_integer(json_is_integer(nf) ? json_integer_value(nf) : 300));
+    bool ok = check_point(point, techniques, field, err);
+    json_decref(point);
+    return ok;
+}
+
 /* Point p of a grid, exactly as it will be submitted; the error names the
  * combination ("vary", point 3: frames=2, capture_interval=5) and the job
  * field and rule it breaks. */
@@ -488,19 +507,7 @@ static bool parse_into(const json_t *body, const struct technique_catalog *techn
     json_t *base = json_object_get(body, "base");
     if (!json_is_object(base))
         return job_error_set(err, "base", "must be a job object");
-    /* Checked as its points will run: with the baseline as the reference
-     * when it names none (point_defaults), so that fields needing one
-     * (temporal, metrics) may be given. */
-    json_t *as_point = json_deep_copy(base);
-    if (!json_object_get(as_point, "reference") || json_is_null(json_object_get(as_point, "reference")))
-        json_object_set_new(as_point, "reference", json_string(baseline(techniques)));
-    json_t *ci = json_object_get(as_point, "capture_interval"), *nf = json_object_get(as_point, "frames");
-    if (!ci || (json_is_integer(ci) && json_integer_value(ci) == 0))
-        json_object_set_new(as_point, "capture_interval",
-                            json_integer(json_is_integer(nf) ? json_integer_value(nf) : 300));
-    bool base_ok = check_point(as_point, techniques, "base", err);
-    json_decref(as_point);
-    if (!base_ok)
+    if (!check_as_point(base, techniques, "base", err))
         return false;
     json_t *vary = json_object_get(body, "vary"), *find = json_object_get(body, "find");
     if (!!vary == !!find)
@@ -533,7 +540,7 @@ static bool parse_into(const json_t *body, const struct technique_catalog *techn
                 snprintf(field, sizeof(field), "vary.%.*s[%zu]", (int)jf_utf8_prefix(key, 40),
                          key, i);
                 json_t *job = with_field(base, key, value);
-                bool ok = check_point(job, techniques, field, err);
+                bool ok = check_as_point(job, techniques, field, err);
                 json_decref(job);
                 if (!ok)
                     return false;
@@ -664,6 +671,7 @@ json_t *sweep_point_job(const struct sweep_spec *s, size_t index, json_t **value
         }
         json_object_del(job, "reference");
         json_object_del(job, "metrics");
+        json_object_del(job, "temporal"); /* flicker is against a reference, too */
         json_object_set_new(job, "capture_interval", json_integer(0));
         return job;
     }

@@ -372,5 +372,20 @@ int main(void)
     rejects("{\"base\":{\"reference\":\"forward\",\"capture_interval\":5},\"vary\":{\"reference.supersample\":[2,5]}}",
             "vary.reference.supersample[1]");
     rejects("{\"base\":{},\"vary\":{\"temporal.frames\":[1]}}", "vary.temporal.frames[0]");
+    /* A base is checked as its points run (the baseline as reference,
+     * captures at the last frame), so temporal needs no more than that. */
+    {
+        struct sweep_spec s;
+        struct job_error err;
+        CHECK(parse("{\"base\":{\"technique\":\"osl\",\"frames\":6,\"temporal\":{\"frames\":3}},"
+                    "\"vary\":{\"scene.lights\":[2,4]}}", &s, &err));
+        json_t *values, *job = sweep_point_job(&s, 1, &values);
+        struct job_spec spec;
+        CHECK(job_spec_parse(job, techniques, &spec, &err) && spec.temporal_frames == 3 &&
+              !strcmp(spec.reference, "forward") && spec.capture_interval == 6);
+        json_decref(job);
+        json_decref(values);
+        sweep_spec_finish(&s);
+    }
     return check_finish("test_sweep");
 }

@@ -61,7 +61,7 @@ struct job_detail {
     double other_share;
 };
 
-static void job_detail(struct conn *c, const char *id, struct job_detail *d)
+static void job_detail(struct conn *c, const char *id, bool by_reference, struct job_detail *d)
 {
     memset(d, 0, sizeof(*d));
     d->other_share = NAN;
@@ -71,6 +71,19 @@ static void job_detail(struct conn *c, const char *id, struct job_detail *d)
     json_t *spec = json_object_get(job, "spec");
     workload_key(spec, d->key, sizeof(d->key));
     workload_describe(spec, d->workload, sizeof(d->workload));
+    /* A quality figure is a series per reference too: scores against
+     * forward and against forward supersampled are never one trend. The
+     * timing figures ignore the reference, which changes nothing timed. */
+    json_t *ref = json_object_get(spec, "reference");
+    if (by_reference && json_is_object(ref)) {
+        size_t used = strlen(d->key);
+        snprintf(d->key + used, sizeof(d->key) - used, "@%.20sx%lld",
+                 json_string_value(json_object_get(ref, "technique")) ? json_string_value(json_object_get(ref, "technique")) : "?",
+                 (long long)json_integer_value(json_object_get(ref, "supersample")));
+    } else if (by_reference && json_is_string(ref)) {
+        size_t used = strlen(d->key);
+        snprintf(d->key + used, sizeof(d->key) - used, "@%.20s", json_string_value(ref));
+    }
     json_t *inter = json_object_get(json_object_get(job, RK_RESULT), RK_INTERFERENCE);
     json_t *share = json_object_get(inter, "other_cpu_share");
     d->has_share = json_is_number(share);
@@ -138,7 +151,7 @@ static bool history_render(struct conn *c, const struct options *o, json_t *jobs
         const char *status = json_string_value(json_object_get(e, "status"));
         const char *renderer = json_string_value(json_object_get(figs, "gl_renderer"));
         struct job_detail d;
-        job_detail(c, id, &d);
+        job_detail(c, id, !strcmp(figure, RK_WORST_SSIM), &d);
         json_object_set_new(workloads, d.key, json_string(d.workload));
         noisy += d.noisy;
         if (d.has_share)

@@ -49,6 +49,8 @@
 #define RK_WORST_SSIM "worst_ssim"
 #define RK_WORST_SSIM_MIN "worst_ssim_min"
 #define RK_WORST_FLIP "worst_flip"
+#define RK_WORST_FLICKER "worst_flicker" /* temporal.frames: {value, frame} */
+#define RK_TEMPORAL "temporal"           /* a capture's flicker run, and the job's summary */
 #define RK_PDIFF_FAILED_CAPTURES "pdiff_failed_captures"
 #define RK_PDIFF_FAILED_FRAMES "pdiff_failed_frames"
 

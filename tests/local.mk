@@ -16,6 +16,7 @@ UNIT_TESTS = \
 	tests/unit/test_scene \
 	tests/unit/test_osl \
 	tests/unit/test_metrics \
+	tests/unit/test_flicker \
 	tests/unit/test_sweep \
 	tests/unit/test_interference \
 	tests/unit/test_records \
@@ -42,6 +43,7 @@ tests_unit_test_stats_LDADD = $(CORE_LIBS)
 tests_unit_test_scene_LDADD = $(CORE_LIBS)
 tests_unit_test_osl_LDADD = $(CORE_LIBS)
 tests_unit_test_metrics_LDADD = $(CORE_LIBS)
+tests_unit_test_flicker_LDADD = $(CORE_LIBS)
 tests_unit_test_sweep_LDADD = $(CORE_LIBS)
 tests_unit_test_effects_LDADD = $(CORE_LIBS)
 tests_unit_test_records_LDADD = $(CORE_LIBS)
@@ -120,6 +122,7 @@ E2E_TESTS = \
 	tests/e2e/e2e_pbr.py \
 	tests/e2e/e2e_client.py \
 	tests/e2e/e2e_metrics.py \
+	tests/e2e/e2e_reference_temporal.py \
 	tests/e2e/e2e_persist.py \
 	tests/e2e/ssim_skimage.py \
 	tests/e2e/e2e_history.py \

@@ -530,8 +530,11 @@ char *report_sweep_html(const json_t *posted, const json_t *device, report_job_d
     json_t *points = json_object_get(sweep, "points");
     if (strcmp(str(sweep, "preset"), "thesis") == 0)
         thesis_tables(&h, points);
-    const char *reference = json_string_value(
-        json_object_get(json_object_get(json_object_get(sweep, "spec"), "base"), "reference"));
+    json_t *base_ref =
+        json_object_get(json_object_get(json_object_get(sweep, "spec"), "base"), "reference");
+    if (json_is_object(base_ref)) /* {"technique", "supersample"} */
+        base_ref = json_object_get(base_ref, "technique");
+    const char *reference = json_string_value(base_ref);
     reference = reference ? reference : "forward";
     add(&h, "<h2>Table</h2><table><tr><th class=\"l\">parameters</th><th class=\"l\">technique</th>"
             "<th class=\"l\">job</th><th>frame_ms median [95%%]</th><th>gpu_ms median [95%%]</th>"
@@ -797,9 +800,12 @@ char *report_job_html(const json_t *job, const char *dir, const json_t *device, 
         technique_figures(&h, r, str(job, "technique"));
         json_t *q = json_object_get(r, RK_QUALITY);
         if (q) {
-            add(&h, "<h2>Quality against %s</h2><p>Worst SSIM %.6f, worst FLIP mean %.5f, "
+            json_int_t ss = json_integer_value(json_object_get(q, "reference_supersample"));
+            add(&h, "<h2>Quality against %s", str(q, "reference"));
+            if (ss > 1)
+                add(&h, ", supersampled %lldx%lld", (long long)ss, (long long)ss);
+            add(&h, "</h2><p>Worst SSIM %.6f, worst FLIP mean %.5f, "
                     "PerceptualDiff failed on %lld of %lld captures.</p>",
-                str(q, "reference"),
                 json_number_value(json_object_get(json_object_get(q, RK_WORST_SSIM), "value")),
                 json_number_value(json_object_get(json_object_get(q, RK_WORST_FLIP), "mean")),
                 (long long)json_integer_value(json_object_get(q, RK_PDIFF_FAILED_CAPTURES)),
@@ -820,6 +826,12 @@ char *report_job_html(const json_t *job, const char *dir, const json_t *device, 
                     json_is_true(json_object_get(pd, "pass")) ? "pass" : "fail",
                     pd ? (json_is_true(json_object_get(pd, "pass")) ? "pass" : "fail") : "-");
             }
+            json_t *tf = json_object_get(c, RK_TEMPORAL);
+            if (tf)
+                add(&h, "; flicker over frames %lld to %lld: %.6f",
+                    (long long)json_integer_value(json_array_get(json_object_get(tf, "frames"), 0)),
+                    (long long)json_integer_value(json_array_get(json_object_get(tf, "frames"), 1)),
+                    json_number_value(json_object_get(tf, "flicker")));
             add(&h, "</h3>");
             thumbnail(&h, dir, JOB_IMAGE_FRAME, frame, "frame");
             if (m) {

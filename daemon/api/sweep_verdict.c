@@ -15,7 +15,10 @@ static double num(const json_t *v, double fallback)
 
 static bool workload_key(const char *k)
 {
-    return !strncmp(k, "scene.", 6) || !strcmp(k, "frames") || !strcmp(k, "warmup_frames");
+    /* As sweep_spec.c's workload_param: points scored against different
+     * references (reference.supersample) are never on one front. */
+    return !strncmp(k, "scene.", 6) || !strcmp(k, "frames") || !strcmp(k, "warmup_frames") ||
+           !strcmp(k, "reference.supersample");
 }
 
 /* "k=v, ..." of the values keep() accepts, in their order; short_keys
@@ -70,7 +73,15 @@ bool sweep_view_init(struct sweep_view *v, const json_t *sweep, const char *seri
     memset(v, 0, sizeof(*v));
     v->series = series;
     const json_t *base = json_object_get(json_object_get(sweep, "spec"), "base");
-    v->reference = json_string_value(json_object_get(base, "reference"));
+    /* A supersampled reference ({"technique", "supersample": N > 1}) is not
+     * its technique's own image: no point is exact against it. */
+    json_t *ref = json_object_get(base, "reference");
+    json_int_t base_ss = json_is_object(ref) && json_is_integer(json_object_get(ref, "supersample"))
+                             ? json_integer_value(json_object_get(ref, "supersample"))
+                             : 1;
+    if (json_is_object(ref))
+        ref = json_object_get(ref, "technique");
+    v->reference = json_string_value(ref);
     v->reference = v->reference ? v->reference : "forward";
     v->status = json_string_value(json_object_get(sweep, "status"));
     v->status = v->status ? v->status : "?";
@@ -100,7 +111,9 @@ bool sweep_view_init(struct sweep_view *v, const json_t *sweep, const char *seri
         p->status = p->status ? p->status : "?";
         values_text(values, keep_not_technique, NULL, true, p->label, sizeof(p->label));
         p->workload = workload_index(v, values);
-        p->reference = !strcmp(p->technique, v->reference);
+        json_t *ss = json_object_get(values, "reference.supersample");
+        p->reference = !strcmp(p->technique, v->reference) &&
+                       (json_is_integer(ss) ? json_integer_value(ss) : base_ss) <= 1;
         json_t *cell = json_object_get(row, series);
         p->ms = num(json_object_get(cell, RK_MEDIAN), NAN);
         p->timed = isfinite(p->ms);

@@ -106,6 +106,15 @@ static bool score_capture(struct job *job, json_t *capture, json_t *summary, cha
     json_t *pdiff = json_object_get(m, "pdiff");
     if (pdiff && !json_is_true(json_object_get(pdiff, "pass")))
         json_array_append_new(json_object_get(summary, RK_PDIFF_FAILED_FRAMES), json_integer(frame));
+    /* temporal.frames: the capture's run of frames, measured on the render
+     * thread (temporal.c); the worst run is the sweeps' flicker_max. */
+    json_t *flicker = json_object_get(json_object_get(capture, RK_TEMPORAL), "flicker");
+    worst = json_object_get(summary, RK_WORST_FLICKER);
+    if (json_is_number(flicker) &&
+        (!worst || json_number_value(flicker) > json_number_value(json_object_get(worst, "value"))))
+        json_object_set_new(summary, RK_WORST_FLICKER,
+                            json_pack("{s:f, s:i}", "value", json_number_value(flicker), "frame",
+                                      frame));
     json_t *psnr = json_object_get(m, "psnr");
     json_t *overall = psnr ? json_object_get(psnr, "overall") : NULL;
     worst = json_object_get(summary, "worst_psnr");
@@ -122,7 +131,8 @@ static void run_task(struct metrics_worker *w, struct task *t)
     struct job *job = t->job;
     char err[512] = "";
     double t0 = clock_mono_s();
-    json_t *summary = json_pack("{s:s, s:i, s:[]}", "reference", job->spec.reference,
+    json_t *summary = json_pack("{s:s, s:i, s:i, s:[]}", "reference", job->spec.reference,
+                                "reference_supersample", job->spec.reference_supersample,
                                 "captures_compared", 0, RK_PDIFF_FAILED_FRAMES);
     json_t *captures = json_object_get(t->result, RK_CAPTURES);
     size_t i;

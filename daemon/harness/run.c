@@ -54,12 +54,15 @@ bool run_setup_targets(struct harness_run *run)
 {
     const struct gpu_caps *caps = &run->gl->caps;
     struct gpu_targets *pool = run->gl->targets;
-    int w = run->spec->scene.width, h = run->spec->scene.height;
+    int scale = run->scale > 1 ? run->scale : 1;
+    int w = run->spec->scene.width * scale, h = run->spec->scene.height * scale;
     if (w > caps->max_texture_size || h > caps->max_texture_size ||
         w > caps->max_viewport[0] || h > caps->max_viewport[1]) {
         snprintf(run->err, sizeof(run->err),
-                 "scene.width/height %dx%d exceed this device's limits "
+                 "%s %dx%d exceed this device's limits "
                  "(GL_MAX_TEXTURE_SIZE %d, GL_MAX_VIEWPORT_DIMS %dx%d)",
+                 scale > 1 ? "scene.width/height times reference.supersample"
+                           : "scene.width/height",
                  w, h, caps->max_texture_size, caps->max_viewport[0], caps->max_viewport[1]);
         return false;
     }

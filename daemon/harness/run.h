@@ -87,6 +87,9 @@ struct harness_run {
     /* Zeroed with the run, so that a still camera's block is built once. */
     struct gpu_frame_data frame_data;
     GLuint ldr_fbo;
+    /* The output is scale times the job's width and height (a supersampled
+     * reference, reference.c); 0 or 1: the job's size. */
+    int scale;
     struct technique_env env;
     struct technique_products products;
     char defines[512];

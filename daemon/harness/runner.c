@@ -28,6 +28,7 @@
 #include "daemon/harness/render_state.h"
 #include "daemon/harness/run.h"
 #include "daemon/harness/telemetry.h"
+#include "daemon/harness/temporal.h"
 #include "daemon/service.h"
 
 /* After a job, a resident set this far above the idle one is given back
@@ -227,6 +228,14 @@ static void run_job(struct runner *r, struct job *job)
         queue_set_phase(r->queue, job, "reference");
         render_state_phase("reference");
         if (!reference_render(&run, &status)) {
+            json_decref(result);
+            result = NULL;
+        }
+    }
+    if (result && spec->temporal_frames) {
+        queue_set_phase(r->queue, job, "temporal");
+        render_state_phase("temporal");
+        if (!temporal_measure(&run, result, &status)) {
             json_decref(result);
             result = NULL;
         }

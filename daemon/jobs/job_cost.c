@@ -73,13 +73,23 @@ void job_cost_estimate(const struct job_spec *spec, struct job_cost *out)
         out->reference_bytes = pixels * ((extra > 0 ? extra : 0) + 4.0) +
                                ibl_bytes(&spec->reference_look.ibl) +
                                shadow_bytes(&spec->reference_look.shadows);
+        /* Supersampled, it holds every plane at N x N the pixels (the pool
+         * makes them anew at that size) and reads back N x N frames. */
+        double n2 = (double)spec->reference_supersample * spec->reference_supersample;
+        if (n2 > 1)
+            out->reference_bytes += pixels * n2 * (look_targets_bpp(&spec->reference_look) + 4.0);
+        /* temporal.frames: the technique's frames of one capture point are
+         * kept while the reference's are drawn, with one of the reference's. */
+        if (spec->temporal_frames)
+            out->temporal_bytes = pixels * 4.0 * (spec->temporal_frames + 2);
         out->metrics_bytes = metrics_memory_bytes(spec->scene.width, spec->scene.height,
                                                   spec->metrics.flip_ppd);
     }
     out->series_bytes = (double)spec->frames * job_spec_runs(spec) * SERIES_DOUBLES_PER_FRAME *
                         sizeof(double);
     out->memory_bytes = out->targets_bytes + out->look_bytes + out->captures_bytes +
-                        out->reference_bytes + out->metrics_bytes + out->series_bytes;
+                        out->reference_bytes + out->metrics_bytes + out->series_bytes +
+                        out->temporal_bytes;
     out->frames_total = (double)(spec->frames + spec->warmup_frames) * job_spec_runs(spec);
     out->pixel_frames = pixels * out->frames_total;
     out->pixel_light_evaluations = out->pixel_frames * spec->scene.lights;
@@ -98,7 +108,9 @@ void job_cost_estimate(const struct job_spec *spec, struct job_cost *out)
         {spec->look.ibl.enabled ? ibl_bytes(&spec->look.ibl) : 0, "look.ibl.resolution"},
         {shadow_bytes(&spec->look.shadows), "look.shadows.atlas"},
         {out->captures_bytes, "capture_interval"},
-        {out->reference_bytes + out->metrics_bytes, "reference"},
+        {out->reference_bytes + out->metrics_bytes,
+         spec->reference_supersample > 1 ? "reference.supersample" : "reference"},
+        {out->temporal_bytes, "temporal.frames"},
         {out->series_bytes, "frames"},
     };
     out->memory_field = parts[0].field;
@@ -112,14 +124,18 @@ void job_cost_estimate(const struct job_spec *spec, struct job_cost *out)
 
 json_t *job_cost_json(const struct job_cost *c)
 {
-    return json_pack("{s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:{s:f, s:f, s:f, s:f, s:f, s:f}}",
-                     "memory_bytes", c->memory_bytes, "targets_bytes", c->targets_bytes,
-                     "look_bytes", c->look_bytes, "captures_bytes", c->captures_bytes,
-                     "reference_bytes", c->reference_bytes, "metrics_bytes", c->metrics_bytes,
-                     "series_bytes", c->series_bytes, "work", "frames", c->frames_total,
-                     "pixel_frames", c->pixel_frames, "pixel_light_evaluations",
-                     c->pixel_light_evaluations, "ibl_samples", c->ibl_samples, "shadow_texels",
-                     c->shadow_texels, "metric_pixels", c->metric_pixels);
+    json_t *o = json_pack("{s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:{s:f, s:f, s:f, s:f, s:f, s:f}}",
+                          "memory_bytes", c->memory_bytes, "targets_bytes", c->targets_bytes,
+                          "look_bytes", c->look_bytes, "captures_bytes", c->captures_bytes,
+                          "reference_bytes", c->reference_bytes, "metrics_bytes",
+                          c->metrics_bytes, "series_bytes", c->series_bytes, "work", "frames",
+                          c->frames_total, "pixel_frames", c->pixel_frames,
+                          "pixel_light_evaluations", c->pixel_light_evaluations, "ibl_samples",
+                          c->ibl_samples, "shadow_texels", c->shadow_texels, "metric_pixels",
+                          c->metric_pixels);
+    if (c->temporal_bytes > 0)
+        json_object_set_new(o, "temporal_bytes", json_real(c->temporal_bytes));
+    return o;
 }
 
 bool job_cost_admit(const struct job_cost *c, struct job_error *err)

@@ -112,6 +112,8 @@ void job_spec_defaults(struct job_spec *out, const struct technique_catalog *tec
     out->repeat = 1;
     out->repeat_auto = false;
     out->reference[0] = '\0';
+    out->reference_supersample = 1;
+    out->temporal_frames = 0;
     metrics_options_defaults(&out->metrics);
     out->timeout_s = default_timeout_s;
 }
@@ -124,6 +126,49 @@ const void *job_spec_technique_options(const struct job_spec *spec)
 const void *job_spec_reference_options(const struct job_spec *spec)
 {
     return spec->reference_index >= 0 ? spec->options[spec->reference_index].bytes : NULL;
+}
+
+/* "reference": a technique name, null, or {"technique": NAME, "supersample":
+ * N}; the object's technique defaults to the baseline, so that a sweep may
+ * vary reference.supersample over a base job that names no reference. */
+static bool parse_reference(const json_t *v, const struct technique_catalog *techniques,
+                            struct job_spec *out, struct job_error *err)
+{
+    if (!json_is_object(v))
+        return get_technique(v, "reference", techniques, true, out->reference,
+                             sizeof(out->reference), &out->reference_index, err);
+    static const char *const keys[] = {"technique", "supersample", NULL};
+    if (!jf_check_keys(v, "reference.", keys, err))
+        return false;
+    json_t *name = json_object_get(v, "technique");
+    if (name && !get_technique(name, "reference.technique", techniques, false, out->reference,
+                               sizeof(out->reference), &out->reference_index, err))
+        return false;
+    if (!name) {
+        if (techniques->baseline < 0)
+            return job_error_set(err, "reference.technique", "must be given: no technique is "
+                                 "the baseline");
+        out->reference_index = techniques->baseline;
+        snprintf(out->reference, sizeof(out->reference), "%s",
+                 techniques->infos[techniques->baseline]->name);
+    }
+    return jf_get_int(v, "supersample", "reference.supersample", 1, JOB_MAX_SUPERSAMPLE,
+                      &out->reference_supersample, err);
+}
+
+/* "temporal": {"frames": K}. */
+static bool parse_temporal(const json_t *v, struct job_spec *out, struct job_error *err)
+{
+    static const char *const keys[] = {"frames", NULL};
+    if (!json_is_object(v))
+        return job_error_set(err, "temporal", "must be an object: {\"frames\": K}");
+    if (!jf_check_keys(v, "temporal.", keys, err))
+        return false;
+    if (!json_object_get(v, "frames"))
+        return job_error_set(err, "temporal.frames", "must be given (%d to %d)",
+                             JOB_MIN_TEMPORAL_FRAMES, JOB_MAX_TEMPORAL_FRAMES);
+    return jf_get_int(v, "frames", "temporal.frames", JOB_MIN_TEMPORAL_FRAMES,
+                      JOB_MAX_TEMPORAL_FRAMES, &out->temporal_frames, err);
 }
 
 /* "repeat": N, or {"auto": true, "max": M}. */
@@ -283,7 +328,7 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
     static const char *const fixed[] = {"technique", "frames", "warmup_frames",
                                         "capture_interval", "scene", "look", "reference",
                                         "reference_look", "metrics", "repeat", "labels",
-                                        "timeout_s"};
+                                        "timeout_s", "temporal"};
     enum { NFIXED = sizeof(fixed) / sizeof(fixed[0]) };
     /* Every technique's options live under its own name; an alias is known
      * when the catalogue has the option it stands for. */
@@ -316,8 +361,7 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
         return job_error_set(err, "technique", "must be given: no technique is the baseline "
                              "a job runs by default");
     json_t *ref = json_object_get(body, "reference");
-    if (ref && !get_technique(ref, "reference", techniques, true, out->reference,
-                              sizeof(out->reference), &out->reference_index, err))
+    if (ref && !parse_reference(ref, techniques, out, err))
         return false;
     /* An alias first, so that the technique's own object may state the
      * same value again, and a different one is caught below. */
@@ -393,6 +437,9 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
     json_t *labels = json_object_get(body, "labels");
     if (labels && !parse_labels(labels, out, err))
         return false;
+    json_t *temporal = json_object_get(body, "temporal");
+    if (temporal && !parse_temporal(temporal, out, err))
+        return false;
     if (!jf_get_int(body, "frames", "frames", 1, 1000000, &out->frames, err) ||
         !jf_get_int(body, "warmup_frames", "warmup_frames", 0, 10000,
                  &out->warmup_frames, err) ||
@@ -412,6 +459,20 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
                     "captured frames with the reference's");
     if (metrics && !out->reference[0])
         return job_error_set(err, "metrics", "needs a reference technique to compare with");
+    /* GL 4.5 guarantees textures and viewports of 16384 a side (the
+     * device may allow more; run.c checks its own limits too). */
+    if (out->reference_supersample > 1 &&
+        ((long)out->scene.width * out->reference_supersample > JOB_SUPERSAMPLE_MAX_SIDE ||
+         (long)out->scene.height * out->reference_supersample > JOB_SUPERSAMPLE_MAX_SIDE))
+        return job_error_set(err, "reference.supersample", "renders %dx%d at %dx%d, more than "
+                             "the %d a side every OpenGL 4.5 device takes: lower it or the size",
+                             out->scene.width, out->scene.height,
+                             out->scene.width * out->reference_supersample,
+                             out->scene.height * out->reference_supersample,
+                             JOB_SUPERSAMPLE_MAX_SIDE);
+    if (temporal && !out->reference[0])
+        return job_error_set(err, "temporal", "needs a reference technique: flicker compares "
+                             "the technique's change from frame to frame with the reference's");
     if (ref_look && !out->reference[0])
         return job_error_set(err, "reference_look", "needs a reference technique to render "
                              "with it");
@@ -532,8 +593,16 @@ json_t *job_spec_to_json(const struct job_spec *spec)
     json_object_set_new(out, "repeat",
                         spec->repeat_auto ? json_pack("{s:b, s:i}", "auto", 1, "max", spec->repeat)
                                           : json_integer(spec->repeat));
+    /* The shorthand whenever it says it all, so that specs without a
+     * supersampled reference read as they always did. */
     json_object_set_new(out, "reference",
-                        spec->reference[0] ? json_string(spec->reference) : json_null());
+                        !spec->reference[0] ? json_null()
+                        : spec->reference_supersample > 1
+                            ? json_pack("{s:s, s:i}", "technique", spec->reference,
+                                        "supersample", spec->reference_supersample)
+                            : json_string(spec->reference));
+    if (spec->temporal_frames)
+        json_object_set_new(out, "temporal", json_pack("{s:i}", "frames", spec->temporal_frames));
     json_object_set_new(out, "timeout_s", json_real(spec->timeout_s));
     if (spec->reference[0])
         json_object_set_new(out, "metrics", metrics_to_json(&spec->metrics));

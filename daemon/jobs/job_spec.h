@@ -28,6 +28,21 @@
 #define JOB_LABEL_KEY_MAX 32
 #define JOB_LABEL_VALUE_MAX 128
 
+/* reference.supersample: the reference renders at N times the job's width
+ * and height and is box-filtered down to them (reference.c), so that
+ * accuracy is measured against the pixel's true colour rather than one
+ * sample of it. 1 to 4: 4 is 16 samples a pixel, past which the box filter's
+ * estimate of a pixel's mean moves by less than an 8-bit level on the
+ * scenes here, while the cost grows with N squared. */
+#define JOB_MAX_SUPERSAMPLE 4
+/* ... and the supersampled size within GL 4.5's minimum GL_MAX_TEXTURE_SIZE
+ * and GL_MAX_VIEWPORT_DIMS. */
+#define JOB_SUPERSAMPLE_MAX_SIDE 16384
+/* temporal.frames: consecutive frames compared at each capture for the
+ * flicker measure (quality/flicker.h). */
+#define JOB_MIN_TEMPORAL_FRAMES 2
+#define JOB_MAX_TEMPORAL_FRAMES 16
+
 struct job_label {
     char key[JOB_LABEL_KEY_MAX + 1];
     char value[JOB_LABEL_VALUE_MAX + 1];
@@ -47,6 +62,8 @@ struct job_spec {
     int repeat;                    /* runs of the job; with repeat_auto, the most */
     bool repeat_auto;              /* stop once the 95% interval is within 2.5% */
     char reference[32];            /* technique to compare captures with; "" for none */
+    int reference_supersample;     /* 1 to JOB_MAX_SUPERSAMPLE: "reference": {"supersample": N} */
+    int temporal_frames;           /* 0, or frames compared at each capture for flicker */
     struct metrics_options metrics; /* used when reference is set */
     /* Every catalogued technique's options, by catalogue index, so that a
      * sweep over techniques keeps each one's settings. */

@@ -39,6 +39,7 @@ static const struct {
     {"look.shadows.atlas", PARAM_INT, 1},  {"look.shadows.tile", PARAM_INT, 1},
     {"look.shadows.bias", PARAM_NUMBER, 0}, {"look.shadows.normal_offset", PARAM_NUMBER, 0},
     {"look.shadows.pcf", PARAM_INT, 1},    {"look.shadows.layout", PARAM_CHOICE, 0},
+    {"reference.supersample", PARAM_INT, 1}, {"temporal.frames", PARAM_INT, 1},
 };
 enum { NPARAMS = sizeof(PARAMS) / sizeof(PARAMS[0]) };
 
@@ -187,6 +188,11 @@ static json_t *with_field(const json_t *job, const char *path, json_t *value)
         other = job_spec_aliased(path);
     if (other)
         del_field(copy, other);
+    /* reference.supersample over the shorthand "reference": "NAME" keeps
+     * the name (the object form's technique defaults to the baseline). */
+    json_t *ref = json_object_get(copy, "reference");
+    if (!strncmp(path, "reference.", 10) && json_is_string(ref))
+        json_object_set_new(copy, "reference", json_pack("{s:O}", "technique", ref));
     jf_set_path(copy, path, json_incref(value));
     return copy;
 }
@@ -238,6 +244,25 @@ static bool check_point(const json_t *job, const struct technique_catalog *techn
     return job_error_set(err, field, "%s: %s", inner.field, inner.message);
 }
 
+/* A base job, or one with a swept value, checked as its points will run:
+ * with the baseline as the reference when it names none and captures at
+ * its last frame at least (point_defaults), so that fields needing a
+ * reference (temporal, metrics) may be given. */
+static bool check_as_point(const json_t *job, const struct technique_catalog *techniques,
+                           const char *field, struct job_error *err)
+{
+    json_t *point = json_deep_copy(job);
+    if (!json_object_get(point, "reference") || json_is_null(json_object_get(point, "reference")))
+        json_object_set_new(point, "reference", json_string(baseline(techniques)));
+    json_t *ci = json_object_get(point, "capture_interval"), *nf = json_object_get(point, "frames");
+    if (!ci || (json_is_integer(ci) && json_integer_value(ci) == 0))
+        json_object_set_new(point, "capture_interval",
+                            json_integer(json_is_integer(nf) ? json_integer_value(nf) : 300));
+    bool ok = check_point(point, techniques, field, err);
+    json_decref(point);
+    return ok;
+}
+
 /* Point p of a grid, exactly as it will be submitted; the error names the
  * combination ("vary", point 3: frames=2, capture_interval=5) and the job
  * field and rule it breaks. */
@@ -267,8 +292,11 @@ static bool check_combination(const struct sweep_spec *s, size_t p, const struct
 
 static bool workload_param(const char *path)
 {
+    /* reference.supersample too: scores against different references are
+     * never compared (the verdict's fronts are per workload), so each
+     * factor is a workload with its timed reference. */
     return strncmp(path, "scene.", 6) == 0 || strcmp(path, "frames") == 0 ||
-           strcmp(path, "warmup_frames") == 0;
+           strcmp(path, "warmup_frames") == 0 || strcmp(path, "reference.supersample") == 0;
 }
 
 /* One timed point of the reference technique per workload of the grid (see
@@ -283,6 +311,8 @@ static bool add_reference_points(struct sweep_spec *out, const json_t *body,
     if (json_is_false(flag))
         return true;
     json_t *r = json_object_get(out->base, "reference");
+    if (json_is_object(r)) /* {"technique", "supersample"}: the technique is what is timed */
+        r = json_object_get(r, "technique");
     const char *ref = json_is_string(r) ? json_string_value(r) : baseline(out->catalog);
     json_t *t = json_object_get(out->base, "technique");
     bool varied = false;
@@ -381,7 +411,8 @@ static bool parse_criterion(const char *text, struct sweep_spec *s, char *why, s
 {
     snprintf(s->criterion_text, sizeof(s->criterion_text), "%s", text);
     snprintf(why, whylen, "must be one of \"pdiff_pass\", \"stable\", \"finite\", "
-             "\"no_overflow\", \"ssim_min >= X\", \"flip_max <= X\"");
+             "\"no_overflow\", \"ssim >= X\", \"ssim_min >= X\", \"flip_max <= X\", "
+             "\"flicker_max <= X\"");
     int r;
     double x;
     if (strcmp(text, "pdiff_pass") == 0)
@@ -397,11 +428,23 @@ static bool parse_criterion(const char *text, struct sweep_spec *s, char *why, s
         if (r == 0)
             return false;
         s->criterion = CRITERION_SSIM_MIN, s->threshold = x;
+    } else if ((r = parse_threshold(text, "ssim", ">=", -1, 1, "SSIM's range", &x, why,
+                                    whylen)) >= 0) {
+        /* The mean SSIM over the frame (the thesis's figure), of the worst
+         * capture; "ssim_min" is its smallest local window. */
+        if (r == 0)
+            return false;
+        s->criterion = CRITERION_SSIM_MEAN, s->threshold = x;
     } else if ((r = parse_threshold(text, "flip_max", "<=", 0, 1, "FLIP's range", &x, why,
                                     whylen)) >= 0) {
         if (r == 0)
             return false;
         s->criterion = CRITERION_FLIP_MAX, s->threshold = x;
+    } else if ((r = parse_threshold(text, "flicker_max", "<=", 0, 1, "flicker's range", &x,
+                                    why, whylen)) >= 0) {
+        if (r == 0)
+            return false;
+        s->criterion = CRITERION_FLICKER_MAX, s->threshold = x;
     } else {
         return false;
     }
@@ -464,7 +507,7 @@ static bool parse_into(const json_t *body, const struct technique_catalog *techn
     json_t *base = json_object_get(body, "base");
     if (!json_is_object(base))
         return job_error_set(err, "base", "must be a job object");
-    if (!check_point(base, techniques, "base", err))
+    if (!check_as_point(base, techniques, "base", err))
         return false;
     json_t *vary = json_object_get(body, "vary"), *find = json_object_get(body, "find");
     if (!!vary == !!find)
@@ -497,7 +540,7 @@ static bool parse_into(const json_t *body, const struct technique_catalog *techn
                 snprintf(field, sizeof(field), "vary.%.*s[%zu]", (int)jf_utf8_prefix(key, 40),
                          key, i);
                 json_t *job = with_field(base, key, value);
-                bool ok = check_point(job, techniques, field, err);
+                bool ok = check_as_point(job, techniques, field, err);
                 json_decref(job);
                 if (!ok)
                     return false;
@@ -558,6 +601,13 @@ static bool parse_into(const json_t *body, const struct technique_catalog *techn
     char why[200];
     if (!parse_criterion(crit ? crit : "", out, why, sizeof(why)))
         return job_error_set(err, "find.while", "%s", why);
+    /* Flicker is measured over frames in a row at each capture, which the
+     * base job asks for. */
+    if (out->criterion == CRITERION_FLICKER_MAX && !json_object_get(base, "temporal"))
+        return job_error_set(err, "find.while", "\"flicker_max <= X\" needs base.temporal "
+                             "({\"frames\": K}, K from %d to %d): flicker is measured over K "
+                             "frames in a row at each capture", JOB_MIN_TEMPORAL_FRAMES,
+                             JOB_MAX_TEMPORAL_FRAMES);
     if (out->criterion == CRITERION_NO_OVERFLOW) {
         char list[200];
         technique_catalog_list(techniques, TECHNIQUE_BOUNDED_LIGHT_LISTS, list, sizeof(list));
@@ -621,6 +671,7 @@ json_t *sweep_point_job(const struct sweep_spec *s, size_t index, json_t **value
         }
         json_object_del(job, "reference");
         json_object_del(job, "metrics");
+        json_object_del(job, "temporal"); /* flicker is against a reference, too */
         json_object_set_new(job, "capture_interval", json_integer(0));
         return job;
     }
@@ -667,6 +718,14 @@ bool sweep_criterion_holds(const struct sweep_spec *s, const json_t *result)
     }
     case CRITERION_FLIP_MAX: {
         json_t *w = json_object_get(json_object_get(q, RK_WORST_FLIP), "max");
+        return w && json_number_value(w) <= s->threshold;
+    }
+    case CRITERION_SSIM_MEAN: {
+        json_t *w = json_object_get(json_object_get(q, RK_WORST_SSIM), "value");
+        return w && json_number_value(w) >= s->threshold;
+    }
+    case CRITERION_FLICKER_MAX: {
+        json_t *w = json_object_get(json_object_get(q, RK_WORST_FLICKER), "value");
         return w && json_number_value(w) <= s->threshold;
     }
     case CRITERION_STABLE:

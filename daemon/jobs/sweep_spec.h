@@ -20,7 +20,10 @@ enum sweep_kind { SWEEP_VARY, SWEEP_FIND };
 
 enum sweep_criterion { CRITERION_PDIFF_PASS, CRITERION_SSIM_MIN, CRITERION_FLIP_MAX, CRITERION_STABLE,
                        CRITERION_FINITE,     /* no capture had NaN or infinite HDR pixels */
-                       CRITERION_NO_OVERFLOW /* no light list overflowed, no shadow dropped */ };
+                       CRITERION_NO_OVERFLOW, /* no light list overflowed, no shadow dropped */
+                       CRITERION_SSIM_MEAN,   /* "ssim >= X": the worst capture's mean SSIM */
+                       CRITERION_FLICKER_MAX  /* "flicker_max <= X": the worst capture run's
+                                               * flicker (temporal.frames) */ };
 
 struct sweep_spec {
     enum sweep_kind kind;

@@ -262,6 +262,9 @@ static json_t *point_row(const json_t *job, json_t *values)
         json_object_set(row, RK_WORST_SSIM_MIN, json_object_get(json_object_get(q, RK_WORST_SSIM_MIN), "value"));
         json_object_set(row, RK_WORST_FLIP, json_object_get(json_object_get(q, RK_WORST_FLIP), "mean"));
         json_object_set(row, RK_PDIFF_FAILED_CAPTURES, json_object_get(q, RK_PDIFF_FAILED_CAPTURES));
+        json_t *flicker = json_object_get(json_object_get(q, RK_WORST_FLICKER), "value");
+        if (flicker) /* temporal.frames: the flicker_max criterion's figure */
+            json_object_set(row, RK_WORST_FLICKER, flicker);
     }
     /* Post hook: the worst capture's non-finite pixels, for breaking points. */
     json_t *nonfinite = json_object_get(r, RK_NONFINITE);

@@ -113,8 +113,86 @@ static void test_max_seconds(void)
     CHECK(parse("{\"timeout_s\":601}", &spec, &err) && spec.timeout_s == 601);
 }
 
+/* reference as {"technique", "supersample"} beside the shorthand, and
+ * temporal.frames: parsed strictly, written back, costed. */
+static void test_reference_temporal(void)
+{
+    struct job_spec spec;
+    struct job_error err;
+    CHECK(parse("{\"technique\":\"unlit\",\"frames\":4,\"capture_interval\":2,"
+                "\"reference\":\"forward\",\"scene\":{\"width\":64,\"height\":48}}", &spec, &err));
+    CHECK(spec.reference_supersample == 1 && spec.temporal_frames == 0);
+    json_t *j = job_spec_to_json(&spec);
+    CHECK(json_is_string(json_object_get(j, "reference")) && !json_object_get(j, "temporal"));
+    json_decref(j);
+    struct job_cost plain, ss;
+    job_cost_estimate(&spec, &plain);
+    CHECK(parse("{\"technique\":\"unlit\",\"frames\":4,\"capture_interval\":2,"
+                "\"reference\":{\"technique\":\"forward\",\"supersample\":4},"
+                "\"temporal\":{\"frames\":3},\"scene\":{\"width\":64,\"height\":48}}", &spec, &err));
+    CHECK(spec.reference_supersample == 4 && !strcmp(spec.reference, "forward") &&
+          spec.temporal_frames == 3 && spec.reference_index >= 0);
+    job_cost_estimate(&spec, &ss);
+    CHECK(ss.reference_bytes > plain.reference_bytes + 64.0 * 48 * 16 * 4 &&
+          ss.temporal_bytes == 64.0 * 48 * 4 * 5);
+    j = job_spec_to_json(&spec);
+    json_t *r = json_object_get(j, "reference");
+    CHECK(json_is_object(r) && json_integer_value(json_object_get(r, "supersample")) == 4 &&
+          !strcmp(json_string_value(json_object_get(r, "technique")), "forward"));
+    CHECK(json_integer_value(json_object_get(json_object_get(j, "temporal"), "frames")) == 3);
+    /* The spec as answered parses to the same job. */
+    struct job_spec again;
+    CHECK(job_spec_parse(j, techniques, &again, &err) && again.reference_supersample == 4 &&
+          again.temporal_frames == 3);
+    json_decref(j);
+    /* The object without a technique is the baseline's; supersample 1 is
+     * written back as the shorthand. */
+    CHECK(parse("{\"technique\":\"unlit\",\"frames\":4,\"capture_interval\":2,"
+                "\"reference\":{\"supersample\":1}}", &spec, &err));
+    CHECK(!strcmp(spec.reference, "forward") && spec.reference_supersample == 1);
+    j = job_spec_to_json(&spec);
+    CHECK(json_is_string(json_object_get(j, "reference")));
+    json_decref(j);
+    const char *base = "{\"technique\":\"unlit\",\"frames\":4,\"capture_interval\":2,";
+    char text[300];
+    static const struct {
+        const char *rest, *field;
+    } bad[] = {
+        {"\"reference\":{\"technique\":\"forward\",\"supersample\":5}}", "reference.supersample"},
+        {"\"reference\":{\"technique\":\"forward\",\"supersample\":0}}", "reference.supersample"},
+        {"\"reference\":{\"technique\":\"forward\",\"supersample\":2.5}}", "reference.supersample"},
+        {"\"reference\":{\"technique\":\"forward\",\"supersample\":\"4\"}}", "reference.supersample"},
+        {"\"reference\":{\"technique\":\"nope\"}}", "reference.technique"},
+        {"\"reference\":{\"technique\":null}}", "reference.technique"},
+        {"\"reference\":{\"technique\":\"forward\",\"samples\":4}}", "reference.samples"},
+        {"\"reference\":4}", "reference"},
+        {"\"reference\":\"forward\",\"temporal\":{\"frames\":1}}", "temporal.frames"},
+        {"\"reference\":\"forward\",\"temporal\":{\"frames\":17}}", "temporal.frames"},
+        {"\"reference\":\"forward\",\"temporal\":{}}", "temporal.frames"},
+        {"\"reference\":\"forward\",\"temporal\":{\"frames\":4,\"x\":1}}", "temporal.x"},
+        {"\"reference\":\"forward\",\"temporal\":4}", "temporal"},
+        {"\"temporal\":{\"frames\":4}}", "temporal"},
+    };
+    for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
+        snprintf(text, sizeof(text), "%s%s", base, bad[i].rest);
+        rejects(text, bad[i].field);
+    }
+    /* Past GL 4.5's guaranteed 16384 a side. */
+    rejects("{\"frames\":1,\"capture_interval\":1,\"reference\":{\"supersample\":4},"
+            "\"scene\":{\"width\":4097,\"height\":64}}", "reference.supersample");
+    CHECK(parse("{\"frames\":1,\"capture_interval\":1,\"reference\":{\"supersample\":4},"
+                "\"scene\":{\"width\":4096,\"height\":64}}", &spec, &err));
+    /* Over the memory a job may take, the supersampled reference is named. */
+    job_cost_set_memory_limit(64.0 * 1048576);
+    rejects("{\"technique\":\"unlit\",\"frames\":1,\"capture_interval\":1,\"reference\":"
+            "{\"technique\":\"forward\",\"supersample\":4},\"scene\":{\"width\":512,\"height\":512}}",
+            "reference.supersample");
+    job_cost_set_memory_limit(0);
+}
+
 int main(void)
 {
+    test_reference_temporal();
     struct job_spec spec;
     struct job_error err;
 

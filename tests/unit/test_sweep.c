@@ -250,6 +250,13 @@ int main(void)
         {"ssim_min >= 1e-310", "closer to 0", 0}, {"ssim_min >= 0.9x", "decimal", 0},
         {"ssim_min >= ", "decimal", 0}, {"ssim_min >= .", "decimal", 0},
         {"ssim_max >= 0.9", "one of", 0}, {"flip_max >= 0.1", "one of", 0},
+        /* The mean SSIM (the thesis's figure) beside its smallest window. */
+        {"ssim >= 0.99", NULL, 0.99}, {"ssim>=-0.5", NULL, -0.5}, {"ssim >= 1.5", "from -1 to 1", 0},
+        {"ssim >= nan", "decimal", 0}, {"ssim >= 0x1p-1", "decimal", 0},
+        {"ssim >= 1e-400", "closer to 0", 0}, {"ssim <= 0.9", "one of", 0},
+        {"ssim > 0.9", "one of", 0}, {"ssim_mean >= 0.9", "one of", 0},
+        /* flicker_max needs base.temporal, which this base lacks. */
+        {"flicker_max <= 0.01", "base.temporal", 0},
     };
     for (size_t i = 0; i < sizeof(whiles) / sizeof(whiles[0]); i++) {
         char text[256];
@@ -264,6 +271,120 @@ int main(void)
             CHECK(ok && s.threshold == whiles[i].x);
         if (ok != !whiles[i].rule || (!ok && !strstr(err.message, whiles[i].rule)))
             fprintf(stderr, "  for %s: %s\n", whiles[i].crit, ok ? "accepted" : err.message);
+        sweep_spec_finish(&s);
+    }
+    /* flicker_max over a base with temporal frames: strict as the others. */
+    static const struct {
+        const char *crit, *rule;
+        double x;
+    } flickers[] = {
+        {"flicker_max <= 0.01", NULL, 0.01}, {"flicker_max<=1", NULL, 1},
+        {"flicker_max <= 0", NULL, 0}, {"flicker_max <= 1.5", "from 0 to 1", 0},
+        {"flicker_max <= -0.1", "from 0 to 1", 0}, {"flicker_max <= inf", "decimal", 0},
+        {"flicker_max >= 0.1", "one of", 0}, {"flicker <= 0.1", "one of", 0},
+    };
+    for (size_t i = 0; i < sizeof(flickers) / sizeof(flickers[0]); i++) {
+        char text[300];
+        snprintf(text, sizeof(text), "{\"base\":{\"technique\":\"osl\",\"temporal\":"
+                 "{\"frames\":4}},\"find\":{\"param\":\"scene.light_speed\",\"from\":0,"
+                 "\"to\":9,\"while\":\"%s\"}}", flickers[i].crit);
+        struct sweep_spec s;
+        struct job_error err;
+        bool ok = parse(text, &s, &err);
+        if (flickers[i].rule)
+            CHECK(!ok && strcmp(err.field, "find.while") == 0 && strstr(err.message, flickers[i].rule));
+        else
+            CHECK(ok && s.criterion == CRITERION_FLICKER_MAX && s.threshold == flickers[i].x);
+        if (ok != !flickers[i].rule || (!ok && !strstr(err.message, flickers[i].rule)))
+            fprintf(stderr, "  for %s: %s\n", flickers[i].crit, ok ? "accepted" : err.message);
+        sweep_spec_finish(&s);
+    }
+    /* The criteria read the worst capture's mean SSIM and flicker. */
+    {
+        struct sweep_spec s;
+        struct job_error err;
+        CHECK(parse("{\"base\":{},\"find\":{\"param\":\"scene.light_speed\",\"from\":0,"
+                    "\"to\":9,\"while\":\"ssim >= 0.98\"}}", &s, &err));
+        CHECK(s.criterion == CRITERION_SSIM_MEAN);
+        json_t *r = json_pack("{s:{s:{s:f}, s:{s:f}}}", "quality", "worst_ssim", "value", 0.985,
+                              "worst_ssim_min", "value", 0.5);
+        CHECK(sweep_criterion_holds(&s, r)); /* the mean, not the smallest window */
+        json_decref(r);
+        r = json_pack("{s:{s:{s:f}, s:{s:f}}}", "quality", "worst_ssim", "value", 0.97,
+                      "worst_ssim_min", "value", 0.99);
+        CHECK(!sweep_criterion_holds(&s, r));
+        json_decref(r);
+        r = json_pack("{s:{}}", "quality");
+        CHECK(!sweep_criterion_holds(&s, r));
+        json_decref(r);
+        sweep_spec_finish(&s);
+        CHECK(parse("{\"base\":{\"temporal\":{\"frames\":3}},\"find\":{\"param\":"
+                    "\"scene.light_speed\",\"from\":0,\"to\":9,\"while\":\"flicker_max <= 0.02\"}}",
+                    &s, &err));
+        r = json_pack("{s:{s:{s:f, s:i}}}", "quality", "worst_flicker", "value", 0.01, "frame", 5);
+        CHECK(sweep_criterion_holds(&s, r));
+        json_decref(r);
+        r = json_pack("{s:{s:{s:f, s:i}}}", "quality", "worst_flicker", "value", 0.03, "frame", 5);
+        CHECK(!sweep_criterion_holds(&s, r));
+        json_decref(r);
+        r = json_pack("{s:{}}", "quality"); /* no flicker measured: does not hold */
+        CHECK(!sweep_criterion_holds(&s, r));
+        json_decref(r);
+        /* Probes carry the base's temporal frames. */
+        json_t *probe = sweep_probe_job(&s, 4.5);
+        CHECK(json_integer_value(json_object_get(json_object_get(probe, "temporal"), "frames")) == 3);
+        json_decref(probe);
+        sweep_spec_finish(&s);
+    }
+    /* reference.supersample and temporal.frames are sweep axes; over the
+     * shorthand "reference": "forward" the name is kept. */
+    {
+        struct sweep_spec s;
+        struct job_error err;
+        CHECK(parse("{\"base\":{\"technique\":\"unlit\",\"reference\":\"forward\","
+                    "\"frames\":4,\"capture_interval\":4},\"vary\":{\"reference.supersample\":[1,2,4]}}", &s, &err));
+        CHECK(s.ngrid == 3);
+        json_t *values, *job = sweep_point_job(&s, 2, &values);
+        json_t *ref = json_object_get(job, "reference");
+        CHECK(json_is_object(ref) &&
+              !strcmp(json_string_value(json_object_get(ref, "technique")), "forward") &&
+              json_integer_value(json_object_get(ref, "supersample")) == 4);
+        struct job_spec spec;
+        CHECK(job_spec_parse(job, techniques, &spec, &err) && spec.reference_supersample == 4 &&
+              !strcmp(spec.reference, "forward"));
+        json_decref(job);
+        json_decref(values);
+        sweep_spec_finish(&s);
+        /* Over a base without a reference: the baseline's, supersampled. */
+        CHECK(parse("{\"base\":{\"technique\":\"unlit\",\"frames\":4},"
+                    "\"find\":{\"param\":\"reference.supersample\",\"from\":1,\"to\":4,"
+                    "\"while\":\"ssim >= 0.9\"}}", &s, &err));
+        job = sweep_probe_job(&s, 2);
+        CHECK(job_spec_parse(job, techniques, &spec, &err) && spec.reference_supersample == 2 &&
+              !strcmp(spec.reference, "forward"));
+        json_decref(job);
+        sweep_spec_finish(&s);
+        json_t *sweepable = sweep_params_json(techniques);
+        CHECK(json_object_get(sweepable, "reference.supersample") &&
+              json_object_get(sweepable, "temporal.frames"));
+        json_decref(sweepable);
+    }
+    rejects("{\"base\":{\"reference\":\"forward\",\"capture_interval\":5},\"vary\":{\"reference.supersample\":[2,5]}}",
+            "vary.reference.supersample[1]");
+    rejects("{\"base\":{},\"vary\":{\"temporal.frames\":[1]}}", "vary.temporal.frames[0]");
+    /* A base is checked as its points run (the baseline as reference,
+     * captures at the last frame), so temporal needs no more than that. */
+    {
+        struct sweep_spec s;
+        struct job_error err;
+        CHECK(parse("{\"base\":{\"technique\":\"osl\",\"frames\":6,\"temporal\":{\"frames\":3}},"
+                    "\"vary\":{\"scene.lights\":[2,4]}}", &s, &err));
+        json_t *values, *job = sweep_point_job(&s, 1, &values);
+        struct job_spec spec;
+        CHECK(job_spec_parse(job, techniques, &spec, &err) && spec.temporal_frames == 3 &&
+              !strcmp(spec.reference, "forward") && spec.capture_interval == 6);
+        json_decref(job);
+        json_decref(values);
         sweep_spec_finish(&s);
     }
     return check_finish("test_sweep");

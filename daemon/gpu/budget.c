@@ -33,8 +33,6 @@ void gpu_budget_init(struct gpu_budget *b, bool (*stop)(void *ctx), void *ctx)
     b->stop = stop;
     b->ctx = ctx;
     b->loop_slot = -1;
-    for (int i = 0; i < GPU_BUDGET_KEYS; i++)
-        b->piece[i].key = -1;
 }
 
 static bool should_stop(struct gpu_budget *b)
@@ -68,46 +66,72 @@ bool gpu_budget_sync(struct gpu_budget *b)
     return gpu_budget_wait(b, glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0));
 }
 
-static struct gpu_budget_piece *piece(struct gpu_budget *b, int key, int *slot)
+/* The call's count from its site in this frame. */
+static int nth_call(struct gpu_budget *b, const char *site)
 {
-    int free_slot = -1;
+    for (int i = 0; i < b->nseen; i++)
+        if (b->seen[i].site == site)
+            return b->seen[i].calls++;
+    if (b->nseen < GPU_BUDGET_KEYS)
+        b->seen[b->nseen++] = (struct gpu_budget_site){.site = site, .calls = 1};
+    return 0;
+}
+
+static struct gpu_budget_piece *piece(struct gpu_budget *b, const char *site, int *slot)
+{
+    int nth = nth_call(b, site), free_slot = -1;
     for (int i = 0; i < GPU_BUDGET_KEYS; i++) {
-        if (b->piece[i].key == key) {
+        if (b->piece[i].site == site && b->piece[i].nth == nth) {
             *slot = i;
             return &b->piece[i];
         }
-        if (b->piece[i].key < 0 && free_slot < 0)
+        if (!b->piece[i].site && free_slot < 0)
             free_slot = i;
     }
     /* More pieces than slots: the last one is shared, measured as one. */
     *slot = free_slot >= 0 ? free_slot : GPU_BUDGET_KEYS - 1;
     struct gpu_budget_piece *p = &b->piece[*slot];
     if (free_slot >= 0)
-        *p = (struct gpu_budget_piece){.key = key, .whole_s = -1.0};
+        *p = (struct gpu_budget_piece){.site = site, .nth = nth, .unit_s = -1.0,
+                                       .whole_s = -1.0};
     return p;
 }
 
-static bool cheap(const struct gpu_budget_piece *p)
+/* What a run of the piece over `units` pixels or items should cost, from
+ * its first run; < 0 before that. */
+static double estimate_s(const struct gpu_budget_piece *p, double units)
+{
+    return p->unit_s < 0.0 ? -1.0 : p->unit_s * units;
+}
+
+static bool cheap(const struct gpu_budget_piece *p, double units)
+{
+    double s = estimate_s(p, units);
+    return s >= 0.0 && s < free_s;
+}
+
+static bool loop_cheap(const struct gpu_budget_piece *p)
 {
     return p->whole_s >= 0.0 && p->whole_s < free_s;
 }
 
-void gpu_tiles_begin(struct gpu_budget *b, int w, int h, struct gpu_tiles *t)
+void gpu_tiles_begin_at(struct gpu_budget *b, const char *site, int w, int h,
+                        struct gpu_tiles *t)
 {
     *t = (struct gpu_tiles){.slot = -1, .w = w, .h = h, .first = true, .tw = w, .th = h};
     if (!b || b->stopped)
         return;
-    struct gpu_budget_piece *p = piece(b, b->next_key++, &t->slot);
-    t->sliced = !cheap(p);
+    struct gpu_budget_piece *p = piece(b, site, &t->slot);
+    t->sliced = !cheap(p, (double)w * h);
     /* Measured alone: what earlier passes left in flight is not its cost. */
-    if (t->sliced && p->whole_s < 0.0)
+    if (t->sliced && p->unit_s < 0.0)
         gpu_budget_sync(b);
     t->prev_done = clock_mono_s();
 }
 
-void gpu_range_begin(struct gpu_budget *b, int n, struct gpu_tiles *t)
+void gpu_range_begin_at(struct gpu_budget *b, const char *site, int n, struct gpu_tiles *t)
 {
-    gpu_tiles_begin(b, n, 1, t);
+    gpu_tiles_begin_at(b, site, n, 1, t);
     t->range = true;
 }
 
@@ -165,7 +189,7 @@ bool gpu_tiles_next(struct gpu_budget *b, struct gpu_tiles *t)
         t->done = true;
         /* The piece's first run waits for its last tiles, to learn its whole
          * cost; later runs leave them queued. */
-        bool measure = go && p->whole_s < 0.0;
+        bool measure = go && p->unit_s < 0.0;
         while (t->in_flight > 0) {
             if (measure) {
                 go = retire(b, p, t) && go;
@@ -176,14 +200,15 @@ bool gpu_tiles_next(struct gpu_budget *b, struct gpu_tiles *t)
                 t->in_flight--;
             }
         }
-        if (measure && go)
-            p->whole_s = t->total_s;
+        if (measure && go && (double)t->w * t->h > 0)
+            p->unit_s = t->total_s / ((double)t->w * t->h);
         b->pieces_sliced += t->tiles > 1;
         return false;
     }
     /* Equal tiles, as many as the piece's cost measured whole asks for
      * (MEASURE_TILES on its first run, while it is measured). */
-    double n = p->whole_s < 0.0 ? MEASURE_TILES : ceil(p->whole_s / slice_s);
+    double whole = estimate_s(p, (double)t->w * t->h);
+    double n = whole < 0.0 ? MEASURE_TILES : ceil(whole / slice_s);
     if (n < 1.0 / max_fraction)
         n = ceil(1.0 / max_fraction);
     double want = ceil((double)t->w * t->h / n);
@@ -218,13 +243,13 @@ bool gpu_tiles_next(struct gpu_budget *b, struct gpu_tiles *t)
     return true;
 }
 
-void gpu_loop_begin(struct gpu_budget *b)
+void gpu_loop_begin_at(struct gpu_budget *b, const char *site)
 {
     if (!b)
         return;
-    struct gpu_budget_piece *p = piece(b, b->next_key++, &b->loop_slot);
+    struct gpu_budget_piece *p = piece(b, site, &b->loop_slot);
     b->loop_calls = 0;
-    if (cheap(p)) {
+    if (loop_cheap(p)) {
         p->every = INT_MAX;
         return;
     }

@@ -31,10 +31,18 @@
 /* Pieces (tile loops, checkpoint loops) one run may tell apart. */
 #define GPU_BUDGET_KEYS 128
 
+/* A piece is a call site of gpu_tiles_begin, gpu_range_begin or
+ * gpu_loop_begin and its nth call from there in a frame: a pass that some
+ * frames skip (OSL's reshading with still lights) does not shift the pieces
+ * after it onto another's measure. */
 struct gpu_budget_piece {
-    int key;        /* caller's id, -1 for an unused slot */
-    double whole_s; /* the last whole run of the piece, seconds; < 0 before one */
-    int every;      /* checkpoints: calls between waits */
+    const char *site; /* __FILE__:__LINE__ of the call; NULL for an unused slot */
+    int nth;          /* its calls from there before it in the frame */
+    double unit_s;    /* tiles and ranges: the first run's seconds per pixel or item,
+                       * so that the estimate follows the work a run is given; < 0
+                       * before one */
+    double whole_s;   /* loops: the last whole run, seconds; < 0 before one */
+    int every;        /* checkpoints: calls between waits */
 };
 
 struct gpu_budget {
@@ -47,7 +55,12 @@ struct gpu_budget {
     int64_t waits;  /* fences waited for, in all */
     int64_t pieces_sliced; /* runs of a piece drawn in more than one tile or chunk */
     struct gpu_budget_piece piece[GPU_BUDGET_KEYS];
-    int next_key;   /* pieces are told apart by their order in a frame */
+    /* Calls from each site so far in this frame. */
+    struct gpu_budget_site {
+        const char *site;
+        int calls;
+    } seen[GPU_BUDGET_KEYS];
+    int nseen;
     /* checkpoint loop in progress */
     int loop_slot, loop_calls;
     double loop_t0;
@@ -61,14 +74,17 @@ void gpu_budget_init(struct gpu_budget *b, bool (*stop)(void *ctx), void *ctx);
 void gpu_budget_configure(double slice_s, double free_s, double largest_fraction);
 /* The slice and the bound below which a piece runs whole, as configured. */
 void gpu_budget_limits(double *slice_s, double *free_s);
-/* At the start of each frame (and of each set-up that draws): the pieces
- * that follow are numbered from 0 again, so that the nth piece of every
+/* At the start of each frame (and of each set-up that draws): each site's
+ * calls are counted from 0 again, so that the nth call from a site in every
  * frame is the same piece of work. */
 static inline void gpu_budget_frame(struct gpu_budget *b)
 {
     if (b)
-        b->next_key = 0;
+        b->nseen = 0;
 }
+#define GPU_BUDGET_STR_(x) #x
+#define GPU_BUDGET_STR(x) GPU_BUDGET_STR_(x)
+#define GPU_BUDGET_SITE __FILE__ ":" GPU_BUDGET_STR(__LINE__)
 static inline bool gpu_budget_stopped(const struct gpu_budget *b) { return b && b->stopped; }
 
 /* Waits for fence (deleting it), asking stop every few milliseconds. False
@@ -97,18 +113,22 @@ struct gpu_tiles {
     int tiles;     /* drawn so far */
     double cur_submit, prev_done, total_s;
 };
-void gpu_tiles_begin(struct gpu_budget *b, int w, int h, struct gpu_tiles *t);
+void gpu_tiles_begin_at(struct gpu_budget *b, const char *site, int w, int h,
+                        struct gpu_tiles *t);
+#define gpu_tiles_begin(b, w, h, t) gpu_tiles_begin_at((b), GPU_BUDGET_SITE, (w), (h), (t))
 bool gpu_tiles_next(struct gpu_budget *b, struct gpu_tiles *t);
 /* The same over a range of n work items (w = n, h = 1) that is not drawn,
  * such as a compute dispatch's groups: the body reads [t.tx, t.tx + t.tw),
  * and the scissor is left alone. */
-void gpu_range_begin(struct gpu_budget *b, int n, struct gpu_tiles *t);
+void gpu_range_begin_at(struct gpu_budget *b, const char *site, int n, struct gpu_tiles *t);
+#define gpu_range_begin(b, n, t) gpu_range_begin_at((b), GPU_BUDGET_SITE, (n), (t))
 
 /* Checkpoints in a loop of many draws or dispatches: gpu_loop_begin before
  * it, gpu_loop_step after each iteration (false: stopped, leave the loop),
  * gpu_loop_end after it. Between waits, as many iterations as keep the GPU
  * work near GPU_BUDGET_SLICE_S. */
-void gpu_loop_begin(struct gpu_budget *b);
+void gpu_loop_begin_at(struct gpu_budget *b, const char *site);
+#define gpu_loop_begin(b) gpu_loop_begin_at((b), GPU_BUDGET_SITE)
 bool gpu_loop_step(struct gpu_budget *b);
 void gpu_loop_end(struct gpu_budget *b);
 

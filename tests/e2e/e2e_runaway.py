@@ -15,6 +15,11 @@ cancel, timeout and SIGTERM act within about a second.
   frames, saying why, not when the time has run out; the 202 states the
   work a job asks for; --max-job-seconds refuses a larger timeout_s naming
   it and caps the default;
+- a piece is measured once, and the pieces after one that a frame skips
+  keep their own measure: OSL's first shading of every texel (seconds) is
+  drawn in tiles, the frames after it, which reshade nothing, are not
+  (they took the shading's measure and were drawn in tiles, 10 times
+  slower);
 - drawing in tiles changes no pixel: a daemon that slices everything into
   pieces of 2 ms (SHADEBENCH_SLICE_MS=2) renders every technique,
   the post effects and the look byte for byte as one that does not, and says
@@ -88,6 +93,16 @@ try:
           "frame 1" in err and "shading pass" in err and took < 1 + 1.0 * S,
           "timeout_s 1 stops a frame of seconds %.2f s after the job started: %s" % (took, err))
     next_job_is_quick(d, "a timeout")
+
+    # OSL at 256 texels with still lights: the first frame shades 33.5
+    # million texels (seconds on llvmpipe, in tiles), the others nothing; the
+    # raster pass after it must keep its own measure, not the shading's.
+    done = d.run({"technique": "osl", "frames": 12, "warmup_frames": 1,
+                  "scene": {"width": 64, "height": 48}})
+    sliced = done.get("result", {}).get("gpu_budget", {}).get("pieces_sliced", -1)
+    check(done.get("status") == "done" and 0 <= sliced <= 3,
+          "OSL's frames after its first shading are drawn whole: %d runs sliced in 13 frames"
+          % sliced)
 
     # A job that cannot finish in time fails at once: 1,000 frames of about
     # 0.2 s each (0.7 s under load) against 30 s.

@@ -23,13 +23,14 @@ import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
 import testlib  # noqa: E402
+import benchrun  # noqa: E402
 
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument("--counts", default="16,256,4096", help="comma-separated light counts")
 ap.add_argument("--techniques", default="forward,unlit")
 ap.add_argument("--frames", type=int, default=3)
 ap.add_argument("--warmup", type=int, default=1)
-ap.add_argument("--repeat", type=int, default=1)
+ap.add_argument("--repeat", type=int, default=2)
 ap.add_argument("--width", type=int, default=1080)
 ap.add_argument("--height", type=int, default=720)
 ap.add_argument("--json", help="write every result here")
@@ -39,13 +40,15 @@ counts = [int(c) for c in args.counts.split(",")]
 techniques = args.techniques.split(",")
 results = {(t, n): [] for t in techniques for n in counts}
 
+bench = benchrun.Run()
 d = testlib.Daemon()
 try:
     info = d.json("GET", "/v1/info")[1]["device"]
     print("device: %s | %s | %s" % (info["gl_renderer"], info["gl_version"], info["egl_device"]))
     print("scene: lights preset %dx%d, %d timed frames after %d warm-up, %d repeat(s)\n"
           % (args.width, args.height, args.frames, args.warmup, args.repeat))
-    described = None
+    bench.start()
+    print()
     for rep in range(args.repeat):
         for n in counts:
             for t in techniques:
@@ -65,6 +68,7 @@ try:
 finally:
     d.stop()
     d.cleanup()
+bench.end([r for rs in results.values() for r in rs])
 
 
 def med(t, n, series="frame_ms"):

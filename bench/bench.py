@@ -10,7 +10,8 @@ Figures are measured on whatever GL device the daemon picks (shown first).
 On llvmpipe, GL_TIME_ELAPSED covers rasterization only (vertex work and
 compute shaders run outside the query on the CPU), so frame_ms (the
 present-to-present interval) is the figure to compare there; on a GPU both
-are meaningful."""
+are meaningful. The run's commit, command, date and load (/proc/loadavg at
+the start and the end, and the jobs' result.interference) are printed."""
 
 import argparse
 import json
@@ -23,6 +24,7 @@ import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
 import testlib  # noqa: E402
+import benchrun  # noqa: E402
 
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument("--frames", type=int, default=60)
@@ -55,6 +57,7 @@ def job_for(extra, dyn):
     return job
 
 
+bench = benchrun.Run()
 d = testlib.Daemon()
 results = {name: [] for name, _, _ in CONFIGS}
 overhead = {"http": [], "once": []}
@@ -63,6 +66,8 @@ try:
     print("device: %s | %s | %s" % (info["gl_renderer"], info["gl_version"], info["egl_device"]))
     print("scene: grid %dx%d, %d timed frames after %d warm-up, %d repeats\n"
           % (args.width, args.height, args.frames, args.warmup, args.repeat))
+    bench.start()
+    print()
     for rep in range(args.repeat):
         for name, extra, dyn in CONFIGS:
             t0 = time.time()
@@ -89,6 +94,7 @@ try:
 finally:
     d.stop()
     d.cleanup()
+bench.end([r for rs in results.values() for r in rs] + overhead["http"])
 
 
 def med(runs, series):

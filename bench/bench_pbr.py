@@ -80,9 +80,17 @@ def paired(a, b, f=lambda r: r["frame_ms"]["median"]):
     return [f(y) / f(x) for x, y in zip(a, b)]
 
 
-def ratio_cell(a, b):
-    rs = paired(a, b)
-    r = med(b) / med(a)
+def work_ms(r):
+    """CPU milliseconds all the daemon's threads took per timed frame
+    (result.interference): on llvmpipe, where all the work is on the CPU,
+    the cost that other processes' load does not inflate."""
+    i = r.get("interference", {})
+    return i.get("daemon_cpu_share", 0) * i.get("cpus", 1) * i.get("interval_s", 0) * 1e3 / r["frames"]
+
+
+def ratio_cell(a, b, f=lambda r: r["frame_ms"]["median"]):
+    rs = paired(a, b, f)
+    r = med(b, f) / med(a, f)
     return "%.2f (%.2f-%.2f)" % (r, min(rs), max(rs)) if len(rs) > 1 else "%.2f" % r
 
 
@@ -150,6 +158,15 @@ if counts:
         cells = ["%.1f [%.1f]" % (med(tech[(t, n)]), med(tech[(t, n)], lambda r: r["gpu_ms"]["median"]))
                  for t in techniques]
         ratios = [ratio_cell(tech[(techniques[0], n)], tech[(t, n)]) for t in techniques[1:]]
+        print("| %d | %s | %s |" % (n, " | ".join(cells), " | ".join(ratios)))
+    print("\nThe same on cpu_work_ms (the CPU time all the daemon's threads took per timed frame, "
+          "from result.interference; medians over repeats)\n")
+    print("| lights | " + " | ".join(techniques) + " | " +
+          " | ".join("%s / %s" % (t, techniques[0]) for t in techniques[1:]) + " |")
+    print("|---|" + "---|" * (2 * len(techniques) - 1))
+    for n in counts:
+        cells = ["%.1f" % med(tech[(t, n)], work_ms) for t in techniques]
+        ratios = [ratio_cell(tech[(techniques[0], n)], tech[(t, n)], work_ms) for t in techniques[1:]]
         print("| %d | %s | %s |" % (n, " | ".join(cells), " | ".join(ratios)))
 
 if shadow_counts:

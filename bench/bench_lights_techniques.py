@@ -9,7 +9,12 @@ count.
 
   bench/bench_lights_techniques.py [--counts 16,64,256,1024,4096,16384]
       [--frames N] [--warmup N] [--repeat R] [--width W --height H]
-      [--forward-max N] [--techniques a,b,...] [--svg FILE] [--json FILE]
+      [--forward-max N] [--techniques a,b,...] [--variant NAME=TECH:JSON ...]
+      [--svg FILE] [--json FILE]
+
+--variant names a technique with options, usable in --techniques: e.g.
+--variant 'td8=tiled_deferred:{"tile_size": 8}' --techniques unlit,td8,...
+(tiled_deferred_cpu is built in: tiled deferred with CPU binning).
 
 Forward walks every light for every fragment: on llvmpipe at 1080x720 it
 takes about 10 s a frame at 1,024 lights and 40 s at 4,096. Above
@@ -58,6 +63,8 @@ ap.add_argument("--width", type=int, default=1080)
 ap.add_argument("--height", type=int, default=720)
 ap.add_argument("--forward-max", type=int, default=1024, help="largest count forward runs at")
 ap.add_argument("--svg", default="bench-lights-techniques.svg", help="chart file ('' for none)")
+ap.add_argument("--variant", action="append", default=[],
+                help="NAME=TECHNIQUE:JSON, a technique with options (repeatable)")
 ap.add_argument("--json", help="write every result here")
 ap.add_argument("--from-json", help="report on the results a --json run wrote, without running")
 args = ap.parse_args()
@@ -66,6 +73,12 @@ counts = [int(c) for c in args.counts.split(",")]
 names = args.techniques.split(",")
 # Variants by name: technique and its options.
 VARIANTS = {"tiled_deferred_cpu": ("tiled_deferred", {"binning": "cpu"})}
+for v in args.variant:
+    vname, _, rest = v.partition("=")
+    vtech, _, vopts = rest.partition(":")
+    if not vname or not vtech:
+        sys.exit("--variant %r: expected NAME=TECHNIQUE:JSON" % v)
+    VARIANTS[vname] = (vtech, json.loads(vopts) if vopts else None)
 
 
 def job_for(name, n):

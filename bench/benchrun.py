@@ -24,7 +24,10 @@ def _commit():
     try:
         head = subprocess.run(["git", "-C", _ROOT, "rev-parse", "--short", "HEAD"],
                               capture_output=True, text=True, check=True).stdout.strip()
-        dirty = subprocess.run(["git", "-C", _ROOT, "status", "--porcelain", "--untracked-files=no"],
+        # What the figures depend on: the code, the build and the benches (not the docs).
+        dirty = subprocess.run(["git", "-C", _ROOT, "status", "--porcelain", "--untracked-files=no",
+                                "--", "daemon", "client", "common", "shaders", "bench", "tests",
+                                "configure.ac", "Makefile.am"],
                                capture_output=True, text=True, check=True).stdout.strip()
         return head + (" (with uncommitted changes)" if dirty else "")
     except (OSError, subprocess.CalledProcessError):

@@ -12,7 +12,7 @@
   bench/bench_pbr.py [--frames N] [--warmup N] [--repeat R] [--width W --height H]
                      [--lights 8,80,800] [--shadow-lights 4,8,16]
                      [--resolutions 16,32,64,128,256] [--only techniques,shadows,ibl]
-                     [--json FILE]
+                     [--json FILE] [--from-json FILE]
 
 Every configuration runs once per repeat, all of them in each repeat
 (A, B, C, A, B, C, ...), on one daemon; the tables give the medians over the
@@ -49,6 +49,8 @@ ap.add_argument("--shadow-tile", type=int, default=64)
 ap.add_argument("--resolutions", default="16,32,64,128,256")
 ap.add_argument("--teapot-segments", type=int, default=8)
 ap.add_argument("--json", help="write every result here")
+ap.add_argument("--from-json", help="report again on the results a --json run wrote, without running "
+                "(give the same --lights, --shadow-lights, --resolutions and --only)")
 args = ap.parse_args()
 
 scene = {"preset": "teapots", "width": args.width, "height": args.height,
@@ -111,41 +113,59 @@ tech = {(t, n): [] for t in techniques for n in counts}
 shadow = {(name, n): [] for name, _ in layouts for n in shadow_counts}
 ibl = {res: [] for res in resolutions}
 
-bench = benchrun.Run()
-d = testlib.Daemon()
-try:
-    info = d.json("GET", "/v1/info")[1]["device"]
-    print("device: %s | %s | %s" % (info["gl_renderer"], info["gl_version"], info["egl_device"]))
-    print("teapots %dx%d, %d segments a patch edge, %d timed frames after %d warm-up, %d repeats"
-          % (args.width, args.height, args.teapot_segments, args.frames, args.warmup, args.repeat))
-    bench.start()
-    print()
-    for rep in range(args.repeat):
-        # 1. Techniques against light count, physically based.
-        for n in counts:
-            for t in techniques:
-                tech[(t, n)].append(run(d, dict(timing, technique=t, look={"lighting": "pbr"},
-                                                scene=dict(scene, lights=n)),
-                                        "%s, %d lights" % (t, n), rep))
-        # 2. Shadow cost per light: atlas against one cube map per light.
-        for n in shadow_counts:
-            for name, opts in layouts:
-                look = {"lighting": "pbr", "shadows": False}
-                if isinstance(opts, dict):
-                    look["shadows"] = dict(opts, atlas=4096)
-                shadow[(name, n)].append(run(d, dict(timing, technique="forward", look=look,
-                                                     scene=dict(scene, lights=n)),
-                                             "shadows %s, %d lights" % (name, n), rep))
-        # 3. Image-based lighting's setup against probe resolution.
-        for res in resolutions:
-            ibl[res].append(run(d, dict(timing, frames=1, warmup_frames=0, technique="forward",
-                                        look={"lighting": "pbr", "ibl": {"probes": 3, "resolution": res}},
-                                        scene=dict(scene, lights=8)),
-                                "ibl, 3 probes at %d" % res, rep))
-finally:
-    d.stop()
-    d.cleanup()
-bench.end([e["result"] for e in everything])
+if args.from_json:
+    with open(args.from_json) as f:
+        everything = json.load(f)
+    labels = {}
+    for n in counts:
+        for t in techniques:
+            labels["%s, %d lights" % (t, n)] = tech[(t, n)]
+    for n in shadow_counts:
+        for name, _ in layouts:
+            labels["shadows %s, %d lights" % (name, n)] = shadow[(name, n)]
+    for res in resolutions:
+        labels["ibl, 3 probes at %d" % res] = ibl[res]
+    for e in everything:
+        if e["label"] in labels:
+            labels[e["label"]].append(e["result"])
+    args.repeat = max(len(v) for v in labels.values())
+    print("report on %s (%d repeats)" % (args.from_json, args.repeat))
+else:
+    bench = benchrun.Run()
+    d = testlib.Daemon()
+    try:
+        info = d.json("GET", "/v1/info")[1]["device"]
+        print("device: %s | %s | %s" % (info["gl_renderer"], info["gl_version"], info["egl_device"]))
+        print("teapots %dx%d, %d segments a patch edge, %d timed frames after %d warm-up, %d repeats"
+              % (args.width, args.height, args.teapot_segments, args.frames, args.warmup, args.repeat))
+        bench.start()
+        print()
+        for rep in range(args.repeat):
+            # 1. Techniques against light count, physically based.
+            for n in counts:
+                for t in techniques:
+                    tech[(t, n)].append(run(d, dict(timing, technique=t, look={"lighting": "pbr"},
+                                                    scene=dict(scene, lights=n)),
+                                            "%s, %d lights" % (t, n), rep))
+            # 2. Shadow cost per light: atlas against one cube map per light.
+            for n in shadow_counts:
+                for name, opts in layouts:
+                    look = {"lighting": "pbr", "shadows": False}
+                    if isinstance(opts, dict):
+                        look["shadows"] = dict(opts, atlas=4096)
+                    shadow[(name, n)].append(run(d, dict(timing, technique="forward", look=look,
+                                                         scene=dict(scene, lights=n)),
+                                                 "shadows %s, %d lights" % (name, n), rep))
+            # 3. Image-based lighting's setup against probe resolution.
+            for res in resolutions:
+                ibl[res].append(run(d, dict(timing, frames=1, warmup_frames=0, technique="forward",
+                                            look={"lighting": "pbr", "ibl": {"probes": 3, "resolution": res}},
+                                            scene=dict(scene, lights=8)),
+                                    "ibl, 3 probes at %d" % res, rep))
+    finally:
+        d.stop()
+        d.cleanup()
+    bench.end([e["result"] for e in everything])
 
 if counts:
     print("\n1. Physically based shading on teapots (frame_ms, median over %d repeats of the job "
@@ -170,25 +190,29 @@ if counts:
         print("| %d | %s | %s |" % (n, " | ".join(cells), " | ".join(ratios)))
 
 if shadow_counts:
-    print("\n2. Shadow cost per light (forward, PBR): frame_ms (median over repeats), the shadows "
-          "pass's gpu_ms, (frame - no shadows) / lights mapped, and cubes / atlas (ratio of the "
-          "medians, range paired in each repeat)\n")
-    print("| lights | layout | frame_ms | shadows pass gpu_ms | lights mapped | faces | ms per light "
-          "| atlas texels used | / atlas, tile %d |" % args.shadow_tile)
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("\n2. Shadow cost per light (forward, PBR): frame_ms and cpu_work_ms (medians over repeats), "
+          "the shadows pass's gpu_ms, (frame - no shadows) / lights mapped on each, and each layout "
+          "against the atlas with tile %d (ratio of the medians, range paired in each repeat)\n"
+          % args.shadow_tile)
+    print("| lights | layout | frame_ms | cpu_work_ms | shadows pass gpu_ms | lights mapped | faces "
+          "| ms per light (frame) | ms per light (cpu_work) | atlas texels used | frame / atlas "
+          "| cpu_work / atlas |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for n in shadow_counts:
-        base = med(shadow[("none", n)])
+        base, wbase = med(shadow[("none", n)]), med(shadow[("none", n)], work_ms)
         atlas = shadow[(layouts[1][0], n)]
         for name, _ in layouts:
             rs = shadow[(name, n)]
             sh = rs[0].get("shadows", {})
             mapped = sh.get("lights_mapped", {}).get("mean", 0)
-            per = (med(rs) - base) / mapped if mapped else 0.0
-            print("| %d | %s | %.1f | %.1f | %.1f | %.0f | %s | %s | %s |"
-                  % (n, name, med(rs), med(rs, lambda r: section(r, "shadows")), mapped,
-                     sh.get("faces_per_frame", 0), "%.2f" % per if mapped else "-",
+            per = "%.2f" % ((med(rs) - base) / mapped) if mapped else "-"
+            wper = "%.2f" % ((med(rs, work_ms) - wbase) / mapped) if mapped else "-"
+            print("| %d | %s | %.1f | %.1f | %.1f | %.1f | %.0f | %s | %s | %s | %s | %s |"
+                  % (n, name, med(rs), med(rs, work_ms), med(rs, lambda r: section(r, "shadows")), mapped,
+                     sh.get("faces_per_frame", 0), per, wper,
                      "%.0f" % sh.get("atlas_use", {}).get("texels_mean", 0) if sh else "-",
-                     ratio_cell(atlas, rs) if name != "none" else "-"))
+                     ratio_cell(atlas, rs) if name != "none" else "-",
+                     ratio_cell(atlas, rs, work_ms) if name != "none" else "-"))
 
 if resolutions:
     print("\n3. Image-based lighting setup (3 probes + the environment), wall ms, medians over "
@@ -205,6 +229,6 @@ if resolutions:
               % (res, i["prefiltered_levels"], setup("capture"), setup("filter"), setup("brdf_table"),
                  setup("total"), i["bytes"]))
 
-if args.json:
+if args.json and not args.from_json:
     with open(args.json, "w") as f:
         json.dump(everything, f, indent=1)

@@ -137,6 +137,9 @@ finally:
         d.cleanup()
 if d:
     bench.end([r for rs in results.values() for r in rs])
+if args.json and not args.from_json:  # before the report, so that a report's failure loses nothing
+    with open(args.json, "w") as f:
+        json.dump({"%s@%d" % k: v for k, v in results.items()}, f)
 
 
 def work_ms(r):
@@ -146,7 +149,7 @@ def work_ms(r):
 
 
 def med(t, n, series="frame_ms"):
-    rs = results[(t, n)]
+    rs = results.get((t, n))
     if not rs:
         return None
     if series == "work":
@@ -330,6 +333,4 @@ if args.svg:
         f.write("\n".join(out))
     print("\nchart: %s" % args.svg)
 
-if args.json and not args.from_json:
-    with open(args.json, "w") as f:
-        json.dump({"%s@%d" % k: v for k, v in results.items()}, f)
+

@@ -24,6 +24,7 @@ import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
 import testlib  # noqa: E402
+import benchrun  # noqa: E402
 
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument("--pairs", type=int, default=6, help="rounds of (B alone, A then B); at least 4")
@@ -54,6 +55,7 @@ def must_be_done(job, what):
     return job
 
 
+bench = benchrun.Run()
 d = testlib.Daemon()
 alone, behind, rounds = [], [], []
 try:
@@ -61,6 +63,8 @@ try:
     print("device: %s | %s" % (info["gl_renderer"], info["gl_version"]))
     print("A: 1080x720, %d frames, %d captures against forward, all metrics; B: 480x320 forward, %d+%d frames\n"
           % (HEAVY["frames"], HEAVY["frames"] // HEAVY["capture_interval"], args.warmup, args.frames))
+    bench.start()
+    print()
     print("round  case     B frame_ms  B started after A finished  other_cpu  load1  noisy")
     for i in range(args.pairs):
         order = ("alone", "behind") if i % 2 == 0 else ("behind", "alone")
@@ -89,6 +93,7 @@ try:
 finally:
     d.stop()
     d.cleanup()
+bench.end([{"interference": r["interference"]} for r in rounds if r["interference"]])
 
 ratio = statistics.median(behind) / statistics.median(alone)
 paired = [b / a for a, b in zip(alone, behind)]

@@ -9,7 +9,12 @@ count.
 
   bench/bench_lights_techniques.py [--counts 16,64,256,1024,4096,16384]
       [--frames N] [--warmup N] [--repeat R] [--width W --height H]
-      [--forward-max N] [--techniques a,b,...] [--svg FILE] [--json FILE]
+      [--forward-max N] [--techniques a,b,...] [--variant NAME=TECH:JSON ...]
+      [--svg FILE] [--json FILE]
+
+--variant names a technique with options, usable in --techniques: e.g.
+--variant 'td8=tiled_deferred:{"tile_size": 8}' --techniques unlit,td8,...
+(tiled_deferred_cpu is built in: tiled deferred with CPU binning).
 
 Forward walks every light for every fragment: on llvmpipe at 1080x720 it
 takes about 10 s a frame at 1,024 lights and 40 s at 4,096. Above
@@ -26,7 +31,13 @@ On a shared machine frame_ms also measures the other processes: each row
 shows cpu_work_ms as well, the CPU time all the daemon's threads took per
 timed frame (result.interference: daemon_cpu_share x cpus x interval), which
 on llvmpipe (all work on the CPU) is the technique's cost whatever the
-load; crossovers and goals are computed on both."""
+load; crossovers and goals are computed on both.
+
+Interleaved: each repeat runs every technique at every count in turn
+(A, B, A, B over --repeat rounds, default 2); figures are medians over the
+repeats of the job medians and ratios are ratios of those medians. The
+run's commit, command, date and load (/proc/loadavg at the start and the
+end, and the jobs' result.interference) are printed with them."""
 
 import argparse
 import json
@@ -38,6 +49,7 @@ import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
 import testlib  # noqa: E402
+import benchrun  # noqa: E402
 
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument("--counts", default="16,64,256,1024,4096,16384")
@@ -46,11 +58,13 @@ ap.add_argument("--techniques", default="unlit,forward,deferred,tiled_deferred,t
 ap.add_argument("--frames", type=int, default=4, help="timed frames up to 1,024 lights")
 ap.add_argument("--frames-high", type=int, default=2, help="timed frames above 1,024 lights")
 ap.add_argument("--warmup", type=int, default=1)
-ap.add_argument("--repeat", type=int, default=1)
+ap.add_argument("--repeat", type=int, default=2)
 ap.add_argument("--width", type=int, default=1080)
 ap.add_argument("--height", type=int, default=720)
 ap.add_argument("--forward-max", type=int, default=1024, help="largest count forward runs at")
 ap.add_argument("--svg", default="bench-lights-techniques.svg", help="chart file ('' for none)")
+ap.add_argument("--variant", action="append", default=[],
+                help="NAME=TECHNIQUE:JSON, a technique with options (repeatable)")
 ap.add_argument("--json", help="write every result here")
 ap.add_argument("--from-json", help="report on the results a --json run wrote, without running")
 args = ap.parse_args()
@@ -59,6 +73,12 @@ counts = [int(c) for c in args.counts.split(",")]
 names = args.techniques.split(",")
 # Variants by name: technique and its options.
 VARIANTS = {"tiled_deferred_cpu": ("tiled_deferred", {"binning": "cpu"})}
+for v in args.variant:
+    vname, _, rest = v.partition("=")
+    vtech, _, vopts = rest.partition(":")
+    if not vname or not vtech:
+        sys.exit("--variant %r: expected NAME=TECHNIQUE:JSON" % v)
+    VARIANTS[vname] = (vtech, json.loads(vopts) if vopts else None)
 
 
 def job_for(name, n):
@@ -84,6 +104,7 @@ if args.from_json:
             if (t, int(n)) in results:
                 results[(t, int(n))] = rs
 started = time.time()
+bench = benchrun.Run()
 d = None if args.from_json else testlib.Daemon()
 try:
     info = d.json("GET", "/v1/info")[1]["device"] if d else \
@@ -91,8 +112,11 @@ try:
     print("device: %s | %s | %s" % (info["gl_renderer"], info["gl_version"], info["egl_device"]))
     print("scene: lights preset %dx%d, %d (%d above 1,024 lights) timed frames after %d warm-up, "
           "%d repeat(s); "
-          "forward up to %d lights\n" % (args.width, args.height, args.frames, args.frames_high,
-                                        args.warmup, args.repeat, args.forward_max))
+          "forward up to %d lights" % (args.width, args.height, args.frames, args.frames_high,
+                                      args.warmup, args.repeat, args.forward_max))
+    if d:
+        bench.start()
+    print()
     for rep in range(0 if args.from_json else args.repeat):
         for n in counts:
             for t in names:
@@ -112,7 +136,10 @@ finally:
         d.stop()
         d.cleanup()
 if d:
-    print("\nran in %.0f s" % (time.time() - started))
+    bench.end([r for rs in results.values() for r in rs])
+if args.json and not args.from_json:  # before the report, so that a report's failure loses nothing
+    with open(args.json, "w") as f:
+        json.dump({"%s@%d" % k: v for k, v in results.items()}, f)
 
 
 def work_ms(r):
@@ -122,7 +149,7 @@ def work_ms(r):
 
 
 def med(t, n, series="frame_ms"):
-    rs = results[(t, n)]
+    rs = results.get((t, n))
     if not rs:
         return None
     if series == "work":
@@ -306,6 +333,4 @@ if args.svg:
         f.write("\n".join(out))
     print("\nchart: %s" % args.svg)
 
-if args.json and not args.from_json:
-    with open(args.json, "w") as f:
-        json.dump({"%s@%d" % k: v for k, v in results.items()}, f)
+

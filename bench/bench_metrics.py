@@ -3,7 +3,14 @@
 of the thesis scene), scikit-image's SSIM on the same pair in the same run,
 and the time it took to render that pair, all side by side.
 
-  SHADEBENCHD=build/shadebenchd SHADEBENCH_COMPARE=build/shadebench-compare bench/bench_metrics.py [--repeat N]
+  SHADEBENCHD=build/shadebenchd SHADEBENCH_COMPARE=build/shadebench-compare bench/bench_metrics.py
+      [--repeat N] [--render-repeat N]
+
+Interleaved: each of the --repeat rounds runs shadebench's four metrics,
+its SSIM alone and scikit-image's two SSIMs in turn; the pair is rendered
+--render-repeat times (forward, OSL, forward, OSL, ...) before them, and
+its time is the sum of the two techniques' medians of the job medians. The
+run's commit, command, date and load are printed.
 """
 
 import argparse
@@ -26,27 +33,38 @@ except ImportError:
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--repeat", type=int, default=7)
+ap.add_argument("--render-repeat", type=int, default=3)
 ap.add_argument("--width", type=int, default=1080)
 ap.add_argument("--height", type=int, default=720)
 args = ap.parse_args()
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import benchrun  # noqa: E402
+bench = benchrun.Run()
+bench.start()
+print()
 shadebenchd = os.environ.get("SHADEBENCHD", "build/shadebenchd")
 compare = os.environ.get("SHADEBENCH_COMPARE", "build/shadebench-compare")
 
 with tempfile.TemporaryDirectory() as tmp:
     frames = {}
-    render_ms = {}
-    for tech in ("forward", "osl"):
-        job = {"technique": tech, "frames": 30, "warmup_frames": 5, "capture_interval": 30,
-               "async_distance": 20, "scene": {"dynamic": True, "width": args.width, "height": args.height},
-               "osl": {"resolution": "auto"}}
-        path = os.path.join(tmp, tech + ".json")
-        with open(path, "w") as f:
-            json.dump(job, f)
-        out = os.path.join(tmp, tech)
-        subprocess.run([shadebenchd, "--once", path, "--out", out], check=True, capture_output=True)
-        with open(os.path.join(out, "result.json")) as f:
-            render_ms[tech] = json.load(f)["frame_ms"]["median"]
-        frames[tech] = os.path.join(out, "frame-000030.png")
+    renders = {"forward": [], "osl": []}
+    for rep in range(args.render_repeat):
+        for tech in ("forward", "osl"):
+            job = {"technique": tech, "frames": 30, "warmup_frames": 5, "capture_interval": 30,
+                   "async_distance": 20, "scene": {"dynamic": True, "width": args.width, "height": args.height},
+                   "osl": {"resolution": "auto"}}
+            path = os.path.join(tmp, tech + ".json")
+            with open(path, "w") as f:
+                json.dump(job, f)
+            out = os.path.join(tmp, "%s-%d" % (tech, rep))
+            subprocess.run([shadebenchd, "--once", path, "--out", out], check=True, capture_output=True)
+            with open(os.path.join(out, "result.json")) as f:
+                renders[tech].append(json.load(f))
+            print("  [%d/%d] render %-8s frame_ms median %.1f" % (rep + 1, args.render_repeat, tech,
+                                                               renders[tech][-1]["frame_ms"]["median"]),
+                  flush=True)
+            frames.setdefault(tech, os.path.join(out, "frame-000030.png"))
+    render_ms = {t: statistics.median(r["frame_ms"]["median"] for r in rs) for t, rs in renders.items()}
 
     ours = {m: [] for m in ("ssim", "ssim-alone", "pdiff", "psnr", "flip", "all")}
     sk_luma, sk_rgb = [], []
@@ -72,9 +90,11 @@ with tempfile.TemporaryDirectory() as tmp:
         structural_similarity(a, b, channel_axis=2, **kw)
         sk_rgb.append((time.perf_counter() - t) * 1e3)
 
+bench.end(renders["forward"] + renders["osl"])
 med = {m: statistics.median(v) for m, v in ours.items()}
 pair_ms = render_ms["forward"] + render_ms["osl"]
-print("pair: %dx%d forward and OSL renders; medians of %d runs\n" % (args.width, args.height, args.repeat))
+print("\npair: %dx%d forward and OSL renders (%d of each, interleaved); metrics: medians of %d "
+      "interleaved runs\n" % (args.width, args.height, args.render_repeat, args.repeat))
 print("| measurement | ms |")
 print("|---|---|")
 notes = {"ssim": " (luma + R, G, B), beside the others", "ssim-alone": " (luma + R, G, B), alone",

@@ -21,7 +21,9 @@
 Effect costs are the medians of the effect passes' GL_TIME_ELAPSED
 (gpu_sections_ms): on llvmpipe that covers rasterization, which is all a
 full-screen pass does, so they compare there too. frame_ms is reported
-beside them."""
+beside them. The run's commit, command, date and load (/proc/loadavg at the
+start and the end, and the jobs' result.interference) are printed first and
+last."""
 
 import argparse
 import json
@@ -32,6 +34,7 @@ import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
 import testlib  # noqa: E402
+import benchrun  # noqa: E402
 
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument("--frames", type=int, default=10)
@@ -185,6 +188,7 @@ def chain_table():
                  100.0 * m(chain, lambda x: post_ms(x) / x["gpu_ms"]["median"]), *per))
 
 
+bench = benchrun.Run()
 d = testlib.Daemon()
 results = {name: [] for name, _ in CONFIGS}
 toon_results = {}
@@ -193,7 +197,8 @@ try:
     print("device: %s | %s" % (info["gl_renderer"], info["gl_version"]))
     print("scene: grid %dx%d, moving lights, %d timed frames after %d warm-up, %d repeats\n"
           % (args.width, args.height, args.frames, args.warmup, args.repeat))
-    t_start, load0 = time.time(), os.getloadavg()[0]
+    bench.start()
+    print()
     for rep in range(args.repeat):
         for name, job in CONFIGS:
             t0 = time.time()
@@ -211,8 +216,8 @@ try:
             sys.exit("%s failed: %s" % (name, done.get("error")))
         toon_results[name] = {"result": done["result"], "share": outline_share(d, done, d.tmp)}
         print("  %-26s objects outlined %5.1f %%" % (name, 100.0 * toon_results[name]["share"][0]), flush=True)
-    print("\n(%.0f s in all; load average %.2f before, %.2f after, on %d cores)\n"
-          % (time.time() - t_start, load0, os.getloadavg()[0], os.cpu_count()))
+    bench.end([r for rs in results.values() for r in rs] + [t["result"] for t in toon_results.values()])
+    print()
     if "bloom" in PARTS:
         bloom_table()
     if "ssao" in PARTS:

@@ -123,6 +123,12 @@ def stamp_id(t, serial):
     return time.strftime("%Y%m%d-%H%M%S", time.gmtime(t)) + "-%04d" % (serial % 10000)
 
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import benchrun  # noqa: E402
+bench = benchrun.Run()
+bench.start()
+
+
 def uptime_load():
     with open("/proc/loadavg") as f:
         return f.read().split()[0]
@@ -301,3 +307,4 @@ if args.keep:
     print("state kept in", tmp)
 else:
     shutil.rmtree(tmp)
+bench.end([])

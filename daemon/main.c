@@ -445,6 +445,18 @@ static bool set_memory_budget(const struct options *o, const struct http_limits 
     return true;
 }
 
+/* The device's MSAA limit for job_spec_parse, so that a job over it is
+ * refused naming msaa when it is submitted rather than failing when it
+ * runs (jobs queued before a restart are checked by the harness). */
+static void set_max_msaa(struct runner *r)
+{
+    json_t *device = runner_device_json(r);
+    json_t *m = json_object_get(json_object_get(device, "caps"), "max_msaa");
+    if (json_is_integer(m))
+        job_spec_set_max_msaa((int)json_integer_value(m));
+    json_decref(device);
+}
+
 /* The render thread as the HTTP layer sees it (http.h). */
 static void render_state(void *r, struct render_state *out) { runner_state(r, out); }
 static json_t *render_device_json(void *r) { return runner_device_json(r); }
@@ -515,6 +527,7 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
         return 1;
     }
     pin_loaded_modules();
+    set_max_msaa(r);
     double budget, driver;
     if (!set_memory_budget(o, &limits, &budget, &driver, err, sizeof(err))) {
         LOG(LOG_ERROR, "%s", err);

@@ -23,6 +23,7 @@
 #define SB_SSBO_NONFINITE 10    /* the harness's NaN and infinity pixel counters */
 #define SB_SSBO_LIGHT_SUMMARY 11 /* per cell, one bit per non-zero word of light bits */
 #define SB_SSBO_SHADOW_LIGHTS 12 /* per light: where its shadow map's faces lie */
+#define SB_SSBO_EDGE_STATS 13   /* MSAA g-buffer: edge pixels this frame and over the run */
 
 /* Texture units. */
 #define SB_TEX_HDR 0

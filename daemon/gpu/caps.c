@@ -32,12 +32,23 @@ void gpu_caps_query(struct gpu_caps *c)
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &ssbo);
     c->max_ssbo_bytes = ssbo;
     glGetQueryiv(GL_TIME_ELAPSED, GL_QUERY_COUNTER_BITS, &c->timer_query_bits);
+    c->max_samples = geti(GL_MAX_SAMPLES);
+    c->max_color_texture_samples = geti(GL_MAX_COLOR_TEXTURE_SAMPLES);
+    c->max_depth_texture_samples = geti(GL_MAX_DEPTH_TEXTURE_SAMPLES);
+    c->max_integer_samples = geti(GL_MAX_INTEGER_SAMPLES);
+    int m = c->max_samples;
+    m = c->max_color_texture_samples < m ? c->max_color_texture_samples : m;
+    m = c->max_depth_texture_samples < m ? c->max_depth_texture_samples : m;
+    /* A job asks for a power of two: the largest one within the limits. */
+    c->max_msaa = 1;
+    while (c->max_msaa * 2 <= m && c->max_msaa < 8)
+        c->max_msaa *= 2;
     c->debug_groups = epoxy_gl_version() >= 43 || epoxy_has_gl_extension("GL_KHR_debug");
 }
 
 json_t *gpu_caps_json(const struct gpu_caps *c)
 {
-    return json_pack(
+    json_t *j = json_pack(
         "{s:i, s:i, s:[i, i], s:i, s:i, s:i, s:[i, i, i], s:[i, i, i], s:i, s:i, s:i, s:i, s:i, "
         "s:I, s:i, s:b}",
         "max_texture_size", c->max_texture_size, "max_renderbuffer_size",
@@ -53,4 +64,12 @@ json_t *gpu_caps_json(const struct gpu_caps *c)
         "max_ssbo_bindings", c->max_ssbo_bindings, "max_uniform_block_bytes",
         c->max_uniform_block_bytes, "max_ssbo_bytes", (json_int_t)c->max_ssbo_bytes,
         "timer_query_bits", c->timer_query_bits, "debug_groups", c->debug_groups);
+    json_object_set_new(j, "max_samples", json_integer(c->max_samples));
+    json_object_set_new(j, "max_color_texture_samples",
+                        json_integer(c->max_color_texture_samples));
+    json_object_set_new(j, "max_depth_texture_samples",
+                        json_integer(c->max_depth_texture_samples));
+    json_object_set_new(j, "max_integer_samples", json_integer(c->max_integer_samples));
+    json_object_set_new(j, "max_msaa", json_integer(c->max_msaa));
+    return j;
 }

@@ -17,6 +17,13 @@ struct gpu_caps {
     int max_ssbo_bindings, max_uniform_block_bytes;
     long long max_ssbo_bytes;
     int timer_query_bits;
+    /* Multisampling: GL_MAX_SAMPLES, GL_MAX_COLOR_TEXTURE_SAMPLES,
+     * GL_MAX_DEPTH_TEXTURE_SAMPLES, GL_MAX_INTEGER_SAMPLES, and max_msaa,
+     * the most a job's "msaa" may ask: the least of the first three (the
+     * harness's output and the g-buffers are multisampled textures, none of
+     * them integer), capped at 8. */
+    int max_samples, max_color_texture_samples, max_depth_texture_samples, max_integer_samples;
+    int max_msaa;
     bool debug_groups; /* glPushDebugGroup available (KHR_debug / GL 4.3) */
 };
 

@@ -10,6 +10,9 @@ struct target {
     GLuint tex;
     GLenum format;
     int w, h;
+    int samples; /* asked for; 1: GL_TEXTURE_2D; more: GL_TEXTURE_2D_MULTISAMPLE */
+    int given;   /* what the driver allocated (at least samples) */
+    unsigned epoch; /* the pool's epoch when it was last asked for */
 };
 
 struct framebuffer {
@@ -21,6 +24,7 @@ struct framebuffer {
 };
 
 struct gpu_targets {
+    unsigned epoch;
     struct target targets[GPU_TARGETS_MAX];
     struct framebuffer fbos[GPU_TARGETS_MAX];
 };
@@ -65,12 +69,22 @@ static double format_bytes(GLenum format)
 GLuint gpu_targets_texture(struct gpu_targets *t, const char *name, GLenum format, int w, int h,
                            char *err, size_t errlen)
 {
+    return gpu_targets_texture_ms(t, name, format, w, h, 1, err, errlen);
+}
+
+GLuint gpu_targets_texture_ms(struct gpu_targets *t, const char *name, GLenum format, int w,
+                              int h, int samples, char *err, size_t errlen)
+{
     struct target *slot = NULL;
+    samples = samples > 1 ? samples : 1;
     for (int i = 0; i < GPU_TARGETS_MAX && !slot; i++)
         if (t->targets[i].tex && strcmp(t->targets[i].name, name) == 0)
             slot = &t->targets[i];
-    if (slot && slot->format == format && slot->w == w && slot->h == h)
+    if (slot && slot->format == format && slot->w == w && slot->h == h &&
+        slot->samples == samples) {
+        slot->epoch = t->epoch;
         return slot->tex;
+    }
     for (int i = 0; i < GPU_TARGETS_MAX && !slot; i++)
         if (!t->targets[i].tex)
             slot = &t->targets[i];
@@ -85,17 +99,34 @@ GLuint gpu_targets_texture(struct gpu_targets *t, const char *name, GLenum forma
     slot->format = format;
     slot->w = w;
     slot->h = h;
+    slot->samples = slot->given = samples;
+    slot->epoch = t->epoch;
     glGenTextures(1, &slot->tex);
-    glBindTexture(GL_TEXTURE_2D, slot->tex);
-    glTexStorage2D(GL_TEXTURE_2D, 1, format, w, h);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glBindTexture(GL_TEXTURE_2D, 0);
+    if (samples > 1) {
+        /* Fixed sample locations: every plane of a framebuffer places its
+         * samples alike, which a g-buffer read per sample relies on. A
+         * multisampled texture has no sampler state to set. */
+        glBindTexture(GL_TEXTURE_2D_MULTISAMPLE, slot->tex);
+        glTexStorage2DMultisample(GL_TEXTURE_2D_MULTISAMPLE, samples, format, w, h, GL_TRUE);
+        /* A driver may give more samples than asked (llvmpipe makes 2 into
+         * 4): count, and let readers loop over, the ones it gave. */
+        GLint given = 0;
+        glGetTexLevelParameteriv(GL_TEXTURE_2D_MULTISAMPLE, 0, GL_TEXTURE_SAMPLES, &given);
+        slot->given = given > samples ? given : samples;
+        glBindTexture(GL_TEXTURE_2D_MULTISAMPLE, 0);
+    } else {
+        glBindTexture(GL_TEXTURE_2D, slot->tex);
+        glTexStorage2D(GL_TEXTURE_2D, 1, format, w, h);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        glBindTexture(GL_TEXTURE_2D, 0);
+    }
     if (glGetError() != GL_NO_ERROR) {
-        snprintf(err, errlen, "render target %s (%dx%d, format 0x%04x) could not be allocated",
-                 name, w, h, format);
+        snprintf(err, errlen,
+                 "render target %s (%dx%d, format 0x%04x, %d samples) could not be allocated",
+                 name, w, h, format, samples);
         glDeleteTextures(1, &slot->tex);
         memset(slot, 0, sizeof(*slot));
         return 0;
@@ -106,12 +137,30 @@ GLuint gpu_targets_texture(struct gpu_targets *t, const char *name, GLenum forma
     return slot->tex;
 }
 
-static bool has_stencil(const struct gpu_targets *t, GLuint tex)
+static const struct target *find_target(const struct gpu_targets *t, GLuint tex)
 {
     for (int i = 0; tex && i < GPU_TARGETS_MAX; i++)
         if (t->targets[i].tex == tex)
-            return t->targets[i].format == GL_DEPTH24_STENCIL8;
-    return false;
+            return &t->targets[i];
+    return NULL;
+}
+
+static bool has_stencil(const struct gpu_targets *t, GLuint tex)
+{
+    const struct target *x = find_target(t, tex);
+    return x && (x->format == GL_DEPTH24_STENCIL8 || x->format == GL_DEPTH32F_STENCIL8);
+}
+
+int gpu_targets_samples(const struct gpu_targets *t, GLuint tex)
+{
+    const struct target *x = find_target(t, tex);
+    return x ? x->given : 1;
+}
+
+/* The texture target a pool texture attaches and binds as. */
+GLenum gpu_targets_kind(const struct gpu_targets *t, GLuint tex)
+{
+    return gpu_targets_samples(t, tex) > 1 ? GL_TEXTURE_2D_MULTISAMPLE : GL_TEXTURE_2D;
 }
 
 GLuint gpu_targets_fbo(struct gpu_targets *t, const char *name, const GLuint *colors, int ncolors,
@@ -138,8 +187,8 @@ GLuint gpu_targets_fbo(struct gpu_targets *t, const char *name, const GLuint *co
     GLenum bufs[8];
     for (int i = 0; i < 8; i++) {
         GLuint tex = i < ncolors ? colors[i] : 0;
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + (GLenum)i, GL_TEXTURE_2D,
-                               tex, 0);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + (GLenum)i,
+                               gpu_targets_kind(t, tex), tex, 0);
         bufs[i] = GL_COLOR_ATTACHMENT0 + (GLenum)i;
     }
     /* Detach both first: the attachment point follows the format, and a
@@ -147,7 +196,7 @@ GLuint gpu_targets_fbo(struct gpu_targets *t, const char *name, const GLuint *co
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_TEXTURE_2D, 0, 0);
     glFramebufferTexture2D(GL_FRAMEBUFFER,
                            has_stencil(t, depth) ? GL_DEPTH_STENCIL_ATTACHMENT : GL_DEPTH_ATTACHMENT,
-                           GL_TEXTURE_2D, depth, 0);
+                           gpu_targets_kind(t, depth), depth, 0);
     if (ncolors)
         glDrawBuffers(ncolors, bufs);
     else
@@ -170,6 +219,19 @@ double gpu_targets_bytes(const struct gpu_targets *t)
     double b = 0;
     for (int i = 0; i < GPU_TARGETS_MAX; i++)
         if (t->targets[i].tex)
-            b += format_bytes(t->targets[i].format) * t->targets[i].w * t->targets[i].h;
+            b += format_bytes(t->targets[i].format) * t->targets[i].w * t->targets[i].h *
+                 t->targets[i].given;
+    return b;
+}
+
+void gpu_targets_new_epoch(struct gpu_targets *t) { t->epoch++; }
+
+double gpu_targets_bytes_in_use(const struct gpu_targets *t)
+{
+    double b = 0;
+    for (int i = 0; i < GPU_TARGETS_MAX; i++)
+        if (t->targets[i].tex && t->targets[i].epoch == t->epoch)
+            b += format_bytes(t->targets[i].format) * t->targets[i].w * t->targets[i].h *
+                 t->targets[i].given;
     return b;
 }

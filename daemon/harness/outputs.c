@@ -67,7 +67,7 @@ bool outputs_read_capture(struct harness_run *run, int k)
     glBindFramebuffer(GL_READ_FRAMEBUFFER, run->ldr_fbo);
     glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, cap->pixels);
     if (run->hdr_scratch)
-        read_hdr_stats(run->env.output_fbo, w, h, run->hdr_scratch, &cap->hdr);
+        read_hdr_stats(run->hdr_fbo, w, h, run->hdr_scratch, &cap->hdr);
     if (!post_chain_count_nonfinite(run->post, run->hdr_resolved, &cap->nonfinite, run->err,
                                     sizeof(run->err)))
         return false;
@@ -285,6 +285,7 @@ json_t *outputs_write(struct harness_run *run)
     json_object_set_new(result, RK_NONFINITE, nonfinite_summary(run));
     look_stages_describe(&run->stages, result);
     json_object_set_new(result, "targets_bytes", json_real(gpu_targets_bytes(run->gl->targets)));
+    json_object_set_new(result, "msaa", run_msaa_json(run));
     json_object_set_new(result, RK_STARTED_UNIX, json_real(run->job->started));
     if (heatmap)
         json_object_set(result, RK_HEATMAP, heatmap);

@@ -82,7 +82,19 @@ bool run_setup_targets(struct harness_run *run)
                        : 0;
     if (!run->ldr_fbo)
         return false;
+    run->hdr_fbo = out, run->hdr_color = color, run->hdr_depth = depth;
+    run->msaa_pass = -1;
+    int samples = run->spec->msaa > 1 ? run->spec->msaa : 1;
+    if (samples > 1 && !run_msaa_targets(run, hdr_format, w, h, &samples, &out, &color, &depth))
+        return false;
     look_defines(run->look, run->defines, sizeof(run->defines));
+    if (samples > 1) {
+        /* Programs that sample the output's depth or a g-buffer read every
+         * sample: sampler2DMS variants (shaders/common/msaa.glsl). */
+        size_t used = strlen(run->defines);
+        snprintf(run->defines + used, sizeof(run->defines) - used,
+                 "#define SB_MSAA_SAMPLES %d\n", samples);
+    }
     run->env = (struct technique_env){
         .frames = run->spec->frames,
         .warmup_frames = run->spec->warmup_frames,
@@ -98,6 +110,7 @@ bool run_setup_targets(struct harness_run *run)
         .output_depth = depth,
         .width = w,
         .height = h,
+        .samples = samples,
         .defines = run->defines,
         .products = &run->products,
         .budget = &run->budget,
@@ -118,7 +131,8 @@ bool run_setup_passes(struct harness_run *run, const void *options, int64_t time
     const struct technique *tech = run->tech;
     int post_passes = post_spec_pass_names(&run->look->post, NULL, 0);
     int look_passes = (run->stages.shadows != NULL) + run->stages.sky_on;
-    run->timer = gpu_timer_create(technique_pass_count(tech) + look_passes + post_passes + 1,
+    run->timer = gpu_timer_create(technique_pass_count(tech) + look_passes + post_passes + 1 +
+                                      (run->env.samples > 1),
                                   timed_frames);
     if (!run->timer) {
         snprintf(run->err, sizeof(run->err), "cannot create GPU timer queries");
@@ -133,11 +147,14 @@ bool run_setup_passes(struct harness_run *run, const void *options, int64_t time
         .width = run->env.width,
         .height = run->env.height,
         .hdr_format = run->look->hdr == LOOK_HDR_RGBA16F ? GL_RGBA16F : GL_RGBA32F,
-        .color = run->env.output_color,
-        .depth = run->env.output_depth,
+        .color = run->hdr_color,
+        .depth = run->hdr_depth,
         .targets = run->env.targets,
         .budget = &run->budget,
     };
+    if (fits && run->env.samples > 1 &&
+        (run->msaa_pass = gpu_passes_add(&run->passes, "msaa_resolve")) < 0)
+        fits = false;
     if (fits && !(run->post = post_chain_create(&frame, &run->look->post, &run->passes, run->err,
                                                 sizeof(run->err))))
         return false;
@@ -200,6 +217,7 @@ bool run_prepare(struct harness_run *run, bool capture)
         snprintf(run->err, sizeof(run->err), "out of memory preparing the job");
         return false;
     }
+    gpu_targets_new_epoch(run->gl->targets);
     if (!gpu_scene_init(&run->gpu, &run->scene, run->err, sizeof(run->err)) ||
         !run_setup_targets(run) ||
         !look_stages_init(&run->stages, &spec->look, &run->scene, &run->gpu,
@@ -312,6 +330,8 @@ bool run_frame(struct harness_run *run, int64_t k, bool timed)
     }
     look_stages_after(&run->stages, &run->passes, run->sky_pass, run->env.output_fbo,
                       run->env.width, run->env.height);
+    if (run->msaa_pass >= 0)
+        run_msaa_resolve(run);
     run->hdr_resolved = post_chain_run(run->post);
     resolve(run);
     gpu_timer_end_frame(run->timer);

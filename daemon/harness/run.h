@@ -90,6 +90,11 @@ struct harness_run {
     /* The output is scale times the job's width and height (a supersampled
      * reference, reference.c); 0 or 1: the job's size. */
     int scale;
+    /* The single-sample HDR output the post chain, the HDR statistics and
+     * the resolve read: the technique's own at msaa 1, else what the MSAA
+     * resolve (msaa_pass) writes from the technique's multisampled output. */
+    GLuint hdr_fbo, hdr_color, hdr_depth;
+    int msaa_pass; /* -1 at msaa 1 */
     struct technique_env env;
     struct technique_products products;
     char defines[512];
@@ -122,6 +127,20 @@ bool run_setup_targets(struct harness_run *run);
 /* The technique's passes (its own, the look's shadows and sky, the post
  * chain's, then the resolve) and a timer for timed_frames frames. */
 bool run_setup_passes(struct harness_run *run, const void *options, int64_t timed_frames);
+
+/* MSAA (daemon/harness/msaa.c): the multisampled output a technique draws
+ * into at spec->msaa samples, w x h (a supersampled reference's size too),
+ * made beside the single-sample one (out,
+ * color and depth are replaced by the multisampled ones, samples by the
+ * count the driver gave, which may be more), false with
+ * run->err when the device cannot; and the timed pass that resolves it into
+ * run->hdr_fbo: colour averaged, depth (and stencil) from one sample, as
+ * glBlitFramebuffer resolves them, for the post chain's depth readers. */
+bool run_msaa_targets(struct harness_run *run, GLenum hdr_format, int w, int h, int *samples,
+                      GLuint *out, GLuint *color, GLuint *depth);
+void run_msaa_resolve(struct harness_run *run);
+/* The result's "msaa" object: samples, the reference's, how it resolves. */
+json_t *run_msaa_json(const struct harness_run *run);
 
 /* Builds the post chain's effects once the technique was created: the
  * normals it publishes (if any) choose their programs. */

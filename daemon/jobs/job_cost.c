@@ -51,10 +51,18 @@ static double hdr_bytes(const struct look_spec *look)
     return look->hdr == LOOK_HDR_RGBA16F ? 8.0 : 16.0;
 }
 
-static double look_targets_bpp(const struct look_spec *look)
+/* With msaa > 1 the technique draws into multisampled colour and depth
+ * (and the deferred family into a multisampled g-buffer with an edge
+ * stencil of its own) that the harness resolves into the single-sample
+ * output: those take hdr + 8 bytes a sample, and the planes scale by the
+ * samples too. Samples as asked: a driver that gives more (llvmpipe: 4 for
+ * 2) takes more, which no GL-free estimate can know. */
+static double look_targets_bpp(const struct look_spec *look, int msaa)
 {
     double hdr = hdr_bytes(look);
-    return HARNESS_BPP(hdr) + TECHNIQUE_PLANES_BPP + look->post.count * POST_EFFECT_BPP(hdr);
+    double samples = msaa > 1 ? msaa : 1;
+    return HARNESS_BPP(hdr) + (msaa > 1 ? (hdr + 8.0) * samples : 0.0) +
+           TECHNIQUE_PLANES_BPP * samples + look->post.count * POST_EFFECT_BPP(hdr);
 }
 
 void job_cost_estimate(const struct job_spec *spec, struct job_cost *out)
@@ -63,13 +71,14 @@ void job_cost_estimate(const struct job_spec *spec, struct job_cost *out)
     int captures = job_spec_capture_count(spec);
     bool reference = spec->reference[0] != '\0';
     *out = (struct job_cost){0};
-    out->targets_bytes = pixels * look_targets_bpp(&spec->look);
+    out->targets_bytes = pixels * look_targets_bpp(&spec->look, spec->msaa);
     out->look_bytes = ibl_bytes(&spec->look.ibl) + shadow_bytes(&spec->look.shadows);
     out->captures_bytes = captures * pixels * CAPTURE_BPP;
     if (reference) {
         /* Its planes, should its look need more than the job's, and the
          * frame it reads back; its captures go straight to PNG. */
-        double extra = look_targets_bpp(&spec->reference_look) - look_targets_bpp(&spec->look);
+        double extra = look_targets_bpp(&spec->reference_look, spec->msaa) -
+                       look_targets_bpp(&spec->look, spec->msaa);
         out->reference_bytes = pixels * ((extra > 0 ? extra : 0) + 4.0) +
                                ibl_bytes(&spec->reference_look.ibl) +
                                shadow_bytes(&spec->reference_look.shadows);
@@ -77,7 +86,8 @@ void job_cost_estimate(const struct job_spec *spec, struct job_cost *out)
          * makes them anew at that size) and reads back N x N frames. */
         double n2 = (double)spec->reference_supersample * spec->reference_supersample;
         if (n2 > 1)
-            out->reference_bytes += pixels * n2 * (look_targets_bpp(&spec->reference_look) + 4.0);
+            out->reference_bytes +=
+                pixels * n2 * (look_targets_bpp(&spec->reference_look, spec->msaa) + 4.0);
         /* temporal.frames: the technique's frames of one capture point are
          * kept while the reference's are drawn, with one of the reference's. */
         if (spec->temporal_frames)

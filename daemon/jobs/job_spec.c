@@ -70,6 +70,10 @@ static bool alias_target(const struct technique_catalog *c, int alias, int *tech
 }
 
 static double default_timeout_s, max_job_s;
+static int max_msaa;
+
+void job_spec_set_max_msaa(int samples) { max_msaa = samples > 0 ? samples : 0; }
+int job_spec_max_msaa(void) { return max_msaa; }
 
 void job_spec_set_default_timeout(double seconds) { default_timeout_s = seconds; }
 double job_spec_default_timeout(void) { return default_timeout_s; }
@@ -116,6 +120,7 @@ void job_spec_defaults(struct job_spec *out, const struct technique_catalog *tec
     out->temporal_frames = 0;
     metrics_options_defaults(&out->metrics);
     out->timeout_s = default_timeout_s;
+    out->msaa = 1;
 }
 
 const void *job_spec_technique_options(const struct job_spec *spec)
@@ -328,7 +333,7 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
     static const char *const fixed[] = {"technique", "frames", "warmup_frames",
                                         "capture_interval", "scene", "look", "reference",
                                         "reference_look", "metrics", "repeat", "labels",
-                                        "timeout_s", "temporal"};
+                                        "timeout_s", "temporal", "msaa"};
     enum { NFIXED = sizeof(fixed) / sizeof(fixed[0]) };
     /* Every technique's options live under its own name; an alias is known
      * when the catalogue has the option it stands for. */
@@ -446,8 +451,16 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
         !jf_get_int(body, "capture_interval", "capture_interval", 0, 1000000,
                  &out->capture_interval, err) ||
         !jf_get_number(body, "timeout_s", "timeout_s", 0.0, 1e7, &out->timeout_s, err) ||
-        !apply_max_seconds(body, out, err))
+        !apply_max_seconds(body, out, err) ||
+        !jf_get_int(body, "msaa", "msaa", 1, 8, &out->msaa, err))
         return false;
+    if (out->msaa & (out->msaa - 1))
+        return job_error_set(err, "msaa", "must be 1, 2, 4 or 8 (samples a pixel)");
+    if (max_msaa && out->msaa > max_msaa)
+        return job_error_set(err, "msaa", "must be at most %d: this device's limit (/v1/info: "
+                             "device.caps.max_msaa, the least of GL_MAX_SAMPLES, "
+                             "GL_MAX_COLOR_TEXTURE_SAMPLES and GL_MAX_DEPTH_TEXTURE_SAMPLES)",
+                             max_msaa);
 
     json_t *scene;
     if (!jf_get_object(body, "scene", "scene", &scene, err) ||
@@ -604,6 +617,7 @@ json_t *job_spec_to_json(const struct job_spec *spec)
     if (spec->temporal_frames)
         json_object_set_new(out, "temporal", json_pack("{s:i}", "frames", spec->temporal_frames));
     json_object_set_new(out, "timeout_s", json_real(spec->timeout_s));
+    json_object_set_new(out, "msaa", json_integer(spec->msaa));
     if (spec->reference[0])
         json_object_set_new(out, "metrics", metrics_to_json(&spec->metrics));
     if (spec->reference_look_given)

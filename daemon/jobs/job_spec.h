@@ -75,6 +75,8 @@ struct job_spec {
     int nlabels;                   /* sorted by key */
     struct job_label labels[JOB_MAX_LABELS];
     double timeout_s;              /* running time allowed, all phases; 0: no limit */
+    int msaa;                      /* samples a pixel of the output (1, 2, 4, 8); the
+                                    * reference renders at the same count */
 };
 
 /* The timeout_s a job gets when it names none (--job-timeout). Set once at
@@ -88,6 +90,13 @@ double job_spec_default_timeout(void);
  * before any thread parses jobs. */
 void job_spec_set_max_seconds(double seconds);
 double job_spec_max_seconds(void);
+
+/* The most MSAA samples the device renders (gpu_caps.max_msaa), so that a
+ * job over it is refused naming msaa at submission; 0 (the default, before
+ * the render thread is up) checks only the rule 1, 2, 4 or 8, and the run
+ * then fails naming msaa. Set once at start-up, before HTTP threads parse. */
+void job_spec_set_max_msaa(int samples);
+int job_spec_max_msaa(void);
 
 
 /* Fills defaults, then applies and validates the body. techniques is the

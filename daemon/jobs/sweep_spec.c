@@ -22,7 +22,7 @@ static const struct {
 } PARAMS[] = {
     {"technique", PARAM_CHOICE, 0},        {"reference", PARAM_CHOICE, 0},
     {"frames", PARAM_INT, 1},              {"warmup_frames", PARAM_INT, 1},
-    {"capture_interval", PARAM_INT, 1},
+    {"capture_interval", PARAM_INT, 1},    {"msaa", PARAM_INT, 1},
     {"scene.lights", PARAM_INT, 1},        {"scene.dynamic", PARAM_BOOL, 0},
     {"scene.width", PARAM_INT, 1},         {"scene.height", PARAM_INT, 1},
     {"scene.sphere_segments", PARAM_INT, 2}, {"scene.light_speed", PARAM_NUMBER, 0},
@@ -294,9 +294,11 @@ static bool workload_param(const char *path)
 {
     /* reference.supersample too: scores against different references are
      * never compared (the verdict's fronts are per workload), so each
-     * factor is a workload with its timed reference. */
+     * factor is a workload with its timed reference; msaa too: the
+     * reference renders at the job's samples. */
     return strncmp(path, "scene.", 6) == 0 || strcmp(path, "frames") == 0 ||
-           strcmp(path, "warmup_frames") == 0 || strcmp(path, "reference.supersample") == 0;
+           strcmp(path, "warmup_frames") == 0 || strcmp(path, "reference.supersample") == 0 ||
+           strcmp(path, "msaa") == 0;
 }
 
 /* One timed point of the reference technique per workload of the grid (see

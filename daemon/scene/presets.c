@@ -269,6 +269,23 @@ static bool build_sphere(struct scene *s)
     return true;
 }
 
+/* plane: one flat ground that fills the frame, seen from above at a slant:
+ * every pixel holds the same surface, so an MSAA edge pass finds no edge
+ * (tests/e2e/e2e_msaa.py), while lights close over it vary its shading. */
+static bool build_plane(struct scene *s)
+{
+    if (!alloc_instances(s, 1))
+        return false;
+    struct scene_instance *ground = &s->instances[0];
+    ground->mesh = SCENE_MESH_PLANE;
+    ground->scale = 40.0f / SCENE_PLANE_HALF;
+    ground->albedo[0] = ground->albedo[1] = ground->albedo[2] = 0.7f;
+    s->light_volume = (struct scene_box){{-3.0f, 0.6f, -3.0f}, {3.0f, 1.2f, 3.0f}};
+    s->light_orbit_plane = SCENE_ORBIT_XZ;
+    set_pose(s, 0.0f, 6.0f, 2.0f, 0.0f, 0.0f, 0.0f, 40.0f);
+    return scene_place_lights(s, 0.5f);
+}
+
 bool scene_build_preset(struct scene *s, bool *materials_set)
 {
     *materials_set = false;
@@ -285,6 +302,8 @@ bool scene_build_preset(struct scene *s, bool *materials_set)
         return build_chart(s);
     case SCENE_PRESET_SPHERE:
         return build_sphere(s);
+    case SCENE_PRESET_PLANE:
+        return build_plane(s);
     }
     return false;
 }

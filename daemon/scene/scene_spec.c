@@ -4,7 +4,8 @@
 #include <stdio.h>
 #include <string.h>
 
-const char *const scene_preset_names[] = {"grid", "lights", "teapots", "chart", "sphere", NULL};
+const char *const scene_preset_names[] = {"grid", "lights", "teapots", "chart", "sphere",
+                                             "plane", NULL};
 const char *const scene_layout_names[] = {"halton", "uniform", "grid", "clustered", NULL};
 const char *const scene_materials_names[] = {"uniform", "varied", "preset", NULL};
 const char *const scene_camera_names[] = {"static", "orbit", "flythrough", NULL};
@@ -27,6 +28,8 @@ static const struct {
     /* A row of lights in front of the chart, above the camera. */
     [SCENE_PRESET_CHART] = {4, SCENE_LAYOUT_GRID, 30.0, SCENE_MATERIALS_PRESET},
     [SCENE_PRESET_SPHERE] = {1, SCENE_LAYOUT_GRID, 10.0, SCENE_MATERIALS_UNIFORM},
+    /* Lights low over the plane, so that its shading varies across it. */
+    [SCENE_PRESET_PLANE] = {6, SCENE_LAYOUT_HALTON, 2.5, SCENE_MATERIALS_UNIFORM},
 };
 
 void scene_spec_preset_defaults(struct scene_spec *s, enum scene_preset preset)

@@ -15,6 +15,7 @@ enum scene_preset {
     SCENE_PRESET_TEAPOTS, /* seed 002: eight teapots, a container, ground and sky */
     SCENE_PRESET_CHART,   /* spheres by metallic (rows) and roughness (columns) */
     SCENE_PRESET_SPHERE,  /* one sphere in the spec's material: the furnace test's */
+    SCENE_PRESET_PLANE,   /* one flat ground filling the frame: no edges (MSAA's test) */
 };
 enum scene_light_layout {
     SCENE_LAYOUT_HALTON,    /* the thesis's low-discrepancy spread (Halton 2, 3, 5) */

@@ -59,6 +59,13 @@ struct technique_env {
      * later passes may sample, both width x height, attached to output_fbo. */
     GLuint output_fbo, output_color, output_depth;
     int width, height;
+    /* MSAA samples a pixel of the output (the job's "msaa"): 1, or 2 to 8,
+     * when output_color and output_depth are GL_TEXTURE_2D_MULTISAMPLE
+     * (bind and attach them as such; gpu_targets_kind says which) that the
+     * harness resolves after the technique's passes. A technique that
+     * samples the depth (tile depth bounds, a g-buffer) reads every sample;
+     * planes it draws beside the output take the same count. */
+    int samples;
     /* #define lines for the look (lighting model), to pass to
      * gl_program_build for every program that lights. */
     const char *defines;

@@ -4,6 +4,12 @@
 #include "light_grid.glsl"
 #include "heat.glsl"
 layout(location = 0) out vec4 out_color;
+#ifdef SB_MSAA_SAMPLES
+// At MSAA the stencil keeps each lighting run (per pixel, per sample) to its
+// pixels: test it before the shader, which the heat map's image writes
+// would otherwise put after it, every pixel then paying for both runs.
+layout(early_fragment_tests) in;
+#endif
 
 void main()
 {
@@ -16,6 +22,10 @@ void main()
         color = shade_cell(grid_cell(gl_FragCoord.xy, d), s.P, s.N, surface_material(s),
                            evaluations);
     }
+#ifdef GBUFFER_PER_SAMPLE
+    heat_add(pixel, evaluations); // each sample's, over a cleared map
+#else
     heat_set(pixel, evaluations);
+#endif
     out_color = vec4(color, 1.0);
 }

@@ -95,33 +95,126 @@ vec3 gbuffer_position(vec2 frag, float depth)
     return w.xyz / w.w;
 }
 
-// The surface a g-buffer pixel holds.
-layout(binding = SB_TEX_DEPTH) uniform sampler2D u_gbuffer_depth;
-layout(binding = SB_TEX_GBUFFER0) uniform sampler2D u_gbuffer_albedo;
-layout(binding = SB_TEX_GBUFFER1) uniform sampler2D u_gbuffer_normal;
-layout(binding = SB_TEX_GBUFFER2) uniform sampler2D u_gbuffer_material;
+// The surface a g-buffer pixel holds. With MSAA (SB_MSAA_SAMPLES) the
+// planes and the depth are multisampled: a program built with
+// GBUFFER_PER_SAMPLE runs once a sample (gl_SampleID) and reads its own;
+// one built without runs once a pixel, for pixels the edge pass left
+// unmarked (all samples of one surface), and reads sample 0's planes with
+// the depth at the centre of the sample pattern (the mean of the samples'
+// depths: on a plane depth is linear in window position), so that it
+// shades the point forward shades.
+#include "msaa.glsl"
+layout(binding = SB_TEX_DEPTH) uniform msaa_sampler2D u_gbuffer_depth;
+layout(binding = SB_TEX_GBUFFER0) uniform msaa_sampler2D u_gbuffer_albedo;
+layout(binding = SB_TEX_GBUFFER1) uniform msaa_sampler2D u_gbuffer_normal;
+layout(binding = SB_TEX_GBUFFER2) uniform msaa_sampler2D u_gbuffer_material;
+#ifdef SB_MSAA_SAMPLES
+// Each sample's position within its pixel (glGetMultisamplefv), and their
+// mean, set at create (gbuffer.c).
+uniform vec2 u_sample_pos[SB_MSAA_SAMPLES];
+uniform vec2 u_sample_centre;
+#endif
 
 struct Surface {
     vec3 P, N, albedo;
     float specular, shininess, metallic, roughness;
 };
 
-// False for background pixels (nothing drawn: depth 1).
-bool gbuffer_surface(ivec2 pixel, out Surface s)
+void gbuffer_planes(ivec2 pixel, int i, inout Surface s)
 {
-    float depth = texelFetch(u_gbuffer_depth, pixel, 0).r;
-    if (depth >= 1.0)
-        return false;
-    s.P = gbuffer_position(vec2(pixel) + 0.5, depth);
-    s.N = gbuffer_decode_normal(texelFetch(u_gbuffer_normal, pixel, 0));
-    s.albedo = gbuffer_decode_albedo(texelFetch(u_gbuffer_albedo, pixel, 0));
-    vec4 m = texelFetch(u_gbuffer_material, pixel, 0);
+    s.N = gbuffer_decode_normal(msaa_fetch(u_gbuffer_normal, pixel, i));
+    s.albedo = gbuffer_decode_albedo(msaa_fetch(u_gbuffer_albedo, pixel, i));
+    vec4 m = msaa_fetch(u_gbuffer_material, pixel, i);
     s.specular = m.r;
     s.shininess = m.g;
     s.metallic = m.b;
     s.roughness = m.a;
+}
+
+#ifdef SB_MSAA_SAMPLES
+// Forward at MSAA shades each surface in a pixel once, at the pixel's
+// centre (its attributes extrapolated there), and so does lighting here: P,
+// a point of the surface within the pixel, moves along the surface's plane
+// (normal N) to where the ray through the centre meets it. Seen edge-on the
+// plane gives no such point, and P stays.
+vec3 gbuffer_at_centre(ivec2 pixel, vec3 P, vec3 N)
+{
+    vec3 eye = u_frame.eye.xyz;
+    vec3 dir = normalize(gbuffer_position(vec2(pixel) + 0.5, 1.0) - eye);
+    float facing = dot(dir, N);
+    if (abs(facing) < 0.05)
+        return P;
+    vec3 C = eye + dir * (dot(P - eye, N) / facing);
+    // A curved surface's shading normal is not its triangle's plane: near a
+    // silhouette the move would leave the pixel; then P stays.
+    float footprint = distance(P, eye) * 2.0 * u_frame.viewport.w / u_frame.proj[1][1];
+    return distance(C, P) < footprint ? C : P;
+}
+#endif
+
+// False for background pixels (nothing drawn: depth 1).
+bool gbuffer_surface(ivec2 pixel, out Surface s)
+{
+#if !defined(SB_MSAA_SAMPLES)
+    float depth = texelFetch(u_gbuffer_depth, pixel, 0).r;
+    if (depth >= 1.0)
+        return false;
+    s.P = gbuffer_position(vec2(pixel) + 0.5, depth);
+    gbuffer_planes(pixel, 0, s);
+#elif defined(GBUFFER_PER_SAMPLE)
+    int i = gl_SampleID;
+    float depth = texelFetch(u_gbuffer_depth, pixel, i).r;
+    if (depth >= 1.0)
+        return false;
+    gbuffer_planes(pixel, i, s);
+    s.P = gbuffer_at_centre(pixel, gbuffer_position(vec2(pixel) + u_sample_pos[i], depth), s.N);
+#else
+    float depth = 0.0;
+    for (int i = 0; i < SB_MSAA_SAMPLES; i++)
+        depth += texelFetch(u_gbuffer_depth, pixel, i).r;
+    depth /= float(SB_MSAA_SAMPLES);
+    if (texelFetch(u_gbuffer_depth, pixel, 0).r >= 1.0)
+        return false;
+    gbuffer_planes(pixel, 0, s);
+    s.P = gbuffer_at_centre(pixel, gbuffer_position(vec2(pixel) + u_sample_centre, depth), s.N);
+#endif
     return true;
 }
+
+#ifdef SB_MSAA_SAMPLES
+// True when the samples of pixel hold more than one surface: one is
+// background and another not, or their normals, albedo or material differ,
+// or a sample lies off the plane through sample 0 (a surface behind another
+// of the same orientation and colour). Coplanar samples of one object (the
+// two triangles of a quad) are one surface: shading them once is exact.
+bool gbuffer_edge(ivec2 pixel)
+{
+    float d0 = texelFetch(u_gbuffer_depth, pixel, 0).r;
+    vec4 n0 = texelFetch(u_gbuffer_normal, pixel, 0);
+    vec4 a0 = texelFetch(u_gbuffer_albedo, pixel, 0);
+    vec4 m0 = texelFetch(u_gbuffer_material, pixel, 0);
+    vec3 P0 = gbuffer_position(vec2(pixel) + u_sample_pos[0], d0);
+    vec3 N0 = gbuffer_decode_normal(n0);
+    // 24-bit depth is good to about 1e-4 of the distance at the scenes'
+    // depths: ten times that is noise, a surface behind another is not.
+    float tolerance = 1e-3 * max(distance(P0, u_frame.eye.xyz), 1.0);
+    for (int i = 1; i < SB_MSAA_SAMPLES; i++) {
+        float d = texelFetch(u_gbuffer_depth, pixel, i).r;
+        if ((d >= 1.0) != (d0 >= 1.0))
+            return true;
+        if (d0 >= 1.0)
+            continue;
+        if (texelFetch(u_gbuffer_normal, pixel, i) != n0 ||
+            texelFetch(u_gbuffer_albedo, pixel, i) != a0 ||
+            texelFetch(u_gbuffer_material, pixel, i) != m0)
+            return true;
+        vec3 P = gbuffer_position(vec2(pixel) + u_sample_pos[i], d);
+        if (abs(dot(P - P0, N0)) > tolerance)
+            return true;
+    }
+    return false;
+}
+#endif
 
 // The surface's material, as the lighting library's Material forms take it
 // (scene_data.glsl declares the struct).

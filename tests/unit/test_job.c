@@ -405,6 +405,27 @@ int main(void)
     rejects("{\"timeout_s\":\"1h\"}", "timeout_s");
     job_spec_set_default_timeout(0);
 
+    /* msaa: 1 unless given; 1, 2, 4 or 8, and at most the device's limit
+     * once the daemon knows it; the framebuffers' estimate grows with it. */
+    CHECK(parse("{}", &spec, &err) && spec.msaa == 1);
+    CHECK(parse("{\"msaa\":8}", &spec, &err) && spec.msaa == 8);
+    rejects("{\"msaa\":3}", "msaa");
+    rejects("{\"msaa\":0}", "msaa");
+    rejects("{\"msaa\":16}", "msaa");
+    rejects("{\"msaa\":\"4x\"}", "msaa");
+    job_spec_set_max_msaa(4);
+    CHECK(parse("{\"msaa\":4}", &spec, &err) && spec.msaa == 4);
+    rejects("{\"msaa\":8}", "msaa");
+    {
+        struct job_spec one, four;
+        struct job_cost c1, c4;
+        CHECK(parse("{}", &one, &err) && parse("{\"msaa\":4}", &four, &err));
+        job_cost_estimate(&one, &c1);
+        job_cost_estimate(&four, &c4);
+        CHECK(c4.targets_bytes > 3.0 * c1.targets_bytes);
+    }
+    job_spec_set_max_msaa(0);
+
     /* At most 1000 captures a job, however small the frames. */
     rejects("{\"frames\":100000,\"capture_interval\":99,\"scene\":{\"width\":16,\"height\":16}}",
             "capture_interval");

@@ -2,7 +2,7 @@
 
 #include <stddef.h>
 
-static const char *const passes[] = {"binning", "gbuffer", "lighting", NULL};
+static const char *const passes[] = {"binning", "gbuffer", "edges", "lighting", NULL};
 
 static const struct opt_field options[] = {
     CLUSTER_OPTION_ROWS(struct clustered_deferred_options, cluster),

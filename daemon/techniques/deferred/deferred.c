@@ -17,7 +17,7 @@
 #include "daemon/techniques/shared/gbuffer.h"
 #include "daemon/techniques/shared/heat.h"
 
-enum { PASS_GBUFFER, PASS_LIGHTING };
+enum { PASS_GBUFFER, PASS_EDGES, PASS_LIGHTING };
 /* deferred_light.vert's sphere: 16 segments, 8 rings. */
 enum { VOLUME_VERTICES = 16 * 8 * 6, RECT_VERTICES = 6 };
 
@@ -31,8 +31,9 @@ static const char *const bounds_defines[] = {
 struct deferred {
     struct gbuffer gbuffer;
     struct heat heat;
-    struct scene_program ambient, light;
-    GLint ambient_heat, light_heat;
+    /* [0] once a pixel; [1] once a sample, for the edge pixels at msaa > 1. */
+    struct scene_program ambient[2], light[2];
+    GLint ambient_heat[2], light_heat[2];
     GLuint light_fbo, empty_vao;
     int bounds;
 };
@@ -53,12 +54,9 @@ static bool deferred_create(const struct technique_env *env, void **state, char 
     if (!gbuffer_init(&d->gbuffer, env, &o->gbuffer, err, errlen) ||
         !heat_init(&d->heat, env, err, errlen))
         goto fail;
-    d->light_fbo = gpu_targets_fbo(env->targets, "deferred.light", &env->output_color, 1, 0,
-                                   err, errlen);
+    d->light_fbo = gbuffer_light_fbo(&d->gbuffer, env, "deferred.light", err, errlen);
     if (!d->light_fbo)
         goto fail;
-    char defines[1024];
-    snprintf(defines, sizeof(defines), "%s%s", bounds_defines[d->bounds], d->gbuffer.defines);
     const struct gl_stage ambient[] = {
         {GL_VERTEX_SHADER, {"fullscreen.vert"}},
         {GL_FRAGMENT_SHADER, {"deferred_ambient.frag"}},
@@ -67,16 +65,20 @@ static bool deferred_create(const struct technique_env *env, void **state, char 
         {GL_VERTEX_SHADER, {"deferred_light.vert"}},
         {GL_FRAGMENT_SHADER, {"deferred_light.frag"}},
     };
-    GLuint ambient_prog = gl_program_build("deferred ambient", ambient, 2, defines, err, errlen);
-    if (!ambient_prog)
-        goto fail;
-    d->ambient = gpu_scene_program(env->gpu, ambient_prog);
-    GLuint light_prog = gl_program_build("deferred lights", light, 2, defines, err, errlen);
-    if (!light_prog)
-        goto fail;
-    d->light = gpu_scene_program(env->gpu, light_prog);
-    d->ambient_heat = heat_location(ambient_prog);
-    d->light_heat = heat_location(light_prog);
+    for (int run = 0; run < gbuffer_shading_runs(&d->gbuffer); run++) {
+        GLuint ambient_prog = gbuffer_program(&d->gbuffer, "deferred ambient", ambient, 2,
+                                              bounds_defines[d->bounds], run == 1, err, errlen);
+        if (!ambient_prog)
+            goto fail;
+        d->ambient[run] = gpu_scene_program(env->gpu, ambient_prog);
+        GLuint light_prog = gbuffer_program(&d->gbuffer, "deferred lights", light, 2,
+                                            bounds_defines[d->bounds], run == 1, err, errlen);
+        if (!light_prog)
+            goto fail;
+        d->light[run] = gpu_scene_program(env->gpu, light_prog);
+        d->ambient_heat[run] = heat_location(ambient_prog);
+        d->light_heat[run] = heat_location(light_prog);
+    }
     glGenVertexArrays(1, &d->empty_vao);
     return true;
 fail:
@@ -91,9 +93,13 @@ static bool deferred_render(void *state, const struct technique_env *env, int64_
     struct deferred *d = state;
     bool heat = heat_wanted(env, frame);
     gpu_scene_set_light_rows(env->gpu, &frame, 1);
-    heat_enable(d->ambient.prog, d->ambient_heat, heat);
-    heat_enable(d->light.prog, d->light_heat, heat);
+    int runs = gbuffer_shading_runs(&d->gbuffer);
+    for (int run = 0; run < runs; run++) {
+        heat_enable(d->ambient[run].prog, d->ambient_heat[run], heat);
+        heat_enable(d->light[run].prog, d->light_heat[run], heat);
+    }
     gbuffer_draw(&d->gbuffer, env, PASS_GBUFFER);
+    gbuffer_edges_draw(&d->gbuffer, env, PASS_EDGES, frame);
 
     gpu_pass_begin(env->passes, PASS_LIGHTING, d->light_fbo, env->width, env->height);
     glDisable(GL_DEPTH_TEST);
@@ -103,29 +109,36 @@ static bool deferred_render(void *state, const struct technique_env *env, int64_
         heat_bind(&d->heat); /* the ambient pass zeroes every pixel's count */
     glBindVertexArray(d->empty_vao);
     /* Each tile gets the ambient term, then every light in index order:
-     * what each pixel sums is the same as in one draw of each. */
+     * what each pixel sums is the same as in one draw of each. At msaa > 1
+     * the pixels the edge pass left unmarked are shaded once, the marked
+     * ones once a sample (the stencil keeps the two runs apart). */
     struct gpu_tiles t;
-    for (gpu_tiles_begin(env->budget, env->width, env->height, &t); gpu_tiles_next(env->budget, &t);) {
-        glDisable(GL_BLEND);
-        glDisable(GL_CULL_FACE);
-        gpu_scene_bind(env->gpu, &d->ambient);
-        glDrawArrays(GL_TRIANGLES, 0, 3);
-        if (env->scene->light_count == 0)
-            continue;
-        if (heat)
-            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-        glEnable(GL_BLEND);
-        glBlendFunc(GL_ONE, GL_ONE);
-        if (d->bounds == LIGHT_BOUNDS_VOLUME) {
-            /* The far side of each sphere covers its projection once, whether
-             * the eye is outside the sphere or inside it. */
-            glEnable(GL_CULL_FACE);
-            glCullFace(GL_FRONT);
+    for (gpu_tiles_begin(env->budget, env->width, env->height, &t);
+         gpu_tiles_next(env->budget, &t);) {
+        for (int run = 0; run < runs; run++) {
+            gbuffer_shading_state(&d->gbuffer, run);
+            glDisable(GL_BLEND);
+            glDisable(GL_CULL_FACE);
+            gpu_scene_bind(env->gpu, &d->ambient[run]);
+            glDrawArrays(GL_TRIANGLES, 0, 3);
+            if (env->scene->light_count == 0)
+                continue;
+            if (heat)
+                glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+            glEnable(GL_BLEND);
+            glBlendFunc(GL_ONE, GL_ONE);
+            if (d->bounds == LIGHT_BOUNDS_VOLUME) {
+                /* The far side of each sphere covers its projection once,
+                 * whether the eye is outside the sphere or inside it. */
+                glEnable(GL_CULL_FACE);
+                glCullFace(GL_FRONT);
+            }
+            gpu_scene_bind(env->gpu, &d->light[run]);
+            glDrawArraysInstanced(GL_TRIANGLES, 0,
+                                  d->bounds == LIGHT_BOUNDS_VOLUME ? VOLUME_VERTICES
+                                                                   : RECT_VERTICES,
+                                  env->scene->light_count);
         }
-        gpu_scene_bind(env->gpu, &d->light);
-        glDrawArraysInstanced(GL_TRIANGLES, 0,
-                              d->bounds == LIGHT_BOUNDS_VOLUME ? VOLUME_VERTICES : RECT_VERTICES,
-                              env->scene->light_count);
     }
     glBindVertexArray(0);
     if (heat)
@@ -147,10 +160,12 @@ static void deferred_destroy(void *state)
     struct deferred *d = state;
     if (!d)
         return;
-    if (d->ambient.prog)
-        glDeleteProgram(d->ambient.prog);
-    if (d->light.prog)
-        glDeleteProgram(d->light.prog);
+    for (int run = 0; run < 2; run++) {
+        if (d->ambient[run].prog)
+            glDeleteProgram(d->ambient[run].prog);
+        if (d->light[run].prog)
+            glDeleteProgram(d->light[run].prog);
+    }
     if (d->empty_vao)
         glDeleteVertexArrays(1, &d->empty_vao);
     gbuffer_finish(&d->gbuffer);

@@ -2,7 +2,7 @@
 
 #include <stddef.h>
 
-static const char *const passes[] = {"gbuffer", "lighting", NULL};
+static const char *const passes[] = {"gbuffer", "edges", "lighting", NULL};
 
 static const struct opt_field options[] = {
     {.name = "light_bounds", .type = OPT_CHOICE, .def = LIGHT_BOUNDS_SCISSOR_TIGHT,

@@ -5,6 +5,12 @@
 #include "heat.glsl"
 flat in int v_light;
 layout(location = 0) out vec4 out_color;
+#ifdef SB_MSAA_SAMPLES
+// At MSAA the stencil keeps each lighting run (per pixel, per sample) to its
+// pixels: test it before the shader, which the heat map's image writes
+// would otherwise put after it, every pixel then paying for both runs.
+layout(early_fragment_tests) in;
+#endif
 
 void main()
 {

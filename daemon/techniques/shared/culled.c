@@ -14,10 +14,13 @@ struct culled {
     struct depth_prepass prepass;
     struct light_grid grid;
     struct heat heat;
-    struct scene_program shade;
-    GLint heat_loc;
+    /* [0] once a pixel; [1] (deferred at msaa > 1) once a sample, for the
+     * edge pixels. */
+    struct scene_program shade[2];
+    GLint heat_loc[2];
+    int runs;
     GLuint light_fbo, empty_vao;
-    int pass_geometry, pass_binning, pass_shading;
+    int pass_geometry, pass_edges, pass_binning, pass_shading;
 };
 
 bool culled_create(const struct technique_env *env, const struct culled_config *cfg,
@@ -31,9 +34,12 @@ bool culled_create(const struct technique_env *env, const struct culled_config *
     *state = c;
     c->cfg = *cfg;
     bool tiles = cfg->grid.kind == LIGHT_GRID_TILES;
+    /* The deferred ones time their edge pass (MSAA) after the g-buffer. */
     c->pass_geometry = tiles ? 0 : 1;
-    c->pass_binning = tiles ? 1 : 0;
-    c->pass_shading = 2;
+    c->pass_edges = cfg->deferred ? c->pass_geometry + 1 : -1;
+    c->pass_binning = tiles ? 1 + cfg->deferred : 0;
+    c->pass_shading = 2 + cfg->deferred;
+    c->runs = 1;
     if (!light_grid_init(&c->grid, env, &cfg->grid, err, errlen) ||
         !heat_init(&c->heat, env, err, errlen))
         goto fail;
@@ -41,15 +47,24 @@ bool culled_create(const struct technique_env *env, const struct culled_config *
     if (cfg->deferred) {
         if (!gbuffer_init(&c->gbuffer, env, &cfg->gbuffer, err, errlen))
             goto fail;
-        c->light_fbo = gpu_targets_fbo(env->targets, "culled.light", &env->output_color, 1, 0,
-                                       err, errlen);
+        c->light_fbo = gbuffer_light_fbo(&c->gbuffer, env, "culled.light", err, errlen);
         const struct gl_stage stages[] = {
             {GL_VERTEX_SHADER, {"fullscreen.vert"}},
             {GL_FRAGMENT_SHADER, {"culled_deferred.frag"}},
         };
-        if (!c->light_fbo ||
-            !(prog = gl_program_build("culled deferred lighting", stages, 2, c->gbuffer.defines,
-                                      err, errlen)))
+        if (!c->light_fbo)
+            goto fail;
+        c->runs = gbuffer_shading_runs(&c->gbuffer);
+        for (int run = 1; run < c->runs; run++) {
+            GLuint p = gbuffer_program(&c->gbuffer, "culled deferred lighting", stages, 2, "",
+                                       true, err, errlen);
+            if (!p)
+                goto fail;
+            c->shade[run] = gpu_scene_program(env->gpu, p);
+            c->heat_loc[run] = heat_location(p);
+        }
+        if (!(prog = gbuffer_program(&c->gbuffer, "culled deferred lighting", stages, 2, "",
+                                     false, err, errlen)))
             goto fail;
         glGenVertexArrays(1, &c->empty_vao);
     } else {
@@ -62,8 +77,8 @@ bool culled_create(const struct technique_env *env, const struct culled_config *
                                       errlen)))
             goto fail;
     }
-    c->shade = gpu_scene_program(env->gpu, prog);
-    c->heat_loc = heat_location(prog);
+    c->shade[0] = gpu_scene_program(env->gpu, prog);
+    c->heat_loc[0] = heat_location(prog);
     return true;
 fail:
     culled_destroy(c);
@@ -85,12 +100,14 @@ bool culled_render(void *state, const struct technique_env *env, int64_t frame, 
     bool tiles = c->cfg.grid.kind == LIGHT_GRID_TILES;
     bool heat = heat_wanted(env, frame);
     gpu_scene_set_light_rows(env->gpu, &frame, 1);
-    heat_enable(c->shade.prog, c->heat_loc, heat);
+    for (int run = 0; run < c->runs; run++)
+        heat_enable(c->shade[run].prog, c->heat_loc[run], heat);
     if (!tiles)
         binning(c, env, frame);
-    if (c->cfg.deferred)
+    if (c->cfg.deferred) {
         gbuffer_draw(&c->gbuffer, env, c->pass_geometry);
-    else
+        gbuffer_edges_draw(&c->gbuffer, env, c->pass_edges, frame);
+    } else
         depth_prepass_draw(&c->prepass, env, c->pass_geometry);
     if (tiles)
         binning(c, env, frame);
@@ -100,27 +117,33 @@ bool culled_render(void *state, const struct technique_env *env, int64_t frame, 
         glDisable(GL_DEPTH_TEST);
         glDisable(GL_CULL_FACE);
         gbuffer_bind(&c->gbuffer, env);
-        if (heat)
+        /* Per-sample shading adds each sample's evaluations: from zero. */
+        if (heat && c->runs > 1)
+            heat_clear(&c->heat, c->light_fbo);
+        else if (heat)
             heat_bind(&c->heat);
-        gpu_scene_bind(env->gpu, &c->shade);
         light_grid_bind(&c->grid);
         glBindVertexArray(c->empty_vao);
         struct gpu_tiles t;
         for (gpu_tiles_begin(env->budget, env->width, env->height, &t);
              gpu_tiles_next(env->budget, &t);)
-            glDrawArrays(GL_TRIANGLES, 0, 3);
+            for (int run = 0; run < c->runs; run++) {
+                gbuffer_shading_state(&c->gbuffer, run);
+                gpu_scene_bind(env->gpu, &c->shade[run]);
+                glDrawArrays(GL_TRIANGLES, 0, 3);
+            }
         glBindVertexArray(0);
     } else {
         gpu_pass_begin(env->passes, c->pass_shading, env->output_fbo, env->width, env->height);
         depth_prepass_shading_state();
         if (heat)
             heat_clear(&c->heat, env->output_fbo);
-        gpu_scene_bind(env->gpu, &c->shade);
+        gpu_scene_bind(env->gpu, &c->shade[0]);
         light_grid_bind(&c->grid);
         struct gpu_tiles t;
         for (gpu_tiles_begin(env->budget, env->width, env->height, &t);
              gpu_tiles_next(env->budget, &t);)
-            gpu_scene_draw(env->gpu, &c->shade);
+            gpu_scene_draw(env->gpu, &c->shade[0]);
     }
     if (heat)
         heat_done();
@@ -148,8 +171,9 @@ void culled_destroy(void *state)
     struct culled *c = state;
     if (!c)
         return;
-    if (c->shade.prog)
-        glDeleteProgram(c->shade.prog);
+    for (int run = 0; run < 2; run++)
+        if (c->shade[run].prog)
+            glDeleteProgram(c->shade[run].prog);
     if (c->empty_vao)
         glDeleteVertexArrays(1, &c->empty_vao);
     gbuffer_finish(&c->gbuffer);

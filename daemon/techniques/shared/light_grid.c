@@ -250,8 +250,15 @@ bool light_grid_init(struct light_grid *g, const struct technique_env *env,
     const char *defines = tiles ? "#define GRID_TILES 1\n" : "";
     if (tiles) {
         g->tile_depth_buf = make_buffer((double)g->cells * 8.0, &g->buffer_bytes);
-        if (!(g->depth_prog = build_compute("tile depth bounds", "tile_depth.comp", defines, err,
-                                            errlen)))
+        /* A multisampled depth is read sample by sample (msaa.glsl). */
+        char depth_defines[64];
+        snprintf(depth_defines, sizeof(depth_defines), "%s", defines);
+        if (env->samples > 1)
+            snprintf(depth_defines + strlen(depth_defines),
+                     sizeof(depth_defines) - strlen(depth_defines),
+                     "#define SB_MSAA_SAMPLES %d\n", env->samples);
+        if (!(g->depth_prog = build_compute("tile depth bounds", "tile_depth.comp", depth_defines,
+                                            err, errlen)))
             return false;
     }
     return (g->scatter_prog = build_compute("light scatter", "light_scatter.comp", defines, err,
@@ -392,7 +399,7 @@ void light_grid_build(struct light_grid *g, const struct technique_env *env, int
         if (g->cfg.kind == LIGHT_GRID_TILES) {
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_TILE_DEPTH, g->tile_depth_buf);
             glActiveTexture(GL_TEXTURE0 + SB_TEX_DEPTH);
-            glBindTexture(GL_TEXTURE_2D, env->output_depth);
+            glBindTexture(gpu_targets_kind(env->targets, env->output_depth), env->output_depth);
             glActiveTexture(GL_TEXTURE0);
             glUseProgram(g->depth_prog);
             glDispatchCompute((GLuint)g->block.dims[0], (GLuint)g->block.dims[1], 1);

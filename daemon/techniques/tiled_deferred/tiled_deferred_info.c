@@ -2,7 +2,7 @@
 
 #include <stddef.h>
 
-static const char *const passes[] = {"gbuffer", "binning", "lighting", NULL};
+static const char *const passes[] = {"gbuffer", "edges", "binning", "lighting", NULL};
 
 static const struct opt_field options[] = {
     {.name = "tile_size", .type = OPT_INT, .def = 16, .min = 8, .max = 128,

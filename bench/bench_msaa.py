@@ -28,6 +28,7 @@ import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
 import testlib  # noqa: E402
+import benchrun  # noqa: E402
 
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument("--counts", default="16,256,1024")
@@ -51,6 +52,8 @@ def med(xs):
     return statistics.median(xs) if xs else float("nan")
 
 
+bench = benchrun.Run()
+bench.start()
 d = testlib.Daemon()
 runs = {}
 loads = []
@@ -115,7 +118,8 @@ try:
                          mib))
     la = [x[0] for x in loads]
     oc = [x[1] for x in loads]
-    print("\nload: 1-minute load average %.1f to %.1f (median %.1f), other processes' CPU share "
+    bench.end([r for rs in runs.values() for r in rs])
+    print("load: 1-minute load average %.1f to %.1f (median %.1f), other processes' CPU share "
           "%.2f to %.2f (median %.2f); %d jobs in %.0f s"
           % (min(la), max(la), med(la), min(oc), max(oc), med(oc), len(loads),
              time.time() - t_start))

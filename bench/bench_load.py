@@ -103,7 +103,7 @@ try:
         unloaded.append(job["result"]["frame_ms"]["median"])
         # The measured job waits behind a blocker while the load builds up
         # (its long-polls wait on the measured job itself), then runs under it.
-        blocker = d.submit(dict(JOB, frames=1000000))
+        blocker = d.submit(dict(JOB, frames=1000000, timeout_s=0))
         while d.json("GET", "/v1/jobs/" + blocker)[1]["status"] != "running":
             time.sleep(0.05)
         measured = d.submit(JOB)
@@ -124,7 +124,7 @@ try:
 
     wrk = shutil.which("wrk")
     if wrk:
-        blocker = d.submit(dict(JOB, frames=1000000))
+        blocker = d.submit(dict(JOB, frames=1000000, timeout_s=0))
         for path in ("/healthz", "/v1/info", "/v1/jobs", "/v1/jobs/" + blocker, "/metrics"):
             out = subprocess.run([wrk, "-t2", "-c32", "-d5s", d.base + path], capture_output=True,
                                  text=True).stdout

@@ -75,7 +75,7 @@ try:
     check(d.json("GET", "/v1/jobs/%s?wait=-1" % good)[0] == 400, "negative wait is 400")
 
     # A full queue answers 429: one job running, 64 waiting.
-    long_job = {"frames": 1000000, "warmup_frames": 0, "scene": {"width": 32, "height": 32}}
+    long_job = {"frames": 1000000, "warmup_frames": 0, "timeout_s": 0, "scene": {"width": 32, "height": 32}}
     ids = [d.submit(long_job)]
     deadline = time.time() + 30
     while d.json("GET", "/v1/jobs/" + ids[0])[1]["status"] != "running" and time.time() < deadline:

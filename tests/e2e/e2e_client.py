@@ -114,7 +114,7 @@ try:
     fetched = cl.path("fetched")
     out = cl.run("fetch", job_id, "--out", fetched)
     check(out.returncode == 0 and os.path.exists(os.path.join(fetched, "flip-000006.png")), "fetch downloads")
-    long_id = cl.run("submit", cl.write("long", {"frames": 1000000, "warmup_frames": 0,
+    long_id = cl.run("submit", cl.write("long", {"frames": 1000000, "warmup_frames": 0, "timeout_s": 0,
                                                  "scene": {"width": 32, "height": 32}})).stdout.strip()
     out = cl.run("fetch", long_id, "--out", fetched)
     check(out.returncode == 2 and "already holds" in out.stderr, "fetch refuses another job's folder")

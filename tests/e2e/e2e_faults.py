@@ -101,7 +101,7 @@ try:
     # /healthz: what the render thread does.
     health = d.json("GET", "/healthz")[1]
     check(health.get("render", {}).get("state") == "idle", "idle: %s" % health)
-    long_job = d.submit(dict(TINY, frames=1000000))
+    long_job = d.submit(dict(TINY, frames=1000000, timeout_s=0))
     wait_status(d, long_job, ("running",))
     time.sleep(0.3)
     status, health = d.json("GET", "/healthz")

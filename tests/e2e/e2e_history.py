@@ -32,7 +32,7 @@ try:
     o = d.run(dict(JOB, technique="osl", capture_interval=6, reference="forward",
                    osl={"resolution": "auto"}, labels={"branch": "topic", "commit": "ccc"}))
     check(a["spec"]["labels"] == {"branch": "main", "commit": "aaa"}, "the spec keeps the labels")
-    long_id = d.submit({"frames": 1000000, "warmup_frames": 0, "scene": {"width": 32, "height": 32}})
+    long_id = d.submit({"frames": 1000000, "warmup_frames": 0, "timeout_s": 0, "scene": {"width": 32, "height": 32}})
     d.json("DELETE", "/v1/jobs/" + long_id)
     d.wait(long_id)
 

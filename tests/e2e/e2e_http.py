@@ -95,7 +95,7 @@ try:
     check(status == 200 and sub["id"] in ids and again["id"] in ids, "list has the jobs")
 
     # Cancel a running job and a queued one; many waiting clients never block others.
-    long_job = dict(JOB, frames=100000, capture_interval=0, scene={"width": 64, "height": 64})
+    long_job = dict(JOB, frames=100000, timeout_s=0, capture_interval=0, scene={"width": 64, "height": 64})
     running = d.submit(long_job)
     queued = d.submit(long_job)
     deadline = time.time() + 30

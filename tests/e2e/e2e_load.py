@@ -110,7 +110,7 @@ def trickle(port):
 
 d = testlib.Daemon()
 try:
-    job = d.submit({"frames": 1000000, "warmup_frames": 0, "scene": {"width": 128, "height": 128}})
+    job = d.submit({"frames": 1000000, "warmup_frames": 0, "timeout_s": 0, "scene": {"width": 128, "height": 128}})
     deadline = time.time() + 30
     while d.json("GET", "/v1/jobs/" + job)[1].get("status") != "running" and time.time() < deadline:
         time.sleep(0.05)

@@ -100,13 +100,13 @@ endif
 # in this order, so the short ones fill in beside the long ones instead of
 # one long test running alone at the end.
 E2E_TESTS = \
+	tests/e2e/e2e_msaa.py \
 	tests/e2e/e2e_report.py \
 	tests/e2e/e2e_faults.py \
 	tests/e2e/e2e_runaway.py \
 	tests/e2e/e2e_hardening.py \
 	tests/e2e/e2e_many_lights.py \
 	tests/e2e/e2e_techniques.py \
-	tests/e2e/e2e_msaa.py \
 	tests/e2e/e2e_load.py \
 	tests/e2e/e2e_osl.py \
 	tests/e2e/e2e_ab.py \

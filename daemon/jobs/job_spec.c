@@ -467,6 +467,10 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
         (scene && !scene_spec_parse(scene, &out->scene, err)))
         return false;
 
+    /* A reference with no word on captures scores the last frame, as a
+     * sweep's point does; an explicit 0 asks for no captures at all. */
+    if (out->reference[0] && out->capture_interval == 0 && !json_object_get(body, "capture_interval"))
+        out->capture_interval = out->frames;
     if (out->reference[0] && out->capture_interval == 0)
         return job_error_set(err, "reference", "needs capture_interval > 0: metrics compare the "
                     "captured frames with the reference's");

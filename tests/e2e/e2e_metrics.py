@@ -93,7 +93,7 @@ try:
     check(picked == ["psnr"], "a list picks metrics: %s" % picked)
 
     # Bad metric options name the field.
-    for body, field in (({"reference": "forward"}, "reference"),
+    for body, field in (({"reference": "forward", "capture_interval": 0}, "reference"),
                         (dict(JOB, reference="no_such_technique"), "reference"),
                         (dict(JOB, reference=None, metrics=["ssim"]), "metrics"),
                         (dict(JOB, metrics={"pdiff": {"fov": -1}}), "metrics.pdiff.fov"),

@@ -119,6 +119,11 @@ static void test_reference_temporal(void)
 {
     struct job_spec spec;
     struct job_error err;
+    /* A reference with no word on captures scores the last frame; an
+     * explicit 0 is refused. */
+    CHECK(parse("{\"frames\":8,\"reference\":\"forward\"}", &spec, &err) &&
+          spec.capture_interval == 8);
+    rejects("{\"frames\":8,\"capture_interval\":0,\"reference\":\"forward\"}", "reference");
     CHECK(parse("{\"technique\":\"unlit\",\"frames\":4,\"capture_interval\":2,"
                 "\"reference\":\"forward\",\"scene\":{\"width\":64,\"height\":48}}", &spec, &err));
     CHECK(spec.reference_supersample == 1 && spec.temporal_frames == 0);

@@ -59,9 +59,11 @@ static bool out_of_time(struct harness_run *run, int seq, double fastest_s)
 {
     const struct job *job = run->job;
     int left = run->spec->warmup_frames + run->spec->frames - seq - 1;
-    double more = fastest_s * left, ran = clock_unix_s() - job->started;
-    if (job->spec.timeout_s <= 0 || job->started <= 0 || !isfinite(fastest_s) || more < 1.0 ||
-        ran + more <= job->spec.timeout_s)
+    double more = fastest_s * left;
+    if (job->spec.timeout_s <= 0 || job->started <= 0 || !isfinite(fastest_s) || more < 1.0)
+        return false;
+    double ran = clock_unix_s() - job->started;
+    if (ran + more <= job->spec.timeout_s)
         return false;
     snprintf(run->err, sizeof(run->err),
              "timeout: the job cannot finish within its timeout_s of %g s: after %.1f s, "

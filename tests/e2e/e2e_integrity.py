@@ -83,7 +83,11 @@ try:
     before = d.run(SMALL)["result"]["interference"]["daemon_minor_faults"]
     check(d.run(LARGE)["status"] == "done", "a large job")
     after = d.run(SMALL)["result"]["interference"]["daemon_minor_faults"]
-    check(after <= max(2000, 10 * before),
+    print("page faults in a small job's timed frames: %d before a large job, %d after" % (before, after))
+    # Without a large job in between the count still spreads from 0 to about
+    # 6,000 (the driver's bins, the other threads): the bound sits between
+    # that and the 88,000 of the bug.
+    check(after <= max(20000, 10 * before),
           "a small job after a large one: %d page faults in its timed frames (%d before it)" % (after, before))
 
     # Repeated jobs: every run says what could have disturbed it.

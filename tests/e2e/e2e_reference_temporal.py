@@ -85,6 +85,20 @@ try:
     check(flicker[8] > 3 * flicker[0] and flicker[8] > 1e-4,
           "OSL's flicker grows with async distance: %s" % flicker)
 
+    # SSAO with few samples shimmers as the camera moves: against 64 samples,
+    # 4 flicker more than 32 (0.00049 and 0.00029 when written).
+    ssao = {}
+    for n in (4, 32):
+        j = d.run({"technique": "forward", "frames": 4, "warmup_frames": 0, "capture_interval": 4,
+                   "reference": "forward", "temporal": {"frames": 6}, "metrics": ["ssim"],
+                   "look": {"post": [{"ssao": {"samples": n}}]},
+                   "reference_look": {"post": [{"ssao": {"samples": 64}}]},
+                   "scene": {"preset": "grid", "width": 160, "height": 120, "camera": "orbit"}})
+        ssao[n] = (j.get("result", {}).get("quality", {}).get("worst_flicker") or {}).get("value")
+    print("SSAO flicker against 64 samples: %s" % ssao)
+    check(ssao[4] is not None and ssao[32] is not None and ssao[4] > 1.2 * ssao[32],
+          "SSAO at 4 samples flickers more than at 32: %s" % ssao)
+
     # Sweeps: reference.supersample as an axis (each factor its own
     # workload: forward is exact only against x1) ...
     code, reply = d.json("POST", "/v1/sweeps", {

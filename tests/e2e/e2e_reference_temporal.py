@@ -124,6 +124,20 @@ try:
     check(sw["status"] == "done" and bp.get("outcome") == "boundary" and 0 <= bp.get("value", -1) < 8,
           "flicker_max finds a boundary: %s" % bp)
     check(all("worst_flicker" in r for r in sw["points"]), "rows carry worst_flicker")
+    # ... and a find on the mean SSIM (the thesis's measure): where OSL at
+    # d = 8 drops below 0.999 as its lights speed up (0.99997 still, 0.9988
+    # at speed 1, 0.963 at 8).
+    code, reply = d.json("POST", "/v1/sweeps", {
+        "base": dict(JOB, technique="osl", osl={"async_distance": 8, "resolution": 32},
+                     reference="forward", metrics=["ssim"]),
+        "find": {"param": "scene.light_speed", "from": 0, "to": 8,
+                 "while": "ssim >= 0.999", "steps": 6}})
+    check(code == 202, "find on the mean SSIM accepted: %s" % reply)
+    sw = d.wait_sweep(reply["id"])
+    bp = sw.get("result", {}).get("breaking_point", {})
+    check(sw["status"] == "done" and bp.get("outcome") == "boundary" and
+          0 <= bp.get("value", -1) < 1 and bp.get("value", 9) < bp.get("first_failing", -1) <= 1,
+          "ssim >= 0.999 brackets a boundary below light speed 1: %s" % bp)
     code, reply = d.json("POST", "/v1/sweeps", {
         "base": dict(JOB, technique="osl"), "find": {"param": "scene.light_speed", "from": 0, "to": 8,
                                                       "while": "flicker_max <= 0.01"}})

@@ -16,6 +16,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "client/fleet.h"
 #include "common/clock.h" /* clock_mono_s: every interval the client measures */
 
 enum { EXIT_PASS = 0, EXIT_FAIL = 1, EXIT_ERROR = 2, EXIT_INCONCLUSIVE = 3 };
@@ -37,6 +38,7 @@ struct options {
     json_t *filters;          /* history: --filter KEY=VALUE, as query arguments */
     const char *since;
     const char *figure;       /* history: frame_ms, gpu_ms, cpu_ms or worst_ssim */
+    struct fleet_options fleet; /* sweep --slurm */
 };
 
 struct conn {

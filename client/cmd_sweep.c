@@ -7,82 +7,11 @@
 #include <string.h>
 
 #include "client/client.h"
+#include "client/fleet.h"
 #include "client/verdicts.h"
 #include "client/junit.h"
 #include "common/fsutil.h"
 #include "common/result_keys.h"
-
-static void csv_cell(FILE *f, const json_t *v)
-{
-    if (json_is_number(v))
-        fprintf(f, "%.10g", json_number_value(v));
-    else if (json_is_string(v))
-        fprintf(f, "\"%s\"", json_string_value(v)); /* values never hold quotes here */
-    else if (json_is_boolean(v))
-        fputs(json_is_true(v) ? "true" : "false", f);
-}
-
-/* One row per point: the swept values, then the figures. */
-static bool write_csv(const json_t *sweep, const char *path)
-{
-    FILE *f = fopen(path, "w");
-    if (!f)
-        return false;
-    json_t *points = json_object_get(sweep, "points");
-    json_t *keys = json_array(); /* swept fields, in order of first appearance */
-    size_t i, k;
-    json_t *row, *key;
-    json_array_foreach(points, i, row) {
-        const char *name;
-        json_t *v;
-        json_object_foreach(json_object_get(row, "values"), name, v) {
-            bool seen = false;
-            json_array_foreach(keys, k, key) seen = seen || !strcmp(json_string_value(key), name);
-            if (!seen)
-                json_array_append_new(keys, json_string(name));
-        }
-    }
-    json_array_foreach(keys, k, key) fprintf(f, "%s,", json_string_value(key));
-    static const char *const series[] = {RK_FRAME_MS, RK_GPU_MS, RK_CPU_MS};
-    fprintf(f, "technique,job,status");
-    for (int s = 0; s < 3; s++)
-        fprintf(f, ",%s_median,%s_ci95_low,%s_ci95_high,%s_over", series[s], series[s], series[s],
-                series[s]);
-    fprintf(f, ",worst_ssim,worst_ssim_min,worst_flip,pdiff_failed_captures,criterion_holds\n");
-    json_array_foreach(points, i, row) {
-        json_t *values = json_object_get(row, "values");
-        json_array_foreach(keys, k, key) {
-            csv_cell(f, json_object_get(values, json_string_value(key)));
-            fputc(',', f);
-        }
-        csv_cell(f, json_object_get(row, "technique"));
-        fputc(',', f);
-        csv_cell(f, json_object_get(row, "job"));
-        fputc(',', f);
-        csv_cell(f, json_object_get(row, "status"));
-        for (int s = 0; s < 3; s++) {
-            json_t *cell = json_object_get(row, series[s]);
-            json_t *ci = json_object_get(cell, RK_CI95);
-            fputc(',', f);
-            csv_cell(f, json_object_get(cell, RK_MEDIAN));
-            fputc(',', f);
-            csv_cell(f, json_array_get(ci, 0));
-            fputc(',', f);
-            csv_cell(f, json_array_get(ci, 1));
-            fputc(',', f);
-            csv_cell(f, json_object_get(cell, "over"));
-        }
-        static const char *const tail[] = {RK_WORST_SSIM, RK_WORST_SSIM_MIN, RK_WORST_FLIP,
-                                           RK_PDIFF_FAILED_CAPTURES, "criterion_holds"};
-        for (size_t t = 0; t < sizeof(tail) / sizeof(tail[0]); t++) {
-            fputc(',', f);
-            csv_cell(f, json_object_get(row, tail[t]));
-        }
-        fputc('\n', f);
-    }
-    json_decref(keys);
-    return fclose(f) == 0;
-}
 
 /* "osl async_distance=5 scene.lights=8": the point's content, stable from
  * build to build. */
@@ -228,7 +157,7 @@ static bool download_all(struct conn *c, const json_t *sweep, const char *dir)
     snprintf(path, sizeof(path), "%s/sweep.json", dir);
     ok = ok && fs_write_json_atomic(path, sweep);
     snprintf(path, sizeof(path), "%s/table.csv", dir);
-    ok = ok && write_csv(sweep, path);
+    ok = ok && sweep_csv_write(sweep, path);
     /* file name, chart name, query */
     static const char *const charts[][3] = {
         {"speed_accuracy", "speed_accuracy", ""},

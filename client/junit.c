@@ -123,7 +123,7 @@ static size_t junit_skipped(const struct junit *j)
     return n;
 }
 
-static void xml_escaped(FILE *f, const char *s)
+void xml_escaped(FILE *f, const char *s)
 {
     for (; s && *s; s++)
         switch (*s) {

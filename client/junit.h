@@ -49,6 +49,10 @@ void junit_out(struct junit_case *c, const char *fmt, ...) __attribute__((format
 void junit_prop_num(struct junit_case *c, const char *name, double value);
 void junit_prop_str(struct junit_case *c, const char *name, const char *value);
 
+/* s as XML (and HTML) text or attribute value: markup characters escaped,
+ * control characters other than newline and tab dropped. */
+void xml_escaped(FILE *f, const char *s);
+
 size_t junit_failures(const struct junit *j);
 /* Failures other than undecided checks, and undecided checks (skipped or
  * failed on request). */

@@ -44,6 +44,14 @@ static void usage(FILE *f)
             "  ab JOB.json --server-b URL   the same job on two daemons\n"
             "  sweep SWEEP.json    start a sweep; with --wait --out DIR download its table,\n"
             "                      charts and report\n"
+            "  sweep SWEEP.json --slurm --out DIR   run the sweep's points as Slurm job arrays\n"
+            "                      (shadebenchd --once on the nodes), then gather them\n"
+            "  sweep --slurm --resume DIR           gather what finished, run what is missing\n"
+            "  plan SWEEP.json --out DIR   only expand the sweep into DIR/plan/N.json, for CI\n"
+            "                      runners that run each point with shadebenchd --once\n"
+            "  gather DIR...       merge fleet folders (Slurm's, or CI runners' tasks/LABEL/N)\n"
+            "                      into one sweep result (--out OUT, default the first DIR)\n"
+            "  compare-devices DIR the device table of a gathered sweep\n"
             "  history             finished jobs matching --filter, with a trend (--out DIR)\n"
             "  status ID           one line: status, technique, progress, error\n"
             "  list                every job, one a line\n"
@@ -87,6 +95,18 @@ static void usage(FILE *f)
             "  --since TIME        jobs created since TIME (2026-11-21, 2026-11-21T10:00:00Z, or\n"
             "                      seconds since 1970)\n"
             "  --figure NAME       frame_ms, gpu_ms, cpu_ms or worst_ssim (default as --series)\n\n"
+            "Fleet (sweep --slurm; see docs/fleet.md):\n"
+            "  --slurm             submit the points to Slurm instead of a daemon\n"
+            "  --devices D1,D2     one array per device class, each constrained to the node\n"
+            "                      feature of its name (or NAME=CONSTRAINT)\n"
+            "  --constraint C      one device class, the nodes with feature C\n"
+            "  --partition P       sbatch --partition\n"
+            "  --gres G            sbatch --gres, e.g. gpu:1\n"
+            "  --max-parallel N    at most N tasks of an array at once (--array=...%%N)\n"
+            "  --time-limit T      sbatch --time for each task\n"
+            "  --requeue           let Slurm requeue a task whose node fails\n"
+            "  --shadebenchd PATH  the daemon on the nodes (default: the one beside this client)\n"
+            "  --resume DIR        complete a fleet folder: resubmit only the missing points\n\n"
             "  --timeout S         give up waiting after S seconds\n"
             "  --quiet             no progress or verdict lines on stderr\n\n"
             "Exit status: 0 pass, 1 regression or quality failure (or a failed job),\n"
@@ -187,7 +207,9 @@ int main(int argc, char **argv)
     enum { O_SERVER = 256, O_TOKEN, O_TOKEN_FILE, O_WAIT, O_OUT, O_JUNIT, O_MIN_SSIM, O_MAX_FLIP,
            O_BASELINE, O_SLOWDOWN, O_SERIES, O_TIMEOUT, O_QUIET, O_HELP, O_VERSION, O_RUNS,
            O_RERUNS, O_FAIL_INC, O_ALLOW, O_CONFIDENCE, O_NOISE, O_LABEL, O_FILTER, O_SINCE,
-           O_FIGURE, O_SERVER_B, O_NO_FAIL_INC, O_JSON };
+           O_FIGURE, O_SERVER_B, O_NO_FAIL_INC, O_JSON, O_SLURM, O_DEVICES, O_CONSTRAINT,
+           O_PARTITION, O_GRES, O_MAX_PARALLEL, O_TIME_LIMIT, O_REQUEUE, O_SHADEBENCHD,
+           O_RESUME };
     static const struct option longopts[] = {
         {"server", required_argument, NULL, O_SERVER},
         {"token", required_argument, NULL, O_TOKEN},
@@ -217,6 +239,16 @@ int main(int argc, char **argv)
         {"server-b", required_argument, NULL, O_SERVER_B},
         {"no-fail-inconclusive", no_argument, NULL, O_NO_FAIL_INC},
         {"json", no_argument, NULL, O_JSON},
+        {"slurm", no_argument, NULL, O_SLURM},
+        {"devices", required_argument, NULL, O_DEVICES},
+        {"constraint", required_argument, NULL, O_CONSTRAINT},
+        {"partition", required_argument, NULL, O_PARTITION},
+        {"gres", required_argument, NULL, O_GRES},
+        {"max-parallel", required_argument, NULL, O_MAX_PARALLEL},
+        {"time-limit", required_argument, NULL, O_TIME_LIMIT},
+        {"requeue", no_argument, NULL, O_REQUEUE},
+        {"shadebenchd", required_argument, NULL, O_SHADEBENCHD},
+        {"resume", required_argument, NULL, O_RESUME},
         {NULL, 0, NULL, 0},
     };
     /* CI sets the default once for every command; the flags override it. */
@@ -256,6 +288,16 @@ int main(int argc, char **argv)
         case O_FAIL_INC: o.fail_inconclusive = true; break;
         case O_NO_FAIL_INC: o.fail_inconclusive = false; break;
         case O_JSON: raw_json = true; break;
+        case O_SLURM: o.fleet.slurm = true; break;
+        case O_DEVICES: o.fleet.devices = optarg; break;
+        case O_CONSTRAINT: o.fleet.constraint = optarg; break;
+        case O_PARTITION: o.fleet.partition = optarg; break;
+        case O_GRES: o.fleet.gres = optarg; break;
+        case O_MAX_PARALLEL: o.fleet.max_parallel = count(optarg, "--max-parallel", 1, 100000); break;
+        case O_TIME_LIMIT: o.fleet.time_limit = optarg; break;
+        case O_REQUEUE: o.fleet.requeue = true; break;
+        case O_SHADEBENCHD: o.fleet.shadebenchd = optarg; break;
+        case O_RESUME: o.fleet.resume = optarg; break;
         case O_ALLOW: o.allow_mismatch = true; break;
         case O_LABEL: key_value(optarg, "--label", o.labels); break;
         case O_FILTER: key_value(optarg, "--filter", o.filters); break;
@@ -285,8 +327,8 @@ int main(int argc, char **argv)
         }
     }
     if (optind >= argc)
-        die_usage("no command given (submit, ab, sweep, history, status, list, cancel, fetch, "
-                  "info; --help explains them)");
+        die_usage("no command given (submit, ab, sweep, plan, gather, compare-devices, history, "
+                  "status, list, cancel, fetch, info; --help explains them)");
     const char *cmd = argv[optind];
     int nargs = argc - optind - 1;
     const char *arg = nargs > 0 ? argv[optind + 1] : NULL;
@@ -295,7 +337,8 @@ int main(int argc, char **argv)
         int min, max;
     } commands[] = {
         {"submit", 1, 1}, {"status", 1, 1}, {"cancel", 1, 1}, {"fetch", 1, 1}, {"list", 0, 0},
-        {"info", 0, 0},   {"ab", 1, 2},     {"sweep", 1, 1},  {"history", 0, 0},
+        {"info", 0, 0},   {"ab", 1, 2},     {"sweep", 0, 1},  {"history", 0, 0},
+        {"gather", 1, 64}, {"compare-devices", 1, 1}, {"plan", 1, 1},
     };
     size_t k = 0;
     while (k < sizeof(commands) / sizeof(commands[0]) && strcmp(commands[k].name, cmd) != 0)
@@ -313,12 +356,28 @@ int main(int argc, char **argv)
     if (nargs < commands[k].min || nargs > commands[k].max)
         die_usage("%s takes %s", cmd, commands[k].max == 0 ? "no argument"
                                       : commands[k].min == commands[k].max ? "one argument"
-                                                                           : "one or two arguments");
-    if (!strcmp(cmd, "fetch") && !o.out_dir)
-        die_usage("fetch needs --out DIR");
+                                      : commands[k].max == 64 ? "one to 64 folders"
+                                                              : "one or two arguments");
+    const struct fleet_options *fl = &o.fleet;
+    bool fleet_flags = fl->devices || fl->constraint || fl->partition || fl->gres ||
+                       fl->max_parallel || fl->time_limit || fl->requeue || fl->shadebenchd ||
+                       fl->resume;
+    if (!strcmp(cmd, "sweep") && (nargs == 0) != (fl->slurm && fl->resume != NULL))
+        die_usage(nargs ? "sweep --resume DIR takes no sweep file: the plan is in DIR"
+                        : "sweep takes a sweep file (or --slurm --resume DIR)");
+    if (fleet_flags && !fl->slurm)
+        die_usage("--devices, --constraint, --partition, --gres, --max-parallel, --time-limit, "
+                  "--requeue, --shadebenchd and --resume belong to sweep --slurm");
+    if (fl->slurm && strcmp(cmd, "sweep") != 0)
+        die_usage("--slurm belongs to sweep");
+    if (fl->slurm && (o.wait || o.baseline || o.junit))
+        die_usage("sweep --slurm always waits for its arrays; --wait, --baseline and --junit "
+                  "belong to a daemon's sweep");
+    if ((!strcmp(cmd, "fetch") || !strcmp(cmd, "plan")) && !o.out_dir)
+        die_usage("%s needs --out DIR", cmd);
     if (!strcmp(cmd, "ab") && (nargs == 2) == (server_b != NULL))
         die_usage("ab takes two job files, or one job file and --server-b URL");
-    if (!strcmp(cmd, "sweep") && o.out_dir && !o.wait)
+    if (!strcmp(cmd, "sweep") && o.out_dir && !o.wait && !fl->slurm)
         die_usage("sweep --out needs --wait: the table is complete once the sweep ends");
     if (strcmp(cmd, "history") != 0 && (json_object_size(o.filters) || o.since || o.figure))
         die_usage("--filter, --since and --figure belong to history");
@@ -370,7 +429,13 @@ int main(int argc, char **argv)
     else if (!strcmp(cmd, "ab"))
         rc = cmd_ab(&c, server_b ? &cb : &c, &o, arg, nargs == 2 ? argv[optind + 2] : arg);
     else if (!strcmp(cmd, "sweep"))
-        rc = cmd_sweep(&c, &o, arg);
+        rc = fl->slurm ? cmd_sweep_slurm(&o, arg) : cmd_sweep(&c, &o, arg);
+    else if (!strcmp(cmd, "gather"))
+        rc = cmd_gather(&o, (const char *const *)&argv[optind + 1], nargs);
+    else if (!strcmp(cmd, "plan"))
+        rc = cmd_plan(&o, arg);
+    else if (!strcmp(cmd, "compare-devices"))
+        rc = cmd_compare_devices(&o, arg);
     else
         rc = cmd_history(&c, &o);
     conn_finish(&c);

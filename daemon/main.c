@@ -1,5 +1,6 @@
 #define _GNU_SOURCE /* dl_iterate_phdr, RTLD_NODELETE */
 #include <dlfcn.h>
+#include <errno.h>
 #include <getopt.h>
 #include <link.h>
 #include <limits.h>
@@ -16,6 +17,8 @@
 #include "config.h"
 #include "daemon/gpu/egl.h"
 #include "common/fsutil.h"
+#include "common/clock.h"
+#include "daemon/jobs/records.h"
 #include "daemon/api/http.h"
 #include "daemon/harness/telemetry.h"
 #include "daemon/jobs/job_cost.h"
@@ -100,7 +103,8 @@ static void usage(FILE *f)
             "  --port-file FILE     write the bound port to FILE once listening\n"
             "  --list-devices       print the EGL devices and exit\n"
             "  --once JOB.json      run one job without HTTP, then exit\n"
-            "  --out DIR            with --once: where result.json and frames go\n"
+            "  --out DIR            with --once: where result.json, job.json, task.json and\n"
+            "                       frames go (written whole: renamed into place at the end)\n"
             "  --gl-debug           request a debug GL context\n"
             "  --log-level LEVEL    debug, info, warn or error (default info)\n"
             "  --version, --help\n\n"
@@ -350,9 +354,56 @@ static int list_devices(void)
     return 0;
 }
 
+/* What ran where, for a fleet's gathering: the node, the exit status and,
+ * under Slurm, the job and array task ids from its environment. */
+static json_t *once_task_json(const char *status, int rc, double started, double finished)
+{
+    char host[256] = "";
+    if (gethostname(host, sizeof(host) - 1) != 0)
+        host[0] = '\0';
+    json_t *t = json_pack("{s:s, s:s, s:i, s:f, s:f}", "node", host, "status", status, "exit_status",
+                          rc, "started_unix", started, "finished_unix", finished);
+    static const char *const slurm[][2] = {
+        {"job_id", "SLURM_JOB_ID"},           {"array_job_id", "SLURM_ARRAY_JOB_ID"},
+        {"array_task_id", "SLURM_ARRAY_TASK_ID"}, {"restart_count", "SLURM_RESTART_COUNT"},
+        {"partition", "SLURM_JOB_PARTITION"}, {"node", "SLURMD_NODENAME"},
+        {"gpus", "SLURM_JOB_GPUS"},
+    };
+    json_t *sl = json_object();
+    for (size_t i = 0; i < sizeof(slurm) / sizeof(slurm[0]); i++) {
+        const char *v = getenv(slurm[i][1]);
+        if (v && v[0])
+            json_object_set_new(sl, slurm[i][0], json_string(v));
+    }
+    if (json_object_size(sl))
+        json_object_set_new(t, "slurm", sl);
+    else
+        json_decref(sl);
+    return t;
+}
+
+/* --out DIR appears whole or not at all: the job renders into a sibling
+ * DIR.partial-HOST-PID, which is renamed to DIR once job.json and task.json
+ * are in it, so that a fleet's gathering never reads a half-written folder
+ * whatever kills the task (a partial folder is what a killed one leaves). */
+static bool once_publish(const char *partial, const char *out)
+{
+    if (rename(partial, out) == 0)
+        return true;
+    if (errno != EEXIST && errno != ENOTEMPTY)
+        return false;
+    char old[PATH_MAX + 64];
+    snprintf(old, sizeof(old), "%s.old-%ld", out, (long)getpid());
+    if (rename(out, old) != 0 || rename(partial, out) != 0)
+        return false;
+    record_remove_dir(old);
+    return true;
+}
+
 static int run_once(const struct options *o, const struct technique_catalog *catalog)
 {
     size_t len = 0;
+    double started = clock_unix_s();
     char *text = fs_read_file(o->once, JOB_MAX_BODY_BYTES + 1, &len);
     if (!text) {
         fprintf(stderr, "shadebenchd: cannot read %s\n", o->once);
@@ -370,8 +421,17 @@ static int run_once(const struct options *o, const struct technique_catalog *cat
             fprintf(stderr, "shadebenchd: %s: %s: %s\n", o->once, jerr.field, jerr.message);
         return 2;
     }
-    if (!fs_mkdir_p(o->out)) {
-        fprintf(stderr, "shadebenchd: cannot create %s\n", o->out);
+    char host[64] = "";
+    if (gethostname(host, sizeof(host) - 1) != 0)
+        snprintf(host, sizeof(host), "host");
+    char partial[PATH_MAX];
+    if ((size_t)snprintf(partial, sizeof(partial), "%s.partial-%s-%ld", o->out, host,
+                         (long)getpid()) >= sizeof(partial)) {
+        fprintf(stderr, "shadebenchd: --out %s: the path is too long\n", o->out);
+        return 2;
+    }
+    if (!fs_mkdir_p(partial)) {
+        fprintf(stderr, "shadebenchd: cannot create %s: %s\n", partial, strerror(errno));
         return 2;
     }
     char err[PATH_MAX + 300];
@@ -383,12 +443,13 @@ static int run_once(const struct options *o, const struct technique_catalog *cat
         fprintf(stderr, "shadebenchd: %s\n", q || !store ? err : "out of memory");
         queue_destroy(q);
         store_close(store);
+        record_remove_dir(partial);
         return 1;
     }
     pin_loaded_modules();
     char id[24];
     int rc = 1;
-    if (queue_submit(q, &spec, o->out, id) == QUEUE_OK) {
+    if (queue_submit(q, &spec, partial, id) == QUEUE_OK) {
         json_t *job;
         const char *status = "running";
         for (;;) {
@@ -401,9 +462,22 @@ static int run_once(const struct options *o, const struct technique_catalog *cat
         json_dumpf(job, stdout, JSON_INDENT(2));
         putchar('\n');
         rc = strcmp(status, "done") == 0 ? 0 : 1;
+        char path[PATH_MAX + 32];
+        snprintf(path, sizeof(path), "%s/job.json", partial);
+        json_t *task = once_task_json(status, rc, started, clock_unix_s());
+        bool written = fs_write_json_atomic(path, job);
+        snprintf(path, sizeof(path), "%s/task.json", partial);
+        written = written && fs_write_json_atomic(path, task);
+        json_decref(task);
+        if (!written || !once_publish(partial, o->out)) {
+            fprintf(stderr, "shadebenchd: cannot write %s: %s\n", written ? o->out : path,
+                    strerror(errno));
+            rc = 2;
+        }
         json_decref(job);
     } else {
-        fprintf(stderr, "shadebenchd: cannot create the job in %s\n", o->out);
+        fprintf(stderr, "shadebenchd: cannot create the job in %s\n", partial);
+        record_remove_dir(partial);
     }
     runner_destroy(r);
     queue_destroy(q);

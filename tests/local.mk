@@ -28,6 +28,7 @@ UNIT_TESTS = \
 	tests/unit/test_http \
 	tests/unit/test_routes \
 	tests/unit/test_charts \
+	tests/unit/test_fleet \
 	tests/unit/test_culling \
 	tests/unit/test_effects \
 	tests/unit/test_pbr \
@@ -60,9 +61,11 @@ tests_unit_test_client_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_job_filter_SOURCES = tests/unit/test_job_filter.c daemon/api/job_filter.c \
 	daemon/api/job_filter.h
 tests_unit_test_job_filter_LDADD = $(CORE_LIBS)
-tests_unit_test_charts_SOURCES = tests/unit/test_charts.c daemon/api/charts.c daemon/api/charts.h \
-	daemon/api/sweep_verdict.c daemon/api/sweep_verdict.h daemon/api/report.c daemon/api/report.h
-tests_unit_test_charts_LDADD = $(CORE_LIBS) $(CAIRO_LIBS) -lm
+tests_unit_test_charts_SOURCES = tests/unit/test_charts.c
+tests_unit_test_charts_LDADD = $(REPORT_LIBS)
+# The fleet's device view, with the client's CSV and the reports it reads.
+tests_unit_test_fleet_SOURCES = tests/unit/test_fleet.c client/fleet_view.c
+tests_unit_test_fleet_LDADD = $(REPORT_LIBS)
 tests_unit_test_culling_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_pbr_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_teapot_LDADD = $(CORE_LIBS) -lm
@@ -78,7 +81,7 @@ tests_unit_test_http_SOURCES = tests/unit/test_http.c $(API_SOURCES) \
 	daemon/jobs/sweeps.c daemon/jobs/sweeps.h \
 	daemon/harness/telemetry.c daemon/harness/telemetry.h \
 	daemon/harness/render_state.c daemon/harness/render_state.h
-tests_unit_test_http_LDADD = $(CORE_LIBS) $(MHD_LIBS) $(CAIRO_LIBS) -lm
+tests_unit_test_http_LDADD = $(REPORT_LIBS) $(MHD_LIBS)
 # The fuzz targets, replayed over their corpora in make check (tests/fuzz/run.sh
 # builds them with clang and libFuzzer instead).
 tests_fuzz_replay_job_SOURCES = tests/fuzz/fuzz_job.c tests/fuzz/replay.c
@@ -101,6 +104,7 @@ endif
 # one long test running alone at the end.
 E2E_TESTS = \
 	tests/e2e/e2e_msaa.py \
+	tests/e2e/e2e_fleet.py \
 	tests/e2e/e2e_report.py \
 	tests/e2e/e2e_faults.py \
 	tests/e2e/e2e_runaway.py \

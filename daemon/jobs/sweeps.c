@@ -16,6 +16,7 @@
 #include "common/stats.h"
 #include "daemon/jobs/records.h"
 #include "daemon/jobs/store.h"
+#include "daemon/jobs/sweep_table.h"
 #include "common/result_keys.h"
 
 /* At most this many finished sweeps go at a time (retention). */
@@ -210,76 +211,6 @@ static struct sweep *find_locked(struct sweeps *s, const char *id)
     return store_live_find(&s->live, id);
 }
 
-static json_t *point_row(const json_t *job, json_t *values)
-{
-    json_t *r = json_object_get(job, RK_RESULT);
-    json_t *spec = json_object_get(job, "spec");
-    json_t *row = json_pack("{s:o, s:s, s:s, s:O}", "values", values, "job",
-                            json_string_value(json_object_get(job, "id")), "status",
-                            json_string_value(json_object_get(job, "status")), "technique",
-                            json_object_get(spec, "technique"));
-    if (json_object_get(job, "error"))
-        json_object_set(row, "error", json_object_get(job, "error"));
-    if (!r)
-        return row;
-    json_t *rep = json_object_get(r, RK_REPEAT);
-    static const char *const series[] = {RK_FRAME_MS, RK_GPU_MS, RK_CPU_MS};
-    for (int k = 0; k < 3; k++) {
-        json_t *st = json_object_get(r, series[k]);
-        json_t *across = rep ? json_object_get(rep, series[k]) : NULL;
-        /* Repeated jobs: the mean of run medians and its interval; single runs:
-         * the median and its distribution-free interval. */
-        json_t *cell =
-            across ? json_pack("{s:O, s:O, s:s}", RK_MEDIAN, json_object_get(across, RK_MEAN), RK_CI95,
-                               json_object_get(across, RK_CI95), "over", "runs")
-                   : json_pack("{s:O, s:O, s:s}", RK_MEDIAN, json_object_get(st, RK_MEDIAN), RK_CI95,
-                               json_object_get(st, RK_MEDIAN_CI95), "over", "frames");
-        /* The distribution of the (first run's) frames, for the charts. */
-        static const char *const keep[] = {RK_MIN, RK_P5, RK_P95, RK_P99, RK_MAX};
-        for (int i = 0; i < 5; i++)
-            json_object_set(cell, keep[i], json_object_get(st, keep[i]));
-        json_object_set_new(row, series[k], cell);
-    }
-    if (rep)
-        json_object_set(row, RK_STABLE, json_object_get(rep, RK_STABLE));
-    /* Execution time of the timed frames, over runs: what the thesis tabled. */
-    json_t *runs = json_object_get(r, RK_RUNS);
-    size_t nruns = runs ? json_array_size(runs) : 1;
-    double *walls = malloc(nruns * sizeof(double));
-    if (walls) {
-        for (size_t i = 0; i < nruns; i++)
-            walls[i] = json_number_value(json_object_get(runs ? json_array_get(runs, i) : r, RK_WALL_S));
-        struct stats st;
-        stats_compute(walls, nruns, &st);
-        json_object_set_new(row, RK_WALL_S, json_pack("{s:I, s:f, s:f, s:f}", RK_RUNS, (json_int_t)nruns,
-                                                     RK_MEAN, st.mean, RK_MEDIAN, st.median, RK_STDDEV,
-                                                     st.stddev));
-        free(walls);
-    }
-    json_t *q = json_object_get(r, RK_QUALITY);
-    if (q) {
-        json_object_set(row, RK_WORST_SSIM, json_object_get(json_object_get(q, RK_WORST_SSIM), "value"));
-        json_object_set(row, RK_WORST_SSIM_MIN, json_object_get(json_object_get(q, RK_WORST_SSIM_MIN), "value"));
-        json_object_set(row, RK_WORST_FLIP, json_object_get(json_object_get(q, RK_WORST_FLIP), "mean"));
-        json_object_set(row, RK_PDIFF_FAILED_CAPTURES, json_object_get(q, RK_PDIFF_FAILED_CAPTURES));
-        json_t *flicker = json_object_get(json_object_get(q, RK_WORST_FLICKER), "value");
-        if (flicker) /* temporal.frames: the flicker_max criterion's figure */
-            json_object_set(row, RK_WORST_FLICKER, flicker);
-    }
-    /* Post hook: the worst capture's non-finite pixels, for breaking points. */
-    json_t *nonfinite = json_object_get(r, RK_NONFINITE);
-    if (nonfinite)
-        json_object_set(row, "nonfinite_pixels", json_object_get(nonfinite, RK_PIXELS_MAX));
-    /* Bounded light lists and the shadow atlas: where they overflow. */
-    json_int_t lists, shadows;
-    sweep_overflow_frames(r, &lists, &shadows);
-    if (lists >= 0)
-        json_object_set_new(row, "light_overflow_frames", json_integer(lists));
-    if (shadows >= 0)
-        json_object_set_new(row, "shadow_drop_frames", json_integer(shadows));
-    return row;
-}
-
 /* Resumed after a stop: the point job that was queued or running then is
  * still in the store (requeued, same spec); returns its id to wait for, or
  * "" to submit the point afresh. */
@@ -401,7 +332,7 @@ static int probe(double v, void *arg)
     json_t *values = json_object();
     json_object_set_new(values, c->sw->spec.params[0],
                         c->sw->spec.integer ? json_integer((json_int_t)v) : json_real(v));
-    json_t *row = point_row(job, values);
+    json_t *row = sweep_table_row(job, values);
     const char *unjudged = NULL;
     if (strcmp(json_string_value(json_object_get(job, "status")), "done") != 0)
         snprintf(c->sw->error, sizeof(c->sw->error), "probe at %g %s: %s", v,
@@ -418,34 +349,6 @@ static int probe(double v, void *arg)
     return holds;
 }
 
-/* With one numeric parameter, the question the thesis answered by hand:
- * the largest value whose captures all pass PerceptualDiff. Over the whole
- * table, so that a resumed sweep counts the points run before the stop. */
-static json_t *vary_result(const struct sweep *sw)
-{
-    json_t *passing = json_array(), *best = NULL, *row;
-    size_t i;
-    json_array_foreach(sw->points, i, row) {
-        json_t *failed = json_object_get(row, RK_PDIFF_FAILED_CAPTURES);
-        if (json_is_integer(failed) && json_integer_value(failed) == 0)
-            json_array_append(passing, json_object_get(row, "values"));
-    }
-    json_t *res = json_pack("{s:o}", "pdiff_passing", passing);
-    if (sw->spec.nparams == 1) {
-        json_t *values;
-        json_array_foreach(passing, i, values) {
-            json_t *v = json_object_get(values, sw->spec.params[0]);
-            if (json_is_number(v) && (!best || json_number_value(v) > json_number_value(best)))
-                best = v;
-        }
-        json_object_set_new(res, "largest_pdiff_pass",
-                            json_pack("{s:s, s:O}", "param", sw->spec.params[0], "value",
-                                      best ? best : json_null()));
-    }
-    return res;
-}
-
-
 static void run_sweep(struct sweeps *s, struct sweep *sw)
 {
     bool ok = true;
@@ -461,7 +364,7 @@ static void run_sweep(struct sweeps *s, struct sweep *sw)
                 ok = false;
                 break;
             }
-            add_row(s, sw, point_row(job, values));
+            add_row(s, sw, sweep_table_row(job, values));
             json_decref(job);
             /* Cancelled while its last point ran: the point is in the table,
              * cancelled, and the sweep is not done. */
@@ -469,7 +372,7 @@ static void run_sweep(struct sweeps *s, struct sweep *sw)
                 ok = false;
         }
         if (ok)
-            result = vary_result(sw);
+            result = sweep_table_result(&sw->spec, sw->points);
     } else {
         struct probe_ctx ctx = {s, sw};
         struct bisect_result r;

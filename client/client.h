@@ -114,6 +114,10 @@ json_t *load_json_file(const char *what, const char *path, char *err, size_t cap
 char *job_text_for_submit(const char *file, const struct options *o, int repeat, char *err,
                           size_t cap);
 
+/* --label KEY=VALUE on a sweep: into its base job's labels, so that every
+ * point job carries them (a daemon's sweep and a fleet's alike). */
+void sweep_add_labels(json_t *body, const json_t *labels);
+
 /* Commands: each returns an exit status. */
 int cmd_submit(struct conn *c, const struct options *o, const char *file);
 int cmd_fetch(struct conn *c, const struct options *o, const char *id);

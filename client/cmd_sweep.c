@@ -178,6 +178,20 @@ static bool download_all(struct conn *c, const json_t *sweep, const char *dir)
     return conn_download(c, url, path) && ok;
 }
 
+void sweep_add_labels(json_t *body, const json_t *labels)
+{
+    json_t *base = json_object_get(body, "base");
+    if (!json_object_size(labels) || !json_is_object(base))
+        return;
+    /* Labels reach the point jobs through the base job. */
+    json_t *into = json_object_get(base, "labels");
+    if (!json_is_object(into)) {
+        into = json_object();
+        json_object_set_new(base, "labels", into);
+    }
+    json_object_update(into, (json_t *)labels);
+}
+
 int cmd_sweep(struct conn *c, const struct options *o, const char *file)
 {
     char err[600];
@@ -195,16 +209,7 @@ int cmd_sweep(struct conn *c, const struct options *o, const char *file)
         json_decref(body);
         return EXIT_ERROR;
     }
-    json_t *base = json_object_get(body, "base");
-    if (json_object_size(o->labels) && json_is_object(base)) {
-        /* Labels reach the point jobs through the base job. */
-        json_t *labels = json_object_get(base, "labels");
-        if (!json_is_object(labels)) {
-            labels = json_object();
-            json_object_set_new(base, "labels", labels);
-        }
-        json_object_update(labels, o->labels);
-    }
+    sweep_add_labels(body, o->labels);
     char *text = json_dumps(body, JSON_COMPACT);
     json_decref(body);
     double t0 = clock_mono_s();

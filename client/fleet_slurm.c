@@ -679,6 +679,7 @@ int cmd_sweep_slurm(const struct options *o, const char *sweep_file)
             json_decref(body);
             goto out;
         }
+        sweep_add_labels(body, o->labels);
         classes = device_classes(fo, err, sizeof(err));
         bool planned = classes && fleet_plan_write(body, real, err, sizeof(err));
         json_decref(body);

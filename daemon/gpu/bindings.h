@@ -24,6 +24,14 @@
 #define SB_SSBO_LIGHT_SUMMARY 11 /* per cell, one bit per non-zero word of light bits */
 #define SB_SSBO_SHADOW_LIGHTS 12 /* per light: where its shadow map's faces lie */
 #define SB_SSBO_EDGE_STATS 13   /* MSAA g-buffer: edge pixels this frame and over the run */
+/* OSL's visibility "seen" (osl_select.comp): per atlas block its instance
+ * and the shading it holds; per instance the shading its schedule asks for;
+ * the blocks selected this frame; the pass's counters and indirect dispatch. */
+#define SB_SSBO_OSL_BLOCK_TILE 14
+#define SB_SSBO_OSL_SHADED 15
+#define SB_SSBO_OSL_VERSIONS 16
+#define SB_SSBO_OSL_LIST 17
+#define SB_SSBO_OSL_STATS 18
 
 /* Texture units. */
 #define SB_TEX_HDR 0
@@ -65,5 +73,6 @@
 /* Image units. */
 #define SB_IMG_OSL_ATLAS 0
 #define SB_IMG_HEAT 1 /* light evaluations per pixel (r32ui) */
+#define SB_IMG_OSL_MARKS 2 /* per atlas block, the last frame the raster pass sampled it (r32i) */
 
 #endif

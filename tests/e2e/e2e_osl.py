@@ -1,7 +1,8 @@
 """Object Space Lighting end to end: it shows forward's image within the
 stated texture-sampling bound, async shading shades fewer texels, the
 lighting pass runs once for still lights, frame k is the same image however
-the run started, and bad OSL options answer 400."""
+the run started, visibility "seen" gives the same pixels from fewer texels
+and counts what outruns it, and bad OSL options answer 400."""
 
 import os
 
@@ -75,12 +76,43 @@ try:
     diff = testlib.png_diff(a, b)
     check(diff and diff["max_abs"] == 0, "frame 10 identical with 0 or 7 warm-up frames: %s" % diff)
 
+    # Visibility "seen": only the atlas blocks the raster pass read (and
+    # their neighbours) are shaded, each with the shading its schedule asks
+    # for. The same pixels as whole tiles from fewer texels, frame k still a
+    # pure function of k, nothing shaded for still lights after the first
+    # frame, and a camera that outruns the one-block margin is counted.
+    seen = dict(dyn, async_distance=20, capture_interval=10, frames=10, warmup_frames=2,
+                osl={"resolution": 64, "visibility": "seen"})
+    r_whole, p_whole = capture(d, dict(seen, osl={"resolution": 64}), "whole")
+    r_seen, p_seen = capture(d, seen, "seen")
+    diff = testlib.png_diff(p_whole, p_seen)
+    check(diff and diff["max_abs"] == 0, "seen gives whole tiles' pixels: %s" % diff)
+    vis = r_seen.get("osl", {}).get("visibility", {})
+    check(vis.get("mode") == "seen" and vis.get("stale_blocks") == 0,
+          "a still camera reads no block with other shading: %s" % vis)
+    t_whole = r_whole["osl"]["texels_shaded_per_frame"]["mean"]
+    t_seen = r_seen["osl"]["texels_shaded_per_frame"]["mean"]
+    check(0 < t_seen < 0.9 * t_whole, "seen shades fewer texels: %s vs %s" % (t_seen, t_whole))
+    _, p_late = capture(d, dict(seen, warmup_frames=7), "seen-late")
+    diff = testlib.png_diff(p_seen, p_late)
+    check(diff and diff["max_abs"] == 0, "seen: frame 10 identical after 2 or 7 warm-up frames: %s"
+          % diff)
+    still = d.run(dict(seen, scene=dict(dyn["scene"], dynamic=False)))["result"]["osl"]
+    check(still["texels_shaded_per_frame"]["max"] == 0 and
+          still.get("visibility", {}).get("active") is False,
+          "seen, still lights: nothing shaded after the first frame, and no marking: %s" % still)
+    fly = d.run(dict(seen, frames=12, scene=dict(dyn["scene"], camera="flythrough")))
+    stale = fly.get("result", {}).get("osl", {}).get("visibility", {}).get("stale_blocks", 0)
+    check(fly["status"] == "done" and stale > 0,
+          "a flythrough outruns the margin, and the stale blocks are counted: %s" % stale)
+
     # Bad OSL options name their field; an atlas too big fails the job clearly.
     for body, field in (({"technique": "osl", "osl": {"resolution": 100}}, "osl.resolution"),
                         ({"technique": "osl", "osl": {"resolution": "fine"}}, "osl.resolution"),
                         ({"technique": "osl", "async_distance": -1}, "async_distance"),
                         ({"technique": "osl", "osl": {"texel_density": -2}}, "osl.texel_density"),
-                        ({"technique": "osl", "osl": {"rezolution": 64}}, "osl.rezolution")):
+                        ({"technique": "osl", "osl": {"rezolution": 64}}, "osl.rezolution"),
+                        ({"technique": "osl", "osl": {"visibility": "some"}}, "osl.visibility")):
         testlib.rejects(d, body, field)
     big = d.run({"technique": "osl", "frames": 1, "warmup_frames": 0, "scene": SCENE,
                  "osl": {"resolution": 1024}})

@@ -9,5 +9,6 @@ GLSL_FILES += \
 	%reldir%/osl_texgen.vert \
 	%reldir%/osl_texgen.frag \
 	%reldir%/osl_light.comp \
+	%reldir%/osl_select.comp \
 	%reldir%/osl_draw.vert \
 	%reldir%/osl_draw.frag

@@ -5,8 +5,10 @@
  *     frame into one shared atlas, one tile per instance;
  *  3. rasterization: every object drawn sampling its tile.
  * Beyond the thesis: osl.resolution "auto" sizes each tile from the object's
- * size on screen, and osl.reshade "touched" reshades only objects a moving
- * light reaches (see osl_schedule.h). */
+ * size on screen, osl.reshade "touched" reshades only objects a moving
+ * light reaches (see osl_schedule.h), and osl.visibility "seen" shades only
+ * the atlas blocks the raster pass sampled (osl_select.comp). */
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -55,7 +57,36 @@ struct osl {
     int initial_objects;
     double initial_texels;
     int frames; /* timed frames of the job */
+
+    /* osl.visibility "seen": the blocks to shade are chosen on the GPU from
+     * what the raster pass sampled (osl_select.comp); the figures are
+     * counted there and read once, by describe. */
+    bool seen;        /* asked for, and lights that move: otherwise the first frame's
+                       * shading of every block stays valid, as with whole tiles */
+    bool seen_asked;
+    bool camera_moves; /* else the first frame's marks stand for every frame */
+    bool marked_once;
+    struct scene_program draw_mark; /* the raster pass that marks what it reads */
+    GLuint select_prog;
+    GLint sel_frame_loc, sel_initial_loc, sel_mode_loc, sel_count_loc, sel_count_prev_loc,
+        sel_seen_since_loc, sel_margin_loc, sel_blocks_loc, sel_max_groups_loc, light_blocks_x_loc;
+    GLint draw_frame_loc;
+    int64_t last_frame; /* the last frame rendered, for the last stale check */
+    bool last_counted;
+    GLuint block_tile_buf, shaded_buf, version_buf, list_buf, stats_buf, marks_tex;
+    int blocks_x, blocks_y;
+    GLint *versions; /* per instance: the shading its schedule asks for, its light row */
+    GLuint stale_blocks;
+    double pixels;   /* of the output, for texels per pixel */
 };
+
+/* The "version" of an object's shading nothing reaches: ambient only, the
+ * same whenever it was shaded. No due frame equals it (nor the INT_MIN of a
+ * block never shaded). */
+#define OSL_VERSION_UNLIT INT_MAX
+
+/* Blocks around a seen one that are shaded too, for a camera that moves. */
+#define OSL_SEEN_MARGIN(o) ((o)->camera_moves ? 1 : 0)
 
 static int log2i(int v)
 {
@@ -187,6 +218,177 @@ static bool generate_textures(struct osl *o, const struct technique_env *env)
     return ok;
 }
 
+static GLuint ssbo(GLsizeiptr bytes, const void *data, GLenum usage)
+{
+    GLuint b;
+    glGenBuffers(1, &b);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, b);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, bytes, data, usage);
+    return b;
+}
+
+/* osl.visibility "seen": per atlas block its instance and the shading it
+ * holds (none yet), per instance its scheduled shading, the block list and
+ * counters, the marks image, and the selection program. */
+static bool seen_create(struct osl *o, const struct technique_env *env, char *err, size_t errlen)
+{
+    const struct scene *s = env->scene;
+    int n = s->instance_count;
+    o->blocks_x = o->atlas_w / 8;
+    o->blocks_y = o->atlas_h / 8;
+    size_t blocks = (size_t)o->blocks_x * (size_t)o->blocks_y;
+    GLuint *owner = malloc(blocks * sizeof(GLuint));
+    GLint *never = malloc(blocks * 2 * sizeof(GLint));
+    o->versions = calloc((size_t)n * 2, sizeof(GLint));
+    if (!owner || !never || !o->versions) {
+        free(owner);
+        free(never);
+        snprintf(err, errlen, "osl: out of memory");
+        return false;
+    }
+    for (size_t b = 0; b < blocks; b++) {
+        owner[b] = 0xffffffffu;
+        never[b * 2] = INT_MIN;     /* no shading held */
+        never[b * 2 + 1] = INT_MIN; /* never the scheduled one */
+    }
+    for (int i = 0; i < n; i++)
+        for (int y = o->tiles[i].y / 8; y < (o->tiles[i].y + o->tiles[i].size) / 8; y++)
+            for (int x = o->tiles[i].x / 8; x < (o->tiles[i].x + o->tiles[i].size) / 8; x++)
+                owner[(size_t)y * (size_t)o->blocks_x + (size_t)x] = (GLuint)i;
+    o->block_tile_buf = ssbo((GLsizeiptr)(blocks * sizeof(GLuint)), owner, GL_STATIC_DRAW);
+    o->shaded_buf = ssbo((GLsizeiptr)(blocks * 2 * sizeof(GLint)), never, GL_DYNAMIC_DRAW);
+    o->version_buf = ssbo((GLsizeiptr)((size_t)n * 2 * sizeof(GLint)), NULL, GL_STREAM_DRAW);
+    o->list_buf = ssbo((GLsizeiptr)(blocks * 2 * sizeof(GLuint)), NULL, GL_DYNAMIC_DRAW);
+    static const GLuint zero[8];
+    o->stats_buf = ssbo(sizeof(zero), zero, GL_DYNAMIC_DRAW);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    free(owner);
+    free(never);
+    glGenTextures(1, &o->marks_tex);
+    glBindTexture(GL_TEXTURE_2D, o->marks_tex);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_R32I, o->blocks_x, o->blocks_y);
+    const GLint unseen = INT_MIN;
+    glClearTexImage(o->marks_tex, 0, GL_RED_INTEGER, GL_INT, &unseen);
+
+    const struct gl_stage select[] = {{GL_COMPUTE_SHADER, {"osl_select.comp"}}};
+    if (!(o->select_prog = gl_program_build("osl select", select, 1, NULL, err, errlen)))
+        return false;
+    GLint max_groups = 0;
+    glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &max_groups);
+    GLuint sp = o->select_prog;
+    o->sel_frame_loc = glGetUniformLocation(sp, "u_frame_index");
+    o->sel_initial_loc = glGetUniformLocation(sp, "u_initial");
+    o->sel_mode_loc = glGetUniformLocation(sp, "u_mode");
+    o->sel_count_loc = glGetUniformLocation(sp, "u_count");
+    o->sel_count_prev_loc = glGetUniformLocation(sp, "u_count_prev");
+    o->sel_blocks_loc = glGetUniformLocation(sp, "u_blocks");
+    o->sel_max_groups_loc = glGetUniformLocation(sp, "u_max_groups");
+    glProgramUniform2i(sp, o->sel_blocks_loc, o->blocks_x, o->blocks_y);
+    glProgramUniform1i(sp, o->sel_max_groups_loc, max_groups);
+    o->light_blocks_x_loc = glGetUniformLocation(o->light.prog, "u_blocks_x");
+    glProgramUniform1i(o->light.prog, o->light_blocks_x_loc, o->blocks_x);
+    const struct gl_stage draw[] = {
+        {GL_VERTEX_SHADER, {"osl_draw.vert"}},
+        {GL_FRAGMENT_SHADER, {"osl_draw.frag"}},
+    };
+    GLuint mark_prog = gl_program_build("osl draw (marking)", draw, 2, "#define OSL_SEEN 1\n", err,
+                                        errlen);
+    if (!mark_prog)
+        return false;
+    o->draw_mark = gpu_scene_program(env->gpu, mark_prog);
+    glProgramUniform1i(mark_prog, glGetUniformLocation(mark_prog, "u_atlas"), SB_TEX_OSL_ATLAS);
+    glProgramUniform2f(mark_prog, glGetUniformLocation(mark_prog, "u_atlas_size"),
+                       (float)o->atlas_w, (float)o->atlas_h);
+    o->draw_frame_loc = glGetUniformLocation(mark_prog, "u_frame_index");
+    o->sel_seen_since_loc = glGetUniformLocation(sp, "u_seen_since");
+    o->sel_margin_loc = glGetUniformLocation(sp, "u_margin");
+    glProgramUniform1i(sp, o->sel_margin_loc, OSL_SEEN_MARGIN(o));
+    return true;
+}
+
+static void seen_bind(const struct osl *o)
+{
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_BLOCK_TILE, o->block_tile_buf);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_SHADED, o->shaded_buf);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_VERSIONS, o->version_buf);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_LIST, o->list_buf);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_STATS, o->stats_buf);
+    glBindImageTexture(SB_IMG_OSL_MARKS, o->marks_tex, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32I);
+}
+
+/* Each object's scheduled shading at frame: its last due frame s, lit with
+ * the lights of s (light row frame - s), or OSL_VERSION_UNLIT when reshade
+ * "touched" and no moving light reaches it at s (any shading without light
+ * is the same), or 0 when the lights stand still. Selects the blocks seen
+ * whose shading differs, and shades them: a pure function of frame for
+ * every block the raster pass reads, as long as each was seen (or next to
+ * one seen) the frame before. */
+static void seen_light_pass(struct osl *o, const struct technique_env *env, int64_t frame,
+                            bool initial, bool count)
+{
+    const struct scene *s = env->scene;
+    const struct osl_options *opt = env->options;
+    bool moving = s->spec.dynamic && s->spec.light_speed > 0;
+    for (int i = 0; i < s->instance_count; i++) {
+        int64_t due = osl_schedule_last(&o->schedule, i, frame);
+        GLint version = (GLint)due;
+        if (!moving)
+            version = 0;
+        else if (opt->reshade == OSL_RESHADE_TOUCHED && !osl_touched(s, i, due))
+            version = OSL_VERSION_UNLIT;
+        o->versions[i * 2] = version;
+        o->versions[i * 2 + 1] = (GLint)(frame - due);
+    }
+    int rows = o->schedule.max_period > 0 ? o->schedule.max_period : 1;
+    for (int r = 0; r < rows; r++)
+        o->rows[r] = frame - r;
+    gpu_scene_set_light_rows(env->gpu, o->rows, rows);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, o->version_buf);
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0,
+                    (GLsizeiptr)((size_t)s->instance_count * 2 * sizeof(GLint)), o->versions);
+    static const GLuint none[4];
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, o->stats_buf);
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof(none), none);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+
+    /* The raster pass's marks of the frame before, then the selection. */
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    seen_bind(o);
+    glUseProgram(o->select_prog);
+    glUniform1i(o->sel_frame_loc, (GLint)frame);
+    glUniform1i(o->sel_initial_loc, initial);
+    glUniform1i(o->sel_count_loc, count);
+    /* The frame before counts when it was a timed frame rendered just before. */
+    glUniform1i(o->sel_count_prev_loc, !initial && o->last_counted && o->last_frame == frame - 1);
+    o->last_counted = false;
+    glUniform1i(o->sel_mode_loc, 0);
+    /* A still camera sees the same blocks every frame: the first frame's
+     * marks stand for all. */
+    glUniform1i(o->sel_seen_since_loc, o->camera_moves ? (GLint)(frame - 1) : INT_MIN + 1);
+    GLuint blocks = (GLuint)o->blocks_x * (GLuint)o->blocks_y;
+    glDispatchCompute((blocks + 63) / 64, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glUniform1i(o->sel_mode_loc, 1);
+    glDispatchCompute(1, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
+
+    gpu_scene_bind(env->gpu, &o->light);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_TILES, o->tile_buffer);
+    seen_bind(o);
+    glBindImageTexture(SB_IMG_OSL_ATLAS, o->atlas, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
+    for (int m = 0; m < SCENE_MESH_COUNT; m++) {
+        glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_MESH + m * 2);
+        glBindTexture(GL_TEXTURE_2D, o->position_tex[m]);
+        glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_MESH + 1 + m * 2);
+        glBindTexture(GL_TEXTURE_2D, o->normal_tex[m]);
+    }
+    glActiveTexture(GL_TEXTURE0);
+    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, o->stats_buf);
+    glDispatchComputeIndirect(0);
+    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+}
+
 static void osl_destroy(void *state);
 
 static bool osl_create(const struct technique_env *env, void **state, char *err,
@@ -232,8 +434,14 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
         {GL_FRAGMENT_SHADER, {"osl_draw.frag"}},
     };
     GLuint light_prog = 0, draw_prog = 0;
+    o->seen_asked = opt->visibility == OSL_VISIBILITY_SEEN;
+    o->seen = o->seen_asked && s->spec.dynamic && s->spec.light_speed > 0;
+    o->camera_moves = scene_camera_moves(s);
+    char light_defines[2048];
+    snprintf(light_defines, sizeof(light_defines), "%s%s", env->defines ? env->defines : "",
+             o->seen ? "#define OSL_BLOCK_LIST 1\n" : "");
     if (!(o->texgen_prog = gl_program_build("osl texgen", texgen, 2, NULL, err, errlen)) ||
-        !(light_prog = gl_program_build("osl lighting", light, 1, env->defines, err, errlen)) ||
+        !(light_prog = gl_program_build("osl lighting", light, 1, light_defines, err, errlen)) ||
         !(draw_prog = gl_program_build("osl draw", draw, 2, NULL, err, errlen))) {
         glDeleteProgram(light_prog);
         goto fail;
@@ -291,6 +499,8 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)((size_t)n * 4 * sizeof(GLuint)),
                  NULL, GL_STREAM_DRAW);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    if (o->seen && !seen_create(o, env, err, errlen))
+        goto fail;
     return true;
 oom:
     snprintf(err, errlen, "osl: out of memory");
@@ -358,6 +568,33 @@ static bool osl_render(void *state, const struct technique_env *env, int64_t fra
                        char *err, size_t errlen)
 {
     struct osl *o = state;
+    if (o->seen) {
+        o->pixels = (double)env->width * env->height;
+        bool counted = frame >= 1 && frame <= o->frames;
+        seen_light_pass(o, env, frame, !o->shaded_once, counted);
+        o->timed_frames += counted;
+        o->shaded_once = true;
+        gpu_pass_begin(env->passes, PASS_RASTER, env->output_fbo, env->width, env->height);
+        glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        bool mark = o->camera_moves || !o->marked_once;
+        const struct scene_program *draw = mark ? &o->draw_mark : &o->draw;
+        gpu_scene_bind(env->gpu, draw);
+        if (mark)
+            glUniform1i(o->draw_frame_loc, (GLint)frame);
+        o->marked_once = true;
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_TILES, o->tile_buffer);
+        seen_bind(o);
+        o->last_frame = frame;
+        o->last_counted = counted && mark;
+        glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_ATLAS);
+        glBindTexture(GL_TEXTURE_2D, o->atlas);
+        struct gpu_tiles t;
+        for (gpu_tiles_begin(env->budget, env->width, env->height, &t); gpu_tiles_next(env->budget, &t);)
+            gpu_scene_draw(env->gpu, draw);
+        gpu_pass_end(env->passes);
+        return technique_keep_going(env, err, errlen);
+    }
     int count = osl_schedule_plan(&o->schedule, env->scene, frame, !o->shaded_once,
                                   ((const struct osl_options *)env->options)->reshade, o->plan);
     double texels = count ? light_pass(o, env, frame, count) : 0.0;
@@ -409,10 +646,32 @@ static json_t *osl_describe(void *state)
         tile_texels += (double)o->tiles[i].size * o->tiles[i].size;
     }
     double frames = o->timed_frames ? o->timed_frames : 1;
+    if (o->seen) {
+        /* Counted on the GPU over the timed frames; read once, here, after
+         * checking the last frame's reads (the next frame would have). */
+        if (o->last_counted) {
+            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+            seen_bind(o);
+            glUseProgram(o->select_prog);
+            glUniform1i(o->sel_frame_loc, (GLint)(o->last_frame + 1));
+            glUniform1i(o->sel_count_prev_loc, 1);
+            glUniform1i(o->sel_mode_loc, 2);
+            glDispatchCompute(((GLuint)o->blocks_x * (GLuint)o->blocks_y + 63) / 64, 1, 1);
+            glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+            o->last_counted = false;
+        }
+        GLuint stats[8] = {0};
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, o->stats_buf);
+        glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof(stats), stats);
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+        o->texels_sum = 64.0 * stats[4];
+        o->texels_max = 64.0 * stats[5];
+        o->stale_blocks = stats[6];
+    }
     double texgen_bytes = 0;
     for (int m = 0; m < SCENE_MESH_COUNT; m++)
         texgen_bytes += o->base_size[m] ? 2.0 * 16.0 * o->base_size[m] * o->base_size[m] * 4.0 / 3.0 : 0;
-    return json_pack(
+    json_t *d = json_pack(
         "{s:{s:f, s:i}, s:{s:f, s:f, s:f}, s:{s:i, s:i, s:f, s:f, s:f}, s:o, s:o, s:{s:i, s:f}, s:f}",
         "objects_reshaded_per_frame", "mean", o->reshaded_sum / frames, "max", o->reshaded_max,
         "texels_shaded_per_frame", "mean", o->texels_sum / frames, "max", o->texels_max,
@@ -423,6 +682,26 @@ static json_t *osl_describe(void *state)
         "tiles_by_size", tiles, "objects_by_period", periods,
         "initial_shading", "objects", o->initial_objects, "texels", o->initial_texels,
         "texgen_bytes", texgen_bytes);
+    if (o->seen_asked && !o->seen && d)
+        json_object_set_new(d, "visibility",
+                            json_pack("{s:s, s:b, s:s}", "mode", "seen", "active", 0, "why",
+                                      "the lights stand still: the first frame shades every "
+                                      "block once, and that shading stays what the schedule "
+                                      "asks for"));
+    if (o->seen && d) {
+        /* Objects are not reshaded whole: only the texels are counted. */
+        json_object_del(d, "objects_reshaded_per_frame");
+        json_object_del(d, "initial_shading");
+        json_object_set_new(d, "visibility",
+                            json_pack("{s:s, s:b, s:b, s:f, s:I, s:I, s:i, s:i}", "mode", "seen",
+                                      "active", 1, "camera_moves", o->camera_moves,
+                                      "texels_per_pixel",
+                                      o->pixels > 0 ? o->texels_sum / frames / o->pixels : 0.0,
+                                      "stale_blocks", (json_int_t)o->stale_blocks,
+                                      "blocks", (json_int_t)o->blocks_x * o->blocks_y,
+                                      "margin_blocks", OSL_SEEN_MARGIN(o), "block_texels", 64));
+    }
+    return d;
 }
 
 static void osl_destroy(void *state)
@@ -438,6 +717,13 @@ static void osl_destroy(void *state)
     glDeleteTextures(1, &o->atlas);
     glDeleteBuffers(1, &o->tile_buffer);
     glDeleteBuffers(1, &o->work_buffer);
+    glDeleteProgram(o->select_prog);
+    glDeleteProgram(o->draw_mark.prog);
+    GLuint seen_bufs[] = {o->block_tile_buf, o->shaded_buf, o->version_buf, o->list_buf,
+                          o->stats_buf};
+    glDeleteBuffers(5, seen_bufs);
+    glDeleteTextures(1, &o->marks_tex);
+    free(o->versions);
     osl_schedule_finish(&o->schedule);
     free(o->tiles);
     free(o->plan);

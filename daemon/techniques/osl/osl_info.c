@@ -6,6 +6,7 @@
 
 static const char *const passes[] = {"lighting", "raster", NULL};
 static const char *const reshade_choices[] = {"touched", "all", NULL};
+static const char *const visibility_choices[] = {"all", "seen", NULL};
 
 static const struct opt_field options[] = {
     {.name = "resolution", .type = OPT_POW2_OR_AUTO, .def = 256, .min = OSL_TILE_MIN,
@@ -27,6 +28,14 @@ static const struct opt_field options[] = {
                 "every floor(r / async_distance) + 1 frames; 0 reshades every frame. The "
                 "job's top-level async_distance is an alias",
      .offset = offsetof(struct osl_options, async_distance)},
+    {.name = "visibility", .type = OPT_CHOICE, .def = OSL_VISIBILITY_ALL,
+     .choices = visibility_choices,
+     .summary = "all shades whole tiles, as the thesis did; seen shades only the 8x8 atlas "
+                "blocks the raster pass sampled in the frame before, or next to one (the "
+                "margin for motion), each when its shading is not the one its object's "
+                "schedule asks for: reshading follows what the camera sees. A block the "
+                "raster pass reads while it holds other shading is counted (stale_blocks)",
+     .offset = offsetof(struct osl_options, visibility)},
     {0},
 };
 

@@ -11,6 +11,11 @@ enum osl_reshade {
     OSL_RESHADE_ALL,     /* every due object, lit by a moving light or not */
 };
 
+enum osl_visibility {
+    OSL_VISIBILITY_ALL,  /* shade whole tiles (the thesis) */
+    OSL_VISIBILITY_SEEN, /* shade the atlas blocks the last frame sampled, and their neighbours */
+};
+
 struct osl_options {
     int resolution; /* tile edge in texels; 0 means "auto" */
     double texel_density;
@@ -18,6 +23,7 @@ struct osl_options {
     /* Async shading (thesis 3.1.2.3): an object at camera distance r is
      * reshaded every floor(r / async_distance) + 1 frames; 0 every frame. */
     double async_distance;
+    int visibility; /* enum osl_visibility */
 };
 
 extern const struct technique_info osl_info;

@@ -1,6 +1,9 @@
 // OSL lighting pass: one 8x8 block of one object's tile per work group. The
 // work list holds one entry per object to shade: (instance, light row,
 // first block, blocks per tile row); a group finds its entry by binary search.
+// With OSL_BLOCK_LIST (osl.visibility "seen") the groups come from an
+// indirect dispatch over the blocks osl_select.comp listed: (atlas block,
+// light row) each.
 #include "lighting.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -20,8 +23,26 @@ uniform int u_groups_x;
 uniform uint u_group_base;
 uniform uint u_group_end;
 
+#ifdef OSL_BLOCK_LIST
+layout(std430, binding = SB_SSBO_OSL_BLOCK_TILE) readonly buffer BlockTile { uint block_instance[]; };
+layout(std430, binding = SB_SSBO_OSL_LIST) readonly buffer List { uvec2 list[]; };
+layout(std430, binding = SB_SSBO_OSL_STATS) readonly buffer Stats { uvec4 dispatch; };
+uniform int u_blocks_x; // the atlas's width in blocks
+#endif
+
 void main()
 {
+#ifdef OSL_BLOCK_LIST
+    uint slot = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+    if (slot >= dispatch.w)
+        return;
+    uvec2 entry = list[slot];
+    int instance = int(block_instance[entry.x]);
+    ivec4 tile = tiles[instance];
+    ivec2 atlas_block = ivec2(int(entry.x) % u_blocks_x, int(entry.x) / u_blocks_x);
+    ivec2 texel = atlas_block * 8 - tile.xy + ivec2(gl_LocalInvocationID.xy);
+    int light_row = int(entry.y);
+#else
     uint group = u_group_base + gl_WorkGroupID.y * uint(u_groups_x) + gl_WorkGroupID.x;
     int lo = 0, hi = u_work_count - 1;
     if (u_work_count == 0 || group >= u_group_end ||
@@ -39,6 +60,8 @@ void main()
     uint local_block = group - w.z;
     ivec2 texel = ivec2(local_block % w.w, local_block / w.w) * 8 + ivec2(gl_LocalInvocationID.xy);
     ivec4 tile = tiles[instance];
+    int light_row = int(w.y);
+#endif
 
     Instance inst = instances[instance];
     vec4 p, n;
@@ -60,7 +83,7 @@ void main()
     vec3 color = vec3(0.0);
     if (p.w > 0.0) {
         vec3 world = inst.pos_scale.xyz + inst.pos_scale.w * p.xyz;
-        color = shade_all_lights(world, normalize(n.xyz), instance_material(instance), int(w.y));
+        color = shade_all_lights(world, normalize(n.xyz), instance_material(instance), light_row);
     }
     imageStore(u_atlas, tile.xy + texel, vec4(color, 1.0));
 }

@@ -267,8 +267,17 @@ static bool seen_create(struct osl *o, const struct technique_env *env, char *er
     glGenTextures(1, &o->marks_tex);
     glBindTexture(GL_TEXTURE_2D, o->marks_tex);
     glTexStorage2D(GL_TEXTURE_2D, 1, GL_R32I, o->blocks_x, o->blocks_y);
-    const GLint unseen = INT_MIN;
-    glClearTexImage(o->marks_tex, 0, GL_RED_INTEGER, GL_INT, &unseen);
+    /* Never read yet (glClearTexImage is GL 4.4; the daemon asks for 4.3). */
+    GLint *unseen = malloc(blocks * sizeof(GLint));
+    if (!unseen) {
+        snprintf(err, errlen, "osl: out of memory");
+        return false;
+    }
+    for (size_t b = 0; b < blocks; b++)
+        unseen[b] = INT_MIN;
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, o->blocks_x, o->blocks_y, GL_RED_INTEGER, GL_INT, unseen);
+    free(unseen);
 
     const struct gl_stage select[] = {{GL_COMPUTE_SHADER, {"osl_select.comp"}}};
     if (!(o->select_prog = gl_program_build("osl select", select, 1, NULL, err, errlen)))

@@ -1,6 +1,8 @@
 #define _GNU_SOURCE /* dl_iterate_phdr, RTLD_NODELETE */
+#include <dirent.h>
 #include <dlfcn.h>
 #include <errno.h>
+#include <sys/stat.h>
 #include <getopt.h>
 #include <link.h>
 #include <limits.h>
@@ -400,6 +402,29 @@ static bool once_publish(const char *partial, const char *out)
     return true;
 }
 
+/* An --out folder that may be replaced: absent, empty, or a result folder
+ * (a job's files only: no subfolder, and its result.json or job.json). */
+static bool once_replaceable(const char *out)
+{
+    DIR *d = opendir(out);
+    if (!d)
+        return errno == ENOENT;
+    bool any = false, result = false, foreign = false;
+    struct dirent *e;
+    char path[PATH_MAX + 300];
+    while ((e = readdir(d))) {
+        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
+            continue;
+        any = true;
+        result = result || !strcmp(e->d_name, "result.json") || !strcmp(e->d_name, "job.json");
+        snprintf(path, sizeof(path), "%s/%s", out, e->d_name);
+        struct stat st;
+        foreign = foreign || lstat(path, &st) != 0 || !S_ISREG(st.st_mode);
+    }
+    closedir(d);
+    return !any || (result && !foreign);
+}
+
 static int run_once(const struct options *o, const struct technique_catalog *catalog)
 {
     size_t len = 0;
@@ -424,8 +449,25 @@ static int run_once(const struct options *o, const struct technique_catalog *cat
     char host[64] = "";
     if (gethostname(host, sizeof(host) - 1) != 0)
         snprintf(host, sizeof(host), "host");
+    /* The folder is replaced whole, so it must be one: not "/" or ".", and
+     * not a folder of other files. */
+    char out[PATH_MAX];
+    snprintf(out, sizeof(out), "%s", o->out);
+    size_t out_len = strlen(out);
+    while (out_len > 1 && out[out_len - 1] == '/')
+        out[--out_len] = '\0';
+    const char *base = strrchr(out, '/') ? strrchr(out, '/') + 1 : out;
+    if (!strcmp(base, "") || !strcmp(base, ".") || !strcmp(base, "..")) {
+        fprintf(stderr, "shadebenchd: --out %s: name a folder of its own for the result\n", o->out);
+        return 2;
+    }
+    if (!once_replaceable(out)) {
+        fprintf(stderr, "shadebenchd: --out %s holds other files than a result: choose a new or "
+                        "empty folder, or one --once wrote\n", o->out);
+        return 2;
+    }
     char partial[PATH_MAX];
-    if ((size_t)snprintf(partial, sizeof(partial), "%s.partial-%s-%ld", o->out, host,
+    if ((size_t)snprintf(partial, sizeof(partial), "%s.partial-%s-%ld", out, host,
                          (long)getpid()) >= sizeof(partial)) {
         fprintf(stderr, "shadebenchd: --out %s: the path is too long\n", o->out);
         return 2;
@@ -469,7 +511,7 @@ static int run_once(const struct options *o, const struct technique_catalog *cat
         snprintf(path, sizeof(path), "%s/task.json", partial);
         written = written && fs_write_json_atomic(path, task);
         json_decref(task);
-        if (!written || !once_publish(partial, o->out)) {
+        if (!written || !once_publish(partial, out)) {
             fprintf(stderr, "shadebenchd: cannot write %s: %s\n", written ? o->out : path,
                     strerror(errno));
             rc = 2;

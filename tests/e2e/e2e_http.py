@@ -131,6 +131,19 @@ try:
     check(once["gpu_ms"]["n"] == 12 and len(once["captures"]) == 2, "--once result")
     diff = testlib.png_diff(png, os.path.join(once_dir, "frame-000012.png"))
     check(diff and diff["max_abs"] == 0, "--once gives the daemon's pixels: %s" % diff)
+    check(os.path.exists(os.path.join(once_dir, "job.json")) and
+          os.path.exists(os.path.join(once_dir, "task.json")) and
+          not [n for n in os.listdir(tmp) if ".partial-" in n],
+          "--once adds job.json and task.json, and leaves no partial folder")
+    # It replaces its folder whole, so a folder of other files is refused, untouched.
+    foreign = os.path.join(tmp, "foreign")
+    os.makedirs(foreign)
+    open(os.path.join(foreign, "notes.txt"), "w").close()
+    out = subprocess.run([testlib.SHADEBENCHD, "--once", job_path, "--out", foreign],
+                         capture_output=True, text=True)
+    check(out.returncode == 2 and "other files" in out.stderr and
+          os.listdir(foreign) == ["notes.txt"], "--once refuses a folder of other files: %s"
+          % out.stderr[-300:])
     check(d.alive(), "daemon still running")
 finally:
     code = d.stop()

@@ -87,10 +87,7 @@ else:
     bench.end([r for rs in results.values() for r in rs])
 
 
-def work_ms(r):
-    """CPU milliseconds the daemon's threads took per timed frame."""
-    i = r.get("interference", {})
-    return i.get("daemon_cpu_share", 0) * i.get("cpus", 1) * i.get("interval_s", 0) * 1e3 / r["frames"]
+work_ms = benchrun.cpu_work_ms
 
 
 def med(t, n, series="frame_ms"):

@@ -142,10 +142,7 @@ if args.json and not args.from_json:  # before the report, so that a report's fa
         json.dump({"%s@%d" % k: v for k, v in results.items()}, f)
 
 
-def work_ms(r):
-    """CPU milliseconds the daemon's threads took per timed frame."""
-    i = r.get("interference", {})
-    return i.get("daemon_cpu_share", 0) * i.get("cpus", 1) * i.get("interval_s", 0) * 1e3 / r["frames"]
+work_ms = benchrun.cpu_work_ms
 
 
 def med(t, n, series="frame_ms"):

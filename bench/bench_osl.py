@@ -39,9 +39,7 @@ ap.add_argument("--json", help="write every result here")
 args = ap.parse_args()
 
 
-def cpu_work_ms(r):
-    i = r.get("interference", {})
-    return i.get("daemon_cpu_share", 0) * i.get("cpus", 1) * i.get("interval_s", 0) * 1e3 / r["frames"]
+cpu_work_ms = benchrun.cpu_work_ms
 
 
 def med(xs):

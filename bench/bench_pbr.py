@@ -82,12 +82,7 @@ def paired(a, b, f=lambda r: r["frame_ms"]["median"]):
     return [f(y) / f(x) for x, y in zip(a, b)]
 
 
-def work_ms(r):
-    """CPU milliseconds all the daemon's threads took per timed frame
-    (result.interference): on llvmpipe, where all the work is on the CPU,
-    the cost that other processes' load does not inflate."""
-    i = r.get("interference", {})
-    return i.get("daemon_cpu_share", 0) * i.get("cpus", 1) * i.get("interval_s", 0) * 1e3 / r["frames"]
+work_ms = benchrun.cpu_work_ms
 
 
 def ratio_cell(a, b, f=lambda r: r["frame_ms"]["median"]):

@@ -34,6 +34,14 @@ def _commit():
         return "unknown"
 
 
+def cpu_work_ms(r):
+    """CPU milliseconds all the daemon's threads took per timed frame
+    (result.interference): on llvmpipe, where all the work is on the CPU, the
+    cost that other processes' load inflates least."""
+    i = r.get("interference", {})
+    return i.get("daemon_cpu_share", 0) * i.get("cpus", 1) * i.get("interval_s", 0) * 1e3 / r["frames"]
+
+
 class Run:
     """Call start() before the first job and end(results) after the last."""
 

@@ -218,6 +218,22 @@ static bool generate_textures(struct osl *o, const struct technique_env *env)
     return ok;
 }
 
+/* The lighting pass's program and inputs, whichever way it finds its blocks:
+ * the tiles, the atlas to write, each mesh's position and normal textures. */
+static void bind_light_inputs(const struct osl *o, const struct technique_env *env)
+{
+    gpu_scene_bind(env->gpu, &o->light);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_TILES, o->tile_buffer);
+    glBindImageTexture(SB_IMG_OSL_ATLAS, o->atlas, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
+    for (int m = 0; m < SCENE_MESH_COUNT; m++) {
+        glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_MESH + m * 2);
+        glBindTexture(GL_TEXTURE_2D, o->position_tex[m]);
+        glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_MESH + 1 + m * 2);
+        glBindTexture(GL_TEXTURE_2D, o->normal_tex[m]);
+    }
+    glActiveTexture(GL_TEXTURE0);
+}
+
 static GLuint ssbo(GLsizeiptr bytes, const void *data, GLenum usage)
 {
     GLuint b;
@@ -381,17 +397,8 @@ static void seen_light_pass(struct osl *o, const struct technique_env *env, int6
     glDispatchCompute(1, 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
 
-    gpu_scene_bind(env->gpu, &o->light);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_TILES, o->tile_buffer);
+    bind_light_inputs(o, env);
     seen_bind(o);
-    glBindImageTexture(SB_IMG_OSL_ATLAS, o->atlas, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
-    for (int m = 0; m < SCENE_MESH_COUNT; m++) {
-        glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_MESH + m * 2);
-        glBindTexture(GL_TEXTURE_2D, o->position_tex[m]);
-        glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_MESH + 1 + m * 2);
-        glBindTexture(GL_TEXTURE_2D, o->normal_tex[m]);
-    }
-    glActiveTexture(GL_TEXTURE0);
     glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, o->stats_buf);
     glDispatchComputeIndirect(0);
     glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
@@ -545,17 +552,8 @@ static double light_pass(struct osl *o, const struct technique_env *env, int64_t
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, o->work_buffer);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)((size_t)count * 4 * sizeof(GLuint)),
                  o->work, GL_STREAM_DRAW);
-    gpu_scene_bind(env->gpu, &o->light);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_TILES, o->tile_buffer);
+    bind_light_inputs(o, env);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_WORK, o->work_buffer);
-    glBindImageTexture(SB_IMG_OSL_ATLAS, o->atlas, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
-    for (int m = 0; m < SCENE_MESH_COUNT; m++) {
-        glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_MESH + m * 2);
-        glBindTexture(GL_TEXTURE_2D, o->position_tex[m]);
-        glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_MESH + 1 + m * 2);
-        glBindTexture(GL_TEXTURE_2D, o->normal_tex[m]);
-    }
-    glActiveTexture(GL_TEXTURE0);
     glUniform1i(o->work_count_loc, count);
     /* The blocks in ranges of bounded cost (all at once unless that is
      * costly): each a dispatch of its own. */

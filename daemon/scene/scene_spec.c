@@ -132,13 +132,58 @@ static bool parse_camera(const json_t *scene, struct scene_spec *s, struct job_e
     return true;
 }
 
+bool scene_asset_name_valid(const char *name)
+{
+    size_t n = strlen(name);
+    if (n == 0 || n > SCENE_ASSET_NAME_MAX || name[0] == '.')
+        return false;
+    for (size_t i = 0; i < n; i++) {
+        char c = name[i];
+        if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+              c == '.' || c == '_' || c == '-'))
+            return false;
+    }
+    return true;
+}
+
+static bool parse_asset(const json_t *scene, struct scene_spec *s, struct job_error *err)
+{
+    json_t *v = json_object_get(scene, "asset");
+    if (!v) {
+        if (json_object_get(scene, "asset_sha256"))
+            return job_error_set(err, "scene.asset_sha256", "needs scene.asset");
+        return true;
+    }
+    if (!json_is_string(v) || !scene_asset_name_valid(json_string_value(v)))
+        return job_error_set(err, "scene.asset",
+                             "must be the name of a stored asset (GET /v1/assets): 1 to %d "
+                             "letters, digits, '.', '_' or '-', not starting with '.'",
+                             SCENE_ASSET_NAME_MAX);
+    snprintf(s->asset, sizeof(s->asset), "%s", json_string_value(v));
+    s->asset_sha256[0] = '\0';
+    /* A spec written back carries the hash; a client may pin one too (the
+     * job is then refused when the stored asset of that name differs). */
+    json_t *h = json_object_get(scene, "asset_sha256");
+    if (!h)
+        return true;
+    const char *hex = json_is_string(h) ? json_string_value(h) : "";
+    bool ok = strlen(hex) == 64;
+    for (int i = 0; ok && i < 64; i++)
+        ok = (hex[i] >= '0' && hex[i] <= '9') || (hex[i] >= 'a' && hex[i] <= 'f');
+    if (!ok)
+        return job_error_set(err, "scene.asset_sha256",
+                             "must be 64 lowercase hexadecimal digits (the asset's SHA-256)");
+    memcpy(s->asset_sha256, hex, 65);
+    return true;
+}
+
 bool scene_spec_parse(const json_t *scene, struct scene_spec *s, struct job_error *err)
 {
     static const char *const keys[] = {
         "preset", "lights", "dynamic", "width", "height", "sphere_segments",
         "teapot_segments", "tessellation_error_px", "light_speed", "light_radius", "light_intensity",
         "light_layout", "materials", "specular", "shininess", "metallic", "roughness",
-        "camera", NULL};
+        "camera", "asset", "asset_sha256", NULL};
     if (!jf_check_keys(scene, "scene.", keys, err))
         return false;
     int preset = (int)s->preset, layout, materials;
@@ -169,7 +214,7 @@ bool scene_spec_parse(const json_t *scene, struct scene_spec *s, struct job_erro
         !jf_get_number(scene, "shininess", "scene.shininess", 1.0, 4096.0, &s->shininess, err) ||
         !jf_get_number(scene, "metallic", "scene.metallic", 0.0, 1.0, &s->metallic, err) ||
         !jf_get_number(scene, "roughness", "scene.roughness", 0.0, 1.0, &s->roughness, err) ||
-        !parse_camera(scene, s, err))
+        !parse_camera(scene, s, err) || !parse_asset(scene, s, err))
         return false;
     s->light_layout = (enum scene_light_layout)layout;
     s->materials = (enum scene_materials)materials;
@@ -203,5 +248,10 @@ json_t *scene_spec_to_json(const struct scene_spec *s)
     json_object_set_new(o, "camera", json_pack("{s:s, s:i}", "path",
                                                scene_camera_names[s->camera], "period",
                                                s->camera_period));
+    if (s->asset[0]) {
+        json_object_set_new(o, "asset", json_string(s->asset));
+        if (s->asset_sha256[0])
+            json_object_set_new(o, "asset_sha256", json_string(s->asset_sha256));
+    }
     return o;
 }

@@ -41,6 +41,7 @@ enum {
     SCENE_SEGMENTS_AUTO = 0, /* sphere_segments "auto" */
     SCENE_MAX_CAMERA_PERIOD = 1000000,
     SCENE_TEAPOT_SEGMENTS_AUTO = 0, /* teapot_segments "auto" */
+    SCENE_ASSET_NAME_MAX = 128,
 };
 
 struct scene_spec {
@@ -59,7 +60,17 @@ struct scene_spec {
     double specular, shininess, metallic, roughness;
     enum scene_camera_path camera;
     int camera_period; /* frames per loop of a moving camera */
+    /* "asset": a stored glTF asset's name (daemon/scene/asset.h); empty for
+     * the presets. Its SHA-256 is filled in when the job is accepted (the
+     * HTTP side looks the name up), so that the result names the exact file
+     * and a gate never compares two different scenes. */
+    char asset[SCENE_ASSET_NAME_MAX + 1];
+    char asset_sha256[65];
 };
+
+/* An asset name: 1 to SCENE_ASSET_NAME_MAX bytes of letters, digits, '.',
+ * '_' and '-', not starting with '.'. Safe as a file name. */
+bool scene_asset_name_valid(const char *name);
 
 /* The grid preset with every option at its default. */
 void scene_spec_defaults(struct scene_spec *s);

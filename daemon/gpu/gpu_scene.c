@@ -11,10 +11,19 @@ bool gpu_scene_init(struct gpu_scene *g, const struct scene *s, char *err, size_
     memset(g, 0, sizeof(*g));
     g->scene = s;
     g->uploaded_frame = INT64_MIN;
-    glGenVertexArrays(SCENE_MESH_COUNT, g->vao);
-    glGenBuffers(SCENE_MESH_COUNT, g->vbo);
-    glGenBuffers(SCENE_MESH_COUNT, g->ebo);
-    for (int m = 0; m < SCENE_MESH_COUNT; m++) {
+    g->mesh_count = s->mesh_count;
+    g->vao = calloc((size_t)g->mesh_count, sizeof(GLuint));
+    g->vbo = calloc((size_t)g->mesh_count, sizeof(GLuint));
+    g->ebo = calloc((size_t)g->mesh_count, sizeof(GLuint));
+    if (!g->vao || !g->vbo || !g->ebo) {
+        snprintf(err, errlen, "out of memory for scene buffers");
+        gpu_scene_finish(g);
+        return false;
+    }
+    glGenVertexArrays(g->mesh_count, g->vao);
+    glGenBuffers(g->mesh_count, g->vbo);
+    glGenBuffers(g->mesh_count, g->ebo);
+    for (int m = 0; m < g->mesh_count; m++) {
         const struct mesh *mesh = &s->meshes[m];
         glBindVertexArray(g->vao[m]);
         glBindBuffer(GL_ARRAY_BUFFER, g->vbo[m]);
@@ -36,6 +45,12 @@ bool gpu_scene_init(struct gpu_scene *g, const struct scene *s, char *err, size_
         glEnableVertexAttribArray(3);
         glVertexAttribPointer(3, 4, GL_FLOAT, GL_FALSE, stride,
                               (void *)offsetof(struct mesh_vertex, chart));
+        glEnableVertexAttribArray(4);
+        glVertexAttribPointer(4, 2, GL_FLOAT, GL_FALSE, stride,
+                              (void *)offsetof(struct mesh_vertex, tex));
+        glEnableVertexAttribArray(5);
+        glVertexAttribPointer(5, 4, GL_FLOAT, GL_FALSE, stride,
+                              (void *)offsetof(struct mesh_vertex, tangent));
     }
     glBindVertexArray(0);
 
@@ -87,9 +102,15 @@ void gpu_scene_finish(struct gpu_scene *g)
 {
     if (!g || !g->scene)
         return;
-    glDeleteVertexArrays(SCENE_MESH_COUNT, g->vao);
-    glDeleteBuffers(SCENE_MESH_COUNT, g->vbo);
-    glDeleteBuffers(SCENE_MESH_COUNT, g->ebo);
+    if (g->vao)
+        glDeleteVertexArrays(g->mesh_count, g->vao);
+    if (g->vbo)
+        glDeleteBuffers(g->mesh_count, g->vbo);
+    if (g->ebo)
+        glDeleteBuffers(g->mesh_count, g->ebo);
+    free(g->vao);
+    free(g->vbo);
+    free(g->ebo);
     glDeleteBuffers(1, &g->instance_buffer);
     glDeleteBuffers(1, &g->light_buffer);
     glDeleteBuffers(1, &g->position_buffer);
@@ -141,7 +162,9 @@ void gpu_scene_draw(const struct gpu_scene *g, const struct scene_program *p)
 {
     const struct scene *s = g->scene;
     int base = 0;
-    for (int m = 0; m < SCENE_MESH_COUNT; m++) {
+    for (int m = 0; m < g->mesh_count; m++) {
+        if (!s->mesh_instance_count[m])
+            continue;
         glUniform1i(p->instance_base, base);
         glBindVertexArray(g->vao[m]);
         glDrawElementsInstanced(GL_TRIANGLES, (GLsizei)s->meshes[m].index_count,

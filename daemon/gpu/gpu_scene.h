@@ -15,7 +15,8 @@
 
 struct gpu_scene {
     const struct scene *scene;
-    GLuint vao[SCENE_MESH_COUNT], vbo[SCENE_MESH_COUNT], ebo[SCENE_MESH_COUNT];
+    GLuint *vao, *vbo, *ebo; /* per mesh of the scene (scene.mesh_count) */
+    int mesh_count;
     GLuint instance_buffer, light_buffer, position_buffer;
     int position_rows;          /* rows allocated in position_buffer */
     int64_t uploaded_frame;     /* frame in row 0 when rows == 1, else INT64_MIN */

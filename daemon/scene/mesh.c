@@ -29,6 +29,19 @@ void mesh_finish(struct mesh *m)
     memset(m, 0, sizeof(*m));
 }
 
+void mesh_compute_box(struct mesh *m)
+{
+    for (int k = 0; k < 3; k++) {
+        m->box_min[k] = m->vertex_count ? INFINITY : 0.0f;
+        m->box_max[k] = m->vertex_count ? -INFINITY : 0.0f;
+    }
+    for (uint32_t i = 0; i < m->vertex_count; i++)
+        for (int k = 0; k < 3; k++) {
+            m->box_min[k] = fminf(m->box_min[k], m->vertices[i].pos[k]);
+            m->box_max[k] = fmaxf(m->box_max[k], m->vertices[i].pos[k]);
+        }
+}
+
 bool mesh_create_sphere(struct mesh *out, float radius, int segments)
 {
     /* Latitude-longitude sphere: one chart covering the whole tile. The pole

@@ -19,6 +19,11 @@ struct mesh_vertex {
     float normal[3];
     float uv[2];
     float chart[4]; /* u0, v0, u1, v1 of the chart this vertex belongs to */
+    /* The material's texture coordinates and tangent frame (an asset's
+     * TEXCOORD_0 and TANGENT, handedness in w); the procedural meshes have
+     * no textures and leave them 0. */
+    float tex[2];
+    float tangent[4];
 };
 
 struct mesh {
@@ -29,6 +34,7 @@ struct mesh {
     /* UV units per object-space unit along the chart's densest direction;
      * lets a tile size be chosen from an object's size on screen. */
     float uv_per_unit;
+    float box_min[3], box_max[3]; /* object space; mesh_compute_box */
 };
 
 bool mesh_create_sphere(struct mesh *out, float radius, int segments);
@@ -36,5 +42,7 @@ bool mesh_create_cube(struct mesh *out, float half_extent);
 /* A square in the XZ plane facing +y, one chart over the whole tile. */
 bool mesh_create_plane(struct mesh *out, float half_extent);
 void mesh_finish(struct mesh *m);
+/* Sets box_min and box_max from the vertices (zero for an empty mesh). */
+void mesh_compute_box(struct mesh *m);
 
 #endif

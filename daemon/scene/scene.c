@@ -12,11 +12,13 @@
 static const double PI = 3.14159265358979323846;
 
 const char *const scene_mesh_names[] = {"sphere", "cube", "plane", "teapot", NULL};
+const char *const scene_light_type_names[] = {"point", "spot", "directional", NULL};
 
 /* Object-space half extents of instance i's axis-aligned box. */
-static void instance_half_extent(const struct scene_instance *in, float out[3])
+static void instance_half_extent(const struct scene *s, const struct scene_instance *in,
+                                 float out[3])
 {
-    switch (in->mesh) {
+    switch ((enum scene_mesh)in->mesh) {
     case SCENE_MESH_SPHERE:
         out[0] = out[1] = out[2] = SCENE_SPHERE_RADIUS * in->scale;
         return;
@@ -27,9 +29,15 @@ static void instance_half_extent(const struct scene_instance *in, float out[3])
         for (int k = 0; k < 3; k++)
             out[k] = SCENE_TEAPOT_HALF[k] * in->scale;
         return;
-    default:
+    case SCENE_MESH_PLANE:
         out[0] = out[2] = SCENE_PLANE_HALF * in->scale;
         out[1] = 0.0f;
+        return;
+    default:
+        /* An asset's mesh, centred on its instance's position. */
+        for (int k = 0; k < 3; k++)
+            out[k] = fmaxf(-s->meshes[in->mesh].box_min[k], s->meshes[in->mesh].box_max[k]) *
+                     in->scale;
         return;
     }
 }
@@ -49,7 +57,7 @@ static void compute_bounds(struct scene *s)
     for (int i = 0; i < s->instance_count; i++) {
         const struct scene_instance *in = &s->instances[i];
         float half[3];
-        instance_half_extent(in, half);
+        instance_half_extent(s, in, half);
         for (int k = 0; k < 3; k++) {
             s->bounds.min[k] = fminf(s->bounds.min[k], in->pos[k] - half[k]);
             s->bounds.max[k] = fmaxf(s->bounds.max[k], in->pos[k] + half[k]);
@@ -68,13 +76,17 @@ bool scene_init(struct scene *out, const struct scene_spec *spec)
     memset(out, 0, sizeof(*out));
     out->spec = *spec;
     bool materials_set = false;
-    if (!scene_build_preset(out, &materials_set))
+    out->mesh_count = SCENE_MESH_PROCEDURAL;
+    if (!(out->meshes = calloc((size_t)out->mesh_count, sizeof(*out->meshes))) ||
+        !scene_build_preset(out, &materials_set) ||
+        !(out->mesh_instance_count = calloc((size_t)out->mesh_count, sizeof(int))))
         goto fail;
     for (int i = 0; i < out->instance_count; i++) {
         /* Each mesh is one instanced draw over a contiguous range. */
-        if (i && out->instances[i].mesh < out->instances[i - 1].mesh)
+        int m = out->instances[i].mesh;
+        if ((i && m < out->instances[i - 1].mesh) || m < 0 || m >= out->mesh_count)
             goto fail;
-        out->mesh_instance_count[out->instances[i].mesh]++;
+        out->mesh_instance_count[m]++;
     }
     scene_assign_materials(out, materials_set);
     compute_bounds(out);
@@ -87,6 +99,8 @@ bool scene_init(struct scene *out, const struct scene_spec *spec)
         (out->mesh_instance_count[SCENE_MESH_TEAPOT] &&
          !mesh_create_teapot(&out->meshes[SCENE_MESH_TEAPOT], out->teapot_segments, 1.0f)))
         goto fail;
+    for (int m = 0; m < out->mesh_count; m++)
+        mesh_compute_box(&out->meshes[m]);
 
     struct scene_camera cam;
     scene_camera_at(out, 0, &cam);
@@ -109,8 +123,10 @@ void scene_finish(struct scene *s)
 {
     if (!s)
         return;
-    for (int m = 0; m < SCENE_MESH_COUNT; m++)
+    for (int m = 0; s->meshes && m < s->mesh_count; m++)
         mesh_finish(&s->meshes[m]);
+    free(s->meshes);
+    free(s->mesh_instance_count);
     free(s->instances);
     free(s->lights);
     memset(s, 0, sizeof(*s));
@@ -162,7 +178,7 @@ float scene_projected_diameter(const struct scene *s, int i)
 uint64_t scene_triangles(const struct scene *s)
 {
     uint64_t total = 0;
-    for (int m = 0; m < SCENE_MESH_COUNT; m++)
+    for (int m = 0; m < s->mesh_count; m++)
         total += (uint64_t)s->mesh_instance_count[m] * (s->meshes[m].index_count / 3);
     return total;
 }
@@ -187,7 +203,7 @@ bool scene_instance_in_view(const struct scene *s, int i, const struct scene_cam
 {
     const struct scene_instance *in = &s->instances[i];
     float half[3];
-    instance_half_extent(in, half);
+    instance_half_extent(s, in, half);
     for (int corner = 0; corner < 8; corner++) {
         float p[3];
         for (int k = 0; k < 3; k++)
@@ -290,7 +306,7 @@ static json_t *describe_camera(const struct scene *s)
 json_t *scene_describe(const struct scene *s)
 {
     json_t *by_mesh = json_object();
-    for (int m = 0; m < SCENE_MESH_COUNT; m++)
+    for (int m = 0; m < SCENE_MESH_PROCEDURAL; m++)
         json_object_set_new(by_mesh, scene_mesh_names[m], json_integer(s->mesh_instance_count[m]));
     json_t *lights = describe_lights(s);
     if (!lights) {

@@ -14,9 +14,12 @@
 #include "daemon/scene/mesh.h"
 #include "daemon/scene/scene_math.h"
 
-/* Instances are grouped by mesh in this order, one instanced draw each. */
+/* Instances are grouped by mesh in index order, one instanced draw each.
+ * The procedural meshes come first, at these indices (empty when unused);
+ * an asset's meshes follow, from SCENE_MESH_PROCEDURAL on, one instance
+ * each. */
 enum scene_mesh {
-    SCENE_MESH_SPHERE, SCENE_MESH_CUBE, SCENE_MESH_PLANE, SCENE_MESH_TEAPOT, SCENE_MESH_COUNT
+    SCENE_MESH_SPHERE, SCENE_MESH_CUBE, SCENE_MESH_PLANE, SCENE_MESH_TEAPOT, SCENE_MESH_PROCEDURAL
 };
 extern const char *const scene_mesh_names[]; /* "sphere", "cube", "plane", "teapot" */
 
@@ -31,12 +34,19 @@ struct scene_instance {
     float pos[3];
     float scale; /* uniform: object-space normals stay world-space normals */
     float albedo[3];
-    enum scene_mesh mesh;
+    int mesh; /* index into scene.meshes: enum scene_mesh, or an asset's mesh */
     struct scene_material material;
 };
 
 /* The plane a dynamic light circles in around its centre. */
 enum scene_orbit_plane { SCENE_ORBIT_XY, SCENE_ORBIT_XZ };
+
+/* Point lights light every direction; a spot light only its cone (full
+ * inside cos_inner, fading to 0 at cos_outer, glTF's smooth falloff); a
+ * directional light has no position and reaches everything (radius is
+ * unused, and the culling techniques bin it into every cell). */
+enum scene_light_type { SCENE_LIGHT_POINT, SCENE_LIGHT_SPOT, SCENE_LIGHT_DIRECTIONAL };
+extern const char *const scene_light_type_names[]; /* "point", "spot", "directional" */
 
 struct scene_light {
     float centre[3];
@@ -45,6 +55,9 @@ struct scene_light {
     float color[3];
     int period;   /* frames per revolution */
     int phase;    /* frames */
+    enum scene_light_type type; /* zero: point, what every preset places */
+    float direction[3];         /* spot and directional: unit, the way the light shines */
+    float cos_inner, cos_outer; /* spot: cosines of the cone's inner and outer angles */
 };
 
 struct scene_box {
@@ -74,10 +87,11 @@ struct scene_rig {
 
 struct scene {
     struct scene_spec spec;
-    struct mesh meshes[SCENE_MESH_COUNT];
+    struct mesh *meshes;           /* mesh_count: the procedural ones, then an asset's */
+    int mesh_count;
     struct scene_instance *instances;
     int instance_count;
-    int mesh_instance_count[SCENE_MESH_COUNT];
+    int *mesh_instance_count;      /* per mesh */
     struct scene_light *lights;
     int light_count;
     enum scene_orbit_plane light_orbit_plane;

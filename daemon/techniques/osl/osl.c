@@ -27,7 +27,7 @@ enum { PASS_LIGHTING, PASS_RASTER };
 
 /* osl_light.comp has one position and one normal sampler per
  * mesh and selects them by branch: keep both in step. */
-_Static_assert(SCENE_MESH_COUNT == 4, "osl_light.comp samples exactly four meshes");
+_Static_assert(SCENE_MESH_PROCEDURAL == 4, "osl_light.comp samples exactly four meshes");
 
 /* Atlas memory ceiling; the device's texture size limit applies as well. */
 static const double OSL_MAX_ATLAS_BYTES = 1024.0 * 1024.0 * 1024.0;
@@ -37,8 +37,8 @@ struct osl {
     struct scene_program light, draw;
     GLint work_count_loc, groups_x_loc; /* the lighting pass's per-frame uniforms */
     GLint group_base_loc, group_end_loc;
-    GLuint position_tex[SCENE_MESH_COUNT], normal_tex[SCENE_MESH_COUNT];
-    int base_size[SCENE_MESH_COUNT]; /* level 0 edge of each mesh's textures */
+    GLuint position_tex[SCENE_MESH_PROCEDURAL], normal_tex[SCENE_MESH_PROCEDURAL];
+    int base_size[SCENE_MESH_PROCEDURAL]; /* level 0 edge of each mesh's textures */
     GLuint atlas, tile_buffer, work_buffer;
     int atlas_w, atlas_h;
     int groups_x_max;
@@ -172,7 +172,7 @@ static bool generate_textures(struct osl *o, const struct technique_env *env)
     static const GLenum bufs[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
     glDrawBuffers(2, bufs);
     bool ok = true;
-    for (int m = 0; m < SCENE_MESH_COUNT && ok; m++) {
+    for (int m = 0; m < SCENE_MESH_PROCEDURAL && ok; m++) {
         int base = 0, smallest = OSL_TILE_MAX;
         for (int i = 0; i < s->instance_count; i++)
             if ((int)s->instances[i].mesh == m) {
@@ -225,7 +225,7 @@ static void bind_light_inputs(const struct osl *o, const struct technique_env *e
     gpu_scene_bind(env->gpu, &o->light);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_TILES, o->tile_buffer);
     glBindImageTexture(SB_IMG_OSL_ATLAS, o->atlas, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
-    for (int m = 0; m < SCENE_MESH_COUNT; m++) {
+    for (int m = 0; m < SCENE_MESH_PROCEDURAL; m++) {
         glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_MESH + m * 2);
         glBindTexture(GL_TEXTURE_2D, o->position_tex[m]);
         glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_MESH + 1 + m * 2);
@@ -412,6 +412,11 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
 {
     const struct scene *s = env->scene;
     int n = s->instance_count;
+    if (s->mesh_count > SCENE_MESH_PROCEDURAL) {
+        snprintf(err, errlen, "osl: scenes from assets (scene.asset) are not supported yet: "
+                 "the lighting pass samples the four procedural meshes only");
+        return false;
+    }
     struct osl *o = calloc(1, sizeof(*o));
     if (!o)
         goto oom;
@@ -470,7 +475,7 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
     o->group_end_loc = glGetUniformLocation(light_prog, "u_group_end");
     /* Texture units never change: position and normal of mesh m on units
      * 1 + 2m and 2 + 2m for the lighting pass, the atlas on unit 0. */
-    for (int m = 0; m < SCENE_MESH_COUNT; m++) {
+    for (int m = 0; m < SCENE_MESH_PROCEDURAL; m++) {
         char name[32];
         snprintf(name, sizeof(name), "u_position[%d]", m);
         glProgramUniform1i(light_prog, glGetUniformLocation(light_prog, name),
@@ -676,7 +681,7 @@ static json_t *osl_describe(void *state)
         o->stale_blocks = stats[6];
     }
     double texgen_bytes = 0;
-    for (int m = 0; m < SCENE_MESH_COUNT; m++)
+    for (int m = 0; m < SCENE_MESH_PROCEDURAL; m++)
         texgen_bytes += o->base_size[m] ? 2.0 * 16.0 * o->base_size[m] * o->base_size[m] * 4.0 / 3.0 : 0;
     json_t *d = json_pack(
         "{s:{s:f, s:i}, s:{s:f, s:f, s:f}, s:{s:i, s:i, s:f, s:f, s:f}, s:o, s:o, s:{s:i, s:f}, s:f}",
@@ -719,8 +724,8 @@ static void osl_destroy(void *state)
     glDeleteProgram(o->texgen_prog);
     glDeleteProgram(o->light.prog);
     glDeleteProgram(o->draw.prog);
-    glDeleteTextures(SCENE_MESH_COUNT, o->position_tex);
-    glDeleteTextures(SCENE_MESH_COUNT, o->normal_tex);
+    glDeleteTextures(SCENE_MESH_PROCEDURAL, o->position_tex);
+    glDeleteTextures(SCENE_MESH_PROCEDURAL, o->normal_tex);
     glDeleteTextures(1, &o->atlas);
     glDeleteBuffers(1, &o->tile_buffer);
     glDeleteBuffers(1, &o->work_buffer);

@@ -37,18 +37,18 @@ static const char *field_name(const struct light_grid_config *cfg, char *buf, si
  * first and last slices still reach the clip planes, so every pixel has a
  * cell. Boxes rather than bounding spheres: a ground plane's sphere would
  * stretch the range far beyond the plane. */
-static void slice_range(const struct light_grid *g, const struct scene *s,
+static void slice_range(const struct scene *s,
                         const struct scene_camera *cam, float out[2])
 {
     float lo = cam->far_z, hi = cam->near_z;
     const float *v = cam->view;
     for (int i = 0; i < s->instance_count; i++) {
         const struct scene_instance *in = &s->instances[i];
+        const struct mesh *m = &s->meshes[in->mesh];
         for (int corner = 0; corner < 8; corner++) {
             float p[3];
             for (int k = 0; k < 3; k++)
-                p[k] = in->pos[k] + in->scale * (corner >> k & 1 ? g->mesh_box[in->mesh][1][k]
-                                                                 : g->mesh_box[in->mesh][0][k]);
+                p[k] = in->pos[k] + in->scale * (corner >> k & 1 ? m->box_max[k] : m->box_min[k]);
             float z = -(v[2] * p[0] + v[6] * p[1] + v[10] * p[2] + v[14]);
             lo = fminf(lo, z);
             hi = fmaxf(hi, z);
@@ -65,7 +65,7 @@ static void slice_range(const struct light_grid *g, const struct scene *s,
 static void set_slices(struct light_grid *g, const struct scene *s, const struct scene_camera *cam)
 {
     float range[2];
-    slice_range(g, s, cam, range);
+    slice_range(s, cam, range);
     bool exponential = g->cfg.slices == CLUSTER_SLICES_EXPONENTIAL;
     double span = exponential ? log(range[1] / range[0]) : range[1] - range[0];
     g->block.slices[0] = range[0];
@@ -141,17 +141,6 @@ bool light_grid_init(struct light_grid *g, const struct technique_env *env,
     g->lights = env->scene->light_count;
     g->frames = env->frames;
     g->camera_moves = scene_camera_moves(env->scene);
-    for (int m = 0; m < SCENE_MESH_COUNT; m++) {
-        const struct mesh *mesh = &env->scene->meshes[m];
-        for (int k = 0; k < 3; k++)
-            g->mesh_box[m][0][k] = mesh->vertex_count ? INFINITY : 0.0f,
-            g->mesh_box[m][1][k] = mesh->vertex_count ? -INFINITY : 0.0f;
-        for (uint32_t i = 0; i < mesh->vertex_count; i++)
-            for (int k = 0; k < 3; k++) {
-                g->mesh_box[m][0][k] = fminf(g->mesh_box[m][0][k], mesh->vertices[i].pos[k]);
-                g->mesh_box[m][1][k] = fmaxf(g->mesh_box[m][1][k], mesh->vertices[i].pos[k]);
-            }
-    }
     bool tiles = cfg->kind == LIGHT_GRID_TILES;
     bool cpu = tiles && cfg->binning == LIGHT_BINNING_CPU;
     char field[96];

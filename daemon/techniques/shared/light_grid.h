@@ -67,7 +67,6 @@ struct light_grid {
     struct light_grid_block block;
     int cells, words, lights, width, height, frames;
     bool camera_moves; /* slices follow the camera's depth range every frame */
-    float mesh_box[SCENE_MESH_COUNT][2][3]; /* object-space min and max of each mesh */
     long long capacity; /* index entries */
     GLuint tile_depth_buf, bits_buf, summary_buf, stats_buf;
     /* Each frame writes the next of a ring of blocks and lists, so that

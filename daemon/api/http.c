@@ -1213,6 +1213,9 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
     if (*upload_data_size && req->upload) {
         assets_upload_write(req->upload, upload_data, *upload_data_size);
         *upload_data_size = 0;
+        /* Past the limit (a chunked body, whose length was not known), the
+         * rest is read and dropped, then answered 413: libmicrohttpd takes
+         * no answer in the middle of a body. Its body deadline bounds it. */
         return MHD_YES;
     }
     if (*upload_data_size) {

@@ -539,15 +539,24 @@ static void run_upload(struct assets *a, struct task *t)
     json_t *description = NULL;
     char original[PATH_MAX + 80];
     path_of(a, t->sha256, t->ext, original, sizeof(original));
-    /* The same bytes stored before: the temporary goes, the original stays. */
+    /* The same bytes stored before: the temporary goes, the original stays.
+     * Else it is made durable here, on the worker, not on the HTTP thread
+     * that received it (an fsync of 256 MiB can take seconds). */
+    int fd = -1;
     if (exists(original))
         unlink(t->path);
-    else if (rename(t->path, original) != 0) {
-        set_error(&e, 500, "state_dir", "cannot move the upload to %s: %s", original,
-                  strerror(errno));
+    else if ((fd = open(t->path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW)) < 0 || fsync(fd) != 0 ||
+             rename(t->path, original) != 0) {
+        int err = errno;
+        if (fd >= 0)
+            close(fd);
+        set_error(&e, err == ENOSPC || err == EDQUOT ? 507 : 500, "state_dir",
+                  "cannot store the upload as %s: %s", original, strerror(err));
         unlink(t->path);
         goto fail;
     }
+    if (fd >= 0)
+        close(fd);
     if (!ensure_cache(a, t->sha256, original, &description, &e))
         goto fail;
     bool replaced = false;
@@ -1069,10 +1078,9 @@ uint64_t assets_upload_finish(struct asset_upload *u, struct assets_error *e)
                   strerror(ENOSPC));
         goto refuse;
     }
-    if (u->io_errno || fsync(u->fd) != 0) {
-        int err = u->io_errno ? u->io_errno : errno;
-        set_error(e, err == ENOSPC || err == EDQUOT ? 507 : 500, "state_dir",
-                  "cannot store the upload in %s: %s", a->dir, strerror(err));
+    if (u->io_errno) {
+        set_error(e, 500, "state_dir", "cannot store the upload in %s: %s", a->dir,
+                  strerror(u->io_errno));
         goto refuse;
     }
     if (u->bytes == 0) {

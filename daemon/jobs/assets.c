@@ -638,8 +638,8 @@ static void run_dir(struct assets *a, struct task *t)
         set_dir_state(a, t->name, DIR_READY, NULL);
         return;
     }
-    char msg[700];
-    snprintf(msg, sizeof(msg), "%d %s: %s", e.status, e.field, e.message);
+    char msg[512]; /* dir_entry.error's size */
+    snprintf(msg, sizeof(msg), "%u %.40s: %.440s", e.status, e.field, e.message);
     LOG(LOG_WARN, "assets: --asset-dir %s: %s", t->path, msg);
     set_dir_state(a, t->name, DIR_FAILED, msg);
 }

@@ -30,6 +30,7 @@
 #include "daemon/harness/runner.h"
 #include "daemon/service.h"
 #include "daemon/jobs/sweeps.h"
+#include "daemon/jobs/assets.h"
 #include "daemon/techniques/catalog.h"
 #include "daemon/techniques/technique.h"
 #include "daemon/effects/effect_info.h"
@@ -51,6 +52,9 @@ struct options {
     double max_job_s;
     double stall_s;
     double memory_budget_mib; /* 0: the driver, the connections, and half the RAM for a job */
+    char asset_dir[1024];      /* --asset-dir: read-only assets; "": none */
+    char asset_converter[1024]; /* --asset-converter; "": shadebench-asset beside the daemon */
+    double max_asset_bytes;     /* --max-asset-bytes; 0: ASSETS_MAX_BYTES_DEFAULT */
     bool list_devices;
     bool gl_debug;
 };
@@ -101,6 +105,13 @@ static void usage(FILE *f)
             "  --max-connections N  HTTP connections open at once, in total (default 4096)\n"
             "  --max-connections-per-ip N\n"
             "                       HTTP connections open at once from one address (default 64)\n"
+            "  --max-asset-bytes N  the largest asset file PUT /v1/assets/NAME takes (default\n"
+            "                       268435456, 256 MiB)\n"
+            "  --asset-dir DIR      a read-only folder of .glb and .gltf files, each an asset\n"
+            "                       named by its file name (converted in the background at start)\n"
+            "  --asset-converter PATH\n"
+            "                       the glTF converter (default: shadebench-asset beside this\n"
+            "                       executable)\n"
             "  --config FILE        settings file (default " DEFAULT_CONFIG " if present)\n"
             "  --port-file FILE     write the bound port to FILE once listening\n"
             "  --list-devices       print the EGL devices and exit\n"
@@ -113,12 +124,14 @@ static void usage(FILE *f)
             "Settings come from, in rising order: defaults, the config file (lines of\n"
             "\"key = value\": listen, state-dir, device, queue-size, token, keep-jobs,\n"
             "keep-days, job-timeout, max-job-seconds, stall-seconds, memory-budget,\n"
-            "max-connections, max-connections-per-ip, log-level), the environment\n"
+            "max-connections, max-connections-per-ip, max-asset-bytes, asset-dir,\n"
+            "asset-converter, log-level), the environment\n"
             "(SHADEBENCH_LISTEN, SHADEBENCH_STATE_DIR, SHADEBENCH_DEVICE,\n"
             "SHADEBENCH_QUEUE_SIZE, SHADEBENCH_TOKEN_FILE, SHADEBENCH_KEEP_JOBS,\n"
             "SHADEBENCH_KEEP_DAYS, SHADEBENCH_JOB_TIMEOUT, SHADEBENCH_MAX_JOB_SECONDS,\n"
             "SHADEBENCH_STALL_SECONDS, SHADEBENCH_MEMORY_BUDGET,\n"
             "SHADEBENCH_MAX_CONNECTIONS, SHADEBENCH_MAX_CONNECTIONS_PER_IP,\n"
+            "SHADEBENCH_MAX_ASSET_BYTES, SHADEBENCH_ASSET_DIR, SHADEBENCH_ASSET_CONVERTER,\n"
             "SHADEBENCH_LOG_LEVEL), the flags.\n");
 }
 
@@ -183,6 +196,14 @@ static bool apply_setting(struct options *o, const char *key, const char *value,
     } else if (strcmp(key, "max-connections-per-ip") == 0) {
         if (!parse_int(value, 1, 1000000, &o->max_connections_per_ip))
             rule = "must be an integer from 1 to 1000000";
+    } else if (strcmp(key, "max-asset-bytes") == 0) {
+        if (!parse_number(value, 1, 1099511627776.0, &o->max_asset_bytes) ||
+            o->max_asset_bytes != (double)(uint64_t)o->max_asset_bytes)
+            rule = "must be a whole number of bytes from 1 to 1099511627776 (1 TiB)";
+    } else if (strcmp(key, "asset-dir") == 0) {
+        snprintf(o->asset_dir, sizeof(o->asset_dir), "%s", value);
+    } else if (strcmp(key, "asset-converter") == 0) {
+        snprintf(o->asset_converter, sizeof(o->asset_converter), "%s", value);
     } else if (strcmp(key, "log-level") == 0) {
         static const char *const levels[] = {"debug", "info", "warn", "error"};
         rule = "must be debug, info, warn or error";
@@ -243,7 +264,8 @@ static bool load_environment(struct options *o)
     static const char *const keys[] = {"listen", "state-dir", "device", "queue-size",
                                        "token-file", "keep-jobs", "keep-days", "job-timeout",
                                        "max-job-seconds", "stall-seconds", "memory-budget", "max-connections",
-                                       "max-connections-per-ip", "log-level", NULL};
+                                       "max-connections-per-ip", "max-asset-bytes", "asset-dir",
+                                       "asset-converter", "log-level", NULL};
     for (const char *const *k = keys; *k; k++) {
         char name[64] = "SHADEBENCH_";
         size_t n = strlen(name);
@@ -652,8 +674,27 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
         store_close(store);
         return 1;
     }
+    /* After queue_load: a queued job's pinned asset keeps its files. */
+    struct assets_config acfg = {.state_dir = state_dir, .asset_dir = o->asset_dir,
+                                 .converter = o->asset_converter,
+                                 .max_asset_bytes = o->max_asset_bytes > 0
+                                                        ? (uint64_t)o->max_asset_bytes
+                                                        : ASSETS_MAX_BYTES_DEFAULT};
+    asset_store_limits_defaults(&acfg.limits);
+    acfg.limits.max_file_bytes = acfg.max_asset_bytes;
+    asset_run_limits_defaults(&acfg.run);
+    struct assets *assets = assets_create(&acfg, store, q, err, sizeof(err));
+    if (!assets) {
+        LOG(LOG_ERROR, "%s", err);
+        runner_destroy(r);
+        queue_destroy(q);
+        store_close(store);
+        return 1;
+    }
+    queue_set_asset_resolver(q, assets_queue_resolver, assets);
     struct sweeps *sweeps = sweeps_create(q, catalog);
     const struct http_context http_ctx = {.catalog = catalog, .queue = q, .sweeps = sweeps,
+                                          .assets = assets,
                                           .render_state = render_state,
                                           .device_json = render_device_json, .render = r,
                                           .stall_s = o->stall_s, .memory_budget_bytes = budget,
@@ -663,6 +704,8 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
     if (!http) {
         LOG(LOG_ERROR, "%s", sweeps ? err : "cannot start the sweep thread");
         sweeps_destroy(sweeps);
+        queue_set_asset_resolver(q, NULL, NULL);
+        assets_destroy(assets);
         runner_destroy(r);
         queue_destroy(q);
         store_close(store);
@@ -696,6 +739,8 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
     service_stopping();
     http_server_destroy(http);
     sweeps_destroy(sweeps);
+    queue_set_asset_resolver(q, NULL, NULL);
+    assets_destroy(assets);
     /* Within a few seconds whatever runs (systemd's stop timeout is longer):
      * the running job is back in the queue once the render thread stops
      * it, and a frame still draining on the GPU is not waited for. */
@@ -734,7 +779,7 @@ int main(int argc, char **argv)
                         .keep_jobs = KEEP_JOBS_DEFAULT, .keep_days = KEEP_DAYS_DEFAULT};
     snprintf(o.listen, sizeof(o.listen), "127.0.0.1:8460");
     enum { OPT_LISTEN = 256, OPT_STATE, OPT_DEVICE, OPT_QUEUE, OPT_TOKEN, OPT_KEEP_JOBS,
-           OPT_KEEP_DAYS, OPT_JOB_TIMEOUT, OPT_MAX_JOB, OPT_STALL, OPT_MEMORY, OPT_MAX_CONN, OPT_MAX_CONN_IP, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_ONCE, OPT_OUT, OPT_DEBUG,
+           OPT_KEEP_DAYS, OPT_JOB_TIMEOUT, OPT_MAX_JOB, OPT_STALL, OPT_MEMORY, OPT_MAX_CONN, OPT_MAX_CONN_IP, OPT_MAX_ASSET, OPT_ASSET_DIR, OPT_ASSET_CONV, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_ONCE, OPT_OUT, OPT_DEBUG,
            OPT_LOG, OPT_VERSION, OPT_HELP };
     static const struct option longopts[] = {
         {"listen", required_argument, NULL, OPT_LISTEN},
@@ -750,6 +795,9 @@ int main(int argc, char **argv)
         {"memory-budget", required_argument, NULL, OPT_MEMORY},
         {"max-connections", required_argument, NULL, OPT_MAX_CONN},
         {"max-connections-per-ip", required_argument, NULL, OPT_MAX_CONN_IP},
+        {"max-asset-bytes", required_argument, NULL, OPT_MAX_ASSET},
+        {"asset-dir", required_argument, NULL, OPT_ASSET_DIR},
+        {"asset-converter", required_argument, NULL, OPT_ASSET_CONV},
         {"config", required_argument, NULL, OPT_CONFIG},
         {"port-file", required_argument, NULL, OPT_PORT_FILE},
         {"list-devices", no_argument, NULL, OPT_LIST},
@@ -783,6 +831,9 @@ int main(int argc, char **argv)
         case OPT_MEMORY: key = "memory-budget"; break;
         case OPT_MAX_CONN: key = "max-connections"; break;
         case OPT_MAX_CONN_IP: key = "max-connections-per-ip"; break;
+        case OPT_MAX_ASSET: key = "max-asset-bytes"; break;
+        case OPT_ASSET_DIR: key = "asset-dir"; break;
+        case OPT_ASSET_CONV: key = "asset-converter"; break;
         case OPT_LOG: key = "log-level"; break;
         case OPT_CONFIG: config = optarg; config_required = true; break;
         case OPT_PORT_FILE: o.port_file = optarg; break;

@@ -121,6 +121,7 @@ E2E_TESTS = \
 	tests/e2e/e2e_gate.py \
 	tests/e2e/e2e_charts.py \
 	tests/e2e/e2e_http.py \
+	tests/e2e/e2e_assets.py \
 	tests/e2e/e2e_scene.py \
 	tests/e2e/e2e_post.py \
 	tests/e2e/e2e_badinput.py \
@@ -152,6 +153,7 @@ SANITIZER_TESTS = $(UNIT_TESTS) \
 	tests/e2e/e2e_store.py \
 	tests/e2e/e2e_load.py \
 	tests/e2e/e2e_http.py \
+	tests/e2e/e2e_assets.py \
 	tests/e2e/e2e_persist.py \
 	tests/e2e/e2e_badinput.py
 check-sanitizers:

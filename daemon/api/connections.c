@@ -133,7 +133,7 @@ static double check_locked(struct connections *cs, double now, bool jobs_changed
                 resume_locked(cs, k, WAKE_STOPPING);
             else if (now >= k->wait_until)
                 resume_locked(cs, k, WAKE_TIMEOUT);
-            else if (((k->kind == WAIT_JOB && jobs_changed) ||
+            else if ((((k->kind == WAIT_JOB || k->kind == WAIT_ASSET) && jobs_changed) ||
                       (k->kind == WAIT_SWEEP && sweep_tick)) &&
                      cached_done(cs, &cache, k->kind, k->id))
                 resume_locked(cs, k, WAKE_READY);
@@ -353,6 +353,16 @@ struct conn *connections_of(struct MHD_Connection *c)
     const union MHD_ConnectionInfo *info =
         MHD_get_connection_info(c, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
     return info ? info->socket_context : NULL;
+}
+
+void connections_body_deadline(struct connections *cs, struct conn *k, double seconds)
+{
+    if (!k)
+        return;
+    pthread_mutex_lock(&cs->lock);
+    if (k->state == K_BODY && seconds > cs->cfg.body_s)
+        k->deadline = clock_mono_s() + seconds;
+    pthread_mutex_unlock(&cs->lock);
 }
 
 void connections_headers_in(struct connections *cs, struct conn *k)

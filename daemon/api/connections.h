@@ -31,7 +31,8 @@ struct conn;
 /* Why a suspended request was resumed. */
 enum wake { WAKE_NONE, WAKE_READY, WAKE_TIMEOUT, WAKE_GONE, WAKE_STOPPING };
 
-enum wait_kind { WAIT_JOB, WAIT_SWEEP };
+/* WAIT_ASSET: an upload's conversion; its id is the ticket (assets.h). */
+enum wait_kind { WAIT_JOB, WAIT_SWEEP, WAIT_ASSET };
 
 /* True when a wait on kind/id can end now (finished, or no longer there).
  * Called on the watcher thread, which holds no lock of the caller's. */
@@ -62,6 +63,9 @@ struct conn *connections_of(struct MHD_Connection *c);
 
 /* The request's headers are in: its body deadline starts. */
 void connections_headers_in(struct connections *cs, struct conn *k);
+/* An upload's body may take this long from now (a large asset over a slow
+ * link) instead of body_s; never shorter than body_s. */
+void connections_body_deadline(struct connections *cs, struct conn *k, double seconds);
 /* The request is complete and being answered: no deadline but libmicrohttpd's
  * idle timeout while the answer is sent. */
 void connections_answering(struct connections *cs, struct conn *k);

@@ -54,8 +54,8 @@ enum {
 };
 
 /* The status codes the request counters of /metrics keep apart. */
-static const unsigned COUNTED_CODES[] = {200, 202, 400, 401, 404, 405, 409, 413,
-                                         429, 431, 500, 503, 507, 0 /* other */};
+static const unsigned COUNTED_CODES[] = {200, 201, 202, 400, 401, 403, 404, 405, 409, 413,
+                                         422, 429, 431, 500, 503, 507, 0 /* other */};
 enum { NCODES = sizeof(COUNTED_CODES) / sizeof(COUNTED_CODES[0]) };
 
 struct http_server {
@@ -132,6 +132,10 @@ struct request {
      * once the headers are in, and the query's size. */
     const char *target_field, *target_rule;
     size_t query_args;
+    /* PUT /v1/assets/NAME: the body streams into the upload; once it is in,
+     * the request waits (suspended) on the conversion's ticket. */
+    struct asset_upload *upload;
+    uint64_t ticket;
 };
 
 /* Set by answer_waited just before it closes the connection of a client
@@ -193,6 +197,15 @@ static enum MHD_Result respond_error(struct MHD_Connection *c, unsigned status,
     snprintf(e.field, sizeof(e.field), "%s", field);
     snprintf(e.message, sizeof(e.message), "%s", message);
     return respond_json(c, status, job_error_to_json(&e));
+}
+
+/* An asset's refusal (assets.h): its message may be longer than a job
+ * error's 256 bytes (it can name a path). */
+static enum MHD_Result respond_asset_error(struct MHD_Connection *c, const struct assets_error *e)
+{
+    return respond_json(c, e->status ? e->status : MHD_HTTP_INTERNAL_SERVER_ERROR,
+                        json_pack("{s:{s:s, s:s}}", "error", "field", e->field[0] ? e->field : "body",
+                                  "message", e->message));
 }
 
 static enum MHD_Result respond_405(struct MHD_Connection *c, const char *allow, const char *rule)
@@ -280,7 +293,7 @@ static json_t *info_json(struct http_server *s)
     /* From the GL-free catalogue: HTTP threads never touch GL. */
     json_t *techs = technique_catalog_json(s->ctx.catalog);
     const struct http_limits *l = &s->limits;
-    return json_pack("{s:s, s:s, s:s, s:o, s:o, s:o, s:o, s:o, s:{s:i, s:i, s:i, s:I, s:I, s:f, "
+    json_t *info = json_pack("{s:s, s:s, s:s, s:o, s:o, s:o, s:o, s:o, s:{s:i, s:i, s:i, s:I, s:I, s:f, "
                      "s:f, s:I, s:f, s:f, s:I, s:I}}",
                      "name", "shadebenchd", "version", PACKAGE_VERSION, "api", "v1", "memory",
                      memory, "device",
@@ -296,6 +309,15 @@ static json_t *info_json(struct http_server *s)
                      job_spec_default_timeout(), "max_job_seconds", job_spec_max_seconds(),
                      "max_captures",
                      (json_int_t)JOB_MAX_CAPTURES, "max_image_pixels", (json_int_t)IMAGE_MAX_PIXELS);
+    /* The asset limits (assets.h): the upload's body limit, the converter's
+     * limits on what an asset may hold, and its memory, CPU and time. */
+    json_t *limits = json_object_get(info, "limits");
+    if (limits && s->ctx.assets) {
+        json_t *assets = assets_info_json(s->ctx.assets);
+        json_object_set(limits, "max_asset_bytes", json_object_get(assets, "max_asset_bytes"));
+        json_object_set_new(limits, "assets", assets);
+    }
+    return info;
 }
 
 /* The render thread's state as /healthz shows it. */
@@ -484,10 +506,23 @@ static enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *
     if (!job_spec_parse_text(req->body ? req->body : "", req->len, s->ctx.catalog,
                              &spec, &err))
         return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
+    /* scene.asset: pinned to the stored asset's hash here, so that the
+     * answer names the rule (400 unknown, 409 a different pinned hash);
+     * queue_submit resolves again, for the sweeps' points. */
+    if (spec.scene.asset[0]) {
+        struct assets_error ae;
+        if (!s->ctx.assets)
+            return respond_error(c, MHD_HTTP_BAD_REQUEST, "scene.asset",
+                                 "this daemon has no asset store");
+        if (!assets_resolve(s->ctx.assets, &spec.scene, &ae))
+            return respond_asset_error(c, &ae);
+    }
     char id[24];
     switch (queue_submit(s->queue, &spec, NULL, id)) {
     case QUEUE_OK:
         break;
+    case QUEUE_REFUSED: /* the asset changed since: its rule */
+        return respond_error(c, MHD_HTTP_CONFLICT, "scene.asset", queue_submit_error());
     case QUEUE_FULL: {
         char msg[96];
         snprintf(msg, sizeof(msg), "the queue is full (%d jobs waiting); retry later",
@@ -645,6 +680,8 @@ static bool sweep_finished(const json_t *sw)
 static bool wait_done(void *ctx, enum wait_kind kind, const char *id)
 {
     struct http_server *s = ctx;
+    if (kind == WAIT_ASSET)
+        return !s->ctx.assets || assets_ticket_done(s->ctx.assets, strtoull(id, NULL, 10));
     if (kind == WAIT_JOB) {
         char dir[PATH_MAX];
         enum job_status st;
@@ -685,6 +722,19 @@ static enum MHD_Result answer_waited(struct http_server *s, struct MHD_Connectio
          * (shadebench_http_waits_abandoned_total), logged at debug. */
         closing_gone_client = true;
         return MHD_NO;
+    }
+    if (req->ticket) {
+        unsigned status;
+        json_t *body;
+        if (s->ctx.assets && assets_ticket_take(s->ctx.assets, req->ticket, &status, &body)) {
+            req->ticket = 0;
+            return respond_json(c, status, body);
+        }
+        return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "body",
+                             why == WAKE_TIMEOUT ? "the conversion is still waiting or running "
+                                                   "past its time; GET /v1/assets/NAME later"
+                                                 : "the daemon is stopping: the upload was not "
+                                                   "converted; upload it again once it is back");
     }
     if (why == WAKE_STOPPING && req->wait_status == MHD_HTTP_OK)
         return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "wait",
@@ -794,6 +844,24 @@ static enum MHD_Result post_sweep(struct http_server *s, struct MHD_Connection *
         json_decref(body);
         return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
     }
+    /* A sweep on an asset: refused now rather than at its first point (each
+     * point is pinned to the asset's hash when the sweep submits it). */
+    const json_t *asset = json_object_get(json_object_get(spec.base, "scene"), "asset");
+    if (json_is_string(asset)) {
+        struct scene_spec probe;
+        struct assets_error ae;
+        memset(&probe, 0, sizeof(probe));
+        snprintf(probe.asset, sizeof(probe.asset), "%s", json_string_value(asset));
+        if (!s->ctx.assets || !assets_resolve(s->ctx.assets, &probe, &ae)) {
+            sweep_spec_finish(&spec);
+            json_decref(body);
+            if (s->ctx.assets)
+                snprintf(ae.field, sizeof(ae.field), "base.scene.asset");
+            return s->ctx.assets ? respond_asset_error(c, &ae)
+                                 : respond_error(c, MHD_HTTP_BAD_REQUEST, "base.scene.asset",
+                                                 "this daemon has no asset store");
+        }
+    }
     char id[24];
     enum queue_submit_result r = sweeps_submit(s->sweeps, &spec, body, id);
     sweep_spec_finish(&spec);
@@ -861,6 +929,93 @@ static enum MHD_Result sweep_resource(struct http_server *s, struct MHD_Connecti
     return ret;
 }
 
+struct asset_list_args {
+    const char *cursor;
+    int limit;
+    const char *bad, *rule;
+};
+
+static enum MHD_Result asset_list_arg(void *cls, enum MHD_ValueKind kind, const char *key,
+                                      const char *value)
+{
+    (void)kind;
+    struct asset_list_args *a = cls;
+    if (strcmp(key, "limit") == 0) {
+        char *end;
+        long v = value ? strtol(value, &end, 10) : 0;
+        if (!value || *end || end == value || v < 1 || v > STORE_LIMIT_MAX) {
+            a->bad = "limit";
+            a->rule = "must be an integer from 1 to 1000";
+            return MHD_NO;
+        }
+        a->limit = (int)v;
+    } else if (strcmp(key, "cursor") == 0) {
+        if (!value || !scene_asset_name_valid(value)) {
+            a->bad = "cursor";
+            a->rule = "must be an asset name, as the previous page's \"next\" gives it";
+            return MHD_NO;
+        }
+        a->cursor = value;
+    } else {
+        a->bad = key;
+        a->rule = "unknown argument: the asset list takes limit and cursor";
+        return MHD_NO;
+    }
+    return MHD_YES;
+}
+
+/* /v1/assets and /v1/assets/NAME (daemon/jobs/assets.h). PUT reaches here
+ * only once its body is in and refused before any conversion (begin
+ * answered in refuse_early, finish in on_request). */
+static enum MHD_Result asset_resource(struct http_server *s, struct MHD_Connection *c,
+                                      const char *method, struct request *req)
+{
+    if (!s->ctx.assets)
+        return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "url",
+                             "this daemon has no asset store");
+    struct assets_error e = {0};
+    json_t *body;
+    if (req->route.kind == ROUTE_ASSETS) {
+        struct asset_list_args a = {.cursor = "", .limit = STORE_LIMIT_DEFAULT};
+        MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, asset_list_arg, &a);
+        if (a.bad)
+            return respond_error(c, MHD_HTTP_BAD_REQUEST, a.bad, a.rule);
+        body = assets_list(s->ctx.assets, a.cursor, a.limit, &e);
+    } else if (req->route.asset_too_long) {
+        return respond_error(c, MHD_HTTP_BAD_REQUEST, "name",
+                             "an asset name is at most 128 bytes");
+    } else if (strcmp(method, "DELETE") == 0) {
+        body = assets_delete(s->ctx.assets, req->route.asset, &e);
+    } else {
+        body = assets_describe(s->ctx.assets, req->route.asset, &e);
+    }
+    if (!body)
+        return respond_asset_error(c, &e);
+    return respond_json(c, MHD_HTTP_OK, body);
+}
+
+/* The upload's body is in: its conversion is queued and the request waits
+ * for it without a thread (connections.h), as a long-poll does. */
+static enum MHD_Result finish_upload(struct http_server *s, struct MHD_Connection *c,
+                                     struct request *req)
+{
+    struct assets_error e = {0};
+    struct asset_upload *u = req->upload;
+    req->upload = NULL;
+    uint64_t ticket = assets_upload_finish(u, &e);
+    if (!ticket)
+        return respond_asset_error(c, &e);
+    req->ticket = ticket;
+    char id[32];
+    snprintf(id, sizeof(id), "%llu", (unsigned long long)ticket);
+    if (!connections_suspend(s->conns, req->conn, WAIT_ASSET, id,
+                             assets_answer_wait_s(s->ctx.assets)))
+        return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "body",
+                             "the daemon is stopping; upload the asset again once it is back");
+    req->waiting = true;
+    return MHD_YES;
+}
+
 static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
                                 const char *method, struct request *req)
 {
@@ -889,6 +1044,9 @@ static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
             return post_sweep(s, c, req);
         }
         return respond_list(s, c, ROUTE_SWEEPS);
+    case ROUTE_ASSETS:
+    case ROUTE_ASSET:
+        return asset_resource(s, c, method, req);
     case ROUTE_JOB:
     case ROUTE_JOB_REPORT:
     case ROUTE_JOB_CHART:
@@ -992,6 +1150,32 @@ static bool refuse_early(struct http_server *s, struct MHD_Connection *c, const 
         return true;
     }
     const char *cl = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Content-Length");
+    if (req->route.kind == ROUTE_ASSET && strcmp(method, "PUT") == 0) {
+        /* The file streams to disk (assets.h): its own limit, not a job's. */
+        if (!s->ctx.assets) {
+            *ret = respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "url",
+                                 "this daemon has no asset store");
+            return true;
+        }
+        if (req->route.asset_too_long) {
+            *ret = respond_error(c, MHD_HTTP_BAD_REQUEST, "name",
+                                 "an asset name is at most 128 bytes");
+            return true;
+        }
+        uint64_t length = cl ? strtoull(cl, NULL, 10) : 0;
+        struct assets_error e = {0};
+        req->upload = assets_upload_begin(s->ctx.assets, req->route.asset, length, &e);
+        if (!req->upload) {
+            req->too_large = e.status == MHD_HTTP_CONTENT_TOO_LARGE;
+            *ret = respond_asset_error(c, &e);
+            return true;
+        }
+        /* Its body's deadline grows with its size: 1 MiB/s at least. */
+        uint64_t expect = length ? length : assets_max_bytes(s->ctx.assets);
+        connections_body_deadline(s->conns, req->conn,
+                                  s->limits.body_timeout_s + (double)expect / (1 << 20));
+        return false;
+    }
     if (cl && strtoull(cl, NULL, 10) > JOB_MAX_BODY_BYTES) {
         /* libmicrohttpd closes the connection after this answer. */
         req->too_large = true;
@@ -1026,6 +1210,14 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
         }
         return MHD_YES;
     }
+    if (*upload_data_size && req->upload) {
+        assets_upload_write(req->upload, upload_data, *upload_data_size);
+        *upload_data_size = 0;
+        /* Past the limit (a chunked body, whose length was not known), the
+         * rest is read and dropped, then answered 413: libmicrohttpd takes
+         * no answer in the middle of a body. Its body deadline bounds it. */
+        return MHD_YES;
+    }
     if (*upload_data_size) {
         if (!req->too_large && req->len + *upload_data_size <= JOB_MAX_BODY_BYTES) {
             char *body = realloc(req->body, req->len + *upload_data_size + 1);
@@ -1044,6 +1236,8 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
     if (req->waiting)
         return answer_waited(s, c, req);
     connections_answering(s->conns, req->conn);
+    if (req->upload)
+        return finish_upload(s, c, req);
     /* Jansson reads a NUL byte as the end of the text, so that what follows
      * it would go unread: a body is JSON text, which has none. */
     const char *nul = req->body ? memchr(req->body, '\0', req->len) : NULL;
@@ -1099,6 +1293,9 @@ static void on_completed(void *cls, struct MHD_Connection *c, void **con_cls,
         unsigned status = connections_status(k);
         if (status)
             atomic_fetch_add(&s->requests[req->route.kind][code_index(status)], 1);
+        assets_upload_abort(req->upload); /* a client that went away mid-body */
+        if (req->ticket && s->ctx.assets)
+            assets_ticket_drop(s->ctx.assets, req->ticket);
         free(req->body);
         free(req);
         *con_cls = NULL;
@@ -1229,6 +1426,8 @@ struct http_server *http_server_create(const char *listen, const struct http_lim
         return NULL;
     }
     queue_set_listener(s->queue, on_queue_change, s->conns);
+    if (s->ctx.assets)
+        assets_set_listener(s->ctx.assets, on_queue_change, s->conns);
     const union MHD_DaemonInfo *info = MHD_get_daemon_info(s->mhd, MHD_DAEMON_INFO_BIND_PORT);
     s->port = info ? info->port : (int)port;
     return s;
@@ -1240,6 +1439,8 @@ void http_server_destroy(struct http_server *s)
         return;
     connections_stop(s->conns, STOP_GRACE_S);
     queue_set_listener(s->queue, NULL, NULL);
+    if (s->ctx.assets)
+        assets_set_listener(s->ctx.assets, NULL, NULL);
     MHD_stop_daemon(s->mhd);
     connections_destroy(s->conns);
     pthread_mutex_destroy(&s->token_lock);

@@ -12,6 +12,7 @@
 #include <jansson.h>
 
 #include "daemon/harness/render_state.h"
+#include "daemon/jobs/assets.h"
 #include "daemon/jobs/queue.h"
 #include "daemon/jobs/sweeps.h"
 #include "daemon/techniques/catalog.h"
@@ -40,6 +41,9 @@ struct http_context {
     const struct technique_catalog *catalog; /* jobs and sweeps are parsed against it */
     struct queue *queue;
     struct sweeps *sweeps;
+    /* The assets (/v1/assets, a job's scene.asset); NULL: none (the asset
+     * endpoints answer 503 and a job naming one is refused). */
+    struct assets *assets;
     /* The render thread as the API sees it, without GL: what it is doing
      * (render_state.h: whether it runs, its job and phase, its last
      * progress), for /healthz and /metrics, which must stay cheap (the

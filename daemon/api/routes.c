@@ -22,6 +22,9 @@ static const struct {
     [ROUTE_SWEEP] = {"/v1/sweeps/{id}", "GET, HEAD, DELETE", "use GET or DELETE on a sweep"},
     [ROUTE_SWEEP_CHART] = {"/v1/sweeps/{id}/charts/{name}", "GET, HEAD", "use GET"},
     [ROUTE_SWEEP_REPORT] = {"/v1/sweeps/{id}/report.html", "GET, HEAD", "use GET"},
+    [ROUTE_ASSETS] = {"/v1/assets", "GET, HEAD", "use GET to list assets; PUT /v1/assets/NAME uploads one"},
+    [ROUTE_ASSET] = {"/v1/assets/{name}", "GET, HEAD, PUT, DELETE",
+                     "use PUT to upload the asset's file as the body, GET or DELETE"},
 };
 
 
@@ -159,6 +162,21 @@ bool route_parse(const char *url, struct route *r)
         r->kind = ROUTE_SWEEPS;
     else if (strncmp(url, "/v1/sweeps/", 11) == 0)
         return sweep_routes(url + 11, r);
+    else if (strcmp(url, "/v1/assets") == 0 || strcmp(url, "/v1/assets/") == 0)
+        r->kind = ROUTE_ASSETS;
+    else if (strncmp(url, "/v1/assets/", 11) == 0) {
+        /* One path segment; its rules are the handler's (a 400 naming it). */
+        const char *name = url + 11;
+        if (strchr(name, '/'))
+            return none(r, "url", "no such resource: an asset is /v1/assets/NAME");
+        size_t len = strlen(name);
+        r->asset_too_long = len > ROUTE_ASSET_NAME_MAX;
+        if (r->asset_too_long)
+            len = ROUTE_ASSET_NAME_MAX;
+        memcpy(r->asset, name, len);
+        r->asset[len] = '\0';
+        r->kind = ROUTE_ASSET;
+    }
     else
         return none(r, "url", "no such route");
     return true;
@@ -200,7 +218,9 @@ bool route_method_ok(enum route_kind kind, const char *method, const char **allo
     if (strcmp(method, "POST") == 0)
         return kind == ROUTE_JOBS || kind == ROUTE_SWEEPS;
     if (strcmp(method, "DELETE") == 0)
-        return kind == ROUTE_JOB || kind == ROUTE_SWEEP;
+        return kind == ROUTE_JOB || kind == ROUTE_SWEEP || kind == ROUTE_ASSET;
+    if (strcmp(method, "PUT") == 0)
+        return kind == ROUTE_ASSET;
     return false;
 }
 
@@ -222,6 +242,11 @@ void route_timings_url(const char *id, char out[ROUTE_URL_MAX])
 void route_sweep_url(const char *id, char out[ROUTE_URL_MAX])
 {
     snprintf(out, ROUTE_URL_MAX, "/v1/sweeps/%s", id);
+}
+
+void route_asset_url(const char *name, char out[ROUTE_URL_MAX + ROUTE_ASSET_NAME_MAX])
+{
+    snprintf(out, ROUTE_URL_MAX + ROUTE_ASSET_NAME_MAX, "/v1/assets/%s", name);
 }
 
 void route_image_url(const char *id, enum job_image image, int frame, char out[ROUTE_URL_MAX])

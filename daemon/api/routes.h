@@ -26,9 +26,13 @@ enum route_kind {
     ROUTE_SWEEP,
     ROUTE_SWEEP_CHART,
     ROUTE_SWEEP_REPORT,
+    ROUTE_ASSETS, /* /v1/assets */
+    ROUTE_ASSET,  /* /v1/assets/{name} */
     ROUTE_COUNT
 };
 
+
+#define ROUTE_ASSET_NAME_MAX 128
 
 struct route {
     enum route_kind kind;
@@ -37,6 +41,11 @@ struct route {
     bool chart_png;    /* charts: .png (else .svg) */
     enum job_image image; /* images: which kind (common/job_files.h) */
     int frame;         /* images: 1 to 999999999 */
+    /* ROUTE_ASSET: the name as given (up to ROUTE_ASSET_NAME_MAX bytes; a
+     * longer one is cut and flagged). The handler checks it
+     * (scene_asset_name_valid) so that a bad one is a 400 naming it. */
+    char asset[ROUTE_ASSET_NAME_MAX + 1];
+    bool asset_too_long;
     /* ROUTE_NONE: what the 404 names. */
     const char *field, *message;
 };
@@ -76,6 +85,7 @@ void route_job_url(const char *id, char out[ROUTE_URL_MAX]);
 void route_sweep_url(const char *id, char out[ROUTE_URL_MAX]);
 /* A finished job's per-frame figures (timings.csv). */
 void route_timings_url(const char *id, char out[ROUTE_URL_MAX]);
+void route_asset_url(const char *name, char out[ROUTE_URL_MAX + ROUTE_ASSET_NAME_MAX]);
 void route_image_url(const char *id, enum job_image image, int frame, char out[ROUTE_URL_MAX]);
 
 /* A page of a list (kind ROUTE_JOBS or ROUTE_SWEEPS) with its n query

@@ -48,6 +48,10 @@ struct queue {
     void *needed_ctx;
     pthread_mutex_t repair;    /* one repair of a damaged result.json at a time */
     pthread_mutex_t retention; /* one retention pass at a time */
+    /* scene.asset's resolver (queue_set_asset_resolver); set before
+     * submissions start, read without the lock. */
+    queue_asset_resolver resolve_asset;
+    void *resolve_ctx;
 };
 
 /* A job's state as taken under the lock, written after it is released. The
@@ -292,6 +296,19 @@ enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *sp
 {
     char why[PATH_MAX + 300] = "";
     records_set_submit_error("%s", "");
+    /* Every job naming an asset, a sweep's points included, is pinned to the
+     * asset's hash as it is accepted (daemon/jobs/assets.h). */
+    struct job_spec resolved;
+    if (spec->scene.asset[0] && q->resolve_asset) {
+        char field[64], message[512];
+        resolved = *spec;
+        if (!q->resolve_asset(q->resolve_ctx, &resolved.scene, field, sizeof(field), message,
+                              sizeof(message))) {
+            records_set_submit_error("%s: %s", field, message);
+            return QUEUE_REFUSED;
+        }
+        spec = &resolved;
+    }
     if (!queue_room_to_accept(q, "job"))
         return QUEUE_IO_ERROR;
     pthread_mutex_lock(&q->lock);
@@ -936,4 +953,28 @@ static void apply_retention(struct queue *q, bool startup)
     }
     pthread_mutex_unlock(&q->retention);
     free(ids);
+}
+
+void queue_set_asset_resolver(struct queue *q, queue_asset_resolver fn, void *ctx)
+{
+    q->resolve_asset = fn;
+    q->resolve_ctx = ctx;
+}
+
+bool queue_asset_in_use(struct queue *q, const char *name, const char *sha256,
+                        char id_out[RECORD_ID_LEN])
+{
+    bool used = false;
+    pthread_mutex_lock(&q->lock);
+    for (size_t i = 0; i < q->live.count && !used; i++) {
+        const struct job *j = q->live.items[i];
+        if (job_status_finished(j->status) || !j->spec.scene.asset[0])
+            continue;
+        used = (name && strcmp(j->spec.scene.asset, name) == 0) ||
+               (sha256 && strcmp(j->spec.scene.asset_sha256, sha256) == 0);
+        if (used)
+            snprintf(id_out, RECORD_ID_LEN, "%s", j->id);
+    }
+    pthread_mutex_unlock(&q->lock);
+    return used;
 }

@@ -56,7 +56,9 @@ struct queue;
 
 /* QUEUE_IO_ERROR: the job could not be persisted, so it was not accepted
  * (nothing of it is left behind); queue_submit_error says why. */
-enum queue_submit_result { QUEUE_OK, QUEUE_FULL, QUEUE_STOPPING, QUEUE_IO_ERROR };
+/* QUEUE_REFUSED: the job names an asset the resolver refused
+ * (queue_submit_error says which field and why). */
+enum queue_submit_result { QUEUE_OK, QUEUE_FULL, QUEUE_STOPPING, QUEUE_IO_ERROR, QUEUE_REFUSED };
 
 /* On store (a store in memory for --once, where queue_submit's dir_override
  * names the single job's directory); the store outlives the queue. */
@@ -151,5 +153,16 @@ bool queue_job_dir(struct queue *q, const char *id, char *dir, size_t cap,
  * queue stops, with the queue's lock held: it must return at once and take
  * no lock (the HTTP layer writes to an eventfd). Set once, before serving. */
 void queue_set_listener(struct queue *q, void (*fn)(void *ctx), void *ctx);
+
+/* scene.asset: called by queue_submit (any thread, no lock of the queue's
+ * held) for a spec naming an asset; fills scene->asset_sha256, or returns
+ * false with the field and the rule. Set once, before submissions start. */
+typedef bool (*queue_asset_resolver)(void *ctx, struct scene_spec *scene, char *field,
+                                     size_t field_cap, char *message, size_t message_cap);
+void queue_set_asset_resolver(struct queue *q, queue_asset_resolver fn, void *ctx);
+/* Is a queued or running job using the asset of that name, or of that hash
+ * (either may be NULL)? *id_out gets the first such job's id. Any thread. */
+bool queue_asset_in_use(struct queue *q, const char *name, const char *sha256,
+                        char id_out[RECORD_ID_LEN]);
 
 #endif

@@ -19,7 +19,8 @@
 #define STORE_READERS 8
 /* Rows per transaction when importing directories. */
 #define STORE_BATCH 256
-#define STORE_SCHEMA_VERSION 1
+/* 1: records, labels, removals. 2: assets (issue 21). */
+#define STORE_SCHEMA_VERSION 2
 
 /* The schema. Status is text, so that the database reads plainly in the
  * sqlite3 shell and in the tests. Rows are WITHOUT ROWID, keyed by (kind,
@@ -43,6 +44,23 @@ static const char SCHEMA[] =
     /* Records whose rows are gone and whose directories may not be yet. */
     "CREATE TABLE IF NOT EXISTS removals ("
     " kind INTEGER NOT NULL, id TEXT NOT NULL, PRIMARY KEY (kind, id)) WITHOUT ROWID;";
+
+/* The migrations, MIGRATIONS[v - 1] taking a store of schema v - 1 to v.
+ * Schema 1 is written with IF NOT EXISTS and applied at every start (the
+ * stores before user_version was kept); each later one runs once, in the
+ * transaction that sets user_version, so a crash leaves the old schema whole.
+ * A daemon older than a store's schema refuses to open it (open_writer). */
+static const char MIGRATION_2[] =
+    /* Assets by name (daemon/jobs/assets.h): the file's SHA-256 names its
+     * files, STATE_DIR/assets/SHA256.{glb,gltf,sbasset}; several names may
+     * share one. source is "upload" or "dir" (--asset-dir, read-only over
+     * HTTP); description is the converter's JSON. */
+    "CREATE TABLE IF NOT EXISTS assets ("
+    " name TEXT NOT NULL PRIMARY KEY, sha256 TEXT NOT NULL, ext TEXT NOT NULL,"
+    " size INTEGER NOT NULL, created REAL NOT NULL, updated REAL NOT NULL,"
+    " source TEXT NOT NULL, description TEXT) WITHOUT ROWID;"
+    "CREATE INDEX IF NOT EXISTS assets_sha256 ON assets (sha256);";
+static const char *const MIGRATIONS[STORE_SCHEMA_VERSION] = {SCHEMA, MIGRATION_2};
 
 static const char PUT_ROW[] =
     "INSERT INTO records (kind, id, status, technique, created, started, finished, done, total,"
@@ -300,9 +318,15 @@ static bool open_writer(struct store *s, bool *damaged, char *err, size_t errlen
         }
         free(check);
     }
-    char sql[sizeof(SCHEMA) + 64];
-    snprintf(sql, sizeof(sql), "BEGIN IMMEDIATE;%sPRAGMA user_version = %d;COMMIT",
-             SCHEMA, STORE_SCHEMA_VERSION);
+    /* Schema 1 always (idempotent), then each migration the store lacks. */
+    char sql[sizeof(SCHEMA) + sizeof(MIGRATION_2) + 64];
+    int at = snprintf(sql, sizeof(sql), "BEGIN IMMEDIATE;%s", SCHEMA);
+    for (int m = v < 1 ? 1 : v; m < STORE_SCHEMA_VERSION; m++)
+        at += snprintf(sql + at, sizeof(sql) - (size_t)at, "%s", MIGRATIONS[m]);
+    snprintf(sql + at, sizeof(sql) - (size_t)at, "PRAGMA user_version = %d;COMMIT",
+             STORE_SCHEMA_VERSION);
+    if (v < STORE_SCHEMA_VERSION && v > 0)
+        LOG(LOG_INFO, "store: %s: schema %d to %d", s->path, v, STORE_SCHEMA_VERSION);
     if (!exec(s, s->writer, sql, err, errlen)) {
         *damaged = damaged_code(sqlite3_extended_errcode(s->writer));
         sqlite3_exec(s->writer, "ROLLBACK", NULL, NULL, NULL);
@@ -1293,4 +1317,167 @@ int store_import(struct store *s, enum store_kind kind, const char *legacy_file,
     free(im.known);
     free(im.batch);
     return n;
+}
+
+/* Assets (issue 21). Few rows, written rarely (an upload, a delete, a
+ * start with --asset-dir): each write is a transaction of its own under the
+ * write lock, and a full disk is the caller's 507 (an asset is not a state
+ * that must be recorded; the reserve stays for jobs). */
+
+void store_asset_finish(struct store_asset *a)
+{
+    json_decref(a->description);
+    a->description = NULL;
+}
+
+bool store_asset_put(struct store *s, const struct store_asset *a, char *err, size_t errlen)
+{
+    static const char sql[] =
+        "INSERT INTO assets (name, sha256, ext, size, created, updated, source, description)"
+        " VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8) ON CONFLICT (name) DO UPDATE SET"
+        " sha256 = excluded.sha256, ext = excluded.ext, size = excluded.size,"
+        " updated = excluded.updated, source = excluded.source,"
+        " description = excluded.description";
+    pthread_mutex_lock(&s->write_lock);
+    sqlite3_stmt *st = NULL;
+    bool ok = sqlite3_prepare_v2(s->writer, sql, -1, &st, NULL) == SQLITE_OK;
+    if (ok) {
+        sqlite3_bind_text(st, 1, a->name, -1, SQLITE_STATIC);
+        sqlite3_bind_text(st, 2, a->sha256, -1, SQLITE_STATIC);
+        sqlite3_bind_text(st, 3, a->ext, -1, SQLITE_STATIC);
+        sqlite3_bind_int64(st, 4, (sqlite3_int64)a->size);
+        sqlite3_bind_double(st, 5, a->created);
+        sqlite3_bind_double(st, 6, a->updated);
+        sqlite3_bind_text(st, 7, a->from_dir ? "dir" : "upload", -1, SQLITE_STATIC);
+        bind_json(st, 8, a->description);
+        ok = sqlite3_step(st) == SQLITE_DONE;
+    }
+    if (!ok)
+        db_error(s, s->writer, "write", err, errlen);
+    sqlite3_finalize(st);
+    pthread_mutex_unlock(&s->write_lock);
+    return ok;
+}
+
+#define ASSET_COLUMNS "name, sha256, ext, size, created, updated, source, description"
+
+static void read_asset(sqlite3_stmt *st, struct store_asset *a)
+{
+    column_copy(st, 0, a->name, sizeof(a->name));
+    column_copy(st, 1, a->sha256, sizeof(a->sha256));
+    column_copy(st, 2, a->ext, sizeof(a->ext));
+    a->size = (uint64_t)sqlite3_column_int64(st, 3);
+    a->created = sqlite3_column_double(st, 4);
+    a->updated = sqlite3_column_double(st, 5);
+    const char *source = (const char *)sqlite3_column_text(st, 6);
+    a->from_dir = source && strcmp(source, "dir") == 0;
+    a->description = column_json(st, 7);
+}
+
+enum store_found store_asset_get(struct store *s, const char *name, struct store_asset *out)
+{
+    memset(out, 0, sizeof(*out));
+    sqlite3 *db = reader_take(s);
+    if (!db)
+        return STORE_ERROR;
+    sqlite3_stmt *st = NULL;
+    enum store_found found = STORE_ERROR;
+    if (sqlite3_prepare_v2(db, "SELECT " ASSET_COLUMNS " FROM assets WHERE name = ?", -1, &st,
+                           NULL) == SQLITE_OK) {
+        sqlite3_bind_text(st, 1, name, -1, SQLITE_STATIC);
+        int rc = sqlite3_step(st);
+        if (rc == SQLITE_ROW) {
+            read_asset(st, out);
+            found = STORE_FOUND;
+        } else if (rc == SQLITE_DONE) {
+            found = STORE_MISSING;
+        }
+    }
+    if (found == STORE_ERROR) {
+        char err[PATH_MAX + 300];
+        db_error(s, db, "read", err, sizeof(err));
+        LOG(LOG_ERROR, "store: asset %s: %s", name, err);
+    }
+    sqlite3_finalize(st);
+    reader_give(s, db);
+    return found;
+}
+
+bool store_asset_delete(struct store *s, const char *name, char *err, size_t errlen)
+{
+    pthread_mutex_lock(&s->write_lock);
+    sqlite3_stmt *st = NULL;
+    bool ok = sqlite3_prepare_v2(s->writer, "DELETE FROM assets WHERE name = ?", -1, &st, NULL) ==
+              SQLITE_OK;
+    if (ok) {
+        sqlite3_bind_text(st, 1, name, -1, SQLITE_STATIC);
+        ok = sqlite3_step(st) == SQLITE_DONE;
+    }
+    if (!ok)
+        db_error(s, s->writer, "write", err, errlen);
+    sqlite3_finalize(st);
+    pthread_mutex_unlock(&s->write_lock);
+    return ok;
+}
+
+int store_asset_hash_refs(struct store *s, const char *sha256)
+{
+    sqlite3 *db = reader_take(s);
+    if (!db)
+        return -1;
+    sqlite3_stmt *st = NULL;
+    int n = -1;
+    if (sqlite3_prepare_v2(db, "SELECT count(*) FROM assets WHERE sha256 = ?", -1, &st, NULL) ==
+        SQLITE_OK) {
+        sqlite3_bind_text(st, 1, sha256, -1, SQLITE_STATIC);
+        if (sqlite3_step(st) == SQLITE_ROW)
+            n = sqlite3_column_int(st, 0);
+    }
+    sqlite3_finalize(st);
+    reader_give(s, db);
+    return n;
+}
+
+bool store_asset_list(struct store *s, const char *after, int limit, bool dir_only,
+                      store_asset_fn fn, void *ctx, char next[STORE_ASSET_NAME_CAP], char *err,
+                      size_t errlen)
+{
+    next[0] = '\0';
+    sqlite3 *db = reader_take(s);
+    if (!db) {
+        snprintf(err, errlen, "cannot open a read connection to the store (see the log)");
+        return false;
+    }
+    sqlite3_stmt *st = NULL;
+    bool ok = sqlite3_prepare_v2(db,
+                                 dir_only ? "SELECT " ASSET_COLUMNS " FROM assets WHERE name > ?"
+                                            " AND source = 'dir' ORDER BY name LIMIT ?"
+                                          : "SELECT " ASSET_COLUMNS " FROM assets WHERE name > ?"
+                                            " ORDER BY name LIMIT ?",
+                                 -1, &st, NULL) == SQLITE_OK;
+    if (ok) {
+        sqlite3_bind_text(st, 1, after ? after : "", -1, SQLITE_STATIC);
+        sqlite3_bind_int(st, 2, limit + 1); /* one more: is there a next page? */
+        int n = 0, rc;
+        while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+            struct store_asset a;
+            memset(&a, 0, sizeof(a));
+            read_asset(st, &a);
+            if (n++ == limit) {
+                store_asset_finish(&a);
+                break;
+            }
+            fn(ctx, &a);
+            snprintf(next, STORE_ASSET_NAME_CAP, "%s", a.name);
+            store_asset_finish(&a);
+        }
+        ok = rc == SQLITE_ROW || rc == SQLITE_DONE;
+        if (ok && n <= limit)
+            next[0] = '\0';
+    }
+    if (!ok)
+        db_error(s, db, "read", err, errlen);
+    sqlite3_finalize(st);
+    reader_give(s, db);
+    return ok;
 }

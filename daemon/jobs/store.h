@@ -220,4 +220,32 @@ typedef bool (*store_import_fn)(void *ctx, const char *id, const char *dir, stru
 int store_import(struct store *s, enum store_kind kind, const char *legacy_file,
                  store_import_fn import, void *ctx, char *err, size_t errlen);
 
+/* Assets (daemon/jobs/assets.h), table assets (schema 2). A name is at most
+ * SCENE_ASSET_NAME_MAX (128) bytes. */
+#define STORE_ASSET_NAME_CAP 130
+struct store_asset {
+    char name[STORE_ASSET_NAME_CAP];
+    char sha256[65];   /* of the uploaded file, lowercase hex */
+    char ext[8];       /* "glb" or "gltf": the original's extension */
+    uint64_t size;     /* the uploaded file's bytes */
+    double created, updated; /* unix seconds: the first upload, the last */
+    bool from_dir;     /* --asset-dir: read-only over HTTP */
+    json_t *description; /* the converter's, or NULL */
+};
+void store_asset_finish(struct store_asset *a);
+/* Inserts or replaces the asset of that name (created kept on replace). */
+bool store_asset_put(struct store *s, const struct store_asset *a, char *err, size_t errlen);
+/* out is zeroed in every case (store_asset_finish it). */
+enum store_found store_asset_get(struct store *s, const char *name, struct store_asset *out);
+bool store_asset_delete(struct store *s, const char *name, char *err, size_t errlen);
+/* How many names point at that hash; -1 on a database error. */
+int store_asset_hash_refs(struct store *s, const char *sha256);
+/* A page of assets by name after `after` ("" from the start), at most
+ * limit; dir_only: those of --asset-dir. fn must be quick and must not call
+ * the store. next gets the cursor of the following page, "" when none. */
+typedef void (*store_asset_fn)(void *ctx, const struct store_asset *a);
+bool store_asset_list(struct store *s, const char *after, int limit, bool dir_only,
+                      store_asset_fn fn, void *ctx, char next[STORE_ASSET_NAME_CAP], char *err,
+                      size_t errlen);
+
 #endif

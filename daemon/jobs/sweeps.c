@@ -259,6 +259,11 @@ static json_t *run_point(struct sweeps *s, struct sweep *sw, json_t *job_body)
                      queue_submit_error());
             return NULL;
         }
+        if (r == QUEUE_REFUSED) {
+            snprintf(sw->error, sizeof(sw->error), "point job refused: %.400s",
+                     queue_submit_error());
+            return NULL;
+        }
         if (r != QUEUE_FULL) {
             snprintf(sw->error, sizeof(sw->error), "cannot queue a point job");
             return NULL;

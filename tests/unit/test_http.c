@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/time.h>
 #include <time.h>
 #include <unistd.h>
@@ -206,7 +207,28 @@ int main(void)
     struct http_limits limits;
     http_limits_defaults(&limits);
     limits.max_connections_per_ip = 3;
+    /* Assets, with a converter of the test's own (the CLI contract of
+     * shadebench-asset: exit 0 with a description, 2 with a refusal): what
+     * is tested here is the HTTP layer and the store, not the loader. */
+    char converter[PATH_MAX];
+    snprintf(converter, sizeof(converter), "%s/converter.sh", state);
+    static const char script[] =
+        "#!/bin/sh\n"
+        "case \"$(head -c 4 \"$2\")\" in\n"
+        "glTF) printf cache > \"$3\"; echo '{\"meshes\":2,\"triangles\":12}'; exit 0;;\n"
+        "*) echo '{\"status\":422,\"field\":\"magic\",\"message\":\"not a glb\"}'; exit 2;;\n"
+        "esac\n";
+    CHECK(fs_write_atomic(converter, script, sizeof(script) - 1) && chmod(converter, 0755) == 0);
+    struct assets_config acfg = {.state_dir = state, .converter = converter,
+                                 .max_asset_bytes = 4096};
+    asset_store_limits_defaults(&acfg.limits);
+    asset_run_limits_defaults(&acfg.run);
+    struct assets *assets = q ? assets_create(&acfg, store, q, err, sizeof(err)) : NULL;
+    CHECK(assets != NULL);
+    if (assets)
+        queue_set_asset_resolver(q, assets_queue_resolver, assets);
     const struct http_context ctx = {.catalog = &catalog, .queue = q, .sweeps = sweeps,
+                                     .assets = assets,
                                      .render_state = fake_state, .device_json = fake_device,
                                      .stall_s = 0.3};
     struct http_server *http = sweeps ? http_server_create("127.0.0.1:0", &limits, &ctx, err,
@@ -485,6 +507,82 @@ int main(void)
     CHECK(r.status == 200);
     reply_finish(&r);
 
+    /* Assets: upload (201, then 200 for the same bytes), describe, list,
+     * refusals naming the field, a job pinned to the hash, a delete refused
+     * while that job is queued, then allowed. */
+    r = request(port, "PUT", "/v1/assets/a.glb", "glTF asset one", NULL);
+    CHECK(r.status == 201 && str(r.json, "sha256") && strlen(str(r.json, "sha256")) == 64 &&
+          json_integer_value(json_object_get(json_object_get(r.json, "description"),
+                                             "triangles")) == 12);
+    char sha[65] = "";
+    if (str(r.json, "sha256"))
+        snprintf(sha, sizeof(sha), "%s", str(r.json, "sha256"));
+    reply_finish(&r);
+    char cache[PATH_MAX + 100];
+    CHECK(asset_store_cache_path(state, sha, cache, sizeof(cache)) && access(cache, R_OK) == 0);
+    CHECK(!asset_store_cache_path(state, "../../etc/passwd", cache, sizeof(cache)) && !cache[0]);
+    r = request(port, "PUT", "/v1/assets/a.glb", "glTF asset one", NULL);
+    CHECK(r.status == 200 && str(r.json, "sha256") && strcmp(str(r.json, "sha256"), sha) == 0);
+    reply_finish(&r);
+    r = request(port, "GET", "/v1/assets/a.glb", NULL, NULL);
+    CHECK(r.status == 200 && str(r.json, "sha256") && strcmp(str(r.json, "sha256"), sha) == 0);
+    reply_finish(&r);
+    r = request(port, "GET", "/v1/assets", NULL, NULL);
+    CHECK(r.status == 200 && json_array_size(json_object_get(r.json, "assets")) == 1 &&
+          json_integer_value(json_object_get(
+              json_object_get(json_array_get(json_object_get(r.json, "assets"), 0), "summary"),
+              "meshes")) == 2);
+    reply_finish(&r);
+    r = request(port, "PUT", "/v1/assets/b.glb", "nope", NULL);
+    CHECK(r.status == 422 && error_field(&r) && strcmp(error_field(&r), "magic") == 0);
+    reply_finish(&r);
+    r = request(port, "PUT", "/v1/assets/.b.glb", "glTF", NULL);
+    CHECK(r.status == 400 && error_field(&r) && strcmp(error_field(&r), "name") == 0);
+    reply_finish(&r);
+    r = request(port, "POST", "/v1/assets/b.glb", "glTF", NULL);
+    CHECK(r.status == 405 && strstr(r.body, "PUT"));
+    reply_finish(&r);
+    static const char big_put[] = "PUT /v1/assets/c.glb HTTP/1.1\r\nHost: 127.0.0.1\r\n"
+                                  "Connection: close\r\nContent-Length: 5000\r\n\r\n";
+    r = raw_request(port, big_put, sizeof(big_put) - 1);
+    CHECK(r.status == 413 && error_field(&r) && strcmp(error_field(&r), "body") == 0);
+    reply_finish(&r);
+    r = request(port, "GET", "/v1/assets/b.glb", NULL, NULL);
+    CHECK(r.status == 404 && error_field(&r) && strcmp(error_field(&r), "name") == 0);
+    reply_finish(&r);
+    r = request(port, "POST", "/v1/jobs",
+                "{\"technique\":\"unlit\",\"frames\":2,\"scene\":{\"asset\":\"b.glb\"}}", NULL);
+    CHECK(r.status == 400 && error_field(&r) && strcmp(error_field(&r), "scene.asset") == 0);
+    reply_finish(&r);
+    r = request(port, "POST", "/v1/jobs",
+                "{\"technique\":\"unlit\",\"frames\":2,\"scene\":{\"asset\":\"a.glb\"}}", NULL);
+    CHECK(r.status == 202 && str(r.json, "id"));
+    char asset_job[32] = "";
+    if (str(r.json, "id"))
+        snprintf(asset_job, sizeof(asset_job), "%s", str(r.json, "id"));
+    reply_finish(&r);
+    char job_path[64];
+    snprintf(job_path, sizeof(job_path), "/v1/jobs/%s", asset_job);
+    r = request(port, "GET", job_path, NULL, NULL);
+    CHECK(r.status == 200 &&
+          str(json_object_get(json_object_get(r.json, "spec"), "scene"), "asset_sha256") &&
+          strcmp(str(json_object_get(json_object_get(r.json, "spec"), "scene"), "asset_sha256"),
+                 sha) == 0);
+    reply_finish(&r);
+    r = request(port, "DELETE", "/v1/assets/a.glb", NULL, NULL);
+    CHECK(r.status == 409 && strstr(r.body, asset_job));
+    reply_finish(&r);
+    r = request(port, "DELETE", job_path, NULL, NULL);
+    CHECK(r.status == 200);
+    reply_finish(&r);
+    r = request(port, "DELETE", "/v1/assets/a.glb", NULL, NULL);
+    CHECK(r.status == 200);
+    reply_finish(&r);
+    CHECK(asset_store_cache_path(state, sha, cache, sizeof(cache)) && access(cache, F_OK) != 0);
+    struct store_asset gone;
+    CHECK(store_asset_get(store, "a.glb", &gone) == STORE_MISSING);
+    store_asset_finish(&gone);
+
     /* With a token, everything but /healthz needs it. */
     CHECK(http_server_set_token(http, "s3cret"));
     r = request(port, "GET", "/v1/info", NULL, NULL);
@@ -502,6 +600,8 @@ int main(void)
 
     http_server_destroy(http);
     sweeps_destroy(sweeps);
+    queue_set_asset_resolver(q, NULL, NULL);
+    assets_destroy(assets);
     queue_stop(q);
     queue_destroy(q);
     store_close(store);

@@ -71,6 +71,22 @@ int main(void)
     CHECK(!route_method_ok(ROUTE_JOBS, "PUT", &allow, &rule) && strstr(allow, "POST"));
     CHECK(!route_method_ok(ROUTE_INFO, "DELETE", &allow, &rule) && strcmp(allow, "GET, HEAD") == 0);
     CHECK(!route_method_ok(ROUTE_HEALTHZ, "POST", &allow, &rule));
+    /* Assets: one path segment, its rules left to the handler (a 400). */
+    CHECK(kind_of("/v1/assets", &r) == ROUTE_ASSETS && kind_of("/v1/assets/", &r) == ROUTE_ASSETS);
+    CHECK(kind_of("/v1/assets/scene.glb", &r) == ROUTE_ASSET && strcmp(r.asset, "scene.glb") == 0 &&
+          !r.asset_too_long);
+    CHECK(kind_of("/v1/assets/..", &r) == ROUTE_ASSET && strcmp(r.asset, "..") == 0);
+    CHECK(kind_of("/v1/assets/a/b.glb", &r) == ROUTE_NONE && strcmp(r.field, "url") == 0);
+    char long_asset[200];
+    snprintf(long_asset, sizeof(long_asset), "/v1/assets/%0150d", 0);
+    CHECK(kind_of(long_asset, &r) == ROUTE_ASSET && r.asset_too_long &&
+          strlen(r.asset) == ROUTE_ASSET_NAME_MAX);
+    CHECK(route_method_ok(ROUTE_ASSET, "PUT", &allow, &rule) &&
+          route_method_ok(ROUTE_ASSET, "DELETE", &allow, &rule));
+    CHECK(!route_method_ok(ROUTE_ASSET, "POST", &allow, &rule) && strstr(allow, "PUT"));
+    CHECK(!route_method_ok(ROUTE_ASSETS, "PUT", &allow, &rule));
+    CHECK(!route_method_ok(ROUTE_JOB, "PUT", &allow, &rule));
+    CHECK(strcmp(route_label(ROUTE_ASSET), "/v1/assets/{name}") == 0);
     CHECK(strcmp(route_label(ROUTE_JOB), "/v1/jobs/{id}") == 0);
     CHECK(strcmp(route_label((enum route_kind)99), "other") == 0);
 

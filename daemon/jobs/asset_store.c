@@ -1,0 +1,89 @@
+#define _POSIX_C_SOURCE 200809L
+#include "daemon/jobs/asset_store.h"
+
+#include <stdio.h>
+#include <string.h>
+
+bool asset_store_sha256_valid(const char *sha256)
+{
+    if (!sha256 || strlen(sha256) != 64)
+        return false;
+    for (const char *p = sha256; *p; p++)
+        if (!((*p >= '0' && *p <= '9') || (*p >= 'a' && *p <= 'f')))
+            return false;
+    return true;
+}
+
+static bool fits(int n, size_t cap, char *out)
+{
+    if (n < 0 || (size_t)n >= cap) {
+        if (cap)
+            out[0] = '\0';
+        return false;
+    }
+    return true;
+}
+
+bool asset_store_dir(const char *state_dir, char *out, size_t cap)
+{
+    return fits(snprintf(out, cap, "%s/%s", state_dir, ASSET_STORE_DIR), cap, out);
+}
+
+bool asset_store_cache_path(const char *state_dir, const char *sha256, char *out, size_t cap)
+{
+    if (!asset_store_sha256_valid(sha256)) {
+        if (cap)
+            out[0] = '\0';
+        return false;
+    }
+    return fits(snprintf(out, cap, "%s/%s/%s.%s", state_dir, ASSET_STORE_DIR, sha256,
+                         ASSET_CACHE_EXT), cap, out);
+}
+
+bool asset_store_original_path(const char *state_dir, const char *sha256, const char *ext,
+                               char *out, size_t cap)
+{
+    if (!asset_store_sha256_valid(sha256) || (strcmp(ext, "glb") != 0 && strcmp(ext, "gltf") != 0)) {
+        if (cap)
+            out[0] = '\0';
+        return false;
+    }
+    return fits(snprintf(out, cap, "%s/%s/%s.%s", state_dir, ASSET_STORE_DIR, sha256, ext), cap,
+                out);
+}
+
+void asset_store_limits_defaults(struct asset_limits *lim)
+{
+    memset(lim, 0, sizeof(*lim));
+    lim->max_file_bytes = 256ull << 20;
+    lim->max_vertices = 16ull << 20;
+    lim->max_indices = 48ull << 20;
+    lim->max_texture_pixels = 256ull << 20;
+    lim->max_texture_edge = 8192;
+    lim->max_meshes = 65536;
+    lim->max_materials = 4096;
+    lim->max_images = 4096;
+    lim->max_lights = 1024;
+    lim->max_cameras = 1024;
+}
+
+json_t *asset_store_limits_json(const struct asset_limits *lim)
+{
+    return json_pack("{s:I, s:I, s:I, s:I, s:I, s:I, s:I, s:I, s:I, s:I}", "max_file_bytes",
+                     (json_int_t)lim->max_file_bytes, "max_vertices",
+                     (json_int_t)lim->max_vertices, "max_indices", (json_int_t)lim->max_indices,
+                     "max_texture_pixels", (json_int_t)lim->max_texture_pixels,
+                     "max_texture_edge", (json_int_t)lim->max_texture_edge, "max_meshes",
+                     (json_int_t)lim->max_meshes, "max_materials", (json_int_t)lim->max_materials,
+                     "max_images", (json_int_t)lim->max_images, "max_lights",
+                     (json_int_t)lim->max_lights, "max_cameras", (json_int_t)lim->max_cameras);
+}
+
+void asset_run_limits_defaults(struct asset_run_limits *r)
+{
+    /* Decoded textures alone may reach 1 GiB at the default limits; the
+     * importer's own copies come on top. */
+    r->memory_bytes = 4ull << 30;
+    r->cpu_s = 120;
+    r->wall_s = 180;
+}

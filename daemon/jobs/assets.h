@@ -1,0 +1,111 @@
+#ifndef SHADEBENCH_ASSETS_H
+#define SHADEBENCH_ASSETS_H
+
+/* The assets (issue 21): glTF 2.0 files uploaded over HTTP (PUT
+ * /v1/assets/NAME) or provided read-only by the operator (--asset-dir),
+ * each converted once into a cache file the render thread reads
+ * (asset_store.h has the paths). The glTF file is never parsed in the
+ * daemon: the converter, shadebench-asset, runs as a child process under
+ * an address-space and CPU-time limit, at lower priority, with a
+ * wall-clock time-out, one conversion at a time (ASSETS_WORKERS), on a
+ * thread of this module: an upload never holds an HTTP thread while it
+ * converts, and never competes with the render thread for more than one
+ * core. The records (name -> hash, size, the converter's description) are
+ * rows of the store (table assets), so they survive restarts.
+ *
+ * Threads: the functions are called from libmicrohttpd's threads (uploads,
+ * lists, descriptions, deletes, a job's resolution), the sweep thread
+ * (queue_submit's resolver) and main (create, destroy). The worker thread
+ * is this module's own. GL-free. */
+
+#include <jansson.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "daemon/jobs/asset_store.h"
+#include "daemon/jobs/queue.h"
+#include "daemon/jobs/store.h"
+#include "daemon/scene/scene_spec.h"
+
+/* Conversions at once, and uploads that may stream or wait to convert at
+ * once: more are answered 429. */
+#define ASSETS_WORKERS 1
+#define ASSETS_MAX_UPLOADS 4
+#define ASSETS_MAX_BYTES_DEFAULT (256ull << 20)
+/* A converter's answer on stdout beyond this is not JSON we can use. */
+#define ASSETS_MAX_STDOUT (1u << 20)
+
+struct assets_config {
+    const char *state_dir;
+    const char *asset_dir; /* NULL or "": none */
+    const char *converter; /* NULL or "": shadebench-asset beside /proc/self/exe */
+    uint64_t max_asset_bytes; /* an upload's body (--max-asset-bytes) */
+    struct asset_limits limits;
+    struct asset_run_limits run;
+};
+
+/* Why a request is refused: the HTTP status, the field and the rule; job
+ * the id of the job that holds an asset (409). */
+struct assets_error {
+    unsigned status;
+    char field[64];
+    char message[512];
+};
+
+struct assets;
+
+/* Scans --asset-dir (names only: the files are hashed and converted on the
+ * worker, so a large folder never delays the start), drops the rows of
+ * files that left it, removes leftover temporaries and files no name
+ * points at. Call after queue_load (a queued job's pinned hash keeps its
+ * files). NULL with err. */
+struct assets *assets_create(const struct assets_config *cfg, struct store *store,
+                             struct queue *queue, char *err, size_t errlen);
+/* Kills a running conversion, ends the worker, answers waiting uploads
+ * 503. Accepts NULL. */
+void assets_destroy(struct assets *a);
+/* fn(ctx) is called (any thread, no lock held) when an upload's answer is
+ * ready: the HTTP layer resumes its waits. */
+void assets_set_listener(struct assets *a, void (*fn)(void *ctx), void *ctx);
+
+uint64_t assets_max_bytes(const struct assets *a);
+/* How long an upload's answer may take once its body is in. */
+double assets_answer_wait_s(const struct assets *a);
+/* /v1/info's "assets": the converter's limits, the body limit, the caps. */
+json_t *assets_info_json(const struct assets *a);
+
+/* PUT /v1/assets/NAME. begin: the headers are in (content_length 0:
+ * unknown, chunked); NULL with e when refused. write: each piece of the
+ * body, hashed and written to a temporary file under STATE_DIR/assets; past
+ * the limit, or on a full disk, the rest is read and dropped and finish
+ * answers 413 or 507. finish consumes u: queues the conversion and returns
+ * its ticket (> 0), whose answer assets_ticket_take gives once
+ * assets_ticket_done; 0 with e when refused. abort: the client went away. */
+struct asset_upload;
+struct asset_upload *assets_upload_begin(struct assets *a, const char *name,
+                                         uint64_t content_length, struct assets_error *e);
+void assets_upload_write(struct asset_upload *u, const void *data, size_t len);
+uint64_t assets_upload_finish(struct asset_upload *u, struct assets_error *e);
+void assets_upload_abort(struct asset_upload *u);
+bool assets_ticket_done(struct assets *a, uint64_t ticket);
+/* The answer (a new reference) and its status; the ticket is released.
+ * False when there is no such ticket. */
+bool assets_ticket_take(struct assets *a, uint64_t ticket, unsigned *status, json_t **body);
+/* The client went away: the conversion goes on, its answer is dropped. */
+void assets_ticket_drop(struct assets *a, uint64_t ticket);
+
+/* GET /v1/assets/NAME, GET /v1/assets?limit=&cursor=, DELETE
+ * /v1/assets/NAME: a new reference, or NULL with e. */
+json_t *assets_describe(struct assets *a, const char *name, struct assets_error *e);
+json_t *assets_list(struct assets *a, const char *cursor, int limit, struct assets_error *e);
+json_t *assets_delete(struct assets *a, const char *name, struct assets_error *e);
+
+/* A job's scene.asset: fills scene->asset_sha256 from the store, or
+ * refuses (400 unknown name, 409 pinned hash differs or still converting). */
+bool assets_resolve(struct assets *a, struct scene_spec *scene, struct assets_error *e);
+/* queue_submit's resolver (queue.h), ctx the assets. */
+bool assets_queue_resolver(void *ctx, struct scene_spec *scene, char *field, size_t field_cap,
+                           char *message, size_t message_cap);
+
+#endif

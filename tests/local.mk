@@ -33,7 +33,8 @@ UNIT_TESTS = \
 	tests/unit/test_effects \
 	tests/unit/test_pbr \
 	tests/unit/test_teapot \
-	tests/unit/test_lighting
+	tests/unit/test_lighting \
+	tests/unit/test_asset
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
 	tests/fuzz/replay-route
@@ -70,6 +71,7 @@ tests_unit_test_culling_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_pbr_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_teapot_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_lighting_LDADD = $(CORE_LIBS) -lm
+tests_unit_test_asset_LDADD = $(CORE_LIBS) -lm
 tests_tools_png_tool_SOURCES = tests/tools/png_tool.c
 tests_tools_png_tool_LDADD = $(CORE_LIBS)
 noinst_HEADERS = tests/unit/check.h tests/unit/catalog_fixture.h tests/fuzz/fuzz.h
@@ -132,6 +134,7 @@ E2E_TESTS = \
 	tests/e2e/ssim_skimage.py \
 	tests/e2e/e2e_history.py \
 	tests/e2e/e2e_verdicts.py \
+	tests/e2e/e2e_assets.py \
 	tests/e2e/systemd_sandbox.py \
 	tests/e2e/systemd_unit.sh
 
@@ -153,7 +156,8 @@ SANITIZER_TESTS = $(UNIT_TESTS) \
 	tests/e2e/e2e_load.py \
 	tests/e2e/e2e_http.py \
 	tests/e2e/e2e_persist.py \
-	tests/e2e/e2e_badinput.py
+	tests/e2e/e2e_badinput.py \
+	tests/e2e/e2e_assets.py
 check-sanitizers:
 if SANITIZERS
 	$(MAKE) $(AM_MAKEFLAGS) check TESTS='$(SANITIZER_TESTS)'
@@ -201,7 +205,8 @@ AM_TESTS_ENVIRONMENT = \
 	SHADEBENCH_UNIT='$(abs_top_builddir)/systemd/shadebenchd.service'; \
 	FUZZ_REPLAY_DIR='$(abs_top_builddir)/tests/fuzz'; \
 	SANDBOX_RUN='$(abs_top_builddir)/tests/tools/sandbox-run'; \
+	SHADEBENCH_ASSET='$(abs_top_builddir)/shadebench-asset'; \
 	export SHADEBENCHD PNG_TOOL SHADEBENCH_COMPARE SHADEBENCH_CLIENT SHADEBENCH_UNIT FUZZ_REPLAY_DIR \
-	SANDBOX_RUN; \
+	SANDBOX_RUN SHADEBENCH_ASSET; \
 	$(AM_TESTS_ENVIRONMENT_SAN)
 

@@ -365,6 +365,8 @@ static bool check_container(struct ctx *c, const uint8_t *data, size_t len)
     }
     json_error_t je;
     c->root = json_loadb((const char *)data, len, JSON_REJECT_DUPLICATES, &je);
+    if (!c->root && json_error_code(&je) == json_error_out_of_memory)
+        return fail(c, 500, "file", "out of memory parsing the JSON");
     if (!c->root)
         return fail(c, 400, "file", "bad JSON at line %d, column %d: %s", je.line, je.column, je.text);
     if (!json_is_object(c->root))
@@ -1704,7 +1706,10 @@ bool asset_convert_buffer(const uint8_t *data, size_t len, const struct asset_li
                                     aiProcess_CalcTangentSpace,
                                 c.glb ? "glb" : "gltf");
     if (!sc) {
-        fail(&c, 400, "file", "assimp could not import it: %s", aiGetErrorString());
+        /* The checks passed, so this is the importer's own failure (out of
+         * memory under the limits, or a rule of assimp's the checks do not
+         * know): the loader failed, not a verdict on the file. */
+        fail(&c, 500, "file", "assimp could not import it: %s", aiGetErrorString());
         goto done;
     }
     if (!build_meshes(&c, sc, infos, in_scene, out) || !build_materials(&c, out) ||

@@ -37,7 +37,7 @@ UNIT_TESTS = \
 	tests/unit/test_asset
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
-	tests/fuzz/replay-route
+	tests/fuzz/replay-route tests/fuzz/replay-asset_cache tests/fuzz/replay-asset_convert
 tests_unit_test_job_LDADD = $(CORE_LIBS)
 tests_unit_test_options_LDADD = libsb-common.a $(JANSSON_LIBS) $(LIBS)
 tests_unit_test_store_LDADD = $(CORE_LIBS)
@@ -94,6 +94,12 @@ tests_fuzz_replay_png_metrics_SOURCES = tests/fuzz/fuzz_png_metrics.c tests/fuzz
 tests_fuzz_replay_png_metrics_LDADD = $(CORE_LIBS)
 tests_fuzz_replay_route_SOURCES = tests/fuzz/fuzz_route.c tests/fuzz/replay.c daemon/api/routes.c
 tests_fuzz_replay_route_LDADD = $(CORE_LIBS)
+tests_fuzz_replay_asset_cache_SOURCES = tests/fuzz/fuzz_asset_cache.c tests/fuzz/replay.c
+tests_fuzz_replay_asset_cache_LDADD = $(CORE_LIBS)
+tests_fuzz_replay_asset_convert_SOURCES = tests/fuzz/fuzz_asset_convert.c tests/fuzz/replay.c \
+	$(ASSET_CONVERT_SOURCES)
+tests_fuzz_replay_asset_convert_CFLAGS = $(AM_CFLAGS) $(ASSIMP_CFLAGS) $(JPEG_CFLAGS)
+tests_fuzz_replay_asset_convert_LDADD = $(CORE_LIBS) $(ASSIMP_LIBS) $(JPEG_LIBS) -lm
 if HAVE_SECCOMP
 check_PROGRAMS += tests/tools/sandbox-run
 tests_tools_sandbox_run_SOURCES = tests/tools/sandbox_run.c

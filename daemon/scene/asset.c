@@ -360,6 +360,12 @@ bool asset_file_write(const struct asset *a, const char *path, char *err, size_t
         free(tmp);
         return false;
     }
+    /* Readable like the files beside it (mkstemp makes 0600). */
+    if (fchmod(fd, 0644) != 0) {
+        snprintf(err, errlen, "asset cache: %s: %s", tmp, strerror(errno));
+        close(fd);
+        goto fail;
+    }
     struct writer w = {fdopen(fd, "wb"), false};
     if (!w.f) {
         snprintf(err, errlen, "asset cache: %s: %s", tmp, strerror(errno));

@@ -215,6 +215,19 @@ static bool decode_uri(struct ctx *c, const char *uri, const char *field, struct
     size_t hlen = (size_t)(comma - uri);
     if (hlen < 7 || strncmp(comma - 7, ";base64", 7) != 0)
         return fail(c, 400, field, "data: URI is not base64");
+    /* The media type as type/subtype of plain characters: assimp parses it
+     * too, and 5.2 reads past a missing slash. */
+    const char *mt = uri + 5, *mt_end = comma - 7;
+    int slashes = 0;
+    for (const char *q = mt; q < mt_end; q++) {
+        bool plain = (*q >= 'a' && *q <= 'z') || (*q >= 'A' && *q <= 'Z') || (*q >= '0' && *q <= '9') ||
+                     *q == '.' || *q == '+' || *q == '-' || *q == '/';
+        if (!plain)
+            return fail(c, 400, field, "data: URI has a malformed media type");
+        slashes += *q == '/';
+    }
+    if (slashes != 1 || mt[0] == '/' || mt_end[-1] == '/')
+        return fail(c, 400, field, "data: URI has no type/subtype media type");
     const uint8_t *p = (const uint8_t *)comma + 1;
     size_t n = strlen((const char *)p);
     uint8_t *buf = malloc(n / 4 * 3 + 3);
@@ -876,6 +889,14 @@ static bool check_images(struct ctx *c)
                 return false;
         } else {
             int64_t view, stride;
+            /* Required with a bufferView, and one of the two glTF allows
+             * (assimp 5.2 reads past a mimeType without a slash). */
+            const char *mime = json_string_value(json_object_get(im, "mimeType"));
+            if (!mime || (strcmp(mime, "image/png") != 0 && strcmp(mime, "image/jpeg") != 0)) {
+                char f[80];
+                snprintf(f, sizeof(f), "images[%zu].mimeType", i);
+                return fail(c, 400, f, "must be image/png or image/jpeg");
+            }
             if (!get_index(c, im, "bufferView", field, true, json_array_size(c->views), &view) ||
                 !view_span(c, (size_t)view, &c->images[i], &stride))
                 return false;

@@ -18,6 +18,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+enum { IGNORED_NAME_MAX = 128 }; /* the longest string the cache holds, with its NUL */
+
 const char *const asset_texture_slot_names[] = {"base_color", "metallic_roughness", "normal",
                                                 "occlusion", "emissive"};
 const char *const asset_alpha_mode_names[] = {"opaque", "mask", "blend"};
@@ -75,6 +77,22 @@ void asset_finish(struct asset *a)
 
 /* ---- description ---- */
 
+/* A name as a JSON string: names come from the file (or a damaged cache)
+ * and may be cut inside a UTF-8 sequence, which jansson refuses; any byte
+ * of an invalid sequence becomes '?'. */
+static json_t *name_json(const char *s)
+{
+    json_t *j = json_string(s);
+    if (j)
+        return j;
+    char buf[IGNORED_NAME_MAX];
+    size_t n = strnlen(s, sizeof(buf) - 1);
+    for (size_t i = 0; i < n; i++)
+        buf[i] = (unsigned char)s[i] < 0x80 ? s[i] : '?';
+    buf[n] = '\0';
+    return json_string(buf);
+}
+
 static json_t *vec3(const float v[3])
 {
     return json_pack("[fff]", (double)v[0], (double)v[1], (double)v[2]);
@@ -97,7 +115,7 @@ json_t *asset_describe(const struct asset *a)
         verts += m->vertex_count;
         from_file += m->uv1_from_file;
         waste_weighted += (double)m->uv1_waste * (m->index_count / 3);
-        if (json_array_append_new(meshes, json_pack("{ss si sI sI ss sf ss}", "name", m->name,
+        if (json_array_append_new(meshes, json_pack("{so si sI sI ss sf ss}", "name", name_json(m->name),
                 "material", (int)m->material, "vertices", (json_int_t)m->vertex_count,
                 "triangles", (json_int_t)(m->index_count / 3),
                 "uv1", m->uv1_from_file ? "file" : "generated", "uv1_waste", (double)m->uv1_waste,
@@ -112,7 +130,7 @@ json_t *asset_describe(const struct asset *a)
         for (int s = 0; s < ASSET_TEX_SLOTS; s++)
             if (m->tex[s].image >= 0)
                 json_array_append_new(slots, json_string(asset_texture_slot_names[s]));
-        json_t *o = json_pack("{ss ss sb so}", "name", m->name,
+        json_t *o = json_pack("{so ss sb so}", "name", name_json(m->name),
                               "alpha_mode", asset_alpha_mode_names[m->alpha_mode],
                               "double_sided", m->double_sided, "textures", slots);
         if (!o || json_array_append_new(mats, o))
@@ -123,23 +141,23 @@ json_t *asset_describe(const struct asset *a)
     for (uint32_t i = 0; i < a->image_count; i++) {
         const struct asset_image *im = &a->images[i];
         pixels += (uint64_t)im->width * im->height;
-        if (json_array_append_new(texs, json_pack("{ss sI sI}", "name", im->name,
+        if (json_array_append_new(texs, json_pack("{so sI sI}", "name", name_json(im->name),
                                                   "width", (json_int_t)im->width,
                                                   "height", (json_int_t)im->height)))
             goto oom;
     }
     for (uint32_t i = 0; i < a->light_count; i++)
         json_array_append_new(json_object_get(lights, asset_light_type_names[a->lights[i].type]),
-                              json_string(a->lights[i].name));
+                              name_json(a->lights[i].name));
     for (uint32_t i = 0; i < a->camera_count; i++) {
         const struct asset_camera *c = &a->cameras[i];
-        if (json_array_append_new(cams, json_pack("{ss ss sf}", "name", c->name,
+        if (json_array_append_new(cams, json_pack("{so ss sf}", "name", name_json(c->name),
                                                   "type", c->perspective ? "perspective" : "orthographic",
                                                   "yfov", (double)c->yfov)))
             goto oom;
     }
     for (uint32_t i = 0; i < a->ignored_count; i++)
-        json_array_append_new(ign, json_string(a->ignored[i]));
+        json_array_append_new(ign, name_json(a->ignored[i]));
     double waste = tris ? waste_weighted / (double)tris : 0.0;
     const char *origin = a->mesh_count == 0 ? "none"
                          : from_file == a->mesh_count ? "file"

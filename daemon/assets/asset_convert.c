@@ -177,10 +177,26 @@ static bool get_floats(struct ctx *c, json_t *obj, const char *key, const char *
     return true;
 }
 
+/* A name cut at ASSET_NAME_MAX - 1 bytes may end inside a UTF-8
+ * sequence: drop the partial sequence, so that the name stays text. */
+static void utf8_trim(char *s)
+{
+    size_t n = strlen(s), i = n;
+    while (i > 0 && ((unsigned char)s[i - 1] & 0xC0) == 0x80)
+        i--;
+    if (i > 0 && (unsigned char)s[i - 1] >= 0xC0) {
+        unsigned char lead = (unsigned char)s[i - 1];
+        size_t want = lead >= 0xF0 ? 4 : lead >= 0xE0 ? 3 : 2;
+        if (n - (i - 1) < want)
+            s[i - 1] = '\0';
+    }
+}
+
 static void copy_name(char *dst, json_t *obj, const char *fallback)
 {
     const char *s = json_string_value(json_object_get(obj, "name"));
     snprintf(dst, ASSET_NAME_MAX, "%s", s && s[0] ? s : fallback);
+    utf8_trim(dst);
 }
 
 /* ---- data URIs ---- */
@@ -1542,10 +1558,14 @@ static bool build_mesh(struct ctx *c, const struct aiMesh *am, const double m[16
     out->uv1_from_file = uv1_file;
     out->tangents_from_file = pi->has_tangent && am->mTangents;
     const char *nname = json_string_value(json_object_get(node, "name"));
-    if (nname && nname[0])
-        snprintf(out->name, ASSET_NAME_MAX, "%s/%zu", nname, p);
-    else
+    if (nname && nname[0]) {
+        char head[48]; /* room for "/" and the primitive's number */
+        snprintf(head, sizeof(head), "%s", nname);
+        utf8_trim(head);
+        snprintf(out->name, ASSET_NAME_MAX, "%s/%u", head, (unsigned)p);
+    } else {
         snprintf(out->name, ASSET_NAME_MAX, "node%zu/mesh%zu/%zu", node_index, mi, p);
+    }
     struct asset_vertex *vs = out->vertices;
     if (uv1_file)
         for (unsigned v = 0; v < am->mNumVertices; v++)

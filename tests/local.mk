@@ -34,7 +34,8 @@ UNIT_TESTS = \
 	tests/unit/test_pbr \
 	tests/unit/test_teapot \
 	tests/unit/test_lighting \
-	tests/unit/test_asset
+	tests/unit/test_asset \
+	tests/unit/test_uv_charts
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
 	tests/fuzz/replay-route tests/fuzz/replay-asset_cache tests/fuzz/replay-asset_convert
@@ -72,6 +73,9 @@ tests_unit_test_pbr_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_teapot_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_lighting_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_asset_LDADD = $(CORE_LIBS) -lm
+tests_unit_test_uv_charts_SOURCES = tests/unit/test_uv_charts.c daemon/assets/uv_charts.c \
+	daemon/assets/uv_charts.h
+tests_unit_test_uv_charts_LDADD = -lm
 tests_tools_png_tool_SOURCES = tests/tools/png_tool.c
 tests_tools_png_tool_LDADD = $(CORE_LIBS)
 noinst_HEADERS = tests/unit/check.h tests/unit/catalog_fixture.h tests/fuzz/fuzz.h

@@ -20,6 +20,7 @@
  *    cameras' yfov, and the images, decoded here with libpng and libjpeg
  *    from the bytes stage 1 checked. */
 #include "daemon/assets/asset_convert.h"
+#include "daemon/assets/uv_charts.h"
 
 #include <assimp/cimport.h>
 #include <assimp/mesh.h>
@@ -1435,29 +1436,6 @@ static double tri_area2(const float a[2], const float b[2], const float cc[2])
     return fabs((double)(b[0] - a[0]) * (cc[1] - a[1]) - (double)(cc[0] - a[0]) * (b[1] - a[1])) / 2;
 }
 
-/* Per-triangle charts: two triangles per square cell of a g x g grid, each
- * the cell's lower-left or upper-right half, inset by a texel of a
- * 256-texel cell on every side and split along the diagonal by two more,
- * so that bilinear filtering at that resolution never reads a neighbour. */
-static void chart_uv(uint32_t t, uint32_t g, float uv[3][2])
-{
-    uint32_t cell = t / 2, cx = cell % g, cy = cell / g;
-    double sz = 1.0 / g, e = sz / 256.0, d = sz * 2.0 / 256.0;
-    double x0 = cx * sz + e, y0 = cy * sz + e, x1 = (cx + 1) * sz - e, y1 = (cy + 1) * sz - e;
-    if (t % 2 == 0) {
-        uv[0][0] = (float)x0, uv[0][1] = (float)y0;
-        uv[1][0] = (float)(x1 - d), uv[1][1] = (float)y0;
-        uv[2][0] = (float)x0, uv[2][1] = (float)(y1 - d);
-    } else {
-        uv[0][0] = (float)x1, uv[0][1] = (float)y1;
-        uv[1][0] = (float)(x0 + d), uv[1][1] = (float)y1;
-        uv[2][0] = (float)x1, uv[2][1] = (float)(y0 + d);
-    }
-    for (int k = 0; k < 3; k++)
-        for (int j = 0; j < 2; j++)
-            uv[k][j] = uv[k][j] < 0 ? 0 : uv[k][j] > 1 ? 1 : uv[k][j];
-}
-
 /* Vertex v of assimp's mesh in world space (uv1 from the file, when it has
  * one; the caller sets generated charts). */
 static bool fill_vertex(struct ctx *c, const struct aiMesh *am, unsigned v, const double m[16],
@@ -1545,13 +1523,58 @@ static bool build_mesh(struct ctx *c, const struct aiMesh *am, const double m[16
         }
     if (pi->has_uv1 && !uv1_file)
         ignore(c, "TEXCOORD_1 outside [0, 1] (uv1 generated instead)");
-    uint64_t nv = uv1_file ? am->mNumVertices : 3ull * ntri;
-    if (nv > c->lim->max_vertices)
-        return fail(c, 422, "limits.max_vertices", "%s has %" PRIu64 " vertices", field, nv);
+    /* The triangles' corners, mirrored ones swapped so that front faces
+     * stay counter-clockwise after a negative-determinant matrix. */
+    uint32_t *corners = malloc((size_t)ntri * 3 * sizeof(uint32_t));
+    float *world = uv1_file ? NULL : malloc((size_t)am->mNumVertices * 3 * sizeof(float));
+    struct uv_charts charts = {0};
+    bool ok = false;
+    if (!corners || (!uv1_file && !world)) {
+        fail(c, 500, field, "out of memory");
+        goto done;
+    }
+    uint32_t t = 0;
+    for (unsigned f = 0; f < am->mNumFaces; f++) {
+        const struct aiFace *face = &am->mFaces[f];
+        if (face->mNumIndices != 3)
+            continue;
+        for (int k = 0; k < 3; k++) {
+            int kk = det < 0 ? (k == 1 ? 2 : k == 2 ? 1 : 0) : k;
+            corners[3 * t + k] = face->mIndices[kk];
+            if (face->mIndices[kk] >= am->mNumVertices) {
+                fail(c, 500, field, "assimp gave an index out of range");
+                goto done;
+            }
+        }
+        t++;
+    }
+    uint64_t nv = am->mNumVertices;
+    if (!uv1_file) {
+        for (unsigned v = 0; v < am->mNumVertices; v++) {
+            const float p3[3] = {am->mVertices[v].x, am->mVertices[v].y, am->mVertices[v].z};
+            xform_point(m, p3, world + 3 * (size_t)v);
+        }
+        char cerr[128];
+        if (!uv_charts_build(world, am->mNumVertices, corners, ntri, c->lim->max_vertices, &charts,
+                             cerr, sizeof(cerr))) {
+            if (strstr(cerr, "memory"))
+                fail(c, 500, field, "%s", cerr);
+            else
+                fail(c, 422, "limits.max_vertices", "%s: %s", field, cerr);
+            goto done;
+        }
+        nv = charts.vertex_count;
+    }
+    if (nv > c->lim->max_vertices) {
+        fail(c, 422, "limits.max_vertices", "%s has %" PRIu64 " vertices", field, nv);
+        goto done;
+    }
     out->vertices = calloc((size_t)nv, sizeof(*out->vertices));
     out->indices = malloc((size_t)ntri * 3 * sizeof(uint32_t));
-    if (!out->vertices || !out->indices)
-        return fail(c, 500, field, "out of memory");
+    if (!out->vertices || !out->indices) {
+        fail(c, 500, field, "out of memory");
+        goto done;
+    }
     out->vertex_count = (uint32_t)nv;
     out->index_count = ntri * 3;
     out->material = material;
@@ -1567,39 +1590,19 @@ static bool build_mesh(struct ctx *c, const struct aiMesh *am, const double m[16
         snprintf(out->name, ASSET_NAME_MAX, "node%zu/mesh%zu/%zu", node_index, mi, p);
     }
     struct asset_vertex *vs = out->vertices;
-    if (uv1_file)
-        for (unsigned v = 0; v < am->mNumVertices; v++)
-            if (!fill_vertex(c, am, v, m, nm, det, &vs[v], field))
-                return false;
-    uint32_t o = 0, t = 0;
-    uint32_t g = (uint32_t)ceil(sqrt((ntri + 1) / 2.0));
-    double covered = 0;
-    for (unsigned f = 0; f < am->mNumFaces; f++) {
-        const struct aiFace *face = &am->mFaces[f];
-        if (face->mNumIndices != 3)
-            continue;
-        float cuv[3][2];
-        if (!uv1_file)
-            chart_uv(t, g ? g : 1, cuv);
-        for (int k = 0; k < 3; k++) {
-            /* A negative determinant mirrors the triangle: swap two corners
-             * so that front faces stay counter-clockwise. */
-            int kk = det < 0 ? (k == 1 ? 2 : k == 2 ? 1 : 0) : k;
-            unsigned v = face->mIndices[kk];
-            if (v >= am->mNumVertices)
-                return fail(c, 500, field, "assimp gave an index out of range");
-            uint32_t dst = uv1_file ? v : o++;
-            out->indices[t * 3 + k] = dst;
-            if (!uv1_file) {
-                if (!fill_vertex(c, am, v, m, nm, det, &vs[dst], field))
-                    return false;
-                vs[dst].uv1[0] = cuv[k][0];
-                vs[dst].uv1[1] = cuv[k][1];
-            }
+    for (uint32_t v = 0; v < out->vertex_count; v++) {
+        if (!fill_vertex(c, am, uv1_file ? v : charts.source[v], m, nm, det, &vs[v], field))
+            goto done;
+        if (!uv1_file) {
+            vs[v].uv1[0] = charts.uv[v][0];
+            vs[v].uv1[1] = charts.uv[v][1];
         }
+    }
+    memcpy(out->indices, uv1_file ? corners : charts.indices, (size_t)ntri * 3 * sizeof(uint32_t));
+    double covered = 0;
+    for (t = 0; t < ntri; t++) {
         const uint32_t *ix = &out->indices[t * 3];
         covered += tri_area2(vs[ix[0]].uv1, vs[ix[1]].uv1, vs[ix[2]].uv1);
-        t++;
     }
     double waste = 1.0 - covered;
     out->uv1_waste = (float)(waste < 0 ? 0 : waste > 1 ? 1 : waste);
@@ -1612,7 +1615,12 @@ static bool build_mesh(struct ctx *c, const struct aiMesh *am, const double m[16
             out->box_min[r] = fminf(out->box_min[r], vs[v].pos[r]);
             out->box_max[r] = fmaxf(out->box_max[r], vs[v].pos[r]);
         }
-    return true;
+    ok = true;
+done:
+    free(corners);
+    free(world);
+    uv_charts_free(&charts);
+    return ok;
 }
 
 static bool build_meshes(struct ctx *c, const struct aiScene *sc, struct prim_info **infos,

@@ -618,6 +618,7 @@ struct prim_info {
     uint64_t vertices, indices; /* as the file has them */
     uint64_t triangles;
     bool has_uv1, has_tangent, triangles_mode;
+    int64_t uv_accessor[2]; /* TEXCOORD_0 and _1's accessors, -1 for none */
 };
 
 static bool check_attribute(struct ctx *c, json_t *attrs, const char *name, const char *field,
@@ -688,6 +689,10 @@ static bool check_primitive(struct ctx *c, size_t m, size_t p, json_t *prim, str
         !check_attribute(c, attrs, "TEXCOORD_0", f, pa.count, UV, 2, &present) ||
         !check_attribute(c, attrs, "TEXCOORD_1", f, pa.count, UV, 2, &pi->has_uv1))
         return false;
+    for (int set = 0; set < 2; set++) {
+        json_t *uv = json_object_get(attrs, set ? "TEXCOORD_1" : "TEXCOORD_0");
+        pi->uv_accessor[set] = uv ? json_integer_value(uv) : -1;
+    }
     /* The rest are checked for range (assimp reads colours, joints and
      * weights too), whatever their type. */
     const char *key;
@@ -1438,8 +1443,9 @@ static double tri_area2(const float a[2], const float b[2], const float cc[2])
 
 /* Vertex v of assimp's mesh in world space (uv1 from the file, when it has
  * one; the caller sets generated charts). */
-static bool fill_vertex(struct ctx *c, const struct aiMesh *am, unsigned v, const double m[16],
-                        const double nm[9], double det, struct asset_vertex *vx, const char *field)
+static bool fill_vertex(struct ctx *c, const struct aiMesh *am, float *const uvs[2], unsigned v,
+                        const double m[16], const double nm[9], double det, struct asset_vertex *vx,
+                        const char *field)
 {
     const float pos[3] = {am->mVertices[v].x, am->mVertices[v].y, am->mVertices[v].z};
     xform_point(m, pos, vx->pos);
@@ -1481,12 +1487,12 @@ static bool fill_vertex(struct ctx *c, const struct aiMesh *am, unsigned v, cons
             vx->tangent[3] = (float)(det < 0 ? -w : w);
         }
     }
-    if (am->mTextureCoords[0]) {
-        vx->uv0[0] = am->mTextureCoords[0][v].x;
-        vx->uv0[1] = 1.0f - am->mTextureCoords[0][v].y; /* assimp flips V; glTF's back */
+    if (uvs[0]) {
+        vx->uv0[0] = uvs[0][2 * v];
+        vx->uv0[1] = uvs[0][2 * v + 1];
     }
-    if (am->mTextureCoords[1]) {
-        float u = am->mTextureCoords[1][v].x, w = 1.0f - am->mTextureCoords[1][v].y;
+    if (uvs[1]) {
+        float u = uvs[1][2 * v], w = uvs[1][2 * v + 1];
         vx->uv1[0] = u < 0 ? 0 : u > 1 ? 1 : u;
         vx->uv1[1] = w < 0 ? 0 : w > 1 ? 1 : w;
     }
@@ -1514,21 +1520,63 @@ static bool build_mesh(struct ctx *c, const struct aiMesh *am, const double m[16
         ntri += am->mFaces[f].mNumIndices == 3;
     if (!ntri)
         return true; /* points or lines only: already in ignored */
-    bool uv1_file = pi->has_uv1 && am->mTextureCoords[1];
-    if (uv1_file)
-        for (unsigned v = 0; v < am->mNumVertices && uv1_file; v++) {
-            float u = am->mTextureCoords[1][v].x, w = 1.0f - am->mTextureCoords[1][v].y;
-            if (!(u >= -1e-4f && u <= 1.0001f && w >= -1e-4f && w <= 1.0001f))
-                uv1_file = false;
+    /* Both uv sets in glTF's convention (origin top left), from assimp or,
+     * for quantized accessors, which assimp 5.2 copies as raw bytes into
+     * floats, decoded here from the checked accessor. */
+    float *uvs[2] = {NULL, NULL};
+    uint32_t *corners = NULL;
+    float *world = NULL;
+    struct uv_charts charts = {0};
+    bool ok = false, uv1_file = false;
+    for (int set = 0; set < 2; set++) {
+        if (pi->uv_accessor[set] < 0)
+            continue;
+        if (!(uvs[set] = malloc((size_t)am->mNumVertices * 2 * sizeof(float)))) {
+            fail(c, 500, field, "out of memory");
+            goto done;
         }
-    if (pi->has_uv1 && !uv1_file)
+        struct accessor acc;
+        if (!check_accessor(c, (size_t)pi->uv_accessor[set], &acc))
+            goto done;
+        if (acc.count != am->mNumVertices) {
+            fail(c, 500, field, "assimp made %u vertices of %" PRIu64, am->mNumVertices, acc.count);
+            goto done;
+        }
+        bool normalized = json_is_true(json_object_get(json_array_get(c->accessors,
+                                                                      (size_t)pi->uv_accessor[set]),
+                                                       "normalized"));
+        for (unsigned v = 0; v < am->mNumVertices; v++) {
+            if (acc.ctype == 5126) {
+                if (!am->mTextureCoords[set]) {
+                    fail(c, 500, field, "assimp dropped TEXCOORD_%d", set);
+                    goto done;
+                }
+                uvs[set][2 * v] = am->mTextureCoords[set][v].x;
+                uvs[set][2 * v + 1] = 1.0f - am->mTextureCoords[set][v].y; /* assimp flips V */
+                continue;
+            }
+            const uint8_t *e = acc.view.data + acc.offset + acc.stride * v;
+            for (int k = 0; k < 2; k++) {
+                float x = acc.ctype == 5121 ? e[k] : (float)(e[2 * k] | e[2 * k + 1] << 8);
+                uvs[set][2 * v + k] = normalized ? x / (acc.ctype == 5121 ? 255.0f : 65535.0f) : x;
+            }
+        }
+    }
+    uv1_file = uvs[1] != NULL;
+    for (unsigned v = 0; uv1_file && v < am->mNumVertices; v++) {
+        float u = uvs[1][2 * v], w = uvs[1][2 * v + 1];
+        if (!(u >= -1e-4f && u <= 1.0001f && w >= -1e-4f && w <= 1.0001f))
+            uv1_file = false;
+    }
+    if (uvs[1] && !uv1_file) {
         ignore(c, "TEXCOORD_1 outside [0, 1] (uv1 generated instead)");
+        free(uvs[1]);
+        uvs[1] = NULL;
+    }
     /* The triangles' corners, mirrored ones swapped so that front faces
      * stay counter-clockwise after a negative-determinant matrix. */
-    uint32_t *corners = malloc((size_t)ntri * 3 * sizeof(uint32_t));
-    float *world = uv1_file ? NULL : malloc((size_t)am->mNumVertices * 3 * sizeof(float));
-    struct uv_charts charts = {0};
-    bool ok = false;
+    corners = malloc((size_t)ntri * 3 * sizeof(uint32_t));
+    world = uv1_file ? NULL : malloc((size_t)am->mNumVertices * 3 * sizeof(float));
     if (!corners || (!uv1_file && !world)) {
         fail(c, 500, field, "out of memory");
         goto done;
@@ -1591,7 +1639,7 @@ static bool build_mesh(struct ctx *c, const struct aiMesh *am, const double m[16
     }
     struct asset_vertex *vs = out->vertices;
     for (uint32_t v = 0; v < out->vertex_count; v++) {
-        if (!fill_vertex(c, am, uv1_file ? v : charts.source[v], m, nm, det, &vs[v], field))
+        if (!fill_vertex(c, am, uvs, uv1_file ? v : charts.source[v], m, nm, det, &vs[v], field))
             goto done;
         if (!uv1_file) {
             vs[v].uv1[0] = charts.uv[v][0];
@@ -1619,6 +1667,8 @@ static bool build_mesh(struct ctx *c, const struct aiMesh *am, const double m[16
 done:
     free(corners);
     free(world);
+    free(uvs[0]);
+    free(uvs[1]);
     uv_charts_free(&charts);
     return ok;
 }

@@ -315,6 +315,47 @@ def realistic_asset(big_maps=False):
     return g
 
 
+def quantized_asset():
+    """TEXCOORD_0 as normalized unsigned shorts and TEXCOORD_1 as normalized
+    unsigned bytes (core glTF allows both; assimp 5.2 misreads them, so the
+    converter decodes them itself)."""
+    g = Gltf()
+    pos, nrm, uv0, uv1, idx = cube()
+    n = len(pos) // 3
+    attrs = {"POSITION": g.accessor(pos, 5126, "VEC3", n), "NORMAL": g.accessor(nrm, 5126, "VEC3", n)}
+    q0 = [int(round(x * 65535)) for x in uv0]
+    q1 = [int(round(x * 255)) for x in uv1]
+    attrs["TEXCOORD_0"] = g.accessor(q0, 5123, "VEC2", n)
+    attrs["TEXCOORD_1"] = g.accessor(q1 + [0] * (-len(q1) % 4), 5121, "VEC2", n)
+    for k in ("TEXCOORD_0", "TEXCOORD_1"):
+        g.doc["accessors"][attrs[k]]["normalized"] = True
+    prim = {"attributes": attrs, "indices": g.accessor(idx, 5123, "SCALAR", len(idx))}
+    g.doc["meshes"].append({"primitives": [prim], "name": "qcube"})
+    g.node(mesh=0, name="qcube")
+    return g
+
+
+def skinned_asset():
+    """A cube bound to a two-joint skin (JOINTS_0 as bytes): drawn in its
+    bind pose, the skin reported as ignored."""
+    g = Gltf()
+    pos, nrm, uv0, uv1, idx = cube()
+    n = len(pos) // 3
+    mesh = g.mesh((pos, nrm, uv0, uv1, idx), uv1=False, name="skinned")
+    attrs = g.doc["meshes"][mesh]["primitives"][0]["attributes"]
+    attrs["JOINTS_0"] = g.accessor([0, 1, 0, 0] * n, 5121, "VEC4", n)
+    attrs["WEIGHTS_0"] = g.accessor([0.5, 0.5, 0.0, 0.0] * n, 5126, "VEC4", n)
+    ident = [1.0, 0, 0, 0, 0, 1.0, 0, 0, 0, 0, 1.0, 0, 0, 0, 0, 1.0]
+    ibm = g.accessor(ident * 2, 5126, "MAT4", 2)
+    j0 = g.node(root=False, name="root_joint", children=[])
+    j1 = g.node(root=False, name="tip_joint", translation=[0, 1, 0])
+    g.doc["nodes"][j0]["children"] = [j1]
+    g.doc["skins"] = [{"joints": [j0, j1], "inverseBindMatrices": ibm, "skeleton": j0}]
+    body = g.node(mesh=mesh, skin=0, name="body")
+    g.doc["scenes"][0]["nodes"].append(j0)
+    return g
+
+
 # ---- bad assets ----
 
 def bad_accessor_oob():
@@ -421,6 +462,10 @@ def build_all(out, realistic=False, big_maps=False):
                   "ignored": ["animations", "extension KHR_texture_transform",
                               "extension KHR_materials_clearcoat", "points and lines primitives",
                               "orthographic cameras (drawn as perspective)", "KHR_texture_transform"]})
+    write("quantized.glb", quantized_asset().glb(), exit=0,
+          expect={"meshes": 1, "triangles": 12, "vertices": 24, "uv1": "file"})
+    write("skinned.glb", skinned_asset().glb(), exit=0,
+          expect={"meshes": 1, "triangles": 12, "uv1": "generated", "ignored": ["skins"]})
     jpg = jpeg_bytes()
     if jpg:
         g = Gltf()

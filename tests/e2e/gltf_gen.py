@@ -66,11 +66,23 @@ def pattern_png(size, rgba_a, rgba_b, cell=8):
     return png_bytes(size, size, [row0 if (y // cell) % 2 == 0 else row1 for y in range(size)])
 
 
+# A 16x16 baseline JPEG of (30, 160, 90), quality 95, made for this file
+# with libjpeg-turbo's jpeg_mem_dest (288 bytes): the JPEG case where PIL is
+# not installed (Python has no JPEG encoder of its own).
+SOLID16_JPEG = base64.b64decode(
+    "/9j/4AAQSkZJRgABAQAAAQABAAD/2wBDAAIBAQEBAQIBAQECAgICAgQDAgICAgUEBAMEBg"
+    "UGBgYFBgYGBwkIBgcJBwYGCAsICQoKCgoKBggLDAsKDAkKCgr/2wBDAQICAgICAgUDAwUK"
+    "BwYHCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCg"
+    "r/wAARCAAQABADASIAAhEBAxEB/8QAFQABAQAAAAAAAAAAAAAAAAAAAAb/xAAUEAEAAAAA"
+    "AAAAAAAAAAAAAAAA/8QAFQEBAQAAAAAAAAAAAAAAAAAABgj/xAAUEQEAAAAAAAAAAAAAAA"
+    "AAAAAA/9oADAMBAAIRAxEAPwCDAC0Jv//Z")
+
+
 def jpeg_bytes(size=16):
     try:
         from PIL import Image  # only for the JPEG case
     except ImportError:
-        return None
+        return SOLID16_JPEG if size == 16 else None
     import io
     im = Image.new("RGB", (size, size), (30, 160, 90))
     buf = io.BytesIO()

@@ -487,6 +487,15 @@ def build_all(out, realistic=False, big_maps=False):
         write("jpeg.glb", g.glb(), exit=0,
               expect={"meshes": 1, "triangles": 12, "textures": [[16, 16]], "uv1": "generated",
                       "texel_near": {"image": 0, "x": 8, "y": 8, "rgba": [30, 160, 90, 255], "tolerance": 4}})
+        # The same with the frame's sample precision 7: libjpeg's error exit.
+        sof = jpg.index(b"\xff\xc0")
+        bad = bytearray(jpg)
+        bad[sof + 4] = 7
+        g = Gltf()
+        t = g.texture(g.image(bytes(bad), mime="image/jpeg"))
+        m = g.material(pbrMetallicRoughness={"baseColorTexture": {"index": t}})
+        g.node(mesh=g.mesh(cube(), material=m, uv1=False))
+        write("bad_jpeg.glb", g.glb(), exit=2, status=400, field="images[0]")
     if realistic:
         data = realistic_asset(big_maps).glb()
         write("realistic_2k.glb" if big_maps else "realistic.glb", data, exit=0,

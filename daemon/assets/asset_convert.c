@@ -949,13 +949,13 @@ static bool check_textures_materials(struct ctx *c)
         json_t *t = json_array_get(c->textures, i);
         char field[64];
         snprintf(field, sizeof(field), "textures[%zu]", i);
-        int64_t idx;
+        int64_t source, sampler;
         if (!json_is_object(t))
             return fail(c, 400, field, "must be an object");
-        if (!get_index(c, t, "source", field, false, c->nimages, &idx) ||
-            !get_index(c, t, "sampler", field, false, json_array_size(c->samplers), &idx))
+        if (!get_index(c, t, "source", field, false, c->nimages, &source) ||
+            !get_index(c, t, "sampler", field, false, json_array_size(c->samplers), &sampler))
             return false;
-        if (idx < 0 && json_object_get(t, "extensions"))
+        if (source < 0 && json_object_get(t, "extensions"))
             ignore(c, "textures in extension formats");
     }
     for (size_t i = 0; i < json_array_size(c->samplers); i++) {
@@ -1161,7 +1161,8 @@ static bool decode_png(struct ctx *c, struct span s, struct asset_image *im, con
         png_image_free(&p);
         return fail(c, 400, field, "bad PNG: the size changed while reading");
     }
-    im->rgba = malloc(PNG_IMAGE_SIZE(p));
+    /* Sized here in size_t: PNG_IMAGE_SIZE is 32-bit arithmetic. */
+    im->rgba = malloc((size_t)im->width * im->height * 4);
     if (!im->rgba) {
         png_image_free(&p);
         return fail(c, 500, field, "out of memory");
@@ -1758,7 +1759,7 @@ bool asset_convert_buffer(const uint8_t *data, size_t len, const struct asset_li
     bool *in_scene = NULL;
     const struct aiScene *sc = NULL;
     bool ok = false;
-    if ((uint64_t)len > lim->max_file_bytes) {
+    if ((uint64_t)len > lim->max_file_bytes || len > UINT32_MAX /* assimp takes an unsigned size */) {
         fail(&c, 422, "limits.max_file_bytes", "%zu bytes, the limit is %" PRIu64, len,
              lim->max_file_bytes);
         goto done;

@@ -404,6 +404,17 @@ bool asset_file_write(const struct asset *a, const char *path, char *err, size_t
         snprintf(err, errlen, "asset cache: cannot rename to %s: %s", path, strerror(errno));
         goto fail;
     }
+    /* The rename itself made durable: fsync the folder (best effort; a
+     * folder that cannot be opened still holds the whole file). */
+    char *slash = strrchr(tmp, '/');
+    if (slash) {
+        *slash = '\0';
+        int dfd = open(slash == tmp ? "/" : tmp, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+        if (dfd >= 0) {
+            fsync(dfd);
+            close(dfd);
+        }
+    }
     free(tmp);
     return true;
 fail:

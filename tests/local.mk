@@ -33,10 +33,12 @@ UNIT_TESTS = \
 	tests/unit/test_effects \
 	tests/unit/test_pbr \
 	tests/unit/test_teapot \
-	tests/unit/test_lighting
+	tests/unit/test_lighting \
+	tests/unit/test_asset \
+	tests/unit/test_uv_charts
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
-	tests/fuzz/replay-route
+	tests/fuzz/replay-route tests/fuzz/replay-asset_cache tests/fuzz/replay-asset_convert
 tests_unit_test_job_LDADD = $(CORE_LIBS)
 tests_unit_test_options_LDADD = libsb-common.a $(JANSSON_LIBS) $(LIBS)
 tests_unit_test_store_LDADD = $(CORE_LIBS)
@@ -70,6 +72,10 @@ tests_unit_test_culling_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_pbr_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_teapot_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_lighting_LDADD = $(CORE_LIBS) -lm
+tests_unit_test_asset_LDADD = $(CORE_LIBS) -lm
+tests_unit_test_uv_charts_SOURCES = tests/unit/test_uv_charts.c daemon/assets/uv_charts.c \
+	daemon/assets/uv_charts.h
+tests_unit_test_uv_charts_LDADD = -lm
 tests_tools_png_tool_SOURCES = tests/tools/png_tool.c
 tests_tools_png_tool_LDADD = $(CORE_LIBS)
 noinst_HEADERS = tests/unit/check.h tests/unit/catalog_fixture.h tests/fuzz/fuzz.h
@@ -92,6 +98,12 @@ tests_fuzz_replay_png_metrics_SOURCES = tests/fuzz/fuzz_png_metrics.c tests/fuzz
 tests_fuzz_replay_png_metrics_LDADD = $(CORE_LIBS)
 tests_fuzz_replay_route_SOURCES = tests/fuzz/fuzz_route.c tests/fuzz/replay.c daemon/api/routes.c
 tests_fuzz_replay_route_LDADD = $(CORE_LIBS)
+tests_fuzz_replay_asset_cache_SOURCES = tests/fuzz/fuzz_asset_cache.c tests/fuzz/replay.c
+tests_fuzz_replay_asset_cache_LDADD = $(CORE_LIBS)
+tests_fuzz_replay_asset_convert_SOURCES = tests/fuzz/fuzz_asset_convert.c tests/fuzz/replay.c \
+	$(ASSET_CONVERT_SOURCES)
+tests_fuzz_replay_asset_convert_CFLAGS = $(AM_CFLAGS) $(ASSIMP_CFLAGS) $(JPEG_CFLAGS)
+tests_fuzz_replay_asset_convert_LDADD = $(CORE_LIBS) $(ASSIMP_LIBS) $(JPEG_LIBS) -lm
 if HAVE_SECCOMP
 check_PROGRAMS += tests/tools/sandbox-run
 tests_tools_sandbox_run_SOURCES = tests/tools/sandbox_run.c
@@ -133,6 +145,7 @@ E2E_TESTS = \
 	tests/e2e/ssim_skimage.py \
 	tests/e2e/e2e_history.py \
 	tests/e2e/e2e_verdicts.py \
+	tests/e2e/e2e_asset_convert.py \
 	tests/e2e/systemd_sandbox.py \
 	tests/e2e/systemd_unit.sh
 
@@ -155,7 +168,8 @@ SANITIZER_TESTS = $(UNIT_TESTS) \
 	tests/e2e/e2e_http.py \
 	tests/e2e/e2e_assets.py \
 	tests/e2e/e2e_persist.py \
-	tests/e2e/e2e_badinput.py
+	tests/e2e/e2e_badinput.py \
+	tests/e2e/e2e_asset_convert.py
 check-sanitizers:
 if SANITIZERS
 	$(MAKE) $(AM_MAKEFLAGS) check TESTS='$(SANITIZER_TESTS)'
@@ -203,7 +217,8 @@ AM_TESTS_ENVIRONMENT = \
 	SHADEBENCH_UNIT='$(abs_top_builddir)/systemd/shadebenchd.service'; \
 	FUZZ_REPLAY_DIR='$(abs_top_builddir)/tests/fuzz'; \
 	SANDBOX_RUN='$(abs_top_builddir)/tests/tools/sandbox-run'; \
+	SHADEBENCH_ASSET='$(abs_top_builddir)/shadebench-asset'; \
 	export SHADEBENCHD PNG_TOOL SHADEBENCH_COMPARE SHADEBENCH_CLIENT SHADEBENCH_UNIT FUZZ_REPLAY_DIR \
-	SANDBOX_RUN; \
+	SANDBOX_RUN SHADEBENCH_ASSET; \
 	$(AM_TESTS_ENVIRONMENT_SAN)
 

@@ -88,7 +88,8 @@ struct asset_mesh {
     struct asset_vertex *vertices;
     uint32_t *indices; /* triangles; every index < vertex_count */
     bool uv1_from_file;      /* else the converter's charts */
-    bool tangents_from_file; /* else generated (MikkTSpace-like, per triangle) */
+    bool tangents_from_file; /* else generated (assimp's CalcTangentSpace from uv0, or any
+                              * unit tangent perpendicular to the normal where there is no uv0) */
     float box_min[3], box_max[3];
     /* uv1's share of [0, 1]^2 that no triangle covers (gutters, chart
      * packing): the texels object-space shading allocates and never uses. */

@@ -1,0 +1,229 @@
+#define _POSIX_C_SOURCE 200809L /* mkdtemp, setrlimit */
+/* shadebench-asset: the glTF converter the daemon runs as a child process
+ * (docs/assets.md). One thread; it reads IN_FILE and writes OUT_CACHE and
+ * nothing else.
+ *
+ *   shadebench-asset convert IN_FILE OUT_CACHE [--max-file-bytes N]
+ *       [--max-vertices N] [--max-indices N] [--max-texture-pixels N]
+ *       [--max-texture-edge N] [--max-memory BYTES] [--max-cpu-seconds S]
+ *
+ * Exit 0: OUT_CACHE written, stdout one JSON object (asset_describe). Exit
+ * 2: the asset is refused, stdout {"status": 400|422, "field", "message"}.
+ * Anything else (1 for usage or the converter's own failures, a signal from
+ * the limits): the loader failed. */
+#include <errno.h>
+#include <fcntl.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "daemon/assets/asset_convert.h"
+
+static int usage(void)
+{
+    fprintf(stderr, "usage: shadebench-asset convert IN_FILE OUT_CACHE [--max-file-bytes N] "
+                    "[--max-vertices N] [--max-indices N] [--max-texture-pixels N] "
+                    "[--max-texture-edge N] [--max-memory BYTES] [--max-cpu-seconds S]\n");
+    return 1;
+}
+
+static bool parse_u64(const char *s, uint64_t *out)
+{
+    if (!s || !*s || *s == '-')
+        return false;
+    char *end;
+    errno = 0;
+    unsigned long long v = strtoull(s, &end, 10);
+    if (errno || *end)
+        return false;
+    *out = v;
+    return true;
+}
+
+static int refuse(int status, const char *field, const char *message)
+{
+    json_t *o = json_pack("{si ss ss}", "status", status, "field", field, "message", message);
+    if (!o)
+        return 1;
+    char *s = json_dumps(o, JSON_COMPACT);
+    json_decref(o);
+    if (!s)
+        return 1;
+    printf("%s\n", s);
+    free(s);
+    return fflush(stdout) == 0 ? 2 : 1;
+}
+
+static void limit(int resource, uint64_t value, const char *what)
+{
+    struct rlimit rl = {(rlim_t)value, (rlim_t)value};
+    if (setrlimit(resource, &rl) != 0)
+        fprintf(stderr, "shadebench-asset: cannot set %s to %" PRIu64 " (%s); continuing without\n",
+                what, value, strerror(errno));
+}
+
+/* The whole file, at most max bytes (one more is read to tell "over"). */
+static uint8_t *read_input(const char *path, uint64_t max, size_t *len, bool *over)
+{
+    *over = false;
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0)
+        return NULL;
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        close(fd);
+        errno = EINVAL;
+        return NULL;
+    }
+    if ((uint64_t)st.st_size > max) {
+        close(fd);
+        *over = true;
+        *len = (size_t)st.st_size;
+        return NULL;
+    }
+    size_t cap = (size_t)st.st_size + 1, n = 0;
+    uint8_t *buf = malloc(cap);
+    if (!buf) {
+        close(fd);
+        return NULL;
+    }
+    for (;;) {
+        ssize_t r = read(fd, buf + n, cap - n);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r < 0) {
+            free(buf);
+            close(fd);
+            return NULL;
+        }
+        if (r == 0)
+            break;
+        n += (size_t)r;
+        if (n == cap) { /* the file grew: over what fstat said */
+            free(buf);
+            close(fd);
+            *over = n > max;
+            errno = EFBIG;
+            return NULL;
+        }
+    }
+    close(fd);
+    *len = n;
+    return buf;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 4 || strcmp(argv[1], "convert") != 0)
+        return usage();
+    const char *in = argv[2], *out = argv[3];
+    struct asset_limits lim;
+    asset_limits_defaults(&lim);
+    uint64_t max_memory = 0, max_cpu = 0;
+    for (int i = 4; i < argc; i += 2) {
+        uint64_t v;
+        if (i + 1 >= argc || !parse_u64(argv[i + 1], &v)) {
+            fprintf(stderr, "shadebench-asset: %s needs a non-negative integer\n", argv[i]);
+            return usage();
+        }
+        if (!strcmp(argv[i], "--max-file-bytes"))
+            lim.max_file_bytes = v;
+        else if (!strcmp(argv[i], "--max-vertices"))
+            lim.max_vertices = v;
+        else if (!strcmp(argv[i], "--max-indices"))
+            lim.max_indices = v;
+        else if (!strcmp(argv[i], "--max-texture-pixels"))
+            lim.max_texture_pixels = v;
+        else if (!strcmp(argv[i], "--max-texture-edge") && v <= UINT32_MAX)
+            lim.max_texture_edge = (uint32_t)v;
+        else if (!strcmp(argv[i], "--max-memory"))
+            max_memory = v;
+        else if (!strcmp(argv[i], "--max-cpu-seconds"))
+            max_cpu = v;
+        else
+            return usage();
+    }
+    /* The limits first, before the file is read: a hostile file meets them
+     * from its first byte. */
+    if (max_memory)
+        limit(RLIMIT_AS, max_memory, "RLIMIT_AS");
+    if (max_cpu)
+        limit(RLIMIT_CPU, max_cpu, "RLIMIT_CPU");
+
+    /* jansson would read /dev/urandom for its hash seed at the first
+     * object; seeding it here keeps the converter's reads to IN_FILE, and
+     * the seed still unknown to the file's author. */
+    struct timespec now;
+    clock_gettime(CLOCK_REALTIME, &now);
+    json_object_seed((size_t)now.tv_nsec ^ ((size_t)getpid() << 16) ^ (size_t)now.tv_sec);
+
+    /* The output's full path, taken before leaving the working directory. */
+    char *out_abs = NULL;
+    if (out[0] == '/') {
+        out_abs = strdup(out);
+    } else {
+        char cwd[4096];
+        if (getcwd(cwd, sizeof(cwd))) {
+            out_abs = malloc(strlen(cwd) + strlen(out) + 2);
+            if (out_abs)
+                sprintf(out_abs, "%s/%s", cwd, out);
+        }
+    }
+    if (!out_abs) {
+        fprintf(stderr, "shadebench-asset: cannot resolve %s\n", out);
+        return 1;
+    }
+    size_t len = 0;
+    bool over = false;
+    uint8_t *data = read_input(in, lim.max_file_bytes, &len, &over);
+    if (!data) {
+        free(out_abs);
+        if (over) {
+            char msg[160];
+            snprintf(msg, sizeof(msg), "%zu bytes, the limit is %" PRIu64, len, lim.max_file_bytes);
+            return refuse(422, "limits.max_file_bytes", msg);
+        }
+        fprintf(stderr, "shadebench-asset: cannot read %s: %s\n", in, strerror(errno));
+        return 1;
+    }
+    /* Nothing relative resolves against the caller's folder from here on:
+     * the converter reads no file but IN_FILE (already in memory). */
+    if (chdir("/") != 0)
+        fprintf(stderr, "shadebench-asset: cannot chdir to /: %s\n", strerror(errno));
+
+    struct asset a;
+    struct asset_convert_error cerr;
+    bool ok = asset_convert_buffer(data, len, &lim, &a, &cerr);
+    free(data);
+    if (!ok) {
+        free(out_abs);
+        if (cerr.status == 400 || cerr.status == 422)
+            return refuse(cerr.status, cerr.field, cerr.message);
+        fprintf(stderr, "shadebench-asset: %s: %s\n", cerr.field, cerr.message);
+        return 1;
+    }
+    char err[512];
+    if (!asset_file_write(&a, out_abs, err, sizeof(err))) {
+        fprintf(stderr, "shadebench-asset: %s\n", err);
+        asset_finish(&a);
+        free(out_abs);
+        return 1;
+    }
+    free(out_abs);
+    json_t *d = asset_describe(&a);
+    asset_finish(&a);
+    char *s = d ? json_dumps(d, JSON_COMPACT) : NULL;
+    json_decref(d);
+    if (!s) {
+        fprintf(stderr, "shadebench-asset: out of memory\n");
+        return 1;
+    }
+    printf("%s\n", s);
+    free(s);
+    return fflush(stdout) == 0 ? 0 : 1;
+}

@@ -1,0 +1,547 @@
+#!/usr/bin/env python3
+"""glTF 2.0 test assets, made from nothing (standard library only; PIL for
+the one JPEG case, when it is installed).
+
+    python3 tests/e2e/gltf_gen.py --out DIR [--realistic] [--big-maps]
+
+writes the good and bad assets into DIR with manifest.json, which says for
+each file what shadebench-asset must answer: the exit code, and for a
+refusal the status and field, for a good asset the figures its description
+must show. Importable: build_all(out_dir, realistic=False, big_maps=False)
+returns the manifest; Gltf is the builder the assets are written with.
+
+Patterns are known: the base colour texture is BASE_TEXEL everywhere but a
+2x2 checker in its top-left corner, so a decoded texel can be checked
+exactly.
+"""
+import argparse
+import base64
+import json
+import math
+import os
+import struct
+import zlib
+
+BASE_TEXEL = (200, 100, 50, 255)  # sRGB, the flat region of the base colour map
+
+
+def png_bytes(width, height, rows):
+    """An 8-bit RGBA PNG; rows is a list of height bytes objects of width*4."""
+    def chunk(kind, data):
+        body = kind + data
+        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body) & 0xFFFFFFFF)
+    raw = b"".join(b"\x00" + r for r in rows)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0))
+            + chunk(b"IDAT", zlib.compress(raw, 1)) + chunk(b"IEND", b""))
+
+
+def png_header_only(width, height):
+    """A PNG whose IHDR claims width x height, with no image data: the
+    converter must refuse it from the header, before decoding."""
+    def chunk(kind, data):
+        body = kind + data
+        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body) & 0xFFFFFFFF)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0))
+            + chunk(b"IEND", b""))
+
+
+def base_color_png(size=8):
+    rows = []
+    for y in range(size):
+        row = bytearray()
+        for x in range(size):
+            if x < 2 and y < 2:
+                row += bytes((255, 255, 255, 255) if (x + y) % 2 == 0 else (0, 0, 0, 255))
+            else:
+                row += bytes(BASE_TEXEL)
+        rows.append(bytes(row))
+    return png_bytes(size, size, rows)
+
+
+def pattern_png(size, rgba_a, rgba_b, cell=8):
+    """A checker of two colours; rows repeat, so even 2K maps are quick."""
+    a, b = bytes(rgba_a), bytes(rgba_b)
+    row0 = b"".join((a if (x // cell) % 2 == 0 else b) for x in range(size))
+    row1 = b"".join((b if (x // cell) % 2 == 0 else a) for x in range(size))
+    return png_bytes(size, size, [row0 if (y // cell) % 2 == 0 else row1 for y in range(size)])
+
+
+# A 16x16 baseline JPEG of (30, 160, 90), quality 95, made for this file
+# with libjpeg-turbo's jpeg_mem_dest (288 bytes): the JPEG case where PIL is
+# not installed (Python has no JPEG encoder of its own).
+SOLID16_JPEG = base64.b64decode(
+    "/9j/4AAQSkZJRgABAQAAAQABAAD/2wBDAAIBAQEBAQIBAQECAgICAgQDAgICAgUEBAMEBg"
+    "UGBgYFBgYGBwkIBgcJBwYGCAsICQoKCgoKBggLDAsKDAkKCgr/2wBDAQICAgICAgUDAwUK"
+    "BwYHCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCg"
+    "r/wAARCAAQABADASIAAhEBAxEB/8QAFQABAQAAAAAAAAAAAAAAAAAAAAb/xAAUEAEAAAAA"
+    "AAAAAAAAAAAAAAAA/8QAFQEBAQAAAAAAAAAAAAAAAAAABgj/xAAUEQEAAAAAAAAAAAAAAA"
+    "AAAAAA/9oADAMBAAIRAxEAPwCDAC0Jv//Z")
+
+
+def jpeg_bytes(size=16):
+    try:
+        from PIL import Image  # only for the JPEG case
+    except ImportError:
+        return SOLID16_JPEG if size == 16 else None
+    import io
+    im = Image.new("RGB", (size, size), (30, 160, 90))
+    buf = io.BytesIO()
+    im.save(buf, format="JPEG", quality=95)
+    return buf.getvalue()
+
+
+class Gltf:
+    """A glTF document and its one binary buffer."""
+
+    def __init__(self):
+        self.bin = bytearray()
+        self.doc = {"asset": {"version": "2.0", "generator": "shadebench gltf_gen.py"},
+                    "scene": 0, "scenes": [{"nodes": []}], "nodes": [], "meshes": [],
+                    "buffers": [], "bufferViews": [], "accessors": []}
+
+    def _list(self, key):
+        return self.doc.setdefault(key, [])
+
+    def view(self, data, stride=None):
+        while len(self.bin) % 4:
+            self.bin.append(0)
+        v = {"buffer": 0, "byteOffset": len(self.bin), "byteLength": len(data)}
+        if stride:
+            v["byteStride"] = stride
+        self.bin += data
+        self.doc["bufferViews"].append(v)
+        return len(self.doc["bufferViews"]) - 1
+
+    def accessor(self, values, ctype, atype, count):
+        fmt = {5126: "f", 5125: "I", 5123: "H", 5121: "B"}[ctype]
+        data = struct.pack("<%d%s" % (len(values), fmt), *values)
+        acc = {"bufferView": self.view(data), "componentType": ctype, "type": atype, "count": count}
+        if atype == "VEC3" and ctype == 5126:
+            acc["min"] = [min(values[i::3]) for i in range(3)]
+            acc["max"] = [max(values[i::3]) for i in range(3)]
+        self.doc["accessors"].append(acc)
+        return len(self.doc["accessors"]) - 1
+
+    def mesh(self, geom, material=None, uv1=True, tangents=False, name=None, mode=None):
+        pos, nrm, uv0, uv1v, idx = geom
+        n = len(pos) // 3
+        attrs = {"POSITION": self.accessor(pos, 5126, "VEC3", n),
+                 "NORMAL": self.accessor(nrm, 5126, "VEC3", n),
+                 "TEXCOORD_0": self.accessor(uv0, 5126, "VEC2", n)}
+        if uv1:
+            attrs["TEXCOORD_1"] = self.accessor(uv1v, 5126, "VEC2", n)
+        if tangents:
+            tan = []
+            for i in range(n):
+                tan += [1.0, 0.0, 0.0, 1.0]
+            attrs["TANGENT"] = self.accessor(tan, 5126, "VEC4", n)
+        prim = {"attributes": attrs,
+                "indices": self.accessor(idx, 5125 if n > 65535 else 5123, "SCALAR", len(idx))}
+        if material is not None:
+            prim["material"] = material
+        if mode is not None:
+            prim["mode"] = mode
+        m = {"primitives": [prim]}
+        if name:
+            m["name"] = name
+        self.doc["meshes"].append(m)
+        return len(self.doc["meshes"]) - 1
+
+    def node(self, root=True, **kw):
+        self.doc["nodes"].append(kw)
+        i = len(self.doc["nodes"]) - 1
+        if root:
+            self.doc["scenes"][0]["nodes"].append(i)
+        return i
+
+    def image(self, data, mime="image/png", name=None):
+        img = {"bufferView": self.view(data), "mimeType": mime}
+        if name:
+            img["name"] = name
+        self._list("images").append(img)
+        return len(self.doc["images"]) - 1
+
+    def texture(self, image, sampler=None):
+        t = {"source": image}
+        if sampler is not None:
+            t["sampler"] = sampler
+        self._list("textures").append(t)
+        return len(self.doc["textures"]) - 1
+
+    def material(self, **kw):
+        self._list("materials").append(kw)
+        return len(self.doc["materials"]) - 1
+
+    def light(self, **kw):
+        self.doc.setdefault("extensions", {}).setdefault("KHR_lights_punctual", {"lights": []})
+        lights = self.doc["extensions"]["KHR_lights_punctual"]["lights"]
+        lights.append(kw)
+        used = self.doc.setdefault("extensionsUsed", [])
+        if "KHR_lights_punctual" not in used:
+            used.append("KHR_lights_punctual")
+        return len(lights) - 1
+
+    def finish_buffer(self):
+        while len(self.bin) % 4:
+            self.bin.append(0)
+        self.doc["buffers"] = [{"byteLength": len(self.bin)}]
+
+    def glb(self):
+        self.finish_buffer()
+        js = json.dumps(self.doc, separators=(",", ":")).encode()
+        js += b" " * (-len(js) % 4)
+        out = struct.pack("<I I", len(js), 0x4E4F534A) + js
+        out += struct.pack("<I I", len(self.bin), 0x004E4942) + bytes(self.bin)
+        return b"glTF" + struct.pack("<I I", 2, 12 + len(out)) + out
+
+    def gltf_data_uri(self):
+        """The same document as .gltf JSON, its buffer and images as data URIs."""
+        self.finish_buffer()
+        doc = json.loads(json.dumps(self.doc))
+        for img in doc.get("images", []):
+            if "bufferView" not in img:
+                continue
+            v = doc["bufferViews"][img["bufferView"]]
+            data = bytes(self.bin[v["byteOffset"]:v["byteOffset"] + v["byteLength"]])
+            del img["bufferView"]
+            img["uri"] = "data:%s;base64,%s" % (img.pop("mimeType", "image/png"),
+                                                base64.b64encode(data).decode())
+        doc["buffers"][0]["uri"] = "data:application/octet-stream;base64," + \
+            base64.b64encode(bytes(self.bin)).decode()
+        return json.dumps(doc, indent=1).encode()
+
+
+def cube(size=1.0, chart_uv1=True):
+    """24 vertices, 12 triangles; uv1 puts the 6 faces in a 3x2 grid."""
+    faces = [((1, 0, 0), (0, 0, -1), (0, 1, 0)), ((-1, 0, 0), (0, 0, 1), (0, 1, 0)),
+             ((0, 1, 0), (1, 0, 0), (0, 0, -1)), ((0, -1, 0), (1, 0, 0), (0, 0, 1)),
+             ((0, 0, 1), (1, 0, 0), (0, 1, 0)), ((0, 0, -1), (-1, 0, 0), (0, 1, 0))]
+    pos, nrm, uv0, uv1, idx = [], [], [], [], []
+    h = size / 2
+    for f, (n, u, v) in enumerate(faces):
+        base = len(pos) // 3
+        cx, cy = f % 3, f // 3
+        for (a, b) in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
+            pos += [h * (n[k] + a * u[k] + b * v[k]) for k in range(3)]
+            nrm += list(map(float, n))
+            uv0 += [(a + 1) / 2, 1 - (b + 1) / 2]
+            uv1 += [(cx + 0.05 + 0.9 * (a + 1) / 2) / 3, (cy + 0.05 + 0.9 * (1 - (b + 1) / 2)) / 2]
+        idx += [base, base + 1, base + 2, base, base + 2, base + 3]
+    return pos, nrm, uv0, uv1, idx
+
+
+def grid(n, size=2.0, z=0.0):
+    """An n x n quad grid in the xy plane facing +z: 2 n^2 triangles."""
+    pos, nrm, uv0, uv1, idx = [], [], [], [], []
+    for j in range(n + 1):
+        for i in range(n + 1):
+            pos += [size * (i / n - 0.5), size * (j / n - 0.5), z + 0.05 * math.sin(i * 0.7 + j * 0.3)]
+            nrm += [0.0, 0.0, 1.0]
+            uv0 += [i / n, 1 - j / n]
+            uv1 += [i / n, 1 - j / n]
+    for j in range(n):
+        for i in range(n):
+            a = j * (n + 1) + i
+            idx += [a, a + 1, a + n + 2, a, a + n + 2, a + n + 1]
+    return pos, nrm, uv0, uv1, idx
+
+
+def textured(normal_map=True, uv1=False):
+    g = Gltf()
+    smp = g._list("samplers")
+    smp.append({"magFilter": 9728, "minFilter": 9728, "wrapS": 33071, "wrapT": 33648})
+    base = g.texture(g.image(base_color_png(), name="base"), sampler=0)
+    mr = g.texture(g.image(pattern_png(16, (0, 128, 255, 255), (0, 200, 0, 255)), name="mr"))
+    mat = {"name": "painted", "pbrMetallicRoughness": {
+        "baseColorFactor": [1, 1, 1, 1], "baseColorTexture": {"index": base},
+        "metallicRoughnessTexture": {"index": mr}, "metallicFactor": 0.5, "roughnessFactor": 0.75},
+        "emissiveFactor": [0.1, 0.2, 0.3]}
+    if normal_map:
+        nm = g.texture(g.image(pattern_png(32, (128, 128, 255, 255), (160, 128, 230, 255)), name="normal"))
+        mat["normalTexture"] = {"index": nm, "scale": 0.8}
+    m = g.material(**mat)
+    mesh = g.mesh(cube(), material=m, uv1=uv1, name="cube")
+    g.node(mesh=mesh, name="cube_a")
+    g.node(mesh=mesh, name="cube_b", translation=[3, 0, 0], rotation=[0, 0.3826834, 0, 0.9238795],
+           scale=[1, 2, 1])
+    g.doc["cameras"] = [{"type": "perspective", "name": "main",
+                         "perspective": {"yfov": 0.9, "znear": 0.1, "zfar": 100, "aspectRatio": 1.5}}]
+    g.node(camera=0, name="cam_node", translation=[0, 1, 6])
+    pl = g.light(type="point", name="bulb", color=[1, 0.9, 0.8], intensity=20, range=10)
+    sl = g.light(type="spot", name="torch", intensity=50, spot={"innerConeAngle": 0.2, "outerConeAngle": 0.5})
+    dl = g.light(type="directional", name="sun", intensity=3)
+    g.node(name="bulb_node", translation=[0, 3, 0], extensions={"KHR_lights_punctual": {"light": pl}})
+    g.node(name="torch_node", translation=[2, 2, 2], extensions={"KHR_lights_punctual": {"light": sl}})
+    g.node(name="sun_node", rotation=[-0.3826834, 0, 0, 0.9238795],
+           extensions={"KHR_lights_punctual": {"light": dl}})
+    return g
+
+
+def alpha_asset():
+    g = Gltf()
+    mask = g.material(name="leaves", alphaMode="MASK", alphaCutoff=0.3, doubleSided=True,
+                      pbrMetallicRoughness={"baseColorFactor": [0.2, 0.8, 0.2, 1]})
+    blend = g.material(name="glass", alphaMode="BLEND",
+                       pbrMetallicRoughness={"baseColorFactor": [0.8, 0.9, 1.0, 0.3]})
+    g.node(mesh=g.mesh(grid(2), material=mask, uv1=False, name="leaf"))
+    g.node(mesh=g.mesh(grid(2, z=0.5), material=blend, uv1=False, name="pane"))
+    return g
+
+
+def extras_asset():
+    """What the converter ignores: an animation, an unknown extension, a
+    points primitive, an orthographic camera, a texture transform."""
+    g = Gltf()
+    t = g.texture(g.image(base_color_png()))
+    m = g.material(name="m", pbrMetallicRoughness={"baseColorTexture": {
+        "index": t, "extensions": {"KHR_texture_transform": {"scale": [2, 2]}}}})
+    n = g.node(mesh=g.mesh(cube(), material=m, uv1=False), name="box")
+    pts = g.mesh(cube(), uv1=False, mode=0, name="points")
+    g.node(mesh=pts, name="dots")
+    times = g.accessor([0.0, 1.0], 5126, "SCALAR", 2)
+    moves = g.accessor([0.0, 0.0, 0.0, 1.0, 0.0, 0.0], 5126, "VEC3", 2)
+    g.doc["animations"] = [{"samplers": [{"input": times, "output": moves}],
+                            "channels": [{"sampler": 0, "target": {"node": n, "path": "translation"}}]}]
+    g.doc["extensionsUsed"] = ["KHR_texture_transform", "KHR_materials_clearcoat"]
+    g.doc["cameras"] = [{"type": "orthographic", "name": "plan",
+                         "orthographic": {"xmag": 2, "ymag": 2, "znear": 0.1, "zfar": 50}}]
+    g.node(camera=0, name="plan_node", translation=[0, 10, 0], rotation=[-0.7071068, 0, 0, 0.7071068])
+    return g
+
+
+def realistic_asset(big_maps=False):
+    """Tens of thousands of triangles, a few dozen textures: 12 materials
+    with base colour, metallic-roughness and normal maps (512 or 2048
+    texels), 12 grid meshes of 64x64 quads (98,304 triangles), no uv1."""
+    g = Gltf()
+    size = 2048 if big_maps else 512
+    for k in range(12):
+        bc = g.texture(g.image(pattern_png(size, (40 + 15 * k, 90, 200 - 10 * k, 255), (230, 220, 200, 255), 16)))
+        mr = g.texture(g.image(pattern_png(size, (0, 100, 20 * k, 255), (0, 220, 0, 255), 32)))
+        nm = g.texture(g.image(pattern_png(size, (128, 128, 255, 255), (150, 110, 240, 255), 8)))
+        mat = g.material(name="mat%d" % k, pbrMetallicRoughness={
+            "baseColorTexture": {"index": bc}, "metallicRoughnessTexture": {"index": mr}},
+            normalTexture={"index": nm})
+        mesh = g.mesh(grid(64, z=0.0), material=mat, uv1=False, name="panel%d" % k)
+        g.node(mesh=mesh, name="panel%d" % k, translation=[(k % 4) * 2.5, (k // 4) * 2.5, 0])
+    return g
+
+
+def quantized_asset():
+    """TEXCOORD_0 as normalized unsigned shorts and TEXCOORD_1 as normalized
+    unsigned bytes (core glTF allows both; assimp 5.2 misreads them, so the
+    converter decodes them itself)."""
+    g = Gltf()
+    pos, nrm, uv0, uv1, idx = cube()
+    n = len(pos) // 3
+    attrs = {"POSITION": g.accessor(pos, 5126, "VEC3", n), "NORMAL": g.accessor(nrm, 5126, "VEC3", n)}
+    q0 = [int(round(x * 65535)) for x in uv0]
+    q1 = [int(round(x * 255)) for x in uv1]
+    attrs["TEXCOORD_0"] = g.accessor(q0, 5123, "VEC2", n)
+    attrs["TEXCOORD_1"] = g.accessor(q1 + [0] * (-len(q1) % 4), 5121, "VEC2", n)
+    for k in ("TEXCOORD_0", "TEXCOORD_1"):
+        g.doc["accessors"][attrs[k]]["normalized"] = True
+    prim = {"attributes": attrs, "indices": g.accessor(idx, 5123, "SCALAR", len(idx))}
+    g.doc["meshes"].append({"primitives": [prim], "name": "qcube"})
+    g.node(mesh=0, name="qcube")
+    return g
+
+
+def skinned_asset():
+    """A cube bound to a two-joint skin (JOINTS_0 as bytes): drawn in its
+    bind pose, the skin reported as ignored."""
+    g = Gltf()
+    pos, nrm, uv0, uv1, idx = cube()
+    n = len(pos) // 3
+    mesh = g.mesh((pos, nrm, uv0, uv1, idx), uv1=False, name="skinned")
+    attrs = g.doc["meshes"][mesh]["primitives"][0]["attributes"]
+    attrs["JOINTS_0"] = g.accessor([0, 1, 0, 0] * n, 5121, "VEC4", n)
+    attrs["WEIGHTS_0"] = g.accessor([0.5, 0.5, 0.0, 0.0] * n, 5126, "VEC4", n)
+    ident = [1.0, 0, 0, 0, 0, 1.0, 0, 0, 0, 0, 1.0, 0, 0, 0, 0, 1.0]
+    ibm = g.accessor(ident * 2, 5126, "MAT4", 2)
+    j0 = g.node(root=False, name="root_joint", children=[])
+    j1 = g.node(root=False, name="tip_joint", translation=[0, 1, 0])
+    g.doc["nodes"][j0]["children"] = [j1]
+    g.doc["skins"] = [{"joints": [j0, j1], "inverseBindMatrices": ibm, "skeleton": j0}]
+    body = g.node(mesh=mesh, skin=0, name="body")
+    g.doc["scenes"][0]["nodes"].append(j0)
+    return g
+
+
+# ---- bad assets ----
+
+def bad_accessor_oob():
+    g = textured(normal_map=False)
+    g.doc["accessors"][0]["count"] += 10  # POSITION runs past its bufferView
+    return g.glb(), "accessors[0]"
+
+
+def bad_view_oob():
+    g = textured(normal_map=False)
+    data = g.glb()
+    doc = json.loads(json.dumps(g.doc))
+    doc["bufferViews"][1]["byteLength"] = len(g.bin) * 2
+    return rebuild_glb(doc, g.bin), "bufferViews[1]"
+
+
+def rebuild_glb(doc, binary):
+    js = json.dumps(doc, separators=(",", ":")).encode()
+    js += b" " * (-len(js) % 4)
+    out = struct.pack("<I I", len(js), 0x4E4F534A) + js
+    out += struct.pack("<I I", len(binary), 0x004E4942) + bytes(binary)
+    return b"glTF" + struct.pack("<I I", 2, 12 + len(out)) + out
+
+
+def bad_index_oob():
+    g = Gltf()
+    pos, nrm, uv0, uv1, idx = cube()
+    idx[5] = 99
+    g.node(mesh=g.mesh((pos, nrm, uv0, uv1, idx), uv1=False))
+    return g.glb(), "meshes[0].primitives[0].indices"
+
+
+def bad_huge_count():
+    g = Gltf()
+    g.node(mesh=g.mesh(cube(), uv1=False))
+    g.doc["accessors"][0]["count"] = 2 ** 31
+    return g.glb(), "accessors[0]"
+
+
+def bad_not_image():
+    g = Gltf()
+    t = g.texture(g.image(b"this is not an image at all, just some text"))
+    m = g.material(pbrMetallicRoughness={"baseColorTexture": {"index": t}})
+    g.node(mesh=g.mesh(cube(), material=m, uv1=False))
+    return g.glb(), "images[0]"
+
+
+def bad_uri(where, uri):
+    g = Gltf()
+    g.node(mesh=g.mesh(cube(), uv1=False))
+    if where == "images":
+        g.doc["images"] = [{"uri": uri}]
+        g.doc["textures"] = [{"source": 0}]
+        g.doc["materials"] = [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]
+        g.doc["meshes"][0]["primitives"][0]["material"] = 0
+        return g.gltf_data_uri(), "images[0].uri"
+    text = json.loads(g.gltf_data_uri())
+    text["buffers"][0]["uri"] = uri
+    return json.dumps(text).encode(), "buffers[0].uri"
+
+
+def bad_big_texture():
+    g = Gltf()
+    t = g.texture(g.image(png_header_only(9000, 4)))
+    m = g.material(pbrMetallicRoughness={"baseColorTexture": {"index": t}})
+    g.node(mesh=g.mesh(cube(), material=m, uv1=False))
+    return g.glb(), "limits.max_texture_edge"
+
+
+def bad_mode(mode):
+    g = Gltf()
+    g.node(mesh=g.mesh(cube(), uv1=False, mode=mode))
+    return g.glb()
+
+
+def build_all(out, realistic=False, big_maps=False):
+    os.makedirs(out, exist_ok=True)
+    manifest = []
+
+    def write(name, data, **expect):
+        with open(os.path.join(out, name), "wb") as f:
+            f.write(data)
+        entry = {"file": name}
+        entry.update(expect)
+        manifest.append(entry)
+
+    # 2 nodes x 12 triangles, generated uv1: one chart per face, 24 vertices each.
+    tex = {"meshes": 2, "triangles": 24, "vertices": 48, "textures": [[8, 8], [16, 16], [32, 32]],
+           "lights": {"point": ["bulb"], "spot": ["torch"], "directional": ["sun"]},
+           "cameras": ["main"], "uv1": "generated", "slots": ["base_color", "metallic_roughness", "normal"],
+           "texel": {"image": 0, "x": 5, "y": 5, "rgba": list(BASE_TEXEL)},
+           "texel_checker": {"image": 0, "x": 1, "y": 0, "rgba": [0, 0, 0, 255]}}
+    write("textured.glb", textured().glb(), exit=0, expect=tex)
+    nn = dict(tex, textures=[[8, 8], [16, 16]], slots=["base_color", "metallic_roughness"])
+    write("no_normal_map.glb", textured(normal_map=False).glb(), exit=0, expect=nn)
+    write("uv1_file.glb", textured(uv1=True).glb(), exit=0,
+          expect=dict(tex, uv1="file"))
+    write("datauri.gltf", textured().gltf_data_uri(), exit=0, expect=tex)
+    write("alpha.glb", alpha_asset().glb(), exit=0,
+          expect={"meshes": 2, "triangles": 16, "vertices": 18, "alpha_modes": ["mask", "blend"], "lights": {},
+                  "cameras": [], "uv1": "generated"})
+    write("extras.glb", extras_asset().glb(), exit=0,
+          expect={"meshes": 1, "triangles": 12, "cameras": ["plan"], "uv1": "generated",
+                  "ignored": ["animations", "extension KHR_texture_transform",
+                              "extension KHR_materials_clearcoat", "points and lines primitives",
+                              "orthographic cameras (drawn as perspective)", "KHR_texture_transform"]})
+    write("quantized.glb", quantized_asset().glb(), exit=0,
+          expect={"meshes": 1, "triangles": 12, "vertices": 24, "uv1": "file"})
+    write("skinned.glb", skinned_asset().glb(), exit=0,
+          expect={"meshes": 1, "triangles": 12, "uv1": "generated", "ignored": ["skins"]})
+    jpg = jpeg_bytes()
+    if jpg:
+        g = Gltf()
+        t = g.texture(g.image(jpg, mime="image/jpeg", name="photo"))
+        m = g.material(pbrMetallicRoughness={"baseColorTexture": {"index": t}})
+        g.node(mesh=g.mesh(cube(), material=m, uv1=False))
+        write("jpeg.glb", g.glb(), exit=0,
+              expect={"meshes": 1, "triangles": 12, "textures": [[16, 16]], "uv1": "generated",
+                      "texel_near": {"image": 0, "x": 8, "y": 8, "rgba": [30, 160, 90, 255], "tolerance": 4}})
+        # The same with the frame's sample precision 7: libjpeg's error exit.
+        sof = jpg.index(b"\xff\xc0")
+        bad = bytearray(jpg)
+        bad[sof + 4] = 7
+        g = Gltf()
+        t = g.texture(g.image(bytes(bad), mime="image/jpeg"))
+        m = g.material(pbrMetallicRoughness={"baseColorTexture": {"index": t}})
+        g.node(mesh=g.mesh(cube(), material=m, uv1=False))
+        write("bad_jpeg.glb", g.glb(), exit=2, status=400, field="images[0]")
+    if realistic:
+        data = realistic_asset(big_maps).glb()
+        write("realistic_2k.glb" if big_maps else "realistic.glb", data, exit=0,
+              expect={"meshes": 12, "triangles": 98304, "uv1": "generated"})
+
+    good = textured(normal_map=False).glb()
+    write("truncated.glb", good[:len(good) // 2], exit=2, status=400, field="file")
+    write("wrong_magic.glb", b"glTX" + good[4:], exit=2, status=400, field="file")
+    write("bad_json.gltf", b'{"asset": {"version": "2.0"}, "nodes": [', exit=2, status=400, field="file")
+    write("glb_version1.glb", good[:4] + struct.pack("<I", 1) + good[8:], exit=2, status=422, field="file")
+    data, field = bad_accessor_oob()
+    write("accessor_oob.glb", data, exit=2, status=400, field=field)
+    data, field = bad_view_oob()
+    write("view_oob.glb", data, exit=2, status=400, field=field)
+    data, field = bad_index_oob()
+    write("index_oob.glb", data, exit=2, status=400, field=field)
+    data, field = bad_huge_count()
+    write("huge_count.glb", data, exit=2, status=422, field=field)
+    data, field = bad_not_image()
+    write("not_image.glb", data, exit=2, status=400, field=field)
+    data, field = bad_uri("buffers", "../../etc/passwd")
+    write("uri_passwd.gltf", data, exit=2, status=400, field=field)
+    data, field = bad_uri("images", "file:///etc/passwd")
+    write("uri_file.gltf", data, exit=2, status=400, field=field)
+    data, field = bad_big_texture()
+    write("big_texture.glb", data, exit=2, status=422, field=field)
+    write("points_only.glb", bad_mode(0), exit=2, status=422, field="meshes")
+    write("bad_mode.glb", bad_mode(9), exit=2, status=422, field="meshes[0].primitives[0]")
+    write("over_vertices.glb", good, exit=2, status=422, field="limits.max_vertices",
+          args=["--max-vertices", "10"])
+    write("over_file_bytes.glb", good, exit=2, status=422, field="limits.max_file_bytes",
+          args=["--max-file-bytes", "100"])
+    with open(os.path.join(out, "manifest.json"), "w") as f:
+        json.dump(manifest, f, indent=1)
+    return manifest
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--realistic", action="store_true", help="also the benchmark-size asset")
+    ap.add_argument("--big-maps", action="store_true", help="2048-texel maps in the realistic asset")
+    a = ap.parse_args()
+    m = build_all(a.out, a.realistic or a.big_maps, a.big_maps)
+    print("gltf_gen: %d files in %s" % (len(m), a.out))
+
+
+if __name__ == "__main__":
+    main()

@@ -680,7 +680,7 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
                                  .max_asset_bytes = o->max_asset_bytes > 0
                                                         ? (uint64_t)o->max_asset_bytes
                                                         : ASSETS_MAX_BYTES_DEFAULT};
-    asset_store_limits_defaults(&acfg.limits);
+    asset_limits_defaults(&acfg.limits);
     acfg.limits.max_file_bytes = acfg.max_asset_bytes;
     asset_run_limits_defaults(&acfg.run);
     struct assets *assets = assets_create(&acfg, store, q, err, sizeof(err));

@@ -52,33 +52,6 @@ bool asset_store_original_path(const char *state_dir, const char *sha256, const 
                 out);
 }
 
-void asset_store_limits_defaults(struct asset_limits *lim)
-{
-    memset(lim, 0, sizeof(*lim));
-    lim->max_file_bytes = 256ull << 20;
-    lim->max_vertices = 16ull << 20;
-    lim->max_indices = 48ull << 20;
-    lim->max_texture_pixels = 256ull << 20;
-    lim->max_texture_edge = 8192;
-    lim->max_meshes = 65536;
-    lim->max_materials = 4096;
-    lim->max_images = 4096;
-    lim->max_lights = 1024;
-    lim->max_cameras = 1024;
-}
-
-json_t *asset_store_limits_json(const struct asset_limits *lim)
-{
-    return json_pack("{s:I, s:I, s:I, s:I, s:I, s:I, s:I, s:I, s:I, s:I}", "max_file_bytes",
-                     (json_int_t)lim->max_file_bytes, "max_vertices",
-                     (json_int_t)lim->max_vertices, "max_indices", (json_int_t)lim->max_indices,
-                     "max_texture_pixels", (json_int_t)lim->max_texture_pixels,
-                     "max_texture_edge", (json_int_t)lim->max_texture_edge, "max_meshes",
-                     (json_int_t)lim->max_meshes, "max_materials", (json_int_t)lim->max_materials,
-                     "max_images", (json_int_t)lim->max_images, "max_lights",
-                     (json_int_t)lim->max_lights, "max_cameras", (json_int_t)lim->max_cameras);
-}
-
 void asset_run_limits_defaults(struct asset_run_limits *r)
 {
     /* Decoded textures alone may reach 1 GiB at the default limits; the

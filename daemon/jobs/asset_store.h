@@ -40,15 +40,6 @@ bool asset_store_original_path(const char *state_dir, const char *sha256, const 
 /* STATE_DIR/assets. */
 bool asset_store_dir(const char *state_dir, char *out, size_t cap);
 
-/* The daemon's limits for the converter: asset.h's defaults
- * (asset_limits_defaults: 256 MiB files, 16 M vertices, 48 M indices,
- * 256 M texture pixels, 8192-texel edges, 65,536 meshes, 4,096 materials
- * and images, 1,024 lights and cameras), with max_file_bytes the daemon's
- * --max-asset-bytes. Kept here until the converter's asset.c is merged;
- * then asset_limits_defaults is the one source. */
-void asset_store_limits_defaults(struct asset_limits *lim);
-/* The limits as /v1/info shows them (asset_limits_to_json's shape). */
-json_t *asset_store_limits_json(const struct asset_limits *lim);
 
 /* What a conversion may take beside the asset's own limits. */
 struct asset_run_limits {

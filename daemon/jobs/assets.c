@@ -923,7 +923,7 @@ json_t *assets_info_json(const struct assets *a)
 {
     return json_pack("{s:I, s:o, s:I, s:I, s:f, s:i, s:i}", "max_asset_bytes",
                      (json_int_t)a->cfg.max_asset_bytes, "limits",
-                     asset_store_limits_json(&a->cfg.limits), "max_memory_bytes",
+                     asset_limits_to_json(&a->cfg.limits), "max_memory_bytes",
                      (json_int_t)a->cfg.run.memory_bytes, "max_cpu_seconds",
                      (json_int_t)a->cfg.run.cpu_s, "timeout_s", a->cfg.run.wall_s,
                      "conversions_at_once", ASSETS_WORKERS, "max_uploads_at_once",

@@ -221,7 +221,7 @@ int main(void)
     CHECK(fs_write_atomic(converter, script, sizeof(script) - 1) && chmod(converter, 0755) == 0);
     struct assets_config acfg = {.state_dir = state, .converter = converter,
                                  .max_asset_bytes = 4096};
-    asset_store_limits_defaults(&acfg.limits);
+    asset_limits_defaults(&acfg.limits);
     asset_run_limits_defaults(&acfg.run);
     struct assets *assets = q ? assets_create(&acfg, store, q, err, sizeof(err)) : NULL;
     CHECK(assets != NULL);

@@ -108,6 +108,10 @@ layout(binding = SB_TEX_DEPTH) uniform msaa_sampler2D u_gbuffer_depth;
 layout(binding = SB_TEX_GBUFFER0) uniform msaa_sampler2D u_gbuffer_albedo;
 layout(binding = SB_TEX_GBUFFER1) uniform msaa_sampler2D u_gbuffer_normal;
 layout(binding = SB_TEX_GBUFFER2) uniform msaa_sampler2D u_gbuffer_material;
+#if defined(SCENE_TEXTURED)
+// Asset scenes' fourth plane: emissive (rgb), occlusion (a), rgba16f.
+layout(binding = SB_TEX_GBUFFER3) uniform msaa_sampler2D u_gbuffer_surface;
+#endif
 #ifdef SB_MSAA_SAMPLES
 // Each sample's position within its pixel (glGetMultisamplefv), and their
 // mean, set at create (gbuffer.c).
@@ -118,6 +122,10 @@ uniform vec2 u_sample_centre;
 struct Surface {
     vec3 P, N, albedo;
     float specular, shininess, metallic, roughness;
+#if defined(SCENE_TEXTURED)
+    vec3 emissive;   // added once, with the ambient term
+    float occlusion; // scales the ambient term only
+#endif
 };
 
 void gbuffer_planes(ivec2 pixel, int i, inout Surface s)
@@ -129,6 +137,11 @@ void gbuffer_planes(ivec2 pixel, int i, inout Surface s)
     s.shininess = m.g;
     s.metallic = m.b;
     s.roughness = m.a;
+#if defined(SCENE_TEXTURED)
+    vec4 e = msaa_fetch(u_gbuffer_surface, pixel, i);
+    s.emissive = e.rgb;
+    s.occlusion = e.a;
+#endif
 }
 
 #ifdef SB_MSAA_SAMPLES

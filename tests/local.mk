@@ -113,6 +113,7 @@ E2E_TESTS = \
 	tests/e2e/e2e_hardening.py \
 	tests/e2e/e2e_many_lights.py \
 	tests/e2e/e2e_techniques.py \
+	tests/e2e/e2e_textured.py \
 	tests/e2e/e2e_load.py \
 	tests/e2e/e2e_osl.py \
 	tests/e2e/e2e_ab.py \

@@ -8,9 +8,17 @@
 // daemon/gpu/gpu_scene.c: materials_init) and up to five textures on the
 // SB_TEX_MATERIAL_* units, which gpu_scene_draw binds with their samplers
 // before each asset mesh's draw, with u_material its row. The entry points:
-//   material_surface(row, uvs, N, tangent, front): the surface at any point
-//     given its uv0 (uvs.xy), uv1 (uvs.zw), geometric normal and tangent
-//     frame; no discard: what object-space shading would bake a texel with;
+//   material_surface_grad(row, uvs, duvdx, duvdy, N, tangent, front): the
+//     surface at any point given its uv0 (uvs.xy), uv1 (uvs.zw), their
+//     screen (or texel) derivatives, which pick the mip level, geometric
+//     normal and tangent frame; no discard, no implicit derivatives: what
+//     object-space shading would bake a texel with (from a compute shader
+//     too, with zero derivatives for the finest level);
+//   material_surface(row, uvs, N, tangent, front): the same with the
+//     fragment's own derivatives, taken here in uniform control flow (a
+//     texture() inside the slots' branches would take them in non-uniform
+//     flow, which GLSL leaves undefined: llvmpipe's differ where a draw is
+//     scissored into tiles);
 //   surface_here(N): the same at this fragment (u_material, the varyings,
 //     gl_FrontFacing), discarding where an alpha-masked material's alpha is
 //     below its cutoff;
@@ -48,11 +56,6 @@ bool material_has(SurfaceMaterial sm, int slot)
     return (sm.slots.x & (1 << slot)) != 0;
 }
 
-vec2 material_uv(SurfaceMaterial sm, int slot, vec4 uvs)
-{
-    return (sm.slots.y & (1 << slot)) != 0 ? uvs.zw : uvs.xy;
-}
-
 // What the lighting library's Material does not carry.
 struct TexturedSurface {
     Material m;
@@ -62,24 +65,30 @@ struct TexturedSurface {
     float alpha;
 };
 
-float material_alpha(SurfaceMaterial sm, vec4 uvs)
+// Slot `slot`'s texel: its uv set and that set's derivatives.
+#define MATERIAL_SAMPLE(sampler_, sm, slot, uvs, dx, dy)                                   \
+    ((sm.slots.y & (1 << (slot))) != 0 ? textureGrad(sampler_, (uvs).zw, (dx).zw, (dy).zw) \
+                                       : textureGrad(sampler_, (uvs).xy, (dx).xy, (dy).xy))
+
+float material_alpha(SurfaceMaterial sm, vec4 uvs, vec4 dx, vec4 dy)
 {
     float a = sm.base_color.a;
     if (material_has(sm, SLOT_BASE_COLOR))
-        a *= texture(u_material_base_color, material_uv(sm, SLOT_BASE_COLOR, uvs)).a;
+        a *= MATERIAL_SAMPLE(u_material_base_color, sm, SLOT_BASE_COLOR, uvs, dx, dy).a;
     return a;
 }
 
-TexturedSurface material_surface(int row, vec4 uvs, vec3 N, vec4 tangent, bool front)
+TexturedSurface material_surface_grad(int row, vec4 uvs, vec4 dx, vec4 dy, vec3 N, vec4 tangent,
+                                      bool front)
 {
     SurfaceMaterial sm = materials[row];
     TexturedSurface s;
     vec4 base = sm.base_color;
     if (material_has(sm, SLOT_BASE_COLOR))
-        base *= texture(u_material_base_color, material_uv(sm, SLOT_BASE_COLOR, uvs));
+        base *= MATERIAL_SAMPLE(u_material_base_color, sm, SLOT_BASE_COLOR, uvs, dx, dy);
     float metallic = sm.params.x, roughness = sm.params.y;
     if (material_has(sm, SLOT_METALLIC_ROUGHNESS)) {
-        vec4 mr = texture(u_material_metallic_roughness, material_uv(sm, SLOT_METALLIC_ROUGHNESS, uvs));
+        vec4 mr = MATERIAL_SAMPLE(u_material_metallic_roughness, sm, SLOT_METALLIC_ROUGHNESS, uvs, dx, dy);
         roughness *= mr.g; // glTF: roughness in green, metallic in blue
         metallic *= mr.b;
     }
@@ -89,7 +98,7 @@ TexturedSurface material_surface(int row, vec4 uvs, vec3 N, vec4 tangent, bool f
     if (material_has(sm, SLOT_NORMAL)) {
         vec3 t = normalize(tangent.xyz - N * dot(N, tangent.xyz));
         vec3 b = cross(N, t) * tangent.w * facing;
-        vec3 tn = texture(u_material_normal, material_uv(sm, SLOT_NORMAL, uvs)).xyz * 2.0 - 1.0;
+        vec3 tn = MATERIAL_SAMPLE(u_material_normal, sm, SLOT_NORMAL, uvs, dx, dy).xyz * 2.0 - 1.0;
         tn.xy *= sm.params.z;
         N = normalize(t * tn.x + b * tn.y + N * tn.z);
     }
@@ -97,16 +106,21 @@ TexturedSurface material_surface(int row, vec4 uvs, vec3 N, vec4 tangent, bool f
     s.occlusion = 1.0;
     if (material_has(sm, SLOT_OCCLUSION))
         s.occlusion = 1.0 + sm.params.w *
-                                (texture(u_material_occlusion, material_uv(sm, SLOT_OCCLUSION, uvs)).r - 1.0);
+                                (MATERIAL_SAMPLE(u_material_occlusion, sm, SLOT_OCCLUSION, uvs, dx, dy).r - 1.0);
     s.emissive = sm.emissive_cutoff.rgb;
     if (material_has(sm, SLOT_EMISSIVE))
-        s.emissive *= texture(u_material_emissive, material_uv(sm, SLOT_EMISSIVE, uvs)).rgb;
+        s.emissive *= MATERIAL_SAMPLE(u_material_emissive, sm, SLOT_EMISSIVE, uvs, dx, dy).rgb;
     // Phong's terms from roughness, as daemon/scene/scene_asset.c sets the
     // constant fallback: Beckmann's exponent, a dielectric's 4% or a metal's.
     s.m = Material(base.rgb, 0.04 + 0.96 * metallic,
                    max(1.0, 2.0 / max(roughness * roughness, 1e-3) - 2.0), metallic, roughness);
     s.alpha = base.a;
     return s;
+}
+
+TexturedSurface material_surface(int row, vec4 uvs, vec3 N, vec4 tangent, bool front)
+{
+    return material_surface_grad(row, uvs, dFdx(uvs), dFdy(uvs), N, tangent, front);
 }
 
 TexturedSurface surface_here(vec3 N)
@@ -120,7 +134,8 @@ TexturedSurface surface_here(vec3 N)
 void surface_alpha_clip()
 {
     SurfaceMaterial sm = materials[u_material];
-    if (sm.emissive_cutoff.w >= 0.0 && material_alpha(sm, v_tex) < sm.emissive_cutoff.w)
+    vec4 dx = dFdx(v_tex), dy = dFdy(v_tex);
+    if (sm.emissive_cutoff.w >= 0.0 && material_alpha(sm, v_tex, dx, dy) < sm.emissive_cutoff.w)
         discard;
 }
 

@@ -357,7 +357,7 @@ bool scene_build_asset(struct scene *s, char *err, size_t errlen)
             for (int k = 0; k < 3; k++)
                 in->albedo[k] = mat ? mat->base_color[k] : 1.0f;
             float rough = mat ? mat->roughness : 1.0f;
-            in->material.metallic = mat ? mat->metallic : 0.0f;
+            in->material.metallic = mat ? mat->metallic : 1.0f;
             in->material.roughness = rough;
             /* Phong's terms from roughness, as the chart preset does. */
             in->material.shininess = fmaxf(1.0f, 2.0f / fmaxf(rough * rough, 1e-3f) - 2.0f);

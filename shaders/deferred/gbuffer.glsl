@@ -206,6 +206,9 @@ bool gbuffer_edge(ivec2 pixel)
     vec4 n0 = texelFetch(u_gbuffer_normal, pixel, 0);
     vec4 a0 = texelFetch(u_gbuffer_albedo, pixel, 0);
     vec4 m0 = texelFetch(u_gbuffer_material, pixel, 0);
+#if defined(SCENE_TEXTURED)
+    vec4 e0 = texelFetch(u_gbuffer_surface, pixel, 0);
+#endif
     vec3 P0 = gbuffer_position(vec2(pixel) + u_sample_pos[0], d0);
     vec3 N0 = gbuffer_decode_normal(n0);
     // 24-bit depth is good to about 1e-4 of the distance at the scenes'
@@ -221,6 +224,10 @@ bool gbuffer_edge(ivec2 pixel)
             texelFetch(u_gbuffer_albedo, pixel, i) != a0 ||
             texelFetch(u_gbuffer_material, pixel, i) != m0)
             return true;
+#if defined(SCENE_TEXTURED)
+        if (texelFetch(u_gbuffer_surface, pixel, i) != e0)
+            return true;
+#endif
         vec3 P = gbuffer_position(vec2(pixel) + u_sample_pos[i], d);
         if (abs(dot(P - P0, N0)) > tolerance)
             return true;

@@ -14,6 +14,7 @@ UNIT_TESTS = \
 	tests/unit/test_options \
 	tests/unit/test_stats \
 	tests/unit/test_scene \
+	tests/unit/test_scene_asset \
 	tests/unit/test_osl \
 	tests/unit/test_metrics \
 	tests/unit/test_flicker \
@@ -44,6 +45,7 @@ tests_unit_test_options_LDADD = libsb-common.a $(JANSSON_LIBS) $(LIBS)
 tests_unit_test_store_LDADD = $(CORE_LIBS)
 tests_unit_test_stats_LDADD = $(CORE_LIBS)
 tests_unit_test_scene_LDADD = $(CORE_LIBS)
+tests_unit_test_scene_asset_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_osl_LDADD = $(CORE_LIBS)
 tests_unit_test_metrics_LDADD = $(CORE_LIBS)
 tests_unit_test_flicker_LDADD = $(CORE_LIBS)
@@ -123,6 +125,7 @@ E2E_TESTS = \
 	tests/e2e/e2e_hardening.py \
 	tests/e2e/e2e_many_lights.py \
 	tests/e2e/e2e_techniques.py \
+	tests/e2e/e2e_textured.py \
 	tests/e2e/e2e_load.py \
 	tests/e2e/e2e_osl.py \
 	tests/e2e/e2e_ab.py \

@@ -32,6 +32,9 @@
 #define SB_SSBO_OSL_VERSIONS 16
 #define SB_SSBO_OSL_LIST 17
 #define SB_SSBO_OSL_STATS 18
+/* Asset scenes (SCENE_TEXTURED): one SurfaceMaterial per asset material,
+ * and glTF's default material after them (shaders/common/surface.glsl). */
+#define SB_SSBO_MATERIALS 19
 
 /* Texture units. */
 #define SB_TEX_HDR 0
@@ -62,11 +65,24 @@
 #define SB_TEX_IBL_BRDF 14        /* the split sum's (A, B) table */
 #define SB_TEX_SHADOW_ATLAS 15    /* depth atlas of every light's six faces */
 #define SB_TEX_SHADOW_CUBES 16    /* or a depth cube map array, a layer a light */
+/* Asset scenes: the drawn mesh's material textures, bound by gpu_scene_draw
+ * before each asset mesh's draw (one unit a glTF slot, in enum
+ * asset_texture_slot order; a slot without a texture is never sampled). */
+#define SB_TEX_MATERIAL_BASE_COLOR 20
+#define SB_TEX_MATERIAL_METALLIC_ROUGHNESS 21
+#define SB_TEX_MATERIAL_NORMAL 22
+#define SB_TEX_MATERIAL_OCCLUSION 23
+#define SB_TEX_MATERIAL_EMISSIVE 24
+#define SB_TEX_GBUFFER3 5 /* asset scenes' g-buffer: emissive, occlusion */
 
 /* Uniform locations of the harness's own programs, explicit so that timed
  * code never looks a name up. */
 #define SB_LOC_SHADOW_VIEW_PROJ 0 /* mat4, locations 0..3 */
 #define SB_LOC_SHADOW_INSTANCE 4  /* int */
+/* Every program that draws scene meshes, asset scenes only: the drawn
+ * mesh's index into the material buffer, set by gpu_scene_draw (and the
+ * shadow pass) per asset mesh. */
+#define SB_LOC_MATERIAL 5         /* int */
 #define SB_LOC_IBL_FACE 0         /* filters: int, the cube face written */
 #define SB_LOC_IBL_PARAMS 1       /* filters: vec4 (roughness or lod, 1 / size, samples, source size) */
 

@@ -1,10 +1,164 @@
 #include "daemon/gpu/gpu_scene.h"
 
 #include "daemon/gpu/bindings.h"
+#include "daemon/scene/asset.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+bool gpu_scene_check_units(char *err, size_t errlen)
+{
+    GLint combined = 0, fragment = 0;
+    glGetIntegerv(GL_MAX_COMBINED_TEXTURE_IMAGE_UNITS, &combined);
+    glGetIntegerv(GL_MAX_TEXTURE_IMAGE_UNITS, &fragment);
+    /* Units 0..16 are the harness's and techniques' (bindings.h), 20..24
+     * the material's; a fragment shader samples at most 5 + 4 g-buffer
+     * planes + depth + the look's 5. */
+    if (combined <= SB_TEX_MATERIAL_EMISSIVE || fragment < 16) {
+        snprintf(err, errlen,
+                 "scene: asset materials need texture units up to %d, and 16 in the fragment "
+                 "stage: this device has GL_MAX_COMBINED_TEXTURE_IMAGE_UNITS %d, "
+                 "GL_MAX_TEXTURE_IMAGE_UNITS %d",
+                 SB_TEX_MATERIAL_EMISSIVE, (int)combined, (int)fragment);
+        return false;
+    }
+    return true;
+}
+
+/* glTF sampler values, with the defaults glTF gives an absent one (and a
+ * value outside the enumeration: the cache reader passes only valid ones,
+ * this keeps GL from an error if it ever does not). */
+static GLint wrap_mode(uint32_t w)
+{
+    return w == GL_CLAMP_TO_EDGE || w == GL_MIRRORED_REPEAT ? (GLint)w : GL_REPEAT;
+}
+
+static GLint min_filter(uint32_t f)
+{
+    return (f >= GL_NEAREST_MIPMAP_NEAREST && f <= GL_LINEAR_MIPMAP_LINEAR) || f == GL_NEAREST ||
+                   f == GL_LINEAR
+               ? (GLint)f
+               : GL_LINEAR_MIPMAP_LINEAR;
+}
+
+static GLuint image_texture(const struct asset_image *im, bool srgb)
+{
+    GLuint t;
+    int edge = (int)(im->width > im->height ? im->width : im->height), levels = 1;
+    while (edge >>= 1)
+        levels++;
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_2D, t);
+    glTexStorage2D(GL_TEXTURE_2D, levels, srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, (GLsizei)im->width,
+                   (GLsizei)im->height);
+    /* The file's first row at v = 0: glTF's uv origin is the image's
+     * top-left corner, so its rows go in as stored. */
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, (GLsizei)im->width, (GLsizei)im->height, GL_RGBA,
+                    GL_UNSIGNED_BYTE, im->rgba);
+    glGenerateMipmap(GL_TEXTURE_2D);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    return t;
+}
+
+/* std430 SurfaceMaterial (shaders/common/surface.glsl): 16 floats. */
+enum { MATERIAL_FLOATS = 16 };
+
+static void material_row(const struct asset_material *m, bool normal_maps, float *o)
+{
+    /* glTF's default material: every factor at its default (white,
+     * metallic 1, roughness 1), no textures, opaque, one-sided. */
+    static const struct asset_material none = {
+        .base_color = {1, 1, 1, 1}, .metallic = 1, .roughness = 1, .alpha_cutoff = 0.5f,
+        .tex = {{-1, 0, 0, 0, 0, 0, 1}, {-1, 0, 0, 0, 0, 0, 1}, {-1, 0, 0, 0, 0, 0, 1},
+                {-1, 0, 0, 0, 0, 0, 1}, {-1, 0, 0, 0, 0, 0, 1}}};
+    if (!m)
+        m = &none;
+    memcpy(&o[0], m->base_color, 4 * sizeof(float));
+    memcpy(&o[4], m->emissive, 3 * sizeof(float));
+    o[7] = m->alpha_mode == ASSET_ALPHA_MASK ? m->alpha_cutoff : -1.0f;
+    o[8] = m->metallic;
+    o[9] = m->roughness;
+    o[10] = m->tex[ASSET_TEX_NORMAL].scale;
+    o[11] = m->tex[ASSET_TEX_OCCLUSION].scale;
+    int32_t bits[4] = {0, 0, (int32_t)m->alpha_mode, m->double_sided};
+    for (int t = 0; t < ASSET_TEX_SLOTS; t++) {
+        if (m->tex[t].image < 0 || (t == ASSET_TEX_NORMAL && !normal_maps))
+            continue;
+        bits[0] |= 1 << t;
+        bits[1] |= (m->tex[t].uv_set == 1) << t;
+    }
+    memcpy(&o[12], bits, sizeof(bits));
+}
+
+static bool materials_init(struct gpu_scene *g, const struct scene *s, char *err, size_t errlen)
+{
+    const struct asset *a = s->asset;
+    if (!gpu_scene_check_units(err, errlen))
+        return false;
+    size_t rows = a->material_count + 1; /* glTF's default material last */
+    float *buf = calloc(rows * MATERIAL_FLOATS, sizeof(float));
+    g->image_tex_count = (int)a->image_count * 2;
+    g->image_tex = calloc((size_t)(g->image_tex_count ? g->image_tex_count : 1), sizeof(GLuint));
+    g->sampler_count = (int)a->material_count * ASSET_TEX_SLOTS;
+    g->samplers = calloc((size_t)(g->sampler_count ? g->sampler_count : 1), sizeof(GLuint));
+    g->mesh_material = calloc((size_t)g->mesh_count, sizeof(*g->mesh_material));
+    if (!buf || !g->image_tex || !g->samplers || !g->mesh_material) {
+        free(buf);
+        snprintf(err, errlen, "out of memory for the asset's materials");
+        return false;
+    }
+    for (uint32_t m = 0; m < a->material_count; m++)
+        material_row(&a->materials[m], s->spec.normal_maps, &buf[m * MATERIAL_FLOATS]);
+    material_row(NULL, true, &buf[a->material_count * MATERIAL_FLOATS]);
+    glGenBuffers(1, &g->material_buffer);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->material_buffer);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(rows * MATERIAL_FLOATS * sizeof(float)),
+                 buf, GL_STATIC_DRAW);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    free(buf);
+    if (g->sampler_count)
+        glGenSamplers(g->sampler_count, g->samplers);
+    for (uint32_t m = 0; m < a->material_count; m++)
+        for (int t = 0; t < ASSET_TEX_SLOTS; t++) {
+            const struct asset_texture_ref *r = &a->materials[m].tex[t];
+            GLuint smp = g->samplers[m * ASSET_TEX_SLOTS + (uint32_t)t];
+            glSamplerParameteri(smp, GL_TEXTURE_WRAP_S, wrap_mode(r->wrap_s));
+            glSamplerParameteri(smp, GL_TEXTURE_WRAP_T, wrap_mode(r->wrap_t));
+            glSamplerParameteri(smp, GL_TEXTURE_MIN_FILTER, min_filter(r->min_filter));
+            glSamplerParameteri(smp, GL_TEXTURE_MAG_FILTER,
+                                r->mag_filter == GL_NEAREST ? GL_NEAREST : GL_LINEAR);
+            /* Anisotropic filtering stays off (its sample pattern is the
+             * driver's: the same job would differ between devices). */
+            if (r->image < 0)
+                continue;
+            bool srgb = t == ASSET_TEX_BASE_COLOR || t == ASSET_TEX_EMISSIVE;
+            GLuint *tex = &g->image_tex[r->image * 2 + srgb];
+            if (!*tex)
+                *tex = image_texture(&a->images[r->image], srgb);
+        }
+    for (int sm = 0; sm < g->mesh_count; sm++) {
+        struct gpu_mesh_material *mm = &g->mesh_material[sm];
+        int am = s->mesh_asset_index ? s->mesh_asset_index[sm] : -1;
+        mm->material = -1;
+        if (am < 0)
+            continue;
+        int mat = a->meshes[am].material;
+        mm->material = mat >= 0 ? mat : (int)a->material_count;
+        if (mat < 0)
+            continue;
+        mm->double_sided = a->materials[mat].double_sided;
+        for (int t = 0; t < ASSET_TEX_SLOTS; t++) {
+            const struct asset_texture_ref *r = &a->materials[mat].tex[t];
+            bool srgb = t == ASSET_TEX_BASE_COLOR || t == ASSET_TEX_EMISSIVE;
+            mm->tex[t] = r->image >= 0 ? g->image_tex[r->image * 2 + srgb] : 0;
+            mm->sampler[t] = g->samplers[(uint32_t)mat * ASSET_TEX_SLOTS + (uint32_t)t];
+        }
+    }
+    return true;
+}
 
 bool gpu_scene_init(struct gpu_scene *g, const struct scene *s, char *err, size_t errlen)
 {
@@ -95,6 +249,10 @@ bool gpu_scene_init(struct gpu_scene *g, const struct scene *s, char *err, size_
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
     free(inst);
     free(light);
+    if (s->asset && !materials_init(g, s, err, errlen)) {
+        gpu_scene_finish(g);
+        return false;
+    }
     return true;
 }
 
@@ -115,6 +273,15 @@ void gpu_scene_finish(struct gpu_scene *g)
     glDeleteBuffers(1, &g->light_buffer);
     glDeleteBuffers(1, &g->position_buffer);
     free(g->position_scratch);
+    if (g->material_buffer)
+        glDeleteBuffers(1, &g->material_buffer);
+    if (g->image_tex && g->image_tex_count)
+        glDeleteTextures(g->image_tex_count, g->image_tex);
+    if (g->samplers && g->sampler_count)
+        glDeleteSamplers(g->sampler_count, g->samplers);
+    free(g->image_tex);
+    free(g->samplers);
+    free(g->mesh_material);
     memset(g, 0, sizeof(*g));
 }
 
@@ -146,7 +313,8 @@ void gpu_scene_set_light_rows(struct gpu_scene *g, const int64_t *frames, int ro
 struct scene_program gpu_scene_program(const struct gpu_scene *g, GLuint prog)
 {
     (void)g;
-    struct scene_program p = {prog, glGetUniformLocation(prog, "u_instance_base")};
+    struct scene_program p = {prog, glGetUniformLocation(prog, "u_instance_base"),
+                              glGetUniformLocation(prog, "u_material"), false};
     return p;
 }
 
@@ -156,19 +324,80 @@ void gpu_scene_bind(const struct gpu_scene *g, const struct scene_program *p)
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_INSTANCES, g->instance_buffer);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHTS, g->light_buffer);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_POSITIONS, g->position_buffer);
+    if (g->material_buffer)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_MATERIALS, g->material_buffer);
+}
+
+void gpu_scene_bind_material(const struct gpu_scene *g, int mesh, GLint material_loc)
+{
+    if (!g->mesh_material || g->mesh_material[mesh].material < 0)
+        return;
+    const struct gpu_mesh_material *mm = &g->mesh_material[mesh];
+    if (material_loc >= 0)
+        glUniform1i(material_loc, mm->material);
+    for (int t = 0; t < 5; t++) {
+        glActiveTexture(GL_TEXTURE0 + SB_TEX_MATERIAL_BASE_COLOR + t);
+        glBindTexture(GL_TEXTURE_2D, mm->tex[t]);
+        glBindSampler(SB_TEX_MATERIAL_BASE_COLOR + t, mm->sampler[t]);
+    }
+    glActiveTexture(GL_TEXTURE0);
+}
+
+/* One mesh's instanced draw; instance_base is its first instance. */
+static void draw_mesh(const struct gpu_scene *g, const struct scene_program *p, int m, int base)
+{
+    const struct scene *s = g->scene;
+    bool uncull = false;
+    if (g->mesh_material) {
+        gpu_scene_bind_material(g, m, p->material);
+        /* Double-sided: both faces drawn (the shaders flip the normal of
+         * back faces); the pass's culling state comes back after. */
+        uncull = g->mesh_material[m].double_sided && glIsEnabled(GL_CULL_FACE);
+        if (uncull)
+            glDisable(GL_CULL_FACE);
+    }
+    bool masked = p->after_prepass && m >= s->asset_mask_first && m < s->asset_blend_first;
+    if (masked)
+        glDepthFunc(GL_EQUAL);
+    glUniform1i(p->instance_base, base);
+    glBindVertexArray(g->vao[m]);
+    glDrawElementsInstanced(GL_TRIANGLES, (GLsizei)s->meshes[m].index_count, GL_UNSIGNED_INT,
+                            NULL, s->mesh_instance_count[m]);
+    if (masked)
+        glDepthFunc(GL_LEQUAL);
+    if (uncull)
+        glEnable(GL_CULL_FACE);
+}
+
+void gpu_scene_draw_mesh(const struct gpu_scene *g, const struct scene_program *p, int mesh)
+{
+    const struct scene *s = g->scene;
+    int base = 0;
+    for (int m = 0; m < mesh; m++)
+        base += s->mesh_instance_count[m];
+    if (s->mesh_instance_count[mesh])
+        draw_mesh(g, p, mesh, base);
+    glBindVertexArray(0);
 }
 
 void gpu_scene_draw(const struct gpu_scene *g, const struct scene_program *p)
 {
     const struct scene *s = g->scene;
     int base = 0;
-    for (int m = 0; m < g->mesh_count; m++) {
+    /* Blended meshes come last (scene_asset.c orders them): the
+     * transparent pass draws them. */
+    for (int m = 0; m < s->asset_blend_first && m < g->mesh_count; m++) {
         if (!s->mesh_instance_count[m])
             continue;
-        glUniform1i(p->instance_base, base);
-        glBindVertexArray(g->vao[m]);
-        glDrawElementsInstanced(GL_TRIANGLES, (GLsizei)s->meshes[m].index_count,
-                                GL_UNSIGNED_INT, NULL, s->mesh_instance_count[m]);
+        if (g->mesh_material)
+            draw_mesh(g, p, m, base);
+        else {
+            /* The procedural scenes' path, call for call what it always was. */
+            glUniform1i(p->instance_base, base);
+            glBindVertexArray(g->vao[m]);
+            glDrawElementsInstanced(GL_TRIANGLES, (GLsizei)s->meshes[m].index_count,
+                                    GL_UNSIGNED_INT, NULL, s->mesh_instance_count[m]);
+        }
         base += s->mesh_instance_count[m];
     }
     glBindVertexArray(0);

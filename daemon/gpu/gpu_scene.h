@@ -3,8 +3,12 @@
 
 /* The scene's GL objects, shared by every technique: one VAO per mesh, the
  * instance buffer (position and scale, albedo and mesh, material), the
- * light buffers and per-frame light positions. Render
- * thread only (it holds the GL context). */
+ * light buffers and per-frame light positions; for asset scenes the
+ * material buffer (SB_SSBO_MATERIALS), the images as textures with mipmaps
+ * (GL_SRGB8_ALPHA8 where a material samples them as base colour or
+ * emissive, GL_RGBA8 for the other slots: an image in both roles gets two)
+ * and a sampler per material slot, bound per asset mesh by gpu_scene_draw.
+ * Render thread only (it holds the GL context). */
 
 #include <epoxy/gl.h>
 #include <stdbool.h>
@@ -21,7 +25,25 @@ struct gpu_scene {
     int position_rows;          /* rows allocated in position_buffer */
     int64_t uploaded_frame;     /* frame in row 0 when rows == 1, else INT64_MIN */
     float *position_scratch;
+    /* Asset scenes: the material buffer, the textures (image_tex[2 i]
+     * linear and [2 i + 1] sRGB, 0 where unused), and per scene mesh the
+     * material index and its five units' textures and samplers, looked up
+     * once at init so a draw only binds. */
+    GLuint material_buffer;
+    GLuint *image_tex;
+    int image_tex_count;
+    GLuint *samplers; /* per asset material and slot */
+    int sampler_count;
+    struct gpu_mesh_material {
+        int material; /* index into the buffer (the default material last) */
+        bool double_sided;
+        GLuint tex[5], sampler[5];
+    } *mesh_material; /* per scene mesh; NULL without an asset */
 };
+
+/* Which meshes gpu_scene_draw draws: the techniques' passes draw opaque and
+ * alpha-masked ones; the harness's transparent pass the blended ones. */
+enum gpu_draw_set { GPU_DRAW_OPAQUE_MASKED, GPU_DRAW_BLENDED };
 
 bool gpu_scene_init(struct gpu_scene *g, const struct scene *s, char *err, size_t errlen);
 void gpu_scene_finish(struct gpu_scene *g);
@@ -36,6 +58,13 @@ void gpu_scene_set_light_rows(struct gpu_scene *g, const int64_t *frames, int ro
 struct scene_program {
     GLuint prog;
     GLint instance_base; /* -1 for programs that draw no instances */
+    GLint material;      /* SB_LOC_MATERIAL, or -1 where the program reads no material */
+    /* Shading after a depth pre-pass (GL_LEQUAL, depth writes off, the
+     * stencil keeping the first fragment): alpha-masked meshes draw with
+     * GL_EQUAL instead, so that a fragment the mask discards, nearer than
+     * the depth the pre-pass kept, never passes the early tests (which
+     * would mark the stencil before the discard). Set by the technique. */
+    bool after_prepass;
 };
 
 /* Looks up prog's per-draw uniform once, so that frames only bind: no
@@ -45,7 +74,20 @@ struct scene_program gpu_scene_program(const struct gpu_scene *g, GLuint prog);
 /* Uses the program and binds the scene buffers at their bindings.h points. */
 void gpu_scene_bind(const struct gpu_scene *g, const struct scene_program *p);
 
-/* Instanced draw of every object, one call per mesh. */
+/* Instanced draw of every opaque and alpha-masked object, one call per mesh
+ * (all of a procedural scene); asset meshes with their material bound
+ * first (textures on SB_TEX_MATERIAL_*, SB_LOC_MATERIAL, face culling off
+ * for double-sided ones). */
 void gpu_scene_draw(const struct gpu_scene *g, const struct scene_program *p);
+/* One mesh of the scene (its instances), material bound: the transparent
+ * pass's draw, in its own order. */
+void gpu_scene_draw_mesh(const struct gpu_scene *g, const struct scene_program *p, int mesh);
+/* Binds mesh's material (asset meshes; nothing for procedural ones): for
+ * passes that draw meshes their own way (the shadow casters). */
+void gpu_scene_bind_material(const struct gpu_scene *g, int mesh, GLint material_loc);
+
+/* Texture units the material path needs: false with err when the device has
+ * too few (GL_MAX_COMBINED_TEXTURE_IMAGE_UNITS, GL_MAX_TEXTURE_IMAGE_UNITS). */
+bool gpu_scene_check_units(char *err, size_t errlen);
 
 #endif

@@ -23,6 +23,7 @@ bool frame_source_open(struct harness_run *run, struct frame_source *src, const 
     *src = (struct frame_source){
         .rr = {.gl = run->gl, .queue = run->queue, .job = run->job, .spec = spec, .tech = tech,
                .look = look, .stages = run->stages, .shadow_pass = -1, .sky_pass = -1,
+               .transparent = run->transparent, .transparent_pass = -1,
                .scale = scale},
         .what = what,
     };

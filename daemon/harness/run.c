@@ -9,6 +9,8 @@
 #include "daemon/gpu/glutil.h"
 #include "daemon/harness/deadline.h"
 #include "daemon/harness/render_state.h"
+#include "daemon/jobs/store.h"
+#include "daemon/scene/asset.h"
 
 bool harness_gl_init(struct harness_gl *g, char *err, size_t errlen)
 {
@@ -88,6 +90,13 @@ bool run_setup_targets(struct harness_run *run)
     if (samples > 1 && !run_msaa_targets(run, hdr_format, w, h, &samples, &out, &color, &depth))
         return false;
     look_defines(run->look, run->defines, sizeof(run->defines));
+    if (scene_spec_is_asset(&run->spec->scene)) {
+        /* Every program that draws the scene reads the asset's materials
+         * (shaders/common/surface.glsl); the procedural scenes' programs
+         * are the same text as ever without it. */
+        size_t used = strlen(run->defines);
+        snprintf(run->defines + used, sizeof(run->defines) - used, "#define SCENE_TEXTURED 1\n");
+    }
     if (samples > 1) {
         /* Programs that sample the output's depth or a g-buffer read every
          * sample: sampler2DMS variants (shaders/common/msaa.glsl). */
@@ -130,7 +139,8 @@ bool run_setup_passes(struct harness_run *run, const void *options, int64_t time
 {
     const struct technique *tech = run->tech;
     int post_passes = post_spec_pass_names(&run->look->post, NULL, 0);
-    int look_passes = (run->stages.shadows != NULL) + run->stages.sky_on;
+    int look_passes = (run->stages.shadows != NULL) + run->stages.sky_on +
+                      (run->transparent.count > 0);
     run->timer = gpu_timer_create(technique_pass_count(tech) + look_passes + post_passes + 1 +
                                       (run->env.samples > 1),
                                   timed_frames);
@@ -142,6 +152,10 @@ bool run_setup_passes(struct harness_run *run, const void *options, int64_t time
                                 run->gl->caps.debug_groups) &&
                 look_stages_add_passes(&run->stages, &run->passes, &run->shadow_pass,
                                        &run->sky_pass);
+    run->transparent_pass = -1;
+    if (fits && run->transparent.count > 0 &&
+        (run->transparent_pass = gpu_passes_add(&run->passes, "transparent")) < 0)
+        fits = false;
     /* The chain's passes now; its effects are built once the technique exists. */
     const struct post_frame frame = {
         .width = run->env.width,
@@ -202,18 +216,54 @@ void run_budget_init(struct harness_run *run)
     run->budget.progress = render_progress;
 }
 
+/* scene.asset: STATE/assets/SHA256.sbasset, the cache the upload wrote,
+ * read whole before anything is timed. */
+static bool load_asset(struct harness_run *run)
+{
+    const struct scene_spec *sc = &run->spec->scene;
+    if (!sc->asset[0])
+        return true;
+    if (!sc->asset_sha256[0]) {
+        snprintf(run->err, sizeof(run->err),
+                 "scene.asset \"%s\": the job carries no asset_sha256 (filled in when the job is "
+                 "accepted)", sc->asset);
+        return false;
+    }
+    const char *state = store_state_dir(queue_store(run->queue));
+    char path[4096], why[600];
+    snprintf(path, sizeof(path), "%s/assets/%s.sbasset", state[0] ? state : ".", sc->asset_sha256);
+    struct asset_limits lim;
+    asset_limits_defaults(&lim);
+    if (!(run->asset = calloc(1, sizeof(*run->asset)))) {
+        snprintf(run->err, sizeof(run->err), "out of memory for the asset");
+        return false;
+    }
+    if (!asset_file_read(run->asset, path, &lim, why, sizeof(why))) {
+        snprintf(run->err, sizeof(run->err), "scene.asset \"%s\": %s", sc->asset, why);
+        return false;
+    }
+    return true;
+}
+
 bool run_prepare(struct harness_run *run, bool capture)
 {
     const struct job_spec *spec = run->spec;
     int n = spec->frames;
     run->look = &spec->look;
-    run->shadow_pass = run->sky_pass = -1;
+    run->shadow_pass = run->sky_pass = run->transparent_pass = -1;
     run_budget_init(run);
-    run->scene_ok = scene_init(&run->scene, &spec->scene);
+    if (!load_asset(run))
+        return false;
+    char why[600];
+    run->scene_ok = scene_build(&run->scene, &spec->scene, run->asset, why, sizeof(why));
+    if (!run->scene_ok) {
+        snprintf(run->err, sizeof(run->err), "%s", why);
+        return false;
+    }
     run->capture_count = capture ? job_spec_capture_count(spec) : 0;
     run->cpu_ms = calloc((size_t)n, sizeof(double));
     run->frame_ms = calloc((size_t)n, sizeof(double));
-    if (!run->scene_ok || !run->cpu_ms || !run->frame_ms) {
+    if (!run->cpu_ms || !run->frame_ms) {
         snprintf(run->err, sizeof(run->err), "out of memory preparing the job");
         return false;
     }
@@ -223,6 +273,8 @@ bool run_prepare(struct harness_run *run, bool capture)
         !look_stages_init(&run->stages, &spec->look, &run->scene, &run->gpu,
                           &run->gl->frame_block, &run->gl->caps, &run->budget, run->defines,
                           run->err, sizeof(run->err)) ||
+        !transparent_init(&run->transparent, &run->gpu, run->defines, run->err,
+                          sizeof(run->err)) ||
         !run_setup_passes(run, job_spec_technique_options(spec),
                           (int64_t)spec->warmup_frames + n))
         return false;
@@ -244,6 +296,7 @@ void run_finish(struct harness_run *run)
         run->tech->destroy(run->state);
     run->state = NULL;
     look_stages_finish(&run->stages);
+    transparent_finish(&run->transparent);
     free(run->hdr_scratch);
     post_chain_destroy(run->post);
     gpu_timer_destroy(run->timer);
@@ -251,6 +304,11 @@ void run_finish(struct harness_run *run)
     gpu_scene_finish(&run->gpu);
     if (run->scene_ok)
         scene_finish(&run->scene);
+    if (run->asset) {
+        asset_finish(run->asset);
+        free(run->asset);
+        run->asset = NULL;
+    }
     for (int i = 0; run->capture && i < run->capture_count; i++) {
         free(run->capture[i].pixels);
         free(run->capture[i].heat);
@@ -330,6 +388,10 @@ bool run_frame(struct harness_run *run, int64_t k, bool timed)
     }
     look_stages_after(&run->stages, &run->passes, run->sky_pass, run->env.output_fbo,
                       run->env.width, run->env.height);
+    if (run->transparent_pass >= 0)
+        transparent_draw(&run->transparent, run->env.gpu, &run->passes, run->transparent_pass,
+                         run->env.output_fbo, run->env.width, run->env.height,
+                         run->frame_data.eye);
     if (run->msaa_pass >= 0)
         run_msaa_resolve(run);
     run->hdr_resolved = post_chain_run(run->post);

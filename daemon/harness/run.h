@@ -21,6 +21,7 @@
 #include "daemon/gpu/pass.h"
 #include "daemon/gpu/targets.h"
 #include "daemon/harness/interference.h"
+#include "daemon/harness/transparent.h"
 #include "daemon/jobs/queue.h"
 #include "daemon/look/look.h"
 #include "daemon/scene/scene.h"
@@ -72,6 +73,9 @@ struct harness_run {
     const struct look_spec *look;
     struct scene scene;
     bool scene_ok;
+    /* scene.asset: the cache file's asset, read in run_prepare (never in a
+     * timed region), which the scene borrows until run_finish. */
+    struct asset *asset;
     struct gpu_scene gpu;
     struct gpu_timer *timer;
     struct gpu_passes passes;
@@ -80,6 +84,11 @@ struct harness_run {
      * measures; the reference borrows them. */
     struct look_stages stages;
     int shadow_pass, sky_pass; /* -1 when the look has none */
+    /* The blended meshes' pass after the sky (transparent.h): owned by the
+     * run that measures, borrowed by the reference; -1 without blended
+     * materials. */
+    struct transparent transparent;
+    int transparent_pass;
     struct post_chain *post;
     GLuint hdr_resolved; /* the HDR colour the resolve reads this frame */
     /* Bounded submissions: asks the job's cancel flag and timeout. */

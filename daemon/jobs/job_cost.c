@@ -102,7 +102,10 @@ void job_cost_estimate(const struct job_spec *spec, struct job_cost *out)
                         out->temporal_bytes;
     out->frames_total = (double)(spec->frames + spec->warmup_frames) * job_spec_runs(spec);
     out->pixel_frames = pixels * out->frames_total;
-    out->pixel_light_evaluations = out->pixel_frames * spec->scene.lights;
+    /* "auto" (an asset scene's default) is counted at the most it can be. */
+    out->pixel_light_evaluations =
+        out->pixel_frames * (spec->scene.lights == SCENE_LIGHTS_AUTO ? SCENE_ASSET_DEFAULT_LIGHTS
+                                                                     : spec->scene.lights);
     const struct ibl_spec *ibl = &spec->look.ibl;
     out->ibl_samples = ibl->enabled ? (ibl->probes + 1) * 6.0 * ibl->resolution *
                                           ibl->resolution * ibl->samples

@@ -36,6 +36,7 @@ struct look_shadows {
     struct gpu_scene *gpu;
     struct shadow_plan plan;
     GLuint prog, fbo, depth, ssbo;
+    GLint material_loc; /* asset scenes: alpha-masked casters read their material */
     struct shadow_light_gpu *rows;
     int *casters; /* scratch: instances within the light */
     int border;
@@ -83,8 +84,12 @@ struct look_shadows *look_shadows_create(const struct shadow_spec *spec,
     }
     const struct gl_stage stages[] = {{GL_VERTEX_SHADER, {"shadow.vert"}},
                                       {GL_FRAGMENT_SHADER, {"shadow.frag"}}};
-    if (!(sh->prog = gl_program_build("shadows", stages, 2, NULL, err, errlen)))
+    /* Asset scenes: casters with an alpha mask cast what they show. */
+    if (!(sh->prog = gl_program_build("shadows", stages, 2,
+                                      s->asset ? "#define SCENE_TEXTURED 1\n" : NULL, err,
+                                      errlen)))
         goto fail;
+    sh->material_loc = glGetUniformLocation(sh->prog, "u_material");
     glGenTextures(1, &sh->depth);
     GLenum target = spec->layout == SHADOW_LAYOUT_ATLAS ? GL_TEXTURE_2D : GL_TEXTURE_CUBE_MAP_ARRAY;
     glBindTexture(target, sh->depth);
@@ -159,6 +164,15 @@ static void draw_casters(struct look_shadows *sh, int ncasters, const float ligh
         if ((int)in->mesh != bound_mesh) {
             bound_mesh = (int)in->mesh;
             glBindVertexArray(sh->gpu->vao[bound_mesh]);
+            if (sh->gpu->mesh_material) {
+                /* A double-sided caster casts from both faces; the others
+                 * keep the pass's front-face culling. */
+                gpu_scene_bind_material(sh->gpu, bound_mesh, sh->material_loc);
+                if (sh->gpu->mesh_material[bound_mesh].double_sided)
+                    glDisable(GL_CULL_FACE);
+                else
+                    glEnable(GL_CULL_FACE);
+            }
         }
         glUniform1i(SB_LOC_SHADOW_INSTANCE, i);
         glDrawElements(GL_TRIANGLES, (GLsizei)s->meshes[in->mesh].index_count, GL_UNSIGNED_INT,
@@ -182,6 +196,8 @@ bool look_shadows_render(struct look_shadows *sh, const struct gpu_passes *passe
     glCullFace(GL_FRONT);
     glUseProgram(sh->prog);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_INSTANCES, sh->gpu->instance_buffer);
+    if (sh->gpu->material_buffer)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_MATERIALS, sh->gpu->material_buffer);
     if (atlas)
         glEnable(GL_SCISSOR_TEST);
     double draws_before = sh->draws_sum;
@@ -206,7 +222,8 @@ bool look_shadows_render(struct look_shadows *sh, const struct gpu_passes *passe
         int ncasters = 0;
         for (int k = 0; k < s->instance_count; k++) {
             const struct scene_instance *in = &s->instances[k];
-            if (in->mesh == SCENE_MESH_PLANE)
+            /* Blended (glass) meshes cast none: they would cast as opaque. */
+            if (in->mesh == SCENE_MESH_PLANE || in->mesh >= s->asset_blend_first)
                 continue;
             float r = radius + scene_instance_bound(s, k);
             float d[3] = {in->pos[0] - l->pos[0], in->pos[1] - l->pos[1], in->pos[2] - l->pos[2]};

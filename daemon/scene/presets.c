@@ -304,6 +304,8 @@ bool scene_build_preset(struct scene *s, bool *materials_set)
         return build_sphere(s);
     case SCENE_PRESET_PLANE:
         return build_plane(s);
+    case SCENE_PRESET_TEXTURED:
+        return false; /* built through the asset path (scene_asset.c) */
     }
     return false;
 }

@@ -3,9 +3,12 @@
 #include "daemon/scene/scene.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "daemon/scene/asset.h"
+#include "daemon/scene/asset_synthetic.h"
 #include "daemon/scene/scene_build.h"
 #include "daemon/scene/teapot.h"
 
@@ -73,13 +76,69 @@ static void compute_bounds(struct scene *s)
 
 bool scene_init(struct scene *out, const struct scene_spec *spec)
 {
+    char err[256];
+    return scene_build(out, spec, NULL, err, sizeof(err));
+}
+
+bool scene_has_blended(const struct scene *s)
+{
+    return s->asset && s->asset_blend_first < s->mesh_count;
+}
+
+/* The asset path: the synthetic asset for the textured preset, the
+ * caller's for scene.asset; instances, meshes, lights and pose from it. */
+static bool build_from_asset(struct scene *out, const struct asset *asset, char *err,
+                             size_t errlen)
+{
+    if (!out->spec.asset[0]) {
+        if (!(out->owned_asset = calloc(1, sizeof(*out->owned_asset))) ||
+            !asset_synthetic_textured(out->owned_asset, err, errlen)) {
+            free(out->owned_asset);
+            out->owned_asset = NULL;
+            if (!err[0])
+                snprintf(err, errlen, "out of memory building the textured preset");
+            return false;
+        }
+        asset = out->owned_asset;
+    } else if (!asset) {
+        snprintf(err, errlen, "scene.asset: the asset \"%s\" was not loaded", out->spec.asset);
+        return false;
+    }
+    out->asset = asset;
+    /* The textured preset draws the look's sky behind it, as the other
+     * presets with open backgrounds do; an uploaded asset is shown alone. */
+    out->sky = !out->spec.asset[0];
+    out->mesh_count = SCENE_MESH_PROCEDURAL + (int)asset->mesh_count;
+    if (!(out->meshes = calloc((size_t)out->mesh_count, sizeof(*out->meshes)))) {
+        snprintf(err, errlen, "out of memory for the asset's meshes");
+        return false;
+    }
+    return scene_build_asset(out, err, errlen);
+}
+
+bool scene_build(struct scene *out, const struct scene_spec *spec, const struct asset *asset,
+                 char *err, size_t errlen)
+{
     memset(out, 0, sizeof(*out));
     out->spec = *spec;
+    out->asset_camera = -1;
+    err[0] = '\0';
     bool materials_set = false;
-    out->mesh_count = SCENE_MESH_PROCEDURAL;
-    if (!(out->meshes = calloc((size_t)out->mesh_count, sizeof(*out->meshes))) ||
-        !scene_build_preset(out, &materials_set) ||
-        !(out->mesh_instance_count = calloc((size_t)out->mesh_count, sizeof(int))))
+    if (scene_spec_is_asset(spec)) {
+        if (!build_from_asset(out, asset, err, errlen))
+            goto fail;
+        materials_set = true; /* the materials' factors, whatever scene.materials says */
+        out->spec.materials = SCENE_MATERIALS_PRESET;
+    } else {
+        out->mesh_count = SCENE_MESH_PROCEDURAL;
+        if (!(out->meshes = calloc((size_t)out->mesh_count, sizeof(*out->meshes))) ||
+            !scene_build_preset(out, &materials_set))
+            goto fail;
+        for (int i = 0; i < out->instance_count; i++)
+            out->instances[i].asset_material = -1;
+        out->asset_mask_first = out->asset_blend_first = out->mesh_count;
+    }
+    if (!(out->mesh_instance_count = calloc((size_t)out->mesh_count, sizeof(int))))
         goto fail;
     for (int i = 0; i < out->instance_count; i++) {
         /* Each mesh is one instanced draw over a contiguous range. */
@@ -114,6 +173,8 @@ bool scene_init(struct scene *out, const struct scene_spec *spec)
     memcpy(out->view_proj, cam.view_proj, sizeof(out->view_proj));
     return true;
 fail:
+    if (!err[0])
+        snprintf(err, errlen, "out of memory building the scene");
     scene_finish(out);
     return false;
 }
@@ -129,6 +190,11 @@ void scene_finish(struct scene *s)
     free(s->mesh_instance_count);
     free(s->instances);
     free(s->lights);
+    free(s->mesh_asset_index);
+    if (s->owned_asset) {
+        asset_synthetic_free(s->owned_asset);
+        free(s->owned_asset);
+    }
     memset(s, 0, sizeof(*s));
 }
 
@@ -303,6 +369,48 @@ static json_t *describe_camera(const struct scene *s)
     return o;
 }
 
+/* What an asset scene is: which asset, its size, materials by alpha mode,
+ * the textures they read, the lights by type and where the camera is. */
+static json_t *describe_asset(const struct scene *s)
+{
+    const struct asset *a = s->asset;
+    uint64_t triangles = 0, vertices = 0;
+    for (uint32_t m = 0; m < a->mesh_count; m++) {
+        triangles += a->meshes[m].index_count / 3;
+        vertices += a->meshes[m].vertex_count;
+    }
+    int modes[3] = {0, 0, 0}, slots[ASSET_TEX_SLOTS] = {0};
+    for (uint32_t m = 0; m < a->material_count; m++) {
+        modes[a->materials[m].alpha_mode]++;
+        for (int t = 0; t < ASSET_TEX_SLOTS; t++)
+            slots[t] += a->materials[m].tex[t].image >= 0;
+    }
+    json_t *by_slot = json_object();
+    for (int t = 0; t < ASSET_TEX_SLOTS; t++)
+        json_object_set_new(by_slot, asset_texture_slot_names[t], json_integer(slots[t]));
+    int types[3] = {0, 0, 0};
+    for (int l = s->generated_light_count; l < s->light_count; l++)
+        types[s->lights[l].type]++;
+    uint64_t texels = 0;
+    for (uint32_t i = 0; i < a->image_count; i++)
+        texels += (uint64_t)a->images[i].width * a->images[i].height;
+    return json_pack(
+        "{s:s, s:s, s:i, s:I, s:I, s:{s:i, s:i, s:i, s:i}, s:{s:i, s:I, s:o}, "
+        "s:{s:i, s:i, s:i, s:i, s:i}, s:s, s:b, s:o}",
+        "name", s->spec.asset[0] ? s->spec.asset : "textured (built in)", "sha256",
+        s->spec.asset_sha256, "meshes", (int)a->mesh_count, "triangles", (json_int_t)triangles,
+        "vertices", (json_int_t)vertices, "materials", "count", (int)a->material_count, "opaque",
+        modes[ASSET_ALPHA_OPAQUE], "mask", modes[ASSET_ALPHA_MASK], "blend",
+        modes[ASSET_ALPHA_BLEND], "textures", "images", (int)a->image_count, "texels",
+        (json_int_t)texels, "materials_by_slot", by_slot, "lights", "from_asset",
+        s->asset_light_count, "point", types[SCENE_LIGHT_POINT], "spot", types[SCENE_LIGHT_SPOT],
+        "directional", types[SCENE_LIGHT_DIRECTIONAL], "generated", s->generated_light_count,
+        "camera", s->asset_camera >= 0 ? a->cameras[s->asset_camera].name : "framed from the bounds",
+        "normal_maps", s->spec.normal_maps, "box",
+        box_json(&(struct scene_box){{a->box_min[0], a->box_min[1], a->box_min[2]},
+                                     {a->box_max[0], a->box_max[1], a->box_max[2]}}));
+}
+
 json_t *scene_describe(const struct scene *s)
 {
     json_t *by_mesh = json_object();
@@ -329,6 +437,8 @@ json_t *scene_describe(const struct scene *s)
                             "lights", lights, "materials",
                             scene_materials_names[s->spec.materials], "camera",
                             describe_camera(s), "bounds", box_json(&s->bounds), "sky", s->sky);
+    if (out && s->asset)
+        json_object_set_new(out, "asset", describe_asset(s));
     if (out && s->mesh_instance_count[SCENE_MESH_TEAPOT])
         json_object_set_new(
             out, "teapot_tessellation",

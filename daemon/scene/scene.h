@@ -14,6 +14,8 @@
 #include "daemon/scene/mesh.h"
 #include "daemon/scene/scene_math.h"
 
+struct asset;
+
 /* Instances are grouped by mesh in index order, one instanced draw each.
  * The procedural meshes come first, at these indices (empty when unused);
  * an asset's meshes follow, from SCENE_MESH_PROCEDURAL on, one instance
@@ -35,7 +37,12 @@ struct scene_instance {
     float scale; /* uniform: object-space normals stay world-space normals */
     float albedo[3];
     int mesh; /* index into scene.meshes: enum scene_mesh, or an asset's mesh */
+    /* The constant fallback (albedo above: the base colour factor; metallic
+     * and roughness the factors) for code that reads no textures. */
     struct scene_material material;
+    /* Index into the scene's asset's materials; -1 for the procedural
+     * instances and for an asset mesh with glTF's default material. */
+    int asset_material;
 };
 
 /* The plane a dynamic light circles in around its centre. */
@@ -111,11 +118,43 @@ struct scene {
     /* The frame-0 camera, flat, for the code that reads one fixed camera. */
     float eye[3], target[3], fovy_deg, near_z, far_z;
     float view[16], proj[16], view_proj[16]; /* column-major */
+    /* Asset scenes (scene_spec_is_asset): the asset, borrowed from the
+     * caller of scene_build (or owned, for the textured preset's synthetic
+     * one), and what the scene made of it. NULL for the presets. Instances
+     * of asset meshes are ordered opaque, masked, blended (each a run of
+     * meshes: asset_mask_first and asset_blend_first are mesh indices), so
+     * that a pass can draw the opaque and masked ones and leave the blended
+     * for the transparent pass. */
+    const struct asset *asset;
+    struct asset *owned_asset;
+    int asset_mask_first, asset_blend_first;
+    int *mesh_asset_index;     /* per scene mesh: the asset's mesh index, -1 procedural */
+    int asset_light_count;     /* lights[generated..]: the asset's, after the generated ones */
+    int generated_light_count;
+    int asset_camera;          /* the asset camera of the static pose, -1: framed from the bounds */
 };
 
+/* An asset's KHR_lights_punctual lights in the daemon's colour scale
+ * (scene_asset.c; docs/scenes.md): SCENE_ASSET_LIGHT_UNIT candela (at 1 m)
+ * or lux make colour 1; a point or spot light without a range reaches as
+ * far as its inverse-square irradiance stays above
+ * SCENE_ASSET_LIGHT_FLOOR_LUX. */
+#define SCENE_ASSET_LIGHT_UNIT 100.0
+#define SCENE_ASSET_LIGHT_FLOOR_LUX 1.0
+
 /* Builds the scene of spec into caller-owned memory. On failure (out of
- * memory) the scene is left finished. */
+ * memory) the scene is left finished. Not for scene.asset specs (they need
+ * the asset: scene_build). */
 bool scene_init(struct scene *out, const struct scene_spec *spec);
+/* The same for any spec: asset is the cache's asset for scene.asset (the
+ * caller keeps it alive until scene_finish), NULL otherwise. False with err
+ * naming what is wrong (an asset field, scene.asset_camera, memory); the
+ * scene is then left finished. */
+bool scene_build(struct scene *out, const struct scene_spec *spec, const struct asset *asset,
+                 char *err, size_t errlen);
+/* True when the scene has blended (glTF "BLEND") materials: the harness's
+ * transparent pass draws them. */
+bool scene_has_blended(const struct scene *s);
 /* Frees what scene_init allocated; takes a zeroed or finished scene. */
 void scene_finish(struct scene *s);
 

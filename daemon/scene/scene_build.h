@@ -21,6 +21,11 @@ extern const float SCENE_TEAPOT_HALF[3];
  * Returns false when out of memory. */
 bool scene_build_preset(struct scene *s, bool *materials_set);
 
+/* scene_asset.c: instances, meshes, light volume, lights and static pose
+ * from s->asset (set), as scene_build_preset does for a preset; the meshes
+ * are built here too (scene_init builds only the procedural ones). */
+bool scene_build_asset(struct scene *s, char *err, size_t errlen);
+
 /* lights.c: allocates and places spec.lights lights in s->light_volume
  * with spec.light_layout, each circling its centre at radius orbit when the
  * scene is dynamic. */

@@ -5,7 +5,7 @@
 #include <string.h>
 
 const char *const scene_preset_names[] = {"grid", "lights", "teapots", "chart", "sphere",
-                                             "plane", NULL};
+                                             "plane", "textured", NULL};
 const char *const scene_layout_names[] = {"halton", "uniform", "grid", "clustered", NULL};
 const char *const scene_materials_names[] = {"uniform", "varied", "preset", NULL};
 const char *const scene_camera_names[] = {"static", "orbit", "flythrough", NULL};
@@ -30,7 +30,15 @@ static const struct {
     [SCENE_PRESET_SPHERE] = {1, SCENE_LAYOUT_GRID, 10.0, SCENE_MATERIALS_UNIFORM},
     /* Lights low over the plane, so that its shading varies across it. */
     [SCENE_PRESET_PLANE] = {6, SCENE_LAYOUT_HALTON, 2.5, SCENE_MATERIALS_UNIFORM},
+    /* Eight generated point lights beside the asset's spot and directional
+     * ones, each reaching a couple of objects. */
+    [SCENE_PRESET_TEXTURED] = {8, SCENE_LAYOUT_UNIFORM, 4.0, SCENE_MATERIALS_PRESET},
 };
+
+bool scene_spec_is_asset(const struct scene_spec *s)
+{
+    return s->asset[0] || s->preset == SCENE_PRESET_TEXTURED;
+}
 
 void scene_spec_preset_defaults(struct scene_spec *s, enum scene_preset preset)
 {
@@ -62,6 +70,53 @@ void scene_spec_defaults(struct scene_spec *s)
     s->roughness = 0.25;
     s->camera = SCENE_CAMERA_STATIC;
     s->camera_period = 360;
+    s->asset_lights = true;
+    s->normal_maps = true;
+}
+
+/* "lights": a count, or "auto" (asset scenes: 0 when the asset has lights,
+ * else SCENE_ASSET_DEFAULT_LIGHTS). An asset scene without the key is
+ * "auto". */
+static bool parse_lights(const json_t *scene, struct scene_spec *s, struct job_error *err)
+{
+    json_t *v = json_object_get(scene, "lights");
+    if (!v) {
+        if (json_object_get(scene, "asset"))
+            s->lights = SCENE_LIGHTS_AUTO;
+        return true;
+    }
+    if (json_is_string(v)) {
+        if (strcmp(json_string_value(v), "auto") != 0 || !scene_spec_is_asset(s))
+            return job_error_set(err, "scene.lights",
+                                 "must be an integer from 0 to %d (\"auto\" only with "
+                                 "scene.asset or the textured preset)",
+                                 SCENE_MAX_LIGHTS);
+        s->lights = SCENE_LIGHTS_AUTO;
+        return true;
+    }
+    return jf_get_int(scene, "lights", "scene.lights", 0, SCENE_MAX_LIGHTS, &s->lights, err);
+}
+
+/* "asset_camera": an index into the asset's cameras or a camera's name. */
+static bool parse_asset_camera(const json_t *scene, struct scene_spec *s,
+                               struct job_error *err)
+{
+    json_t *v = json_object_get(scene, "asset_camera");
+    if (!v)
+        return true;
+    if (!scene_spec_is_asset(s))
+        return job_error_set(err, "scene.asset_camera", "needs scene.asset or the textured preset");
+    if (json_is_integer(v) && json_integer_value(v) >= 0 && json_integer_value(v) < 1024) {
+        snprintf(s->asset_camera, sizeof(s->asset_camera), "%d", (int)json_integer_value(v));
+        return true;
+    }
+    const char *name = json_is_string(v) ? json_string_value(v) : NULL;
+    if (!name || !name[0] || strlen(name) > SCENE_ASSET_CAMERA_MAX)
+        return job_error_set(err, "scene.asset_camera",
+                             "must be a camera's index (0 to 1023) or its name (1 to %d bytes)",
+                             SCENE_ASSET_CAMERA_MAX);
+    snprintf(s->asset_camera, sizeof(s->asset_camera), "%s", name);
+    return true;
 }
 
 static bool parse_segments(const json_t *scene, struct scene_spec *s, struct job_error *err)
@@ -183,7 +238,7 @@ bool scene_spec_parse(const json_t *scene, struct scene_spec *s, struct job_erro
         "preset", "lights", "dynamic", "width", "height", "sphere_segments",
         "teapot_segments", "tessellation_error_px", "light_speed", "light_radius", "light_intensity",
         "light_layout", "materials", "specular", "shininess", "metallic", "roughness",
-        "camera", "asset", "asset_sha256", NULL};
+        "camera", "asset", "asset_sha256", "asset_camera", "asset_lights", "normal_maps", NULL};
     if (!jf_check_keys(scene, "scene.", keys, err))
         return false;
     int preset = (int)s->preset, layout, materials;
@@ -193,7 +248,9 @@ bool scene_spec_parse(const json_t *scene, struct scene_spec *s, struct job_erro
         scene_spec_preset_defaults(s, (enum scene_preset)preset);
     layout = (int)s->light_layout;
     materials = (int)s->materials;
-    if (!jf_get_int(scene, "lights", "scene.lights", 0, SCENE_MAX_LIGHTS, &s->lights, err) ||
+    /* The asset first: whether "lights": "auto" and the asset keys are
+     * allowed depends on it. */
+    if (!parse_asset(scene, s, err) || !parse_lights(scene, s, err) ||
         !jf_get_bool(scene, "dynamic", "scene.dynamic", &s->dynamic, err) ||
         !jf_get_int(scene, "width", "scene.width", 16, 8192, &s->width, err) ||
         !jf_get_int(scene, "height", "scene.height", 16, 8192, &s->height, err) ||
@@ -214,7 +271,15 @@ bool scene_spec_parse(const json_t *scene, struct scene_spec *s, struct job_erro
         !jf_get_number(scene, "shininess", "scene.shininess", 1.0, 4096.0, &s->shininess, err) ||
         !jf_get_number(scene, "metallic", "scene.metallic", 0.0, 1.0, &s->metallic, err) ||
         !jf_get_number(scene, "roughness", "scene.roughness", 0.0, 1.0, &s->roughness, err) ||
-        !parse_camera(scene, s, err) || !parse_asset(scene, s, err))
+        !parse_camera(scene, s, err) || !parse_asset_camera(scene, s, err))
+        return false;
+    if ((json_object_get(scene, "asset_lights") || json_object_get(scene, "normal_maps")) &&
+        !scene_spec_is_asset(s))
+        return job_error_set(err, json_object_get(scene, "asset_lights") ? "scene.asset_lights"
+                                                                         : "scene.normal_maps",
+                             "needs scene.asset or the textured preset");
+    if (!jf_get_bool(scene, "asset_lights", "scene.asset_lights", &s->asset_lights, err) ||
+        !jf_get_bool(scene, "normal_maps", "scene.normal_maps", &s->normal_maps, err))
         return false;
     s->light_layout = (enum scene_light_layout)layout;
     s->materials = (enum scene_materials)materials;
@@ -225,7 +290,8 @@ json_t *scene_spec_to_json(const struct scene_spec *s)
 {
     json_t *o = json_object();
     json_object_set_new(o, "preset", json_string(scene_preset_names[s->preset]));
-    json_object_set_new(o, "lights", json_integer(s->lights));
+    json_object_set_new(o, "lights", s->lights == SCENE_LIGHTS_AUTO ? json_string("auto")
+                                                                    : json_integer(s->lights));
     json_object_set_new(o, "dynamic", json_boolean(s->dynamic));
     json_object_set_new(o, "width", json_integer(s->width));
     json_object_set_new(o, "height", json_integer(s->height));
@@ -252,6 +318,14 @@ json_t *scene_spec_to_json(const struct scene_spec *s)
         json_object_set_new(o, "asset", json_string(s->asset));
         if (s->asset_sha256[0])
             json_object_set_new(o, "asset_sha256", json_string(s->asset_sha256));
+    }
+    if (scene_spec_is_asset(s)) {
+        /* Written only for asset scenes, so the presets' specs (and the
+         * stored records compared against them) are unchanged. */
+        if (s->asset_camera[0])
+            json_object_set_new(o, "asset_camera", json_string(s->asset_camera));
+        json_object_set_new(o, "asset_lights", json_boolean(s->asset_lights));
+        json_object_set_new(o, "normal_maps", json_boolean(s->normal_maps));
     }
     return o;
 }

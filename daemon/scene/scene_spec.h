@@ -16,6 +16,11 @@ enum scene_preset {
     SCENE_PRESET_CHART,   /* spheres by metallic (rows) and roughness (columns) */
     SCENE_PRESET_SPHERE,  /* one sphere in the spec's material: the furnace test's */
     SCENE_PRESET_PLANE,   /* one flat ground filling the frame: no edges (MSAA's test) */
+    /* A textured glTF-style scene built in memory through the asset path
+     * (daemon/scene/asset_synthetic.c): every material feature, one mesh
+     * each, so that every technique's textured and blended paths are tested
+     * without an uploaded file. */
+    SCENE_PRESET_TEXTURED,
 };
 enum scene_light_layout {
     SCENE_LAYOUT_HALTON,    /* the thesis's low-discrepancy spread (Halton 2, 3, 5) */
@@ -42,6 +47,12 @@ enum {
     SCENE_MAX_CAMERA_PERIOD = 1000000,
     SCENE_TEAPOT_SEGMENTS_AUTO = 0, /* teapot_segments "auto" */
     SCENE_ASSET_NAME_MAX = 128,
+    /* scene.lights "auto": an asset scene's default, resolved when the
+     * scene is built (0 generated lights when the asset has lights of its
+     * own, else SCENE_ASSET_DEFAULT_LIGHTS). */
+    SCENE_LIGHTS_AUTO = -1,
+    SCENE_ASSET_DEFAULT_LIGHTS = 16,
+    SCENE_ASSET_CAMERA_MAX = 64,
 };
 
 struct scene_spec {
@@ -66,7 +77,19 @@ struct scene_spec {
      * and a gate never compares two different scenes. */
     char asset[SCENE_ASSET_NAME_MAX + 1];
     char asset_sha256[65];
+    /* Asset scenes (scene.asset or the textured preset): which of the
+     * asset's cameras the static pose is ("" its first; digits an index,
+     * else a name), whether its KHR_lights_punctual lights are used, and
+     * whether normal textures are read (false: every material's normal
+     * texture is ignored, to show what they cost and change). */
+    char asset_camera[SCENE_ASSET_CAMERA_MAX + 1];
+    bool asset_lights;
+    bool normal_maps;
 };
+
+/* True when the scene is built through the asset path (scene.asset, or
+ * the textured preset's synthetic asset). */
+bool scene_spec_is_asset(const struct scene_spec *s);
 
 /* An asset name: 1 to SCENE_ASSET_NAME_MAX bytes of letters, digits, '.',
  * '_' and '-', not starting with '.'. Safe as a file name. */

@@ -10,6 +10,14 @@ uniform int u_instance_base;
 out vec3 v_world;
 out vec3 v_normal;
 flat out int v_instance;
+#if defined(SCENE_TEXTURED)
+// Asset scenes: the material's uv sets and tangent frame (surface.glsl).
+layout(location = 2) in vec2 a_uv; // uv1, the unique parametrisation
+layout(location = 4) in vec2 a_tex; // uv0
+layout(location = 5) in vec4 a_tangent;
+out vec4 v_tex;
+out vec4 v_tangent;
+#endif
 
 void main()
 {
@@ -19,5 +27,9 @@ void main()
     v_world = world;
     v_normal = a_normal; // uniform scale, no rotation: object normal is world normal
     v_instance = id;
+#if defined(SCENE_TEXTURED)
+    v_tex = vec4(a_tex, a_uv);
+    v_tangent = a_tangent; // uniform scale, no rotation, like the normal
+#endif
     gl_Position = u_frame.view_proj * vec4(world, 1.0);
 }

@@ -1,4 +1,10 @@
-// The depth pre-pass: depth only, no colour.
+// The depth pre-pass: depth only, no colour; alpha-masked asset materials
+// discard below their cutoff here as in every pass (surface.glsl).
+#include "surface.glsl"
+
 void main()
 {
+#if defined(SCENE_TEXTURED)
+    surface_alpha_clip();
+#endif
 }

@@ -19,8 +19,14 @@ void main()
     vec3 color = vec3(0.0);
     if (gbuffer_surface(pixel, s)) {
         float d = -(u_frame.view * vec4(s.P, 1.0)).z;
+#if defined(SCENE_TEXTURED)
+        color = shade_cell(grid_cell(gl_FragCoord.xy, d), s.P, s.N, surface_material(s),
+                           s.occlusion, evaluations) +
+                s.emissive;
+#else
         color = shade_cell(grid_cell(gl_FragCoord.xy, d), s.P, s.N, surface_material(s),
                            evaluations);
+#endif
     }
 #ifdef GBUFFER_PER_SAMPLE
     heat_add(pixel, evaluations); // each sample's, over a cleared map

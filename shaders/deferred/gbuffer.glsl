@@ -108,6 +108,10 @@ layout(binding = SB_TEX_DEPTH) uniform msaa_sampler2D u_gbuffer_depth;
 layout(binding = SB_TEX_GBUFFER0) uniform msaa_sampler2D u_gbuffer_albedo;
 layout(binding = SB_TEX_GBUFFER1) uniform msaa_sampler2D u_gbuffer_normal;
 layout(binding = SB_TEX_GBUFFER2) uniform msaa_sampler2D u_gbuffer_material;
+#if defined(SCENE_TEXTURED)
+// Asset scenes' fourth plane: emissive (rgb), occlusion (a), rgba16f.
+layout(binding = SB_TEX_GBUFFER3) uniform msaa_sampler2D u_gbuffer_surface;
+#endif
 #ifdef SB_MSAA_SAMPLES
 // Each sample's position within its pixel (glGetMultisamplefv), and their
 // mean, set at create (gbuffer.c).
@@ -118,6 +122,10 @@ uniform vec2 u_sample_centre;
 struct Surface {
     vec3 P, N, albedo;
     float specular, shininess, metallic, roughness;
+#if defined(SCENE_TEXTURED)
+    vec3 emissive;   // added once, with the ambient term
+    float occlusion; // scales the ambient term only
+#endif
 };
 
 void gbuffer_planes(ivec2 pixel, int i, inout Surface s)
@@ -129,6 +137,11 @@ void gbuffer_planes(ivec2 pixel, int i, inout Surface s)
     s.shininess = m.g;
     s.metallic = m.b;
     s.roughness = m.a;
+#if defined(SCENE_TEXTURED)
+    vec4 e = msaa_fetch(u_gbuffer_surface, pixel, i);
+    s.emissive = e.rgb;
+    s.occlusion = e.a;
+#endif
 }
 
 #ifdef SB_MSAA_SAMPLES
@@ -193,6 +206,9 @@ bool gbuffer_edge(ivec2 pixel)
     vec4 n0 = texelFetch(u_gbuffer_normal, pixel, 0);
     vec4 a0 = texelFetch(u_gbuffer_albedo, pixel, 0);
     vec4 m0 = texelFetch(u_gbuffer_material, pixel, 0);
+#if defined(SCENE_TEXTURED)
+    vec4 e0 = texelFetch(u_gbuffer_surface, pixel, 0);
+#endif
     vec3 P0 = gbuffer_position(vec2(pixel) + u_sample_pos[0], d0);
     vec3 N0 = gbuffer_decode_normal(n0);
     // 24-bit depth is good to about 1e-4 of the distance at the scenes'
@@ -208,6 +224,10 @@ bool gbuffer_edge(ivec2 pixel)
             texelFetch(u_gbuffer_albedo, pixel, i) != a0 ||
             texelFetch(u_gbuffer_material, pixel, i) != m0)
             return true;
+#if defined(SCENE_TEXTURED)
+        if (texelFetch(u_gbuffer_surface, pixel, i) != e0)
+            return true;
+#endif
         vec3 P = gbuffer_position(vec2(pixel) + u_sample_pos[i], d);
         if (abs(dot(P - P0, N0)) > tolerance)
             return true;

@@ -4,9 +4,19 @@
 layout(location = 0) in vec3 a_pos;
 layout(location = SB_LOC_SHADOW_VIEW_PROJ) uniform mat4 u_view_proj;
 layout(location = SB_LOC_SHADOW_INSTANCE) uniform int u_instance;
+#if defined(SCENE_TEXTURED)
+layout(location = 2) in vec2 a_uv;
+layout(location = 4) in vec2 a_tex;
+out vec4 v_tex;
+out vec4 v_tangent;
+#endif
 
 void main()
 {
     Instance inst = instances[u_instance];
+#if defined(SCENE_TEXTURED)
+    v_tex = vec4(a_tex, a_uv);
+    v_tangent = vec4(0.0);
+#endif
     gl_Position = u_view_proj * vec4(inst.pos_scale.xyz + inst.pos_scale.w * a_pos, 1.0);
 }

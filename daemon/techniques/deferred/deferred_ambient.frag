@@ -16,9 +16,20 @@ void main()
 {
     ivec2 pixel = ivec2(gl_FragCoord.xy);
     Surface s;
+#if defined(SCENE_TEXTURED)
+    // Asset materials: occlusion scales the ambient term, emissive is added
+    // here, once (the per-light step adds only lights).
+    out_color = gbuffer_surface(pixel, s)
+                    ? vec4(s.occlusion * light_ambient(surface_material(s), s.P, s.N,
+                                                       normalize(u_frame.eye.xyz - s.P)) +
+                               s.emissive,
+                           1.0)
+                    : vec4(0.0, 0.0, 0.0, 1.0);
+#else
     out_color = gbuffer_surface(pixel, s)
                     ? vec4(light_ambient(surface_material(s), s.P, s.N,
                                          normalize(u_frame.eye.xyz - s.P)), 1.0)
                     : vec4(0.0, 0.0, 0.0, 1.0);
+#endif
     heat_set(pixel, 0u);
 }

@@ -78,6 +78,7 @@ bool culled_create(const struct technique_env *env, const struct culled_config *
             goto fail;
     }
     c->shade[0] = gpu_scene_program(env->gpu, prog);
+    c->shade[0].after_prepass = !c->cfg.deferred;
     c->heat_loc[0] = heat_location(prog);
     return true;
 fail:

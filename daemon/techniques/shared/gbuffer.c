@@ -158,10 +158,15 @@ bool gbuffer_init(struct gbuffer *g, const struct technique_env *env,
                                                              env->height, g->samples, err,
                                                              errlen)
                                     : 0;
-    GLuint planes[3] = {g->albedo_tex, g->normal_tex, g->material_tex};
-    g->fbo = g->material_tex ? gpu_targets_fbo(env->targets, "gbuffer", planes, 3,
-                                               env->output_depth, err, errlen)
-                             : 0;
+    bool textured = env->scene->asset != NULL;
+    if (g->material_tex && textured)
+        g->surface_tex = gpu_targets_texture_ms(env->targets, "gbuffer.surface", GL_RGBA16F,
+                                                env->width, env->height, g->samples, err, errlen);
+    GLuint planes[4] = {g->albedo_tex, g->normal_tex, g->material_tex, g->surface_tex};
+    g->fbo = g->material_tex && (!textured || g->surface_tex)
+                 ? gpu_targets_fbo(env->targets, textured ? "gbuffer.textured" : "gbuffer", planes,
+                                   textured ? 4 : 3, env->output_depth, err, errlen)
+                 : 0;
     if (!g->fbo)
         return false;
     const struct gl_stage stages[] = {
@@ -260,6 +265,8 @@ void gbuffer_draw(const struct gbuffer *g, const struct technique_env *env, int 
     glClearBufferfv(GL_COLOR, 0, zero);
     glClearBufferfv(GL_COLOR, 1, zero);
     glClearBufferfv(GL_COLOR, 2, zero);
+    if (g->surface_tex)
+        glClearBufferfv(GL_COLOR, 3, zero);
     glClear(GL_DEPTH_BUFFER_BIT);
     gpu_scene_bind(env->gpu, &g->program);
     gpu_scene_draw(env->gpu, &g->program);
@@ -277,6 +284,10 @@ void gbuffer_bind(const struct gbuffer *g, const struct technique_env *env)
     glBindTexture(kind, g->normal_tex);
     glActiveTexture(GL_TEXTURE0 + SB_TEX_GBUFFER2);
     glBindTexture(kind, g->material_tex);
+    if (g->surface_tex) {
+        glActiveTexture(GL_TEXTURE0 + SB_TEX_GBUFFER3);
+        glBindTexture(kind, g->surface_tex);
+    }
     glActiveTexture(GL_TEXTURE0);
 }
 
@@ -314,9 +325,13 @@ json_t *gbuffer_describe(const struct gbuffer *g)
                          : "rg32f (specular, shininess)",
                      "bytes_per_pixel",
                      (format_bytes(g->albedo_format) + format_bytes(g->normal_format) +
-                      format_bytes(g->material_format) + 4.0 + (g->samples > 1 ? 4.0 : 0.0)) *
+                      format_bytes(g->material_format) + (g->surface_tex ? 8.0 : 0.0) + 4.0 +
+                      (g->samples > 1 ? 4.0 : 0.0)) *
                          g->samples,
                      "position", "rebuilt from the 24-bit depth texture with inv_view_proj");
     json_object_set_new(d, "msaa", msaa_describe(g, g->pixels));
+    if (g->surface_tex)
+        json_object_set_new(d, "surface_format",
+                            json_string("rgba16f (emissive, occlusion): asset materials"));
     return d;
 }

@@ -27,6 +27,9 @@ struct gbuffer {
     struct gbuffer_options opt;
     GLuint albedo_tex, normal_tex, material_tex, fbo;
     GLenum albedo_format, normal_format, material_format;
+    /* Asset scenes: a fourth plane, emissive and occlusion (rgba16f), what
+     * the textures give beyond the material plane; 0 for the presets. */
+    GLuint surface_tex;
     struct scene_program program;
     /* The layout's #defines and the look's, for every program that reads the
      * g-buffer (pass to gl_program_build). */

@@ -25,6 +25,11 @@
 /* The passes of osl_info, in order. */
 enum { PASS_LIGHTING, PASS_RASTER };
 
+/* Texels filled around an asset's charts: bilinear filtering reaches one
+ * texel past a chart's last centre, and the second covers the raster pass's
+ * seen-margin of moving cameras at the smallest tiles. */
+#define OSL_GUTTER_TEXELS 2
+
 /* Atlas memory ceiling; the device's texture size limit applies as well. */
 static const double OSL_MAX_ATLAS_BYTES = 1024.0 * 1024.0 * 1024.0;
 
@@ -40,6 +45,9 @@ struct osl {
     int geo_w, geo_h, geo_count;
     struct atlas_tile *geo;
     int *geo_entry;
+    /* An asset's entries: texels in all, those no triangle covered, and
+     * those the gutter filling shaded from a chart's edge. */
+    double asset_texels, asset_uncovered, asset_filled;
     GLuint atlas, tile_buffer, work_buffer;
     int atlas_w, atlas_h;
     int groups_x_max;
@@ -187,6 +195,40 @@ static bool plan_geometry(struct osl *o, const struct scene *s, int **sizes_out,
     return true;
 }
 
+/* An asset's uv1 charts are not whole rectangles (the procedural meshes'
+ * are, and the raster pass clamps to them): texels around each chart are
+ * filled from the chart's edge, so that bilinear filtering across the edge
+ * reads about the same surface. Counts what no triangle covered. */
+static bool dilate_entry(struct osl *o, const GLuint scratch[2], int size)
+{
+    size_t texels = (size_t)size * size;
+    float *pos = malloc(texels * 4 * sizeof(float)), *nrm = malloc(texels * 4 * sizeof(float));
+    if (!pos || !nrm) {
+        free(pos);
+        free(nrm);
+        return false;
+    }
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glBindTexture(GL_TEXTURE_2D, scratch[0]);
+    glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, pos);
+    glBindTexture(GL_TEXTURE_2D, scratch[1]);
+    glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, nrm);
+    size_t covered = 0;
+    for (size_t t = 0; t < texels; t++)
+        covered += pos[t * 4 + 3] > 0.0f;
+    o->asset_texels += (double)texels;
+    o->asset_uncovered += (double)(texels - covered);
+    o->asset_filled += (double)osl_dilate_geometry(pos, nrm, size, OSL_GUTTER_TEXELS);
+    glBindTexture(GL_TEXTURE_2D, scratch[0]);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, size, size, GL_RGBA, GL_FLOAT, pos);
+    glBindTexture(GL_TEXTURE_2D, scratch[1]);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, size, size, GL_RGBA, GL_FLOAT, nrm);
+    free(pos);
+    free(nrm);
+    return true;
+}
+
 /* Texture generation: each entry rasterized alone into a scratch texture of
  * its size at the origin, then copied into its place in the geometry
  * atlas. Rendering at the origin keeps every texel the exact sample it was
@@ -251,6 +293,11 @@ static bool generate_textures(struct osl *o, const struct technique_env *env, ch
         glClear(GL_COLOR_BUFFER_BIT);
         glBindVertexArray(env->gpu->vao[m]);
         glDrawElements(GL_TRIANGLES, (GLsizei)s->meshes[m].index_count, GL_UNSIGNED_INT, NULL);
+        if (ok && m >= SCENE_MESH_PROCEDURAL && !dilate_entry(o, scratch, size)) {
+            snprintf(err, errlen, "osl: out of memory filling gutters");
+            ok = false;
+            break;
+        }
         for (int t = 0; t < 2 && ok; t++)
             glCopyImageSubData(scratch[t], GL_TEXTURE_2D, 0, 0, 0, 0, texs[t], GL_TEXTURE_2D, 0,
                                o->geo[e].x, o->geo[e].y, 0, size, size, 1);
@@ -728,6 +775,12 @@ static json_t *osl_describe(void *state)
         "tiles_by_size", tiles, "objects_by_period", periods,
         "initial_shading", "objects", o->initial_objects, "texels", o->initial_texels,
         "texgen_bytes", texgen_bytes);
+    if (d && o->asset_texels > 0)
+        json_object_set_new(d, "asset_charts",
+                            json_pack("{s:f, s:f, s:f, s:i}", "texels", o->asset_texels,
+                                      "uncovered_share", o->asset_uncovered / o->asset_texels,
+                                      "gutter_filled_share", o->asset_filled / o->asset_texels,
+                                      "gutter_texels", OSL_GUTTER_TEXELS));
     if (o->seen_asked && !o->seen && d)
         json_object_set_new(d, "visibility",
                             json_pack("{s:s, s:b, s:s}", "mode", "seen", "active", 0, "why",

@@ -43,7 +43,8 @@
 #define SB_TEX_GBUFFER1 3
 #define SB_TEX_GBUFFER2 4
 #define SB_TEX_OSL_ATLAS 0
-#define SB_TEX_OSL_MESH 1 /* 1 + 2m: position of mesh m, 2 + 2m: normal */
+#define SB_TEX_OSL_GEO_POSITION 1 /* OSL's geometry atlas: object-space positions */
+#define SB_TEX_OSL_GEO_NORMAL 2   /* and normals */
 #define SB_TEX_POST_SRC 0    /* post effects: the colour the effect reads */
 #define SB_TEX_POST_DEPTH 1  /* the technique's depth texture */
 #define SB_TEX_POST_NORMAL 2 /* the technique's g-buffer normals, when it has them */

@@ -150,8 +150,44 @@ static void test_plan(void)
     free(plan);
 }
 
+/* A triangle covering the texels x + y <= 6 of an 8x8 entry: a pass fills
+ * the uncovered texels with a covered 8-neighbour (two diagonals) with the
+ * neighbours' mean; the next pass two more; covered texels never change. */
+static void test_dilate(void)
+{
+    enum { S = 8 };
+    float pos[S * S * 4] = {0}, nrm[S * S * 4] = {0};
+    for (int y = 0; y < S; y++)
+        for (int x = 0; x < S; x++)
+            if (x + y < S - 1) { /* below the anti-diagonal */
+                float *p = &pos[(y * S + x) * 4], *n = &nrm[(y * S + x) * 4];
+                p[0] = (float)x, p[1] = (float)y, p[2] = 0.0f, p[3] = 1.0f;
+                n[2] = 1.0f;
+            }
+    long first = osl_dilate_geometry(pos, nrm, S, 1);
+    CHECK(first == 15); /* x + y == 7 (8 texels) and x + y == 8 (7) */
+    for (int y = 0; y < S; y++)
+        for (int x = 0; x < S; x++) {
+            const float *p = &pos[(y * S + x) * 4];
+            CHECK((p[3] == 1.0f) == (x + y <= S));
+            if (x + y < S - 1)
+                CHECK(p[0] == (float)x && p[1] == (float)y);
+            if (x + y == S - 1)
+                CHECK(nrm[(y * S + x) * 4 + 2] == 1.0f);
+        }
+    /* Texel (7, 0)'s covered neighbours were (6, 0) and (6, 1): x mean 6. */
+    CHECK(pos[(0 * S + 7) * 4 + 0] == 6.0f);
+    /* Texel (7, 1)'s only covered neighbour was (6, 0). */
+    CHECK(pos[(1 * S + 7) * 4 + 0] == 6.0f && pos[(1 * S + 7) * 4 + 1] == 0.0f);
+    CHECK(osl_dilate_geometry(pos, nrm, S, 1) == 11); /* x + y == 9 and 10 */
+    CHECK(osl_dilate_geometry(pos, nrm, S, 8) == 10); /* the rest, then nothing left */
+    float none[S * S * 4] = {0}, none_n[S * S * 4] = {0};
+    CHECK(osl_dilate_geometry(none, none_n, S, 4) == 0);
+}
+
 int main(void)
 {
+    test_dilate();
     test_atlas();
     test_schedule();
     test_plan();

@@ -25,9 +25,10 @@
 /* The passes of osl_info, in order. */
 enum { PASS_LIGHTING, PASS_RASTER };
 
-/* osl_light.comp has one position and one normal sampler per
- * mesh and selects them by branch: keep both in step. */
-_Static_assert(SCENE_MESH_PROCEDURAL == 4, "osl_light.comp samples exactly four meshes");
+/* Texels filled around an asset's charts: bilinear filtering reaches one
+ * texel past a chart's last centre, and the second covers the raster pass's
+ * seen-margin of moving cameras at the smallest tiles. */
+#define OSL_GUTTER_TEXELS 2
 
 /* Atlas memory ceiling; the device's texture size limit applies as well. */
 static const double OSL_MAX_ATLAS_BYTES = 1024.0 * 1024.0 * 1024.0;
@@ -37,8 +38,16 @@ struct osl {
     struct scene_program light, draw;
     GLint work_count_loc, groups_x_loc; /* the lighting pass's per-frame uniforms */
     GLint group_base_loc, group_end_loc;
-    GLuint position_tex[SCENE_MESH_PROCEDURAL], normal_tex[SCENE_MESH_PROCEDURAL];
-    int base_size[SCENE_MESH_PROCEDURAL]; /* level 0 edge of each mesh's textures */
+    /* The geometry atlas: each mesh's object-space position and normal,
+     * rasterized in its UV space once per tile size in use (an entry), the
+     * entries packed side by side; geo_entry[i] is instance i's. */
+    GLuint geo_position, geo_normal;
+    int geo_w, geo_h, geo_count;
+    struct atlas_tile *geo;
+    int *geo_entry;
+    /* An asset's entries: texels in all, those no triangle covered, and
+     * those the gutter filling shaded from a chart's edge. */
+    double asset_texels, asset_uncovered, asset_filled;
     GLuint atlas, tile_buffer, work_buffer;
     int atlas_w, atlas_h;
     int groups_x_max;
@@ -87,14 +96,6 @@ struct osl {
 
 /* Blocks around a seen one that are shaded too, for a camera that moves. */
 #define OSL_SEEN_MARGIN(o) ((o)->camera_moves ? 1 : 0)
-
-static int log2i(int v)
-{
-    int l = 0;
-    while ((1 << (l + 1)) <= v)
-        l++;
-    return l;
-}
 
 static bool check_limits(struct osl *o, const struct technique_env *env, int *max_tex,
                          char *err, size_t errlen)
@@ -160,10 +161,111 @@ static bool choose_tiles(struct osl *o, const struct technique_env *env, int max
     return ok;
 }
 
-static bool generate_textures(struct osl *o, const struct technique_env *env)
+/* The geometry entries: one per (mesh, tile size) in use, in mesh order
+ * then size order, so the same scene always packs the same way. */
+static bool plan_geometry(struct osl *o, const struct scene *s, int **sizes_out, int **mesh_out)
+{
+    int n = s->instance_count;
+    int *sizes = malloc((size_t)(n ? n : 1) * sizeof(int));
+    int *mesh = malloc((size_t)(n ? n : 1) * sizeof(int));
+    o->geo_entry = malloc((size_t)(n ? n : 1) * sizeof(int));
+    if (!sizes || !mesh || !o->geo_entry) {
+        free(sizes);
+        free(mesh);
+        return false;
+    }
+    int count = 0;
+    for (int m = 0; m < s->mesh_count; m++)
+        for (int size = OSL_TILE_MAX; size >= 1; size >>= 1) {
+            int entry = -1;
+            for (int i = 0; i < n; i++) {
+                if (s->instances[i].mesh != m || o->tiles[i].size != size)
+                    continue;
+                if (entry < 0) {
+                    entry = count++;
+                    sizes[entry] = size;
+                    mesh[entry] = m;
+                }
+                o->geo_entry[i] = entry;
+            }
+        }
+    o->geo_count = count;
+    *sizes_out = sizes;
+    *mesh_out = mesh;
+    return true;
+}
+
+/* An asset's uv1 charts are not whole rectangles (the procedural meshes'
+ * are, and the raster pass clamps to them): texels around each chart are
+ * filled from the chart's edge, so that bilinear filtering across the edge
+ * reads about the same surface. Counts what no triangle covered. */
+static bool dilate_entry(struct osl *o, const GLuint scratch[2], int size)
+{
+    size_t texels = (size_t)size * size;
+    float *pos = malloc(texels * 4 * sizeof(float)), *nrm = malloc(texels * 4 * sizeof(float));
+    if (!pos || !nrm) {
+        free(pos);
+        free(nrm);
+        return false;
+    }
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glBindTexture(GL_TEXTURE_2D, scratch[0]);
+    glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, pos);
+    glBindTexture(GL_TEXTURE_2D, scratch[1]);
+    glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, nrm);
+    size_t covered = 0;
+    for (size_t t = 0; t < texels; t++)
+        covered += pos[t * 4 + 3] > 0.0f;
+    o->asset_texels += (double)texels;
+    o->asset_uncovered += (double)(texels - covered);
+    o->asset_filled += (double)osl_dilate_geometry(pos, nrm, size, OSL_GUTTER_TEXELS);
+    glBindTexture(GL_TEXTURE_2D, scratch[0]);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, size, size, GL_RGBA, GL_FLOAT, pos);
+    glBindTexture(GL_TEXTURE_2D, scratch[1]);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, size, size, GL_RGBA, GL_FLOAT, nrm);
+    free(pos);
+    free(nrm);
+    return true;
+}
+
+/* Texture generation: each entry rasterized alone into a scratch texture of
+ * its size at the origin, then copied into its place in the geometry
+ * atlas. Rendering at the origin keeps every texel the exact sample it was
+ * when each mesh had textures of its own (a viewport offset into a larger
+ * target would round window coordinates differently). */
+static bool generate_textures(struct osl *o, const struct technique_env *env, char *err,
+                              size_t errlen)
 {
     const struct scene *s = env->scene;
-    GLuint fbo;
+    int *sizes = NULL, *mesh = NULL;
+    if (!plan_geometry(o, s, &sizes, &mesh)) {
+        snprintf(err, errlen, "osl: out of memory");
+        return false;
+    }
+    o->geo = calloc((size_t)(o->geo_count ? o->geo_count : 1), sizeof(*o->geo));
+    GLint max_tex = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
+    /* 32 bytes a texel (two RGBA32F), against the packer's 4. */
+    bool ok = o->geo && osl_atlas_pack(sizes, o->geo_count, max_tex, 1024.0 * 1024.0 * 1024.0 / 8.0,
+                                       o->geo, &o->geo_w, &o->geo_h, err, errlen);
+    if (!ok) {
+        if (!o->geo)
+            snprintf(err, errlen, "osl: out of memory");
+        free(sizes);
+        free(mesh);
+        return false;
+    }
+    GLuint texs[2], scratch[2] = {0, 0}, fbo;
+    glGenTextures(2, texs);
+    o->geo_position = texs[0];
+    o->geo_normal = texs[1];
+    for (int t = 0; t < 2; t++) {
+        glBindTexture(GL_TEXTURE_2D, texs[t]);
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, o->geo_w, o->geo_h);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    }
     glGenFramebuffers(1, &fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glDisable(GL_DEPTH_TEST);
@@ -171,50 +273,43 @@ static bool generate_textures(struct osl *o, const struct technique_env *env)
     glUseProgram(o->texgen_prog);
     static const GLenum bufs[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
     glDrawBuffers(2, bufs);
-    bool ok = true;
-    for (int m = 0; m < SCENE_MESH_PROCEDURAL && ok; m++) {
-        int base = 0, smallest = OSL_TILE_MAX;
-        for (int i = 0; i < s->instance_count; i++)
-            if ((int)s->instances[i].mesh == m) {
-                if (o->tiles[i].size > base)
-                    base = o->tiles[i].size;
-                if (o->tiles[i].size < smallest)
-                    smallest = o->tiles[i].size;
+    int scratch_size = 0;
+    for (int e = 0; e < o->geo_count && ok; e++) {
+        int size = sizes[e], m = mesh[e];
+        if (size != scratch_size) {
+            glDeleteTextures(2, scratch);
+            glGenTextures(2, scratch);
+            for (int t = 0; t < 2; t++) {
+                glBindTexture(GL_TEXTURE_2D, scratch[t]);
+                glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, size, size);
             }
-        if (!base)
-            continue;
-        o->base_size[m] = base;
-        int levels = log2i(base) - log2i(smallest) + 1;
-        glGenTextures(1, &o->position_tex[m]);
-        glGenTextures(1, &o->normal_tex[m]);
-        GLuint texs[2] = {o->position_tex[m], o->normal_tex[m]};
-        for (int t = 0; t < 2; t++) {
-            glBindTexture(GL_TEXTURE_2D, texs[t]);
-            glTexStorage2D(GL_TEXTURE_2D, levels, GL_RGBA32F, base, base);
-            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST_MIPMAP_NEAREST);
-            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+            scratch_size = size;
         }
-        /* One rasterization per tile size in use: a level is its own UV-space
-         * render, never a filtered copy, so every texel is an exact sample. */
-        for (int l = 0; l < levels && ok; l++) {
-            int size = base >> l;
-            bool used = false;
-            for (int i = 0; i < s->instance_count && !used; i++)
-                used = (int)s->instances[i].mesh == m && o->tiles[i].size == size;
-            if (!used)
-                continue;
-            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texs[0], l);
-            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, texs[1], l);
-            ok = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
-            glViewport(0, 0, size, size);
-            glClearColor(0, 0, 0, 0);
-            glClear(GL_COLOR_BUFFER_BIT);
-            glBindVertexArray(env->gpu->vao[m]);
-            glDrawElements(GL_TRIANGLES, (GLsizei)s->meshes[m].index_count, GL_UNSIGNED_INT, NULL);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, scratch[0], 0);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, scratch[1], 0);
+        ok = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+        glViewport(0, 0, size, size);
+        glClearColor(0, 0, 0, 0);
+        glClear(GL_COLOR_BUFFER_BIT);
+        glBindVertexArray(env->gpu->vao[m]);
+        glDrawElements(GL_TRIANGLES, (GLsizei)s->meshes[m].index_count, GL_UNSIGNED_INT, NULL);
+        if (ok && m >= SCENE_MESH_PROCEDURAL && !dilate_entry(o, scratch, size)) {
+            snprintf(err, errlen, "osl: out of memory filling gutters");
+            ok = false;
+            break;
         }
+        for (int t = 0; t < 2 && ok; t++)
+            glCopyImageSubData(scratch[t], GL_TEXTURE_2D, 0, 0, 0, 0, texs[t], GL_TEXTURE_2D, 0,
+                               o->geo[e].x, o->geo[e].y, 0, size, size, 1);
     }
+    glDeleteTextures(2, scratch);
     glBindVertexArray(0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glDeleteFramebuffers(1, &fbo);
+    free(sizes);
+    free(mesh);
+    if (!ok)
+        snprintf(err, errlen, "osl: texture generation framebuffer incomplete");
     return ok;
 }
 
@@ -225,12 +320,10 @@ static void bind_light_inputs(const struct osl *o, const struct technique_env *e
     gpu_scene_bind(env->gpu, &o->light);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_TILES, o->tile_buffer);
     glBindImageTexture(SB_IMG_OSL_ATLAS, o->atlas, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
-    for (int m = 0; m < SCENE_MESH_PROCEDURAL; m++) {
-        glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_MESH + m * 2);
-        glBindTexture(GL_TEXTURE_2D, o->position_tex[m]);
-        glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_MESH + 1 + m * 2);
-        glBindTexture(GL_TEXTURE_2D, o->normal_tex[m]);
-    }
+    glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_GEO_POSITION);
+    glBindTexture(GL_TEXTURE_2D, o->geo_position);
+    glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_GEO_NORMAL);
+    glBindTexture(GL_TEXTURE_2D, o->geo_normal);
     glActiveTexture(GL_TEXTURE0);
 }
 
@@ -412,11 +505,6 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
 {
     const struct scene *s = env->scene;
     int n = s->instance_count;
-    if (s->mesh_count > SCENE_MESH_PROCEDURAL) {
-        snprintf(err, errlen, "osl: scenes from assets (scene.asset) are not supported yet: "
-                 "the lighting pass samples the four procedural meshes only");
-        return false;
-    }
     struct osl *o = calloc(1, sizeof(*o));
     if (!o)
         goto oom;
@@ -473,23 +561,16 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
     o->groups_x_loc = glGetUniformLocation(light_prog, "u_groups_x");
     o->group_base_loc = glGetUniformLocation(light_prog, "u_group_base");
     o->group_end_loc = glGetUniformLocation(light_prog, "u_group_end");
-    /* Texture units never change: position and normal of mesh m on units
-     * 1 + 2m and 2 + 2m for the lighting pass, the atlas on unit 0. */
-    for (int m = 0; m < SCENE_MESH_PROCEDURAL; m++) {
-        char name[32];
-        snprintf(name, sizeof(name), "u_position[%d]", m);
-        glProgramUniform1i(light_prog, glGetUniformLocation(light_prog, name),
-                           SB_TEX_OSL_MESH + m * 2);
-        snprintf(name, sizeof(name), "u_normal[%d]", m);
-        glProgramUniform1i(light_prog, glGetUniformLocation(light_prog, name),
-                           SB_TEX_OSL_MESH + 1 + m * 2);
-    }
+    /* Texture units never change: the geometry atlas for the lighting
+     * pass, the shading atlas on unit 0 for the raster pass. */
+    glProgramUniform1i(light_prog, glGetUniformLocation(light_prog, "u_position"),
+                       SB_TEX_OSL_GEO_POSITION);
+    glProgramUniform1i(light_prog, glGetUniformLocation(light_prog, "u_normal"),
+                       SB_TEX_OSL_GEO_NORMAL);
     glProgramUniform1i(draw_prog, glGetUniformLocation(draw_prog, "u_atlas"), SB_TEX_OSL_ATLAS);
 
-    if (!generate_textures(o, env)) {
-        snprintf(err, errlen, "osl: texture generation framebuffer incomplete");
+    if (!generate_textures(o, env, err, errlen))
         goto fail;
-    }
     glGenTextures(1, &o->atlas);
     glBindTexture(GL_TEXTURE_2D, o->atlas);
     glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA8, o->atlas_w, o->atlas_h);
@@ -504,11 +585,13 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
     if (!tile_data)
         goto oom;
     for (int i = 0; i < n; i++) {
-        int m = s->instances[i].mesh;
+        const struct atlas_tile *geo = &o->geo[o->geo_entry[i]];
         tile_data[i * 4 + 0] = o->tiles[i].x;
         tile_data[i * 4 + 1] = o->tiles[i].y;
         tile_data[i * 4 + 2] = o->tiles[i].size;
-        tile_data[i * 4 + 3] = log2i(o->base_size[m]) - log2i(o->tiles[i].size);
+        /* Where the instance's geometry lies in the geometry atlas, packed
+         * as x + y * 65536 (both below the device's texture size). */
+        tile_data[i * 4 + 3] = geo->x + geo->y * 65536;
     }
     glGenBuffers(1, &o->tile_buffer);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, o->tile_buffer);
@@ -680,9 +763,7 @@ static json_t *osl_describe(void *state)
         o->texels_max = 64.0 * stats[5];
         o->stale_blocks = stats[6];
     }
-    double texgen_bytes = 0;
-    for (int m = 0; m < SCENE_MESH_PROCEDURAL; m++)
-        texgen_bytes += o->base_size[m] ? 2.0 * 16.0 * o->base_size[m] * o->base_size[m] * 4.0 / 3.0 : 0;
+    double texgen_bytes = 2.0 * 16.0 * o->geo_w * o->geo_h;
     json_t *d = json_pack(
         "{s:{s:f, s:i}, s:{s:f, s:f, s:f}, s:{s:i, s:i, s:f, s:f, s:f}, s:o, s:o, s:{s:i, s:f}, s:f}",
         "objects_reshaded_per_frame", "mean", o->reshaded_sum / frames, "max", o->reshaded_max,
@@ -694,6 +775,12 @@ static json_t *osl_describe(void *state)
         "tiles_by_size", tiles, "objects_by_period", periods,
         "initial_shading", "objects", o->initial_objects, "texels", o->initial_texels,
         "texgen_bytes", texgen_bytes);
+    if (d && o->asset_texels > 0)
+        json_object_set_new(d, "asset_charts",
+                            json_pack("{s:f, s:f, s:f, s:i}", "texels", o->asset_texels,
+                                      "uncovered_share", o->asset_uncovered / o->asset_texels,
+                                      "gutter_filled_share", o->asset_filled / o->asset_texels,
+                                      "gutter_texels", OSL_GUTTER_TEXELS));
     if (o->seen_asked && !o->seen && d)
         json_object_set_new(d, "visibility",
                             json_pack("{s:s, s:b, s:s}", "mode", "seen", "active", 0, "why",
@@ -724,8 +811,10 @@ static void osl_destroy(void *state)
     glDeleteProgram(o->texgen_prog);
     glDeleteProgram(o->light.prog);
     glDeleteProgram(o->draw.prog);
-    glDeleteTextures(SCENE_MESH_PROCEDURAL, o->position_tex);
-    glDeleteTextures(SCENE_MESH_PROCEDURAL, o->normal_tex);
+    glDeleteTextures(1, &o->geo_position);
+    glDeleteTextures(1, &o->geo_normal);
+    free(o->geo);
+    free(o->geo_entry);
     glDeleteTextures(1, &o->atlas);
     glDeleteBuffers(1, &o->tile_buffer);
     glDeleteBuffers(1, &o->work_buffer);

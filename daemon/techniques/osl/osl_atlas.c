@@ -59,3 +59,52 @@ int osl_auto_tile_size(double pixels_per_unit, double uv_per_unit, double texel_
         return OSL_TILE_MIN;
     return size > OSL_TILE_MAX ? OSL_TILE_MAX : size;
 }
+
+long osl_dilate_geometry(float *pos, float *nrm, int size, int passes)
+{
+    long filled = 0;
+    for (int pass = 0; pass < passes; pass++) {
+        /* Coverage as the pass found it: w == 1 marks covered; texels this
+         * pass fills are marked 2 until the pass ends. */
+        long this_pass = 0;
+        for (int y = 0; y < size; y++)
+            for (int x = 0; x < size; x++) {
+                float *p = &pos[((size_t)y * size + x) * 4];
+                if (p[3] != 0.0f)
+                    continue;
+                float ps[3] = {0, 0, 0}, ns[3] = {0, 0, 0};
+                int n = 0;
+                for (int dy = -1; dy <= 1; dy++)
+                    for (int dx = -1; dx <= 1; dx++) {
+                        int qx = x + dx, qy = y + dy;
+                        if ((!dx && !dy) || qx < 0 || qy < 0 || qx >= size || qy >= size)
+                            continue;
+                        const float *q = &pos[((size_t)qy * size + qx) * 4];
+                        if (q[3] != 1.0f)
+                            continue;
+                        const float *m = &nrm[((size_t)qy * size + qx) * 4];
+                        for (int k = 0; k < 3; k++)
+                            ps[k] += q[k], ns[k] += m[k];
+                        n++;
+                    }
+                if (!n)
+                    continue;
+                float len = sqrtf(ns[0] * ns[0] + ns[1] * ns[1] + ns[2] * ns[2]);
+                float *m = &nrm[((size_t)y * size + x) * 4];
+                for (int k = 0; k < 3; k++) {
+                    p[k] = ps[k] / (float)n;
+                    m[k] = len > 0.0f ? ns[k] / len : 0.0f;
+                }
+                p[3] = 2.0f;
+                m[3] = 0.0f;
+                this_pass++;
+            }
+        for (size_t t = 0; t < (size_t)size * size; t++)
+            if (pos[t * 4 + 3] == 2.0f)
+                pos[t * 4 + 3] = 1.0f;
+        filled += this_pass;
+        if (!this_pass)
+            break;
+    }
+    return filled;
+}

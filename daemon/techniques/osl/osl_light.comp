@@ -8,14 +8,16 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std430, binding = SB_SSBO_OSL_TILES) readonly buffer TileBuffer { ivec4 tiles[]; };   // x, y, size, level
+// x, y, size, and where the object's geometry lies in the geometry atlas
+// (x + 65536 y).
+layout(std430, binding = SB_SSBO_OSL_TILES) readonly buffer TileBuffer { ivec4 tiles[]; };
 layout(std430, binding = SB_SSBO_OSL_WORK) readonly buffer WorkBuffer { uvec4 work[]; };
 layout(rgba8, binding = SB_IMG_OSL_ATLAS) writeonly uniform image2D u_atlas;
 
-// Per mesh (SCENE_MESH_COUNT: sphere, cube, plane, teapot); mip level l
-// holds tiles of size base >> l.
-uniform sampler2D u_position[4];
-uniform sampler2D u_normal[4];
+// The geometry atlas: every mesh's object-space position (w = 1 where a
+// texel is covered) and normal, once per tile size in use.
+uniform sampler2D u_position;
+uniform sampler2D u_normal;
 uniform int u_work_count;
 uniform int u_groups_x;
 // The dispatch may cover a range of the blocks only (bounded submissions,
@@ -64,22 +66,9 @@ void main()
 #endif
 
     Instance inst = instances[instance];
-    vec4 p, n;
-    // The mesh differs between groups of one dispatch, so no dynamic indexing.
-    int mesh = int(inst.albedo_mesh.w);
-    if (mesh == 0) {
-        p = texelFetch(u_position[0], texel, tile.w);
-        n = texelFetch(u_normal[0], texel, tile.w);
-    } else if (mesh == 1) {
-        p = texelFetch(u_position[1], texel, tile.w);
-        n = texelFetch(u_normal[1], texel, tile.w);
-    } else if (mesh == 2) {
-        p = texelFetch(u_position[2], texel, tile.w);
-        n = texelFetch(u_normal[2], texel, tile.w);
-    } else {
-        p = texelFetch(u_position[3], texel, tile.w);
-        n = texelFetch(u_normal[3], texel, tile.w);
-    }
+    ivec2 geo = ivec2(tile.w & 0xffff, tile.w >> 16) + texel;
+    vec4 p = texelFetch(u_position, geo, 0);
+    vec4 n = texelFetch(u_normal, geo, 0);
     vec3 color = vec3(0.0);
     if (p.w > 0.0) {
         vec3 world = inst.pos_scale.xyz + inst.pos_scale.w * p.xyz;

@@ -45,6 +45,8 @@
 #define SB_TEX_OSL_ATLAS 0
 #define SB_TEX_OSL_GEO_POSITION 1 /* OSL's geometry atlas: object-space positions */
 #define SB_TEX_OSL_GEO_NORMAL 2   /* and normals */
+#define SB_TEX_OSL_GEO_ALBEDO 3   /* asset scenes: base colour and roughness baked */
+#define SB_TEX_OSL_GEO_SURFACE 4  /* and emissive and occlusion */
 #define SB_TEX_POST_SRC 0    /* post effects: the colour the effect reads */
 #define SB_TEX_POST_DEPTH 1  /* the technique's depth texture */
 #define SB_TEX_POST_NORMAL 2 /* the technique's g-buffer normals, when it has them */

@@ -30,6 +30,10 @@ enum { PASS_LIGHTING, PASS_RASTER };
  * seen-margin of moving cameras at the smallest tiles. */
 #define OSL_GUTTER_TEXELS 2
 
+/* The geometry atlas's channels: position, normal and, in asset scenes,
+ * the baked albedo and surface (osl_texgen.frag). */
+#define OSL_GEO_CHANNELS 4
+
 /* Atlas memory ceiling; the device's texture size limit applies as well. */
 static const double OSL_MAX_ATLAS_BYTES = 1024.0 * 1024.0 * 1024.0;
 
@@ -42,6 +46,9 @@ struct osl {
      * rasterized in its UV space once per tile size in use (an entry), the
      * entries packed side by side; geo_entry[i] is instance i's. */
     GLuint geo_position, geo_normal;
+    /* Asset scenes: the material baked beside them (osl_texgen.frag). */
+    bool textured;
+    GLuint geo_albedo, geo_surface;
     int geo_w, geo_h, geo_count;
     struct atlas_tile *geo;
     int *geo_entry;
@@ -199,41 +206,44 @@ static bool plan_geometry(struct osl *o, const struct scene *s, int **sizes_out,
  * are, and the raster pass clamps to them): texels around each chart are
  * filled from the chart's edge, so that bilinear filtering across the edge
  * reads about the same surface. Counts what no triangle covered. */
-static bool dilate_entry(struct osl *o, const GLuint scratch[2], int size)
+static bool dilate_entry(struct osl *o, const GLuint *scratch, int channels, int size)
 {
     size_t texels = (size_t)size * size;
-    float *pos = malloc(texels * 4 * sizeof(float)), *nrm = malloc(texels * 4 * sizeof(float));
-    if (!pos || !nrm) {
-        free(pos);
-        free(nrm);
-        return false;
+    float *img[OSL_GEO_CHANNELS] = {NULL};
+    bool ok = true;
+    for (int c = 0; c < channels; c++)
+        ok = ok && (img[c] = malloc(texels * 4 * sizeof(float)));
+    if (ok) {
+        glPixelStorei(GL_PACK_ALIGNMENT, 4);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        for (int c = 0; c < channels; c++) {
+            glBindTexture(GL_TEXTURE_2D, scratch[c]);
+            glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, img[c]);
+        }
+        size_t covered = 0;
+        for (size_t t = 0; t < texels; t++)
+            covered += img[0][t * 4 + 3] > 0.0f;
+        o->asset_texels += (double)texels;
+        o->asset_uncovered += (double)(texels - covered);
+        o->asset_filled += (double)osl_dilate_geometry(img[0], img[1], img + 2, channels - 2, size,
+                                                       OSL_GUTTER_TEXELS);
+        for (int c = 0; c < channels; c++) {
+            glBindTexture(GL_TEXTURE_2D, scratch[c]);
+            glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, size, size, GL_RGBA, GL_FLOAT, img[c]);
+        }
     }
-    glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glBindTexture(GL_TEXTURE_2D, scratch[0]);
-    glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, pos);
-    glBindTexture(GL_TEXTURE_2D, scratch[1]);
-    glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, nrm);
-    size_t covered = 0;
-    for (size_t t = 0; t < texels; t++)
-        covered += pos[t * 4 + 3] > 0.0f;
-    o->asset_texels += (double)texels;
-    o->asset_uncovered += (double)(texels - covered);
-    o->asset_filled += (double)osl_dilate_geometry(pos, nrm, size, OSL_GUTTER_TEXELS);
-    glBindTexture(GL_TEXTURE_2D, scratch[0]);
-    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, size, size, GL_RGBA, GL_FLOAT, pos);
-    glBindTexture(GL_TEXTURE_2D, scratch[1]);
-    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, size, size, GL_RGBA, GL_FLOAT, nrm);
-    free(pos);
-    free(nrm);
-    return true;
+    for (int c = 0; c < channels; c++)
+        free(img[c]);
+    return ok;
 }
 
-/* Texture generation: each entry rasterized alone into a scratch texture of
+/* Texture generation: each entry rasterized alone into a scratch target of
  * its size at the origin, then copied into its place in the geometry
  * atlas. Rendering at the origin keeps every texel the exact sample it was
  * when each mesh had textures of its own (a viewport offset into a larger
- * target would round window coordinates differently). */
+ * target would round window coordinates differently). Asset scenes bake
+ * their materials into two more channels, each entry with its mesh's
+ * material bound. */
 static bool generate_textures(struct osl *o, const struct technique_env *env, char *err,
                               size_t errlen)
 {
@@ -243,12 +253,14 @@ static bool generate_textures(struct osl *o, const struct technique_env *env, ch
         snprintf(err, errlen, "osl: out of memory");
         return false;
     }
+    int channels = o->textured ? 4 : 2;
     o->geo = calloc((size_t)(o->geo_count ? o->geo_count : 1), sizeof(*o->geo));
     GLint max_tex = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
-    /* 32 bytes a texel (two RGBA32F), against the packer's 4. */
-    bool ok = o->geo && osl_atlas_pack(sizes, o->geo_count, max_tex, 1024.0 * 1024.0 * 1024.0 / 8.0,
-                                       o->geo, &o->geo_w, &o->geo_h, err, errlen);
+    /* 16 bytes a channel's texel (RGBA32F), against the packer's 4. */
+    bool ok = o->geo && osl_atlas_pack(sizes, o->geo_count, max_tex,
+                                       1024.0 * 1024.0 * 1024.0 / (4.0 * channels), o->geo,
+                                       &o->geo_w, &o->geo_h, err, errlen);
     if (!ok) {
         if (!o->geo)
             snprintf(err, errlen, "osl: out of memory");
@@ -256,11 +268,13 @@ static bool generate_textures(struct osl *o, const struct technique_env *env, ch
         free(mesh);
         return false;
     }
-    GLuint texs[2], scratch[2] = {0, 0}, fbo;
-    glGenTextures(2, texs);
+    GLuint texs[OSL_GEO_CHANNELS] = {0}, scratch[OSL_GEO_CHANNELS] = {0}, fbo;
+    glGenTextures(channels, texs);
     o->geo_position = texs[0];
     o->geo_normal = texs[1];
-    for (int t = 0; t < 2; t++) {
+    o->geo_albedo = texs[2];
+    o->geo_surface = texs[3];
+    for (int t = 0; t < channels; t++) {
         glBindTexture(GL_TEXTURE_2D, texs[t]);
         glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, o->geo_w, o->geo_h);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
@@ -270,46 +284,53 @@ static bool generate_textures(struct osl *o, const struct technique_env *env, ch
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
-    glUseProgram(o->texgen_prog);
-    static const GLenum bufs[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-    glDrawBuffers(2, bufs);
+    struct scene_program texgen = gpu_scene_program(env->gpu, o->texgen_prog);
+    gpu_scene_bind(env->gpu, &texgen);
+    static const GLenum bufs[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1,
+                                  GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3};
+    glDrawBuffers(channels, bufs);
     int scratch_size = 0;
     for (int e = 0; e < o->geo_count && ok; e++) {
         int size = sizes[e], m = mesh[e];
         if (size != scratch_size) {
-            glDeleteTextures(2, scratch);
-            glGenTextures(2, scratch);
-            for (int t = 0; t < 2; t++) {
+            glDeleteTextures(channels, scratch);
+            glGenTextures(channels, scratch);
+            for (int t = 0; t < channels; t++) {
                 glBindTexture(GL_TEXTURE_2D, scratch[t]);
                 glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, size, size);
             }
             scratch_size = size;
         }
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, scratch[0], 0);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, scratch[1], 0);
+        for (int t = 0; t < channels; t++)
+            glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0 + (GLenum)t, GL_TEXTURE_2D,
+                                   scratch[t], 0);
         ok = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+        if (!ok) {
+            snprintf(err, errlen, "osl: texture generation framebuffer incomplete");
+            break;
+        }
         glViewport(0, 0, size, size);
         glClearColor(0, 0, 0, 0);
         glClear(GL_COLOR_BUFFER_BIT);
+        if (o->textured)
+            gpu_scene_bind_material(env->gpu, m, SB_LOC_MATERIAL);
         glBindVertexArray(env->gpu->vao[m]);
         glDrawElements(GL_TRIANGLES, (GLsizei)s->meshes[m].index_count, GL_UNSIGNED_INT, NULL);
-        if (ok && m >= SCENE_MESH_PROCEDURAL && !dilate_entry(o, scratch, size)) {
+        if (m >= SCENE_MESH_PROCEDURAL && !dilate_entry(o, scratch, channels, size)) {
             snprintf(err, errlen, "osl: out of memory filling gutters");
             ok = false;
             break;
         }
-        for (int t = 0; t < 2 && ok; t++)
+        for (int t = 0; t < channels; t++)
             glCopyImageSubData(scratch[t], GL_TEXTURE_2D, 0, 0, 0, 0, texs[t], GL_TEXTURE_2D, 0,
                                o->geo[e].x, o->geo[e].y, 0, size, size, 1);
     }
-    glDeleteTextures(2, scratch);
+    glDeleteTextures(channels, scratch);
     glBindVertexArray(0);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glDeleteFramebuffers(1, &fbo);
     free(sizes);
     free(mesh);
-    if (!ok)
-        snprintf(err, errlen, "osl: texture generation framebuffer incomplete");
     return ok;
 }
 
@@ -324,6 +345,12 @@ static void bind_light_inputs(const struct osl *o, const struct technique_env *e
     glBindTexture(GL_TEXTURE_2D, o->geo_position);
     glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_GEO_NORMAL);
     glBindTexture(GL_TEXTURE_2D, o->geo_normal);
+    if (o->textured) {
+        glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_GEO_ALBEDO);
+        glBindTexture(GL_TEXTURE_2D, o->geo_albedo);
+        glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_GEO_SURFACE);
+        glBindTexture(GL_TEXTURE_2D, o->geo_surface);
+    }
     glActiveTexture(GL_TEXTURE0);
 }
 
@@ -409,8 +436,10 @@ static bool seen_create(struct osl *o, const struct technique_env *env, char *er
         {GL_VERTEX_SHADER, {"osl_draw.vert"}},
         {GL_FRAGMENT_SHADER, {"osl_draw.frag"}},
     };
-    GLuint mark_prog = gl_program_build("osl draw (marking)", draw, 2, "#define OSL_SEEN 1\n", err,
-                                        errlen);
+    char mark_defines[2048];
+    snprintf(mark_defines, sizeof(mark_defines), "#define OSL_SEEN 1\n%s",
+             env->scene->asset ? env->defines : "");
+    GLuint mark_prog = gl_program_build("osl draw (marking)", draw, 2, mark_defines, err, errlen);
     if (!mark_prog)
         return false;
     o->draw_mark = gpu_scene_program(env->gpu, mark_prog);
@@ -549,9 +578,15 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
     char light_defines[2048];
     snprintf(light_defines, sizeof(light_defines), "%s%s", env->defines ? env->defines : "",
              o->seen ? "#define OSL_BLOCK_LIST 1\n" : "");
-    if (!(o->texgen_prog = gl_program_build("osl texgen", texgen, 2, NULL, err, errlen)) ||
+    /* Asset scenes bake their materials in texture generation and cut the
+     * mask's holes in the raster pass, both through surface.glsl: those
+     * programs take the scene's defines (SCENE_TEXTURED) there only, so the
+     * procedural scenes' programs stay the text they always were. */
+    const char *scene_defines = s->asset ? env->defines : NULL;
+    o->textured = s->asset != NULL;
+    if (!(o->texgen_prog = gl_program_build("osl texgen", texgen, 2, scene_defines, err, errlen)) ||
         !(light_prog = gl_program_build("osl lighting", light, 1, light_defines, err, errlen)) ||
-        !(draw_prog = gl_program_build("osl draw", draw, 2, NULL, err, errlen))) {
+        !(draw_prog = gl_program_build("osl draw", draw, 2, scene_defines, err, errlen))) {
         glDeleteProgram(light_prog);
         goto fail;
     }
@@ -567,6 +602,12 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
                        SB_TEX_OSL_GEO_POSITION);
     glProgramUniform1i(light_prog, glGetUniformLocation(light_prog, "u_normal"),
                        SB_TEX_OSL_GEO_NORMAL);
+    if (o->textured) {
+        glProgramUniform1i(light_prog, glGetUniformLocation(light_prog, "u_albedo"),
+                           SB_TEX_OSL_GEO_ALBEDO);
+        glProgramUniform1i(light_prog, glGetUniformLocation(light_prog, "u_surface"),
+                           SB_TEX_OSL_GEO_SURFACE);
+    }
     glProgramUniform1i(draw_prog, glGetUniformLocation(draw_prog, "u_atlas"), SB_TEX_OSL_ATLAS);
 
     if (!generate_textures(o, env, err, errlen))
@@ -813,6 +854,8 @@ static void osl_destroy(void *state)
     glDeleteProgram(o->draw.prog);
     glDeleteTextures(1, &o->geo_position);
     glDeleteTextures(1, &o->geo_normal);
+    glDeleteTextures(1, &o->geo_albedo);
+    glDeleteTextures(1, &o->geo_surface);
     free(o->geo);
     free(o->geo_entry);
     glDeleteTextures(1, &o->atlas);

@@ -60,7 +60,8 @@ int osl_auto_tile_size(double pixels_per_unit, double uv_per_unit, double texel_
     return size > OSL_TILE_MAX ? OSL_TILE_MAX : size;
 }
 
-long osl_dilate_geometry(float *pos, float *nrm, int size, int passes)
+long osl_dilate_geometry(float *pos, float *nrm, float *const *extra, int extra_count, int size,
+                         int passes)
 {
     long filled = 0;
     for (int pass = 0; pass < passes; pass++) {
@@ -72,7 +73,7 @@ long osl_dilate_geometry(float *pos, float *nrm, int size, int passes)
                 float *p = &pos[((size_t)y * size + x) * 4];
                 if (p[3] != 0.0f)
                     continue;
-                float ps[3] = {0, 0, 0}, ns[3] = {0, 0, 0};
+                float ps[3] = {0, 0, 0}, ns[4] = {0, 0, 0, 0}, es[4][4] = {{0}};
                 int n = 0;
                 for (int dy = -1; dy <= 1; dy++)
                     for (int dx = -1; dx <= 1; dx++) {
@@ -82,21 +83,30 @@ long osl_dilate_geometry(float *pos, float *nrm, int size, int passes)
                         const float *q = &pos[((size_t)qy * size + qx) * 4];
                         if (q[3] != 1.0f)
                             continue;
-                        const float *m = &nrm[((size_t)qy * size + qx) * 4];
+                        size_t at = ((size_t)qy * size + qx) * 4;
                         for (int k = 0; k < 3; k++)
-                            ps[k] += q[k], ns[k] += m[k];
+                            ps[k] += q[k];
+                        for (int k = 0; k < 4; k++)
+                            ns[k] += nrm[at + k];
+                        for (int e = 0; e < extra_count && e < 4; e++)
+                            for (int k = 0; k < 4; k++)
+                                es[e][k] += extra[e][at + k];
                         n++;
                     }
                 if (!n)
                     continue;
                 float len = sqrtf(ns[0] * ns[0] + ns[1] * ns[1] + ns[2] * ns[2]);
-                float *m = &nrm[((size_t)y * size + x) * 4];
+                size_t at = ((size_t)y * size + x) * 4;
+                float *m = &nrm[at];
                 for (int k = 0; k < 3; k++) {
                     p[k] = ps[k] / (float)n;
                     m[k] = len > 0.0f ? ns[k] / len : 0.0f;
                 }
+                m[3] = ns[3] / (float)n;
+                for (int e = 0; e < extra_count && e < 4; e++)
+                    for (int k = 0; k < 4; k++)
+                        extra[e][at + k] = es[e][k] / (float)n;
                 p[3] = 2.0f;
-                m[3] = 0.0f;
                 this_pass++;
             }
         for (size_t t = 0; t < (size_t)size * size; t++)

@@ -33,12 +33,14 @@ int osl_auto_tile_size(double pixels_per_unit, double uv_per_unit, double texel_
 
 /* Gutter filling for UV layouts whose charts do not cover whole rectangles
  * (an asset's uv1): texels no triangle covered (position w == 0) that touch
- * a covered one (8-neighbourhood) take the mean position and normal of the
- * covered neighbours and become covered (w = 1), `passes` times, each pass
- * reading the coverage the one before left. Bilinear filtering at a chart's
- * edge then reads shading of about the edge's surface instead of black.
- * pos and nrm are size x size RGBA float images (rows of size texels);
+ * a covered one (8-neighbourhood) take the mean position, normal (xyz
+ * renormalised, w averaged) and extra channels of the covered neighbours
+ * and become covered (w = 1), `passes` times, each pass reading the
+ * coverage the one before left. Bilinear filtering at a chart's edge then
+ * reads shading of about the edge's surface instead of black. pos, nrm and
+ * the extra images are size x size RGBA float images (rows of size texels);
  * returns the texels filled. */
-long osl_dilate_geometry(float *pos, float *nrm, int size, int passes);
+long osl_dilate_geometry(float *pos, float *nrm, float *const *extra, int extra_count, int size,
+                         int passes);
 
 #endif

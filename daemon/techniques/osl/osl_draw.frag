@@ -7,8 +7,13 @@ layout(location = 0) out vec4 out_color;
 // osl.visibility "seen": mark the atlas blocks this fragment's bilinear
 // footprint reads, with the frame. The next frame shades what was seen and
 // checks that each block read here held its scheduled shading
-// (osl_select.comp). Only fragments that pass the depth test mark.
+// (osl_select.comp). Only fragments that pass the depth test mark, except
+// in asset scenes: there an alpha-masked fragment may discard, and early
+// fragment tests would write its depth all the same, so the tests run late
+// and fragments behind others mark too (more shading, never less).
+#if !defined(SCENE_TEXTURED)
 layout(early_fragment_tests) in;
+#endif
 layout(r32i, binding = SB_IMG_OSL_MARKS) writeonly uniform iimage2D u_marks;
 uniform int u_frame_index;
 #endif
@@ -16,8 +21,16 @@ uniform int u_frame_index;
 uniform sampler2D u_atlas;
 uniform vec2 u_atlas_size;
 
+#if defined(SCENE_TEXTURED)
+// The mask's cut-out at the pixel, as every other technique draws it.
+#include "surface.glsl"
+#endif
+
 void main()
 {
+#if defined(SCENE_TEXTURED)
+    surface_alpha_clip();
+#endif
     // Clamp to the centres of the first and last texels inside the chart:
     // the bilinear footprint then never leaves the chart, which is the gutter.
     float size = float(v_tile.z);

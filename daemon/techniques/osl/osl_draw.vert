@@ -4,6 +4,12 @@
 layout(location = 0) in vec3 a_pos;
 layout(location = 2) in vec2 a_uv;
 layout(location = 3) in vec4 a_chart;
+#if defined(SCENE_TEXTURED)
+layout(location = 4) in vec2 a_tex;
+layout(location = 5) in vec4 a_tangent;
+out vec4 v_tex;     // surface.glsl's inputs, for the alpha mask
+out vec4 v_tangent;
+#endif
 
 layout(std430, binding = SB_SSBO_OSL_TILES) readonly buffer TileBuffer { ivec4 tiles[]; };
 
@@ -18,6 +24,10 @@ void main()
     int id = u_instance_base + gl_InstanceID;
     Instance inst = instances[id];
     v_uv = a_uv;
+#if defined(SCENE_TEXTURED)
+    v_tex = vec4(a_tex, a_uv);
+    v_tangent = a_tangent;
+#endif
     v_chart = a_chart;
     v_tile = tiles[id];
     gl_Position = u_frame.view_proj * vec4(inst.pos_scale.xyz + inst.pos_scale.w * a_pos, 1.0);

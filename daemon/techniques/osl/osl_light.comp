@@ -18,6 +18,28 @@ layout(rgba8, binding = SB_IMG_OSL_ATLAS) writeonly uniform image2D u_atlas;
 // texel is covered) and normal, once per tile size in use.
 uniform sampler2D u_position;
 uniform sampler2D u_normal;
+#if defined(SCENE_TEXTURED)
+// Asset scenes: the material baked by osl_texgen.frag. The normal's w is
+// metallic.
+uniform sampler2D u_albedo;  // linear base colour, roughness
+uniform sampler2D u_surface; // emissive, occlusion
+
+// Every light on a baked texel, as surface_shade_all_lights (surface.glsl)
+// shades a fragment: ambient scaled by occlusion, emissive after lighting,
+// Phong's terms from roughness as material_surface_grad derives them.
+vec3 shade_baked(vec3 P, vec3 N, float metallic, vec4 albedo, vec4 surface, int row)
+{
+    float roughness = albedo.a;
+    Material m = Material(albedo.rgb, 0.04 + 0.96 * metallic,
+                          max(1.0, 2.0 / max(roughness * roughness, 1e-3) - 2.0), metallic,
+                          roughness);
+    vec3 V = normalize(u_frame.eye.xyz - P);
+    vec3 color = surface.a * light_ambient(m, P, N, V);
+    for (int i = 0; i < u_frame.counts.y; i++)
+        color += light_contribution(i, light_position(i, row), P, N, V, m);
+    return color + surface.rgb;
+}
+#endif
 uniform int u_work_count;
 uniform int u_groups_x;
 // The dispatch may cover a range of the blocks only (bounded submissions,
@@ -72,7 +94,12 @@ void main()
     vec3 color = vec3(0.0);
     if (p.w > 0.0) {
         vec3 world = inst.pos_scale.xyz + inst.pos_scale.w * p.xyz;
+#if defined(SCENE_TEXTURED)
+        color = shade_baked(world, normalize(n.xyz), n.w, texelFetch(u_albedo, geo, 0),
+                            texelFetch(u_surface, geo, 0), light_row);
+#else
         color = shade_all_lights(world, normalize(n.xyz), instance_material(instance), light_row);
+#endif
     }
     imageStore(u_atlas, tile.xy + texel, vec4(color, 1.0));
 }

@@ -33,7 +33,8 @@ UNIT_TESTS = \
 	tests/unit/test_effects \
 	tests/unit/test_pbr \
 	tests/unit/test_teapot \
-	tests/unit/test_lighting
+	tests/unit/test_lighting \
+	tests/unit/test_light_shape
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
 	tests/fuzz/replay-route
@@ -43,6 +44,7 @@ tests_unit_test_store_LDADD = $(CORE_LIBS)
 tests_unit_test_stats_LDADD = $(CORE_LIBS)
 tests_unit_test_scene_LDADD = $(CORE_LIBS)
 tests_unit_test_osl_LDADD = $(CORE_LIBS)
+tests_unit_test_light_shape_LDADD = $(CORE_LIBS)
 tests_unit_test_metrics_LDADD = $(CORE_LIBS)
 tests_unit_test_flicker_LDADD = $(CORE_LIBS)
 tests_unit_test_sweep_LDADD = $(CORE_LIBS)

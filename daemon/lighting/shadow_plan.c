@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "daemon/scene/light_shape.h"
+
 int shadow_cube_layers(const struct shadow_spec *spec, int lights)
 {
     double texels = (double)spec->atlas * spec->atlas;
@@ -60,16 +62,15 @@ static int nearest_pow2(double v)
     return l > 30 ? 1 << 30 : 1 << (int)l;
 }
 
-/* Whether a caster (any object but the ground) lies within the light. */
-static bool has_caster(const struct scene *s, const float pos[3], float radius)
+/* Whether a caster (any object but the ground) lies within the light (its
+ * sphere, or a spot light's cone). */
+static bool has_caster(const struct scene *s, const struct scene_light *light, const float pos[3])
 {
     for (int i = 0; i < s->instance_count; i++) {
         const struct scene_instance *in = &s->instances[i];
         if (in->mesh == SCENE_MESH_PLANE)
             continue;
-        float r = radius + scene_instance_bound(s, i);
-        float d[3] = {in->pos[0] - pos[0], in->pos[1] - pos[1], in->pos[2] - pos[2]};
-        if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < r * r)
+        if (scene_light_reaches(light, pos, in->pos, scene_instance_bound(s, i)))
             return true;
     }
     return false;
@@ -119,21 +120,27 @@ bool shadow_plan_frame(struct shadow_plan *p, const struct scene *s, const struc
 {
     struct scene_camera cam;
     scene_camera_at(s, frame, &cam);
-    p->mapped = p->culled = p->no_casters = p->dropped = 0;
+    p->mapped = p->culled = p->no_casters = p->dropped = p->directional = 0;
     p->texels = 0;
     int need = 0;
     for (int i = 0; i < p->lights; i++) {
         struct shadow_light_plan *l = &p->light[i];
-        float radius = s->lights[i].radius;
+        const struct scene_light *light = &s->lights[i];
+        float radius = light->radius, centre[3], bound;
         scene_light_position(s, i, frame, l->pos);
         l->size = 0;
         l->importance = 0;
-        if (!scene_sphere_in_frustum(cam.view_proj, l->pos, radius, false)) {
+        if (!scene_light_bound(light, l->pos, centre, &bound)) {
+            l->status = SHADOW_DIRECTIONAL;
+            p->directional++;
+            continue;
+        }
+        if (!scene_sphere_in_frustum(cam.view_proj, centre, bound, false)) {
             l->status = SHADOW_CULLED;
             p->culled++;
             continue;
         }
-        if (!has_caster(s, l->pos, radius)) {
+        if (!has_caster(s, light, l->pos)) {
             l->status = SHADOW_NO_CASTERS;
             p->no_casters++;
             continue;

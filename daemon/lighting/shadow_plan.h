@@ -6,7 +6,11 @@
  * what the plan says, daemon/look/shadows.c).
  *
  * A light needs a map only when its sphere of influence reaches the view
- * frustum and holds a caster (an object other than the ground). Its
+ * frustum and holds a caster (an object other than the ground). A spot
+ * light is a point light with a cone: the same six faces from its position
+ * (far plane its radius), needed when its cone's bounding sphere reaches
+ * the frustum and its cone a caster. A directional light gets no map (it
+ * is reported unshadowed, never shadowed wrongly). Its
  * importance is the radius in pixels of that sphere on screen (seed 002:
  * attenuation distance and distance to the camera); with tile "auto" each
  * face gets the nearest power of two to it, within min_tile..max_tile.
@@ -35,6 +39,8 @@ enum shadow_status {
     SHADOW_NO_CASTERS, /* nothing within its radius can cast a shadow */
     SHADOW_MAPPED,
     SHADOW_DROPPED,    /* needed a map, but the atlas was full */
+    SHADOW_DIRECTIONAL, /* a directional light: no omni map can hold it; unshadowed,
+                           counted (shadows.directional_unshadowed) */
 };
 
 struct shadow_light_plan {
@@ -50,7 +56,7 @@ struct shadow_plan {
     struct shadow_light_plan *light;
     int layers; /* cubes: layers of the cube map array */
     /* This frame. */
-    int mapped, culled, no_casters, dropped;
+    int mapped, culled, no_casters, dropped, directional;
     double texels; /* atlas texels the faces cover */
     /* Scratch, sized at init. */
     int *order, *sizes, *slots;

@@ -18,6 +18,7 @@
 #include "daemon/gpu/glutil.h"
 #include "daemon/lighting/cube_faces.h"
 #include "daemon/lighting/shadow_plan.h"
+#include "daemon/scene/light_shape.h"
 
 static const float SHADOW_NEAR = 0.02f;
 
@@ -43,7 +44,7 @@ struct look_shadows {
     /* Timed frames. */
     int frames;
     double mapped_sum, texels_sum, faces_sum, draws_sum, dropped_sum;
-    int mapped_min, mapped_max, dropped_max, culled_last, no_casters_last;
+    int mapped_min, mapped_max, dropped_max, culled_last, no_casters_last, directional;
     double texels_max;
     int frames_with_drops;
     int dropped_lights[MAX_DROPPED_LISTED], ndropped_lights, dropped_distinct;
@@ -208,9 +209,8 @@ bool look_shadows_render(struct look_shadows *sh, const struct gpu_passes *passe
             const struct scene_instance *in = &s->instances[k];
             if (in->mesh == SCENE_MESH_PLANE)
                 continue;
-            float r = radius + scene_instance_bound(s, k);
-            float d[3] = {in->pos[0] - l->pos[0], in->pos[1] - l->pos[1], in->pos[2] - l->pos[2]};
-            if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < r * r)
+            /* A spot light's casters are those its cone reaches. */
+            if (scene_light_reaches(&s->lights[i], l->pos, in->pos, scene_instance_bound(s, k)))
                 sh->casters[ncasters++] = k;
         }
         for (int f = 0; f < 6; f++) {
@@ -270,6 +270,7 @@ bool look_shadows_render(struct look_shadows *sh, const struct gpu_passes *passe
     sh->texels_max = p->texels > sh->texels_max ? p->texels : sh->texels_max;
     sh->culled_last = p->culled;
     sh->no_casters_last = p->no_casters;
+    sh->directional = p->directional;
     if (p->dropped) {
         sh->frames_with_drops++;
         for (int i = 0; i < p->lights; i++)
@@ -299,7 +300,7 @@ json_t *look_shadows_describe(const struct look_shadows *sh)
         }
     return json_pack(
         "{s:s, s:i, s:o, s:f, s:i, s:i, s:{s:f, s:i, s:i}, s:{s:f, s:f, s:f, s:f}, s:f, s:f, "
-        "s:o, s:{s:s, s:i, s:f, s:i, s:i, s:o, s:s}, s:i, s:i}",
+        "s:o, s:{s:s, s:i, s:f, s:i, s:i, s:o, s:s}, s:i, s:i, s:{s:i, s:s}}",
         "layout", shadow_layout_names[spec->layout], "atlas", spec->atlas, "tile",
         spec->tile ? json_integer(spec->tile) : json_string("auto"), "bytes", sh->bytes, "pcf",
         spec->pcf, "border_texels", sh->border, "lights_mapped", "mean", sh->mapped_sum / n, "min",
@@ -313,7 +314,9 @@ json_t *look_shadows_describe(const struct look_shadows *sh)
         "lights that needed a map but did not fit the atlas at min_tile, least important "
         "first; 'lights' lists the first 64 of them by index",
         "lights_culled_last_frame", sh->culled_last, "lights_without_casters_last_frame",
-        sh->no_casters_last);
+        sh->no_casters_last, "skipped_lights", "directional", sh->directional, "note",
+        "directional lights cast no shadows (omni maps cannot hold them): they light every "
+        "surface facing them unshadowed");
 }
 
 void look_shadows_destroy(struct look_shadows *sh)

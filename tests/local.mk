@@ -112,6 +112,7 @@ E2E_TESTS = \
 	tests/e2e/e2e_runaway.py \
 	tests/e2e/e2e_hardening.py \
 	tests/e2e/e2e_many_lights.py \
+	tests/e2e/e2e_light_types.py \
 	tests/e2e/e2e_techniques.py \
 	tests/e2e/e2e_load.py \
 	tests/e2e/e2e_osl.py \

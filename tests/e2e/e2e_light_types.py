@@ -15,6 +15,7 @@
   turned away from it);
 - spot cones visibly limit the lit area: fewer pixels differ from the
   ambient-only image under spots than under the same lights as points;
+- PBR: the physically based model agrees too;
 - shadows: spots cast with the omni maps (deferred with shadows agrees with
   forward with shadows), the sun is reported unshadowed
   (shadows.skipped_lights.directional);
@@ -154,6 +155,10 @@ try:
     print("  lit pixels, 16 lights: %s" % areas)
     check(len(areas) == 2 and 0 < areas["spot"] < 0.6 * areas["point"],
           "spot cones limit the lit area: %s" % areas)
+
+    # The physically based model shades them the same way everywhere.
+    for tech in ("clustered_deferred", "forward_plus"):
+        matches(d, job(tech, both, look={"lighting": "pbr"}), "%s, PBR, spots and the sun" % tech)
 
     # Shadows: spots with omni maps, the sun reported unshadowed.
     shadows = {"look": {"shadows": {"atlas": 1024}}}

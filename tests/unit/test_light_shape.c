@@ -277,6 +277,25 @@ static void test_scene(void)
     CHECK(!any);
     scene_finish(&only_sun);
 
+    /* ... and a moving spot touches only objects its point would: a subset,
+     * and a smaller one. */
+    struct scene_spec moving = spec;
+    moving.dynamic = true;
+    moving.sun = false;
+    struct scene spot_scene, point_scene;
+    CHECK(scene_init(&spot_scene, &moving));
+    moving.light_type = SCENE_LIGHT_POINT;
+    CHECK(scene_init(&point_scene, &moving));
+    int by_spot = 0, by_point = 0, outside = 0;
+    for (int k = 0; k < 20; k++)
+        for (int i = 0; i < spot_scene.instance_count; i++) {
+            bool sp = osl_touched(&spot_scene, i, k), pt = osl_touched(&point_scene, i, k);
+            by_spot += sp, by_point += pt, outside += sp && !pt;
+        }
+    CHECK(outside == 0 && by_spot > 0 && by_spot < by_point);
+    scene_finish(&spot_scene);
+    scene_finish(&point_scene);
+
     /* Shadows: the sun gets no map and is counted; spots are planned. */
     struct shadow_spec sh;
     shadow_spec_defaults(&sh);

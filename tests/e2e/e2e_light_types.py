@@ -15,7 +15,8 @@
   turned away from it);
 - spot cones visibly limit the lit area: fewer pixels differ from the
   ambient-only image under spots than under the same lights as points;
-- PBR: the physically based model agrees too;
+- MSAA 4 (clustered forward bit for bit, clustered deferred's per-sample
+  lighting) and PBR agree too;
 - shadows: spots cast with the omni maps (deferred with shadows agrees with
   forward with shadows), the sun is reported unshadowed
   (shadows.skipped_lights.directional);
@@ -155,6 +156,11 @@ try:
     print("  lit pixels, 16 lights: %s" % areas)
     check(len(areas) == 2 and 0 < areas["spot"] < 0.6 * areas["point"],
           "spot cones limit the lit area: %s" % areas)
+
+    # MSAA: the per-sample paths shade and bin them alike.
+    matches(d, job("clustered_forward", both, msaa=4), "clustered_forward, msaa 4, spots and the sun",
+            identical=True)
+    matches(d, job("clustered_deferred", both, msaa=4), "clustered_deferred, msaa 4, spots and the sun")
 
     # The physically based model shades them the same way everywhere.
     for tech in ("clustered_deferred", "forward_plus"):

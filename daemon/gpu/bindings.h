@@ -32,6 +32,7 @@
 #define SB_SSBO_OSL_VERSIONS 16
 #define SB_SSBO_OSL_LIST 17
 #define SB_SSBO_OSL_STATS 18
+#define SB_SSBO_SHADOW_SUNS 19 /* per directional light's map: its projection */
 
 /* Texture units. */
 #define SB_TEX_HDR 0
@@ -62,6 +63,7 @@
 #define SB_TEX_IBL_BRDF 14        /* the split sum's (A, B) table */
 #define SB_TEX_SHADOW_ATLAS 15    /* depth atlas of every light's six faces */
 #define SB_TEX_SHADOW_CUBES 16    /* or a depth cube map array, a layer a light */
+#define SB_TEX_SHADOW_SUNS 17     /* depth array: a layer a directional light */
 
 /* Uniform locations of the harness's own programs, explicit so that timed
  * code never looks a name up. */

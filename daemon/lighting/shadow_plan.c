@@ -17,6 +17,58 @@ int shadow_cube_layers(const struct shadow_spec *spec, int lights)
 
 int shadow_border(int pcf) { return pcf + 1; }
 
+int shadow_sun_size(const struct shadow_spec *spec)
+{
+    /* Half the atlas's edge: a quarter of its memory a sun. */
+    int size = spec->atlas / 2;
+    return size < 256 ? 256 : size > 4096 ? 4096 : size;
+}
+
+void shadow_sun_fit(const struct scene_box *b, const float dir[3], int size, float view_proj[16],
+                    float *texel_world, float *depth_range)
+{
+    /* A basis with f along the light: r and u span the map. */
+    const float *f = dir;
+    float up[3] = {0.0f, 1.0f, 0.0f};
+    if (fabsf(f[1]) > 0.99f)
+        up[1] = 0.0f, up[2] = 1.0f;
+    float r[3] = {f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2],
+                  f[0] * up[1] - f[1] * up[0]};
+    float rl = sqrtf(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+    for (int k = 0; k < 3; k++)
+        r[k] /= rl;
+    float u[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]};
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int c = 0; c < 8; c++) {
+        float p[3];
+        for (int k = 0; k < 3; k++)
+            p[k] = c >> k & 1 ? b->max[k] : b->min[k];
+        float q[3] = {r[0] * p[0] + r[1] * p[1] + r[2] * p[2],
+                      u[0] * p[0] + u[1] * p[1] + u[2] * p[2],
+                      f[0] * p[0] + f[1] * p[1] + f[2] * p[2]};
+        for (int k = 0; k < 3; k++)
+            lo[k] = fminf(lo[k], q[k]), hi[k] = fmaxf(hi[k], q[k]);
+    }
+    /* A margin of 1% and a unit: nothing on the box's faces at the edge. */
+    float scale[3], shift[3];
+    for (int k = 0; k < 3; k++) {
+        float pad = 0.01f * (hi[k] - lo[k]) + (k == 2 ? 1.0f : 0.05f);
+        lo[k] -= pad, hi[k] += pad;
+        scale[k] = 2.0f / (hi[k] - lo[k]);
+        shift[k] = -(hi[k] + lo[k]) / (hi[k] - lo[k]);
+    }
+    const float *axis[3] = {r, u, f};
+    memset(view_proj, 0, 16 * sizeof(float));
+    for (int row = 0; row < 3; row++) {
+        for (int col = 0; col < 3; col++)
+            view_proj[col * 4 + row] = scale[row] * axis[row][col];
+        view_proj[12 + row] = shift[row];
+    }
+    view_proj[15] = 1.0f;
+    *texel_world = fmaxf(hi[0] - lo[0], hi[1] - lo[1]) / (float)size;
+    *depth_range = hi[2] - lo[2];
+}
+
 float shadow_face_widen(int size, int border)
 {
     int inner = size - 2 * border;

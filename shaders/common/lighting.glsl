@@ -79,7 +79,10 @@ vec3 light_contribution(int i, vec3 Lpos, vec3 P, vec3 N, vec3 V, Material m)
     if (nl <= 0.0)
         return vec3(0.0);
 #if defined(LOOK_SHADOWS)
-    att *= shadow_visibility(i, P, N, nl);
+    if (type == LIGHT_DIRECTIONAL)
+        att *= shadow_sun_visibility(i, P, N);
+    else
+        att *= shadow_visibility(i, P, N, nl);
 #endif
 #if defined(LIGHTING_PBR)
     // Light colours are the irradiance a light gives a surface facing it

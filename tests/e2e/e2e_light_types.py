@@ -18,11 +18,13 @@
 - MSAA 4 (clustered forward bit for bit, clustered deferred's per-sample
   lighting) and PBR agree too;
 - shadows: spots cast with the omni maps (deferred with shadows agrees with
-  forward with shadows), the sun is reported unshadowed
-  (shadows.skipped_lights.directional);
+  forward with shadows), the sun with its own orthographic map: ray-cast
+  on the sphere preset, the ground the sphere hides from the sun is
+  darker, nothing else changes, no acne on its sunlit side;
 - the scene options: written back in the spec, described by type, bad
   values answered 400 naming the field; a sweep varies scene.light_type."""
 
+import math
 import os
 
 import testlib
@@ -170,10 +172,87 @@ try:
     shadows = {"look": {"shadows": {"atlas": 1024}}}
     done = matches(d, job("deferred", both, **shadows), "deferred with shadows, spots and the sun")
     sh = done.get("result", {}).get("shadows", {})
-    skipped = sh.get("skipped_lights", {})
-    print("  shadows: mapped %s, skipped %s" % (sh.get("lights_mapped"), skipped))
-    check(skipped.get("directional") == 1 and sh.get("lights_mapped", {}).get("max", 0) > 0,
-          "spots get maps, the sun is reported unshadowed: %s" % skipped)
+    print("  shadows: mapped %s, directional %s, skipped %s"
+          % (sh.get("lights_mapped"), sh.get("directional"), sh.get("skipped_lights")))
+    check(sh.get("directional", {}).get("mapped") == 1 and
+          sh.get("skipped_lights", {}).get("directional") == 0 and
+          sh.get("lights_mapped", {}).get("max", 0) > 0,
+          "spots get omni maps, the sun its own: %s" % sh.get("directional"))
+    # The sun's map: the sphere preset lit by the sun alone, ray-cast here
+    # (as e2e_pbr does for a point light): the ground the sphere hides from
+    # the sun is darker, nothing else changes, no acne on the sphere's lit
+    # side.
+    pixels, sun_dir = {}, None
+    for on in (False, True):
+        done = d.run({"technique": "forward", "frames": 1, "warmup_frames": 0, "capture_interval": 1,
+                      "look": {"lighting": "pbr", "shadows": {"pcf": 1} if on else False},
+                      "scene": {"preset": "sphere", "width": 160, "height": 120, "lights": 0,
+                                "sun": True, "roughness": 0.6}})
+        check(done.get("status") == "done", "sun shadow job runs: %s" % done.get("error"))
+        pixels[on] = frame_pixels(d, done, "sun-shadow-%d" % on)
+        camera = done.get("result", {}).get("scene", {}).get("camera", {})
+        sun_dir = done.get("result", {}).get("scene", {}).get("lights", {}).get("sun_light", {}).get("direction")
+    if check(pixels[False] and pixels[True] and sun_dir and camera, "sun shadow frames"):
+        L = [-c for c in sun_dir]
+        eye, target = camera["eye_at_frame_0"], camera["target_at_frame_0"]
+        fwd = [t - e for t, e in zip(target, eye)]
+        n = math.sqrt(sum(c * c for c in fwd))
+        fwd = [c / n for c in fwd]
+        right = [-fwd[2], 0.0, fwd[0]]
+        n = math.sqrt(sum(c * c for c in right))
+        right = [c / n for c in right]
+        up = [right[1] * fwd[2] - right[2] * fwd[1], right[2] * fwd[0] - right[0] * fwd[2],
+              right[0] * fwd[1] - right[1] * fwd[0]]
+        tan_half = math.tan(math.radians(camera["fovy_deg"]) / 2)
+
+        def ray_sphere(o, dvec, r):
+            b = sum(a * c for a, c in zip(o, dvec))
+            c = sum(a * a for a in o) - r * r
+            disc = b * b - c
+            return None if disc < 0 else -b - math.sqrt(disc)
+
+        def shaded(g, r):
+            # The ray from g towards the sun passes within r of the centre.
+            t = -sum(a * c for a, c in zip(g, L))
+            if t < 0:
+                return False
+            closest = [a + t * c for a, c in zip(g, L)]
+            return math.sqrt(sum(c * c for c in closest)) < r
+
+        w, h = 160, 120
+        off, on = pixels[False], pixels[True]
+        core = core_dark = outside_changed = lit_changed = 0
+        for y in range(h):
+            for x in range(w):
+                sx = (2 * (x + 0.5) / w - 1) * tan_half * w / h
+                sy = (1 - 2 * (y + 0.5) / h) * tan_half
+                dvec = [f + sx * r + sy * u for f, r, u in zip(fwd, right, up)]
+                n = math.sqrt(sum(c * c for c in dvec))
+                dvec = [c / n for c in dvec]
+                a, b = sum(off[y * w + x]) / 3.0, sum(on[y * w + x]) / 3.0
+                t = ray_sphere(eye, dvec, 0.8)
+                if t is not None and t > 0:
+                    p = [e + t * c for e, c in zip(eye, dvec)]
+                    if sum(q * c for q, c in zip(p, L)) / 0.8 > 0.3 and abs(a - b) > 2:
+                        lit_changed += 1
+                    continue
+                if dvec[1] >= 0:
+                    continue
+                t = (-0.8 - eye[1]) / dvec[1]
+                g = [e + t * c for e, c in zip(eye, dvec)]
+                if abs(g[0]) > 5.5 or abs(g[2]) > 5.5:
+                    continue
+                if shaded(g, 0.8 * 0.85):
+                    core += 1
+                    core_dark += b <= 0.6 * a
+                elif not shaded(g, 0.8 * 1.15 + 0.05) and abs(a - b) > 2:
+                    outside_changed += 1
+        print("  sun shadow: %d of %d ground pixels in the core darker, %d changed outside, "
+              "%d changed on the lit side" % (core_dark, core, outside_changed, lit_changed))
+        check(core > 50 and core_dark == core,
+              "the ground the sphere hides from the sun is in shadow: %d of %d" % (core_dark, core))
+        check(outside_changed == 0, "no pixel changes where no shadow can fall: %d" % outside_changed)
+        check(lit_changed == 0, "no acne on the sphere's sunlit side: %d" % lit_changed)
 
     # The options: spec, errors, sweeps.
     spec = lit.get("spec", {}).get("scene", {})

@@ -309,6 +309,36 @@ static void test_scene(void)
     CHECK(plan.mapped + plan.culled + plan.no_casters + plan.dropped + plan.directional == 65);
     shadow_plan_finish(&plan);
 
+    /* The sun's map: every corner of the scene's bounds inside its clip
+     * box, nearer the sun nearer 0 in depth, the texel as stated. */
+    float vp[16], texel, range;
+    int size = shadow_sun_size(&sh);
+    CHECK(size == sh.atlas / 2 || size == 4096 || size == 256);
+    shadow_sun_fit(&spots.bounds, sun->direction, size, vp, &texel, &range);
+    float prev = -2.0f;
+    bool inside = true, ordered = true;
+    for (int c = 0; c < 8; c++) {
+        float p[3], q[4];
+        for (int k = 0; k < 3; k++)
+            p[k] = c >> k & 1 ? spots.bounds.max[k] : spots.bounds.min[k];
+        for (int r = 0; r < 4; r++)
+            q[r] = vp[r] * p[0] + vp[4 + r] * p[1] + vp[8 + r] * p[2] + vp[12 + r];
+        inside &= q[3] == 1.0f && fabsf(q[0]) < 1 && fabsf(q[1]) < 1 && fabsf(q[2]) < 1;
+        (void)prev;
+    }
+    /* Along the light, depth grows. */
+    for (int k = 0; k < 5; k++) {
+        float p[3] = {sun->direction[0] * (float)k, sun->direction[1] * (float)k,
+                      sun->direction[2] * (float)k};
+        float z = vp[2] * p[0] + vp[6] * p[1] + vp[10] * p[2] + vp[14];
+        ordered &= z > prev;
+        prev = z;
+    }
+    CHECK(inside && ordered);
+    CHECK(texel > 0 && texel < 0.05f && range > 2.0f);
+    printf("sun map on the lights preset: %d texels, %.4f units a texel, depth range %.2f\n", size,
+           texel, range);
+
     scene_finish(&points);
     scene_finish(&spots);
 }

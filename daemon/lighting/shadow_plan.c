@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "daemon/lighting/cube_faces.h"
 #include "daemon/scene/light_shape.h"
 
 int shadow_cube_layers(const struct shadow_spec *spec, int lights)
@@ -16,6 +17,29 @@ int shadow_cube_layers(const struct shadow_spec *spec, int lights)
 }
 
 int shadow_border(int pcf) { return pcf + 1; }
+
+/* Whether a spot light's cone (unit axis, outer half-angle) may reach cube
+ * face f's frustum (widened by w): false only when the whole cone lies
+ * behind one of the frustum's planes through the light (the face's own, or
+ * a side's: inside is f w -+ s >= 0 and f w -+ t >= 0, as in
+ * sphere_meets_face), that is when the axis makes more than 90 degrees plus
+ * the half-angle with the plane's inward normal; a margin covers the
+ * receivers' normal offset. A face the cone cannot reach is never looked
+ * up: every point the spot lights lies in a face it reaches, and a point
+ * it does not light returns before the lookup. */
+bool shadow_cone_meets_face(const float axis[3], float cos_outer, int f, float w)
+{
+    float fw[3], sa[3], ta[3];
+    cube_face_axes(f, fw, sa, ta);
+    float sin_outer = sqrtf(fmaxf(0.0f, 1.0f - cos_outer * cos_outer)) + 0.02f;
+    float a_f = axis[0] * fw[0] + axis[1] * fw[1] + axis[2] * fw[2];
+    float a_s = axis[0] * sa[0] + axis[1] * sa[1] + axis[2] * sa[2];
+    float a_t = axis[0] * ta[0] + axis[1] * ta[1] + axis[2] * ta[2];
+    float norm = sqrtf(w * w + 1.0f);
+    return a_f >= -sin_outer && (a_f * w - a_s) / norm >= -sin_outer &&
+           (a_f * w + a_s) / norm >= -sin_outer && (a_f * w - a_t) / norm >= -sin_outer &&
+           (a_f * w + a_t) / norm >= -sin_outer;
+}
 
 int shadow_sun_size(const struct shadow_spec *spec)
 {

@@ -89,6 +89,12 @@ int shadow_sun_size(const struct shadow_spec *spec);
 void shadow_sun_fit(const struct scene_box *b, const float dir[3], int size, float view_proj[16],
                     float *texel_world, float *depth_range);
 
+/* Whether a spot light's cone (unit axis, outer half-angle's cosine) may
+ * reach cube face f's frustum widened by w: the shadow pass draws only
+ * those faces of a spot's map (conservative: the faces holding any
+ * direction inside the cone always pass). */
+bool shadow_cone_meets_face(const float axis[3], float cos_outer, int f, float w);
+
 /* Cube faces per layer that the layout's memory bound allows. */
 int shadow_cube_layers(const struct shadow_spec *spec, int lights);
 

@@ -284,6 +284,7 @@ bool look_shadows_render(struct look_shadows *sh, const struct gpu_passes *passe
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_INSTANCES, sh->gpu->instance_buffer);
     if (atlas)
         glEnable(GL_SCISSOR_TEST);
+    int faces = 0; /* drawn this frame: six a point light, fewer a spot */
     double draws_before = sh->draws_sum;
     gpu_loop_begin(budget);
     for (int i = 0; i < p->lights && gpu_loop_step(budget); i++) {
@@ -318,7 +319,14 @@ bool look_shadows_render(struct look_shadows *sh, const struct gpu_passes *passe
             if (scene_light_reaches(&s->lights[i], l->pos, in->pos, scene_instance_bound(s, k)))
                 sh->casters[ncasters++] = k;
         }
+        const struct scene_light *light = &s->lights[i];
         for (int f = 0; f < 6; f++) {
+            /* A spot renders only the faces its cone reaches (one, for a
+             * spot of up to 30 degrees along an axis). */
+            if (light->type == SCENE_LIGHT_SPOT &&
+                !shadow_cone_meets_face(light->direction, light->cos_outer, f, widen))
+                continue;
+            faces++;
             float vp[16];
             cube_face_view_proj(f, l->pos, widen, SHADOW_NEAR, radius, vp);
             if (atlas) {
@@ -374,7 +382,7 @@ bool look_shadows_render(struct look_shadows *sh, const struct gpu_passes *passe
     sh->frames++;
     sh->mapped_sum += p->mapped;
     sh->texels_sum += p->texels;
-    sh->faces_sum += 6.0 * p->mapped;
+    sh->faces_sum += faces;
     sh->dropped_sum += p->dropped;
     sh->mapped_min = p->mapped < sh->mapped_min ? p->mapped : sh->mapped_min;
     sh->mapped_max = p->mapped > sh->mapped_max ? p->mapped : sh->mapped_max;

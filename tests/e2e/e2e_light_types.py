@@ -18,9 +18,10 @@
 - MSAA 4 (clustered forward bit for bit, clustered deferred's per-sample
   lighting) and PBR agree too;
 - shadows: spots cast with the omni maps (deferred with shadows agrees with
-  forward with shadows), the sun with its own orthographic map: ray-cast
-  on the sphere preset, the ground the sphere hides from the sun is
-  darker, nothing else changes, no acne on its sunlit side;
+  forward with shadows; a spot pointing down draws one face), the sun
+  with its own orthographic map: ray-cast on the sphere preset for the sun
+  and for a spot, the ground the sphere hides from the light is darker,
+  nothing else changes, no acne on its lit side;
 - the scene options: written back in the spec, described by type, bad
   values answered 400 naming the field; a sweep varies scene.light_type."""
 
@@ -178,22 +179,33 @@ try:
           sh.get("skipped_lights", {}).get("directional") == 0 and
           sh.get("lights_mapped", {}).get("max", 0) > 0,
           "spots get omni maps, the sun its own: %s" % sh.get("directional"))
-    # The sun's map: the sphere preset lit by the sun alone, ray-cast here
-    # (as e2e_pbr does for a point light): the ground the sphere hides from
-    # the sun is darker, nothing else changes, no acne on the sphere's lit
-    # side.
-    pixels, sun_dir = {}, None
-    for on in (False, True):
-        done = d.run({"technique": "forward", "frames": 1, "warmup_frames": 0, "capture_interval": 1,
-                      "look": {"lighting": "pbr", "shadows": {"pcf": 1} if on else False},
-                      "scene": {"preset": "sphere", "width": 160, "height": 120, "lights": 0,
-                                "sun": True, "roughness": 0.6}})
-        check(done.get("status") == "done", "sun shadow job runs: %s" % done.get("error"))
-        pixels[on] = frame_pixels(d, done, "sun-shadow-%d" % on)
-        camera = done.get("result", {}).get("scene", {}).get("camera", {})
-        sun_dir = done.get("result", {}).get("scene", {}).get("lights", {}).get("sun_light", {}).get("direction")
-    if check(pixels[False] and pixels[True] and sun_dir and camera, "sun shadow frames"):
-        L = [-c for c in sun_dir]
+    # The sun's map, and a spot's omni map (of which only the faces its cone
+    # reaches are drawn): the sphere preset (a sphere of radius 0.8 at the
+    # origin on the ground at y -0.8, its one light 3 units above it) lit by
+    # the sun alone, then by its light as a spot pointing down, ray-cast here
+    # as e2e_pbr does for a point light: the ground the sphere hides from
+    # the light is darker, nothing else changes, no acne on its lit side.
+    for what, scene, light_at in (("the sun", {"lights": 0, "sun": True}, None),
+                                  ("a spot", {"light_type": "spot", "spot_angle_deg": 40},
+                                   [0.0, 3.0, 0.0])):
+        pixels, sun_dir, camera = {}, None, {}
+        for on in (False, True):
+            done = d.run({"technique": "forward", "frames": 1, "warmup_frames": 0,
+                          "capture_interval": 1,
+                          "look": {"lighting": "pbr", "shadows": {"pcf": 1} if on else False},
+                          "scene": dict({"preset": "sphere", "width": 160, "height": 120,
+                                         "roughness": 0.6}, **scene)})
+            check(done.get("status") == "done", "%s shadow job runs: %s" % (what, done.get("error")))
+            pixels[on] = frame_pixels(d, done, "shadow-%s-%d" % (what[-3:], on))
+            r = done.get("result", {})
+            camera = r.get("scene", {}).get("camera", {})
+            sun_dir = r.get("scene", {}).get("lights", {}).get("sun_light", {}).get("direction")
+            if on and light_at:
+                check(r.get("shadows", {}).get("faces_per_frame") == 1.0,
+                      "a spot pointing down draws one face: %s" % r.get("shadows", {}).get("faces_per_frame"))
+        if not check(pixels[False] and pixels[True] and camera and (sun_dir or light_at),
+                     "%s shadow frames" % what):
+            continue
         eye, target = camera["eye_at_frame_0"], camera["target_at_frame_0"]
         fwd = [t - e for t, e in zip(target, eye)]
         n = math.sqrt(sum(c * c for c in fwd))
@@ -205,6 +217,14 @@ try:
               right[0] * fwd[1] - right[1] * fwd[0]]
         tan_half = math.tan(math.radians(camera["fovy_deg"]) / 2)
 
+        def towards(p):
+            """Unit direction from p to the light, and how far the light is."""
+            if light_at is None:
+                return [-c for c in sun_dir], float("inf")
+            v = [a - b for a, b in zip(light_at, p)]
+            length = math.sqrt(sum(c * c for c in v))
+            return [c / length for c in v], length
+
         def ray_sphere(o, dvec, r):
             b = sum(a * c for a, c in zip(o, dvec))
             c = sum(a * a for a in o) - r * r
@@ -212,10 +232,9 @@ try:
             return None if disc < 0 else -b - math.sqrt(disc)
 
         def shaded(g, r):
-            # The ray from g towards the sun passes within r of the centre.
-            t = -sum(a * c for a, c in zip(g, L))
-            if t < 0:
-                return False
+            # The path from g to the light passes within r of the centre.
+            L, far = towards(g)
+            t = min(max(-sum(a * c for a, c in zip(g, L)), 0.0), far)
             closest = [a + t * c for a, c in zip(g, L)]
             return math.sqrt(sum(c * c for c in closest)) < r
 
@@ -233,7 +252,7 @@ try:
                 t = ray_sphere(eye, dvec, 0.8)
                 if t is not None and t > 0:
                     p = [e + t * c for e, c in zip(eye, dvec)]
-                    if sum(q * c for q, c in zip(p, L)) / 0.8 > 0.3 and abs(a - b) > 2:
+                    if sum(q * c for q, c in zip(p, towards(p)[0])) / 0.8 > 0.3 and abs(a - b) > 2:
                         lit_changed += 1
                     continue
                 if dvec[1] >= 0:
@@ -247,12 +266,13 @@ try:
                     core_dark += b <= 0.6 * a
                 elif not shaded(g, 0.8 * 1.15 + 0.05) and abs(a - b) > 2:
                     outside_changed += 1
-        print("  sun shadow: %d of %d ground pixels in the core darker, %d changed outside, "
-              "%d changed on the lit side" % (core_dark, core, outside_changed, lit_changed))
+        print("  %s's shadow: %d of %d ground pixels in the core darker, %d changed outside, "
+              "%d changed on the lit side" % (what, core_dark, core, outside_changed, lit_changed))
         check(core > 50 and core_dark == core,
-              "the ground the sphere hides from the sun is in shadow: %d of %d" % (core_dark, core))
-        check(outside_changed == 0, "no pixel changes where no shadow can fall: %d" % outside_changed)
-        check(lit_changed == 0, "no acne on the sphere's sunlit side: %d" % lit_changed)
+              "the ground the sphere hides from %s is in shadow: %d of %d" % (what, core_dark, core))
+        check(outside_changed == 0, "%s: no pixel changes where no shadow can fall: %d"
+              % (what, outside_changed))
+        check(lit_changed == 0, "%s: no acne on the sphere's lit side: %d" % (what, lit_changed))
 
     # The options: spec, errors, sweeps.
     spec = lit.get("spec", {}).get("scene", {})

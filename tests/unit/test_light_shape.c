@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "daemon/lighting/cube_faces.h"
 #include "daemon/lighting/shadow_plan.h"
 #include "daemon/scene/light_shape.h"
 #include "daemon/scene/scene.h"
@@ -335,6 +336,29 @@ static void test_scene(void)
         prev = z;
     }
     CHECK(inside && ordered);
+
+    /* A spot's map draws only the faces its cone reaches: every direction
+     * inside a cone lies in a face that passes (with widening 1, the
+     * tightest), and a spot of up to 30 degrees down an axis needs one. */
+    int missing = 0, passed = 0;
+    for (int n = 0; n < 500; n++) {
+        float axis[3];
+        random_unit(axis);
+        double t = (1.0 + frand() * 88.0) * PI / 180.0;
+        for (int k = 0; k < 200; k++) {
+            float u[3];
+            around(axis, frand() * t, frand() * 2 * PI, u);
+            missing += !shadow_cone_meets_face(axis, (float)cos(t), cube_face_of(u), 1.0f);
+        }
+        for (int f = 0; f < 6; f++)
+            passed += shadow_cone_meets_face(axis, (float)cos(t), f, 1.0f);
+    }
+    CHECK(missing == 0);
+    CHECK(passed < 500 * 6);
+    int down_faces = 0;
+    for (int f = 0; f < 6; f++)
+        down_faces += shadow_cone_meets_face((float[3]){0, -1, 0}, (float)cos(PI / 6), f, 1.2f);
+    CHECK(down_faces == 1);
     CHECK(texel > 0 && texel < 0.05f && range > 2.0f);
     printf("sun map on the lights preset: %d texels, %.4f units a texel, depth range %.2f\n", size,
            texel, range);

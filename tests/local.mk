@@ -36,7 +36,8 @@ UNIT_TESTS = \
 	tests/unit/test_teapot \
 	tests/unit/test_lighting \
 	tests/unit/test_asset \
-	tests/unit/test_uv_charts
+	tests/unit/test_uv_charts \
+	tests/unit/test_light_shape
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
 	tests/fuzz/replay-route tests/fuzz/replay-asset_cache tests/fuzz/replay-asset_convert
@@ -47,6 +48,7 @@ tests_unit_test_stats_LDADD = $(CORE_LIBS)
 tests_unit_test_scene_LDADD = $(CORE_LIBS)
 tests_unit_test_scene_asset_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_osl_LDADD = $(CORE_LIBS)
+tests_unit_test_light_shape_LDADD = $(CORE_LIBS)
 tests_unit_test_metrics_LDADD = $(CORE_LIBS)
 tests_unit_test_flicker_LDADD = $(CORE_LIBS)
 tests_unit_test_sweep_LDADD = $(CORE_LIBS)
@@ -124,6 +126,7 @@ E2E_TESTS = \
 	tests/e2e/e2e_runaway.py \
 	tests/e2e/e2e_hardening.py \
 	tests/e2e/e2e_many_lights.py \
+	tests/e2e/e2e_light_types.py \
 	tests/e2e/e2e_techniques.py \
 	tests/e2e/e2e_textured.py \
 	tests/e2e/e2e_load.py \

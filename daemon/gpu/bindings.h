@@ -35,6 +35,7 @@
 /* Asset scenes (SCENE_TEXTURED): one SurfaceMaterial per asset material,
  * and glTF's default material after them (shaders/common/surface.glsl). */
 #define SB_SSBO_MATERIALS 19
+#define SB_SSBO_SHADOW_SUNS 20 /* per directional light's map: its projection */
 
 /* Texture units. */
 #define SB_TEX_HDR 0
@@ -68,6 +69,7 @@
 #define SB_TEX_IBL_BRDF 14        /* the split sum's (A, B) table */
 #define SB_TEX_SHADOW_ATLAS 15    /* depth atlas of every light's six faces */
 #define SB_TEX_SHADOW_CUBES 16    /* or a depth cube map array, a layer a light */
+#define SB_TEX_SHADOW_SUNS 17     /* depth array: a layer a directional light */
 /* Asset scenes: the drawn mesh's material textures, bound by gpu_scene_draw
  * before each asset mesh's draw (one unit a glTF slot, in enum
  * asset_texture_slot order; a slot without a texture is never sampled). */

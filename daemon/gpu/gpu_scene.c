@@ -2,6 +2,7 @@
 
 #include "daemon/gpu/bindings.h"
 #include "daemon/scene/asset.h"
+#include "daemon/scene/light_shape.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -213,7 +214,9 @@ bool gpu_scene_init(struct gpu_scene *g, const struct scene *s, char *err, size_
     size_t n = (size_t)s->instance_count;
     float *inst = calloc(n * INSTANCE_FLOATS, sizeof(float));
     size_t lights = (size_t)(s->light_count ? s->light_count : 1);
-    float *light = calloc(lights * 4, sizeof(float));
+    /* std430 Light (shaders/common/scene_data.glsl): three vec4s. */
+    enum { LIGHT_FLOATS = 12 };
+    float *light = calloc(lights * LIGHT_FLOATS, sizeof(float));
     g->position_scratch = calloc(lights * 4, sizeof(float));
     if (!inst || !light || !g->position_scratch) {
         free(inst);
@@ -235,8 +238,19 @@ bool gpu_scene_init(struct gpu_scene *g, const struct scene *s, char *err, size_
         o[11] = in->material.roughness;
     }
     for (int i = 0; i < s->light_count; i++) {
-        memcpy(&light[i * 4], s->lights[i].color, sizeof(s->lights[i].color));
-        light[i * 4 + 3] = s->lights[i].radius;
+        const struct scene_light *l = &s->lights[i];
+        float *o = &light[i * LIGHT_FLOATS];
+        memcpy(&o[0], l->color, sizeof(l->color));
+        o[3] = l->radius;
+        if (l->type != SCENE_LIGHT_POINT)
+            memcpy(&o[4], l->direction, sizeof(l->direction));
+        o[7] = (float)l->type;
+        if (l->type == SCENE_LIGHT_SPOT) {
+            o[8] = l->cos_outer;
+            o[9] = l->cos_inner;
+            o[10] = scene_light_cone_scale(l);
+            o[11] = scene_light_sin_outer(l);
+        }
     }
     glGenBuffers(1, &g->instance_buffer);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->instance_buffer);
@@ -244,7 +258,8 @@ bool gpu_scene_init(struct gpu_scene *g, const struct scene *s, char *err, size_
                  GL_STATIC_DRAW);
     glGenBuffers(1, &g->light_buffer);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->light_buffer);
-    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(lights * 4 * sizeof(float)), light, GL_STATIC_DRAW);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(lights * LIGHT_FLOATS * sizeof(float)), light,
+                 GL_STATIC_DRAW);
     glGenBuffers(1, &g->position_buffer);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
     free(inst);

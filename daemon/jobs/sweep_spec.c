@@ -34,6 +34,8 @@ static const struct {
     {"scene.materials", PARAM_CHOICE, 0},  {"scene.specular", PARAM_NUMBER, 0},
     {"scene.shininess", PARAM_NUMBER, 0},  {"scene.metallic", PARAM_NUMBER, 0},
     {"scene.roughness", PARAM_NUMBER, 0},  {"scene.teapot_segments", PARAM_INT, 1},
+    {"scene.light_type", PARAM_CHOICE, 0}, {"scene.spot_angle_deg", PARAM_NUMBER, 0},
+    {"scene.sun", PARAM_BOOL, 0},
     {"look.ibl.probes", PARAM_INT, 1},     {"look.ibl.resolution", PARAM_INT, 1},
     {"look.ibl.samples", PARAM_INT, 1},    {"look.ibl.blend", PARAM_INT, 1},
     {"look.shadows.atlas", PARAM_INT, 1},  {"look.shadows.tile", PARAM_INT, 1},

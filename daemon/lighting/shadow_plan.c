@@ -6,6 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "daemon/lighting/cube_faces.h"
+#include "daemon/scene/light_shape.h"
+
 int shadow_cube_layers(const struct shadow_spec *spec, int lights)
 {
     double texels = (double)spec->atlas * spec->atlas;
@@ -14,6 +17,81 @@ int shadow_cube_layers(const struct shadow_spec *spec, int lights)
 }
 
 int shadow_border(int pcf) { return pcf + 1; }
+
+/* Whether a spot light's cone (unit axis, outer half-angle) may reach cube
+ * face f's frustum (widened by w): false only when the whole cone lies
+ * behind one of the frustum's planes through the light (the face's own, or
+ * a side's: inside is f w -+ s >= 0 and f w -+ t >= 0, as in
+ * sphere_meets_face), that is when the axis makes more than 90 degrees plus
+ * the half-angle with the plane's inward normal; a margin covers the
+ * receivers' normal offset. A face the cone cannot reach is never looked
+ * up: every point the spot lights lies in a face it reaches, and a point
+ * it does not light returns before the lookup. */
+bool shadow_cone_meets_face(const float axis[3], float cos_outer, int f, float w)
+{
+    float fw[3], sa[3], ta[3];
+    cube_face_axes(f, fw, sa, ta);
+    float sin_outer = sqrtf(fmaxf(0.0f, 1.0f - cos_outer * cos_outer)) + 0.02f;
+    float a_f = axis[0] * fw[0] + axis[1] * fw[1] + axis[2] * fw[2];
+    float a_s = axis[0] * sa[0] + axis[1] * sa[1] + axis[2] * sa[2];
+    float a_t = axis[0] * ta[0] + axis[1] * ta[1] + axis[2] * ta[2];
+    float norm = sqrtf(w * w + 1.0f);
+    return a_f >= -sin_outer && (a_f * w - a_s) / norm >= -sin_outer &&
+           (a_f * w + a_s) / norm >= -sin_outer && (a_f * w - a_t) / norm >= -sin_outer &&
+           (a_f * w + a_t) / norm >= -sin_outer;
+}
+
+int shadow_sun_size(const struct shadow_spec *spec)
+{
+    /* Half the atlas's edge: a quarter of its memory a sun. */
+    int size = spec->atlas / 2;
+    return size < 256 ? 256 : size > 4096 ? 4096 : size;
+}
+
+void shadow_sun_fit(const struct scene_box *b, const float dir[3], int size, float view_proj[16],
+                    float *texel_world, float *depth_range)
+{
+    /* A basis with f along the light: r and u span the map. */
+    const float *f = dir;
+    float up[3] = {0.0f, 1.0f, 0.0f};
+    if (fabsf(f[1]) > 0.99f)
+        up[1] = 0.0f, up[2] = 1.0f;
+    float r[3] = {f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2],
+                  f[0] * up[1] - f[1] * up[0]};
+    float rl = sqrtf(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+    for (int k = 0; k < 3; k++)
+        r[k] /= rl;
+    float u[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]};
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int c = 0; c < 8; c++) {
+        float p[3];
+        for (int k = 0; k < 3; k++)
+            p[k] = c >> k & 1 ? b->max[k] : b->min[k];
+        float q[3] = {r[0] * p[0] + r[1] * p[1] + r[2] * p[2],
+                      u[0] * p[0] + u[1] * p[1] + u[2] * p[2],
+                      f[0] * p[0] + f[1] * p[1] + f[2] * p[2]};
+        for (int k = 0; k < 3; k++)
+            lo[k] = fminf(lo[k], q[k]), hi[k] = fmaxf(hi[k], q[k]);
+    }
+    /* A margin of 1% and a unit: nothing on the box's faces at the edge. */
+    float scale[3], shift[3];
+    for (int k = 0; k < 3; k++) {
+        float pad = 0.01f * (hi[k] - lo[k]) + (k == 2 ? 1.0f : 0.05f);
+        lo[k] -= pad, hi[k] += pad;
+        scale[k] = 2.0f / (hi[k] - lo[k]);
+        shift[k] = -(hi[k] + lo[k]) / (hi[k] - lo[k]);
+    }
+    const float *axis[3] = {r, u, f};
+    memset(view_proj, 0, 16 * sizeof(float));
+    for (int row = 0; row < 3; row++) {
+        for (int col = 0; col < 3; col++)
+            view_proj[col * 4 + row] = scale[row] * axis[row][col];
+        view_proj[12 + row] = shift[row];
+    }
+    view_proj[15] = 1.0f;
+    *texel_world = fmaxf(hi[0] - lo[0], hi[1] - lo[1]) / (float)size;
+    *depth_range = hi[2] - lo[2];
+}
 
 float shadow_face_widen(int size, int border)
 {
@@ -60,16 +138,15 @@ static int nearest_pow2(double v)
     return l > 30 ? 1 << 30 : 1 << (int)l;
 }
 
-/* Whether a caster (any object but the ground) lies within the light. */
-static bool has_caster(const struct scene *s, const float pos[3], float radius)
+/* Whether a caster (any object but the ground) lies within the light (its
+ * sphere, or a spot light's cone). */
+static bool has_caster(const struct scene *s, const struct scene_light *light, const float pos[3])
 {
     for (int i = 0; i < s->instance_count; i++) {
         const struct scene_instance *in = &s->instances[i];
         if (in->mesh == SCENE_MESH_PLANE)
             continue;
-        float r = radius + scene_instance_bound(s, i);
-        float d[3] = {in->pos[0] - pos[0], in->pos[1] - pos[1], in->pos[2] - pos[2]};
-        if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < r * r)
+        if (scene_light_reaches(light, pos, in->pos, scene_instance_bound(s, i)))
             return true;
     }
     return false;
@@ -119,21 +196,27 @@ bool shadow_plan_frame(struct shadow_plan *p, const struct scene *s, const struc
 {
     struct scene_camera cam;
     scene_camera_at(s, frame, &cam);
-    p->mapped = p->culled = p->no_casters = p->dropped = 0;
+    p->mapped = p->culled = p->no_casters = p->dropped = p->directional = 0;
     p->texels = 0;
     int need = 0;
     for (int i = 0; i < p->lights; i++) {
         struct shadow_light_plan *l = &p->light[i];
-        float radius = s->lights[i].radius;
+        const struct scene_light *light = &s->lights[i];
+        float radius = light->radius, centre[3], bound;
         scene_light_position(s, i, frame, l->pos);
         l->size = 0;
         l->importance = 0;
-        if (!scene_sphere_in_frustum(cam.view_proj, l->pos, radius, false)) {
+        if (!scene_light_bound(light, l->pos, centre, &bound)) {
+            l->status = SHADOW_DIRECTIONAL;
+            p->directional++;
+            continue;
+        }
+        if (!scene_sphere_in_frustum(cam.view_proj, centre, bound, false)) {
             l->status = SHADOW_CULLED;
             p->culled++;
             continue;
         }
-        if (!has_caster(s, l->pos, radius)) {
+        if (!has_caster(s, light, l->pos)) {
             l->status = SHADOW_NO_CASTERS;
             p->no_casters++;
             continue;

@@ -6,7 +6,11 @@
  * what the plan says, daemon/look/shadows.c).
  *
  * A light needs a map only when its sphere of influence reaches the view
- * frustum and holds a caster (an object other than the ground). Its
+ * frustum and holds a caster (an object other than the ground). A spot
+ * light is a point light with a cone: the same six faces from its position
+ * (far plane its radius), needed when its cone's bounding sphere reaches
+ * the frustum and its cone a caster. A directional light gets no omni map
+ * but an orthographic one fitted to the scene (shadow_sun_fit). Its
  * importance is the radius in pixels of that sphere on screen (seed 002:
  * attenuation distance and distance to the camera); with tile "auto" each
  * face gets the nearest power of two to it, within min_tile..max_tile.
@@ -35,6 +39,8 @@ enum shadow_status {
     SHADOW_NO_CASTERS, /* nothing within its radius can cast a shadow */
     SHADOW_MAPPED,
     SHADOW_DROPPED,    /* needed a map, but the atlas was full */
+    SHADOW_DIRECTIONAL, /* a directional light: no omni map; its own orthographic map
+                           (shadow_sun_fit), or unshadowed past SHADOW_MAX_SUNS */
 };
 
 struct shadow_light_plan {
@@ -50,7 +56,7 @@ struct shadow_plan {
     struct shadow_light_plan *light;
     int layers; /* cubes: layers of the cube map array */
     /* This frame. */
-    int mapped, culled, no_casters, dropped;
+    int mapped, culled, no_casters, dropped, directional;
     double texels; /* atlas texels the faces cover */
     /* Scratch, sized at init. */
     int *order, *sizes, *slots;
@@ -66,6 +72,28 @@ void shadow_plan_finish(struct shadow_plan *p);
  * and the atlas could not hold them. Never allocates. */
 bool shadow_plan_frame(struct shadow_plan *p, const struct scene *s, const struct shadow_spec *spec,
                        int64_t frame, char *err, size_t errlen);
+
+/* Directional lights' maps (a layer each of one depth texture array, the
+ * first SHADOW_MAX_SUNS directional lights by index; any further ones stay
+ * unshadowed and are counted): an orthographic projection along the
+ * light, fitted to the scene's bounds (every instance's bounding sphere),
+ * so that every caster and receiver lies inside it. The map is
+ * shadow_sun_size texels square. */
+enum { SHADOW_MAX_SUNS = 4 };
+int shadow_sun_size(const struct shadow_spec *spec);
+
+/* The fitted projection of a light shining along unit dir over box b
+ * (column-major, clip z in [-1, 1] from the side the light comes from),
+ * with the world size of one texel of a size-texel map and the depth range
+ * in world units (for the bias, which is in world units). */
+void shadow_sun_fit(const struct scene_box *b, const float dir[3], int size, float view_proj[16],
+                    float *texel_world, float *depth_range);
+
+/* Whether a spot light's cone (unit axis, outer half-angle's cosine) may
+ * reach cube face f's frustum widened by w: the shadow pass draws only
+ * those faces of a spot's map (conservative: the faces holding any
+ * direction inside the cone always pass). */
+bool shadow_cone_meets_face(const float axis[3], float cos_outer, int f, float w);
 
 /* Cube faces per layer that the layout's memory bound allows. */
 int shadow_cube_layers(const struct shadow_spec *spec, int lights);

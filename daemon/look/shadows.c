@@ -18,14 +18,24 @@
 #include "daemon/gpu/glutil.h"
 #include "daemon/lighting/cube_faces.h"
 #include "daemon/lighting/shadow_plan.h"
+#include "daemon/scene/light_shape.h"
 
 static const float SHADOW_NEAR = 0.02f;
 
-/* shaders/common/shadows.glsl, ShadowLight (std430). */
+/* shaders/common/shadows.glsl, ShadowLight (std430). A directional light's
+ * row: params size (0: unshadowed), 0, 0, its map's index. */
 struct shadow_light_gpu {
     float pos_far[4];
     float params[4]; /* size, widen, near, layer */
     int32_t faces[12];
+};
+
+/* shaders/common/shadows.glsl, SunShadow (std430): a directional light's
+ * fitted projection; params: size, one texel in world units, the depth
+ * range in world units, the array layer. */
+struct sun_shadow_gpu {
+    float view_proj[16];
+    float params[4];
 };
 
 enum { MAX_DROPPED_LISTED = 64 };
@@ -50,7 +60,94 @@ struct look_shadows {
     int dropped_lights[MAX_DROPPED_LISTED], ndropped_lights, dropped_distinct;
     unsigned char *ever_dropped;
     int tile_hist[16]; /* faces by log2 size at the first timed frame */
+    /* Directional lights: the first SHADOW_MAX_SUNS by index get a layer of
+     * sun_depth (sun_of[light], -1 for others); the scene's bounds and the
+     * lights' directions never change, so the projections are fitted once. */
+    GLuint sun_depth, sun_fbo, sun_ssbo;
+    int suns, sun_size, directional_total;
+    int *sun_of;
+    struct sun_shadow_gpu sun_rows[SHADOW_MAX_SUNS];
 };
+
+/* The directional lights' maps: a depth array with a layer for each of the
+ * first SHADOW_MAX_SUNS (one 1 x 1 layer when there are none, so that the
+ * lighting library's sampler always has a texture), and their fitted
+ * projections. */
+static bool create_suns(struct look_shadows *sh, char *err, size_t errlen)
+{
+    const struct scene *s = sh->scene;
+    for (int i = 0; i < s->light_count; i++) {
+        sh->sun_of[i] = -1;
+        if (s->lights[i].type != SCENE_LIGHT_DIRECTIONAL)
+            continue;
+        sh->directional_total++;
+        if (sh->suns == SHADOW_MAX_SUNS)
+            continue;
+        int k = sh->suns++;
+        sh->sun_of[i] = k;
+        struct sun_shadow_gpu *row = &sh->sun_rows[k];
+        sh->sun_size = shadow_sun_size(&sh->spec);
+        shadow_sun_fit(&s->bounds, s->lights[i].direction, sh->sun_size, row->view_proj,
+                       &row->params[1], &row->params[2]);
+        row->params[0] = (float)sh->sun_size;
+        row->params[3] = (float)k;
+    }
+    int size = sh->suns ? sh->sun_size : 1, layers = sh->suns ? sh->suns : 1;
+    glGenTextures(1, &sh->sun_depth);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, sh->sun_depth);
+    glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_DEPTH_COMPONENT32F, size, size, layers);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
+    sh->bytes += 4.0 * size * size * layers;
+    glGenFramebuffers(1, &sh->sun_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, sh->sun_fbo);
+    glDrawBuffer(GL_NONE);
+    glReadBuffer(GL_NONE);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, sh->sun_depth, 0, 0);
+    bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (!complete) {
+        snprintf(err, errlen, "look.shadows: the directional lights' framebuffer is incomplete");
+        return false;
+    }
+    glGenBuffers(1, &sh->sun_ssbo);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, sh->sun_ssbo);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)sizeof(sh->sun_rows), sh->sun_rows,
+                 GL_STATIC_DRAW);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    return true;
+}
+
+/* Directional map k: every caster (the ground never casts), back faces, into
+ * its layer. */
+static void render_sun(struct look_shadows *sh, int k)
+{
+    const struct scene *s = sh->scene;
+    glBindFramebuffer(GL_FRAMEBUFFER, sh->sun_fbo);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, sh->sun_depth, 0, k);
+    glViewport(0, 0, sh->sun_size, sh->sun_size);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glUniformMatrix4fv(SB_LOC_SHADOW_VIEW_PROJ, 1, GL_FALSE, sh->sun_rows[k].view_proj);
+    int bound_mesh = -1;
+    for (int c = 0; c < s->instance_count; c++) {
+        const struct scene_instance *in = &s->instances[c];
+        if (in->mesh == SCENE_MESH_PLANE)
+            continue;
+        if ((int)in->mesh != bound_mesh) {
+            bound_mesh = (int)in->mesh;
+            glBindVertexArray(sh->gpu->vao[bound_mesh]);
+        }
+        glUniform1i(SB_LOC_SHADOW_INSTANCE, c);
+        glDrawElements(GL_TRIANGLES, (GLsizei)s->meshes[in->mesh].index_count, GL_UNSIGNED_INT,
+                       NULL);
+        sh->draws_sum += 1;
+    }
+}
 
 struct look_shadows *look_shadows_create(const struct shadow_spec *spec,
                                                const struct scene *s, struct gpu_scene *gpu,
@@ -71,7 +168,8 @@ struct look_shadows *look_shadows_create(const struct shadow_spec *spec,
     sh->rows = calloc(n, sizeof(*sh->rows));
     sh->casters = calloc((size_t)(s->instance_count ? s->instance_count : 1), sizeof(int));
     sh->ever_dropped = calloc(n, 1);
-    if (!sh->rows || !sh->casters || !sh->ever_dropped ||
+    sh->sun_of = calloc(n, sizeof(int));
+    if (!sh->rows || !sh->casters || !sh->ever_dropped || !sh->sun_of ||
         !shadow_plan_init(&sh->plan, s->light_count, spec)) {
         snprintf(err, errlen, "look.shadows: out of memory for %d lights", s->light_count);
         goto fail;
@@ -126,6 +224,8 @@ struct look_shadows *look_shadows_create(const struct shadow_spec *spec,
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(n * sizeof(*sh->rows)), NULL,
                  GL_DYNAMIC_DRAW);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    if (!create_suns(sh, err, errlen))
+        goto fail;
     return sh;
 fail:
     look_shadows_destroy(sh);
@@ -200,12 +300,19 @@ bool look_shadows_render(struct look_shadows *sh, const struct gpu_passes *passe
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_MATERIALS, sh->gpu->material_buffer);
     if (atlas)
         glEnable(GL_SCISSOR_TEST);
+    int faces = 0; /* drawn this frame: six a point light, fewer a spot */
     double draws_before = sh->draws_sum;
     gpu_loop_begin(budget);
     for (int i = 0; i < p->lights && gpu_loop_step(budget); i++) {
         const struct shadow_light_plan *l = &p->light[i];
         struct shadow_light_gpu *row = &sh->rows[i];
         memset(row, 0, sizeof(*row));
+        if (l->status == SHADOW_DIRECTIONAL && sh->sun_of[i] >= 0) {
+            /* Its map is drawn after the omni faces. Past SHADOW_MAX_SUNS:
+             * size 0, unshadowed (counted). */
+            row->params[0] = (float)sh->sun_size;
+            row->params[3] = (float)sh->sun_of[i];
+        }
         if (l->status != SHADOW_MAPPED)
             continue;
         float radius = s->lights[i].radius;
@@ -225,12 +332,18 @@ bool look_shadows_render(struct look_shadows *sh, const struct gpu_passes *passe
             /* Blended (glass) meshes cast none: they would cast as opaque. */
             if (in->mesh == SCENE_MESH_PLANE || in->mesh >= s->asset_blend_first)
                 continue;
-            float r = radius + scene_instance_bound(s, k);
-            float d[3] = {in->pos[0] - l->pos[0], in->pos[1] - l->pos[1], in->pos[2] - l->pos[2]};
-            if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < r * r)
+            /* A spot light's casters are those its cone reaches. */
+            if (scene_light_reaches(&s->lights[i], l->pos, in->pos, scene_instance_bound(s, k)))
                 sh->casters[ncasters++] = k;
         }
+        const struct scene_light *light = &s->lights[i];
         for (int f = 0; f < 6; f++) {
+            /* A spot renders only the faces its cone reaches (one, for a
+             * spot of up to 30 degrees along an axis). */
+            if (light->type == SCENE_LIGHT_SPOT &&
+                !shadow_cone_meets_face(light->direction, light->cos_outer, f, widen))
+                continue;
+            faces++;
             float vp[16];
             cube_face_view_proj(f, l->pos, widen, SHADOW_NEAR, radius, vp);
             if (atlas) {
@@ -246,8 +359,12 @@ bool look_shadows_render(struct look_shadows *sh, const struct gpu_passes *passe
         }
     }
     gpu_loop_end(budget);
-    glBindVertexArray(0);
     glDisable(GL_SCISSOR_TEST);
+    for (int k = 0; k < sh->suns; k++)
+        render_sun(sh, k);
+    if (sh->suns)
+        glBindFramebuffer(GL_FRAMEBUFFER, sh->fbo);
+    glBindVertexArray(0);
     glCullFace(GL_BACK);
     if (gpu_budget_stopped(budget)) {
         gpu_pass_end(passes);
@@ -260,8 +377,11 @@ bool look_shadows_render(struct look_shadows *sh, const struct gpu_passes *passe
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
     gpu_pass_end(passes);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_SHADOW_LIGHTS, sh->ssbo);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_SHADOW_SUNS, sh->sun_ssbo);
     glActiveTexture(GL_TEXTURE0 + (atlas ? SB_TEX_SHADOW_ATLAS : SB_TEX_SHADOW_CUBES));
     glBindTexture(atlas ? GL_TEXTURE_2D : GL_TEXTURE_CUBE_MAP_ARRAY, sh->depth);
+    glActiveTexture(GL_TEXTURE0 + SB_TEX_SHADOW_SUNS);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, sh->sun_depth);
     glActiveTexture(GL_TEXTURE0);
 
     if (!timed) {
@@ -279,7 +399,7 @@ bool look_shadows_render(struct look_shadows *sh, const struct gpu_passes *passe
     sh->frames++;
     sh->mapped_sum += p->mapped;
     sh->texels_sum += p->texels;
-    sh->faces_sum += 6.0 * p->mapped;
+    sh->faces_sum += faces;
     sh->dropped_sum += p->dropped;
     sh->mapped_min = p->mapped < sh->mapped_min ? p->mapped : sh->mapped_min;
     sh->mapped_max = p->mapped > sh->mapped_max ? p->mapped : sh->mapped_max;
@@ -316,7 +436,8 @@ json_t *look_shadows_describe(const struct look_shadows *sh)
         }
     return json_pack(
         "{s:s, s:i, s:o, s:f, s:i, s:i, s:{s:f, s:i, s:i}, s:{s:f, s:f, s:f, s:f}, s:f, s:f, "
-        "s:o, s:{s:s, s:i, s:f, s:i, s:i, s:o, s:s}, s:i, s:i}",
+        "s:o, s:{s:s, s:i, s:f, s:i, s:i, s:o, s:s}, s:i, s:i, s:{s:i, s:i, s:i, s:s}, "
+        "s:{s:i, s:s}}",
         "layout", shadow_layout_names[spec->layout], "atlas", spec->atlas, "tile",
         spec->tile ? json_integer(spec->tile) : json_string("auto"), "bytes", sh->bytes, "pcf",
         spec->pcf, "border_texels", sh->border, "lights_mapped", "mean", sh->mapped_sum / n, "min",
@@ -330,7 +451,13 @@ json_t *look_shadows_describe(const struct look_shadows *sh)
         "lights that needed a map but did not fit the atlas at min_tile, least important "
         "first; 'lights' lists the first 64 of them by index",
         "lights_culled_last_frame", sh->culled_last, "lights_without_casters_last_frame",
-        sh->no_casters_last);
+        sh->no_casters_last, "directional", "lights", sh->directional_total, "mapped", sh->suns,
+        "map_size", sh->sun_size, "rule",
+        "each of the first 4 directional lights (by index) gets an orthographic map, "
+        "map_size texels square (half the atlas edge, 256 to 4096), fitted to the scene's "
+        "bounds; PCF, bias and normal offset as the omni maps'",
+        "skipped_lights", "directional", sh->directional_total - sh->suns, "note",
+        "directional lights past the first 4 light unshadowed");
 }
 
 void look_shadows_destroy(struct look_shadows *sh)
@@ -342,6 +469,10 @@ void look_shadows_destroy(struct look_shadows *sh)
     glDeleteTextures(1, &sh->depth);
     glDeleteFramebuffers(1, &sh->fbo);
     glDeleteBuffers(1, &sh->ssbo);
+    glDeleteTextures(1, &sh->sun_depth);
+    glDeleteFramebuffers(1, &sh->sun_fbo);
+    glDeleteBuffers(1, &sh->sun_ssbo);
+    free(sh->sun_of);
     shadow_plan_finish(&sh->plan);
     free(sh->rows);
     free(sh->casters);

@@ -1,7 +1,9 @@
 #ifndef SHADEBENCH_LOOK_SHADOWS_H
 #define SHADEBENCH_LOOK_SHADOWS_H
 
-/* Omni shadow maps (look.shadows), run by the harness for every technique:
+/* Omni shadow maps (look.shadows), run by the harness for every technique
+ * (and an orthographic map for each of the first SHADOW_MAX_SUNS
+ * directional lights, fitted to the scene):
  * each frame, in its own timed pass before the technique's, it plans which
  * lights get maps and where (daemon/lighting/shadow_plan.h), renders the
  * casters reaching each face into the depth atlas (or the cube map array),

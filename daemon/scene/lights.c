@@ -6,6 +6,8 @@
 
 #include "daemon/scene/scene_build.h"
 
+static const double PI = 3.14159265358979323846;
+
 /* The thesis's spread, written so that the grid preset's volume gives
  * exactly the floats it always had: x = (h2 - 1/2) 40, y = 10 h3 - 0.5,
  * z = 1.5 - 24 h5. */
@@ -77,6 +79,27 @@ static void place_clustered(const struct scene_box *b, int n, int i, float out[3
     }
 }
 
+const float SCENE_SUN_DIRECTION[3] = {-0.3577709f, -0.8944272f, -0.2683282f};
+const float SCENE_SUN_COLOR[3] = {0.6f, 0.57f, 0.5f};
+
+bool scene_add_sun(struct scene *s)
+{
+    if (!s->spec.sun)
+        return true;
+    struct scene_light *grown = realloc(s->lights, (size_t)(s->light_count + 1) * sizeof(*grown));
+    if (!grown)
+        return false;
+    s->lights = grown;
+    struct scene_light *l = &s->lights[s->light_count++];
+    *l = (struct scene_light){.type = SCENE_LIGHT_DIRECTIONAL, .period = 1, .cos_inner = 1.0f,
+                              .cos_outer = 1.0f};
+    for (int k = 0; k < 3; k++) {
+        l->direction[k] = SCENE_SUN_DIRECTION[k];
+        l->color[k] = SCENE_SUN_COLOR[k] * (float)s->spec.light_intensity;
+    }
+    return true;
+}
+
 bool scene_place_lights(struct scene *s, float orbit)
 {
     const struct scene_spec *spec = &s->spec;
@@ -107,6 +130,14 @@ bool scene_place_lights(struct scene *s, float orbit)
         scene_hsv_to_rgb(i * 0.618033988749895, 0.6, 1.6, l->color);
         for (int k = 0; k < 3; k++)
             l->color[k] *= (float)spec->light_intensity;
+        if (spec->light_type == SCENE_LIGHT_SPOT) {
+            /* Straight down, at the light volume's floor and the objects. */
+            double outer = spec->spot_angle_deg * PI / 180.0;
+            l->type = SCENE_LIGHT_SPOT;
+            l->direction[1] = -1.0f;
+            l->cos_outer = (float)cos(outer);
+            l->cos_inner = (float)cos(outer * SCENE_SPOT_INNER_RATIO);
+        }
         /* Whole frames per revolution keep positions exact for any frame
          * index; light_speed divides the period (0 holds the lights still). */
         int base_period = 180 + 40 * (i % 7);

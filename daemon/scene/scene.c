@@ -1,6 +1,7 @@
 /* Building a scene (preset, materials, bounds, camera rig, tessellation,
  * meshes) and the queries every technique and the harness make of it. */
 #include "daemon/scene/scene.h"
+#include "daemon/scene/light_shape.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -138,7 +139,7 @@ bool scene_build(struct scene *out, const struct scene_spec *spec, const struct 
             out->instances[i].asset_material = -1;
         out->asset_mask_first = out->asset_blend_first = out->mesh_count;
     }
-    if (!(out->mesh_instance_count = calloc((size_t)out->mesh_count, sizeof(int))))
+    if (!scene_add_sun(out) || !(out->mesh_instance_count = calloc((size_t)out->mesh_count, sizeof(int))))
         goto fail;
     for (int i = 0; i < out->instance_count; i++) {
         /* Each mesh is one instanced draw over a contiguous range. */
@@ -300,17 +301,23 @@ static json_t *box_json(const struct scene_box *b)
 
 static json_t *describe_lights(const struct scene *s)
 {
-    /* How many lights reach each object at frame 0 (a light's sphere meets
-     * the object's bounding sphere; the ground left out) and how many light
-     * centres are on screen: the overlap the light radius controls. */
+    /* How many lights reach each object at frame 0 (a light's region, its
+     * sphere or a spot's cone, meets the object's bounding sphere, as
+     * light_shape.h tests it; a directional light reaches every object; the
+     * ground left out) and how many light positions are on screen (of the
+     * lights that have one): the overlap the light radius controls. */
     struct scene_camera cam;
     scene_camera_at(s, 0, &cam);
     float *pos = malloc((size_t)(s->light_count ? s->light_count : 1) * 3 * sizeof(float));
     if (!pos)
         return NULL;
-    int on_screen = 0;
+    int on_screen = 0, positioned = 0, by_type[3] = {0, 0, 0};
     for (int l = 0; l < s->light_count; l++) {
         scene_light_position(s, l, 0, &pos[l * 3]);
+        by_type[s->lights[l].type]++;
+        if (s->lights[l].type == SCENE_LIGHT_DIRECTIONAL)
+            continue;
+        positioned++;
         on_screen += point_in_clip(cam.view_proj, &pos[l * 3]);
     }
     double sum = 0;
@@ -321,27 +328,39 @@ static json_t *describe_lights(const struct scene *s)
             continue;
         float bound = scene_instance_bound(s, i);
         int reach = 0;
-        for (int l = 0; l < s->light_count; l++) {
-            float d[3] = {pos[l * 3] - in->pos[0], pos[l * 3 + 1] - in->pos[1],
-                          pos[l * 3 + 2] - in->pos[2]};
-            float r = s->lights[l].radius + bound;
-            reach += d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < r * r;
-        }
+        for (int l = 0; l < s->light_count; l++)
+            reach += scene_light_reaches(&s->lights[l], &pos[l * 3], in->pos, bound);
         sum += reach;
         most = reach > most ? reach : most;
         objects++;
     }
     free(pos);
-    return json_pack("{s:i, s:s, s:f, s:f, s:o, s:s, s:f, s:f, s:{s:f, s:i}}", "count",
-                     s->light_count, "layout", scene_layout_names[s->spec.light_layout],
-                     "radius", s->spec.light_radius, "intensity", s->spec.light_intensity,
-                     "volume", box_json(&s->light_volume), "orbit_plane",
-                     s->light_orbit_plane == SCENE_ORBIT_XY ? "xy" : "xz", "orbit",
-                     s->light_count ? (double)s->lights[0].orbit : 0.0,
-                     "on_screen_at_frame_0",
-                     s->light_count ? (double)on_screen / s->light_count : 0.0,
-                     "per_object_at_frame_0", "mean", objects ? sum / objects : 0.0, "max",
-                     most);
+    json_t *out = json_pack(
+        "{s:i, s:s, s:f, s:f, s:o, s:s, s:f, s:f, s:{s:f, s:i}, s:{s:i, s:i, s:i}, s:s, s:b}",
+        "count", s->light_count, "layout", scene_layout_names[s->spec.light_layout], "radius",
+        s->spec.light_radius, "intensity", s->spec.light_intensity, "volume",
+        box_json(&s->light_volume), "orbit_plane",
+        s->light_orbit_plane == SCENE_ORBIT_XY ? "xy" : "xz", "orbit",
+        s->light_count ? (double)s->lights[0].orbit : 0.0, "on_screen_at_frame_0",
+        positioned ? (double)on_screen / positioned : 0.0, "per_object_at_frame_0", "mean",
+        objects ? sum / objects : 0.0, "max", most, "by_type", "point",
+        by_type[SCENE_LIGHT_POINT], "spot", by_type[SCENE_LIGHT_SPOT], "directional",
+        by_type[SCENE_LIGHT_DIRECTIONAL], "type", scene_light_type_names[s->spec.light_type],
+        "sun", s->spec.sun);
+    if (out && s->spec.light_type == SCENE_LIGHT_SPOT)
+        json_object_set_new(out, "spot",
+                            json_pack("{s:f, s:f, s:[f, f, f]}", "outer_deg",
+                                      s->spec.spot_angle_deg, "inner_deg",
+                                      s->spec.spot_angle_deg * SCENE_SPOT_INNER_RATIO,
+                                      "direction", 0.0, -1.0, 0.0));
+    if (out && s->spec.sun)
+        json_object_set_new(out, "sun_light",
+                            json_pack("{s:i, s:o, s:[f, f, f]}", "index", s->light_count - 1,
+                                      "direction", vec3_json(SCENE_SUN_DIRECTION), "color",
+                                      (double)s->lights[s->light_count - 1].color[0],
+                                      (double)s->lights[s->light_count - 1].color[1],
+                                      (double)s->lights[s->light_count - 1].color[2]));
+    return out;
 }
 
 static json_t *describe_camera(const struct scene *s)

@@ -55,6 +55,15 @@ enum scene_orbit_plane { SCENE_ORBIT_XY, SCENE_ORBIT_XZ };
 enum scene_light_type { SCENE_LIGHT_POINT, SCENE_LIGHT_SPOT, SCENE_LIGHT_DIRECTIONAL };
 extern const char *const scene_light_type_names[]; /* "point", "spot", "directional" */
 
+/* Generated lights (scene.light_type "spot", scene.sun; lights.c): a
+ * generated spot's inner half-angle is this share of its outer one, and the
+ * sun shines along SCENE_SUN_DIRECTION (unit: down, a little towards -x and
+ * -z, so that the objects' sides facing the camera are lit) with
+ * SCENE_SUN_COLOR times scene.light_intensity. */
+#define SCENE_SPOT_INNER_RATIO 0.75
+extern const float SCENE_SUN_DIRECTION[3];
+extern const float SCENE_SUN_COLOR[3];
+
 struct scene_light {
     float centre[3];
     float orbit;  /* circle radius around centre, in the scene's orbit plane */

@@ -31,6 +31,10 @@ bool scene_build_asset(struct scene *s, char *err, size_t errlen);
  * scene is dynamic. */
 bool scene_place_lights(struct scene *s, float orbit);
 
+/* lights.c: with spec.sun, appends the directional light (after the
+ * preset's own, whose colours the presets may have changed). */
+bool scene_add_sun(struct scene *s);
+
 /* materials.c: each instance's material from spec.materials and the
  * spec's material values; "preset" keeps what the preset set when it set
  * materials (materials_set), else it is "uniform". */

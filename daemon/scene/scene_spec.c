@@ -1,6 +1,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "daemon/scene/scene_spec.h"
 
+#include "daemon/scene/scene.h" /* scene_light_type_names */
+
 #include <stdio.h>
 #include <string.h>
 
@@ -61,6 +63,9 @@ void scene_spec_defaults(struct scene_spec *s)
     s->teapot_segments = 12;
     s->light_speed = 1.0;
     s->light_intensity = 1.0;
+    s->light_type = SCENE_LIGHT_POINT;
+    s->spot_angle_deg = 30.0;
+    s->sun = false;
     /* The constants of the thesis's Phong (shaders/common/lighting.glsl);
      * roughness 0.25 is about the Beckmann roughness of Phong exponent 32,
      * sqrt(2 / (32 + 2)), for the lighting models to come. */
@@ -232,16 +237,28 @@ static bool parse_asset(const json_t *scene, struct scene_spec *s, struct job_er
     return true;
 }
 
+/* "light_type": the generated lights are points or spots; a directional
+ * light is the sun's option (one light, not hundreds of suns). */
+static bool parse_light_type(const json_t *scene, int *type, struct job_error *err)
+{
+    static const char *const generated[] = {"point", "spot", NULL};
+    if (!jf_get_choice(scene, "light_type", "scene.light_type", generated, type, err))
+        return false;
+    /* The enum's order is the names' (scene_light_type_names). */
+    return true;
+}
+
 bool scene_spec_parse(const json_t *scene, struct scene_spec *s, struct job_error *err)
 {
     static const char *const keys[] = {
         "preset", "lights", "dynamic", "width", "height", "sphere_segments",
         "teapot_segments", "tessellation_error_px", "light_speed", "light_radius", "light_intensity",
-        "light_layout", "materials", "specular", "shininess", "metallic", "roughness",
-        "camera", "asset", "asset_sha256", "asset_camera", "asset_lights", "normal_maps", NULL};
+        "light_layout", "light_type", "spot_angle_deg", "sun", "materials", "specular",
+        "shininess", "metallic", "roughness", "camera", "asset", "asset_sha256", "asset_camera",
+        "asset_lights", "normal_maps", NULL};
     if (!jf_check_keys(scene, "scene.", keys, err))
         return false;
-    int preset = (int)s->preset, layout, materials;
+    int preset = (int)s->preset, layout, materials, light_type = s->light_type;
     if (!jf_get_choice(scene, "preset", "scene.preset", scene_preset_names, &preset, err))
         return false;
     if (json_object_get(scene, "preset"))
@@ -265,6 +282,10 @@ bool scene_spec_parse(const json_t *scene, struct scene_spec *s, struct job_erro
                        &s->light_intensity, err) ||
         !jf_get_choice(scene, "light_layout", "scene.light_layout", scene_layout_names, &layout,
                        err) ||
+        !parse_light_type(scene, &light_type, err) ||
+        !jf_get_number(scene, "spot_angle_deg", "scene.spot_angle_deg", 0.5, 89.0,
+                       &s->spot_angle_deg, err) ||
+        !jf_get_bool(scene, "sun", "scene.sun", &s->sun, err) ||
         !jf_get_choice(scene, "materials", "scene.materials", scene_materials_names,
                        &materials, err) ||
         !jf_get_number(scene, "specular", "scene.specular", 0.0, 16.0, &s->specular, err) ||
@@ -282,6 +303,7 @@ bool scene_spec_parse(const json_t *scene, struct scene_spec *s, struct job_erro
         !jf_get_bool(scene, "normal_maps", "scene.normal_maps", &s->normal_maps, err))
         return false;
     s->light_layout = (enum scene_light_layout)layout;
+    s->light_type = light_type;
     s->materials = (enum scene_materials)materials;
     return true;
 }
@@ -306,6 +328,9 @@ json_t *scene_spec_to_json(const struct scene_spec *s)
     json_object_set_new(o, "light_radius", json_real(s->light_radius));
     json_object_set_new(o, "light_intensity", json_real(s->light_intensity));
     json_object_set_new(o, "light_layout", json_string(scene_layout_names[s->light_layout]));
+    json_object_set_new(o, "light_type", json_string(scene_light_type_names[s->light_type]));
+    json_object_set_new(o, "spot_angle_deg", json_real(s->spot_angle_deg));
+    json_object_set_new(o, "sun", json_boolean(s->sun));
     json_object_set_new(o, "materials", json_string(scene_materials_names[s->materials]));
     json_object_set_new(o, "specular", json_real(s->specular));
     json_object_set_new(o, "shininess", json_real(s->shininess));

@@ -67,6 +67,14 @@ struct scene_spec {
     double light_radius;          /* influence radius of every light */
     double light_intensity;       /* scales every light's colour */
     enum scene_light_layout light_layout;
+    /* What the generated lights are (enum scene_light_type, scene.h; the
+     * presets place point lights unless "light_type" says "spot": each a
+     * spot pointing straight down, with outer half-angle spot_angle_deg and
+     * inner SCENE_SPOT_INNER_RATIO of it). sun adds one directional light
+     * after them (scene.h: SCENE_SUN_DIRECTION, SCENE_SUN_COLOR). */
+    int light_type;
+    double spot_angle_deg;
+    bool sun;
     enum scene_materials materials;
     double specular, shininess, metallic, roughness;
     enum scene_camera_path camera;

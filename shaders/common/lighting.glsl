@@ -15,6 +15,7 @@
 // read shininess as roughness (Beckmann's sqrt(2 / (n + 2))) and metallic 0.
 #include "frame.glsl"
 #include "scene_data.glsl"
+#include "light_shape.glsl"
 
 #if !defined(LIGHTING_PHONG) && !defined(LIGHTING_BLINN_PHONG) && !defined(LIGHTING_PBR)
 #define LIGHTING_PHONG 1
@@ -45,23 +46,43 @@ vec3 light_position(int i, int row)
 }
 
 // Light i at Lpos on the surface point P (normal N, towards the eye V).
-// Attenuation reaches exactly 0 at the light's radius, so culling a light by
-// its radius never changes the image.
+// Point and spot lights: attenuation reaches exactly 0 at the light's radius,
+// and a spot's cone falloff exactly 0 at its outer angle, so culling a light
+// by its sphere or cone never changes the image. A directional light (Lpos
+// unused) is unattenuated and lights every surface facing it, from
+// -direction.
 vec3 light_contribution(int i, vec3 Lpos, vec3 P, vec3 N, vec3 V, Material m)
 {
-    vec3 Lv = Lpos - P;
-    float r = lights[i].color_radius.w;
-    float d2 = dot(Lv, Lv);
-    if (d2 >= r * r)
-        return vec3(0.0);
-    float att = 1.0 - d2 / (r * r);
-    att *= att;
-    vec3 L = Lv * inversesqrt(d2);
+    int type = light_type(i);
+    vec3 L;
+    float att;
+    if (type == LIGHT_DIRECTIONAL) {
+        L = -lights[i].direction_type.xyz;
+        att = 1.0;
+    } else {
+        vec3 Lv = Lpos - P;
+        float r = lights[i].color_radius.w;
+        float d2 = dot(Lv, Lv);
+        if (d2 >= r * r)
+            return vec3(0.0);
+        att = 1.0 - d2 / (r * r);
+        att *= att;
+        L = Lv * inversesqrt(d2);
+        if (type == LIGHT_SPOT) {
+            float cone = light_spot_falloff(i, -L);
+            if (cone <= 0.0)
+                return vec3(0.0);
+            att *= cone;
+        }
+    }
     float nl = dot(N, L);
     if (nl <= 0.0)
         return vec3(0.0);
 #if defined(LOOK_SHADOWS)
-    att *= shadow_visibility(i, P, N, nl);
+    if (type == LIGHT_DIRECTIONAL)
+        att *= shadow_sun_visibility(i, P, N);
+    else
+        att *= shadow_visibility(i, P, N, nl);
 #endif
 #if defined(LIGHTING_PBR)
     // Light colours are the irradiance a light gives a surface facing it
@@ -90,7 +111,7 @@ vec3 light_contribution(int i, vec3 Lpos, vec3 P, vec3 N, vec3 V, vec3 albedo,
     return light_contribution(i, Lpos, P, N, V, material_from_phong(albedo, specular, shininess));
 }
 
-// Light that does not come from the scene's point lights: Phong's constant
+// Light that does not come from the scene's lights: Phong's constant
 // term; under PBR a uniform environment of radiance AMBIENT, or with
 // LOOK_IBL the harness's environment and probes.
 vec3 light_ambient(Material m, vec3 P, vec3 N, vec3 V)

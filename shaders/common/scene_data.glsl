@@ -27,10 +27,17 @@ Material instance_material(int id)
                     inst.material.w);
 }
 
+// std430, 48 bytes; written by daemon/gpu/gpu_scene.c in this order. The
+// type is a float holding LIGHT_POINT, LIGHT_SPOT or LIGHT_DIRECTIONAL
+// (enum scene_light_type); a point light's other fields are 0.
 struct Light {
-    vec4 color_radius; // colour (scaled by scene.light_intensity), influence radius
-                       // (attenuation is 0 beyond it)
+    vec4 color_radius;   // colour (scaled by scene.light_intensity), influence radius
+                         // (attenuation is 0 beyond it; unused by directional lights)
+    vec4 direction_type; // unit direction the light shines (spot, directional), type
+    vec4 cone;           // spot: cos outer, cos inner, 1 / max(cos inner - cos outer,
+                         // 1e-3) (glTF's angle scale), sin outer (for the culling)
 };
+const int LIGHT_POINT = 0, LIGHT_SPOT = 1, LIGHT_DIRECTIONAL = 2;
 layout(std430, binding = SB_SSBO_LIGHTS) readonly buffer LightBuffer { Light lights[]; };
 
 // Rows of u_frame.counts.y positions; row 0 is the frame being drawn, OSL uses

@@ -3,7 +3,8 @@
 // frame (daemon/harness/shadows.c). Each light's six faces lie in one depth
 // atlas (or, with SHADOW_CUBES, in a layer of a cube map array); a light
 // without a map this frame (culled, nothing to cast, or dropped when the
-// atlas was full) is unshadowed. Percentage-closer filtering over
+// atlas was full) is unshadowed. A directional light has an orthographic
+// map of its own instead (shadow_sun_visibility). Percentage-closer filtering over
 // (2 SHADOW_PCF + 1)^2 bilinear comparisons; the receiver is moved
 // SHADOW_NORMAL_OFFSET shadow-map texels along its normal and compared
 // SHADOW_BIAS world units nearer the light.
@@ -20,6 +21,17 @@ struct ShadowLight {
 layout(std430, binding = SB_SSBO_SHADOW_LIGHTS) readonly buffer ShadowBuffer {
     ShadowLight shadow_lights[];
 };
+
+// daemon/look/shadows.c, struct sun_shadow_gpu (std430, 80 bytes): a
+// directional light's orthographic projection fitted to the scene's bounds.
+struct SunShadow {
+    mat4 view_proj;
+    vec4 params; // size in texels, one texel in world units, depth range in world units, layer
+};
+layout(std430, binding = SB_SSBO_SHADOW_SUNS) readonly buffer SunShadowBuffer {
+    SunShadow sun_shadows[];
+};
+layout(binding = SB_TEX_SHADOW_SUNS) uniform sampler2DArrayShadow u_shadow_suns;
 
 #if defined(SHADOW_CUBES)
 layout(binding = SB_TEX_SHADOW_CUBES) uniform samplerCubeArrayShadow u_shadow_cubes;
@@ -62,5 +74,26 @@ float shadow_visibility(int i, vec3 P, vec3 N, float nl)
             sum += texture(u_shadow_atlas, vec3(tc * (1.0 / SHADOW_ATLAS_SIZE), ref));
         }
 #endif
+    return sum / float((2 * SHADOW_PCF + 1) * (2 * SHADOW_PCF + 1));
+}
+
+// Directional light i: its map (shadow_lights[i].params: size, 0 when it has
+// none, and the map's index in w), the same filter, normal offset and bias
+// as the omni maps. Outside the fitted bounds: lit.
+float shadow_sun_visibility(int i, vec3 P, vec3 N)
+{
+    vec4 p = shadow_lights[i].params;
+    if (p.x <= 0.0)
+        return 1.0;
+    SunShadow s = sun_shadows[int(p.w)];
+    vec3 q = P + N * (SHADOW_NORMAL_OFFSET * s.params.y);
+    vec3 c = (s.view_proj * vec4(q, 1.0)).xyz * 0.5 + 0.5;
+    if (any(lessThan(c, vec3(0.0))) || any(greaterThan(c, vec3(1.0))))
+        return 1.0;
+    float ref = c.z - SHADOW_BIAS / s.params.z;
+    float texel = 1.0 / s.params.x, sum = 0.0;
+    for (int y = -SHADOW_PCF; y <= SHADOW_PCF; y++)
+        for (int x = -SHADOW_PCF; x <= SHADOW_PCF; x++)
+            sum += texture(u_shadow_suns, vec4(c.xy + vec2(x, y) * texel, s.params.w, ref));
     return sum / float((2 * SHADOW_PCF + 1) * (2 * SHADOW_PCF + 1));
 }

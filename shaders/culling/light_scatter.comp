@@ -5,6 +5,11 @@
 // the result independent of invocation order, so the lists
 // light_compact.comp writes are the same every run; the summary lets it
 // visit only the words that hold lights (and zero them for the next frame).
+// A spot light's sphere is its cone's bounding sphere (light_shape.glsl),
+// and a cell that sphere touches is kept only if the cone itself may touch
+// the cell's bounding sphere (Wronski's cone test). A directional light
+// lights everything: its bit goes into every cell (of tiles, every tile with
+// a surface), so lists stay in ascending index order, as forward sums.
 #include "light_grid.glsl"
 #include "light_bounds.glsl"
 layout(local_size_x = 64) in;
@@ -26,18 +31,26 @@ void main()
     int i = int(gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 64u + gl_GlobalInvocationID.x);
     if (i >= u_grid.counts.x)
         return;
-    vec3 world = light_position(i, 0);
-    float r = lights[i].color_radius.w;
-    ivec4 rect = light_rect(LIGHT_RECT_TIGHT, world, r);
+    vec3 apex = light_position(i, 0), world;
+    float r;
+    bool everywhere = !light_bound_sphere(i, apex, world, r);
+    bool spot = light_type(i) == LIGHT_SPOT;
+    ivec4 rect = everywhere ? ivec4(0, 0, ivec2(u_frame.viewport.xy))
+                            : light_rect(LIGHT_RECT_TIGHT, world, r);
     if (rect.x >= rect.z || rect.y >= rect.w)
         return;
     vec3 c = (u_frame.view * vec4(world, 1.0)).xyz;
+    // The cone in view space, and the slack its test is given: the test's
+    // rounding must never leave out a cell a sliver of the cone lights.
+    vec3 apex_v = (u_frame.view * vec4(apex, 1.0)).xyz;
+    vec3 axis_v = mat3(u_frame.view) * lights[i].direction_type.xyz;
+    float range = lights[i].color_radius.w, cone_slack = 1e-3 * range + 1e-4;
     ivec2 size = ivec2(u_grid.tile.xy);
     ivec2 t0 = rect.xy / size, t1 = min((rect.zw - 1) / size, u_grid.dims.xy - 1);
     int z0 = 0, z1 = 0;
 #if !defined(GRID_TILES)
-    z0 = grid_slice(max(-c.z - r, u_frame.clip.x));
-    z1 = grid_slice(-c.z + r);
+    z0 = everywhere ? 0 : grid_slice(max(-c.z - r, u_frame.clip.x));
+    z1 = everywhere ? u_grid.dims.z - 1 : grid_slice(-c.z + r);
 #endif
     float px = u_frame.proj[0][0], sx = u_frame.proj[2][0];
     float py = u_frame.proj[1][1], sy = u_frame.proj[2][1];
@@ -57,7 +70,7 @@ void main()
             float pad_row = 1e-3 * dr.y + 1e-4;
             float dy = c.y - clamp(c.y, y0 * (y0 >= 0.0 ? dr.x : dr.y) - pad_row,
                                    y1 * (y1 >= 0.0 ? dr.y : dr.x) + pad_row);
-            if (dz * dz + dy * dy > r * r)
+            if (!everywhere && dz * dz + dy * dy > r * r)
                 continue;
 #endif
             for (int tx = t0.x; tx <= t1.x; tx++) {
@@ -79,7 +92,13 @@ void main()
                 vec3 hi = vec3(x1 * (x1 >= 0.0 ? dr.y : dr.x), y1 * (y1 >= 0.0 ? dr.y : dr.x),
                                -dr.x) + pad;
                 vec3 q = clamp(c, lo, hi) - c;
-                if (dot(q, q) <= r * r &&
+                bool touches = everywhere || dot(q, q) <= r * r;
+                if (touches && spot)
+                    touches = light_cone_touches_sphere(apex_v, axis_v, range,
+                                                        lights[i].cone.x, lights[i].cone.w,
+                                                        0.5 * (lo + hi),
+                                                        0.5 * length(hi - lo) + cone_slack);
+                if (touches &&
                     atomicOr(light_bits[cell * u_grid.lists.z + int(word)], bit) == 0u)
                     atomicOr(light_summary[cell * u_grid.counts.z + int(word >> 5u)],
                              1u << (word & 31u));

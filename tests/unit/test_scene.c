@@ -745,7 +745,7 @@ static bool round_trips(const char *json)
     json_t *again = scene_spec_to_json(&b);
     ok = ok && json_equal(out, again) && memcmp(&a, &b, sizeof(a)) == 0;
     /* Every option is written back. */
-    ok = ok && json_object_size(out) == 18;
+    ok = ok && json_object_size(out) == 21;
     json_decref(in);
     json_decref(out);
     json_decref(again);

@@ -3,9 +3,12 @@
 // triangles, the scissor rectangle drawn rather than set, so that one draw
 // covers every light), the light's sphere (back faces of a 16 x 8 latitude-
 // longitude mesh made from gl_VertexID, scaled to enclose the true sphere),
-// or the whole screen.
+// or the whole screen. A spot light's bound is its cone's bounding sphere
+// (light_shape.glsl); a directional light's is the whole screen whatever the
+// option (in the volume mode a screen-filling quad wound to face away, which
+// the front-face culling keeps).
 #include "light_bounds.glsl"
-#include "scene_data.glsl"
+#include "light_shape.glsl"
 flat out int v_light;
 
 const int SPHERE_SEGMENTS = 16, SPHERE_RINGS = 8;
@@ -14,9 +17,18 @@ void main()
 {
     int i = gl_InstanceID;
     v_light = i;
-    vec3 world = light_positions[i].xyz;
-    float r = lights[i].color_radius.w;
+    vec3 world;
+    float r;
+    bool bounded = light_bound_sphere(i, light_positions[i].xyz, world, r);
 #if defined(DEFERRED_BOUNDS_VOLUME)
+    if (!bounded) {
+        // Clockwise: a back face, kept by glCullFace(GL_FRONT); the rest of
+        // the mesh's vertices collapse to a point.
+        const vec2 quad[6] = vec2[6](vec2(-1, -1), vec2(1, 1), vec2(1, -1), vec2(-1, -1),
+                                     vec2(-1, 1), vec2(1, 1));
+        gl_Position = vec4(gl_VertexID < 6 ? quad[gl_VertexID] : vec2(0.0), 0.0, 1.0);
+        return;
+    }
     // Quad q of the mesh, corner k of its two triangles (counter-clockwise seen
     // from outside, so culling front faces keeps the far side).
     int q = gl_VertexID / 6, k = gl_VertexID % 6;
@@ -30,12 +42,16 @@ void main()
     // facet's diagonal angle), about 3.9% here: grow the mesh by 6%.
     gl_Position = u_frame.view_proj * vec4(world + 1.06 * r * dir, 1.0);
 #else
+    ivec4 rect;
+    if (!bounded)
+        rect = ivec4(0, 0, ivec2(u_frame.viewport.xy));
+    else
 #if defined(DEFERRED_BOUNDS_FULLSCREEN)
-    ivec4 rect = ivec4(0, 0, ivec2(u_frame.viewport.xy));
+    rect = ivec4(0, 0, ivec2(u_frame.viewport.xy));
 #elif defined(DEFERRED_BOUNDS_SCISSOR_LOOSE)
-    ivec4 rect = light_rect(LIGHT_RECT_LOOSE, world, r);
+    rect = light_rect(LIGHT_RECT_LOOSE, world, r);
 #else
-    ivec4 rect = light_rect(LIGHT_RECT_TIGHT, world, r);
+    rect = light_rect(LIGHT_RECT_TIGHT, world, r);
 #endif
     const ivec2 corner[6] = ivec2[6](ivec2(0, 0), ivec2(1, 0), ivec2(1, 1), ivec2(0, 0),
                                      ivec2(1, 1), ivec2(0, 1));

@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "daemon/scene/light_shape.h"
+
 int osl_period(double distance, double async_distance)
 {
     if (async_distance <= 0.0)
@@ -70,11 +72,13 @@ bool osl_touched(const struct scene *scene, int i, int64_t frame)
     const float *c = scene->instances[i].pos;
     float bound = scene_instance_bound(scene, i);
     for (int l = 0; l < scene->light_count; l++) {
+        /* A directional light never moves, so it never changes what it
+         * lights: it forces no reshade. A spot light reaches by its cone. */
+        if (scene->lights[l].type == SCENE_LIGHT_DIRECTIONAL)
+            continue;
         float p[3];
         scene_light_position(scene, l, frame, p);
-        float d[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
-        float reach = scene->lights[l].radius + bound;
-        if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < reach * reach)
+        if (scene_light_reaches(&scene->lights[l], p, c, bound))
             return true;
     }
     return false;

@@ -40,7 +40,10 @@ void osl_schedule_finish(struct osl_schedule *s);
 int64_t osl_schedule_last(const struct osl_schedule *s, int i, int64_t frame);
 bool osl_schedule_due(const struct osl_schedule *s, int i, int64_t frame);
 
-/* True when a light of the (dynamic) scene reaches instance i's bounds at frame. */
+/* True when a moving light of the (dynamic) scene reaches instance i's
+ * bounds at frame: a point light by its sphere, a spot light by its cone
+ * (daemon/scene/light_shape.h); a directional light never moves, so it
+ * never counts. */
 bool osl_touched(const struct scene *scene, int i, int64_t frame);
 
 /* Objects to shade at frame; initial shades everything (first frame drawn).

@@ -12,6 +12,7 @@
 #include "common/stats.h"
 #include "daemon/gpu/bindings.h"
 #include "daemon/gpu/glutil.h"
+#include "daemon/scene/light_shape.h"
 
 /* Index entries a frame's lists may take at most (64 MiB, times the ring),
  * whatever the device allows: past it a scene is better served by larger
@@ -286,7 +287,9 @@ static int stats_slot(const struct light_grid *g, int64_t frame)
 
 /* Seed 003's CPU-built grid: each light's tight screen rectangle (no depth
  * bounds: the depth buffer lives on the GPU) appended to the tiles it
- * covers, in light order, then uploaded. */
+ * covers, in light order, then uploaded. A spot light's rectangle is its
+ * cone's bounding sphere's (no cone test per tile here); a directional
+ * light's the whole screen. */
 static void build_cpu(struct light_grid *g, const struct technique_env *env, int64_t frame,
                       int slot, const struct scene_camera *cam)
 {
@@ -294,12 +297,16 @@ static void build_cpu(struct light_grid *g, const struct technique_env *env, int
     const int tw = (int)g->block.tile[0], th = (int)g->block.tile[1], tx = g->block.dims[0];
     memset(g->counts, 0, (size_t)g->cells * sizeof(uint32_t));
     for (int i = 0; i < g->lights; i++) {
-        float p[3];
+        float p[3], centre[3], radius;
         int *r = &g->rects[i * 4];
         scene_light_position(s, i, frame, p);
-        if (!light_rect(LIGHT_BOUNDS_SCISSOR_TIGHT, p, s->lights[i].radius, cam->view,
-                        cam->proj, cam->view_proj, cam->near_z, cam->far_z, g->width, g->height,
-                        r)) {
+        /* A spot light by its cone's bounding sphere; a directional light
+         * in every tile. */
+        if (!scene_light_bound(&s->lights[i], p, centre, &radius)) {
+            r[0] = r[1] = 0, r[2] = g->width, r[3] = g->height;
+        } else if (!light_rect(LIGHT_BOUNDS_SCISSOR_TIGHT, centre, radius, cam->view,
+                               cam->proj, cam->view_proj, cam->near_z, cam->far_z, g->width,
+                               g->height, r)) {
             r[0] = 1, r[2] = 0; /* no tile */
             continue;
         }

@@ -266,10 +266,10 @@ static void convert_light(const struct scene *s, const struct asset_light *al,
         l->cos_outer = cosf(al->outer_cone);
         break;
     case ASSET_LIGHT_DIRECTIONAL:
-        /* No position: the centre is set far up-light of the bounds with a
-         * radius that covers them, so that code that reads every light as a
-         * point (until the lighting library shades directional lights) sees
-         * one that reaches everything, nearly evenly. */
+        /* No position: the lighting library and the light grids read the
+         * type and direction alone. The centre is still set far up-light of
+         * the bounds with a radius that covers them, for the code that
+         * measures distances to every light (scene_describe's counts). */
         l->type = SCENE_LIGHT_DIRECTIONAL;
         for (int k = 0; k < 3; k++)
             l->centre[k] = c[k] - 4.0f * diag * al->direction[k];

@@ -2,7 +2,9 @@
 asset path without an uploaded file), at 160x120 and a handful of frames:
 - every technique but osl and unlit agrees with forward (SSIM >= 0.999,
   PerceptualDiff passing), each with the harness's transparent pass timed
-  after its own passes and the sky; osl refuses asset scenes, naming why;
+  after its own passes and the sky; osl renders them too, baking the
+  materials into its geometry atlas, nearer forward than OSL_BOUND (object
+  space shading samples what the others filter: docs/techniques.md);
 - normal maps change the image (scene.normal_maps false against true);
 - a known sRGB texel comes through: unlit, tone map none at exposure 1,
   shows the swatch's texel decoded to linear by the sRGB sampler, within 1;
@@ -20,6 +22,10 @@ from testlib import check
 testlib.skip_without_egl()
 
 SSIM_BOUND = 0.999
+# OSL on the textured preset at 160x120 measured 0.9828 (0.9914 at 480x320):
+# its shading is sampled from the atlas where the other techniques' textures
+# are mipmapped (docs/techniques.md, "OSL on asset scenes").
+OSL_BOUND = 0.975
 W, H = 160, 120
 SCENE = {"preset": "textured", "width": W, "height": H}
 JOB = {"frames": 2, "warmup_frames": 1, "capture_interval": 2, "scene": SCENE}
@@ -142,9 +148,18 @@ try:
               and q.get("pdiff_failed_captures") == 0,
               "%s %s agrees with forward: SSIM %.5f (%s)" % (name, extra, ssim, done.get("error")))
 
-    osl = d.run(dict(JOB, technique="osl"))
-    check(osl.get("status") == "failed" and "asset" in (osl.get("error") or ""),
-          "osl refuses asset scenes: %s %s" % (osl.get("status"), osl.get("error")))
+    osl = d.run(dict(JOB, technique="osl", reference="forward"))
+    result = osl.get("result", {})
+    ssim = result.get("quality", {}).get("worst_ssim", {}).get("value", 0)
+    charts = result.get("osl", {}).get("asset_charts", {})
+    check(osl.get("status") == "done" and ssim >= OSL_BOUND,
+          "osl renders the textured preset near forward: SSIM %.5f >= %s (%s)"
+          % (ssim, OSL_BOUND, osl.get("error")))
+    check(list(result.get("gpu_sections_ms", {}))
+          == ["lighting", "raster", "sky", "transparent", "resolve"],
+          "osl: its passes, the sky, the transparent pass: %s" % list(result.get("gpu_sections_ms", {})))
+    check(0 < charts.get("uncovered_share", 0) < 0.5 and charts.get("gutter_filled_share", 0) > 0,
+          "osl reports its asset charts' uncovered texels and the gutters it filled: %s" % charts)
 
     # Normal maps: the bumps change the lit image.
     flat = d.run(dict(JOB, technique="forward", scene=dict(SCENE, normal_maps=False)))

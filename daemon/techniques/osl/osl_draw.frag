@@ -26,17 +26,16 @@ uniform vec2 u_atlas_size;
 #include "surface.glsl"
 #endif
 
-void main()
+// One bilinear sample of the atlas at uv (clamped to the centres of the
+// first and last texels inside the chart: the bilinear footprint then never
+// leaves the chart, which is the gutter), marking with osl.visibility
+// "seen" the blocks it reads.
+vec3 atlas_sample(vec2 uv)
 {
-#if defined(SCENE_TEXTURED)
-    surface_alpha_clip();
-#endif
-    // Clamp to the centres of the first and last texels inside the chart:
-    // the bilinear footprint then never leaves the chart, which is the gutter.
     float size = float(v_tile.z);
     vec2 lo = (ceil(v_chart.xy * size - 0.5) + 0.5) / size;
     vec2 hi = (floor(v_chart.zw * size - 0.5) + 0.5) / size;
-    vec2 uv = clamp(v_uv, lo, hi);
+    uv = clamp(uv, lo, hi);
     vec2 atlas_uv = (vec2(v_tile.xy) + uv * size) / u_atlas_size;
 #ifdef OSL_SEEN
     // The texels bilinear filtering reads with a weight above zero (at a
@@ -49,5 +48,29 @@ void main()
         for (int x = b0.x; x <= b1.x; x++)
             imageStore(u_marks, ivec2(x, y), ivec4(u_frame_index));
 #endif
-    out_color = vec4(texture(u_atlas, atlas_uv).rgb, 1.0);
+    return texture(u_atlas, atlas_uv).rgb;
+}
+
+void main()
+{
+#if defined(SCENE_TEXTURED)
+    // Asset scenes: where a pixel covers several texels (far or small), one
+    // bilinear sample aliases detail the other techniques' mipmapped
+    // textures average away; up to 4 x 4 samples spread over the pixel's
+    // footprint (a box filter) average it here too. Derivatives first, in
+    // uniform control flow (the mask's discard follows).
+    float size = float(v_tile.z);
+    vec2 dx = dFdx(v_uv), dy = dFdy(v_uv);
+    int nx = clamp(int(ceil(length(dx) * size)), 1, 4);
+    int ny = clamp(int(ceil(length(dy) * size)), 1, 4);
+    surface_alpha_clip();
+    vec3 sum = vec3(0.0);
+    for (int j = 0; j < ny; j++)
+        for (int i = 0; i < nx; i++)
+            sum += atlas_sample(v_uv + ((float(i) + 0.5) / float(nx) - 0.5) * dx +
+                                ((float(j) + 0.5) / float(ny) - 0.5) * dy);
+    out_color = vec4(sum / float(nx * ny), 1.0);
+#else
+    out_color = vec4(atlas_sample(v_uv), 1.0);
+#endif
 }

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """The many-lights family against light count: every light-culling
-technique with `forward` and `unlit` as anchors, on the `lights` preset, in
+technique with `forward` and `unlit` as anchors, on the `lights` preset (or
+on a glTF asset with --asset, its generated lights placed in its bounds), in
 one run on one daemon, interleaved across repeats. Prints frame_ms medians,
 ratios to forward and to unlit, where each technique's binning stands, the
 overflow counters, the crossover points ("from N lights on, X beats Y") and
@@ -10,7 +11,7 @@ count.
   bench/bench_lights_techniques.py [--counts 16,64,256,1024,4096,16384]
       [--frames N] [--warmup N] [--repeat R] [--width W --height H]
       [--forward-max N] [--techniques a,b,...] [--variant NAME=TECH:JSON ...]
-      [--svg FILE] [--json FILE]
+      [--svg FILE] [--json FILE] [--asset FILE.glb]
 
 --variant names a technique with options, usable in --techniques: e.g.
 --variant 'td8=tiled_deferred:{"tile_size": 8}' --techniques unlit,td8,...
@@ -67,6 +68,8 @@ ap.add_argument("--variant", action="append", default=[],
                 help="NAME=TECHNIQUE:JSON, a technique with options (repeatable)")
 ap.add_argument("--json", help="write every result here")
 ap.add_argument("--from-json", help="report on the results a --json run wrote, without running")
+ap.add_argument("--asset", help="a .glb or .gltf: uploaded to the daemon and rendered instead of the "
+                "lights preset, with --counts generated point lights in its bounds (its own lights off)")
 args = ap.parse_args()
 
 counts = [int(c) for c in args.counts.split(",")]
@@ -81,12 +84,17 @@ for v in args.variant:
     VARIANTS[vname] = (vtech, json.loads(vopts) if vopts else None)
 
 
+ASSET_NAME = os.path.basename(args.asset) if args.asset else None
+SCENE = {"asset": ASSET_NAME, "asset_lights": False} if args.asset else {"preset": "lights"}
+SCENE_LABEL = "asset %s" % ASSET_NAME if args.asset else "lights preset"
+
+
 def job_for(name, n):
     tech, opts = VARIANTS.get(name, (name, None))
     job = {"technique": tech, "frames": args.frames if n <= 1024 else args.frames_high,
            "warmup_frames": args.warmup,
            "capture_interval": 0,
-           "scene": {"preset": "lights", "lights": n, "width": args.width, "height": args.height}}
+           "scene": dict(SCENE, lights=n, width=args.width, height=args.height)}
     if opts:
         job[tech] = opts
     return job
@@ -110,7 +118,18 @@ try:
     info = d.json("GET", "/v1/info")[1]["device"] if d else \
         next(iter(rs[0] for rs in results.values() if rs))["device"]
     print("device: %s | %s | %s" % (info["gl_renderer"], info["gl_version"], info["egl_device"]))
-    print("scene: lights preset %dx%d, %d (%d above 1,024 lights) timed frames after %d warm-up, "
+    if d and args.asset:
+        with open(args.asset, "rb") as f:
+            body = f.read()
+        t0 = time.time()
+        status, up = d.json("PUT", "/v1/assets/" + ASSET_NAME, body, timeout=600)
+        if status not in (200, 201):
+            sys.exit("uploading %s: %d %s" % (args.asset, status, up))
+        desc = up.get("description", {})
+        print("asset: %s, %d bytes, %d triangles, %d textures, uploaded and converted in %.2f s"
+              % (ASSET_NAME, len(body), desc.get("triangles", 0), len(desc.get("textures", [])),
+                 time.time() - t0))
+    print("scene: " + SCENE_LABEL + " %dx%d, %d (%d above 1,024 lights) timed frames after %d warm-up, "
           "%d repeat(s); "
           "forward up to %d lights" % (args.width, args.height, args.frames, args.frames_high,
                                       args.warmup, args.repeat, args.forward_max))
@@ -323,8 +342,8 @@ if args.svg:
         out.append('<line x1="%d" x2="%d" y1="%d" y2="%d" stroke="%s" stroke-width="2"/><text x="%d" '
                    'y="%d">%s</text>' % (W - R + 10, W - R + 30, T + 10 + 18 * k, T + 10 + 18 * k, c,
                                          W - R + 35, T + 14 + 18 * k, t))
-    out.append('<text x="%d" y="%d">frame_ms, lights preset %dx%d (dashed: extrapolated)</text>'
-               % (L, T - 5 if T > 15 else 12, args.width, args.height))
+    out.append('<text x="%d" y="%d">frame_ms, %s %dx%d (dashed: extrapolated)</text>'
+               % (L, T - 5 if T > 15 else 12, SCENE_LABEL, args.width, args.height))
     out.append("</svg>")
     with open(args.svg, "w") as f:
         f.write("\n".join(out))

@@ -289,7 +289,16 @@ json_t *outputs_write(struct harness_run *run)
     json_object_set_new(result, RK_STARTED_UNIX, json_real(run->job->started));
     if (heatmap)
         json_object_set(result, RK_HEATMAP, heatmap);
-    json_object_set_new(result, "scene", scene_describe(&run->scene));
+    json_t *scene = scene_describe(&run->scene);
+    json_t *asset = json_object_get(scene, "asset");
+    if (run->asset && json_is_object(asset))
+        json_object_set_new(asset, "load_ms",
+                            json_pack("{s:f, s:f, s:s}", "read", run->asset_read_ms,
+                                      "scene_and_upload", run->scene_upload_ms, "includes",
+                                      "reading the cache file; building the scene, its "
+                                      "textures with mipmaps and buffers up to a glFinish; "
+                                      "before the warm-up, outside every timed region"));
+    json_object_set_new(result, "scene", scene);
     /* What could have disturbed the timed region. */
     json_object_set_new(result, RK_INTERFERENCE,
                         interference_json(&run->interference[0], &run->interference[1]));

@@ -7,6 +7,7 @@
 
 #include "daemon/gpu/bindings.h"
 #include "daemon/gpu/glutil.h"
+#include "common/clock.h"
 #include "daemon/harness/deadline.h"
 #include "daemon/harness/render_state.h"
 #include "daemon/jobs/store.h"
@@ -252,8 +253,10 @@ bool run_prepare(struct harness_run *run, bool capture)
     run->look = &spec->look;
     run->shadow_pass = run->sky_pass = run->transparent_pass = -1;
     run_budget_init(run);
+    double t0 = clock_mono_s();
     if (!load_asset(run))
         return false;
+    double t1 = clock_mono_s();
     char why[600];
     run->scene_ok = scene_build(&run->scene, &spec->scene, run->asset, why, sizeof(why));
     if (!run->scene_ok) {
@@ -268,8 +271,14 @@ bool run_prepare(struct harness_run *run, bool capture)
         return false;
     }
     gpu_targets_new_epoch(run->gl->targets);
-    if (!gpu_scene_init(&run->gpu, &run->scene, run->err, sizeof(run->err)) ||
-        !run_setup_targets(run) ||
+    if (!gpu_scene_init(&run->gpu, &run->scene, run->err, sizeof(run->err)))
+        return false;
+    if (run->asset) {
+        glFinish();
+        run->asset_read_ms = (t1 - t0) * 1e3;
+        run->scene_upload_ms = (clock_mono_s() - t1) * 1e3;
+    }
+    if (!run_setup_targets(run) ||
         !look_stages_init(&run->stages, &spec->look, &run->scene, &run->gpu,
                           &run->gl->frame_block, &run->gl->caps, &run->budget, run->defines,
                           run->err, sizeof(run->err)) ||

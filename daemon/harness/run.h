@@ -76,6 +76,10 @@ struct harness_run {
     /* scene.asset: the cache file's asset, read in run_prepare (never in a
      * timed region), which the scene borrows until run_finish. */
     struct asset *asset;
+    /* Asset scenes, set-up before the warm-up: reading the cache file, and
+     * building the scene and its GL objects (textures with their mipmaps,
+     * buffers) up to a glFinish. */
+    double asset_read_ms, scene_upload_ms;
     struct gpu_scene gpu;
     struct gpu_timer *timer;
     struct gpu_passes passes;

@@ -327,6 +327,66 @@ def realistic_asset(big_maps=False):
     return g
 
 
+def showcase_asset():
+    """The docs' captures (docs/assets/make_captures.py): a textured court.
+    A ground of 32 x 32 quads (a checker base colour, a bump normal map, a
+    metallic-roughness map), four boxes (bricks with a normal map, polished
+    metal, an emissive panel, one with a second uv set), an alpha-masked
+    fence, a blended glass pane, a point, a spot and a directional light, a
+    camera looking over it."""
+    g = Gltf()
+    flat = [-0.7071068, 0, 0, 0.7071068]  # grid's xy plane laid down, facing +y
+    checker = g.texture(g.image(pattern_png(256, (200, 190, 170, 255), (70, 80, 95, 255), 32), name="tiles"))
+    bumps = g.texture(g.image(pattern_png(128, (128, 128, 255, 255), (168, 150, 225, 255), 4), name="bumps"))
+    rough = g.texture(g.image(pattern_png(64, (0, 60, 0, 255), (0, 220, 0, 255), 16), name="roughness"))
+    ground = g.material(name="tiles", pbrMetallicRoughness={
+        "baseColorTexture": {"index": checker}, "metallicRoughnessTexture": {"index": rough},
+        "metallicFactor": 0.0}, normalTexture={"index": bumps, "scale": 1.0})
+    g.node(mesh=g.mesh(grid(32, size=12.0), material=ground, uv1=False, name="ground"),
+           name="ground", rotation=flat)
+    bricks = g.texture(g.image(pattern_png(128, (150, 60, 40, 255), (120, 110, 100, 255), 16), name="bricks"))
+    mortar = g.texture(g.image(pattern_png(128, (128, 128, 255, 255), (128, 200, 200, 255), 16), name="mortar"))
+    brick = g.material(name="bricks", pbrMetallicRoughness={"baseColorTexture": {"index": bricks},
+                                                            "metallicFactor": 0.0, "roughnessFactor": 0.8},
+                       normalTexture={"index": mortar})
+    metal = g.material(name="metal", pbrMetallicRoughness={"baseColorFactor": [0.9, 0.8, 0.5, 1],
+                                                           "metallicFactor": 1.0, "roughnessFactor": 0.3})
+    glow = g.texture(g.image(pattern_png(32, (255, 160, 40, 255), (40, 20, 10, 255), 4), name="glow"))
+    panel = g.material(name="panel", emissiveFactor=[1, 1, 1], emissiveTexture={"index": glow},
+                       pbrMetallicRoughness={"baseColorFactor": [0.2, 0.2, 0.2, 1]})
+    box = g.mesh(cube(1.5), material=brick, uv1=False, name="brick_box")
+    g.node(mesh=box, name="bricks_a", translation=[-3.0, 0.75, -1.0])
+    g.node(mesh=box, name="bricks_b", translation=[2.5, 0.75, -3.0], rotation=[0, 0.3826834, 0, 0.9238795])
+    g.node(mesh=g.mesh(cube(1.2), material=metal, uv1=True, name="metal_box"), name="metal",
+           translation=[0.0, 0.6, 1.5])
+    g.node(mesh=g.mesh(cube(1.0), material=panel, uv1=False, name="panel_box"), name="panel",
+           translation=[3.5, 0.5, 2.0])
+    fence_img = g.texture(g.image(pattern_png(64, (60, 140, 60, 255), (0, 0, 0, 0), 8), name="fence"))
+    fence = g.material(name="fence", alphaMode="MASK", alphaCutoff=0.5, doubleSided=True,
+                       pbrMetallicRoughness={"baseColorTexture": {"index": fence_img}, "metallicFactor": 0.0})
+    g.node(mesh=g.mesh(grid(4, size=3.0), material=fence, uv1=False, name="fence"), name="fence",
+           translation=[-1.0, 1.5, -4.5])
+    glass = g.material(name="glass", alphaMode="BLEND",
+                       pbrMetallicRoughness={"baseColorFactor": [0.7, 0.85, 1.0, 0.35], "metallicFactor": 0.0,
+                                             "roughnessFactor": 0.1})
+    g.node(mesh=g.mesh(grid(2, size=2.0), material=glass, uv1=False, name="pane"), name="pane",
+           translation=[1.0, 1.0, 3.5])
+    g.doc["cameras"] = [{"type": "perspective", "name": "court",
+                         "perspective": {"yfov": 0.8, "znear": 0.1, "zfar": 100, "aspectRatio": 4 / 3}}]
+    # Looking down at about 35 degrees towards the court's centre.
+    g.node(camera=0, name="camera", translation=[0, 6.5, 10.5], rotation=[-0.2923717, 0, 0, 0.9563048])
+    pl = g.light(type="point", name="lamp", color=[1, 0.85, 0.6], intensity=200, range=8)
+    sl = g.light(type="spot", name="spot", color=[0.7, 0.8, 1], intensity=800, range=12,
+                 spot={"innerConeAngle": 0.3, "outerConeAngle": 0.5})
+    dl = g.light(type="directional", name="sun", color=[1, 0.95, 0.85], intensity=150)
+    g.node(name="lamp", translation=[-1.0, 3.0, 3.5], extensions={"KHR_lights_punctual": {"light": pl}})
+    g.node(name="spot", translation=[2.5, 5.0, 0.0], rotation=[-0.7071068, 0, 0, 0.7071068],
+           extensions={"KHR_lights_punctual": {"light": sl}})
+    g.node(name="sun", rotation=[-0.3535534, 0.3535534, 0.1464466, 0.8535534],
+           extensions={"KHR_lights_punctual": {"light": dl}})
+    return g
+
+
 def quantized_asset():
     """TEXCOORD_0 as normalized unsigned shorts and TEXCOORD_1 as normalized
     unsigned bytes (core glTF allows both; assimp 5.2 misreads them, so the

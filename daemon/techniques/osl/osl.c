@@ -738,8 +738,9 @@ static int age_quantile(const GLuint *age, double q)
 
 /* Objects with a block read (the marks hold the last frame each block was
  * read: with a still camera, the first frame's reads), and objects with a
- * block shaded in a timed frame. Read back once, after the run. */
-static void seen_objects(const struct osl *o, int out[2])
+ * block shaded in a timed frame, and objects shaded in a timed frame with
+ * no block read. Read back once, after the run. */
+static void seen_objects(const struct osl *o, int out[3])
 {
     size_t blocks = (size_t)o->blocks_x * (size_t)o->blocks_y;
     int n = o->schedule.count;
@@ -766,10 +767,11 @@ static void seen_objects(const struct osl *o, int out[2])
         if (shaded[b * 8 + 3] >= 1 && shaded[b * 8 + 3] <= o->frames)
             flags[owner[b]] |= 2;
     }
-    out[0] = out[1] = 0;
+    out[0] = out[1] = out[2] = 0;
     for (int i = 0; i < n; i++) {
         out[0] += flags[i] & 1;
         out[1] += (flags[i] >> 1) & 1;
+        out[2] += flags[i] == 2; /* reshaded, never read */
     }
 done:
     free(marks);
@@ -796,7 +798,7 @@ static json_t *osl_describe(void *state)
     }
     double frames = o->timed_frames ? o->timed_frames : 1;
     GLuint stats[OSL_STATS_HEAD + 64] = {0};
-    int objects[2] = {-1, -1};
+    int objects[3] = {-1, -1, -1};
     if (o->seen) {
         /* Counted on the GPU over the timed frames; read once, here, after
          * checking the last frame's reads (the next frame would have). */
@@ -855,6 +857,7 @@ static json_t *osl_describe(void *state)
         if (objects[0] >= 0) {
             json_object_set_new(vis, "objects_read", json_integer(objects[0]));
             json_object_set_new(vis, "objects_reshaded", json_integer(objects[1]));
+            json_object_set_new(vis, "unread_objects_reshaded", json_integer(objects[2]));
         }
         /* Frames since the lights of each read block's shading, over the
          * blocks the timed frames read. */

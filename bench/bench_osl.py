@@ -1,19 +1,26 @@
 #!/usr/bin/env python3
 """OSL's options against forward on the thesis grid (issue 25): forward,
-OSL as the thesis had it (whole tiles) and OSL with visibility "seen", at
+OSL with whole tiles ("all", the thesis's shading), with visibility "seen"
+(the default), seen with a reshade budget (osl.budget_texels), seen with
+lighting-change detection (osl.change_threshold), and seen with both, at
 async distance 1, 5, 20 and 60, with moving and with still lights, auto
-tiles, in one run on one daemon, interleaved (each round runs every
+tiles (plus the thesis's own OSL, 256 texels and whole tiles, at d 20 with
+moving lights), in one run on one daemon, interleaved (each round runs every
 configuration, so that load spreads evenly over them). Prints per
 configuration: the median frame_ms and its ratio to forward's in the same
 round (the median of the per-round ratios), cpu_work_ms (the CPU time all
 the daemon's threads took per timed frame: what load moves least on
 llvmpipe), the lighting and raster passes' medians (which pass is the
 cost), texels shaded per frame and per pixel on screen, the frame times'
-spread (p99 / median), and stale blocks (blocks read with other shading
-than scheduled, visibility "seen" only).
+spread (p99 / median), stale blocks (blocks read with other shading
+than scheduled, visibility "seen" only), the staleness of the blocks read
+(frames since the lights of their shading: median, p95, max), budget
+overflows and reshades saved by change detection. With --quality, each
+configuration at d 20 with moving lights runs once more against forward
+(reference: forward) and its worst SSIM is printed.
 
   bench/bench_osl.py [--distances 1,5,20,60] [--frames N] [--warmup N] [--repeat R]
-      [--width W --height H] [--json FILE]
+      [--width W --height H] [--budget TEXELS] [--threshold T] [--quality] [--json FILE]
 
 On llvmpipe GL_TIME_ELAPSED covers rasterisation only, so frame_ms (and
 cpu_work_ms) compare techniques there; on a GPU gpu_ms does."""
@@ -35,6 +42,9 @@ ap.add_argument("--warmup", type=int, default=3)
 ap.add_argument("--repeat", type=int, default=3)
 ap.add_argument("--width", type=int, default=1080)
 ap.add_argument("--height", type=int, default=720)
+ap.add_argument("--budget", type=int, default=196608, help="osl.budget_texels of the budget rows")
+ap.add_argument("--threshold", type=float, default=0.02, help="osl.change_threshold of the change rows")
+ap.add_argument("--quality", action="store_true", help="SSIM against forward at d 20, moving lights")
 ap.add_argument("--json", help="write every result here")
 args = ap.parse_args()
 
@@ -46,14 +56,43 @@ def med(xs):
     return statistics.median(xs) if xs else float("nan")
 
 
+# (technique, async distance, label): the label names the OSL options.
+OPTIONS = {
+    "all": {"resolution": "auto", "visibility": "all"},
+    "seen": {},  # the defaults: auto tiles, seen
+    "budget": {"budget_texels": args.budget},
+    "change": {"change_threshold": args.threshold},
+    "both": {"budget_texels": args.budget, "change_threshold": args.threshold},
+    "thesis": {"resolution": 256, "visibility": "all"},
+}
+DISTANCES = [float(x) for x in args.distances.split(",")]
 configs = [("forward", None, None)]
-for dist in [float(x) for x in args.distances.split(",")]:
-    for vis in ("all", "seen"):
-        configs.append(("osl", dist, vis))
+for dist in DISTANCES:
+    for label in ("all", "seen", "budget", "change", "both"):
+        configs.append(("osl", dist, label))
+if 20.0 in DISTANCES:
+    configs.append(("osl", 20.0, "thesis"))
+
+
+def runs_with(c, moving):
+    """Still lights reshade nothing after the first frame: the budget and
+    change detection have nothing to act on, and the thesis's 256 texels
+    are measured with moving lights only."""
+    return moving or c[2] in (None, "all", "seen")
 
 
 def name(c):
     return "forward" if c[0] == "forward" else "osl %s d=%g" % (c[2], c[1])
+
+
+def job_for(c, moving, frames, warmup):
+    job = {"technique": c[0], "frames": frames, "warmup_frames": warmup,
+           "scene": {"preset": "grid", "dynamic": moving, "width": args.width,
+                     "height": args.height}}
+    if c[0] == "osl":
+        job["async_distance"] = c[1]
+        job["osl"] = dict(OPTIONS[c[2]])
+    return job
 
 
 bench = benchrun.Run()
@@ -64,18 +103,17 @@ rows = {}
 try:
     dev = d.json("GET", "/v1/info")[1]["device"]
     print("device: %s | %s" % (dev["gl_renderer"], dev["gl_version"]))
-    print("scene: grid %dx%d, %d timed frames after %d warm-up, %d interleaved rounds, auto tiles"
-          % (args.width, args.height, args.frames, args.warmup, args.repeat), flush=True)
+    print("scene: grid %dx%d, %d timed frames after %d warm-up, %d interleaved rounds, auto "
+          "tiles; budget %d texels, change threshold %g" % (args.width, args.height, args.frames,
+                                                            args.warmup, args.repeat, args.budget,
+                                                            args.threshold), flush=True)
     for rep in range(args.repeat):
         for moving in (True, False):
             fwd_ms = None
             for c in configs:
-                job = {"technique": c[0], "frames": args.frames, "warmup_frames": args.warmup,
-                       "scene": {"preset": "grid", "dynamic": moving, "width": args.width,
-                                 "height": args.height}}
-                if c[0] == "osl":
-                    job["async_distance"] = c[1]
-                    job["osl"] = {"resolution": "auto", "visibility": c[2]}
+                if not runs_with(c, moving):
+                    continue
+                job = job_for(c, moving, args.frames, args.warmup)
                 done = d.run(job)
                 if done.get("status") != "done":
                     sys.exit("bench_osl: %s failed: %s" % (name(c), done.get("error")))
@@ -86,7 +124,8 @@ try:
                     fwd_ms = ms
                 row = rows.setdefault((moving, c), {"ms": [], "ratio": [], "cpu": [], "light": [],
                                                      "raster": [], "texels": [], "spread": [],
-                                                     "stale": []})
+                                                     "stale": [], "age": [], "over": [],
+                                                     "saved": []})
                 row["ms"].append(ms)
                 row["ratio"].append(ms / fwd_ms)
                 row["cpu"].append(cpu_work_ms(r))
@@ -97,24 +136,48 @@ try:
                 o = r.get("osl", {})
                 row["texels"].append(o.get("texels_shaded_per_frame", {}).get("mean", 0.0))
                 row["stale"].append(o.get("visibility", {}).get("stale_blocks", 0))
-                print("  round %d %s %-18s frame_ms %8.2f (x%.2f of forward)"
+                st = o.get("staleness")
+                row["age"].append((st["median"], st["p95"], st["max"]) if st else None)
+                row["over"].append(o.get("budget", {}).get("overflow_frames", 0))
+                row["saved"].append(o.get("change", {}).get("reshades_saved_per_frame", 0.0))
+                print("  round %d %s %-20s frame_ms %8.2f (x%.2f of forward)"
                       % (rep + 1, "moving" if moving else "still ", name(c), ms, ms / fwd_ms),
                       flush=True)
+    quality = {}
+    if args.quality and 20.0 in DISTANCES:
+        for c in configs:
+            if c[0] != "osl" or c[1] != 20.0:
+                continue
+            job = job_for(c, True, args.frames, args.warmup)
+            job.update(reference="forward", capture_interval=args.frames)
+            done = d.run(job)
+            q = done.get("result", {}).get("quality", {})
+            quality[c] = q.get("worst_ssim", {}).get("value")
+            print("  quality %-20s worst SSIM against forward %s" % (name(c), quality[c]),
+                  flush=True)
 finally:
     testlib.stop_and_check(d)
 
 pixels = args.width * args.height
 for moving in (True, False):
     print("\n%s lights: median over %d rounds" % ("moving" if moving else "still", args.repeat))
-    print("%-18s %9s %8s %9s %9s %9s %12s %9s %8s %6s" % (
+    print("%-20s %9s %6s %9s %9s %9s %12s %9s %8s %7s %11s %5s %6s" % (
         "configuration", "frame_ms", "/fwd", "cpu_work", "lighting", "raster", "texels/frame",
-        "texels/px", "p99/med", "stale"))
+        "texels/px", "p99/med", "stale", "age m/95/mx", "over", "saved"))
     for c in configs:
+        if (moving, c) not in rows:
+            continue
         row = rows[(moving, c)]
         t = med(row["texels"])
-        print("%-18s %9.2f %8.2f %9.2f %9.2f %9.2f %12.0f %9.3f %8.2f %6d" % (
+        ages = [a for a in row["age"] if a]
+        age = "%d/%d/%d" % tuple(max(a[k] for a in ages) for k in range(3)) if ages else "-"
+        print("%-20s %9.2f %6.2f %9.2f %9.2f %9.2f %12.0f %9.3f %8.2f %7d %11s %5d %6.1f" % (
             name(c), med(row["ms"]), med(row["ratio"]), med(row["cpu"]), med(row["light"]),
-            med(row["raster"]), t, t / pixels, med(row["spread"]), max(row["stale"])))
+            med(row["raster"]), t, t / pixels, med(row["spread"]), max(row["stale"]), age,
+            max(row["over"]), med(row["saved"])))
+if quality:
+    print("\nworst SSIM against forward, d 20, moving lights: " +
+          ", ".join("%s %.5f" % (c[2], v) for c, v in quality.items() if v is not None))
 bench.end(results)
 if args.json:
     with open(args.json, "w") as f:

@@ -21,6 +21,13 @@ configuration at d 20 with moving lights runs once more against forward
 
   bench/bench_osl.py [--distances 1,5,20,60] [--frames N] [--warmup N] [--repeat R]
       [--width W --height H] [--budget TEXELS] [--threshold T] [--quality] [--json FILE]
+      [--svg FILE]
+  bench/bench_osl.py --chart RESULTS.txt --svg FILE   # the chart again from a run's output
+
+The chart (standard library only) draws OSL's frame time over forward's
+against async distance, moving lights, one line per configuration, on a
+log scale, beside the thesis's own factors (dynamic scene, GPUs, d 20:
+5.12, 11.27 and 11.75; chapter 4.1).
 
 On llvmpipe GL_TIME_ELAPSED covers rasterisation only, so frame_ms (and
 cpu_work_ms) compare techniques there; on a GPU gpu_ms does."""
@@ -46,7 +53,91 @@ ap.add_argument("--budget", type=int, default=196608, help="osl.budget_texels of
 ap.add_argument("--threshold", type=float, default=0.02, help="osl.change_threshold of the change rows")
 ap.add_argument("--quality", action="store_true", help="SSIM against forward at d 20, moving lights")
 ap.add_argument("--json", help="write every result here")
+ap.add_argument("--svg", help="chart file")
+ap.add_argument("--chart", help="only draw the chart, from this output of an earlier run")
 args = ap.parse_args()
+
+# The thesis's OSLProg / ForwardProg factors, dynamic scene (d 20, 256
+# texels, whole tiles), on its three GPUs (chapter 4.1).
+THESIS_DYNAMIC = (5.12, 11.27, 11.75)
+
+
+def chart(series, path, title):
+    """series: {label: {distance: ratio to forward}}; log-scale y."""
+    import math
+    W, H, L, R, T, B = 720, 440, 60, 200, 30, 50
+    dists = sorted({d for pts in series.values() for d in pts})
+    ys = [v for pts in series.values() for v in pts.values() if v > 0] + list(THESIS_DYNAMIC) + [1.0]
+    y0, y1 = math.floor(math.log10(min(ys))), math.ceil(math.log10(max(ys)))
+
+    def px(d):
+        return L + (dists.index(d) + 0.5) / len(dists) * (W - L - R)
+
+    def py(v):
+        return H - B - (math.log10(v) - y0) / (y1 - y0) * (H - T - B)
+    colours = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2"]
+    out = ['<svg xmlns="http://www.w3.org/2000/svg" width="%d" height="%d" font-family="sans-serif" '
+           'font-size="12"><rect width="100%%" height="100%%" fill="white"/>' % (W, H)]
+    for e in range(y0, y1 + 1):
+        for m in (1, 2, 5):
+            v = m * 10 ** e
+            if 10 ** y0 <= v <= 10 ** y1:
+                out.append('<line x1="%d" x2="%d" y1="%.1f" y2="%.1f" stroke="#%s"/><text x="%d" '
+                           'y="%.1f" text-anchor="end">%g</text>' % (L, W - R, py(v), py(v),
+                                                                     "999" if v == 1 else "e4e4e4",
+                                                                     L - 5, py(v) + 4, v))
+    out.append('<text x="%d" y="%.1f" fill="#555">forward</text>' % (W - R - 50, py(1.0) - 4))
+    for d in dists:
+        out.append('<text x="%.1f" y="%d" text-anchor="middle">%g</text>' % (px(d), H - B + 18, d))
+    out.append('<text x="%d" y="%d" text-anchor="middle">async distance</text>'
+               % ((L + W - R) / 2, H - 12))
+    for k, (label, pts) in enumerate(series.items()):
+        c = colours[k % len(colours)]
+        xy = [(px(d), py(pts[d])) for d in dists if pts.get(d, 0) > 0]
+        for (ax, ay), (bx, by) in zip(xy, xy[1:]):
+            out.append('<line x1="%.1f" y1="%.1f" x2="%.1f" y2="%.1f" stroke="%s" stroke-width="2"/>'
+                       % (ax, ay, bx, by, c))
+        for ax, ay in xy:
+            out.append('<circle cx="%.1f" cy="%.1f" r="3.5" fill="%s"/>' % (ax, ay, c))
+        out.append('<line x1="%d" x2="%d" y1="%d" y2="%d" stroke="%s" stroke-width="2"/><text x="%d" '
+                   'y="%d">%s</text>' % (W - R + 10, W - R + 30, T + 10 + 18 * k, T + 10 + 18 * k, c,
+                                         W - R + 35, T + 14 + 18 * k, label))
+    if 20.0 in dists:
+        k = len(series)
+        for v in THESIS_DYNAMIC:
+            out.append('<rect x="%.1f" y="%.1f" width="8" height="8" fill="none" stroke="black"/>'
+                       % (px(20.0) + 8, py(v) - 4))
+        out.append('<rect x="%d" y="%d" width="8" height="8" fill="none" stroke="black"/><text x="%d" '
+                   'y="%d">thesis, 3 GPUs (d 20)</text>' % (W - R + 16, T + 6 + 18 * k, W - R + 35,
+                                                            T + 14 + 18 * k))
+    out.append('<text x="%d" y="%d">%s</text>' % (L, T - 10, title))
+    out.append("</svg>")
+    with open(path, "w") as f:
+        f.write("\n".join(out))
+    print("chart: %s" % path)
+
+
+def series_from_text(path):
+    """The moving-lights table of an earlier run's output."""
+    series, on = {}, False
+    for line in open(path):
+        if line.startswith("moving lights:"):
+            on = True
+        elif line.startswith("still lights:"):
+            on = False
+        elif on and line.startswith("osl "):
+            f = line.split()
+            label, d = f[1], float(f[2].split("=")[1])
+            series.setdefault(label, {})[d] = float(f[4])
+    return series
+
+
+if args.chart:
+    if not args.svg:
+        sys.exit("bench_osl: --chart needs --svg")
+    chart(series_from_text(args.chart), args.svg,
+          "OSL / forward frame time, moving lights (from %s)" % os.path.basename(args.chart))
+    sys.exit(0)
 
 
 cpu_work_ms = benchrun.cpu_work_ms
@@ -175,6 +266,13 @@ for moving in (True, False):
             name(c), med(row["ms"]), med(row["ratio"]), med(row["cpu"]), med(row["light"]),
             med(row["raster"]), t, t / pixels, med(row["spread"]), max(row["stale"]), age,
             max(row["over"]), med(row["saved"])))
+if args.svg:
+    series = {}
+    for (moving, c), row in rows.items():
+        if moving and c[0] == "osl":
+            series.setdefault(c[2], {})[c[1]] = med(row["ratio"])
+    chart(series, args.svg, "OSL / forward frame time, moving lights, grid %dx%d"
+          % (args.width, args.height))
 if quality:
     print("\nworst SSIM against forward, d 20, moving lights: " +
           ", ".join("%s %.5f" % (c[2], v) for c, v in quality.items() if v is not None))

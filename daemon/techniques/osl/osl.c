@@ -862,9 +862,11 @@ static json_t *osl_describe(void *state)
         /* Frames since the lights of each read block's shading, over the
          * blocks the timed frames read. */
         const GLuint *age = stats + OSL_STATS_HEAD;
+        json_int_t reads = 0;
+        for (int k = 0; k < 64; k++)
+            reads += age[k];
         json_object_set_new(d, "staleness",
-                            json_pack("{s:I, s:i, s:i, s:i, s:I, s:s}", "reads",
-                                      (json_int_t)stats[11], "median", age_quantile(age, 0.5),
+                            json_pack("{s:I, s:i, s:i, s:i, s:I, s:s}", "reads", reads, "median", age_quantile(age, 0.5),
                                       "p95", age_quantile(age, 0.95), "max",
                                       age_quantile(age, 1.0), "unshaded_reads",
                                       (json_int_t)stats[10], "unit",

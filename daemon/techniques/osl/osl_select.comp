@@ -40,8 +40,9 @@ layout(std430, binding = SB_SSBO_OSL_STATS) buffer Stats {
     uint overflow_frames; // counted frames whose must-shade blocks alone overran the budget
     uint deferred_total;  // candidates left for a later frame, over the counted frames
     uint unshaded_reads;  // blocks a counted frame read that were never shaded
-    uint reads;           // blocks read over the counted frames (the staleness samples)
-    uint age[64];         // blocks read, by frames since the lights of their shading (63: 63 or more)
+    uint spare;
+    uint age[64];         // blocks read over the counted frames (the staleness samples), by
+                          // frames since the lights of their shading (63: 63 or more)
     uint hist[OSL_KEYS];  // this frame's candidates by priority key (with a budget)
 };
 layout(r32i, binding = SB_IMG_OSL_MARKS) readonly uniform iimage2D u_marks;
@@ -135,7 +136,6 @@ void main()
         if (held.x == NEVER) {
             atomicAdd(unshaded_reads, 1u);
         } else {
-            atomicAdd(reads, 1u);
             atomicAdd(age[clamp(u_frame_index - 1 - held.z, 0, 63)], 1u);
         }
     }

@@ -91,6 +91,9 @@ def chart(series, path, title):
         out.append('<text x="%.1f" y="%d" text-anchor="middle">%g</text>' % (px(d), H - B + 18, d))
     out.append('<text x="%d" y="%d" text-anchor="middle">async distance</text>'
                % ((L + W - R) / 2, H - 12))
+    names = {"all": "whole tiles (auto)", "seen": "seen (the default)", "budget": "seen + budget",
+             "change": "seen + change", "both": "seen + budget + change",
+             "thesis": "thesis (256, whole)"}
     for k, (label, pts) in enumerate(series.items()):
         c = colours[k % len(colours)]
         xy = [(px(d), py(pts[d])) for d in dists if pts.get(d, 0) > 0]
@@ -101,7 +104,7 @@ def chart(series, path, title):
             out.append('<circle cx="%.1f" cy="%.1f" r="3.5" fill="%s"/>' % (ax, ay, c))
         out.append('<line x1="%d" x2="%d" y1="%d" y2="%d" stroke="%s" stroke-width="2"/><text x="%d" '
                    'y="%d">%s</text>' % (W - R + 10, W - R + 30, T + 10 + 18 * k, T + 10 + 18 * k, c,
-                                         W - R + 35, T + 14 + 18 * k, label))
+                                         W - R + 35, T + 14 + 18 * k, names.get(label, label)))
     if 20.0 in dists:
         k = len(series)
         for v in THESIS_DYNAMIC:

@@ -277,7 +277,7 @@ int main(void)
     rejects("{\"osl\":{\"resolution\":100}}", "osl.resolution");
     rejects("{\"osl\":{\"resolution\":2048}}", "osl.resolution");
     rejects("{\"osl\":{\"resolution\":\"high\"}}", "osl.resolution");
-    rejects("{\"osl\":{\"texel_density\":0}}", "osl.texel_density");
+    rejects("{\"osl\":{\"texel_density\":0.03}}", "osl.texel_density"); /* 0 is auto */
     rejects("{\"osl\":{\"reshade\":\"some\"}}", "osl.reshade");
     rejects("{\"osl\":{\"resolutoin\":256}}", "osl.resolutoin");
 

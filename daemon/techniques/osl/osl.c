@@ -163,16 +163,21 @@ static bool choose_tiles(struct osl *o, const struct technique_env *env, int max
         snprintf(err, errlen, "out of memory");
         return false;
     }
+    const struct osl_options *opt = env->options;
+    /* 0: one texel a pixel, or two under PBR: at one, bilinear filtering
+     * flattens GGX's narrow highlights (SSIM against forward 0.987 at one,
+     * 0.9965 at two, 0.9993 at four: the lights preset, 160x120). */
+    double density = opt->texel_density;
+    if (density == 0)
+        density = env->defines && strstr(env->defines, "LIGHTING_PBR") ? 2.0 : 1.0;
     for (int i = 0; i < n; i++) {
-        const struct osl_options *opt = env->options;
         if (opt->resolution) {
             sizes[i] = opt->resolution;
             continue;
         }
         double ppu = scene_projected_diameter(s, i) / (2.0 * scene_instance_bound(s, i));
         const struct mesh *m = &s->meshes[s->instances[i].mesh];
-        sizes[i] = osl_auto_tile_size(ppu, m->uv_per_unit / s->instances[i].scale,
-                                      opt->texel_density);
+        sizes[i] = osl_auto_tile_size(ppu, m->uv_per_unit / s->instances[i].scale, density);
     }
     bool ok = osl_atlas_pack(sizes, n, max_tex, OSL_MAX_ATLAS_BYTES, o->tiles, &o->atlas_w,
                              &o->atlas_h, err, errlen);

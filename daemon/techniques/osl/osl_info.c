@@ -17,8 +17,10 @@ static const struct opt_field options[] = {
      .summary = "tile edge in texels for every object (256 is the thesis's); \"auto\" "
                 "(the default) sizes each object's tile from its size on screen",
      .offset = offsetof(struct osl_options, resolution)},
-    {.name = "texel_density", .type = OPT_NUMBER, .def = 1.0, .min = 0.0625, .max = 16.0,
-     .summary = "with resolution \"auto\": texels per covered pixel",
+    {.name = "texel_density", .type = OPT_NUMBER, .def = 0.0, .min = 0.0, .max = 16.0,
+     .summary = "with resolution \"auto\": texels per covered pixel (along each axis), "
+                "0.0625 to 16; 0 (the default): 1, or 2 under PBR lighting, whose GGX "
+                "highlights bilinear filtering of one texel a pixel flattens",
      .offset = offsetof(struct osl_options, texel_density)},
     {.name = "reshade", .type = OPT_CHOICE, .def = OSL_RESHADE_TOUCHED,
      .choices = reshade_choices,
@@ -60,6 +62,10 @@ static bool check(void *opts, const char *prefix, struct job_error *err)
 {
     const struct osl_options *o = opts;
     char field[96];
+    if (o->texel_density != 0 && o->texel_density < 0.0625) {
+        snprintf(field, sizeof(field), "%s.texel_density", prefix);
+        return job_error_set(err, field, "must be 0 (auto) or 0.0625 to 16");
+    }
     if (o->visibility == OSL_VISIBILITY_SEEN)
         return true;
     if (o->budget_texels > 0) {

@@ -392,7 +392,9 @@ static void seen_light_pass(struct osl *o, const struct technique_env *env, int6
     for (int i = 0; i < s->instance_count; i++) {
         int64_t due = osl_schedule_last(&o->schedule, i, frame);
         bool newly_due = due == frame && !initial;
-        bool touched_due = o->change_on && moving && (opt->reshade != OSL_RESHADE_TOUCHED || osl_touched(s, i, due));
+        /* Would the schedule's shading differ from "unlit" (for the count)? */
+        bool touched_due = o->change_on && moving &&
+                           (opt->reshade != OSL_RESHADE_TOUCHED || osl_touched(s, i, due));
         if (o->change_on) {
             /* Keep the shading of the frame anchored while the lights' motion
              * since then cannot change it by more than the threshold; the
@@ -533,7 +535,8 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
             o->change_on = true;
             /* Phong's motion bound; Blinn-Phong's half vector and shadows'
              * visibility have none, so only the range bound holds there. */
-            o->change_lipschitz = !strstr(defs, "LIGHTING_BLINN_PHONG") && !strstr(defs, "LOOK_SHADOWS");
+            o->change_lipschitz =
+                !strstr(defs, "LIGHTING_BLINN_PHONG") && !strstr(defs, "LOOK_SHADOWS");
             o->light_rows += OSL_CHANGE_ROWS;
             o->anchor = malloc((size_t)n * sizeof(int64_t));
             if (!o->anchor)
@@ -760,7 +763,8 @@ static void seen_objects(const struct osl *o, int out[3])
     glGetTexImage(GL_TEXTURE_2D, 0, GL_RED_INTEGER, GL_INT, marks);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, o->shaded_buf);
-    glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(blocks * 8 * sizeof(GLint)), shaded);
+    glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(blocks * 8 * sizeof(GLint)),
+                       shaded);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, o->block_tile_buf);
     glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(blocks * sizeof(GLuint)), owner);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
@@ -871,7 +875,8 @@ static json_t *osl_describe(void *state)
         for (int k = 0; k < 64; k++)
             reads += age[k];
         json_object_set_new(d, "staleness",
-                            json_pack("{s:I, s:i, s:i, s:i, s:I, s:s}", "reads", reads, "median", age_quantile(age, 0.5),
+                            json_pack("{s:I, s:i, s:i, s:i, s:I, s:s}", "reads", reads,
+                                      "median", age_quantile(age, 0.5),
                                       "p95", age_quantile(age, 0.95), "max",
                                       age_quantile(age, 1.0), "unshaded_reads",
                                       (json_int_t)stats[10], "unit",
@@ -893,7 +898,8 @@ static json_t *osl_describe(void *state)
                                       "reshades_due_per_frame", o->change_due / frames,
                                       "reshades_saved_per_frame", o->change_saved / frames));
     else if (o->change_why)
-        json_object_set_new(d, "change", json_pack("{s:b, s:s}", "active", 0, "why", o->change_why));
+        json_object_set_new(d, "change",
+                            json_pack("{s:b, s:s}", "active", 0, "why", o->change_why));
     return d;
 }
 

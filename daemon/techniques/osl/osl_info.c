@@ -35,8 +35,9 @@ static const struct opt_field options[] = {
      .offset = offsetof(struct osl_options, async_distance)},
     {.name = "visibility", .type = OPT_CHOICE, .def = OSL_VISIBILITY_SEEN,
      .choices = visibility_choices,
-     .summary = "all shades whole tiles, as the thesis did; seen (the default) shades only the 8x8 atlas "
-                "blocks the raster pass sampled in the frame before, or next to one (the "
+     .summary = "all shades whole tiles, as the thesis did; seen (the default) shades only "
+                "the 8x8 atlas blocks the raster pass sampled in the frame before, or next "
+                "to one (the "
                 "margin for motion), each when its shading is not the one its object's "
                 "schedule asks for: reshading follows what the camera sees. A block the "
                 "raster pass reads while it holds other shading is counted (stale_blocks)",

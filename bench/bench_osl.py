@@ -52,6 +52,8 @@ ap.add_argument("--height", type=int, default=720)
 ap.add_argument("--budget", type=int, default=196608, help="osl.budget_texels of the budget rows")
 ap.add_argument("--threshold", type=float, default=0.02, help="osl.change_threshold of the change rows")
 ap.add_argument("--quality", action="store_true", help="SSIM against forward at d 20, moving lights")
+ap.add_argument("--temporal", type=int, default=0,
+                help="with --quality: also the flicker over this many frames at the capture")
 ap.add_argument("--json", help="write every result here")
 ap.add_argument("--svg", help="chart file")
 ap.add_argument("--chart", help="only draw the chart, from this output of an earlier run")
@@ -237,18 +239,24 @@ try:
                 print("  round %d %s %-20s frame_ms %8.2f (x%.2f of forward)"
                       % (rep + 1, "moving" if moving else "still ", name(c), ms, ms / fwd_ms),
                       flush=True)
-    quality = {}
+    quality, flickers = {}, {}
     if args.quality and 20.0 in DISTANCES:
         for c in configs:
             if c[0] != "osl" or c[1] != 20.0:
                 continue
             job = job_for(c, True, args.frames, args.warmup)
             job.update(reference="forward", capture_interval=args.frames)
+            if args.temporal:
+                job["temporal"] = {"frames": args.temporal}
             done = d.run(job)
             q = done.get("result", {}).get("quality", {})
             quality[c] = q.get("worst_ssim", {}).get("value")
-            print("  quality %-20s worst SSIM against forward %s" % (name(c), quality[c]),
-                  flush=True)
+            flicker = q.get("worst_flicker", {}).get("value")
+            if flicker is not None:
+                flickers[c] = flicker
+            print("  quality %-20s worst SSIM against forward %s%s" % (
+                name(c), quality[c], ", flicker %s" % flicker if flicker is not None else ""),
+                flush=True)
 finally:
     testlib.stop_and_check(d)
 
@@ -279,6 +287,9 @@ if args.svg:
 if quality:
     print("\nworst SSIM against forward, d 20, moving lights: " +
           ", ".join("%s %.5f" % (c[2], v) for c, v in quality.items() if v is not None))
+if flickers:
+    print("worst flicker against forward over %d frames, d 20, moving lights: " % args.temporal +
+          ", ".join("%s %.5f" % (c[2], v) for c, v in flickers.items()))
 bench.end(results)
 if args.json:
     with open(args.json, "w") as f:

@@ -95,7 +95,7 @@ def chart(series, path, title):
                % ((L + W - R) / 2, H - 12))
     names = {"all": "whole tiles (auto)", "seen": "seen (the default)", "budget": "seen + budget",
              "change": "seen + change", "both": "seen + budget + change",
-             "thesis": "thesis (256, whole)"}
+             "thesis": "thesis's OSL here (256)"}
     for k, (label, pts) in enumerate(series.items()):
         c = colours[k % len(colours)]
         xy = [(px(d), py(pts[d])) for d in dists if pts.get(d, 0) > 0]
@@ -113,7 +113,7 @@ def chart(series, path, title):
             out.append('<rect x="%.1f" y="%.1f" width="8" height="8" fill="none" stroke="black"/>'
                        % (px(20.0) + 8, py(v) - 4))
         out.append('<rect x="%d" y="%d" width="8" height="8" fill="none" stroke="black"/><text x="%d" '
-                   'y="%d">thesis, 3 GPUs (d 20)</text>' % (W - R + 16, T + 6 + 18 * k, W - R + 35,
+                   'y="%d">the thesis, its 3 GPUs</text>' % (W - R + 16, T + 6 + 18 * k, W - R + 35,
                                                             T + 14 + 18 * k))
     out.append('<text x="%d" y="%d">%s</text>' % (L, T - 10, title))
     out.append("</svg>")

@@ -2,7 +2,11 @@
 stated texture-sampling bound, async shading shades fewer texels, the
 lighting pass runs once for still lights, frame k is the same image however
 the run started, visibility "seen" gives the same pixels from fewer texels
-and counts what outruns it, and bad OSL options answer 400."""
+and counts what outruns it, hidden objects are not reshaded and objects
+coming into view are shaded before they are read, osl.budget_texels holds
+every frame and staleness stays within the schedule when it allows, the
+defaults (auto tiles, seen) agree with forward, the thesis's configuration
+is still whole tiles, and bad OSL options answer 400."""
 
 import os
 
@@ -32,7 +36,7 @@ try:
     static = {"frames": 4, "warmup_frames": 1, "capture_interval": 4, "scene": SCENE}
     _, fwd = capture(d, dict(static, technique="forward"), "forward")
     for res in ("256", "auto"):
-        osl = {"resolution": int(res) if res.isdigit() else res}
+        osl = {"resolution": int(res) if res.isdigit() else res, "visibility": "all"}
         result, path = capture(d, dict(static, technique="osl", osl=osl), "osl-" + res)
         diff = testlib.png_diff(fwd, path)
         check(diff and max(diff["mean_abs"]) <= MEAN_BOUND[res],
@@ -46,8 +50,9 @@ try:
         check({"lighting", "raster"} <= set(result.get("gpu_sections_ms", {})),
               "lighting and raster GPU times reported apart")
         if res == "256":
-            check(o["atlas"]["width"] == 8192 and o["atlas"]["height"] == 4096,
-                  "thesis mode: 512 tiles of 256x256 = 8192x4096")
+            # The thesis's own OSL, as the thesis preset pins it: whole tiles.
+            check(o["atlas"]["width"] == 8192 and o["atlas"]["height"] == 4096 and
+                  "visibility" not in o, "thesis mode: 512 whole tiles of 256x256 = 8192x4096")
             texels_256 = o["atlas"]["tile_texels"]
         else:
             check(o["atlas"]["tile_texels"] < texels_256 / 4,
@@ -55,8 +60,10 @@ try:
 
     # Async shading: d > 0 shades fewer texels than d = 0 with moving lights
     # (texels are counted in object space: a smaller image shows the same).
+    # Whole tiles (the thesis's), which count objects.
     dyn = {"technique": "osl", "frames": 12, "warmup_frames": 3,
-           "scene": {"width": 160, "height": 120, "dynamic": True}, "osl": {"resolution": 32}}
+           "scene": {"width": 160, "height": 120, "dynamic": True},
+           "osl": {"resolution": 32, "visibility": "all"}}
     d0 = d.run(dict(dyn, async_distance=0))["result"]["osl"]
     d20 = d.run(dict(dyn, async_distance=20))["result"]["osl"]
     check(0 < d20["texels_shaded_per_frame"]["mean"] < d0["texels_shaded_per_frame"]["mean"],
@@ -65,7 +72,7 @@ try:
     check(d0["objects_reshaded_per_frame"]["max"] < 512,
           "only objects a moving light reaches are reshaded (%s)" % d0["objects_reshaded_per_frame"])
     every = d.run(dict(dyn, async_distance=0, frames=4, warmup_frames=1,
-                       osl={"resolution": 32, "reshade": "all"}))
+                       osl={"resolution": 32, "reshade": "all", "visibility": "all"}))
     check(every["result"]["osl"]["objects_reshaded_per_frame"]["mean"] == 512,
           "reshade=all reshades every object, as the thesis did")
 
@@ -83,7 +90,7 @@ try:
     # frame, and a camera that outruns the one-block margin is counted.
     seen = dict(dyn, async_distance=20, capture_interval=10, frames=10, warmup_frames=2,
                 osl={"resolution": 64, "visibility": "seen"})
-    r_whole, p_whole = capture(d, dict(seen, osl={"resolution": 64}), "whole")
+    r_whole, p_whole = capture(d, dict(seen, osl={"resolution": 64, "visibility": "all"}), "whole")
     r_seen, p_seen = capture(d, seen, "seen")
     diff = testlib.png_diff(p_whole, p_seen)
     check(diff and diff["max_abs"] == 0, "seen gives whole tiles' pixels: %s" % diff)
@@ -106,13 +113,84 @@ try:
     check(fly["status"] == "done" and stale > 0,
           "a flythrough outruns the margin, and the stale blocks are counted: %s" % stale)
 
+    # Hidden objects are not reshaded: with a still camera the blocks read
+    # are the first frame's, and no object without one is shaded later.
+    cam = dict(dyn, async_distance=20, frames=8, warmup_frames=2, osl={})
+    still_cam = d.run(cam)["result"]["osl"]
+    vis = still_cam["visibility"]
+    check(0 < vis["objects_reshaded"] <= vis["objects_read"] < 512 and
+          vis["unread_objects_reshaded"] == 0,
+          "defaults: objects never read (hidden) are never reshaded: %s" % vis)
+    # Objects coming into view (an orbiting camera reads more of them) are
+    # shaded before the first frame that reads them: no stale, no unshaded read.
+    orbit = d.run(dict(cam, scene=dict(dyn["scene"], camera={"path": "orbit", "period": 360})))
+    ovis = orbit["result"]["osl"]["visibility"]
+    ost = orbit["result"]["osl"]["staleness"]
+    check(ovis["objects_read"] > vis["objects_read"] and ovis["stale_blocks"] == 0 and
+          ost["unshaded_reads"] == 0,
+          "orbit: objects come into view shaded (%d objects read against %d, stale %d, "
+          "unshaded %d)" % (ovis["objects_read"], vis["objects_read"], ovis["stale_blocks"],
+                            ost["unshaded_reads"]))
+    # Staleness stays within the schedule when nothing limits shading: a
+    # block read shows the lights of at most (longest period - 1) frames ago.
+    longest = max(int(p) for p in still_cam["objects_by_period"])
+    st = still_cam["staleness"]
+    check(st["reads"] > 0 and st["max"] <= longest - 1 and st["unshaded_reads"] == 0,
+          "no budget: staleness within the longest period %d: %s" % (longest, st))
+    # The budget holds every frame; what it leaves waits, and is counted.
+    unlimited = still_cam["texels_shaded_per_frame"]["max"]
+    budget = int(unlimited / 3) // 64 * 64
+    cut = dict(cam, osl={"budget_texels": budget}, capture_interval=8)
+    r_cut, p_cut = capture(d, cut, "budget-a")
+    o = r_cut["osl"]
+    check(o["budget"]["active"] and o["budget"]["overflow_frames"] == 0 and
+          0 < o["texels_shaded_per_frame"]["max"] <= budget,
+          "budget %d texels respected every frame: %s, %s" % (budget, o["texels_shaded_per_frame"],
+                                                              o["budget"]))
+    check(o["budget"]["deferred_blocks_per_frame"] > 0 and o["visibility"]["stale_blocks"] > 0
+          and o["staleness"]["max"] > st["max"] and o["staleness"]["unshaded_reads"] == 0,
+          "a tight budget defers blocks, reads them older, never unshaded: %s" % o["staleness"])
+    _, p_again = capture(d, cut, "budget-b")
+    diff = testlib.png_diff(p_cut, p_again)
+    check(diff and diff["max_abs"] == 0, "a budget's cut is deterministic: %s" % diff)
+    # A budget that allows what the frame needs changes nothing.
+    roomy = d.run(dict(cam, osl={"budget_texels": int(unlimited) + 64}))["result"]["osl"]
+    check(roomy["staleness"]["max"] <= longest - 1 and roomy["budget"]["deferred_blocks_per_frame"] == 0
+          and roomy["texels_shaded_per_frame"] == still_cam["texels_shaded_per_frame"],
+          "a budget that allows it: the same shading, staleness within the schedule: %s" %
+          roomy["staleness"])
+    # Change detection: a threshold no light's motion reaches keeps every
+    # shading; 0 (the default) is off.
+    kept = d.run(dict(cam, osl={"change_threshold": 1.0}))["result"]["osl"]
+    check(kept["change"]["active"] and kept["change"]["reshades_saved_per_frame"] > 0 and
+          kept["texels_shaded_per_frame"]["mean"] < still_cam["texels_shaded_per_frame"]["mean"],
+          "change_threshold 1 saves reshades: %s" % kept["change"])
+    check("change" not in still_cam, "change detection off by default")
+
+    # The defaults (auto tiles, seen) agree with forward on a dynamic grid
+    # at the thesis's async distance.
+    ref = d.run({"technique": "osl", "async_distance": 20, "reference": "forward", "frames": 6,
+                 "warmup_frames": 2, "capture_interval": 3,
+                 "scene": {"preset": "grid", "dynamic": True, "width": 240, "height": 160}})
+    ssim = ref.get("result", {}).get("quality", {}).get("worst_ssim", {}).get("value", 0)
+    check(ref["status"] == "done" and ssim >= 0.999, "defaults: SSIM %.5f >= 0.999" % ssim)
+    check(ref["spec"]["osl"]["resolution"] == "auto" and ref["spec"]["osl"]["visibility"] == "seen"
+          and ref["spec"]["osl"]["budget_texels"] == 0 and ref["spec"]["osl"]["change_threshold"] == 0,
+          "the defaults written back: %s" % ref["spec"]["osl"])
+
     # Bad OSL options name their field; an atlas too big fails the job clearly.
     for body, field in (({"technique": "osl", "osl": {"resolution": 100}}, "osl.resolution"),
                         ({"technique": "osl", "osl": {"resolution": "fine"}}, "osl.resolution"),
                         ({"technique": "osl", "async_distance": -1}, "async_distance"),
                         ({"technique": "osl", "osl": {"texel_density": -2}}, "osl.texel_density"),
                         ({"technique": "osl", "osl": {"rezolution": 64}}, "osl.rezolution"),
-                        ({"technique": "osl", "osl": {"visibility": "some"}}, "osl.visibility")):
+                        ({"technique": "osl", "osl": {"visibility": "some"}}, "osl.visibility"),
+                        ({"technique": "osl", "osl": {"budget_texels": -1}}, "osl.budget_texels"),
+                        ({"technique": "osl", "osl": {"budget_texels": 4096, "visibility": "all"}},
+                         "osl.budget_texels"),
+                        ({"technique": "osl", "osl": {"change_threshold": 2}}, "osl.change_threshold"),
+                        ({"technique": "osl", "osl": {"change_threshold": 0.1, "visibility": "all"}},
+                         "osl.change_threshold")):
         testlib.rejects(d, body, field)
     big = d.run({"technique": "osl", "frames": 1, "warmup_frames": 0, "scene": SCENE,
                  "osl": {"resolution": 1024}})

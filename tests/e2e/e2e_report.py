@@ -61,6 +61,7 @@ try:
           "every point repeated twice and judged")
     osl_job = d.json("GET", "/v1/jobs/" + [p for p in th["points"] if p["technique"] == "osl"][0]["job"])[1]
     check(osl_job["spec"]["async_distance"] == 20 and osl_job["spec"]["osl"]["resolution"] == 256 and
+          osl_job["spec"]["osl"]["visibility"] == "all" and
           osl_job["spec"]["metrics"]["pdiff"]["fov"] == 22.6 and osl_job["spec"]["scene"]["width"] == 1080 and
           osl_job["spec"]["warmup_frames"] == 0 and osl_job["spec"]["frames"] == 1,
           "the thesis's settings: async 20, 256 texels, PerceptualDiff at 22.6 degrees, 1080x720")

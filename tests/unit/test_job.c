@@ -206,7 +206,13 @@ int main(void)
     CHECK(spec.frames == 300 && spec.warmup_frames == 10 && spec.capture_interval == 0);
     CHECK(spec.scene.width == 1080 && spec.scene.height == 720 && spec.scene.lights == 10);
     CHECK(!spec.scene.dynamic);
-    CHECK(((const struct osl_options *)spec.options[2].bytes)->resolution == 256);
+    {
+        /* OSL's defaults are the configuration that beats forward (issue 25):
+         * auto tiles and visibility "seen", no budget, no change detection. */
+        const struct osl_options *osl = (const struct osl_options *)spec.options[2].bytes;
+        CHECK(osl->resolution == 0 && osl->visibility == OSL_VISIBILITY_SEEN);
+        CHECK(osl->budget_texels == 0 && osl->change_threshold == 0);
+    }
 
     CHECK(parse("{\"technique\":\"osl\",\"frames\":40,\"warmup_frames\":0,"
                 "\"capture_interval\":20,\"async_distance\":20,"
@@ -271,7 +277,7 @@ int main(void)
     rejects("{\"osl\":{\"resolution\":100}}", "osl.resolution");
     rejects("{\"osl\":{\"resolution\":2048}}", "osl.resolution");
     rejects("{\"osl\":{\"resolution\":\"high\"}}", "osl.resolution");
-    rejects("{\"osl\":{\"texel_density\":0}}", "osl.texel_density");
+    rejects("{\"osl\":{\"texel_density\":0.03}}", "osl.texel_density"); /* 0 is auto */
     rejects("{\"osl\":{\"reshade\":\"some\"}}", "osl.reshade");
     rejects("{\"osl\":{\"resolutoin\":256}}", "osl.resolutoin");
 

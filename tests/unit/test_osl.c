@@ -1,3 +1,4 @@
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -183,6 +184,98 @@ static void test_dilate(void)
     CHECK(osl_dilate_geometry(pos, nrm, NULL, 0, S, 8) == 10); /* the rest, then nothing left */
     float none[S * S * 4] = {0}, none_n[S * S * 4] = {0};
     CHECK(osl_dilate_geometry(none, none_n, NULL, 0, S, 4) == 0);
+
+/* Phong's radiance at P with normal N from every light at frame (the
+ * shader's light_contribution, lighting.glsl), largest channel of the
+ * difference between two frames. */
+static double phong_change(const struct scene *sc, int i, const double P[3], const double N[3],
+                           const double V[3], int64_t f0, int64_t f1)
+{
+    const struct scene_instance *in = &sc->instances[i];
+    double out[2][3] = {{0}};
+    for (int f = 0; f < 2; f++)
+        for (int l = 0; l < sc->light_count; l++) {
+            float lp[3];
+            scene_light_position(sc, l, f ? f1 : f0, lp);
+            double Lv[3] = {lp[0] - P[0], lp[1] - P[1], lp[2] - P[2]};
+            double d2 = Lv[0] * Lv[0] + Lv[1] * Lv[1] + Lv[2] * Lv[2], r = sc->lights[l].radius;
+            if (d2 >= r * r)
+                continue;
+            double att = 1.0 - d2 / (r * r), d = sqrt(d2);
+            double L[3] = {Lv[0] / d, Lv[1] / d, Lv[2] / d};
+            double nl = N[0] * L[0] + N[1] * L[1] + N[2] * L[2];
+            if (nl <= 0)
+                continue;
+            double R[3], rv = 0;
+            for (int k = 0; k < 3; k++)
+                R[k] = -L[k] + 2 * nl * N[k];
+            for (int k = 0; k < 3; k++)
+                rv += R[k] * V[k];
+            double sp = pow(rv > 0 ? rv : 0, in->material.shininess);
+            for (int k = 0; k < 3; k++)
+                out[f][k] += sc->lights[l].color[k] * att *
+                             (in->albedo[k] * nl + in->material.specular * sp);
+        }
+    double m = 0;
+    for (int k = 0; k < 3; k++)
+        m = fmax(m, fabs(out[1][k] - out[0][k]));
+    return m;
+}
+
+/* osl.change_threshold's bound holds: no point of an object, with any
+ * normal, changes by more than it says between two frames; objects no
+ * light reaches get 0; Phong's motion term makes it tighter than the
+ * range term for small moves. */
+static void test_change_bound(void)
+{
+    struct scene_spec spec;
+    scene_spec_defaults(&spec);
+    spec.dynamic = true;
+    struct scene sc;
+    CHECK(scene_init(&sc, &spec));
+    struct scene_camera cam;
+    scene_camera_at(&sc, 0, &cam);
+    unsigned seed = 12345;
+    int zero = 0, tighter = 0, violations = 0;
+    for (int i = 0; i < sc.instance_count; i += 3) {
+        for (int gap = 1; gap <= 6; gap += 5) {
+            int64_t f0 = 40 + i % 7, f1 = f0 + gap;
+            double phong = osl_change_bound(&sc, i, f0, f1, true);
+            double range = osl_change_bound(&sc, i, f0, f1, false);
+            CHECK(phong <= range + 1e-12);
+            zero += range == 0;
+            tighter += phong < range;
+            double b = scene_instance_bound(&sc, i);
+            for (int t = 0; t < 200; t++) {
+                double u[3], n[3], len = 0, nlen = 0;
+                for (int k = 0; k < 3; k++) {
+                    seed = seed * 1103515245u + 12345u;
+                    u[k] = ((seed >> 8) & 0xffff) / 32768.0 - 1.0;
+                    seed = seed * 1103515245u + 12345u;
+                    n[k] = ((seed >> 8) & 0xffff) / 32768.0 - 1.0;
+                    len += u[k] * u[k];
+                    nlen += n[k] * n[k];
+                }
+                if (len > 1 || nlen < 1e-6)
+                    continue;
+                double P[3], N[3], V[3], vlen = 0;
+                for (int k = 0; k < 3; k++) {
+                    P[k] = sc.instances[i].pos[k] + b * u[k];
+                    N[k] = n[k] / sqrt(nlen);
+                    V[k] = cam.eye[k] - P[k];
+                    vlen += V[k] * V[k];
+                }
+                for (int k = 0; k < 3; k++)
+                    V[k] /= sqrt(vlen);
+                violations += phong_change(&sc, i, P, N, V, f0, f1) > phong + 1e-6;
+            }
+        }
+    }
+    CHECK(violations == 0);
+    CHECK(zero > 0);    /* far from every light */
+    CHECK(tighter > 0); /* Phong's motion term pays */
+    CHECK(osl_change_bound(&sc, 0, 7, 7, true) == 0);
+    scene_finish(&sc);
 }
 
 int main(void)
@@ -191,5 +284,6 @@ int main(void)
     test_atlas();
     test_schedule();
     test_plan();
+    test_change_bound();
     return check_finish("test_osl");
 }

@@ -24,6 +24,13 @@ struct osl_options {
      * reshaded every floor(r / async_distance) + 1 frames; 0 every frame. */
     double async_distance;
     int visibility; /* enum osl_visibility */
+    /* With visibility "seen": at most this many texels shaded a frame
+     * (whole 8x8 blocks, chosen by priority), 0 for no limit. */
+    int budget_texels;
+    /* With visibility "seen": an object keeps its shading while the bound
+     * on the radiance change its lights' motion can cause stays at or
+     * below this (osl_change.h); 0 reshades whenever its schedule says. */
+    double change_threshold;
 };
 
 extern const struct technique_info osl_info;

@@ -105,3 +105,53 @@ int osl_schedule_plan(const struct osl_schedule *s, const struct scene *scene,
     }
     return n;
 }
+
+double osl_change_bound(const struct scene *scene, int i, int64_t from, int64_t to,
+                        bool lipschitz)
+{
+    if (from == to || !scene->spec.dynamic || scene->spec.light_speed <= 0)
+        return 0.0;
+    const struct scene_instance *in = &scene->instances[i];
+    const float *c = in->pos;
+    double b = scene_instance_bound(scene, i);
+    double A = fmax(in->albedo[0], fmax(in->albedo[1], in->albedo[2]));
+    double S = in->material.specular, n = in->material.shininess;
+    double sum = 0.0;
+    for (int l = 0; l < scene->light_count; l++) {
+        const struct scene_light *L = &scene->lights[l];
+        float p0[3], p1[3];
+        scene_light_position(scene, l, from, p0);
+        scene_light_position(scene, l, to, p1);
+        double seg[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+        double delta = sqrt(seg[0] * seg[0] + seg[1] * seg[1] + seg[2] * seg[2]);
+        if (delta == 0.0)
+            continue;
+        if (L->type != SCENE_LIGHT_POINT)
+            return INFINITY;
+        /* The closest point of the segment to the object's centre. */
+        double t = ((c[0] - p0[0]) * seg[0] + (c[1] - p0[1]) * seg[1] + (c[2] - p0[2]) * seg[2]) /
+                   (delta * delta);
+        t = t < 0 ? 0 : t > 1 ? 1 : t;
+        double q[3] = {p0[0] + t * seg[0] - c[0], p0[1] + t * seg[1] - c[1],
+                       p0[2] + t * seg[2] - c[2]};
+        double dmin = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]) - b;
+        double r = L->radius;
+        if (dmin < 0)
+            dmin = 0;
+        if (dmin >= r)
+            continue;
+        double C = fmax(L->color[0], fmax(L->color[1], L->color[2]));
+        double a = 1.0 - dmin * dmin / (r * r);
+        double bound = C * a * (A + S);
+        /* The last term: Phong's specular can be above 0 where N.L reaches 0
+         * and the contribution drops to 0, a step no motion bound covers. */
+        if (lipschitz && dmin > 0 && n >= 1.0) {
+            double smooth = C * (A + S) * 2.0 * delta / r + C * a * (A + n * S) * delta / dmin +
+                            C * a * S;
+            if (smooth < bound)
+                bound = smooth;
+        }
+        sum += bound;
+    }
+    return sum;
+}

@@ -46,6 +46,26 @@ bool osl_schedule_due(const struct osl_schedule *s, int i, int64_t frame);
  * never counts. */
 bool osl_touched(const struct scene *scene, int i, int64_t frame);
 
+/* A bound on how much the lights' motion between frames from and to can
+ * change the radiance (per channel) of any point of instance i, for a
+ * view that does not move: the sum over the lights of
+ *   min(C a (A + S),  C (A + S) 2 delta / r + C a (A + n S) delta / dmin + C a S)
+ * where C is the light's largest colour channel, r its radius, delta how
+ * far it moved, dmin the least distance from its path (the segment between
+ * its two positions) to the object's bounding sphere, a = 1 - dmin^2/r^2
+ * the largest attenuation on that path, A the object's largest albedo
+ * channel, S its specular and n its shininess. The first term holds for any
+ * contribution in [0, C a (A + S)] (both shadings lie there, so they differ
+ * by no more). The second is Phong's: attenuation 1 - d^2/r^2 changes by at
+ * most 2/r per unit of motion; the unit light vector, N.L and (through the
+ * reflection) R.V by at most 1/dmin per unit; x^n by at most n per unit of
+ * x (n >= 1); and C a S for the step where N.L crosses 0, which cuts a
+ * specular that may not be 0 there. lipschitz false (Blinn-Phong, shadows) keeps only the first term. A
+ * light farther than its radius from the object on its whole path adds 0.
+ * Infinite when a light that is not a point light moved. */
+double osl_change_bound(const struct scene *scene, int i, int64_t from, int64_t to,
+                        bool lipschitz);
+
 /* Objects to shade at frame; initial shades everything (first frame drawn).
  * out must hold scene->instance_count entries. Returns how many. */
 int osl_schedule_plan(const struct osl_schedule *s, const struct scene *scene,

@@ -184,6 +184,7 @@ static void test_dilate(void)
     CHECK(osl_dilate_geometry(pos, nrm, NULL, 0, S, 8) == 10); /* the rest, then nothing left */
     float none[S * S * 4] = {0}, none_n[S * S * 4] = {0};
     CHECK(osl_dilate_geometry(none, none_n, NULL, 0, S, 4) == 0);
+}
 
 /* Phong's radiance at P with normal N from every light at frame (the
  * shader's light_contribution, lighting.glsl), largest channel of the

@@ -1,4 +1,5 @@
 #define _POSIX_C_SOURCE 200809L
+#include "config.h"
 #include "daemon/jobs/asset_store.h"
 
 #include <stdio.h>
@@ -57,6 +58,13 @@ void asset_run_limits_defaults(struct asset_run_limits *r)
     /* Decoded textures alone may reach 1 GiB at the default limits; the
      * importer's own copies come on top. */
     r->memory_bytes = 4ull << 30;
+#ifdef SB_SANITIZERS
+    /* AddressSanitizer reserves terabytes of shadow address space at start:
+     * under an address-space cap the instrumented converter cannot start.
+     * Sanitizer builds run it uncapped (CPU time and the wall-clock
+     * time-out still apply). */
+    r->memory_bytes = 0;
+#endif
     r->cpu_s = 120;
     r->wall_s = 180;
 }

@@ -222,7 +222,8 @@ static void convert(struct assets *a, const char *in, const char *out, struct co
     add_arg(argv, &argc, nums, "--max-indices", l->max_indices);
     add_arg(argv, &argc, nums, "--max-texture-pixels", l->max_texture_pixels);
     add_arg(argv, &argc, nums, "--max-texture-edge", l->max_texture_edge);
-    add_arg(argv, &argc, nums, "--max-memory", a->cfg.run.memory_bytes);
+    if (a->cfg.run.memory_bytes)
+        add_arg(argv, &argc, nums, "--max-memory", a->cfg.run.memory_bytes);
     add_arg(argv, &argc, nums, "--max-cpu-seconds", a->cfg.run.cpu_s);
     argv[argc] = NULL;
 
@@ -251,7 +252,8 @@ static void convert(struct assets *a, const char *in, const char *out, struct co
         if (dup2(devnull, 0) < 0 || dup2(pipefd[1], 1) < 0)
             _exit(127);
         closefrom(3);
-        setrlimit(RLIMIT_AS, &mem);
+        if (mem.rlim_cur)
+            setrlimit(RLIMIT_AS, &mem);
         setrlimit(RLIMIT_CPU, &cpu);
         setpriority(PRIO_PROCESS, 0, 10);
         execv(argv[0], argv);

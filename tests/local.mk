@@ -129,6 +129,7 @@ E2E_TESTS = \
 	tests/e2e/e2e_light_types.py \
 	tests/e2e/e2e_techniques.py \
 	tests/e2e/e2e_textured.py \
+	tests/e2e/e2e_asset_render.py \
 	tests/e2e/e2e_load.py \
 	tests/e2e/e2e_osl.py \
 	tests/e2e/e2e_ab.py \

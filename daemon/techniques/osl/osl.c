@@ -32,6 +32,12 @@ enum { PASS_LIGHTING, PASS_RASTER };
  * seen-margin of moving cameras at the smallest tiles. */
 #define OSL_GUTTER_TEXELS 2
 
+/* The shading atlas: the thesis's 8 bits a channel; asset scenes keep the
+ * radiance's range (RGBA16F), since their emissive surfaces, and anything
+ * seen through glass blended over it, go past 1 where the other techniques
+ * keep it in their HDR output. */
+#define OSL_ATLAS_FORMAT(o) ((o)->textured ? GL_RGBA16F : GL_RGBA8)
+
 /* The geometry atlas's channels: position, normal and, in asset scenes,
  * the baked albedo and surface (osl_texgen.frag). */
 #define OSL_GEO_CHANNELS 4
@@ -187,7 +193,9 @@ static bool choose_tiles(struct osl *o, const struct technique_env *env, int max
         const struct mesh *m = &s->meshes[s->instances[i].mesh];
         sizes[i] = osl_auto_tile_size(ppu, m->uv_per_unit / s->instances[i].scale, density);
     }
-    bool ok = osl_atlas_pack(sizes, n, max_tex, OSL_MAX_ATLAS_BYTES, o->tiles, &o->atlas_w,
+    /* The packer counts 4 bytes a texel; an HDR atlas takes 8. */
+    bool ok = osl_atlas_pack(sizes, n, max_tex, OSL_MAX_ATLAS_BYTES / (o->textured ? 2.0 : 1.0),
+                             o->tiles, &o->atlas_w,
                              &o->atlas_h, err, errlen);
     free(sizes);
     return ok;
@@ -365,7 +373,8 @@ static void bind_light_inputs(const struct osl *o, const struct technique_env *e
 {
     gpu_scene_bind(env->gpu, &o->light);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_TILES, o->tile_buffer);
-    glBindImageTexture(SB_IMG_OSL_ATLAS, o->atlas, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
+    glBindImageTexture(SB_IMG_OSL_ATLAS, o->atlas, 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                       OSL_ATLAS_FORMAT(o));
     glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_GEO_POSITION);
     glBindTexture(GL_TEXTURE_2D, o->geo_position);
     glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_GEO_NORMAL);
@@ -622,6 +631,7 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
     if (!sched || !o->rows)
         goto oom;
 
+    o->textured = s->asset != NULL;
     int max_tex = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
     if (!choose_tiles(o, env, max_tex, err, errlen) ||
@@ -670,7 +680,6 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
      * programs take the scene's defines (SCENE_TEXTURED) there only, so the
      * procedural scenes' programs stay the text they always were. */
     const char *scene_defines = s->asset ? env->defines : NULL;
-    o->textured = s->asset != NULL;
     if (!(o->texgen_prog = gl_program_build("osl texgen", texgen, 2, scene_defines, err, errlen)) ||
         !(light_prog = gl_program_build("osl lighting", light, 1, light_defines, err, errlen)) ||
         !(draw_prog = gl_program_build("osl draw", draw, 2, scene_defines, err, errlen))) {
@@ -701,7 +710,7 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
         goto fail;
     glGenTextures(1, &o->atlas);
     glBindTexture(GL_TEXTURE_2D, o->atlas);
-    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA8, o->atlas_w, o->atlas_h);
+    glTexStorage2D(GL_TEXTURE_2D, 1, OSL_ATLAS_FORMAT(o), o->atlas_w, o->atlas_h);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -961,7 +970,8 @@ static json_t *osl_describe(void *state)
         "texels_shaded_per_frame", "mean", o->texels_sum / frames, "max", o->texels_max,
         "total", o->texels_sum,
         "atlas", "width", o->atlas_w, "height", o->atlas_h, "texels",
-        (double)o->atlas_w * o->atlas_h, "bytes", (double)o->atlas_w * o->atlas_h * 4.0,
+        (double)o->atlas_w * o->atlas_h, "bytes",
+        (double)o->atlas_w * o->atlas_h * (o->textured ? 8.0 : 4.0),
         "tile_texels", tile_texels,
         "tiles_by_size", tiles, "objects_by_period", periods,
         "initial_shading", "objects", o->initial_objects, "texels", o->initial_texels,

@@ -12,7 +12,11 @@ layout(local_size_x = 8, local_size_y = 8) in;
 // (x + 65536 y).
 layout(std430, binding = SB_SSBO_OSL_TILES) readonly buffer TileBuffer { ivec4 tiles[]; };
 layout(std430, binding = SB_SSBO_OSL_WORK) readonly buffer WorkBuffer { uvec4 work[]; };
+#if defined(SCENE_TEXTURED)
+layout(rgba16f, binding = SB_IMG_OSL_ATLAS) writeonly uniform image2D u_atlas; // asset scenes: HDR
+#else
 layout(rgba8, binding = SB_IMG_OSL_ATLAS) writeonly uniform image2D u_atlas;
+#endif
 
 // The geometry atlas: every mesh's object-space position (w = 1 where a
 // texel is covered) and normal, once per tile size in use.
@@ -21,7 +25,7 @@ uniform sampler2D u_normal;
 #if defined(SCENE_TEXTURED)
 // Asset scenes: the material baked by osl_texgen.frag. The normal's w is
 // metallic.
-uniform sampler2D u_albedo;  // linear base colour, roughness
+uniform sampler2D u_albedo;  // linear base colour, roughness (+ 2 for a double-sided material)
 uniform sampler2D u_surface; // emissive, occlusion
 
 // Every light on a baked texel, as surface_shade_all_lights (surface.glsl)
@@ -29,11 +33,17 @@ uniform sampler2D u_surface; // emissive, occlusion
 // Phong's terms from roughness as material_surface_grad derives them.
 vec3 shade_baked(vec3 P, vec3 N, float metallic, vec4 albedo, vec4 surface, int row)
 {
-    float roughness = albedo.a;
+    bool two_sided = albedo.a >= 2.0;
+    float roughness = albedo.a - (two_sided ? 2.0 : 0.0);
     Material m = Material(albedo.rgb, 0.04 + 0.96 * metallic,
                           max(1.0, 2.0 / max(roughness * roughness, 1e-3) - 2.0), metallic,
                           roughness);
     vec3 V = normalize(u_frame.eye.xyz - P);
+    // The side the eye sees, as the other techniques' gl_FrontFacing picks
+    // it (here from the shading normal: a normal map near the silhouette
+    // can tip a texel to the other side).
+    if (two_sided && dot(N, V) < 0.0)
+        N = -N;
     vec3 color = surface.a * light_ambient(m, P, N, V);
     for (int i = 0; i < u_frame.counts.y; i++)
         color += light_contribution(i, light_position(i, row), P, N, V, m);

@@ -10,7 +10,7 @@ layout(location = 1) out vec4 out_normal;
 // metallic, albedo and roughness, emissive and occlusion. The lighting
 // pass then shades many objects in one dispatch without their textures.
 #include "surface.glsl"
-layout(location = 2) out vec4 out_albedo;  // linear base colour, roughness
+layout(location = 2) out vec4 out_albedo;  // linear base colour, roughness (+ 2 double-sided)
 layout(location = 3) out vec4 out_surface; // emissive, occlusion
 #endif
 
@@ -22,7 +22,10 @@ void main()
     // back is shaded as its front.
     TexturedSurface s = material_surface(u_material, v_tex, normalize(v_normal), v_tangent, true);
     out_normal = vec4(s.N, s.m.metallic);
-    out_albedo = vec4(s.m.albedo, s.m.roughness);
+    // A double-sided material is shaded on the side the viewer sees, which
+    // object space cannot know: the lighting pass flips the normal then.
+    bool two_sided = materials[u_material].slots.w != 0;
+    out_albedo = vec4(s.m.albedo, s.m.roughness + (two_sided ? 2.0 : 0.0));
     out_surface = vec4(s.emissive, s.occlusion);
 #else
     out_normal = vec4(v_normal, 0.0);

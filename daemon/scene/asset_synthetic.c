@@ -415,25 +415,8 @@ bool asset_synthetic_textured(struct asset *out, char *err, size_t errlen)
     }
     return true;
 fail:
-    asset_synthetic_free(out);
+    asset_finish(out);
     snprintf(err, errlen, "out of memory building the textured preset's asset");
     return false;
 }
 
-void asset_synthetic_free(struct asset *a)
-{
-    if (!a)
-        return;
-    for (uint32_t i = 0; a->meshes && i < a->mesh_count; i++) {
-        free(a->meshes[i].vertices);
-        free(a->meshes[i].indices);
-    }
-    for (uint32_t i = 0; a->images && i < a->image_count; i++)
-        free(a->images[i].rgba);
-    free(a->meshes);
-    free(a->materials);
-    free(a->images);
-    free(a->lights);
-    free(a->cameras);
-    memset(a, 0, sizeof(*a));
-}

@@ -24,8 +24,6 @@ extern const unsigned char ASSET_SYNTHETIC_FLAT_SRGB[3];
 
 /* Fills *out; on failure (out of memory) it is freed and zeroed. */
 bool asset_synthetic_textured(struct asset *out, char *err, size_t errlen);
-/* Frees what asset_synthetic_textured allocated (not the cache reader's:
- * that is asset_finish's). */
-void asset_synthetic_free(struct asset *a);
+
 
 #endif

@@ -193,7 +193,7 @@ void scene_finish(struct scene *s)
     free(s->lights);
     free(s->mesh_asset_index);
     if (s->owned_asset) {
-        asset_synthetic_free(s->owned_asset);
+        asset_finish(s->owned_asset);
         free(s->owned_asset);
     }
     memset(s, 0, sizeof(*s));

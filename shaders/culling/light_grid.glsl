@@ -55,9 +55,8 @@ int grid_cell(vec2 frag, float d)
 // forward sums them (lights left out contribute exactly 0 there, so the
 // sums agree). An overflowed cell under the fallback policy loops over
 // every light: slower, never wrong. evaluations: lights evaluated.
-#if defined(SCENE_TEXTURED)
-// The same with the ambient term scaled by occlusion (asset materials'
-// occlusion maps; surface.glsl).
+// The ambient term is scaled by occlusion (asset materials' occlusion
+// maps, surface.glsl; 1 elsewhere).
 vec3 shade_cell(int cell, vec3 P, vec3 N, Material m, float occlusion, out uint evaluations)
 {
     vec3 V = normalize(u_frame.eye.xyz - P);
@@ -77,24 +76,8 @@ vec3 shade_cell(int cell, vec3 P, vec3 N, Material m, float occlusion, out uint 
     evaluations = count;
     return color;
 }
-#endif
 
 vec3 shade_cell(int cell, vec3 P, vec3 N, Material m, out uint evaluations)
 {
-    vec3 V = normalize(u_frame.eye.xyz - P);
-    vec3 color = light_ambient(m, P, N, V);
-    uvec2 c = light_cells[cell];
-    if ((c.y & CELL_OVERFLOW) != 0u && u_grid.lists.w != 0) {
-        for (int i = 0; i < u_frame.counts.y; i++)
-            color += light_contribution(i, light_position(i, 0), P, N, V, m);
-        evaluations = uint(u_frame.counts.y);
-        return color;
-    }
-    uint count = c.y & ~CELL_OVERFLOW;
-    for (uint j = 0u; j < count; j++) {
-        int i = int(light_index[c.x + j]);
-        color += light_contribution(i, light_position(i, 0), P, N, V, m);
-    }
-    evaluations = count;
-    return color;
+    return shade_cell(cell, P, N, m, 1.0, evaluations);
 }

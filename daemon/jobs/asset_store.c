@@ -1,5 +1,4 @@
 #define _POSIX_C_SOURCE 200809L
-#include "config.h"
 #include "daemon/jobs/asset_store.h"
 
 #include <stdio.h>
@@ -53,12 +52,22 @@ bool asset_store_original_path(const char *state_dir, const char *sha256, const 
                 out);
 }
 
+/* AddressSanitizer builds: GCC says so with __SANITIZE_ADDRESS__, clang
+ * with __has_feature. */
+#if defined(__SANITIZE_ADDRESS__)
+#define SB_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define SB_ASAN 1
+#endif
+#endif
+
 void asset_run_limits_defaults(struct asset_run_limits *r)
 {
     /* Decoded textures alone may reach 1 GiB at the default limits; the
      * importer's own copies come on top. */
     r->memory_bytes = 4ull << 30;
-#ifdef SB_SANITIZERS
+#if defined(SB_ASAN)
     /* AddressSanitizer reserves terabytes of shadow address space at start:
      * under an address-space cap the instrumented converter cannot start.
      * Sanitizer builds run it uncapped (CPU time and the wall-clock

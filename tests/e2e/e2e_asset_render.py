@@ -13,7 +13,10 @@ through PUT /v1/assets, the converter, the cache and every technique, at
   converter generated, and reports the charts' uncovered texels;
 - alpha.glb (a masked and a blended material): every technique draws the
   blended pane in the harness's transparent pass and agrees with forward;
-- a job pinned to another hash is refused naming scene.asset_sha256."""
+- a job pinned to another hash is refused naming scene.asset_sha256;
+- a file that passes the converter's checks and crashes assimp 5.2 inside
+  the converter (tests/fuzz/regressions/asset_convert) is answered 422, the
+  loader's failure, and the daemon serves on."""
 
 import os
 import sys
@@ -119,6 +122,16 @@ def main():
         check(status in (400, 409) and body.get("error", {}).get("field") == "scene.asset_sha256",
               "a job pinned to another hash is refused naming scene.asset_sha256: %d %s"
               % (status, body))
+
+        # assimp crashing in the converter, a child process: a 422, no harm.
+        crash = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "fuzz", "regressions",
+                             "asset_convert", "assimp-segv-after-checks")
+        with open(crash, "rb") as f:
+            status, body = d.json("PUT", "/v1/assets/crash.glb", f.read())
+        check(status == 422 and "loader failed" in body.get("error", {}).get("message", ""),
+              "assimp's crash in the converter is a 422: %d %s" % (status, body))
+        status, _ = d.json("GET", "/v1/assets/textured.glb")
+        check(status == 200 and d.alive(), "the daemon serves on after the converter crashed")
     finally:
         testlib.stop_and_check(d)
     testlib.finish("e2e_asset_render")

@@ -28,7 +28,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         for (const char *p = r.id; *p; p++)
             FUZZ_ASSERT((*p >= '0' && *p <= '9') || *p == '-');
         bool has_id = r.kind != ROUTE_HEALTHZ && r.kind != ROUTE_METRICS && r.kind != ROUTE_INFO &&
-                      r.kind != ROUTE_JOBS && r.kind != ROUTE_SWEEPS;
+                      r.kind != ROUTE_JOBS && r.kind != ROUTE_SWEEPS && r.kind != ROUTE_ASSETS &&
+                      r.kind != ROUTE_ASSET;
+        /* An asset's name is what the request named, for the handler to
+         * judge (scene_asset_name_valid); it is never empty and never holds
+         * a path separator. */
+        if (r.kind == ROUTE_ASSET)
+            FUZZ_ASSERT(r.asset[0] != '\0' && strchr(r.asset, '/') == NULL);
         FUZZ_ASSERT(has_id == (r.id[0] != '\0'));
         if (r.kind == ROUTE_JOB_IMAGE)
             FUZZ_ASSERT(r.frame >= 1 && r.frame <= 999999999);
@@ -46,7 +52,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FUZZ_ASSERT(allow && allow[0] && rule && rule[0]);
     if (strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0)
         FUZZ_ASSERT(ok);
-    if (strcmp(method, "PUT") == 0 || strcmp(method, "PATCH") == 0 || method[0] == '\0')
+    /* PUT uploads an asset, and nothing else. */
+    if (strcmp(method, "PUT") == 0)
+        FUZZ_ASSERT(ok == (r.kind == ROUTE_ASSET));
+    if (strcmp(method, "PATCH") == 0 || method[0] == '\0')
         FUZZ_ASSERT(!ok);
     return 0;
 }

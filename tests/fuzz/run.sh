@@ -28,8 +28,8 @@ if ! command -v "$cc" >/dev/null 2>&1; then
     exit 1
 fi
 flags="-g -O1 -std=c11 -I. -I$out/gen -fno-omit-frame-pointer -fsanitize=address,undefined
-  -fno-sanitize-recover=undefined $(pkg-config --cflags jansson libpng sqlite3)"
-libs="$(pkg-config --libs jansson libpng sqlite3) -lm -pthread"
+  -fno-sanitize-recover=undefined $(pkg-config --cflags jansson libpng sqlite3 nettle)"
+libs="$(pkg-config --libs jansson libpng sqlite3 nettle) -lm -pthread"
 # The registries' lists for C, as the build generates them (rewritten only
 # when they change, so that what includes them is not rebuilt every run).
 for registry in daemon/techniques/registry.mk daemon/effects/registry.mk; do
@@ -96,9 +96,11 @@ fuzz_one() {
     seeds="tests/fuzz/corpus/$t"
     [ -d "tests/fuzz/regressions/$t" ] && seeds="$seeds tests/fuzz/regressions/$t"
     start=$(date +%s)
-    # Leaks are checked too (LSan, part of ASan): each input must free what it takes.
+    # Leaks are checked too (LSan, part of ASan): each input must free what it
+    # takes, apart from the libraries' own (tests/sanitizers/lsan.supp).
     # shellcheck disable=SC2086
     ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 \
+    LSAN_OPTIONS="suppressions=$PWD/tests/sanitizers/lsan.supp" \
     "$bin" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2560 -max_len=65536 \
         -artifact_prefix="$out/crashes/$t/" -print_final_stats=1 $dict \
         "$out/corpus/$t" $seeds >"$out/$t.log" 2>&1

@@ -48,6 +48,8 @@ static const char *format_name(GLenum f)
         return "rg16_snorm";
     case GL_R32F:
         return "r32f";
+    case GL_SRGB8_ALPHA8:
+        return "srgb8_alpha8";
     default:
         return "rgba8";
     }
@@ -130,6 +132,14 @@ bool gbuffer_init(struct gbuffer *g, const struct technique_env *env,
     snprintf(g->defines, sizeof(g->defines), "%s%s%s", normal_defines[opt->normal],
              albedo_defines[opt->albedo], env->defines ? env->defines : "");
     g->albedo_format = opt->albedo == GBUFFER_ALBEDO_RGBA8 ? GL_RGBA8 : GL_R32F;
+    /* Asset scenes: 8 bits a channel sRGB-encoded, as the textures the
+     * albedo comes from are. Linear 8 bits put steps of 1/255 into dark
+     * base colours that the sRGB texels resolve finely, and a textured
+     * scene lit by many lights shows them (PerceptualDiff failed
+     * clustered_deferred against forward on the showcase asset with 256
+     * lights). The procedural scenes keep their linear plane. */
+    if (g->albedo_format == GL_RGBA8 && env->scene->asset)
+        g->albedo_format = GL_SRGB8_ALPHA8;
     switch (opt->normal) {
     case GBUFFER_NORMAL_FLOAT3:
         g->normal_format = GL_RGBA32F;
@@ -269,7 +279,12 @@ void gbuffer_draw(const struct gbuffer *g, const struct technique_env *env, int 
         glClearBufferfv(GL_COLOR, 3, zero);
     glClear(GL_DEPTH_BUFFER_BIT);
     gpu_scene_bind(env->gpu, &g->program);
+    /* An sRGB albedo plane is encoded on write only with this on (the
+     * other planes are linear formats, which it leaves alone). */
+    if (g->albedo_format == GL_SRGB8_ALPHA8)
+        glEnable(GL_FRAMEBUFFER_SRGB);
     gpu_scene_draw(env->gpu, &g->program);
+    glDisable(GL_FRAMEBUFFER_SRGB);
     gpu_pass_end(env->passes);
 }
 

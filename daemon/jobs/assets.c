@@ -259,23 +259,32 @@ static void convert(struct assets *a, const char *in, const char *out, struct co
         execv(argv[0], argv);
         _exit(127);
     }
+    /* Its own process group from the parent's side too: whichever of the
+     * two runs first, a kill of -pid after this reaches it. */
+    setpgid(pid, pid);
     close(pipefd[1]);
     pipefd[1] = -1;
     pthread_mutex_lock(&a->lock);
     a->child = pid;
+    bool stopping = a->stopping;
     pthread_mutex_unlock(&a->lock);
 
     double deadline = clock_mono_s() + a->cfg.run.wall_s;
     bool timed_out = false, eof = false;
     text = malloc(ASSETS_MAX_STDOUT + 1);
-    while (!eof) {
+    while (!eof && !stopping) {
         double left = deadline - clock_mono_s();
         if (left <= 0) {
             timed_out = true;
             break;
         }
+        /* In slices, so that a daemon stopping (assets_destroy) is not held
+         * up by a converter that still has minutes of its time left. */
         struct pollfd p = {.fd = pipefd[0], .events = POLLIN};
-        int n = poll(&p, 1, (int)(left * 1000) + 1);
+        int n = poll(&p, 1, left > 0.25 ? 250 : (int)(left * 1000) + 1);
+        pthread_mutex_lock(&a->lock);
+        stopping = a->stopping;
+        pthread_mutex_unlock(&a->lock);
         if (n < 0 && errno != EINTR)
             break;
         if (n <= 0)
@@ -306,8 +315,8 @@ static void convert(struct assets *a, const char *in, const char *out, struct co
             status = 0;
             break;
         }
-        if (timed_out || clock_mono_s() >= deadline) {
-            timed_out = true;
+        if (stopping || timed_out || clock_mono_s() >= deadline) {
+            timed_out = !stopping;
             kill(-pid, SIGKILL);
             kill(pid, SIGKILL);
             waitpid(pid, &status, 0);
@@ -326,7 +335,10 @@ static void convert(struct assets *a, const char *in, const char *out, struct co
         json_decref(j);
         j = NULL;
     }
-    if (timed_out) {
+    if (stopping && !timed_out && !WIFEXITED(status)) {
+        snprintf(c->why, sizeof(c->why), "the daemon stopped while it ran");
+        json_decref(j);
+    } else if (timed_out) {
         snprintf(c->why, sizeof(c->why), "it took longer than %g s and was stopped",
                  a->cfg.run.wall_s);
         json_decref(j);
@@ -880,8 +892,10 @@ void assets_destroy(struct assets *a)
         return;
     pthread_mutex_lock(&a->lock);
     a->stopping = true;
-    if (a->child > 0)
+    if (a->child > 0) {
         kill(-a->child, SIGKILL);
+        kill(a->child, SIGKILL);
+    }
     pthread_cond_broadcast(&a->work);
     pthread_mutex_unlock(&a->lock);
     for (int i = 0; i < a->nworkers; i++)

@@ -123,8 +123,24 @@ static bool create_suns(struct look_shadows *sh, char *err, size_t errlen)
     return true;
 }
 
-/* Directional map k: every caster (the ground never casts), back faces, into
- * its layer. */
+/* Binds a caster's mesh and, in asset scenes, its material (an alpha-masked
+ * caster cuts its holes with its own textures) and face culling (a
+ * double-sided one casts from both faces; the others keep the pass's
+ * front-face culling). */
+static void bind_caster(struct look_shadows *sh, int mesh)
+{
+    glBindVertexArray(sh->gpu->vao[mesh]);
+    if (!sh->gpu->mesh_material)
+        return;
+    gpu_scene_bind_material(sh->gpu, mesh, sh->material_loc);
+    if (sh->gpu->mesh_material[mesh].double_sided)
+        glDisable(GL_CULL_FACE);
+    else
+        glEnable(GL_CULL_FACE);
+}
+
+/* Directional map k: every caster (the ground and blended meshes never
+ * cast), back faces, into its layer. */
 static void render_sun(struct look_shadows *sh, int k)
 {
     const struct scene *s = sh->scene;
@@ -136,11 +152,11 @@ static void render_sun(struct look_shadows *sh, int k)
     int bound_mesh = -1;
     for (int c = 0; c < s->instance_count; c++) {
         const struct scene_instance *in = &s->instances[c];
-        if (in->mesh == SCENE_MESH_PLANE)
+        if (in->mesh == SCENE_MESH_PLANE || in->mesh >= s->asset_blend_first)
             continue;
         if ((int)in->mesh != bound_mesh) {
             bound_mesh = (int)in->mesh;
-            glBindVertexArray(sh->gpu->vao[bound_mesh]);
+            bind_caster(sh, bound_mesh);
         }
         glUniform1i(SB_LOC_SHADOW_INSTANCE, c);
         glDrawElements(GL_TRIANGLES, (GLsizei)s->meshes[in->mesh].index_count, GL_UNSIGNED_INT,
@@ -263,16 +279,7 @@ static void draw_casters(struct look_shadows *sh, int ncasters, const float ligh
             continue;
         if ((int)in->mesh != bound_mesh) {
             bound_mesh = (int)in->mesh;
-            glBindVertexArray(sh->gpu->vao[bound_mesh]);
-            if (sh->gpu->mesh_material) {
-                /* A double-sided caster casts from both faces; the others
-                 * keep the pass's front-face culling. */
-                gpu_scene_bind_material(sh->gpu, bound_mesh, sh->material_loc);
-                if (sh->gpu->mesh_material[bound_mesh].double_sided)
-                    glDisable(GL_CULL_FACE);
-                else
-                    glEnable(GL_CULL_FACE);
-            }
+            bind_caster(sh, bound_mesh);
         }
         glUniform1i(SB_LOC_SHADOW_INSTANCE, i);
         glDrawElements(GL_TRIANGLES, (GLsizei)s->meshes[in->mesh].index_count, GL_UNSIGNED_INT,

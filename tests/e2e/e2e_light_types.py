@@ -25,7 +25,6 @@
 - the scene options: written back in the spec, described by type, bad
   values answered 400 naming the field; a sweep varies scene.light_type."""
 
-import math
 import os
 
 import testlib
@@ -206,66 +205,10 @@ try:
         if not check(pixels[False] and pixels[True] and camera and (sun_dir or light_at),
                      "%s shadow frames" % what):
             continue
-        eye, target = camera["eye_at_frame_0"], camera["target_at_frame_0"]
-        fwd = [t - e for t, e in zip(target, eye)]
-        n = math.sqrt(sum(c * c for c in fwd))
-        fwd = [c / n for c in fwd]
-        right = [-fwd[2], 0.0, fwd[0]]
-        n = math.sqrt(sum(c * c for c in right))
-        right = [c / n for c in right]
-        up = [right[1] * fwd[2] - right[2] * fwd[1], right[2] * fwd[0] - right[0] * fwd[2],
-              right[0] * fwd[1] - right[1] * fwd[0]]
-        tan_half = math.tan(math.radians(camera["fovy_deg"]) / 2)
-
-        def towards(p):
-            """Unit direction from p to the light, and how far the light is."""
-            if light_at is None:
-                return [-c for c in sun_dir], float("inf")
-            v = [a - b for a, b in zip(light_at, p)]
-            length = math.sqrt(sum(c * c for c in v))
-            return [c / length for c in v], length
-
-        def ray_sphere(o, dvec, r):
-            b = sum(a * c for a, c in zip(o, dvec))
-            c = sum(a * a for a in o) - r * r
-            disc = b * b - c
-            return None if disc < 0 else -b - math.sqrt(disc)
-
-        def shaded(g, r):
-            # The path from g to the light passes within r of the centre.
-            L, far = towards(g)
-            t = min(max(-sum(a * c for a, c in zip(g, L)), 0.0), far)
-            closest = [a + t * c for a, c in zip(g, L)]
-            return math.sqrt(sum(c * c for c in closest)) < r
-
-        w, h = 160, 120
-        off, on = pixels[False], pixels[True]
-        core = core_dark = outside_changed = lit_changed = 0
-        for y in range(h):
-            for x in range(w):
-                sx = (2 * (x + 0.5) / w - 1) * tan_half * w / h
-                sy = (1 - 2 * (y + 0.5) / h) * tan_half
-                dvec = [f + sx * r + sy * u for f, r, u in zip(fwd, right, up)]
-                n = math.sqrt(sum(c * c for c in dvec))
-                dvec = [c / n for c in dvec]
-                a, b = sum(off[y * w + x]) / 3.0, sum(on[y * w + x]) / 3.0
-                t = ray_sphere(eye, dvec, 0.8)
-                if t is not None and t > 0:
-                    p = [e + t * c for e, c in zip(eye, dvec)]
-                    if sum(q * c for q, c in zip(p, towards(p)[0])) / 0.8 > 0.3 and abs(a - b) > 2:
-                        lit_changed += 1
-                    continue
-                if dvec[1] >= 0:
-                    continue
-                t = (-0.8 - eye[1]) / dvec[1]
-                g = [e + t * c for e, c in zip(eye, dvec)]
-                if abs(g[0]) > 5.5 or abs(g[2]) > 5.5:
-                    continue
-                if shaded(g, 0.8 * 0.85):
-                    core += 1
-                    core_dark += b <= 0.6 * a
-                elif not shaded(g, 0.8 * 1.15 + 0.05) and abs(a - b) > 2:
-                    outside_changed += 1
+        towards = (testlib.towards_point(light_at) if light_at else
+                   (lambda p: ([-c for c in sun_dir], float("inf"))))
+        core, core_dark, outside_changed, lit_changed = testlib.sphere_shadow_counts(
+            camera, pixels[False], pixels[True], 160, 120, towards)
         print("  %s's shadow: %d of %d ground pixels in the core darker, %d changed outside, "
               "%d changed on the lit side" % (what, core_dark, core, outside_changed, lit_changed))
         check(core > 50 and core_dark == core,

@@ -18,7 +18,6 @@
 Small frames and few of them: the whole file runs in about a minute on two
 cores."""
 
-import math
 import os
 
 import testlib
@@ -104,62 +103,9 @@ try:
                   "the shadow pass runs first, the sky after the technique: %s" % sections)
             camera = done["result"]["scene"]["camera"]
             light = [0.0, 3.0, 0.0]
-    eye, target = camera["eye_at_frame_0"], camera["target_at_frame_0"]
-    fwd = [t - e for t, e in zip(target, eye)]
-    n = math.sqrt(sum(c * c for c in fwd))
-    fwd = [c / n for c in fwd]
-    right = [fwd[1] * 0 - fwd[2] * 1, fwd[2] * 0 - fwd[0] * 0, fwd[0] * 1 - fwd[1] * 0]
-    n = math.sqrt(sum(c * c for c in right))
-    right = [c / n for c in right]
-    up = [right[1] * fwd[2] - right[2] * fwd[1], right[2] * fwd[0] - right[0] * fwd[2],
-          right[0] * fwd[1] - right[1] * fwd[0]]
-    tan_half = math.tan(math.radians(camera["fovy_deg"]) / 2)
-
-    def ray_sphere(o, dvec, r):
-        b = sum(a * c for a, c in zip(o, dvec))
-        c = sum(a * a for a in o) - r * r
-        disc = b * b - c
-        return None if disc < 0 else -b - math.sqrt(disc)
-
-    def seg_hits_sphere(p, q, r):
-        dvec = [b - a for a, b in zip(p, q)]
-        length = math.sqrt(sum(c * c for c in dvec))
-        dvec = [c / length for c in dvec]
-        t = -sum(a * c for a, c in zip(p, dvec))
-        t = min(max(t, 0.0), length)
-        closest = [a + t * c for a, c in zip(p, dvec)]
-        return math.sqrt(sum(c * c for c in closest)) < r
-
     (w, h, off), (_, _, on) = pixels[False], pixels[True]
-    core = core_dark = outside_changed = lit_changed = 0
-    for y in range(h):
-        for x in range(w):
-            sx = (2 * (x + 0.5) / w - 1) * tan_half * w / h
-            sy = (1 - 2 * (y + 0.5) / h) * tan_half
-            dvec = [f + sx * r + sy * u for f, r, u in zip(fwd, right, up)]
-            n = math.sqrt(sum(c * c for c in dvec))
-            dvec = [c / n for c in dvec]
-            a = sum(off[y * w + x]) / 3.0
-            b = sum(on[y * w + x]) / 3.0
-            t = ray_sphere(eye, dvec, 0.8)
-            if t is not None and t > 0:
-                p = [e + t * c for e, c in zip(eye, dvec)]
-                lv = [l - q for l, q in zip(light, p)]
-                nl = sum(q * c for q, c in zip(p, lv)) / (0.8 * math.sqrt(sum(c * c for c in lv)))
-                if nl > 0.3 and abs(a - b) > 2:
-                    lit_changed += 1
-                continue
-            if dvec[1] >= 0:
-                continue
-            t = (-0.8 - eye[1]) / dvec[1]
-            g = [e + t * c for e, c in zip(eye, dvec)]
-            if abs(g[0]) > 5.5 or abs(g[2]) > 5.5:
-                continue
-            if seg_hits_sphere(g, light, 0.8 * 0.85):
-                core += 1
-                core_dark += b <= 0.6 * a
-            elif not seg_hits_sphere(g, light, 0.8 * 1.15 + 0.05) and abs(a - b) > 2:
-                outside_changed += 1
+    core, core_dark, outside_changed, lit_changed = testlib.sphere_shadow_counts(
+        camera, off, on, w, h, testlib.towards_point(light))
     check(core > 100 and core_dark == core,
           "the ground under the sphere is in shadow: %d of %d pixels darker" % (core_dark, core))
     check(outside_changed == 0,

@@ -237,3 +237,70 @@ def png_pixels(path):
         pixels.extend(tuple(line[x * bpp:x * bpp + 3]) for x in range(w))
         prev = line
     return w, h, pixels
+
+
+def sphere_shadow_counts(camera, off, on, w, h, towards):
+    """The sphere preset's shadow, ray-cast: a sphere of radius 0.8 at the
+    origin on the ground at y -0.8, seen by camera (result.scene.camera),
+    off and on the w x h frames without and with shadows (png_pixels' pixel
+    lists), towards(p) the unit direction from p to the light and how far it
+    is. Returns (core, core_dark, outside_changed, lit_changed): ground
+    pixels the sphere surely hides from the light and how many of those are
+    darker with shadows, ground pixels no shadow can reach that changed,
+    and pixels on the sphere's lit side that changed (acne)."""
+    import math
+    eye, target = camera["eye_at_frame_0"], camera["target_at_frame_0"]
+
+    def unit(v):
+        n = math.sqrt(sum(c * c for c in v))
+        return [c / n for c in v]
+    fwd = unit([t - e for t, e in zip(target, eye)])
+    right = unit([-fwd[2], 0.0, fwd[0]])
+    up = [right[1] * fwd[2] - right[2] * fwd[1], right[2] * fwd[0] - right[0] * fwd[2],
+          right[0] * fwd[1] - right[1] * fwd[0]]
+    tan_half = math.tan(math.radians(camera["fovy_deg"]) / 2)
+
+    def shaded(g, r):
+        # The path from g to the light passes within r of the centre.
+        L, far = towards(g)
+        t = min(max(-sum(a * c for a, c in zip(g, L)), 0.0), far)
+        return math.sqrt(sum((a + t * c) ** 2 for a, c in zip(g, L))) < r
+
+    core = core_dark = outside_changed = lit_changed = 0
+    for y in range(h):
+        for x in range(w):
+            sx = (2 * (x + 0.5) / w - 1) * tan_half * w / h
+            sy = (1 - 2 * (y + 0.5) / h) * tan_half
+            dvec = unit([f + sx * r + sy * u for f, r, u in zip(fwd, right, up)])
+            a, b = sum(off[y * w + x]) / 3.0, sum(on[y * w + x]) / 3.0
+            bb = sum(e * c for e, c in zip(eye, dvec))
+            disc = bb * bb - (sum(e * e for e in eye) - 0.64)
+            t = None if disc < 0 else -bb - math.sqrt(disc)
+            if t is not None and t > 0:
+                p = [e + t * c for e, c in zip(eye, dvec)]
+                if sum(q * c for q, c in zip(p, towards(p)[0])) / 0.8 > 0.3 and abs(a - b) > 2:
+                    lit_changed += 1
+                continue
+            if dvec[1] >= 0:
+                continue
+            t = (-0.8 - eye[1]) / dvec[1]
+            g = [e + t * c for e, c in zip(eye, dvec)]
+            if abs(g[0]) > 5.5 or abs(g[2]) > 5.5:
+                continue
+            if shaded(g, 0.8 * 0.85):
+                core += 1
+                core_dark += b <= 0.6 * a
+            elif not shaded(g, 0.8 * 1.15 + 0.05) and abs(a - b) > 2:
+                outside_changed += 1
+    return core, core_dark, outside_changed, lit_changed
+
+
+def towards_point(light):
+    """sphere_shadow_counts' towards for a light at a point."""
+    import math
+
+    def towards(p):
+        v = [a - b for a, b in zip(light, p)]
+        n = math.sqrt(sum(c * c for c in v))
+        return [c / n for c in v], n
+    return towards

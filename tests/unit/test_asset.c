@@ -102,20 +102,6 @@ static void make_asset(struct asset *a)
     a->ignored[0] = strdup("animations");
 }
 
-static unsigned char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *buf = malloc((size_t)n);
-    *len = fread(buf, 1, (size_t)n, f);
-    fclose(f);
-    return buf;
-}
-
 static bool refused(const unsigned char *buf, size_t len, const char *needle)
 {
     struct asset_limits lim;
@@ -222,7 +208,7 @@ int main(void)
 
     /* Damage. */
     size_t len = 0;
-    unsigned char *good = slurp(path, &len);
+    unsigned char *good = check_slurp(path, &len);
     CHECK(good && len == (size_t)OFF_MESH + 2 * (64 + 16 + 24 + 4 + 4 * 56 + 24) + 8);
     unsigned char *buf = malloc(len + 16);
     /* Every cut, from empty to one byte short. */

@@ -18,20 +18,6 @@ static void path_of(char *out, size_t cap, const char *name)
     snprintf(out, cap, "%s/%s", dir, name);
 }
 
-static unsigned char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *buf = malloc((size_t)n);
-    *len = fread(buf, 1, (size_t)n, f);
-    fclose(f);
-    return buf;
-}
-
 static void spill(const char *path, const unsigned char *buf, size_t len)
 {
     FILE *f = fopen(path, "wb");
@@ -109,7 +95,7 @@ int main(void)
     image_finish(&img);
 
     size_t len = 0;
-    unsigned char *good = slurp(path, &len);
+    unsigned char *good = check_slurp(path, &len);
     CHECK(good && len > 60);
     unsigned char *bad = malloc(len);
 

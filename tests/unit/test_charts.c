@@ -10,9 +10,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "daemon/api/charts.h"
-#include "daemon/api/report.h"
-#include "daemon/api/sweep_verdict.h"
+#include "daemon/reports/charts.h"
+#include "daemon/reports/report.h"
+#include "daemon/reports/sweep_verdict.h"
 #include "tests/unit/check.h"
 
 static json_t *row(const char *tech, double lights, double async, double ms, double lo, double hi,

@@ -1,5 +1,5 @@
 #define _POSIX_C_SOURCE 200809L
-#include "daemon/api/sweep_verdict.h"
+#include "daemon/reports/sweep_verdict.h"
 
 #include <math.h>
 #include <stdio.h>

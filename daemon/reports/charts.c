@@ -1,8 +1,8 @@
 #define _DEFAULT_SOURCE /* M_PI */
 #define _POSIX_C_SOURCE 200809L
-#include "daemon/api/charts.h"
+#include "daemon/reports/charts.h"
 #include "common/result_keys.h"
-#include "daemon/api/sweep_verdict.h"
+#include "daemon/reports/sweep_verdict.h"
 
 #include <cairo-svg.h>
 #include <cairo.h>

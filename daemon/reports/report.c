@@ -1,5 +1,5 @@
 #define _POSIX_C_SOURCE 200809L
-#include "daemon/api/report.h"
+#include "daemon/reports/report.h"
 
 #include <limits.h>
 #include <math.h>
@@ -9,8 +9,8 @@
 #include <string.h>
 
 #include "config.h"
-#include "daemon/api/charts.h"
-#include "daemon/api/sweep_verdict.h"
+#include "daemon/reports/charts.h"
+#include "daemon/reports/sweep_verdict.h"
 #include "daemon/harness/interference.h" /* INTERFERENCE_RULE */
 #include "common/job_files.h"
 #include "common/png_io.h"

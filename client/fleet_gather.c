@@ -21,7 +21,7 @@
 #include "daemon/reports/charts.h"
 #include "daemon/reports/report.h"
 #include "daemon/reports/sweep_verdict.h"
-#include "daemon/jobs/sweep_table.h"
+#include "daemon/spec/sweep_table.h"
 
 /* A device class's points as the report's job_dir callback finds them. */
 struct class_dirs {

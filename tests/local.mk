@@ -91,7 +91,7 @@ tests_unit_test_http_SOURCES = tests/unit/test_http.c $(API_SOURCES) \
 	daemon/jobs/sweeps.c daemon/jobs/sweeps.h \
 	daemon/harness/telemetry.c daemon/harness/telemetry.h \
 	daemon/harness/render_state.c daemon/harness/render_state.h
-tests_unit_test_http_LDADD = $(REPORT_LIBS) $(MHD_LIBS)
+tests_unit_test_http_LDADD = $(API_LIBS) $(MHD_LIBS)
 # The fuzz targets, replayed over their corpora in make check (tests/fuzz/run.sh
 # builds them with clang and libFuzzer instead).
 tests_fuzz_replay_job_SOURCES = tests/fuzz/fuzz_job.c tests/fuzz/replay.c

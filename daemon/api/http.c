@@ -25,11 +25,11 @@
 #include "daemon/reports/report.h"
 #include "daemon/api/routes.h"
 #include "daemon/harness/telemetry.h"
-#include "daemon/jobs/job_cost.h"
-#include "daemon/jobs/job_spec.h"
+#include "daemon/spec/job_cost.h"
+#include "daemon/spec/job_spec.h"
 #include "daemon/quality/metrics.h"
 #include "daemon/api/job_filter.h"
-#include "daemon/jobs/sweep_spec.h"
+#include "daemon/spec/sweep_spec.h"
 #include "common/result_keys.h"
 
 #ifndef MHD_HTTP_CONTENT_TOO_LARGE

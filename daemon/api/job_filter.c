@@ -7,7 +7,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "daemon/jobs/records.h"
+#include "daemon/store/records.h"
 
 void job_filter_init(struct store_query *q, enum store_kind kind)
 {

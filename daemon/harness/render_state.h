@@ -18,7 +18,7 @@
 
 #include <stdbool.h>
 
-#include "daemon/jobs/records.h"
+#include "daemon/store/records.h"
 
 struct render_state {
     bool alive;               /* the render thread runs (runner_state fills it) */

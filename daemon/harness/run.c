@@ -10,7 +10,7 @@
 #include "common/clock.h"
 #include "daemon/harness/deadline.h"
 #include "daemon/harness/render_state.h"
-#include "daemon/jobs/store.h"
+#include "daemon/store/store.h"
 #include "daemon/scene/asset.h"
 
 bool harness_gl_init(struct harness_gl *g, char *err, size_t errlen)

@@ -23,9 +23,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "daemon/jobs/asset_store.h"
+#include "daemon/store/asset_store.h"
 #include "daemon/jobs/queue.h"
-#include "daemon/jobs/store.h"
+#include "daemon/store/store.h"
 #include "daemon/scene/scene_spec.h"
 
 /* Conversions at once, and uploads that may stream or wait to convert at

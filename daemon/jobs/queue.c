@@ -5,9 +5,9 @@
 #include "common/clock.h"
 #include "common/log.h"
 #include "common/result_keys.h"
-#include "daemon/jobs/job_figures.h"
-#include "daemon/jobs/job_dir.h"
-#include "daemon/jobs/store_reserve.h"
+#include "daemon/spec/job_figures.h"
+#include "daemon/store/job_dir.h"
+#include "daemon/store/store_reserve.h"
 
 #include <errno.h>
 #include <pthread.h>

@@ -25,9 +25,9 @@
 #include <stdatomic.h>
 #include <stdbool.h>
 
-#include "daemon/jobs/job_spec.h"
-#include "daemon/jobs/records.h"
-#include "daemon/jobs/store.h"
+#include "daemon/spec/job_spec.h"
+#include "daemon/store/records.h"
+#include "daemon/store/store.h"
 
 /* id (first: store_live), spec, dir and frames_total never change once the
  * job is accepted;

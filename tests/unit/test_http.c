@@ -23,8 +23,8 @@
 #include "common/log.h"
 #include "daemon/api/connections.h"
 #include "daemon/api/http.h"
-#include "daemon/jobs/job_cost.h"
-#include "daemon/jobs/store.h"
+#include "daemon/spec/job_cost.h"
+#include "daemon/store/store.h"
 
 static atomic_bool render_up = true;
 

@@ -1,5 +1,5 @@
 #define _POSIX_C_SOURCE 200809L
-#include "daemon/jobs/job_spec.h"
+#include "daemon/spec/job_spec.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "daemon/jobs/job_cost.h"
+#include "daemon/spec/job_cost.h"
 
 
 /* A technique name from the catalogue; null gives "" (index -1) where allowed. */

@@ -32,7 +32,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "daemon/jobs/records.h"
+#include "daemon/store/records.h"
 
 #define STORE_FILE "store.db"
 

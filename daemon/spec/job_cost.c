@@ -1,9 +1,9 @@
 #define _POSIX_C_SOURCE 200809L
-#include "daemon/jobs/job_cost.h"
+#include "daemon/spec/job_cost.h"
 
 #include <stdatomic.h>
 
-#include "daemon/jobs/job_spec.h"
+#include "daemon/spec/job_spec.h"
 
 /* Bytes a pixel, from result.targets_bytes on llvmpipe (256x256, a fresh
  * context each), rounded up:

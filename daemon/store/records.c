@@ -1,5 +1,5 @@
 #define _POSIX_C_SOURCE 200809L
-#include "daemon/jobs/records.h"
+#include "daemon/store/records.h"
 
 #include <dirent.h>
 #include <errno.h>

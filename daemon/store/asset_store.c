@@ -1,5 +1,5 @@
 #define _POSIX_C_SOURCE 200809L
-#include "daemon/jobs/asset_store.h"
+#include "daemon/store/asset_store.h"
 
 #include <stdio.h>
 #include <string.h>

@@ -4,7 +4,7 @@
  * by one daemon and the same sweep run across a Slurm array give the same
  * rows. Any thread (pure functions of their arguments). */
 #define _POSIX_C_SOURCE 200809L
-#include "daemon/jobs/sweep_table.h"
+#include "daemon/spec/sweep_table.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -1,4 +1,4 @@
-#include "daemon/jobs/job_figures.h"
+#include "daemon/spec/job_figures.h"
 
 #include "common/result_keys.h"
 

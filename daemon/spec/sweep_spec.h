@@ -10,7 +10,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
-#include "daemon/jobs/job_spec.h"
+#include "daemon/spec/job_spec.h"
 
 #define SWEEP_MAX_POINTS 256
 /* Fields a grid may vary at once. */

@@ -13,8 +13,8 @@
 #include <stdbool.h>
 #include <stddef.h>
 
-#include "daemon/jobs/job_spec.h"
-#include "daemon/jobs/store.h"
+#include "daemon/spec/job_spec.h"
+#include "daemon/store/store.h"
 
 /* The spec's labels as a JSON object of strings. New reference. */
 json_t *job_dir_labels(const struct job_spec *spec);

@@ -1,5 +1,5 @@
 #define _POSIX_C_SOURCE 200809L
-#include "daemon/jobs/sweep_spec.h"
+#include "daemon/spec/sweep_spec.h"
 #include "common/result_keys.h"
 
 #include <errno.h>

@@ -1,5 +1,5 @@
 #define _POSIX_C_SOURCE 200809L
-#include "daemon/jobs/store_reserve.h"
+#include "daemon/store/store_reserve.h"
 
 #include <errno.h>
 #include <fcntl.h>

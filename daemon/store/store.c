@@ -1,5 +1,5 @@
 #define _POSIX_C_SOURCE 200809L
-#include "daemon/jobs/store.h"
+#include "daemon/store/store.h"
 
 #include <errno.h>
 #include <pthread.h>
@@ -12,7 +12,7 @@
 #include <unistd.h>
 
 #include "common/log.h"
-#include "daemon/jobs/store_reserve.h"
+#include "daemon/store/store_reserve.h"
 
 /* Read connections open at once: more than the HTTP pool, the sweep thread
  * and the watcher ask at the same moment, each holding one for a page. */

@@ -1,5 +1,5 @@
 #define _POSIX_C_SOURCE 200809L
-#include "daemon/jobs/job_dir.h"
+#include "daemon/store/job_dir.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -13,7 +13,7 @@
 #include "common/fsutil.h"
 #include "common/log.h"
 #include "common/result_keys.h"
-#include "daemon/jobs/job_figures.h"
+#include "daemon/spec/job_figures.h"
 
 json_t *job_dir_labels(const struct job_spec *spec)
 {

@@ -8,7 +8,7 @@
 
 #include <jansson.h>
 
-#include "daemon/jobs/sweep_spec.h"
+#include "daemon/spec/sweep_spec.h"
 
 /* The row of a finished point job (as GET /v1/jobs/ID answers it, or the
  * job.json that shadebenchd --once writes): values (stolen), job, status,

@@ -22,7 +22,7 @@
 #include "common/clock.h"
 #include "daemon/store/records.h"
 #include "daemon/api/http.h"
-#include "daemon/harness/telemetry.h"
+#include "daemon/status/telemetry.h"
 #include "daemon/spec/job_cost.h"
 #include "daemon/spec/job_spec.h"
 #include "common/log.h"

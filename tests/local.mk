@@ -54,11 +54,7 @@ tests_unit_test_flicker_LDADD = $(CORE_LIBS)
 tests_unit_test_sweep_LDADD = $(CORE_LIBS)
 tests_unit_test_effects_LDADD = $(CORE_LIBS)
 tests_unit_test_records_LDADD = $(CORE_LIBS)
-# The interference module lives with the render thread that samples it, but
-# is GL-free: its test builds it alone.
-tests_unit_test_interference_SOURCES = tests/unit/test_interference.c \
-	daemon/harness/interference.c daemon/harness/interference.h
-tests_unit_test_interference_LDADD = $(CORE_LIBS)
+tests_unit_test_interference_LDADD = libsb-status.a $(CORE_LIBS)
 tests_unit_test_png_LDADD = $(CORE_LIBS)
 tests_unit_test_gate_SOURCES = tests/unit/test_gate.c $(CLIENT_PURE)
 tests_unit_test_gate_LDADD = $(CORE_LIBS) -lm
@@ -88,9 +84,7 @@ tests_unit_test_routes_LDADD = $(CORE_LIBS)
 # The HTTP layer without GL: the API's sources, the store and the real
 # catalogue, with the test as the render thread.
 tests_unit_test_http_SOURCES = tests/unit/test_http.c $(API_SOURCES) \
-	daemon/jobs/sweeps.c daemon/jobs/sweeps.h \
-	daemon/harness/telemetry.c daemon/harness/telemetry.h \
-	daemon/harness/render_state.c daemon/harness/render_state.h
+	daemon/jobs/sweeps.c daemon/jobs/sweeps.h
 tests_unit_test_http_LDADD = $(API_LIBS) $(MHD_LIBS)
 # The fuzz targets, replayed over their corpora in make check (tests/fuzz/run.sh
 # builds them with clang and libFuzzer instead).

@@ -24,7 +24,7 @@
 #include "daemon/api/links.h"
 #include "daemon/reports/report.h"
 #include "daemon/api/routes.h"
-#include "daemon/harness/telemetry.h"
+#include "daemon/status/telemetry.h"
 #include "daemon/spec/job_cost.h"
 #include "daemon/spec/job_spec.h"
 #include "daemon/quality/metrics.h"

@@ -11,7 +11,7 @@
 
 #include <jansson.h>
 
-#include "daemon/harness/render_state.h"
+#include "daemon/status/render_state.h"
 #include "daemon/jobs/assets.h"
 #include "daemon/jobs/queue.h"
 #include "daemon/jobs/sweeps.h"

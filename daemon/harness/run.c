@@ -9,7 +9,7 @@
 #include "daemon/gpu/glutil.h"
 #include "common/clock.h"
 #include "daemon/harness/deadline.h"
-#include "daemon/harness/render_state.h"
+#include "daemon/status/render_state.h"
 #include "daemon/store/store.h"
 #include "daemon/scene/asset.h"
 

@@ -20,7 +20,7 @@
 #include "daemon/gpu/gpu_timer.h"
 #include "daemon/gpu/pass.h"
 #include "daemon/gpu/targets.h"
-#include "daemon/harness/interference.h"
+#include "daemon/status/interference.h"
 #include "daemon/harness/transparent.h"
 #include "daemon/jobs/queue.h"
 #include "daemon/look/look.h"

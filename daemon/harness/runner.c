@@ -25,9 +25,9 @@
 #include "daemon/harness/metrics_stage.h"
 #include "daemon/harness/outputs.h"
 #include "daemon/harness/reference.h"
-#include "daemon/harness/render_state.h"
+#include "daemon/status/render_state.h"
 #include "daemon/harness/run.h"
-#include "daemon/harness/telemetry.h"
+#include "daemon/status/telemetry.h"
 #include "daemon/harness/temporal.h"
 #include "daemon/service.h"
 

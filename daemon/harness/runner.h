@@ -9,7 +9,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
-#include "daemon/harness/render_state.h"
+#include "daemon/status/render_state.h"
 #include "daemon/jobs/queue.h"
 
 struct runner;

@@ -11,7 +11,7 @@
 #include "config.h"
 #include "daemon/reports/charts.h"
 #include "daemon/reports/sweep_verdict.h"
-#include "daemon/harness/interference.h" /* INTERFERENCE_RULE */
+#include "daemon/status/interference.h" /* INTERFERENCE_RULE */
 #include "common/job_files.h"
 #include "common/png_io.h"
 #include "common/result_keys.h"

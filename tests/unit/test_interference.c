@@ -3,7 +3,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "daemon/harness/interference.h"
+#include "daemon/status/interference.h"
 #include "tests/unit/check.h"
 
 static const char *const STAT_A =

@@ -1,5 +1,5 @@
 #define _POSIX_C_SOURCE 200809L
-#include "daemon/harness/telemetry.h"
+#include "daemon/status/telemetry.h"
 
 #include <stdatomic.h>
 #include <stdbool.h>

@@ -1,5 +1,5 @@
 #define _POSIX_C_SOURCE 200809L
-#include "daemon/harness/interference.h"
+#include "daemon/status/interference.h"
 
 #include <errno.h>
 #include <fcntl.h>

@@ -1,5 +1,5 @@
 #define _POSIX_C_SOURCE 200809L
-#include "daemon/harness/render_state.h"
+#include "daemon/status/render_state.h"
 
 #include <stdatomic.h>
 #include <stdint.h>

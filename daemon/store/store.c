@@ -4,7 +4,6 @@
 #include <errno.h>
 #include <pthread.h>
 #include <sqlite3.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,12 +12,11 @@
 
 #include "common/log.h"
 #include "daemon/store/store_reserve.h"
+#include "daemon/store/store_db.h"
 
 /* Read connections open at once: more than the HTTP pool, the sweep thread
  * and the watcher ask at the same moment, each holding one for a page. */
 #define STORE_READERS 8
-/* Rows per transaction when importing directories. */
-#define STORE_BATCH 256
 /* 1: records, labels, removals. 2: assets (issue 21). */
 #define STORE_SCHEMA_VERSION 2
 
@@ -73,33 +71,7 @@ static const char PUT_ROW[] =
     " spec = excluded.spec, extra = excluded.extra, dir = excluded.dir";
 static const char PUT_LABEL[] = "INSERT OR IGNORE INTO labels (kind, id, key, value) VALUES (?, ?, ?, ?)";
 
-/* The columns every read takes, in this order; full reads add the JSON. */
-#define ROW_COLUMNS "id, status, technique, created, started, finished, done, total, error, dir"
-#define ROW_JSON_COLUMNS ", labels, figures, spec, extra"
-
-struct reader {
-    sqlite3 *db;
-    struct reader *next;
-};
-
-struct store {
-    char state_dir[PATH_MAX];
-    char path[PATH_MAX + 16];
-    bool memory; /* one connection, no file: --once */
-    struct record_kind kinds[STORE_KINDS];
-    /* The write connection and its statements; held across each commit. */
-    pthread_mutex_t write_lock;
-    sqlite3 *writer;
-    sqlite3_stmt *put_row, *put_label;
-    bool batch; /* store_import: puts join the open transaction */
-    pthread_mutex_t pool_lock;
-    pthread_cond_t pool_free;
-    struct reader *idle;
-    int readers; /* open, idle or lent */
-    struct store_reserve *reserve; /* NULL in memory, or when it cannot be opened */
-};
-
-static const char *const KIND_DIRS[STORE_KINDS] = {"jobs", "sweeps"};
+const char *const KIND_DIRS[STORE_KINDS] = {"jobs", "sweeps"};
 
 const char *job_status_name(enum job_status s)
 {
@@ -208,8 +180,8 @@ struct record_kind *store_record_kind(struct store *s, enum store_kind kind)
 }
 
 /* "cannot WHAT STATE_DIR/store.db: SQLite's message (the system's)". */
-static void db_error(const struct store *s, sqlite3 *db, const char *what, char *err,
-                     size_t errlen)
+void db_error(const struct store *s, sqlite3 *db, const char *what, char *err,
+              size_t errlen)
 {
     int sys = db ? sqlite3_system_errno(db) : 0;
     snprintf(err, errlen, "cannot %s %s: %s%s%s%s", what,
@@ -369,7 +341,7 @@ static void quarantine_database(struct store *s, const char *reason)
 
 /* Lends a read connection: the writer itself for a store in memory (held
  * under the write lock), else one of the pool, opened when none is idle. */
-static sqlite3 *reader_take(struct store *s)
+sqlite3 *reader_take(struct store *s)
 {
     if (s->memory) {
         pthread_mutex_lock(&s->write_lock);
@@ -400,7 +372,7 @@ static sqlite3 *reader_take(struct store *s)
     return db;
 }
 
-static void reader_give(struct store *s, sqlite3 *db)
+void reader_give(struct store *s, sqlite3 *db)
 {
     if (s->memory) {
         pthread_mutex_unlock(&s->write_lock);
@@ -437,8 +409,6 @@ static void note_last_ids(struct store *s)
     if (db)
         reader_give(s, db);
 }
-
-static void reap_noted(struct store *s);
 
 struct store *store_open(const char *state_dir, char *err, size_t errlen)
 {
@@ -505,7 +475,7 @@ void store_close(struct store *s)
 }
 
 /* SQLite frees the text once the statement is done with it. */
-static void bind_json(sqlite3_stmt *st, int i, const json_t *v)
+void bind_json(sqlite3_stmt *st, int i, const json_t *v)
 {
     char *text = v ? json_dumps(v, JSON_COMPACT) : NULL;
     if (text)
@@ -515,7 +485,7 @@ static void bind_json(sqlite3_stmt *st, int i, const json_t *v)
 }
 
 /* Under the write lock, inside a transaction. */
-static bool put_locked(struct store *s, const struct store_row *r)
+bool put_locked(struct store *s, const struct store_row *r)
 {
     sqlite3_stmt *st = s->put_row;
     sqlite3_bind_int(st, 1, r->kind);
@@ -641,13 +611,13 @@ bool store_unrecorded(struct store *s, enum store_kind kind, const char *id,
 
 void store_unrecorded_done(struct store *s) { store_reserve_found_done(s->reserve); }
 
-static json_t *column_json(sqlite3_stmt *st, int col)
+json_t *column_json(sqlite3_stmt *st, int col)
 {
     const char *text = (const char *)sqlite3_column_text(st, col);
     return text ? json_loads(text, 0, NULL) : NULL;
 }
 
-static void column_copy(sqlite3_stmt *st, int col, char *out, size_t cap)
+void column_copy(sqlite3_stmt *st, int col, char *out, size_t cap)
 {
     const char *text = (const char *)sqlite3_column_text(st, col);
     snprintf(out, cap, "%s", text ? text : "");
@@ -655,7 +625,7 @@ static void column_copy(sqlite3_stmt *st, int col, char *out, size_t cap)
 
 /* Reads ROW_COLUMNS (and, with json, ROW_JSON_COLUMNS) from the statement's
  * current row. */
-static void read_row(struct store *s, sqlite3_stmt *st, bool json, struct store_row *r)
+void read_row(struct store *s, sqlite3_stmt *st, bool json, struct store_row *r)
 {
     column_copy(st, 0, r->id, sizeof(r->id));
     const char *status = (const char *)sqlite3_column_text(st, 1);
@@ -713,771 +683,4 @@ enum store_found store_get(struct store *s, enum store_kind kind, const char *id
     sqlite3_finalize(st);
     reader_give(s, db);
     return found;
-}
-
-/* A statement built piece by piece, with its parameters in order. */
-struct sql {
-    char text[12288];
-    size_t len;
-    bool overflow;
-    int n;
-    struct {
-        enum { P_INT, P_DOUBLE, P_TEXT } type;
-        int64_t i;
-        double d;
-        const char *t;
-    } params[2 * STORE_MAX_TERMS + 16];
-};
-
-__attribute__((format(printf, 2, 3))) static void sql_add(struct sql *q, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    int n = vsnprintf(q->text + q->len, sizeof(q->text) - q->len, fmt, ap);
-    va_end(ap);
-    if (n < 0 || (size_t)n >= sizeof(q->text) - q->len)
-        q->overflow = true;
-    else
-        q->len += (size_t)n;
-}
-
-static void sql_text(struct sql *q, const char *t)
-{
-    if (q->n < (int)(sizeof(q->params) / sizeof(q->params[0])))
-        q->params[q->n].type = P_TEXT, q->params[q->n++].t = t;
-    else
-        q->overflow = true;
-}
-
-static void sql_int(struct sql *q, int64_t i)
-{
-    if (q->n < (int)(sizeof(q->params) / sizeof(q->params[0])))
-        q->params[q->n].type = P_INT, q->params[q->n++].i = i;
-    else
-        q->overflow = true;
-}
-
-static void sql_double(struct sql *q, double d)
-{
-    if (q->n < (int)(sizeof(q->params) / sizeof(q->params[0])))
-        q->params[q->n].type = P_DOUBLE, q->params[q->n++].d = d;
-    else
-        q->overflow = true;
-}
-
-static void sql_bind(const struct sql *q, sqlite3_stmt *st)
-{
-    for (int i = 0; i < q->n; i++) {
-        if (q->params[i].type == P_INT)
-            sqlite3_bind_int64(st, i + 1, q->params[i].i);
-        else if (q->params[i].type == P_DOUBLE)
-            sqlite3_bind_double(st, i + 1, q->params[i].d);
-        else
-            sqlite3_bind_text(st, i + 1, q->params[i].t, -1, SQLITE_STATIC);
-    }
-}
-
-static bool same_group(const struct store_term *a, const struct store_term *b)
-{
-    return a->kind == b->kind && strcmp(a->label, b->label) == 0;
-}
-
-static bool first_of_group(const struct store_query *q, size_t i)
-{
-    for (size_t k = 0; k < i; k++)
-        if (same_group(&q->terms[k], &q->terms[i]))
-            return false;
-    return true;
-}
-
-/* "(?, ?, ?)": the values of the group that starts at term i. */
-static void add_values(struct sql *sql, const struct store_query *q, size_t i)
-{
-    sql_add(sql, "(");
-    bool first = true;
-    for (size_t k = i; k < q->nterms; k++)
-        if (same_group(&q->terms[k], &q->terms[i])) {
-            sql_add(sql, first ? "?" : ", ?");
-            sql_text(sql, q->terms[k].value);
-            first = false;
-        }
-    sql_add(sql, ")");
-}
-
-/* The lower bound on ids: the cursor, or what since allows. Ids are
- * stamped with the second of their submission before created is taken,
- * so a record created at or after since has an id at or after since's
- * stamp; an hour's margin keeps it true whatever happened between the two
- * clock reads. The bound only narrows the scan: created is still compared. */
-static void id_bound(const struct store_query *q, char bound[RECORD_ID_LEN], bool *strict)
-{
-    bound[0] = '\0';
-    *strict = false;
-    char prefix[32] = "";
-    if (q->since_ms > 0) {
-        time_t t = (time_t)(q->since_ms / 1000) - 3600;
-        struct tm tm;
-        if (t > 0 && gmtime_r(&t, &tm))
-            strftime(prefix, sizeof(prefix), "%Y%m%d-%H%M%S", &tm);
-    }
-    if (q->after[0] && strcmp(q->after, prefix) >= 0) {
-        snprintf(bound, RECORD_ID_LEN, "%s", q->after);
-        *strict = true;
-    } else if (prefix[0]) {
-        snprintf(bound, RECORD_ID_LEN, "%s", prefix);
-    }
-}
-
-/* Of the label groups, the one with the fewest rows past the bound (counted
- * up to a cap, so that asking costs little) drives the query: its index
- * gives ids in order, and the others are checked per row. -1: no label. */
-static int driving_label(sqlite3 *db, const struct store_query *q, const char *bound, bool strict)
-{
-    int best = -1;
-    long best_count = 0;
-    int groups = 0;
-    for (size_t i = 0; i < q->nterms; i++)
-        groups += q->terms[i].kind == STORE_TERM_LABEL && first_of_group(q, i);
-    for (size_t i = 0; i < q->nterms; i++) {
-        if (q->terms[i].kind != STORE_TERM_LABEL || !first_of_group(q, i))
-            continue;
-        if (groups == 1)
-            return (int)i;
-        struct sql sql = {.n = 0};
-        sql_add(&sql, "SELECT count(*) FROM (SELECT 1 FROM labels WHERE kind = ? AND key = ? "
-                      "AND value IN ");
-        sql_int(&sql, q->kind);
-        sql_text(&sql, q->terms[i].label);
-        add_values(&sql, q, i);
-        if (bound[0]) {
-            sql_add(&sql, strict ? " AND id > ?" : " AND id >= ?");
-            sql_text(&sql, bound);
-        }
-        sql_add(&sql, " LIMIT 5000)");
-        sqlite3_stmt *st = NULL;
-        long count = 5000;
-        if (!sql.overflow && sqlite3_prepare_v2(db, sql.text, -1, &st, NULL) == SQLITE_OK) {
-            sql_bind(&sql, st);
-            if (sqlite3_step(st) == SQLITE_ROW)
-                count = (long)sqlite3_column_int64(st, 0);
-        }
-        sqlite3_finalize(st);
-        if (best < 0 || count < best_count) {
-            best = (int)i;
-            best_count = count;
-        }
-    }
-    return best;
-}
-
-bool store_list(struct store *s, const struct store_query *q, store_row_fn fn, void *ctx,
-                char next[RECORD_ID_LEN], char *err, size_t errlen)
-{
-    next[0] = '\0';
-    int limit = q->limit > 0 && q->limit <= STORE_LIMIT_MAX ? q->limit : STORE_LIMIT_DEFAULT;
-    sqlite3 *db = reader_take(s);
-    if (!db) {
-        snprintf(err, errlen, "cannot open %s to read", s->path);
-        return false;
-    }
-    char bound[RECORD_ID_LEN];
-    bool strict;
-    id_bound(q, bound, &strict);
-    int driver = driving_label(db, q, bound, strict);
-    struct sql *sql = calloc(1, sizeof(*sql));
-    bool ok = false;
-    sqlite3_stmt *st = NULL;
-    if (!sql) {
-        snprintf(err, errlen, "out of memory");
-        goto out;
-    }
-    const char *columns = "r.id, r.status, r.technique, r.created, r.started, r.finished, r.done,"
-                          " r.total, r.error, r.dir, r.labels, r.figures, NULL, ";
-    const char *extra = q->kind == STORE_SWEEPS ? "r.extra" : "NULL";
-    /* r stands for the row, k for the table whose id the order follows. */
-    const char *k = driver >= 0 ? "l" : "r";
-    if (driver >= 0) {
-        sql_add(sql, "SELECT %s%s FROM labels l CROSS JOIN records r ON r.kind = l.kind "
-                     "AND r.id = l.id WHERE l.kind = ? AND l.key = ? AND l.value IN ",
-                columns, extra);
-        sql_int(sql, q->kind);
-        sql_text(sql, q->terms[driver].label);
-        add_values(sql, q, (size_t)driver);
-    } else {
-        sql_add(sql, "SELECT %s%s FROM records r WHERE r.kind = ?", columns, extra);
-        sql_int(sql, q->kind);
-    }
-    if (bound[0]) {
-        sql_add(sql, strict ? " AND %s.id > ?" : " AND %s.id >= ?", k);
-        sql_text(sql, bound);
-    }
-    for (size_t i = 0; i < q->nterms; i++) {
-        if ((int)i == driver || !first_of_group(q, i))
-            continue;
-        const struct store_term *t = &q->terms[i];
-        if (t->kind == STORE_TERM_LABEL) {
-            sql_add(sql, " AND EXISTS (SELECT 1 FROM labels x WHERE x.kind = r.kind AND "
-                         "x.id = r.id AND x.key = ? AND x.value IN ");
-            sql_text(sql, t->label);
-            add_values(sql, q, i);
-            sql_add(sql, ")");
-        } else {
-            sql_add(sql, t->kind == STORE_TERM_TECHNIQUE ? " AND r.technique IN "
-                                                         : " AND r.status IN ");
-            add_values(sql, q, i);
-        }
-    }
-    if (q->since_ms > 0) {
-        sql_add(sql, " AND r.created >= ?");
-        sql_double(sql, (double)q->since_ms / 1000.0);
-    }
-    sql_add(sql, " ORDER BY %s.id LIMIT ?", k);
-    sql_int(sql, limit + 1); /* one more tells whether a next page exists */
-    if (sql->overflow) {
-        snprintf(err, errlen, "the list's question is too long");
-        goto out;
-    }
-    if (sqlite3_prepare_v2(db, sql->text, -1, &st, NULL) != SQLITE_OK) {
-        db_error(s, db, "read", err, errlen);
-        goto out;
-    }
-    sql_bind(sql, st);
-    int rows = 0, rc;
-    char last[RECORD_ID_LEN] = "";
-    struct store_row row;
-    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
-        if (rows == limit) {
-            snprintf(next, RECORD_ID_LEN, "%s", last);
-            break;
-        }
-        store_row_init(&row, q->kind);
-        read_row(s, st, false, &row);
-        row.labels = column_json(st, 10);
-        row.figures = column_json(st, 11);
-        row.extra = column_json(st, 13);
-        snprintf(last, sizeof(last), "%s", row.id);
-        fn(ctx, &row);
-        store_row_finish(&row);
-        rows++;
-    }
-    ok = rc == SQLITE_ROW || rc == SQLITE_DONE;
-    if (!ok)
-        db_error(s, db, "read", err, errlen);
-out:
-    if (!ok)
-        LOG(LOG_ERROR, "store: list of %s: %s", KIND_DIRS[q->kind], err);
-    sqlite3_finalize(st);
-    free(sql);
-    reader_give(s, db);
-    return ok;
-}
-
-bool store_count(struct store *s, enum store_kind kind, size_t counts[JOB_STATUS_COUNT])
-{
-    memset(counts, 0, JOB_STATUS_COUNT * sizeof(counts[0]));
-    sqlite3 *db = reader_take(s);
-    if (!db)
-        return false;
-    sqlite3_stmt *st = NULL;
-    int rc = SQLITE_ERROR;
-    if (sqlite3_prepare_v2(db, "SELECT status, count(*) FROM records WHERE kind = ? GROUP BY status",
-                           -1, &st, NULL) == SQLITE_OK) {
-        sqlite3_bind_int(st, 1, kind);
-        while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
-            enum job_status status;
-            if (job_status_parse((const char *)sqlite3_column_text(st, 0), &status))
-                counts[status] = (size_t)sqlite3_column_int64(st, 1);
-        }
-    }
-    sqlite3_finalize(st);
-    reader_give(s, db);
-    return rc == SQLITE_DONE;
-}
-
-bool store_each_unfinished(struct store *s, enum store_kind kind, store_row_fn fn, void *ctx)
-{
-    sqlite3 *db = reader_take(s);
-    if (!db)
-        return false;
-    sqlite3_stmt *st = NULL;
-    struct store_row *rows = NULL;
-    size_t n = 0, cap = 0;
-    int rc = SQLITE_ERROR;
-    /* Read them all first: fn may write, which a store in memory (one
-     * connection) cannot do while this read is open. */
-    if (sqlite3_prepare_v2(db, "SELECT " ROW_COLUMNS ROW_JSON_COLUMNS " FROM records WHERE "
-                           "kind = ? AND status IN ('queued', 'running') ORDER BY id",
-                           -1, &st, NULL) == SQLITE_OK) {
-        sqlite3_bind_int(st, 1, kind);
-        while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
-            if (n == cap) {
-                size_t grown = cap ? cap * 2 : 16;
-                struct store_row *more = realloc(rows, grown * sizeof(*rows));
-                if (!more) {
-                    rc = SQLITE_NOMEM;
-                    break;
-                }
-                rows = more;
-                cap = grown;
-            }
-            store_row_init(&rows[n], kind);
-            read_row(s, st, true, &rows[n]);
-            n++;
-        }
-    }
-    if (rc != SQLITE_DONE) {
-        char err[PATH_MAX + 300];
-        db_error(s, db, "read", err, sizeof(err));
-        LOG(LOG_ERROR, "store: unfinished %s: %s", KIND_DIRS[kind], err);
-    }
-    sqlite3_finalize(st);
-    reader_give(s, db);
-    for (size_t i = 0; i < n; i++) {
-        if (rc == SQLITE_DONE)
-            fn(ctx, &rows[i]);
-        store_row_finish(&rows[i]);
-    }
-    free(rows);
-    return rc == SQLITE_DONE;
-}
-
-int store_retention_victims(struct store *s, enum store_kind kind, int keep, double keep_days,
-                            double now, char (*ids)[RECORD_ID_LEN], int max)
-{
-    if ((keep <= 0 && keep_days <= 0) || max <= 0)
-        return 0;
-    struct sql sql = {.n = 0};
-    /* Both rules read the index on (kind, finished) alone. */
-    sql_add(&sql, "SELECT id, finished FROM (");
-    if (keep > 0) {
-        sql_add(&sql, "SELECT id, finished FROM (SELECT id, finished FROM records WHERE kind = ? "
-                      "AND finished > 0 ORDER BY finished DESC, id DESC LIMIT -1 OFFSET ?)");
-        sql_int(&sql, kind);
-        sql_int(&sql, keep);
-    }
-    if (keep_days > 0) {
-        sql_add(&sql, "%sSELECT id, finished FROM records WHERE kind = ? AND finished > 0 AND "
-                      "finished < ?", keep > 0 ? " UNION " : "");
-        sql_int(&sql, kind);
-        sql_double(&sql, now - keep_days * 86400.0);
-    }
-    sql_add(&sql, ") ORDER BY finished, id LIMIT ?");
-    sql_int(&sql, max);
-    sqlite3 *db = reader_take(s);
-    if (!db)
-        return -1;
-    sqlite3_stmt *st = NULL;
-    int n = 0, rc = SQLITE_ERROR;
-    if (sqlite3_prepare_v2(db, sql.text, -1, &st, NULL) == SQLITE_OK) {
-        sql_bind(&sql, st);
-        while (n < max && (rc = sqlite3_step(st)) == SQLITE_ROW)
-            column_copy(st, 0, ids[n++], RECORD_ID_LEN);
-        if (rc == SQLITE_ROW)
-            rc = SQLITE_DONE;
-    }
-    if (rc != SQLITE_DONE) {
-        char err[PATH_MAX + 300];
-        db_error(s, db, "read", err, sizeof(err));
-        LOG(LOG_ERROR, "store: retention of %s: %s", KIND_DIRS[kind], err);
-        n = -1;
-    }
-    sqlite3_finalize(st);
-    reader_give(s, db);
-    return n;
-}
-
-/* Under the write lock. */
-static bool run_each(struct store *s, const char *sql, enum store_kind kind,
-                     char (*ids)[RECORD_ID_LEN], int n)
-{
-    sqlite3_stmt *st = NULL;
-    bool ok = sqlite3_prepare_v2(s->writer, sql, -1, &st, NULL) == SQLITE_OK;
-    for (int i = 0; ok && i < n; i++) {
-        sqlite3_bind_int(st, 1, kind);
-        sqlite3_bind_text(st, 2, ids[i], -1, SQLITE_STATIC);
-        ok = sqlite3_step(st) == SQLITE_DONE;
-        sqlite3_reset(st);
-    }
-    sqlite3_finalize(st);
-    return ok;
-}
-
-static bool clear_notes(struct store *s, enum store_kind kind, char (*ids)[RECORD_ID_LEN], int n)
-{
-    pthread_mutex_lock(&s->write_lock);
-    bool ok = sqlite3_exec(s->writer, "BEGIN IMMEDIATE", NULL, NULL, NULL) == SQLITE_OK &&
-              run_each(s, "DELETE FROM removals WHERE kind = ? AND id = ?", kind, ids, n) &&
-              sqlite3_exec(s->writer, "COMMIT", NULL, NULL, NULL) == SQLITE_OK;
-    if (!ok && !sqlite3_get_autocommit(s->writer))
-        sqlite3_exec(s->writer, "ROLLBACK", NULL, NULL, NULL);
-    pthread_mutex_unlock(&s->write_lock);
-    return ok;
-}
-
-static void remove_dirs(struct store *s, enum store_kind kind, char (*ids)[RECORD_ID_LEN], int n)
-{
-    for (int i = 0; i < n && !s->memory; i++) {
-        char dir[PATH_MAX + RECORD_ID_LEN + 2];
-        snprintf(dir, sizeof(dir), "%s/%s", s->kinds[kind].root, ids[i]);
-        if (access(dir, F_OK) == 0)
-            record_remove_dir(dir);
-    }
-}
-
-bool store_remove(struct store *s, enum store_kind kind, char (*ids)[RECORD_ID_LEN], int n)
-{
-    if (n <= 0)
-        return true;
-    pthread_mutex_lock(&s->write_lock);
-    bool ok = sqlite3_exec(s->writer, "BEGIN IMMEDIATE", NULL, NULL, NULL) == SQLITE_OK &&
-              run_each(s, "INSERT OR IGNORE INTO removals (kind, id) VALUES (?, ?)", kind, ids,
-                       n) &&
-              run_each(s, "DELETE FROM records WHERE kind = ? AND id = ?", kind, ids, n) &&
-              run_each(s, "DELETE FROM labels WHERE kind = ? AND id = ?", kind, ids, n) &&
-              sqlite3_exec(s->writer, "COMMIT", NULL, NULL, NULL) == SQLITE_OK;
-    if (!ok) {
-        char err[PATH_MAX + 300];
-        db_error(s, s->writer, "write", err, sizeof(err));
-        LOG(LOG_ERROR, "retention: %s; nothing removed", err);
-        if (!sqlite3_get_autocommit(s->writer))
-            sqlite3_exec(s->writer, "ROLLBACK", NULL, NULL, NULL);
-    }
-    pthread_mutex_unlock(&s->write_lock);
-    if (!ok)
-        return false;
-    /* Files are removed with no lock held. */
-    remove_dirs(s, kind, ids, n);
-    return clear_notes(s, kind, ids, n);
-}
-
-/* store_open: removals a stop cut short between the rows and the files. */
-static void reap_noted(struct store *s)
-{
-    for (int kind = 0; kind < STORE_KINDS; kind++) {
-        char(*ids)[RECORD_ID_LEN] = NULL;
-        int n = 0, cap = 0;
-        sqlite3 *db = reader_take(s);
-        sqlite3_stmt *st = NULL;
-        if (db && sqlite3_prepare_v2(db, "SELECT id FROM removals WHERE kind = ?", -1, &st, NULL) ==
-                      SQLITE_OK) {
-            sqlite3_bind_int(st, 1, kind);
-            while (sqlite3_step(st) == SQLITE_ROW) {
-                if (n == cap) {
-                    int grown = cap ? cap * 2 : 64;
-                    char(*more)[RECORD_ID_LEN] = realloc(ids, (size_t)grown * RECORD_ID_LEN);
-                    if (!more)
-                        break;
-                    ids = more;
-                    cap = grown;
-                }
-                column_copy(st, 0, ids[n++], RECORD_ID_LEN);
-            }
-        }
-        sqlite3_finalize(st);
-        if (db)
-            reader_give(s, db);
-        if (n) {
-            LOG(LOG_INFO, "store: finishing the removal of %d %s", n, KIND_DIRS[kind]);
-            remove_dirs(s, (enum store_kind)kind, ids, n);
-            clear_notes(s, (enum store_kind)kind, ids, n);
-        }
-        free(ids);
-    }
-}
-
-/* store_import's scan: which directories have rows, and the batch. */
-struct import {
-    struct store *s;
-    enum store_kind kind;
-    const char *legacy_file;
-    store_import_fn fn;
-    void *ctx;
-    char (*known)[RECORD_ID_LEN];
-    size_t nknown;
-    struct store_row *batch;
-    size_t nbatch;
-    int imported;
-    bool failed;
-    char err[PATH_MAX + 300];
-};
-
-static int by_id(const void *a, const void *b) { return strcmp(a, b); }
-
-static bool import_known(void *ctx, const char *id)
-{
-    struct import *im = ctx;
-    return im->nknown && bsearch(id, im->known, im->nknown, RECORD_ID_LEN, by_id) != NULL;
-}
-
-/* Commits the batch, then removes the legacy state files it replaced. */
-static void import_flush(struct import *im)
-{
-    struct store *s = im->s;
-    if (!im->nbatch)
-        return;
-    pthread_mutex_lock(&s->write_lock);
-    bool ok = sqlite3_exec(s->writer, "BEGIN IMMEDIATE", NULL, NULL, NULL) == SQLITE_OK;
-    for (size_t i = 0; ok && i < im->nbatch; i++)
-        ok = put_locked(s, &im->batch[i]);
-    ok = ok && sqlite3_exec(s->writer, "COMMIT", NULL, NULL, NULL) == SQLITE_OK;
-    if (!ok) {
-        db_error(s, s->writer, "write", im->err, sizeof(im->err));
-        if (!sqlite3_get_autocommit(s->writer))
-            sqlite3_exec(s->writer, "ROLLBACK", NULL, NULL, NULL);
-        im->failed = true;
-    }
-    pthread_mutex_unlock(&s->write_lock);
-    for (size_t i = 0; i < im->nbatch; i++) {
-        if (ok && im->legacy_file && !im->batch[i].dir_given) {
-            char path[PATH_MAX + 64];
-            snprintf(path, sizeof(path), "%s/%s", im->batch[i].dir, im->legacy_file);
-            if (unlink(path) != 0 && errno != ENOENT)
-                LOG(LOG_WARN, "store: cannot remove the imported %s: %s", path, strerror(errno));
-        }
-        store_row_finish(&im->batch[i]);
-    }
-    if (ok)
-        im->imported += (int)im->nbatch;
-    im->nbatch = 0;
-}
-
-static void import_one(void *ctx, const char *id, const char *dir)
-{
-    struct import *im = ctx;
-    if (im->failed)
-        return;
-    struct store_row *row = &im->batch[im->nbatch];
-    store_row_init(row, im->kind);
-    snprintf(row->id, sizeof(row->id), "%s", id);
-    snprintf(row->dir, sizeof(row->dir), "%s", dir);
-    if (!im->fn(im->ctx, id, dir, row)) {
-        store_row_finish(row);
-        return;
-    }
-    /* The import names the record by its directory, whatever it set. */
-    snprintf(row->id, sizeof(row->id), "%s", id);
-    snprintf(row->dir, sizeof(row->dir), "%s", dir);
-    row->dir_given = false;
-    record_note_id(&im->s->kinds[im->kind], id);
-    if (++im->nbatch == STORE_BATCH)
-        import_flush(im);
-}
-
-int store_import(struct store *s, enum store_kind kind, const char *legacy_file,
-                 store_import_fn import, void *ctx, char *err, size_t errlen)
-{
-    if (s->memory)
-        return 0;
-    struct import im = {.s = s, .kind = kind, .legacy_file = legacy_file, .fn = import, .ctx = ctx};
-    im.batch = calloc(STORE_BATCH, sizeof(*im.batch));
-    if (!im.batch) {
-        snprintf(err, errlen, "out of memory");
-        return -1;
-    }
-    /* The ids with rows, sorted, so that each directory is looked up
-     * without a query and a known one is never opened. */
-    sqlite3 *db = reader_take(s);
-    sqlite3_stmt *st = NULL;
-    size_t cap = 0;
-    int rc = SQLITE_ERROR;
-    if (db && sqlite3_prepare_v2(db, "SELECT id FROM records WHERE kind = ? ORDER BY id", -1, &st,
-                                 NULL) == SQLITE_OK) {
-        sqlite3_bind_int(st, 1, kind);
-        while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
-            if (im.nknown == cap) {
-                size_t grown = cap ? cap * 2 : 1024;
-                char(*more)[RECORD_ID_LEN] = realloc(im.known, grown * RECORD_ID_LEN);
-                if (!more) {
-                    rc = SQLITE_NOMEM;
-                    break;
-                }
-                im.known = more;
-                cap = grown;
-            }
-            column_copy(st, 0, im.known[im.nknown++], RECORD_ID_LEN);
-        }
-    }
-    if (rc != SQLITE_DONE)
-        db_error(s, db, "read", err, errlen);
-    sqlite3_finalize(st);
-    if (db)
-        reader_give(s, db);
-    int n = -1;
-    if (rc == SQLITE_DONE) {
-        /* SQLite's order is memcmp's, as strcmp's: bsearch agrees with it. */
-        n = record_scan(&s->kinds[kind], import_known, import_one, &im, err, errlen);
-        import_flush(&im);
-        if (im.failed) {
-            snprintf(err, errlen, "%s", im.err);
-            n = -1;
-        } else if (n >= 0) {
-            n = im.imported;
-        }
-    }
-    free(im.known);
-    free(im.batch);
-    return n;
-}
-
-/* Assets (issue 21). Few rows, written rarely (an upload, a delete, a
- * start with --asset-dir): each write is a transaction of its own under the
- * write lock, and a full disk is the caller's 507 (an asset is not a state
- * that must be recorded; the reserve stays for jobs). */
-
-void store_asset_finish(struct store_asset *a)
-{
-    json_decref(a->description);
-    a->description = NULL;
-}
-
-bool store_asset_put(struct store *s, const struct store_asset *a, char *err, size_t errlen)
-{
-    static const char sql[] =
-        "INSERT INTO assets (name, sha256, ext, size, created, updated, source, description)"
-        " VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8) ON CONFLICT (name) DO UPDATE SET"
-        " sha256 = excluded.sha256, ext = excluded.ext, size = excluded.size,"
-        " updated = excluded.updated, source = excluded.source,"
-        " description = excluded.description";
-    pthread_mutex_lock(&s->write_lock);
-    sqlite3_stmt *st = NULL;
-    bool ok = sqlite3_prepare_v2(s->writer, sql, -1, &st, NULL) == SQLITE_OK;
-    if (ok) {
-        sqlite3_bind_text(st, 1, a->name, -1, SQLITE_STATIC);
-        sqlite3_bind_text(st, 2, a->sha256, -1, SQLITE_STATIC);
-        sqlite3_bind_text(st, 3, a->ext, -1, SQLITE_STATIC);
-        sqlite3_bind_int64(st, 4, (sqlite3_int64)a->size);
-        sqlite3_bind_double(st, 5, a->created);
-        sqlite3_bind_double(st, 6, a->updated);
-        sqlite3_bind_text(st, 7, a->from_dir ? "dir" : "upload", -1, SQLITE_STATIC);
-        bind_json(st, 8, a->description);
-        ok = sqlite3_step(st) == SQLITE_DONE;
-    }
-    if (!ok)
-        db_error(s, s->writer, "write", err, errlen);
-    sqlite3_finalize(st);
-    pthread_mutex_unlock(&s->write_lock);
-    return ok;
-}
-
-#define ASSET_COLUMNS "name, sha256, ext, size, created, updated, source, description"
-
-static void read_asset(sqlite3_stmt *st, struct store_asset *a)
-{
-    column_copy(st, 0, a->name, sizeof(a->name));
-    column_copy(st, 1, a->sha256, sizeof(a->sha256));
-    column_copy(st, 2, a->ext, sizeof(a->ext));
-    a->size = (uint64_t)sqlite3_column_int64(st, 3);
-    a->created = sqlite3_column_double(st, 4);
-    a->updated = sqlite3_column_double(st, 5);
-    const char *source = (const char *)sqlite3_column_text(st, 6);
-    a->from_dir = source && strcmp(source, "dir") == 0;
-    a->description = column_json(st, 7);
-}
-
-enum store_found store_asset_get(struct store *s, const char *name, struct store_asset *out)
-{
-    memset(out, 0, sizeof(*out));
-    sqlite3 *db = reader_take(s);
-    if (!db)
-        return STORE_ERROR;
-    sqlite3_stmt *st = NULL;
-    enum store_found found = STORE_ERROR;
-    if (sqlite3_prepare_v2(db, "SELECT " ASSET_COLUMNS " FROM assets WHERE name = ?", -1, &st,
-                           NULL) == SQLITE_OK) {
-        sqlite3_bind_text(st, 1, name, -1, SQLITE_STATIC);
-        int rc = sqlite3_step(st);
-        if (rc == SQLITE_ROW) {
-            read_asset(st, out);
-            found = STORE_FOUND;
-        } else if (rc == SQLITE_DONE) {
-            found = STORE_MISSING;
-        }
-    }
-    if (found == STORE_ERROR) {
-        char err[PATH_MAX + 300];
-        db_error(s, db, "read", err, sizeof(err));
-        LOG(LOG_ERROR, "store: asset %s: %s", name, err);
-    }
-    sqlite3_finalize(st);
-    reader_give(s, db);
-    return found;
-}
-
-bool store_asset_delete(struct store *s, const char *name, char *err, size_t errlen)
-{
-    pthread_mutex_lock(&s->write_lock);
-    sqlite3_stmt *st = NULL;
-    bool ok = sqlite3_prepare_v2(s->writer, "DELETE FROM assets WHERE name = ?", -1, &st, NULL) ==
-              SQLITE_OK;
-    if (ok) {
-        sqlite3_bind_text(st, 1, name, -1, SQLITE_STATIC);
-        ok = sqlite3_step(st) == SQLITE_DONE;
-    }
-    if (!ok)
-        db_error(s, s->writer, "write", err, errlen);
-    sqlite3_finalize(st);
-    pthread_mutex_unlock(&s->write_lock);
-    return ok;
-}
-
-int store_asset_hash_refs(struct store *s, const char *sha256)
-{
-    sqlite3 *db = reader_take(s);
-    if (!db)
-        return -1;
-    sqlite3_stmt *st = NULL;
-    int n = -1;
-    if (sqlite3_prepare_v2(db, "SELECT count(*) FROM assets WHERE sha256 = ?", -1, &st, NULL) ==
-        SQLITE_OK) {
-        sqlite3_bind_text(st, 1, sha256, -1, SQLITE_STATIC);
-        if (sqlite3_step(st) == SQLITE_ROW)
-            n = sqlite3_column_int(st, 0);
-    }
-    sqlite3_finalize(st);
-    reader_give(s, db);
-    return n;
-}
-
-bool store_asset_list(struct store *s, const char *after, int limit, bool dir_only,
-                      store_asset_fn fn, void *ctx, char next[STORE_ASSET_NAME_CAP], char *err,
-                      size_t errlen)
-{
-    next[0] = '\0';
-    sqlite3 *db = reader_take(s);
-    if (!db) {
-        snprintf(err, errlen, "cannot open a read connection to the store (see the log)");
-        return false;
-    }
-    sqlite3_stmt *st = NULL;
-    bool ok = sqlite3_prepare_v2(db,
-                                 dir_only ? "SELECT " ASSET_COLUMNS " FROM assets WHERE name > ?"
-                                            " AND source = 'dir' ORDER BY name LIMIT ?"
-                                          : "SELECT " ASSET_COLUMNS " FROM assets WHERE name > ?"
-                                            " ORDER BY name LIMIT ?",
-                                 -1, &st, NULL) == SQLITE_OK;
-    if (ok) {
-        sqlite3_bind_text(st, 1, after ? after : "", -1, SQLITE_STATIC);
-        sqlite3_bind_int(st, 2, limit + 1); /* one more: is there a next page? */
-        int n = 0, rc;
-        while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
-            struct store_asset a;
-            memset(&a, 0, sizeof(a));
-            read_asset(st, &a);
-            if (n++ == limit) {
-                store_asset_finish(&a);
-                break;
-            }
-            fn(ctx, &a);
-            snprintf(next, STORE_ASSET_NAME_CAP, "%s", a.name);
-            store_asset_finish(&a);
-        }
-        ok = rc == SQLITE_ROW || rc == SQLITE_DONE;
-        if (ok && n <= limit)
-            next[0] = '\0';
-    }
-    if (!ok)
-        db_error(s, db, "read", err, errlen);
-    sqlite3_finalize(st);
-    reader_give(s, db);
-    return ok;
 }

@@ -10,11 +10,91 @@
 
 #include "daemon/scene/scene_spec.h"
 
+/* The status that answers each cause of a refusal (assets.h). */
+static unsigned refusal_status(enum assets_cause cause)
+{
+    switch (cause) {
+    case ASSETS_INVALID:
+        return MHD_HTTP_BAD_REQUEST;
+    case ASSETS_READ_ONLY:
+        return MHD_HTTP_FORBIDDEN;
+    case ASSETS_NOT_FOUND:
+        return MHD_HTTP_NOT_FOUND;
+    case ASSETS_CONFLICT:
+        return MHD_HTTP_CONFLICT;
+    case ASSETS_TOO_LARGE:
+        return MHD_HTTP_CONTENT_TOO_LARGE;
+    case ASSETS_UNCONVERTIBLE:
+        return MHD_HTTP_UNPROCESSABLE_CONTENT;
+    case ASSETS_BUSY:
+        return MHD_HTTP_TOO_MANY_REQUESTS;
+    case ASSETS_STOPPING:
+        return MHD_HTTP_SERVICE_UNAVAILABLE;
+    case ASSETS_NO_SPACE:
+        return MHD_HTTP_INSUFFICIENT_STORAGE;
+    case ASSETS_INTERNAL:
+        break;
+    }
+    return MHD_HTTP_INTERNAL_SERVER_ERROR;
+}
+
+/* An asset's URL, /v1/assets/NAME. */
+static void asset_url(const char *name, char *out, size_t cap)
+{
+    snprintf(out, cap, "/v1/assets/%s", name);
+}
+
+/* Consumes record: the same with its url, after read_only (or last). */
+static json_t *with_url(json_t *record)
+{
+    const char *name = json_string_value(json_object_get(record, "name"));
+    if (!record || !name)
+        return record;
+    char url[STORE_ASSET_NAME_CAP + 16];
+    asset_url(name, url, sizeof(url));
+    json_t *out = json_object();
+    const char *key;
+    json_t *v;
+    bool placed = false;
+    json_object_foreach(record, key, v) {
+        json_object_set(out, key, v);
+        if (strcmp(key, "read_only") == 0) {
+            json_object_set_new(out, "url", json_string(url));
+            placed = true;
+        }
+    }
+    if (!placed)
+        json_object_set_new(out, "url", json_string(url));
+    json_decref(record);
+    return out;
+}
+
+/* GET /v1/assets: the page, each record with its url, the next page's. */
+static json_t *list_json(const struct assets_page *page, int limit)
+{
+    json_t *items = json_array();
+    size_t i;
+    json_t *v;
+    json_array_foreach(page->items, i, v)
+        json_array_append_new(items, with_url(json_incref(v)));
+    json_t *o = json_pack("{s:o}", "assets", items);
+    if (o && page->next[0]) {
+        char url[STORE_ASSET_NAME_CAP + 64];
+        snprintf(url, sizeof(url), "/v1/assets?limit=%d&cursor=%s", limit, page->next);
+        json_object_set_new(o, "next", json_string(url));
+    }
+    if (o && (page->converting || page->failed))
+        json_object_set_new(o, "asset_dir", json_pack("{s:I, s:I}", "converting",
+                                                      (json_int_t)page->converting, "failed",
+                                                      (json_int_t)page->failed));
+    return o;
+}
+
 /* An asset's refusal (assets.h): its message may be longer than a job
  * error's 256 bytes (it can name a path). */
 enum MHD_Result respond_asset_error(struct MHD_Connection *c, const struct assets_error *e)
 {
-    return respond_json(c, e->status ? e->status : MHD_HTTP_INTERNAL_SERVER_ERROR,
+    return respond_json(c, refusal_status(e->cause),
                         json_pack("{s:{s:s, s:s}}", "error", "field", e->field[0] ? e->field : "body",
                                   "message", e->message));
 }
@@ -70,7 +150,11 @@ enum MHD_Result asset_resource(struct http_server *s, struct MHD_Connection *c,
         MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, asset_list_arg, &a);
         if (a.bad)
             return respond_error(c, MHD_HTTP_BAD_REQUEST, a.bad, a.rule);
-        body = assets_list(s->ctx.assets, a.cursor, a.limit, &e);
+        struct assets_page page;
+        if (!assets_list(s->ctx.assets, a.cursor, a.limit, &page, &e))
+            return respond_asset_error(c, &e);
+        body = list_json(&page, a.limit);
+        json_decref(page.items);
     } else if (req->route.asset_too_long) {
         return respond_error(c, MHD_HTTP_BAD_REQUEST, "name",
                              "an asset name is at most 128 bytes");
@@ -78,6 +162,9 @@ enum MHD_Result asset_resource(struct http_server *s, struct MHD_Connection *c,
         body = assets_delete(s->ctx.assets, req->route.asset, &e);
     } else {
         body = assets_describe(s->ctx.assets, req->route.asset, &e);
+        if (!body)
+            return respond_asset_error(c, &e);
+        body = with_url(body);
     }
     if (!body)
         return respond_asset_error(c, &e);
@@ -124,7 +211,7 @@ bool begin_upload(struct http_server *s, struct MHD_Connection *c, struct reques
     struct assets_error e = {0};
     req->upload = assets_upload_begin(s->ctx.assets, req->route.asset, length, &e);
     if (!req->upload) {
-        req->too_large = e.status == MHD_HTTP_CONTENT_TOO_LARGE;
+        req->too_large = e.cause == ASSETS_TOO_LARGE;
         *ret = respond_asset_error(c, &e);
         return true;
     }
@@ -138,11 +225,13 @@ bool begin_upload(struct http_server *s, struct MHD_Connection *c, struct reques
 enum MHD_Result answer_upload(struct http_server *s, struct MHD_Connection *c,
                               struct request *req, enum wake why)
 {
-    unsigned status;
-    json_t *body;
-    if (s->ctx.assets && assets_ticket_take(s->ctx.assets, req->ticket, &status, &body)) {
+    struct assets_answer answer;
+    if (s->ctx.assets && assets_ticket_take(s->ctx.assets, req->ticket, &answer)) {
         req->ticket = 0;
-        return respond_json(c, status, body);
+        if (!answer.record)
+            return respond_asset_error(c, &answer.refusal);
+        return respond_json(c, answer.replaced ? MHD_HTTP_OK : MHD_HTTP_CREATED,
+                            with_url(answer.record));
     }
     return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "body",
                          why == WAKE_TIMEOUT ? "the conversion is still waiting or running "

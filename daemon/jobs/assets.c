@@ -49,8 +49,7 @@ struct task {
 struct ticket {
     uint64_t serial;
     bool done, dropped;
-    unsigned status;
-    json_t *body;
+    struct assets_answer answer;
     struct ticket *next;
 };
 
@@ -100,22 +99,17 @@ struct assets {
     int nworkers;
 };
 
-static void set_error(struct assets_error *e, unsigned status, const char *field, const char *fmt,
-                      ...) __attribute__((format(printf, 4, 5)));
-static void set_error(struct assets_error *e, unsigned status, const char *field, const char *fmt,
-                      ...)
+static void set_error(struct assets_error *e, enum assets_cause cause, const char *field,
+                      const char *fmt, ...) __attribute__((format(printf, 4, 5)));
+static void set_error(struct assets_error *e, enum assets_cause cause, const char *field,
+                      const char *fmt, ...)
 {
-    e->status = status;
+    e->cause = cause;
     snprintf(e->field, sizeof(e->field), "%s", field);
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(e->message, sizeof(e->message), fmt, ap);
     va_end(ap);
-}
-
-static json_t *error_json(const char *field, const char *message)
-{
-    return json_pack("{s:{s:s, s:s}}", "error", "field", field, "message", message);
 }
 
 static void hex(const uint8_t digest[SHA256_DIGEST_SIZE], char out[65])
@@ -126,11 +120,6 @@ static void hex(const uint8_t digest[SHA256_DIGEST_SIZE], char out[65])
         out[2 * i + 1] = digits[digest[i] & 15];
     }
     out[64] = '\0';
-}
-
-static void asset_url(const char *name, char *out, size_t cap)
-{
-    snprintf(out, cap, "/v1/assets/%s", name);
 }
 
 static struct dir_entry *dir_find(struct assets *a, const char *name)
@@ -377,7 +366,7 @@ out:
 
 /* The cache and description of sha, converting in when they are not there
  * yet (an identical file converted before costs nothing). On success
- * *description is a new reference; else *status and e say why. */
+ * *description is a new reference; else e says why. */
 static bool ensure_cache(struct assets *a, const char *sha, const char *in, json_t **description,
                          struct assets_error *e)
 {
@@ -397,25 +386,25 @@ static bool ensure_cache(struct assets *a, const char *sha, const char *in, json
         json_int_t st = json_integer_value(json_object_get(c.out, "status"));
         const char *field = json_string_value(json_object_get(c.out, "field"));
         const char *message = json_string_value(json_object_get(c.out, "message"));
-        set_error(e, st == 400 ? 400 : 422, field ? field : "body", "%s",
+        set_error(e, st == 400 ? ASSETS_INVALID : ASSETS_UNCONVERTIBLE, field ? field : "body", "%s",
                   message ? message : "the converter refused the asset");
         json_decref(c.out);
         unlink(tmp);
         return false;
     }
     if (c.outcome == CONV_FAILED) {
-        set_error(e, 422, "body", "the asset loader failed on this file (%s)", c.why);
+        set_error(e, ASSETS_UNCONVERTIBLE, "body", "the asset loader failed on this file (%s)", c.why);
         unlink(tmp);
         return false;
     }
     if (!exists(tmp) || rename(tmp, cache) != 0) {
-        set_error(e, 422, "body", "the asset loader said it succeeded but wrote no cache file");
+        set_error(e, ASSETS_UNCONVERTIBLE, "body", "the asset loader said it succeeded but wrote no cache file");
         json_decref(c.out);
         unlink(tmp);
         return false;
     }
     if (!fs_write_json_atomic(desc, c.out)) {
-        set_error(e, 507, "state_dir", "cannot write %s: %s", desc, strerror(errno));
+        set_error(e, ASSETS_NO_SPACE, "state_dir", "cannot write %s: %s", desc, strerror(errno));
         json_decref(c.out);
         unlink(cache);
         return false;
@@ -424,15 +413,13 @@ static bool ensure_cache(struct assets *a, const char *sha, const char *in, json
     return true;
 }
 
+/* The API adds the record's url after read_only. */
 static json_t *record_json(const struct store_asset *r, bool full)
 {
-    char url[STORE_ASSET_NAME_CAP + 16];
-    asset_url(r->name, url, sizeof(url));
-    json_t *o = json_pack("{s:s, s:s, s:I, s:s, s:f, s:f, s:s, s:b, s:s}", "name", r->name,
+    json_t *o = json_pack("{s:s, s:s, s:I, s:s, s:f, s:f, s:s, s:b}", "name", r->name,
                           "sha256", r->sha256, "size", (json_int_t)r->size, "format", r->ext,
                           "created", r->created, "updated", r->updated, "source",
-                          r->from_dir ? "asset-dir" : "upload", "read_only", r->from_dir, "url",
-                          url);
+                          r->from_dir ? "asset-dir" : "upload", "read_only", r->from_dir);
     if (!o)
         return NULL;
     if (full) {
@@ -466,13 +453,13 @@ static bool put_record_locked(struct assets *a, const struct task *t, const json
     struct store_asset old;
     enum store_found f = store_asset_get(a->store, t->name, &old);
     if (f == STORE_ERROR) {
-        set_error(e, 500, "store", "cannot read the asset records (see the log)");
+        set_error(e, ASSETS_INTERNAL, "store", "cannot read the asset records (see the log)");
         return false;
     }
     *replaced = f == STORE_FOUND;
     if (f == STORE_FOUND && old.from_dir && t->kind == TASK_UPLOAD) {
         store_asset_finish(&old);
-        set_error(e, 403, "name", "%s comes from the asset directory (--asset-dir): it cannot "
+        set_error(e, ASSETS_READ_ONLY, "name", "%s comes from the asset directory (--asset-dir): it cannot "
                   "be replaced over HTTP", t->name);
         return false;
     }
@@ -486,7 +473,8 @@ static bool put_record_locked(struct assets *a, const struct task *t, const json
     bool ok = store_asset_put(a->store, &r, err, sizeof(err));
     if (!ok) {
         LOG(LOG_ERROR, "assets: %s", err);
-        set_error(e, strstr(err, "full") || strstr(err, "No space") ? 507 : 500, "state_dir",
+        set_error(e, strstr(err, "full") || strstr(err, "No space") ? ASSETS_NO_SPACE : ASSETS_INTERNAL,
+                  "state_dir",
                   "%.480s", err);
     } else if (f == STORE_FOUND && strcmp(old.sha256, t->sha256) != 0) {
         release_files_locked(a, old.sha256);
@@ -526,7 +514,8 @@ static bool hash_file(const char *path, char sha[65], uint64_t *size, char *why,
     return true;
 }
 
-static void finish_ticket(struct assets *a, uint64_t serial, unsigned status, json_t *body)
+/* Takes the answer's record. */
+static void finish_ticket(struct assets *a, uint64_t serial, struct assets_answer *answer)
 {
     pthread_mutex_lock(&a->lock);
     struct ticket **p = &a->tickets;
@@ -534,16 +523,15 @@ static void finish_ticket(struct assets *a, uint64_t serial, unsigned status, js
         p = &(*p)->next;
     if (*p && !(*p)->dropped) {
         (*p)->done = true;
-        (*p)->status = status;
-        (*p)->body = body;
-        body = NULL;
+        (*p)->answer = *answer;
+        answer->record = NULL;
     } else if (*p) {
         struct ticket *t = *p;
         *p = t->next;
         free(t);
     }
     pthread_mutex_unlock(&a->lock);
-    json_decref(body);
+    json_decref(answer->record);
     notify(a);
 }
 
@@ -564,7 +552,7 @@ static void run_upload(struct assets *a, struct task *t)
         int err = errno;
         if (fd >= 0)
             close(fd);
-        set_error(&e, err == ENOSPC || err == EDQUOT ? 507 : 500, "state_dir",
+        set_error(&e, err == ENOSPC || err == EDQUOT ? ASSETS_NO_SPACE : ASSETS_INTERNAL, "state_dir",
                   "cannot store the upload as %s: %s", original, strerror(err));
         unlink(t->path);
         goto fail;
@@ -582,14 +570,16 @@ static void run_upload(struct assets *a, struct task *t)
     pthread_mutex_unlock(&a->lock);
     if (!ok)
         goto fail_unlocked;
-    char url[STORE_ASSET_NAME_CAP + 16];
-    asset_url(t->name, url, sizeof(url));
     LOG(LOG_INFO, "assets: %s %s (%s, %llu bytes)", replaced ? "replaced" : "stored", t->name,
         t->sha256, (unsigned long long)t->size);
-    finish_ticket(a, t->ticket, replaced ? 200 : 201,
-                  json_pack("{s:s, s:s, s:I, s:s, s:O, s:s}", "name", t->name, "sha256",
-                            t->sha256, "size", (json_int_t)t->size, "format", t->ext,
-                            "description", description, "url", url));
+    struct assets_answer stored = {
+        .record = json_pack("{s:s, s:s, s:I, s:s, s:O}", "name", t->name, "sha256", t->sha256,
+                            "size", (json_int_t)t->size, "format", t->ext, "description",
+                            description),
+        .replaced = replaced};
+    if (!stored.record)
+        set_error(&stored.refusal, ASSETS_INTERNAL, "body", "out of memory");
+    finish_ticket(a, t->ticket, &stored);
     json_decref(description);
     return;
 fail:
@@ -599,9 +589,8 @@ fail:
     pthread_mutex_unlock(&a->lock);
 fail_unlocked:
     json_decref(description);
-    LOG(LOG_INFO, "assets: upload of %s refused: %d %s: %s", t->name, e.status, e.field,
-        e.message);
-    finish_ticket(a, t->ticket, e.status, error_json(e.field, e.message));
+    LOG(LOG_INFO, "assets: upload of %s refused: %s: %s", t->name, e.field, e.message);
+    finish_ticket(a, t->ticket, &(struct assets_answer){.refusal = e});
 }
 
 static void set_dir_state(struct assets *a, const char *name, enum dir_state st, const char *why)
@@ -653,7 +642,7 @@ static void run_dir(struct assets *a, struct task *t)
         return;
     }
     char msg[512]; /* dir_entry.error's size */
-    snprintf(msg, sizeof(msg), "%u %.40s: %.440s", e.status, e.field, e.message);
+    snprintf(msg, sizeof(msg), "%.40s: %.440s", e.field, e.message);
     LOG(LOG_WARN, "assets: --asset-dir %s: %s", t->path, msg);
     set_dir_state(a, t->name, DIR_FAILED, msg);
 }
@@ -910,7 +899,7 @@ void assets_destroy(struct assets *a)
     while (a->tickets) {
         struct ticket *t = a->tickets;
         a->tickets = t->next;
-        json_decref(t->body);
+        json_decref(t->answer.record);
         free(t);
     }
     free(a->dir_entries);
@@ -952,7 +941,7 @@ json_t *assets_info_json(const struct assets *a)
 static bool writable_locked(struct assets *a, const char *name, struct assets_error *e)
 {
     if (dir_find(a, name)) {
-        set_error(e, 403, "name", "%s comes from the asset directory (--asset-dir): it cannot "
+        set_error(e, ASSETS_READ_ONLY, "name", "%s comes from the asset directory (--asset-dir): it cannot "
                   "be replaced or deleted over HTTP", name);
         return false;
     }
@@ -963,18 +952,18 @@ struct asset_upload *assets_upload_begin(struct assets *a, const char *name,
                                          uint64_t content_length, struct assets_error *e)
 {
     if (!scene_asset_name_valid(name)) {
-        set_error(e, 400, "name", "an asset name is 1 to %d letters, digits, '.', '_' or '-', "
+        set_error(e, ASSETS_INVALID, "name", "an asset name is 1 to %d letters, digits, '.', '_' or '-', "
                   "not starting with '.'", SCENE_ASSET_NAME_MAX);
         return NULL;
     }
     if (content_length > a->cfg.max_asset_bytes) {
-        set_error(e, 413, "body", "an asset must be at most %llu bytes (--max-asset-bytes); "
+        set_error(e, ASSETS_TOO_LARGE, "body", "an asset must be at most %llu bytes (--max-asset-bytes); "
                   "this one is %llu", (unsigned long long)a->cfg.max_asset_bytes,
                   (unsigned long long)content_length);
         return NULL;
     }
     if (!store_has_room(a->store)) {
-        set_error(e, 507, "state_dir", "the disk of %s is full (%s): no asset is accepted until "
+        set_error(e, ASSETS_NO_SPACE, "state_dir", "the disk of %s is full (%s): no asset is accepted until "
                   "there is room", a->state_dir, strerror(ENOSPC));
         return NULL;
     }
@@ -983,7 +972,7 @@ struct asset_upload *assets_upload_begin(struct assets *a, const char *name,
         uint64_t avail = (uint64_t)vfs.f_bavail * vfs.f_frsize;
         uint64_t need = (content_length ? content_length : 0) + ASSETS_HEADROOM;
         if (avail < need) {
-            set_error(e, 507, "state_dir", "%s has %llu bytes free; this upload needs %llu "
+            set_error(e, ASSETS_NO_SPACE, "state_dir", "%s has %llu bytes free; this upload needs %llu "
                       "(its size and %llu MiB kept for jobs)", a->state_dir,
                       (unsigned long long)avail, (unsigned long long)need,
                       (unsigned long long)(ASSETS_HEADROOM >> 20));
@@ -992,17 +981,17 @@ struct asset_upload *assets_upload_begin(struct assets *a, const char *name,
     }
     struct asset_upload *u = calloc(1, sizeof(*u));
     if (!u) {
-        set_error(e, 500, "body", "out of memory");
+        set_error(e, ASSETS_INTERNAL, "body", "out of memory");
         return NULL;
     }
     pthread_mutex_lock(&a->lock);
     bool ok = writable_locked(a, name, e);
     if (ok && a->stopping) {
-        set_error(e, 503, "body", "the daemon is stopping");
+        set_error(e, ASSETS_STOPPING, "body", "the daemon is stopping");
         ok = false;
     }
     if (ok && a->uploads >= ASSETS_MAX_UPLOADS) {
-        set_error(e, 429, "body", "%d uploads are streaming or converting already; retry later",
+        set_error(e, ASSETS_BUSY, "body", "%d uploads are streaming or converting already; retry later",
                   ASSETS_MAX_UPLOADS);
         ok = false;
     }
@@ -1021,7 +1010,7 @@ struct asset_upload *assets_upload_begin(struct assets *a, const char *name,
     u->fd = open(u->tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0600);
     if (u->fd < 0) {
         int saved = errno;
-        set_error(e, saved == ENOSPC || saved == EDQUOT ? 507 : 500, "state_dir",
+        set_error(e, saved == ENOSPC || saved == EDQUOT ? ASSETS_NO_SPACE : ASSETS_INTERNAL, "state_dir",
                   "cannot create %s: %s", u->tmp, strerror(saved));
         pthread_mutex_lock(&a->lock);
         a->uploads--;
@@ -1085,22 +1074,22 @@ uint64_t assets_upload_finish(struct asset_upload *u, struct assets_error *e)
 {
     struct assets *a = u->a;
     if (u->too_large) {
-        set_error(e, 413, "body", "an asset must be at most %llu bytes (--max-asset-bytes)",
+        set_error(e, ASSETS_TOO_LARGE, "body", "an asset must be at most %llu bytes (--max-asset-bytes)",
                   (unsigned long long)a->cfg.max_asset_bytes);
         goto refuse;
     }
     if (u->disk_full) {
-        set_error(e, 507, "state_dir", "cannot store the upload in %s: %s", a->dir,
+        set_error(e, ASSETS_NO_SPACE, "state_dir", "cannot store the upload in %s: %s", a->dir,
                   strerror(ENOSPC));
         goto refuse;
     }
     if (u->io_errno) {
-        set_error(e, 500, "state_dir", "cannot store the upload in %s: %s", a->dir,
+        set_error(e, ASSETS_INTERNAL, "state_dir", "cannot store the upload in %s: %s", a->dir,
                   strerror(u->io_errno));
         goto refuse;
     }
     if (u->bytes == 0) {
-        set_error(e, 400, "body", "the body must be the asset's .glb or .gltf file; it is empty");
+        set_error(e, ASSETS_INVALID, "body", "the body must be the asset's .glb or .gltf file; it is empty");
         goto refuse;
     }
     close(u->fd);
@@ -1110,7 +1099,7 @@ uint64_t assets_upload_finish(struct asset_upload *u, struct assets_error *e)
     if (!t || !k) {
         free(t);
         free(k);
-        set_error(e, 500, "body", "out of memory");
+        set_error(e, ASSETS_INTERNAL, "body", "out of memory");
         goto refuse;
     }
     uint8_t digest[SHA256_DIGEST_SIZE];
@@ -1128,7 +1117,7 @@ uint64_t assets_upload_finish(struct asset_upload *u, struct assets_error *e)
         pthread_mutex_unlock(&a->lock);
         free(t);
         free(k);
-        set_error(e, 503, "body", "the daemon is stopping");
+        set_error(e, ASSETS_STOPPING, "body", "the daemon is stopping");
         goto refuse;
     }
     k->serial = t->ticket = ++a->serial;
@@ -1158,7 +1147,7 @@ bool assets_ticket_done(struct assets *a, uint64_t serial)
     return done;
 }
 
-bool assets_ticket_take(struct assets *a, uint64_t serial, unsigned *status, json_t **body)
+bool assets_ticket_take(struct assets *a, uint64_t serial, struct assets_answer *out)
 {
     pthread_mutex_lock(&a->lock);
     struct ticket **p = &a->tickets;
@@ -1170,8 +1159,7 @@ bool assets_ticket_take(struct assets *a, uint64_t serial, unsigned *status, jso
     pthread_mutex_unlock(&a->lock);
     if (!t)
         return false;
-    *status = t->status;
-    *body = t->body;
+    *out = t->answer;
     free(t);
     return true;
 }
@@ -1185,7 +1173,7 @@ void assets_ticket_drop(struct assets *a, uint64_t serial)
     if (*p && (*p)->done) {
         struct ticket *t = *p;
         *p = t->next;
-        json_decref(t->body);
+        json_decref(t->answer.record);
         free(t);
     } else if (*p) {
         (*p)->dropped = true; /* finish_ticket frees it */
@@ -1201,11 +1189,11 @@ static bool dir_not_ready_locked(struct assets *a, const char *name, const char 
 {
     struct dir_entry *d = dir_find(a, name);
     if (d && d->state == DIR_PENDING) {
-        set_error(e, 409, field, "%s (from --asset-dir) is being converted; retry shortly", name);
+        set_error(e, ASSETS_CONFLICT, field, "%s (from --asset-dir) is being converted; retry shortly", name);
         return true;
     }
     if (d && d->state == DIR_FAILED) {
-        set_error(e, 422, field, "%s (from --asset-dir) could not be converted: %.400s", name,
+        set_error(e, ASSETS_UNCONVERTIBLE, field, "%s (from --asset-dir) could not be converted: %.400s", name,
                   d->error);
         return true;
     }
@@ -1215,7 +1203,7 @@ static bool dir_not_ready_locked(struct assets *a, const char *name, const char 
 json_t *assets_describe(struct assets *a, const char *name, struct assets_error *e)
 {
     if (!scene_asset_name_valid(name)) {
-        set_error(e, 400, "name", "an asset name is 1 to %d letters, digits, '.', '_' or '-', "
+        set_error(e, ASSETS_INVALID, "name", "an asset name is 1 to %d letters, digits, '.', '_' or '-', "
                   "not starting with '.'", SCENE_ASSET_NAME_MAX);
         return NULL;
     }
@@ -1229,9 +1217,9 @@ json_t *assets_describe(struct assets *a, const char *name, struct assets_error 
     json_t *o = f == STORE_FOUND ? record_json(&r, true) : NULL;
     store_asset_finish(&r);
     if (f == STORE_MISSING)
-        set_error(e, 404, "name", "no asset of that name (GET /v1/assets lists them)");
+        set_error(e, ASSETS_NOT_FOUND, "name", "no asset of that name (GET /v1/assets lists them)");
     else if (!o)
-        set_error(e, 500, "store", "cannot read the asset records (see the log)");
+        set_error(e, ASSETS_INTERNAL, "store", "cannot read the asset records (see the log)");
     return o;
 }
 
@@ -1240,40 +1228,32 @@ static void list_row(void *ctx, const struct store_asset *r)
     json_array_append_new(ctx, record_json(r, false));
 }
 
-json_t *assets_list(struct assets *a, const char *cursor, int limit, struct assets_error *e)
+bool assets_list(struct assets *a, const char *cursor, int limit, struct assets_page *page,
+                 struct assets_error *e)
 {
+    memset(page, 0, sizeof(*page));
     json_t *items = json_array();
-    char next[STORE_ASSET_NAME_CAP], err[PATH_MAX + 300];
-    if (!items || !store_asset_list(a->store, cursor, limit, false, list_row, items, next, err,
-                                    sizeof(err))) {
+    char err[PATH_MAX + 300];
+    if (!items || !store_asset_list(a->store, cursor, limit, false, list_row, items, page->next,
+                                    err, sizeof(err))) {
         json_decref(items);
-        set_error(e, 500, "store", "%.480s", items ? err : "out of memory");
-        return NULL;
+        set_error(e, ASSETS_INTERNAL, "store", "%.480s", items ? err : "out of memory");
+        return false;
     }
-    json_t *o = json_pack("{s:o}", "assets", items);
-    if (o && next[0]) {
-        char url[STORE_ASSET_NAME_CAP + 64];
-        snprintf(url, sizeof(url), "/v1/assets?limit=%d&cursor=%s", limit, next);
-        json_object_set_new(o, "next", json_string(url));
-    }
+    page->items = items;
     pthread_mutex_lock(&a->lock);
-    size_t pending = 0, failed = 0;
     for (size_t i = 0; i < a->ndir; i++) {
-        pending += a->dir_entries[i].state == DIR_PENDING;
-        failed += a->dir_entries[i].state == DIR_FAILED;
+        page->converting += a->dir_entries[i].state == DIR_PENDING;
+        page->failed += a->dir_entries[i].state == DIR_FAILED;
     }
     pthread_mutex_unlock(&a->lock);
-    if (o && (pending || failed))
-        json_object_set_new(o, "asset_dir", json_pack("{s:I, s:I}", "converting",
-                                                      (json_int_t)pending, "failed",
-                                                      (json_int_t)failed));
-    return o;
+    return true;
 }
 
 json_t *assets_delete(struct assets *a, const char *name, struct assets_error *e)
 {
     if (!scene_asset_name_valid(name)) {
-        set_error(e, 400, "name", "an asset name is 1 to %d letters, digits, '.', '_' or '-', "
+        set_error(e, ASSETS_INVALID, "name", "an asset name is 1 to %d letters, digits, '.', '_' or '-', "
                   "not starting with '.'", SCENE_ASSET_NAME_MAX);
         return NULL;
     }
@@ -1285,20 +1265,20 @@ json_t *assets_delete(struct assets *a, const char *name, struct assets_error *e
         goto out;
     enum store_found f = store_asset_get(a->store, name, &r);
     if (f != STORE_FOUND) {
-        set_error(e, f == STORE_MISSING ? 404 : 500, "name",
+        set_error(e, f == STORE_MISSING ? ASSETS_NOT_FOUND : ASSETS_INTERNAL, "name",
                   f == STORE_MISSING ? "no asset of that name (GET /v1/assets lists them)"
                                      : "cannot read the asset records (see the log)");
         goto out;
     }
     char job[RECORD_ID_LEN];
     if (queue_asset_in_use(a->queue, name, NULL, job)) {
-        set_error(e, 409, "name", "job %s (queued or running) uses %s: cancel it or wait for it "
+        set_error(e, ASSETS_CONFLICT, "name", "job %s (queued or running) uses %s: cancel it or wait for it "
                   "to end (DELETE /v1/jobs/%s)", job, name, job);
         goto out;
     }
     char err[PATH_MAX + 300];
     if (!store_asset_delete(a->store, name, err, sizeof(err))) {
-        set_error(e, 500, "store", "%.480s", err);
+        set_error(e, ASSETS_INTERNAL, "store", "%.480s", err);
         goto out;
     }
     release_files_locked(a, r.sha256);
@@ -1323,12 +1303,12 @@ bool assets_resolve(struct assets *a, struct scene_spec *scene, struct assets_er
     enum store_found f = store_asset_get(a->store, scene->asset, &r);
     bool ok = false;
     if (f == STORE_MISSING)
-        set_error(e, 400, "scene.asset", "no asset of that name; PUT /v1/assets/%s first",
+        set_error(e, ASSETS_INVALID, "scene.asset", "no asset of that name; PUT /v1/assets/%s first",
                   scene->asset);
     else if (f == STORE_ERROR)
-        set_error(e, 500, "scene.asset", "cannot read the asset records (see the log)");
+        set_error(e, ASSETS_INTERNAL, "scene.asset", "cannot read the asset records (see the log)");
     else if (scene->asset_sha256[0] && strcmp(scene->asset_sha256, r.sha256) != 0)
-        set_error(e, 409, "scene.asset_sha256", "the asset %s is now %s, not the pinned %s",
+        set_error(e, ASSETS_CONFLICT, "scene.asset_sha256", "the asset %s is now %s, not the pinned %s",
                   scene->asset, r.sha256, scene->asset_sha256);
     else {
         memcpy(scene->asset_sha256, r.sha256, sizeof(scene->asset_sha256));

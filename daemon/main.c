@@ -634,16 +634,21 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
     signal(SIGPIPE, SIG_IGN);
 
     char err[PATH_MAX + 300];
+    int rc = 1;
+    struct queue *q = NULL;
+    struct runner *r = NULL;
+    struct assets *assets = NULL;
+    struct sweeps *sweeps = NULL;
+    struct http_server *http = NULL;
     struct store *store = store_open(state_dir, err, sizeof(err));
     if (!store) {
         LOG(LOG_ERROR, "%s", err);
         return 1;
     }
-    struct queue *q = queue_create(store, o->queue_size);
+    q = queue_create(store, o->queue_size);
     if (!q) {
         LOG(LOG_ERROR, "out of memory");
-        store_close(store);
-        return 1;
+        goto out;
     }
     queue_set_retention(q, o->keep_jobs, o->keep_days);
     /* Earlier jobs first: finished ones are served from the store, queued
@@ -651,28 +656,21 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
     int loaded = queue_load(q, catalog, err, sizeof(err));
     if (loaded < 0) {
         LOG(LOG_ERROR, "%s", err);
-        queue_destroy(q);
-        store_close(store);
-        return 1;
+        goto out;
     }
     if (loaded > 0)
         LOG(LOG_INFO, "%d job(s) in %s/%s", loaded, state_dir, STORE_FILE);
-    struct runner *r = runner_create(q, o->device, o->gl_debug, err, sizeof(err));
+    r = runner_create(q, o->device, o->gl_debug, err, sizeof(err));
     if (!r) {
         LOG(LOG_ERROR, "%s", err);
-        queue_destroy(q);
-        store_close(store);
-        return 1;
+        goto out;
     }
     pin_loaded_modules();
     set_max_msaa(r);
     double budget, driver;
     if (!set_memory_budget(o, &limits, &budget, &driver, err, sizeof(err))) {
         LOG(LOG_ERROR, "%s", err);
-        runner_destroy(r);
-        queue_destroy(q);
-        store_close(store);
-        return 1;
+        goto out;
     }
     /* After queue_load: a queued job's pinned asset keeps its files. */
     struct assets_config acfg = {.state_dir = state_dir, .asset_dir = o->asset_dir,
@@ -683,33 +681,27 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
     asset_limits_defaults(&acfg.limits);
     acfg.limits.max_file_bytes = acfg.max_asset_bytes;
     asset_run_limits_defaults(&acfg.run);
-    struct assets *assets = assets_create(&acfg, store, q, err, sizeof(err));
+    assets = assets_create(&acfg, store, q, err, sizeof(err));
     if (!assets) {
         LOG(LOG_ERROR, "%s", err);
-        runner_destroy(r);
-        queue_destroy(q);
-        store_close(store);
-        return 1;
+        goto out;
     }
     queue_set_asset_resolver(q, assets_queue_resolver, assets);
-    struct sweeps *sweeps = sweeps_create(q, catalog);
+    sweeps = sweeps_create(q, catalog);
+    if (!sweeps) {
+        LOG(LOG_ERROR, "cannot start the sweep thread");
+        goto out;
+    }
     const struct http_context http_ctx = {.catalog = catalog, .queue = q, .sweeps = sweeps,
                                           .assets = assets,
                                           .render_state = render_state,
                                           .device_json = render_device_json, .render = r,
                                           .stall_s = o->stall_s, .memory_budget_bytes = budget,
                                           .driver_bytes = driver};
-    struct http_server *http =
-        sweeps ? http_server_create(o->listen, &limits, &http_ctx, err, sizeof(err)) : NULL;
+    http = http_server_create(o->listen, &limits, &http_ctx, err, sizeof(err));
     if (!http) {
-        LOG(LOG_ERROR, "%s", sweeps ? err : "cannot start the sweep thread");
-        sweeps_destroy(sweeps);
-        queue_set_asset_resolver(q, NULL, NULL);
-        assets_destroy(assets);
-        runner_destroy(r);
-        queue_destroy(q);
-        store_close(store);
-        return 1;
+        LOG(LOG_ERROR, "%s", err);
+        goto out;
     }
     LOG(LOG_INFO, "shadebenchd %s listening on %s (port %d), state in %s", PACKAGE_VERSION,
         o->listen, http_server_port(http), state_dir);
@@ -737,14 +729,18 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
     }
     LOG(LOG_INFO, "signal %d: stopping", sig);
     service_stopping();
+    rc = 0;
+out:
     http_server_destroy(http);
     sweeps_destroy(sweeps);
-    queue_set_asset_resolver(q, NULL, NULL);
+    if (assets)
+        queue_set_asset_resolver(q, NULL, NULL);
     assets_destroy(assets);
-    /* Within a few seconds whatever runs (systemd's stop timeout is longer):
-     * the running job is back in the queue once the render thread stops
-     * it, and a frame still draining on the GPU is not waited for. */
-    if (!runner_stop(r, STOP_RENDER_WAIT_S)) {
+    /* A stop (not a failed start): within a few seconds whatever runs
+     * (systemd's stop timeout is longer): the running job is back in the
+     * queue once the render thread stops it, and a frame still draining on
+     * the GPU is not waited for. */
+    if (rc == 0 && !runner_stop(r, STOP_RENDER_WAIT_S)) {
         LOG(LOG_WARN, "the render thread is still draining GPU work after %d s; exiting without "
             "it (every job's state is stored)", STOP_RENDER_WAIT_S);
         _exit(0);
@@ -752,7 +748,7 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
     runner_destroy(r);
     queue_destroy(q);
     store_close(store);
-    return 0;
+    return rc;
 }
 
 int main(int argc, char **argv)

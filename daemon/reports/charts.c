@@ -2,6 +2,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "daemon/reports/charts.h"
 #include "common/result_keys.h"
+#include "common/axis.h"
 #include "daemon/reports/sweep_verdict.h"
 
 #include <cairo-svg.h>
@@ -153,12 +154,6 @@ static struct axis make_axis(double lo, double hi, bool log_ok, bool nonneg)
     return a;
 }
 
-static double tick_step(double span)
-{
-    double raw = span / 6.0, mag = pow(10.0, floor(log10(raw))), f = raw / mag;
-    return (f < 1.5 ? 1 : f < 3 ? 2 : f < 7 ? 5 : 10) * mag;
-}
-
 /* Calls fn for each tick value of the axis: 1, 2, 5 per decade on log
  * axes, round steps on linear ones. */
 static int ticks(const struct axis *a, double *out, int cap)
@@ -173,7 +168,7 @@ static int ticks(const struct axis *a, double *out, int cap)
             }
         return n;
     }
-    double step = tick_step(a->hi - a->lo);
+    double step = axis_tick_step(a->hi - a->lo);
     for (double v = ceil(a->lo / step) * step; v <= a->hi + step * 1e-9 && n < cap; v += step)
         out[n++] = fabs(v) < step * 1e-6 ? 0.0 : v;
     return n;

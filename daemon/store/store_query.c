@@ -1,5 +1,6 @@
 #define _POSIX_C_SOURCE 200809L
-/* The record store: lists (a page under filters, by the best index), counts, the unfinished rows (store.h). */
+/* The record store: lists (a page under filters, by the best index),
+ * counts, the unfinished rows (store.h). */
 #include "daemon/store/store_db.h"
 
 #include <errno.h>

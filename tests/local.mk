@@ -150,7 +150,11 @@ E2E_TESTS = \
 	tests/e2e/systemd_sandbox.py \
 	tests/e2e/systemd_unit.sh
 
+# The folders' layers (docs/architecture.md), read from the includes.
+STATIC_TESTS = tests/layers.py
+
 TESTS = $(UNIT_TESTS) \
+	$(STATIC_TESTS) \
 	tests/fuzz/replay.sh \
 	$(E2E_TESTS)
 

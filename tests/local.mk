@@ -85,6 +85,7 @@ tests_unit_test_routes_LDADD = $(CORE_LIBS)
 # catalogue, with the test as the render thread.
 tests_unit_test_http_SOURCES = tests/unit/test_http.c $(API_SOURCES) \
 	daemon/jobs/sweeps.c daemon/jobs/sweeps.h
+nodist_tests_unit_test_http_SOURCES = daemon/api/ui_files.c
 tests_unit_test_http_LDADD = $(API_LIBS) $(MHD_LIBS)
 # The fuzz targets, replayed over their corpora in make check (tests/fuzz/run.sh
 # builds them with clang and libFuzzer instead).

@@ -294,6 +294,8 @@ static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
         return respond_json(c, MHD_HTTP_OK, info_json(s));
     case ROUTE_METRICS:
         return respond_metrics(s, c);
+    case ROUTE_UI:
+        return respond_ui(c, &req->route);
     case ROUTE_JOBS:
         if (post) {
             if (req->too_large)
@@ -319,10 +321,12 @@ static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
     case ROUTE_JOB_CHART:
     case ROUTE_JOB_TIMINGS:
     case ROUTE_JOB_IMAGE:
+    case ROUTE_JOB_PDIFF:
         return job_resource(s, c, method, req);
     case ROUTE_SWEEP:
     case ROUTE_SWEEP_CHART:
     case ROUTE_SWEEP_REPORT:
+    case ROUTE_SWEEP_VERDICT:
         return sweep_resource(s, c, method, req);
     default:
         return respond_error(c, MHD_HTTP_NOT_FOUND, req->route.field ? req->route.field : "url",
@@ -402,7 +406,8 @@ static bool refuse_early(struct http_server *s, struct MHD_Connection *c, const 
         *ret = respond_error(c, MHD_HTTP_TOO_MANY_REQUESTS, "connections", rule);
         return true;
     }
-    if (req->route.kind != ROUTE_HEALTHZ && !authorized(s, c)) {
+    /* The dashboard's files hold no data: the page asks for the token. */
+    if (req->route.kind != ROUTE_HEALTHZ && req->route.kind != ROUTE_UI && !authorized(s, c)) {
         *ret = respond_error(c, MHD_HTTP_UNAUTHORIZED, "Authorization",
                              "this daemon needs \"Authorization: Bearer <token>\"");
         return true;

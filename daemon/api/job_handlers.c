@@ -192,6 +192,8 @@ enum MHD_Result job_resource(struct http_server *s, struct MHD_Connection *c,
         job_file_path(dir, JOB_FILE_TIMINGS, path, sizeof(path));
         return respond_file(c, path, "text/csv");
     }
+    if (r->kind == ROUTE_JOB_PDIFF)
+        return respond_pdiff_mask(s, c, r, dir);
     job_image_path(dir, r->image, r->frame, path, sizeof(path));
     if (access(path, R_OK) != 0)
         return respond_error(c, MHD_HTTP_NOT_FOUND, "frame",

@@ -18,13 +18,16 @@ static const struct {
     [ROUTE_JOB_CHART] = {"/v1/jobs/{id}/charts/{name}", "GET, HEAD", "use GET"},
     [ROUTE_JOB_TIMINGS] = {"/v1/jobs/{id}/timings.csv", "GET, HEAD", "use GET"},
     [ROUTE_JOB_IMAGE] = {"/v1/jobs/{id}/{images}/{frame}.png", "GET, HEAD", "use GET"},
+    [ROUTE_JOB_PDIFF] = {"/v1/jobs/{id}/pdiff/{frame}.png", "GET, HEAD", "use GET"},
     [ROUTE_SWEEPS] = {"/v1/sweeps", "GET, HEAD, POST", "use GET to list sweeps or POST to start one"},
     [ROUTE_SWEEP] = {"/v1/sweeps/{id}", "GET, HEAD, DELETE", "use GET or DELETE on a sweep"},
     [ROUTE_SWEEP_CHART] = {"/v1/sweeps/{id}/charts/{name}", "GET, HEAD", "use GET"},
     [ROUTE_SWEEP_REPORT] = {"/v1/sweeps/{id}/report.html", "GET, HEAD", "use GET"},
+    [ROUTE_SWEEP_VERDICT] = {"/v1/sweeps/{id}/verdict", "GET, HEAD", "use GET"},
     [ROUTE_ASSETS] = {"/v1/assets", "GET, HEAD", "use GET to list assets; PUT /v1/assets/NAME uploads one"},
     [ROUTE_ASSET] = {"/v1/assets/{name}", "GET, HEAD, PUT, DELETE",
                      "use PUT to upload the asset's file as the body, GET or DELETE"},
+    [ROUTE_UI] = {"/ui", "GET, HEAD", "use GET"},
 };
 
 
@@ -104,6 +107,12 @@ static bool job_routes(const char *rest, struct route *r)
         r->kind = ROUTE_JOB_CHART;
         return true;
     }
+    if (strncmp(sub, "pdiff/", 6) == 0) {
+        if (!take_frame(sub + 6, r))
+            return none(r, "frame", "masks are K.png with K a captured frame (see result.captures)");
+        r->kind = ROUTE_JOB_PDIFF;
+        return true;
+    }
     for (int k = 0; k < JOB_IMAGE_COUNT; k++) {
         const char *folder = job_image_kind((enum job_image)k)->folder;
         size_t len = strlen(folder);
@@ -136,6 +145,10 @@ static bool sweep_routes(const char *rest, struct route *r)
         r->kind = ROUTE_SWEEP_REPORT;
         return true;
     }
+    if (strcmp(sub, "verdict") == 0) {
+        r->kind = ROUTE_SWEEP_VERDICT;
+        return true;
+    }
     if (strncmp(sub, "charts/", 7) == 0) {
         if (!take_chart(sub + 7, r))
             return none(r, "chart", "charts are NAME.svg or NAME.png");
@@ -162,7 +175,16 @@ bool route_parse(const char *url, struct route *r)
         r->kind = ROUTE_SWEEPS;
     else if (strncmp(url, "/v1/sweeps/", 11) == 0)
         return sweep_routes(url + 11, r);
-    else if (strcmp(url, "/v1/assets") == 0 || strcmp(url, "/v1/assets/") == 0)
+    else if (strcmp(url, "/") == 0 || strcmp(url, "/ui") == 0 || strcmp(url, "/ui/") == 0) {
+        r->kind = ROUTE_UI;
+        snprintf(r->ui, sizeof(r->ui), "/ui/index.html");
+    } else if (strncmp(url, "/ui/", 4) == 0) {
+        /* The handler looks the file up: an unknown one is a 404 there. */
+        if (strlen(url) >= sizeof(r->ui))
+            return none(r, "url", "no such file of the dashboard");
+        r->kind = ROUTE_UI;
+        snprintf(r->ui, sizeof(r->ui), "%s", url);
+    } else if (strcmp(url, "/v1/assets") == 0 || strcmp(url, "/v1/assets/") == 0)
         r->kind = ROUTE_ASSETS;
     else if (strncmp(url, "/v1/assets/", 11) == 0) {
         /* One path segment; its rules are the handler's (a 400 naming it). */
@@ -252,6 +274,16 @@ void route_asset_url(const char *name, char out[ROUTE_URL_MAX + ROUTE_ASSET_NAME
 void route_image_url(const char *id, enum job_image image, int frame, char out[ROUTE_URL_MAX])
 {
     snprintf(out, ROUTE_URL_MAX, "/v1/jobs/%s/%s/%d.png", id, job_image_kind(image)->folder, frame);
+}
+
+void route_pdiff_url(const char *id, int frame, char out[ROUTE_URL_MAX])
+{
+    snprintf(out, ROUTE_URL_MAX, "/v1/jobs/%s/pdiff/%d.png", id, frame);
+}
+
+void route_verdict_url(const char *id, char out[ROUTE_URL_MAX])
+{
+    snprintf(out, ROUTE_URL_MAX, "/v1/sweeps/%s/verdict", id);
 }
 
 /* Query arguments keep the unreserved characters of RFC 3986 and escape

@@ -6,7 +6,7 @@
  * server's lifetime) and one file per resource, each answering its routes:
  * job_handlers.c (/v1/jobs), sweep_handlers.c (/v1/sweeps),
  * asset_handlers.c (/v1/assets), status_handlers.c (/healthz, /v1/info,
- * /metrics).
+ * /metrics), ui_handlers.c (the dashboard's files at / and /ui/).
  *
  * Threads: the handlers run on libmicrohttpd's polling threads; nothing
  * here touches GL. */
@@ -115,6 +115,10 @@ enum MHD_Result respond_list(struct http_server *s, struct MHD_Connection *c,
                              enum route_kind route);
 /* A job or sweep as the API serves it: the stored JSON plus its URLs. */
 json_t *served_job(struct http_server *s, const char *id);
+/* GET /v1/jobs/ID/pdiff/K.png of a done job whose files are in dir
+ * (pdiff_mask.c). */
+enum MHD_Result respond_pdiff_mask(struct http_server *s, struct MHD_Connection *c,
+                                   const struct route *r, const char *dir);
 
 /* /v1/sweeps (sweep_handlers.c). */
 enum MHD_Result post_sweep(struct http_server *s, struct MHD_Connection *c,
@@ -138,6 +142,9 @@ bool begin_upload(struct http_server *s, struct MHD_Connection *c, struct reques
 /* A resumed upload: the conversion's answer, or why there is none. */
 enum MHD_Result answer_upload(struct http_server *s, struct MHD_Connection *c,
                               struct request *req, enum wake why);
+
+/* / and /ui/...: the dashboard's embedded files (ui_handlers.c). */
+enum MHD_Result respond_ui(struct MHD_Connection *c, const struct route *r);
 
 /* /healthz, /v1/info, /metrics (status_handlers.c). */
 enum MHD_Result respond_healthz(struct http_server *s, struct MHD_Connection *c);

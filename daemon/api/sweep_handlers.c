@@ -9,7 +9,9 @@
 
 #include "common/result_keys.h"
 #include "daemon/api/links.h"
+#include "daemon/reports/charts.h"
 #include "daemon/reports/report.h"
+#include "daemon/reports/sweep_verdict.h"
 #include "daemon/spec/sweep_spec.h"
 
 static bool point_job_dir(void *ctx, const char *job_id, char *dir, size_t cap, int *last_frame)
@@ -89,6 +91,23 @@ enum MHD_Result post_sweep(struct http_server *s, struct MHD_Connection *c,
                         json_pack("{s:s, s:s, s:s}", "id", id, "status", "queued", "url", url));
 }
 
+/* GET /v1/sweeps/ID/verdict: the report's verdict as JSON (sweep_verdict.h),
+ * for ?series= or the one that means something on the device. */
+static enum MHD_Result respond_verdict(struct http_server *s, struct MHD_Connection *c,
+                                       const json_t *sw)
+{
+    const char *series = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "series");
+    if (series && strcmp(series, RK_FRAME_MS) && strcmp(series, RK_GPU_MS) &&
+        strcmp(series, RK_CPU_MS))
+        return respond_error(c, MHD_HTTP_BAD_REQUEST, "series", "must be frame_ms, gpu_ms or cpu_ms");
+    if (!series) {
+        json_t *device = s->ctx.device_json(s->ctx.render);
+        series = charts_default_series(device);
+        json_decref(device);
+    }
+    return respond_json(c, MHD_HTTP_OK, sweep_verdict_json(sw, series));
+}
+
 enum MHD_Result sweep_resource(struct http_server *s, struct MHD_Connection *c,
                                const char *method, struct request *req)
 {
@@ -130,6 +149,8 @@ enum MHD_Result sweep_resource(struct http_server *s, struct MHD_Connection *c,
         json_t *device = s->ctx.device_json(s->ctx.render);
         ret = respond_chart(c, sw, r, true, device);
         json_decref(device);
+    } else if (r->kind == ROUTE_SWEEP_VERDICT) {
+        ret = respond_verdict(s, c, sw);
     } else {
         json_t *device = s->ctx.device_json(s->ctx.render);
         size_t len = 0;

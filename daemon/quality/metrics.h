@@ -84,6 +84,11 @@ void pdiff_defaults(struct pdiff_options *o);
 bool pdiff_compute(const struct image *a, const struct image *b,
                    const struct pdiff_options *o, const struct metrics_stop *stop,
                    struct pdiff_result *out, char *err, size_t errlen);
+/* The same, and where failing_mask is not NULL (width x height bytes, zeroed by the
+ * caller) sets the failing pixels to 1: the mask the dashboard shows. */
+bool pdiff_compute_mask(const struct image *a, const struct image *b,
+                        const struct pdiff_options *o, const struct metrics_stop *stop,
+                        struct pdiff_result *out, uint8_t *failing_mask, char *err, size_t errlen);
 
 enum metric_kind { METRIC_SSIM = 1, METRIC_PDIFF = 2, METRIC_PSNR = 4, METRIC_FLIP = 8 };
 #define METRIC_ALL (METRIC_SSIM | METRIC_PDIFF | METRIC_PSNR | METRIC_FLIP)

@@ -223,6 +223,13 @@ bool pdiff_compute(const struct image *a, const struct image *b,
                    const struct pdiff_options *o, const struct metrics_stop *stop,
                    struct pdiff_result *out, char *err, size_t errlen)
 {
+    return pdiff_compute_mask(a, b, o, stop, out, NULL, err, errlen);
+}
+
+bool pdiff_compute_mask(const struct image *a, const struct image *b,
+                        const struct pdiff_options *o, const struct metrics_stop *stop,
+                        struct pdiff_result *out, uint8_t *failing_mask, char *err, size_t errlen)
+{
     memset(out, 0, sizeof(*out));
     if (a->width != b->width || a->height != b->height) {
         snprintf(err, errlen, "pdiff: image sizes differ");
@@ -331,6 +338,8 @@ bool pdiff_compute(const struct image *a, const struct image *b,
                             pass = false;
                     }
                     failed += !pass;
+                    if (failing_mask && !pass)
+                        failing_mask[src] = 1;
                 }
         }
     }

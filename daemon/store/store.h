@@ -173,11 +173,14 @@ struct store_query {
     size_t nterms;
     struct store_term terms[STORE_MAX_TERMS];
     int64_t since_ms;          /* created at or after (ms since 1970); 0: any */
-    char after[RECORD_ID_LEN]; /* the cursor: ids after this one; "": from the start */
+    char after[RECORD_ID_LEN]; /* the cursor: ids after this one (before it when
+                                  newest); "": from the start */
     int limit;                 /* 1 to STORE_LIMIT_MAX */
+    bool newest;               /* newest first (the dashboard's order), else oldest */
 };
 
-/* Calls fn for each row of the page, in id order (submission order), with
+/* Calls fn for each row of the page, in id order (submission order; newest
+ * first with q->newest, when the cursor is the smallest id served), with
  * labels and figures (and a sweep's extra) but no spec. fn must be quick and
  * must not call the store: a read connection is held. next gets the cursor
  * of the following page, or "" when this page is the last. false (logged,

@@ -53,7 +53,8 @@ static void id_bound(const struct store_query *q, char bound[RECORD_ID_LEN], boo
         if (t > 0 && gmtime_r(&t, &tm))
             strftime(prefix, sizeof(prefix), "%Y%m%d-%H%M%S", &tm);
     }
-    if (q->after[0] && strcmp(q->after, prefix) >= 0) {
+    /* Newest first, the cursor is an upper bound (the caller adds it). */
+    if (!q->newest && q->after[0] && strcmp(q->after, prefix) >= 0) {
         snprintf(bound, RECORD_ID_LEN, "%s", q->after);
         *strict = true;
     } else if (prefix[0]) {
@@ -144,6 +145,10 @@ bool store_list(struct store *s, const struct store_query *q, store_row_fn fn, v
         sql_add(sql, strict ? " AND %s.id > ?" : " AND %s.id >= ?", k);
         sql_text(sql, bound);
     }
+    if (q->newest && q->after[0]) {
+        sql_add(sql, " AND %s.id < ?", k);
+        sql_text(sql, q->after);
+    }
     for (size_t i = 0; i < q->nterms; i++) {
         if ((int)i == driver || !first_of_group(q, i))
             continue;
@@ -164,7 +169,7 @@ bool store_list(struct store *s, const struct store_query *q, store_row_fn fn, v
         sql_add(sql, " AND r.created >= ?");
         sql_double(sql, (double)q->since_ms / 1000.0);
     }
-    sql_add(sql, " ORDER BY %s.id LIMIT ?", k);
+    sql_add(sql, q->newest ? " ORDER BY %s.id DESC LIMIT ?" : " ORDER BY %s.id LIMIT ?", k);
     sql_int(sql, limit + 1); /* one more tells whether a next page exists */
     if (sql->overflow) {
         snprintf(err, errlen, "the list's question is too long");

@@ -29,6 +29,7 @@ UNIT_TESTS = \
 	tests/unit/test_http \
 	tests/unit/test_routes \
 	tests/unit/test_charts \
+	tests/unit/test_history \
 	tests/unit/test_fleet \
 	tests/unit/test_culling \
 	tests/unit/test_effects \
@@ -65,6 +66,8 @@ tests_unit_test_job_filter_SOURCES = tests/unit/test_job_filter.c daemon/api/job
 tests_unit_test_job_filter_LDADD = $(CORE_LIBS)
 tests_unit_test_charts_SOURCES = tests/unit/test_charts.c
 tests_unit_test_charts_LDADD = $(REPORT_LIBS)
+tests_unit_test_history_SOURCES = tests/unit/test_history.c
+tests_unit_test_history_LDADD = $(REPORT_LIBS)
 # The fleet's device view, with the client's CSV and the reports it reads.
 tests_unit_test_fleet_SOURCES = tests/unit/test_fleet.c client/fleet_view.c
 tests_unit_test_fleet_LDADD = $(REPORT_LIBS)

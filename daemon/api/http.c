@@ -296,6 +296,8 @@ static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
         return respond_metrics(s, c);
     case ROUTE_UI:
         return respond_ui(c, &req->route);
+    case ROUTE_JOB_HISTORY:
+        return respond_history(s, c, &req->route);
     case ROUTE_JOBS:
         if (post) {
             if (req->too_large)

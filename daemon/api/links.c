@@ -53,6 +53,8 @@ void links_add_job(json_t *job)
     if (result) {
         route_timings_url(id, url);
         json_object_set_new(job, "timings_url", json_string(url));
+        route_history_url(id, url);
+        json_object_set_new(job, "history_url", json_string(url));
     }
     link_captures(id, json_object_get(result, RK_CAPTURES), false);
     link_captures(id, json_object_get(json_object_get(result, RK_HEATMAP), RK_CAPTURES), true);

@@ -19,6 +19,7 @@ static const struct {
     [ROUTE_JOB_TIMINGS] = {"/v1/jobs/{id}/timings.csv", "GET, HEAD", "use GET"},
     [ROUTE_JOB_IMAGE] = {"/v1/jobs/{id}/{images}/{frame}.png", "GET, HEAD", "use GET"},
     [ROUTE_JOB_PDIFF] = {"/v1/jobs/{id}/pdiff/{frame}.png", "GET, HEAD", "use GET"},
+    [ROUTE_JOB_HISTORY] = {"/v1/jobs/{id}/history", "GET, HEAD", "use GET"},
     [ROUTE_SWEEPS] = {"/v1/sweeps", "GET, HEAD, POST", "use GET to list sweeps or POST to start one"},
     [ROUTE_SWEEP] = {"/v1/sweeps/{id}", "GET, HEAD, DELETE", "use GET or DELETE on a sweep"},
     [ROUTE_SWEEP_CHART] = {"/v1/sweeps/{id}/charts/{name}", "GET, HEAD", "use GET"},
@@ -99,6 +100,10 @@ static bool job_routes(const char *rest, struct route *r)
     }
     if (strcmp(sub, JOB_FILE_TIMINGS) == 0) {
         r->kind = ROUTE_JOB_TIMINGS;
+        return true;
+    }
+    if (strcmp(sub, "history") == 0) {
+        r->kind = ROUTE_JOB_HISTORY;
         return true;
     }
     if (strncmp(sub, "charts/", 7) == 0) {
@@ -279,6 +284,11 @@ void route_image_url(const char *id, enum job_image image, int frame, char out[R
 void route_pdiff_url(const char *id, int frame, char out[ROUTE_URL_MAX])
 {
     snprintf(out, ROUTE_URL_MAX, "/v1/jobs/%s/pdiff/%d.png", id, frame);
+}
+
+void route_history_url(const char *id, char out[ROUTE_URL_MAX])
+{
+    snprintf(out, ROUTE_URL_MAX, "/v1/jobs/%s/history", id);
 }
 
 void route_verdict_url(const char *id, char out[ROUTE_URL_MAX])

@@ -23,6 +23,7 @@ enum route_kind {
     ROUTE_JOB_TIMINGS,
     ROUTE_JOB_IMAGE,
     ROUTE_JOB_PDIFF, /* /v1/jobs/{id}/pdiff/{frame}.png: PerceptualDiff's failing pixels */
+    ROUTE_JOB_HISTORY, /* /v1/jobs/{id}/history: its workload's jobs over time */
     ROUTE_SWEEPS,
     ROUTE_SWEEP,
     ROUTE_SWEEP_CHART,
@@ -95,6 +96,7 @@ void route_image_url(const char *id, enum job_image image, int frame, char out[R
 /* A capture's PerceptualDiff mask, made on request. */
 void route_pdiff_url(const char *id, int frame, char out[ROUTE_URL_MAX]);
 void route_verdict_url(const char *id, char out[ROUTE_URL_MAX]);
+void route_history_url(const char *id, char out[ROUTE_URL_MAX]);
 
 /* A page of a list (kind ROUTE_JOBS or ROUTE_SWEEPS) with its n query
  * arguments, each key and value percent-encoded. malloc'ed (the query can

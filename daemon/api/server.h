@@ -143,6 +143,10 @@ bool begin_upload(struct http_server *s, struct MHD_Connection *c, struct reques
 enum MHD_Result answer_upload(struct http_server *s, struct MHD_Connection *c,
                               struct request *req, enum wake why);
 
+/* GET /v1/jobs/ID/history (history_handlers.c). */
+enum MHD_Result respond_history(struct http_server *s, struct MHD_Connection *c,
+                                const struct route *r);
+
 /* / and /ui/...: the dashboard's embedded files (ui_handlers.c). */
 enum MHD_Result respond_ui(struct MHD_Connection *c, const struct route *r);
 

@@ -140,8 +140,9 @@ class Browser:
                 last = self.eval(expression)
             except BrowserError as e:
                 last = e
-            if last and not isinstance(last, BrowserError):
-                return last
+            # JavaScript's truth: an element (serialised as {}) counts.
+            if not isinstance(last, BrowserError) and last not in (None, False, 0, ""):
+                return True if last == {} else last
             time.sleep(0.1)
         raise BrowserError("timed out waiting for %s (last: %s)" % (what or expression, last))
 

@@ -34,6 +34,7 @@ int main(void)
     CHECK(kind_of("/v1/sweeps/5/report.html", &r) == ROUTE_SWEEP_REPORT);
     CHECK(kind_of("/v1/jobs/1/pdiff/100.png", &r) == ROUTE_JOB_PDIFF && r.frame == 100);
     CHECK(kind_of("/v1/jobs/1/pdiff/x.png", &r) == ROUTE_NONE && strcmp(r.field, "frame") == 0);
+    CHECK(kind_of("/v1/jobs/1/history", &r) == ROUTE_JOB_HISTORY && strcmp(r.id, "1") == 0);
     CHECK(kind_of("/v1/sweeps/5/verdict", &r) == ROUTE_SWEEP_VERDICT && strcmp(r.id, "5") == 0);
     /* The dashboard: / and /ui/ are its index; any other /ui/ path is looked up. */
     CHECK(kind_of("/", &r) == ROUTE_UI && strcmp(r.ui, "/ui/index.html") == 0);

@@ -36,7 +36,7 @@ export function frameTimes(parent, csv, series) {
     xlabel: 'frame', ylabel: 'ms', legend: 'always', labelsDiv: legend,
     colors: cols.map((_, i) => colour(i)), strokeWidth: 1.2,
     highlightCircleSize: 3, animatedZooms: false,
-    axes: { y: { valueFormatter: (v) => `${num(v)} ms` } },
+    axes: { y: { valueFormatter: (v) => `${num(v)} ms`, axisLabelWidth: 64 } },
   });
   box.dygraph = g;
   return g;
@@ -77,8 +77,7 @@ export function points(parent, pts, opts) {
     return row;
   });
   const { box, legend } = holder(parent, opts.cls || 'points', opts.height || 340);
-  const rowPoint = (row, name) => sorted.filter((p) => p.series === name)[0] && sorted[row];
-  const g = new Dygraph(box, data, {
+  const options = {
     labels: [opts.xlabel, ...names], xlabel: opts.xlabel, ylabel: opts.ylabel,
     customBars: bars, drawPoints: true, pointSize: 4, highlightCircleSize: 7,
     strokeWidth: opts.lines ? 1.5 : 0, connectSeparatedPoints: !!opts.lines,
@@ -86,19 +85,24 @@ export function points(parent, pts, opts) {
     logscale: !!opts.logy,
     axes: {
       x: { logscale: !!opts.logx, valueFormatter: opts.xformat || ((v) => num(v)),
-        axisLabelFormatter: (v) => num(v, 3) },
-      y: { valueFormatter: opts.yformat || ((v) => num(v)), axisLabelFormatter: opts.yaxis || ((v) => num(v, 3)) },
+        axisLabelFormatter: opts.xaxis || ((v) => num(v, 3)) },
+      y: { valueFormatter: opts.yformat || ((v) => num(v)), axisLabelFormatter: opts.yaxis || ((v) => num(v, 3)),
+        axisLabelWidth: 64 },
     },
-    highlightSeriesOpts: opts.lines ? { strokeWidth: 2.5 } : undefined,
+    xRangePad: 14, yRangePad: 14,
+
     legendFormatter: (d) => {
+      const key = names.map((n, i) => `<span style="color:${colour(i)}">● ${n}</span>`).join(' &nbsp; ');
       if (d.x === undefined || d.x === null)
-        return names.map((n, i) => `<span style="color:${colour(i)}">● ${n}</span>`).join(' &nbsp; ');
-      const p = sorted[d.points && d.points.length ? d.points[0].idx : 0];
-      const s = d.series.find((x) => x.isHighlighted) || d.series.find((x) => x.y !== null && x.y !== undefined);
-      const pt = s ? sorted.find((q, k) => q.series === s.label && Math.abs(q.x - d.x) < 1e-12 && k >= 0) : p;
-      return pt ? `<b>${pt.series}</b> ${pt.label || ''}: ${opts.xlabel} ${opts.xformat ? opts.xformat(pt.x) : num(pt.x)}, ` +
-        `${opts.ylabel} ${opts.yformat ? opts.yformat(pt.y) : num(pt.y)}` +
-        (Number.isFinite(pt.lo) ? ` [${num(pt.lo)}, ${num(pt.hi)}]` : '') + (pt.onClick ? ' · click to open' : '') : '';
+        return key;
+      const s = d.series.find((x) => x.isHighlighted) ||
+        d.series.find((x) => x.y !== null && x.y !== undefined && !Number.isNaN(x.y));
+      const pt = s && sorted.find((q) => q.series === s.label && q.x === d.x);
+      if (!pt)
+        return key;
+      const fx = opts.xformat || ((v) => num(v)), fy = opts.yformat || ((v) => num(v));
+      return `<b>${pt.series}</b> ${pt.label || ''}: ${opts.xlabel} ${fx(pt.x)}, ${opts.ylabel} ${fy(pt.y)}` +
+        (Number.isFinite(pt.lo) ? ` [${num(pt.lo)}, ${num(pt.hi)}]` : '') + (pt.onClick ? ' · click to open its job' : '');
     },
     pointClickCallback: (ev, p) => {
       const pt = sorted.find((q) => q.series === p.name && Math.abs(q.x - p.xval) < 1e-12 &&
@@ -106,9 +110,13 @@ export function points(parent, pts, opts) {
       if (pt && pt.onClick)
         pt.onClick();
     },
-    drawCallback: opts.drawCallback,
-  });
-  void rowPoint;
+  };
+  // dygraphs calls any callback option that is not null: leave absent ones out.
+  if (opts.lines)
+    options.highlightSeriesOpts = { strokeWidth: 2.5 };
+  if (opts.drawCallback)
+    options.drawCallback = opts.drawCallback;
+  const g = new Dygraph(box, data, options);
   box.dygraph = g;
   box.points = sorted;
   return g;

@@ -6,7 +6,7 @@ import * as api from './api.js';
 import * as charts from './charts.js';
 import { ImageCompare } from './imagecmp.js';
 import { progressCell } from './page_jobs.js';
-import { clear, el, errorBox, interval, num, pct, seconds, statusBadge, valueTable, when } from './util.js';
+import { clear, el, errorBox, fill, interval, num, pct, seconds, statusBadge, valueTable, when } from './util.js';
 
 const POLL_MS = 1000;
 // Sections of the result that are not the technique's and have their own place.
@@ -62,8 +62,8 @@ export function headline(job) {
     cards.push(el('div.figure', { dataset: { figure: 'worst_ssim' } }, el('div.name', 'worst SSIM'),
       el('div.value', num(q.worst_ssim.value, 6)), el('div.sub', `frame ${q.worst_ssim.frame} against ${q.reference}`)));
   if (q.worst_flip)
-    cards.push(el('div.figure', el('div.name', 'worst FLIP'), el('div.value', num(q.worst_flip.value, 4)),
-      el('div.sub', `frame ${q.worst_flip.frame}`)));
+    cards.push(el('div.figure', el('div.name', 'worst FLIP'), el('div.value', num(q.worst_flip.mean ?? q.worst_flip.value, 4)),
+      el('div.sub', `mean over frame ${q.worst_flip.frame}; max ${num(q.worst_flip.max, 3)}`)));
   if (q.worst_psnr)
     cards.push(el('div.figure', el('div.name', 'worst PSNR'),
       el('div.value', q.worst_psnr.value === null ? '∞' : `${num(q.worst_psnr.value, 4)} dB`), el('div.sub', `frame ${q.worst_psnr.frame}`)));
@@ -162,7 +162,7 @@ export async function render(main, id) {
         try { await api.send('DELETE', `/v1/jobs/${id}`); } catch (err) { cancel.title = err.message; }
         poll();
       };
-    clear(head).append(
+    fill(head, 
       el('h1', `Job ${job.id} `, statusBadge(job.status)),
       el('p', el('b', job.technique), ' · ', `${(spec.scene || {}).preset || (spec.scene || {}).asset || ''} `,
         `${(spec.scene || {}).width || ''}×${(spec.scene || {}).height || ''}`,
@@ -235,7 +235,9 @@ export async function render(main, id) {
       body.append(el('section.technique', el('h2', `${job.technique}'s figures`), valueTable(own)));
     const rest = Object.keys(r).filter((k) => !HARNESS_KEYS.has(k) && k !== job.technique);
     const more = el('section.more', el('h2', 'Everything else the result says'));
-    for (const k of rest)
+    const scalars = Object.fromEntries(rest.filter((k) => r[k] === null || typeof r[k] !== 'object').map((k) => [k, r[k]]));
+    more.append(valueTable(scalars));
+    for (const k of rest.filter((k) => r[k] !== null && typeof r[k] === 'object'))
       more.append(el('details', el('summary', k), valueTable(r[k])));
     more.append(el('details', el('summary', 'device'), valueTable(r.device)),
       el('details', el('summary', 'spec (the job as understood)'), valueTable(job.spec)));

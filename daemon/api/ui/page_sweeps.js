@@ -6,7 +6,7 @@
 // job.
 import * as api from './api.js';
 import * as charts from './charts.js';
-import { clear, el, errorBox, hashQuery, interval, num, pct, statusBadge, when } from './util.js';
+import { clear, el, errorBox, fill, hashQuery, interval, num, pct, statusBadge, when } from './util.js';
 
 const POLL_MS = 2000;
 
@@ -94,7 +94,7 @@ function findings(verdict) {
 
 function pointTable(sweep, series) {
   const rows = sweep.points || [];
-  const fields = [...new Set(rows.flatMap((r) => Object.keys(r.values || {})))];
+  const fields = [...new Set(rows.flatMap((r) => Object.keys(r.values || {})))].filter((f) => f !== 'technique');
   return el('table.list.points#sweep-points',
     el('thead', el('tr', [...fields, 'technique', 'status', `${series} (ms)`, '95% interval', 'worst SSIM',
       'worst FLIP', 'PerceptualDiff failed', 'job'].map((h) => el('th', h)))),
@@ -182,14 +182,14 @@ export async function render(main, id) {
         try { await api.send('DELETE', `/v1/sweeps/${id}`); } catch (err) { cancel.title = err.message; }
       };
     const p = sweep.progress || {};
-    clear(head).append(el('h1', `Sweep ${id} `, statusBadge(sweep.status)),
+    fill(head, el('h1', `Sweep ${id} `, statusBadge(sweep.status)),
       el('p', `${p.points_done}/${p.points_total} points`, sweep.current_job ? [' · running ',
         el('a', { href: `#/job/${sweep.current_job}` }, sweep.current_job)] : '',
       ' · varies ', Object.keys(((sweep.spec || {}).vary) || ((sweep.spec || {}).find ? { [sweep.spec.find.param]: 1 } : {})).join(', '),
       ' · ', el('a', { href: `${sweep.url}/report.html`, target: '_blank' }, 'report.html'),
       ' · ', el('a', { href: sweep.url, target: '_blank' }, 'JSON'), ' ', cancel),
       sweep.error ? el('p.error', sweep.error) : null);
-    clear(body).append(
+    fill(body, 
       el('section', el('h2', 'Which technique wins where'), summaryTable(verdict), findings(verdict)),
       el('section', el('h2', 'The table'), pointTable(sweep, series)));
     const chartBox = el('section.sweep-charts', el('h2', 'Charts'));

@@ -135,3 +135,8 @@ export function hashQuery() {
   const q = h.indexOf('?');
   return new URLSearchParams(q < 0 ? '' : h.slice(q + 1));
 }
+
+// Replaces a node's children (null, undefined and false left out).
+export function fill(node, ...children) {
+  return append(clear(node), children);
+}

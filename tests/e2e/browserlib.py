@@ -86,7 +86,10 @@ class Browser:
         self.events.append(msg)
         if method == "Runtime.consoleAPICalled":
             text = " ".join(str(a.get("value", a.get("description", ""))) for a in p.get("args", []))
-            self.console.append("console.%s: %s" % (p.get("type"), text))
+            frames = p.get("stackTrace", {}).get("callFrames", [])
+            where = " (at %s)" % ", ".join("%s %s:%d" % (f.get("functionName") or "?", f.get("url", "").rsplit("/", 1)[-1],
+                                                     f.get("lineNumber", 0) + 1) for f in frames[:4]) if frames else ""
+            self.console.append("console.%s: %s%s" % (p.get("type"), text, where))
         elif method == "Runtime.exceptionThrown":
             d = p.get("exceptionDetails", {})
             self.console.append("exception: %s %s" % (d.get("text"), d.get("exception", {}).get("description", "")))

@@ -243,7 +243,8 @@ try:
         return [r.left + cx, r.top + cy, p.job]; })()""")
     b.move(target[0], target[1])
     b.click(target[0], target[1])
-    b.wait("location.hash === '#/job/%s'" % target[2], 20, "the point's job")
+    b.wait("location.hash === '#/job/%s' && document.body.dataset.ready === location.hash" % target[2], 30,
+           "the point's job")
     check(True, "a click on the chart opened the point's job %s" % target[2])
 
     # History of the OSL job's workload.

@@ -23,13 +23,18 @@ const ROUTES = [
 ];
 
 let stop = null;
+let generation = 0;
 
 async function route() {
+  const gen = ++generation;
   if (stop) {
     try { stop(); } catch (e) { /* already gone */ }
     stop = null;
   }
-  const main = clear(document.getElementById('main'));
+  // Each page renders into a view of its own, so that a page left while it
+  // loads writes into a detached view, never into the next page's.
+  const main = el('div.view');
+  clear(document.getElementById('main')).append(main);
   const hash = location.hash || '#/jobs';
   for (const [re, nav, page] of ROUTES) {
     const m = hash.match(re);
@@ -39,11 +44,18 @@ async function route() {
       a.classList.toggle('active', a.dataset.nav === nav));
     try {
       const result = await page()(main, m[1] ? decodeURIComponent(m[1]) : undefined);
-      if (typeof result === 'function')
-        stop = result;
+      if (typeof result === 'function') {
+        if (gen !== generation)
+          result(); // left while it loaded: stop its polling now
+        else
+          stop = result;
+      }
     } catch (err) {
-      main.append(errorBox(err));
+      if (gen === generation)
+        main.append(errorBox(err));
     }
+    if (gen !== generation)
+      return;
     document.body.dataset.page = nav;
     document.body.dataset.ready = hash;
     return;

@@ -11,7 +11,11 @@ export function colour(i) {
   return COLOURS[i % COLOURS.length];
 }
 
+// A chart's box in parent; null when parent has left the document (the
+// page was left while it loaded): dygraphs cannot measure a detached div.
 function holder(parent, cls, height = 280) {
+  if (!parent.isConnected)
+    return null;
   const box = el(`div.chart.${cls}`, { style: { height: `${height}px` } });
   const legend = el('div.chart-legend');
   parent.append(el('div.chart-box', box, legend));
@@ -30,13 +34,17 @@ export function parseCsv(text) {
 export function frameTimes(parent, csv, series) {
   const cols = series.map((s) => csv.header.indexOf(s)).filter((i) => i >= 0);
   const data = csv.rows.map((r) => [r[0], ...cols.map((i) => r[i])]);
-  const { box, legend } = holder(parent, 'frame-times');
+  const h = holder(parent, 'frame-times');
+  if (!h)
+    return null;
+  const { box, legend } = h;
   const g = new Dygraph(box, data, {
     labels: ['frame', ...cols.map((i) => csv.header[i])],
     xlabel: 'frame', ylabel: 'ms', legend: 'always', labelsDiv: legend,
     colors: cols.map((_, i) => colour(i)), strokeWidth: 1.2,
     highlightCircleSize: 3, animatedZooms: false,
-    axes: { y: { valueFormatter: (v) => `${num(v)} ms`, axisLabelWidth: 64 } },
+    axes: { y: { valueFormatter: (v) => `${num(v)} ms`, axisLabelWidth: 64 },
+      x: { axisLabelFormatter: (v) => (Number.isInteger(v) ? String(v) : ''), valueFormatter: (v) => `frame ${v}` } },
   });
   box.dygraph = g;
   return g;
@@ -54,7 +62,10 @@ export function histogram(parent, values, label) {
   for (const v of finite)
     counts[Math.min(bins - 1, Math.floor((v - lo) / width))]++;
   const data = counts.map((c, i) => [lo + (i + 0.5) * width, c]);
-  const { box, legend } = holder(parent, 'histogram', 200);
+  const h = holder(parent, 'histogram', 200);
+  if (!h)
+    return null;
+  const { box, legend } = h;
   const g = new Dygraph(box, data, {
     labels: [label, 'frames'], xlabel: `${label} (ms)`, ylabel: 'frames', stepPlot: true,
     fillGraph: true, legend: 'always', labelsDiv: legend, colors: [colour(0)],
@@ -76,7 +87,10 @@ export function points(parent, pts, opts) {
     row[i] = bars ? [Number.isFinite(p.lo) ? p.lo : p.y, p.y, Number.isFinite(p.hi) ? p.hi : p.y] : p.y;
     return row;
   });
-  const { box, legend } = holder(parent, opts.cls || 'points', opts.height || 340);
+  const h = holder(parent, opts.cls || 'points', opts.height || 340);
+  if (!h)
+    return null;
+  const { box, legend } = h;
   const options = {
     labels: [opts.xlabel, ...names], xlabel: opts.xlabel, ylabel: opts.ylabel,
     customBars: bars, drawPoints: true, pointSize: 4, highlightCircleSize: 7,

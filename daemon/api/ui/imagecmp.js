@@ -175,9 +175,12 @@ export class ImageCompare {
     const z = this.zoomSelect.value;
     if (z !== 'fit')
       return Number(z);
+    // Fit: the width there is, up to 4 times a small capture's pixels
+    // (nearest-neighbour from 2x up), never cut.
     const avail = Math.max(200, (this.root.clientWidth || 900) - 8);
     const across = this.view === 'side' ? 2 : 1;
-    return Math.min(1, (avail / across - 12) / this.w);
+    const s = (avail / across - 12) / this.w;
+    return s >= 1 ? Math.min(4, Math.floor(s * 4) / 4) : s;
   }
 
   // The difference view as ImageData, for the kind and contrast chosen.

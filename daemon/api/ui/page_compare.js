@@ -43,7 +43,7 @@ export async function render(main) {
       ]),
       row('fps', ra.fps, rb.fps),
       row('worst SSIM', ((ra.quality || {}).worst_ssim || {}).value, ((rb.quality || {}).worst_ssim || {}).value, 6),
-      row('worst FLIP', ((ra.quality || {}).worst_flip || {}).value, ((rb.quality || {}).worst_flip || {}).value),
+      row('worst FLIP (mean)', ((ra.quality || {}).worst_flip || {}).mean, ((rb.quality || {}).worst_flip || {}).mean),
       row('triangles per frame', ra.triangles_per_frame, rb.triangles_per_frame),
       row('lights', ra.lights, rb.lights))));
   main.append(el('div.two', el('div', el('h3', 'A'), noiseVerdict(ra)), el('div', el('h3', 'B'), noiseVerdict(rb))));

@@ -120,6 +120,7 @@ E2E_TESTS = \
 	tests/e2e/e2e_msaa.py \
 	tests/e2e/e2e_fleet.py \
 	tests/e2e/e2e_report.py \
+	tests/e2e/e2e_dashboard.py \
 	tests/e2e/e2e_faults.py \
 	tests/e2e/e2e_runaway.py \
 	tests/e2e/e2e_hardening.py \

@@ -136,3 +136,13 @@ export async function listAll(url, key, max = 5000) {
   }
   return out;
 }
+
+// /v1/info, asked once a page load (the header and the filters share it).
+let infoPromise = null;
+export function info() {
+  if (!infoPromise) {
+    infoPromise = json('/v1/info');
+    infoPromise.catch(() => { infoPromise = null; });
+  }
+  return infoPromise;
+}

@@ -65,7 +65,7 @@ async function route() {
 
 async function header() {
   try {
-    const info = await api.json('/v1/info');
+    const info = await api.info();
     const d = info.device || {};
     document.getElementById('device').textContent =
       `${info.name || 'shadebenchd'} ${info.version || ''} · ${d.gl_renderer || d.renderer || ''}`;

@@ -178,9 +178,10 @@ export async function render(main, id) {
       job.error ? el('p.error', job.error) : null);
   }
 
-  async function poll() {
+  async function poll(fresh = false) {
     try {
-      job = await api.json(`/v1/jobs/${id}`);
+      if (!fresh)
+        job = await api.json(`/v1/jobs/${id}`);
     } catch (err) {
       live.replaceChildren(errorBox(err));
     }
@@ -199,6 +200,13 @@ export async function render(main, id) {
 
   async function drawResult() {
     const r = job.result || {};
+    // Everything the page shows is asked for at once, drawn as it comes.
+    const timings = api.text(job.timings_url);
+    timings.catch(() => {});
+    for (const cap of r.captures || [])
+      for (const url of [cap.url, cap.reference_url])
+        if (url)
+          api.imageUrl(url).catch(() => {});
     body.append(noiseVerdict(r), headline(job));
     // Frame times.
     const series = seriesFor(r);
@@ -206,7 +214,7 @@ export async function render(main, id) {
       el('p.muted', `Drag to zoom, double-click to zoom out; ${series} is the figure that compares techniques on this device.`));
     body.append(timesBox);
     try {
-      const csv = charts.parseCsv(await api.text(job.timings_url));
+      const csv = charts.parseCsv(await timings);
       const shown = ['frame_ms', 'gpu_ms', 'cpu_ms'].filter((s) => csv.header.includes(s));
       charts.frameTimes(timesBox, csv, shown);
       const col = csv.header.indexOf(series);
@@ -245,7 +253,7 @@ export async function render(main, id) {
   }
 
   drawHead();
-  await poll();
+  await poll(true);
   return () => {
     stopped = true;
     clearTimeout(timer);

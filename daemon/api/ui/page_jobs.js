@@ -59,7 +59,7 @@ async function cancel(job, button) {
 
 export async function render(main) {
   const query = hashQuery();
-  const info = await api.json('/v1/info').catch(() => ({}));
+  const info = await api.info().catch(() => ({}));
   const techniques = (info.techniques || []).map((t) => t.name);
   const form = el('form.filters', { id: 'job-filters' },
     el('label', 'technique ', el('select', { name: 'technique' },

@@ -140,4 +140,23 @@ bool metrics_write_ssim_map(const char *path, const struct ssim_result *s, char 
 bool metrics_write_flip_map(const char *path, const struct flip_result *f, int width,
                             int height, char *err, size_t errlen);
 
+/* The FLIP map's ramp: its stops (r, g, b in 0..1, from 0 to 1 evenly);
+ * returns their count. /v1/info serves it, so that a page can read values
+ * back from the map. */
+int metrics_flip_ramp(const float (**stops)[3]);
+/* The colour of FLIP value v (0 to 1), as the map writes it. */
+void metrics_flip_ramp_colour(float v, uint8_t rgb[3]);
+/* The value a colour of the map stands for: the nearest point of the ramp. */
+float metrics_flip_ramp_value(const uint8_t rgb[3]);
+
+/* Difference views for people, with contrast (the reports): a FLIP map
+ * (ramp colours) with its values times gain, cut at 1; an SSIM map (grey,
+ * white = 1) with its shortfall from 1 times gain; |a - b| per channel
+ * times gain into out (malloc'ed; image_finish it), with the count of
+ * pixels that differ at all. */
+void metrics_stretch_flip_map(struct image *map, float gain);
+void metrics_stretch_ssim_map(struct image *map, float gain);
+bool metrics_abs_difference(const struct image *a, const struct image *b, float gain,
+                            struct image *out, long *differing);
+
 #endif

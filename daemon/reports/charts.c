@@ -49,8 +49,13 @@ struct level {
 };
 
 struct axis {
-    double lo, hi; /* in log10 units when log */
+    double lo, hi; /* in log10 units when log, in -log10(1 - v) when loss */
     bool log;
+    /* SSIM's axis: -log10(1 - v), so that 0.999, 0.9999 and 0.99999 are a
+     * decade apart instead of a hair; 1 - v below floor (exact, or closer
+     * than a tenth of the best inexact score) sits at floor, the top. */
+    bool loss;
+    double floor;
 };
 
 struct chart {
@@ -123,7 +128,17 @@ static void series_note(const char *series, const json_t *device, bool chosen, c
 /* On a log axis, zero and below sit at the axis' lower end. */
 static double to_axis(const struct axis *a, double v)
 {
+    if (a->loss)
+        return -log10(fmax(1.0 - v, a->floor));
     return a->log ? (v > 0 ? fmax(log10(v), a->lo) : a->lo) : v;
+}
+
+/* A value of the axis' own units back in data units. */
+static double from_axis(const struct axis *a, double t)
+{
+    if (a->loss)
+        return 1.0 - pow(10.0, -t);
+    return a->log ? pow(10.0, t) : t;
 }
 
 static double map(const struct axis *a, double v, double p0, double p1)
@@ -136,7 +151,7 @@ static double map(const struct axis *a, double v, double p0, double p1)
  * below zero. */
 static struct axis make_axis(double lo, double hi, bool log_ok, bool nonneg)
 {
-    struct axis a = {lo, hi, false};
+    struct axis a = {lo, hi, false, false, 0};
     if (log_ok && lo > 0 && hi / lo > 10.0) {
         a.log = true;
         a.lo = log10(lo) - 0.06 * (log10(hi) - log10(lo));
@@ -159,6 +174,22 @@ static struct axis make_axis(double lo, double hi, bool log_ok, bool nonneg)
 static int ticks(const struct axis *a, double *out, int cap)
 {
     int n = 0;
+    if (a->loss) {
+        /* 0.9, 0.99, 0.999, ... (with 1 - 2 and 1 - 5 times the decade where
+         * the axis spans few decades), and exact at the floor. */
+        bool fine = a->hi - a->lo < 3.0;
+        for (int e = (int)floor(a->lo); e <= (int)ceil(a->hi) && n < cap; e++)
+            for (int m = 5; m >= 1 && n < cap; m -= m == 5 ? 3 : (m == 2 ? 1 : 1)) {
+                if (m != 1 && !fine)
+                    continue;
+                double t = -log10(m * pow(10.0, -e));
+                if (t >= a->lo && t <= a->hi && t < -log10(a->floor) - 0.3)
+                    out[n++] = 1.0 - m * pow(10.0, -e);
+            }
+        if (n < cap && -log10(a->floor) <= a->hi)
+            out[n++] = 1.0;
+        return n;
+    }
     if (a->log) {
         for (int e = (int)floor(a->lo); e <= (int)ceil(a->hi) && n < cap; e++)
             for (int m = 1; m <= 5 && n < cap; m += m == 1 ? 1 : 3) {
@@ -401,7 +432,12 @@ static void draw(cairo_t *cr, struct chart *c)
         cairo_line_to(cr, f.x1, y);
         cairo_stroke(cr);
         cairo_set_source_rgb(cr, 0.2, 0.2, 0.2);
-        snprintf(buf, sizeof(buf), "%.6g", tv[i]);
+        if (c->ay.loss && tv[i] >= 1.0)
+            snprintf(buf, sizeof(buf), "1 (exact)");
+        else if (c->ay.loss) /* as many decimals as the nines need: 0.99995 */
+            snprintf(buf, sizeof(buf), "%.*f", (int)ceil(-log10(1.0 - tv[i]) - 1e-9), tv[i]);
+        else
+            snprintf(buf, sizeof(buf), "%.6g", tv[i]);
         text(cr, f.x0 - 8, y + 4, buf, 12, 1.0);
     }
     if (c->categorical_x) {
@@ -439,7 +475,8 @@ static void draw(cairo_t *cr, struct chart *c)
     cairo_save(cr);
     cairo_translate(cr, f.x0 - 66, (f.y0 + f.y1) / 2);
     cairo_rotate(cr, -M_PI / 2);
-    snprintf(axis_label, sizeof(axis_label), "%s%s", c->ylabel, c->ay.log ? " (log scale)" : "");
+    snprintf(axis_label, sizeof(axis_label), "%s%s", c->ylabel,
+             c->ay.loss ? " (log scale of 1 - SSIM)" : c->ay.log ? " (log scale)" : "");
     text(cr, 0, 0, axis_label, 14, 0.5);
     cairo_restore(cr);
     cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
@@ -818,7 +855,8 @@ static json_t *layout_json(const struct chart *c)
                             "x_log", c->ax.log, "y_log", c->ay.log, "points", pts, "workloads",
                             workloads, "fronts", fronts, "levels", levels, "labels_left_out",
                             c->labels_left_out, "footer", footer, "partial", c->partial,
-                            "y_range", c->ay.lo, c->ay.hi);
+                            "y_range", from_axis(&c->ay, c->ay.lo), from_axis(&c->ay, c->ay.hi));
+    json_object_set_new(out, "y_scale", json_string(c->ay.loss ? "one_minus_log" : c->ay.log ? "log" : "linear"));
     json_object_set_new(out, "jnd", c->has_jnd ? json_real(c->jnd_y) : json_null());
     return out;
 }
@@ -903,16 +941,31 @@ static void fit_axes(struct chart *c)
                     yh / ypos > 10.0;
     /* Times never go below zero; a swept parameter or SSIM may. */
     bool sa = strcmp(c->name, "speed_accuracy") == 0;
-    c->ax = c->categorical_x ? (struct axis){-0.5, c->ncategories - 0.5, false}
+    c->ax = c->categorical_x ? (struct axis){-0.5, c->ncategories - 0.5, false, false, 0}
                              : make_axis(x_log_ok ? xpos : xl, xh, x_log_ok, sa);
     c->ay = make_axis(y_log_ok ? ypos : yl, yh, y_log_ok, !sa);
-    if (c->quality_y) {
-        /* From the worst score, or from 0.99 (FLIP 0.01) when every score is
-         * better, to exact: a difference of 1e-5 stays a hair, not a cliff. */
-        double lo = c->flip ? 0.0 : fmin(c->n ? yl : 1.0, 0.99);
-        double hi = c->flip ? fmax(c->n ? yh : 0.0, 0.01) : 1.0;
+    if (c->quality_y && c->flip) {
+        /* FLIP from 0 to the worst, or to 0.01 when every score is better. */
+        double lo = 0.0, hi = fmax(c->n ? yh : 0.0, 0.01);
         double pad = (hi - lo) * 0.06;
-        c->ay = (struct axis){lo - pad, hi + pad, false};
+        c->ay = (struct axis){lo - pad, hi + pad, false, false, 0};
+    } else if (c->quality_y) {
+        /* SSIM on -log10(1 - SSIM): from the worst score (0.99 at least) to
+         * exact, a decade above the best inexact score, so that 0.99998
+         * and 0.99997 are apart and neither is drawn as exact. */
+        double worst = 1.0, best = 1.0;
+        for (int i = 0; i < c->n; i++) {
+            double loss = 1.0 - c->pts[i].y;
+            if (loss > 0) {
+                worst = fmin(worst, c->pts[i].y);
+                best = best >= 1.0 ? c->pts[i].y : fmax(best, c->pts[i].y);
+            }
+        }
+        double floor_loss = best < 1.0 ? (1.0 - best) / 10.0 : 1e-6;
+        double lo = -log10(fmax(1.0 - fmin(worst, 0.99), floor_loss * 10.0));
+        double hi = -log10(floor_loss);
+        double pad = (hi - lo) * 0.06;
+        c->ay = (struct axis){lo - pad, hi + pad, false, true, floor_loss};
     }
 }
 

@@ -15,10 +15,17 @@
 #include "common/job_files.h"
 #include "common/png_io.h"
 #include "common/result_keys.h"
+#include "daemon/reports/diff_views.h"
 
 /* Points of a sweep that get thumbnails: enough to see how the image
  * changes, few enough that the page stays a reasonable size. */
 enum { THUMB_POINTS = 64, THUMB_WIDTH = 240 };
+/* A job report's captures and difference views: at their size up to this
+ * width; the views' contrast (each error times this, cut at the top). */
+enum { VIEW_WIDTH = 960 };
+static const float GAIN_ABS = 8, GAIN_SSIM = 8, GAIN_FLIP = 4;
+
+static const char *str(const json_t *o, const char *key);
 
 struct html {
     char *data;
@@ -95,15 +102,20 @@ static void png_img(struct html *h, const unsigned char *png, size_t len, const 
     put(h, "\">", 2);
 }
 
-/* A thumbnail of a PNG file in the job's directory, or a note if missing. */
-static void thumbnail(struct html *h, const char *dir, enum job_image image, int frame,
-                      const char *caption)
+/* A thumbnail of a PNG file in the job's directory, or a note if missing;
+ * an SSIM or FLIP map with its contrast stretched by gain (0: as it is). */
+static void stretched_thumbnail(struct html *h, const char *dir, enum job_image image, int frame,
+                                float gain, const char *caption)
 {
     char path[PATH_MAX + JOB_IMAGE_NAME_MAX], err[256];
     job_image_path(dir, image, frame, path, sizeof(path));
     struct image img;
     add(h, "<figure>");
     if (png_read_rgb(path, &img, err, sizeof(err))) {
+        if (gain > 0 && image == JOB_IMAGE_FLIP)
+            metrics_stretch_flip_map(&img, gain);
+        else if (gain > 0 && image == JOB_IMAGE_SSIM)
+            metrics_stretch_ssim_map(&img, gain);
         size_t len = 0;
         unsigned char *png = png_encode_thumbnail(&img, THUMB_WIDTH, &len);
         if (png)
@@ -116,6 +128,164 @@ static void thumbnail(struct html *h, const char *dir, enum job_image image, int
     add(h, "<figcaption>");
     escaped(h, caption);
     add(h, "</figcaption></figure>");
+}
+
+static void thumbnail(struct html *h, const char *dir, enum job_image image, int frame,
+                      const char *caption)
+{
+    stretched_thumbnail(h, dir, image, frame, 0, caption);
+}
+
+/* An image of the report's own making, at its size up to VIEW_WIDTH. */
+static void view_figure(struct html *h, const struct image *img, const char *caption)
+{
+    size_t len = 0;
+    unsigned char *png = img && img->rgb ? png_encode_thumbnail(img, VIEW_WIDTH, &len) : NULL;
+    add(h, "<figure class=\"view\">");
+    if (png)
+        png_img(h, png, len, caption, "view");
+    else
+        add(h, "<div class=\"missing\">no image</div>");
+    free(png);
+    add(h, "<figcaption>");
+    escaped(h, caption);
+    add(h, "</figcaption></figure>");
+}
+
+static bool read_image(const char *dir, enum job_image image, int frame, struct image *img)
+{
+    char path[PATH_MAX + JOB_IMAGE_NAME_MAX], err[256];
+    memset(img, 0, sizeof(*img));
+    return job_image_path(dir, image, frame, path, sizeof(path)) &&
+           png_read_rgb(path, img, err, sizeof(err));
+}
+
+/* A job's capture: the frame and its reference at their size, then the
+ * difference views with their contrast stretched, as the dashboard shows
+ * them: |frame - reference|, the SSIM map's shortfall, the FLIP map, and
+ * PerceptualDiff's failing pixels with their count. */
+static void capture_views(struct html *h, const json_t *job, const char *dir, const json_t *cap)
+{
+    int frame = (int)json_integer_value(json_object_get(cap, "frame"));
+    json_t *m = json_object_get(cap, "metrics");
+    struct image test, ref, view;
+    bool has_test = read_image(dir, JOB_IMAGE_FRAME, frame, &test);
+    char caption[256];
+    snprintf(caption, sizeof(caption), "frame %d (%s)", frame, str(job, "technique"));
+    view_figure(h, has_test ? &test : NULL, caption);
+    if (!m) {
+        image_finish(&test);
+        return;
+    }
+    bool has_ref = read_image(dir, JOB_IMAGE_REFERENCE, frame, &ref);
+    const json_t *q = json_object_get(json_object_get(job, RK_RESULT), RK_QUALITY);
+    snprintf(caption, sizeof(caption), "reference (%s)", str(q, "reference"));
+    view_figure(h, has_ref ? &ref : NULL, caption);
+    add(h, "<br>");
+    long differing = 0;
+    if (has_test && has_ref && metrics_abs_difference(&test, &ref, GAIN_ABS, &view, &differing)) {
+        snprintf(caption, sizeof(caption), "|frame - reference| per channel x %g: %ld pixels differ",
+                 GAIN_ABS, differing);
+        view_figure(h, &view, caption);
+        image_finish(&view);
+    }
+    json_t *worst = json_object_get(m, "ssim_min");
+    if (read_image(dir, JOB_IMAGE_SSIM, frame, &view)) {
+        metrics_stretch_ssim_map(&view, GAIN_SSIM);
+        snprintf(caption, sizeof(caption), "SSIM map (white = 1), its shortfall x %g; the worst "
+                 "11x11 window, %.4f, is centred at %lld, %lld", GAIN_SSIM,
+                 json_number_value(json_object_get(worst, "value")),
+                 (long long)json_integer_value(json_object_get(worst, "x")),
+                 (long long)json_integer_value(json_object_get(worst, "y")));
+        view_figure(h, &view, caption);
+        image_finish(&view);
+    }
+    if (read_image(dir, JOB_IMAGE_FLIP, frame, &view)) {
+        metrics_stretch_flip_map(&view, GAIN_FLIP);
+        snprintf(caption, sizeof(caption), "FLIP map x %g (black 0, pale yellow 1); mean %.5f",
+                 GAIN_FLIP, json_number_value(json_object_get(json_object_get(m, "flip"), "mean")));
+        view_figure(h, &view, caption);
+        image_finish(&view);
+    }
+    long failing = 0;
+    char err[256];
+    json_t *pd = json_object_get(m, "pdiff");
+    if (pd && has_ref && diff_views_pdiff_mask(job, dir, frame, &view, &failing, err, sizeof(err))) {
+        snprintf(caption, sizeof(caption), "PerceptualDiff: %ld failing pixels (white), %s at a "
+                 "threshold of %lld", failing, json_is_true(json_object_get(pd, "pass")) ? "passes"
+                 : "fails", (long long)json_integer_value(json_object_get(pd, "threshold_pixels")));
+        view_figure(h, &view, caption);
+        image_finish(&view);
+    }
+    image_finish(&test);
+    image_finish(&ref);
+}
+
+/* A JSON value people read: objects as tables of name and value (nested
+ * ones nested), lists of numbers on one line, lists of objects as a table
+ * with a column a key, reals to 9 significant digits (as dump). */
+static void value_html(struct html *h, const json_t *v)
+{
+    if (json_is_object(v)) {
+        add(h, "<table class=\"kv\">");
+        const char *k;
+        json_t *x;
+        json_object_foreach((json_t *)v, k, x) {
+            add(h, "<tr><th>");
+            escaped(h, k);
+            add(h, "</th><td>");
+            value_html(h, x);
+            add(h, "</td></tr>");
+        }
+        add(h, "</table>");
+    } else if (json_is_array(v)) {
+        size_t i;
+        json_t *x;
+        bool objects = json_array_size(v) > 0;
+        json_array_foreach((json_t *)v, i, x) objects = objects && json_is_object(x);
+        if (objects) {
+            json_t *keys = json_object();
+            json_array_foreach((json_t *)v, i, x) {
+                const char *k;
+                json_t *y;
+                json_object_foreach(x, k, y) json_object_set_new(keys, k, json_true());
+            }
+            add(h, "<table class=\"kv\"><tr>");
+            const char *k;
+            json_t *y;
+            json_object_foreach(keys, k, y) {
+                add(h, "<th>");
+                escaped(h, k);
+                add(h, "</th>");
+            }
+            add(h, "</tr>");
+            json_array_foreach((json_t *)v, i, x) {
+                add(h, "<tr>");
+                json_object_foreach(keys, k, y) {
+                    add(h, "<td>");
+                    value_html(h, json_object_get(x, k));
+                    add(h, "</td>");
+                }
+                add(h, "</tr>");
+            }
+            add(h, "</table>");
+            json_decref(keys);
+        } else {
+            json_array_foreach((json_t *)v, i, x) {
+                if (i)
+                    add(h, ", ");
+                value_html(h, x);
+            }
+        }
+    } else if (json_is_integer(v)) {
+        add(h, "%lld", (long long)json_integer_value(v));
+    } else if (json_is_real(v)) {
+        add(h, "%.9g", json_real_value(v));
+    } else if (json_is_string(v)) {
+        escaped(h, json_string_value(v));
+    } else {
+        add(h, "%s", json_is_true(v) ? "true" : json_is_false(v) ? "false" : "-");
+    }
 }
 
 static void chart(struct html *h, const json_t *subject, const char *name, bool sweep,
@@ -162,9 +332,16 @@ static void head(struct html *h, const char *title, const json_t *device)
            "img.chart{max-width:100%%;border:1px solid #ddd;margin:0.5em 0}"
            "figure{display:inline-block;margin:4px;text-align:center;font-size:12px}"
            "img.thumb{display:block;border:1px solid #ccc}"
+           "img.view{display:block;border:1px solid #ccc;max-width:100%%;"
+           "min-width:min(320px,100%%);image-rendering:pixelated}"
+           "figure.view{display:inline-table;vertical-align:top;max-width:%dpx}"
+           "figure.view figcaption{display:table-caption;caption-side:bottom}"
+           "table.kv{margin:0}table.kv td,table.kv th{text-align:left;border:none;"
+           "border-top:1px solid #eee;padding:2px 8px;vertical-align:top}"
+           "table.kv th{background:none;font-weight:600}"
            ".missing{width:240px;height:60px;background:#eee}"
            "pre{background:#f7f7f7;padding:1em;overflow:auto;font-size:12px}"
-           "</style></head><body><h1>");
+           "</style></head><body><h1>", VIEW_WIDTH);
     escaped(h, title);
     add(h, "</h1><p>shadebenchd %s on <b>", PACKAGE_VERSION);
     escaped(h, str(device, "gl_renderer"));
@@ -256,6 +433,66 @@ static void against_html(struct html *h, const json_t *pt, const char *what)
         add(h, ", as fast as far as the intervals tell as ");
         name_list(h, tied, 4, "");
     }
+}
+
+/* One point of the summary: technique and values, time, and its ratio
+ * to the reference with the interval (or that the two are not told apart). */
+static void summary_point(struct html *h, const json_t *pt)
+{
+    if (!pt || !json_object_get(pt, "technique")) {
+        add(h, "<td class=\"l\">-</td><td>-</td><td>-</td>");
+        return;
+    }
+    char *vals = dump(json_object_get(pt, "values"), JSON_COMPACT);
+    add(h, "<td class=\"l\"><b>");
+    escaped(h, str(pt, "technique"));
+    add(h, "</b> ");
+    escaped(h, vals);
+    free(vals);
+    add(h, "</td><td>%.3f</td>", json_number_value(json_object_get(pt, "ms")));
+    json_t *ci = json_object_get(pt, "ratio_ci");
+    if (!json_object_get(pt, "ratio")) {
+        add(h, "<td>-</td>");
+        return;
+    }
+    bool told = json_is_true(json_object_get(pt, "distinguishable"));
+    double r = json_number_value(json_object_get(pt, "ratio"));
+    double hi = json_number_value(json_array_get(ci, 1));
+    char hi_text[32];
+    if (hi > 1e6)
+        snprintf(hi_text, sizeof(hi_text), "any");
+    else
+        snprintf(hi_text, sizeof(hi_text), "%.2f", hi);
+    add(h, "<td class=\"%s\">%.2f&times; [%.2f, %s]%s</td>", told ? (r < 1 ? "pass" : "fail") : "", r,
+        json_number_value(json_array_get(ci, 0)), hi_text, told ? "" : "<br>not told apart");
+}
+
+/* The summary first: per workload, the fastest technique and its ratio to
+ * the reference with intervals, and the fastest passing PerceptualDiff. */
+static void summary_html(struct html *h, const json_t *verdict)
+{
+    json_t *rows = json_object_get(verdict, "against_reference");
+    if (!json_array_size(rows))
+        return;
+    add(h, "<h2>Which technique wins where</h2><table><tr><th class=\"l\">workload</th>"
+           "<th>reference, ms [95%%]</th><th class=\"l\">fastest</th><th>ms</th>"
+           "<th>ratio to the reference [95%%]</th><th class=\"l\">fastest passing "
+           "PerceptualDiff</th><th>ms</th><th>ratio [95%%]</th></tr>");
+    size_t i;
+    json_t *w;
+    json_array_foreach(rows, i, w) {
+        json_t *ci = json_object_get(w, "reference_ci");
+        add(h, "<tr><td class=\"l\">");
+        escaped(h, str(w, "workload")[0] ? str(w, "workload") : "all points");
+        add(h, "</td><td>");
+        escaped(h, str(w, "reference"));
+        add(h, " %.3f [%.3f, %.3f]</td>", json_number_value(json_object_get(w, "reference_ms")),
+            json_number_value(json_array_get(ci, 0)), json_number_value(json_array_get(ci, 1)));
+        summary_point(h, json_object_get(w, "fastest"));
+        summary_point(h, json_object_get(w, "fastest_passing"));
+        add(h, "</tr>");
+    }
+    add(h, "</table>");
 }
 
 static void verdict_html(struct html *h, const json_t *v)
@@ -525,6 +762,7 @@ char *report_sweep_html(const json_t *posted, const json_t *device, report_job_d
     add(&h, "</p>");
     const char *series = charts_default_series(device);
     json_t *verdict = sweep_verdict_json(sweep, series);
+    summary_html(&h, verdict);
     verdict_html(&h, verdict);
     json_decref(verdict);
     json_t *points = json_object_get(sweep, "points");
@@ -593,7 +831,7 @@ char *report_sweep_html(const json_t *posted, const json_t *device, report_job_d
     chart(&h, sweep, "distribution", true, &o, "frame-time distributions");
 
     add(&h, "<h2>Captures</h2><p>Last capture of each point: the frame, the reference, "
-            "the SSIM map and the FLIP map%s.</p>",
+            "the SSIM map and the FLIP map, their contrast stretched%s.</p>",
         json_array_size(points) > THUMB_POINTS ? " (the first 64 points)" : "");
     json_array_foreach(points, i, row) {
         if (i >= THUMB_POINTS)
@@ -611,8 +849,8 @@ char *report_sweep_html(const json_t *posted, const json_t *device, report_job_d
         free(values);
         thumbnail(&h, dir, JOB_IMAGE_FRAME, frame, "frame");
         thumbnail(&h, dir, JOB_IMAGE_REFERENCE, frame, "reference");
-        thumbnail(&h, dir, JOB_IMAGE_SSIM, frame, "SSIM map");
-        thumbnail(&h, dir, JOB_IMAGE_FLIP, frame, "FLIP map");
+        stretched_thumbnail(&h, dir, JOB_IMAGE_SSIM, frame, GAIN_SSIM, "SSIM map, shortfall x 8");
+        stretched_thumbnail(&h, dir, JOB_IMAGE_FLIP, frame, GAIN_FLIP, "FLIP map x 4");
         add(&h, "</div>");
     }
     add(&h, "<h2>The sweep as posted</h2>");
@@ -686,13 +924,11 @@ static void technique_figures(struct html *h, const json_t *r, const char *techn
     const char *key;
     json_t *v;
     json_object_foreach(own, key, v) {
-        char *text = json_is_string(v) ? NULL : dump(v, JSON_COMPACT);
         add(h, "<tr><td class=\"l\">");
         escaped(h, key);
         add(h, "</td><td class=\"l\">");
-        escaped(h, json_is_string(v) ? json_string_value(v) : text);
+        value_html(h, v);
         add(h, "</td></tr>");
-        free(text);
     }
     json_object_foreach(sections, key, v) {
         add(h, "<tr><td class=\"l\">gpu_ms of pass ");
@@ -833,12 +1069,7 @@ char *report_job_html(const json_t *job, const char *dir, const json_t *device, 
                     (long long)json_integer_value(json_array_get(json_object_get(tf, "frames"), 1)),
                     json_number_value(json_object_get(tf, "flicker")));
             add(&h, "</h3>");
-            thumbnail(&h, dir, JOB_IMAGE_FRAME, frame, "frame");
-            if (m) {
-                thumbnail(&h, dir, JOB_IMAGE_REFERENCE, frame, "reference");
-                thumbnail(&h, dir, JOB_IMAGE_SSIM, frame, "SSIM map");
-                thumbnail(&h, dir, JOB_IMAGE_FLIP, frame, "FLIP map");
-            }
+            capture_views(&h, job, dir, c);
             add(&h, "</div>");
         }
     }

@@ -4,6 +4,24 @@
 // for the tests.
 import { el, num } from './util.js';
 
+// dygraphs is loaded when a page first draws a chart: the job list, the
+// page most often opened cold, draws none.
+let library = null;
+function dygraphs() {
+  if (!library)
+    library = new Promise((resolve, reject) => {
+      const script = document.createElement('script');
+      script.src = '/ui/vendor/dygraph.min.js';
+      script.onload = () => resolve(window.Dygraph);
+      script.onerror = () => {
+        library = null;
+        reject(new Error('the charting library did not load'));
+      };
+      document.head.append(script);
+    });
+  return library;
+}
+
 const COLOURS = ['#1f77b4', '#d62728', '#2ca02c', '#9467bd', '#ff7f0e', '#17becf', '#8c564b',
   '#e377c2', '#7f7f7f', '#bcbd22'];
 
@@ -31,7 +49,8 @@ export function parseCsv(text) {
 }
 
 // The frame times over the run, one line per series.
-export function frameTimes(parent, csv, series) {
+export async function frameTimes(parent, csv, series) {
+  const Dygraph = await dygraphs();
   const cols = series.map((s) => csv.header.indexOf(s)).filter((i) => i >= 0);
   const data = csv.rows.map((r) => [r[0], ...cols.map((i) => r[i])]);
   const h = holder(parent, 'frame-times');
@@ -51,7 +70,8 @@ export function frameTimes(parent, csv, series) {
 }
 
 // The distribution of one series: counts in equal bins (a step line).
-export function histogram(parent, values, label) {
+export async function histogram(parent, values, label) {
+  const Dygraph = await dygraphs();
   const finite = values.filter((v) => Number.isFinite(v));
   if (!finite.length)
     return null;
@@ -77,7 +97,8 @@ export function histogram(parent, values, label) {
 
 // Points grouped in series: [{series, x, y, lo, hi, label, onClick}] with
 // optional intervals on y. A click on a point calls its onClick.
-export function points(parent, pts, opts) {
+export async function points(parent, pts, opts) {
+  const Dygraph = await dygraphs();
   const names = [...new Set(pts.map((p) => p.series))];
   const sorted = [...pts].sort((a, b) => a.x - b.x);
   const bars = pts.some((p) => Number.isFinite(p.lo) && Number.isFinite(p.hi));

@@ -58,7 +58,7 @@ export async function render(main) {
     const rows = [];
     for (let k = 0; k < n; k++)
       rows.push([k + 1, ca.rows[k] ? ca.rows[k][ia] : NaN, cb.rows[k] ? cb.rows[k][ib] : NaN]);
-    charts.frameTimes(times, { header: ['frame', `A ${series}`, `B ${series}`], rows }, [`A ${series}`, `B ${series}`]);
+    await charts.frameTimes(times, { header: ['frame', `A ${series}`, `B ${series}`], rows }, [`A ${series}`, `B ${series}`]);
   } catch (err) {
     times.append(errorBox(err));
   }

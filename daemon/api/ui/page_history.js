@@ -58,7 +58,7 @@ export async function render(main) {
     const box = el('section', el('h2', `${h.figure} over time`),
       el('p.muted', 'Median with its 95% interval; click a point to open its job. Drag to zoom.'));
     main.append(box);
-    charts.points(box, chartPts, {
+    await charts.points(box, chartPts, {
       cls: 'history', xlabel: 'time', ylabel: `${h.figure} (ms)`, lines: false,
       xformat: (v) => new Date(v).toLocaleString(), yformat: (v) => `${num(v)} ms`,
       xaxis: (v) => new Date(v).toLocaleDateString(),

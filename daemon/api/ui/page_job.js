@@ -216,10 +216,10 @@ export async function render(main, id) {
     try {
       const csv = charts.parseCsv(await timings);
       const shown = ['frame_ms', 'gpu_ms', 'cpu_ms'].filter((s) => csv.header.includes(s));
-      charts.frameTimes(timesBox, csv, shown);
+      await charts.frameTimes(timesBox, csv, shown);
       const col = csv.header.indexOf(series);
       timesBox.append(el('h3', `Distribution of ${series}`));
-      charts.histogram(timesBox, csv.rows.map((row) => row[col]), series);
+      await charts.histogram(timesBox, csv.rows.map((row) => row[col]), series);
     } catch (err) {
       timesBox.append(errorBox(err));
     }

@@ -194,8 +194,8 @@ export async function render(main, id) {
       el('section', el('h2', 'The table'), pointTable(sweep, series)));
     const chartBox = el('section.sweep-charts', el('h2', 'Charts'));
     body.append(chartBox);
-    speedAccuracy(chartBox, sweep, series, verdict.reference || ((sweep.spec || {}).base || {}).reference);
-    timeVsParam(chartBox, sweep, series, verdict);
+    await speedAccuracy(chartBox, sweep, series, verdict.reference || ((sweep.spec || {}).base || {}).reference);
+    await timeVsParam(chartBox, sweep, series, verdict);
     if (sweep.status === 'queued' || sweep.status === 'running')
       timer = setTimeout(() => load().catch((err) => body.append(errorBox(err))), POLL_MS);
   }

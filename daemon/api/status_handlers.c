@@ -48,6 +48,22 @@ static json_t *memory_json(const struct http_server *s, double *total)
                      "estimate, its answer's cost.memory_bytes, is over it is refused)");
 }
 
+/* How to read the difference maps back (the dashboard stretches their
+ * contrast): the FLIP map's ramp, and the SSIM map's encoding. */
+static json_t *maps_json(void)
+{
+    const float(*stops)[3];
+    int n = metrics_flip_ramp(&stops);
+    json_t *ramp = json_array();
+    for (int i = 0; i < n; i++)
+        json_array_append_new(ramp, json_pack("[f, f, f]", stops[i][0], stops[i][1], stops[i][2]));
+    return json_pack("{s:{s:o, s:s}, s:{s:s, s:i}}", "flip", "ramp", ramp, "encoding",
+                     "each pixel's FLIP value v (0 to 1) on the ramp's stops, evenly spaced, "
+                     "linearly between them, in sRGB bytes", "ssim", "encoding",
+                     "grey: the local luma SSIM times 255, clamped to [0, 1] (white = 1)",
+                     "inset_px", SSIM_WINDOW / 2);
+}
+
 json_t *info_json(struct http_server *s)
 {
     double total;
@@ -79,6 +95,7 @@ json_t *info_json(struct http_server *s)
         json_object_set(limits, "max_asset_bytes", json_object_get(assets, "max_asset_bytes"));
         json_object_set_new(limits, "assets", assets);
     }
+    json_object_set_new(info, "maps", maps_json());
     return info;
 }
 

@@ -8,39 +8,44 @@
 import * as api from './api.js';
 import { el, num } from './util.js';
 
-// The FLIP map's colour ramp, as daemon/quality/diffmap.c writes it: the
-// page maps each colour back to its value to stretch the contrast.
-const FLIP_RAMP = [
-  [0.00, 0.00, 0.02], [0.23, 0.06, 0.44], [0.55, 0.16, 0.51],
-  [0.87, 0.29, 0.41], [0.99, 0.62, 0.41], [0.99, 0.99, 0.75],
-];
+// The FLIP map's colour ramp as the daemon writes it (/v1/info's
+// maps.flip.ramp): the page maps each colour back to its value to stretch
+// the contrast, and the stretched value to its colour.
+let ramp = null;
+let flipInverse = null;
 
-function rampColour(v) {
-  const stops = FLIP_RAMP.length - 1;
+// C's lrintf: halves to even.
+function roundEven(x) {
+  const r = Math.round(x);
+  return Math.abs(x % 1) === 0.5 && r % 2 ? r - 1 : r;
+}
+
+function rampColour(v, round = roundEven) {
+  const stops = ramp.length - 1;
   v = Math.min(1, Math.max(0, v));
   const pos = v * stops;
   const k = Math.min(Math.floor(pos), stops - 1);
   const t = pos - k;
-  return FLIP_RAMP[k].map((c, i) => Math.round((c + (FLIP_RAMP[k + 1][i] - c) * t) * 255));
+  return ramp[k].map((c, i) => round((c + (ramp[k + 1][i] - c) * t) * 255));
 }
 
-let flipInverse = null;
 // Colour (packed RGB) to FLIP value, for every colour the ramp writes.
 function flipValueOf(r, g, b) {
   if (!flipInverse) {
     flipInverse = new Map();
     const steps = 1 << 16;
-    for (let i = 0; i <= steps; i++) {
-      const [cr, cg, cb] = rampColour(i / steps);
-      const key = (cr << 16) | (cg << 8) | cb;
-      if (!flipInverse.has(key))
-        flipInverse.set(key, i / steps);
-    }
+    for (let i = 0; i <= steps; i++)
+      for (const round of [roundEven, Math.round]) { // float rounding may differ from C's
+        const [cr, cg, cb] = rampColour(i / steps, round);
+        const key = (cr << 16) | (cg << 8) | cb;
+        if (!flipInverse.has(key))
+          flipInverse.set(key, i / steps);
+      }
   }
   const v = flipInverse.get((r << 16) | (g << 8) | b);
   if (v !== undefined)
     return v;
-  // Not a ramp colour (a resampled map): the nearest by luminance order.
+  // Not a ramp colour (a resampled map): by its brightness.
   return Math.min(1, (0.2126 * r + 0.7152 * g + 0.0722 * b) / 255);
 }
 
@@ -75,6 +80,10 @@ export class ImageCompare {
 
   async mount(parent) {
     parent.append(this.root);
+    if (!ramp) {
+      const info = await api.info();
+      ramp = ((info.maps || {}).flip || {}).ramp || [[0, 0, 0], [1, 1, 1]];
+    }
     const [a, b] = await Promise.all([api.image(this.opts.a.url), api.image(this.opts.b.url)]);
     this.w = a.naturalWidth;
     this.h = a.naturalHeight;

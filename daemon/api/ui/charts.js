@@ -122,7 +122,7 @@ export async function points(parent, pts, opts) {
       x: { logscale: !!opts.logx, valueFormatter: opts.xformat || ((v) => num(v)),
         axisLabelFormatter: opts.xaxis || ((v) => num(v, 3)) },
       y: { valueFormatter: opts.yformat || ((v) => num(v)), axisLabelFormatter: opts.yaxis || ((v) => num(v, 3)),
-        axisLabelWidth: 64 },
+        axisLabelWidth: 72 },
     },
     xRangePad: 14, yRangePad: 14,
 
@@ -146,6 +146,8 @@ export async function points(parent, pts, opts) {
         pt.onClick();
     },
   };
+  if (opts.yticker)
+    options.axes.y.ticker = opts.yticker;
   // dygraphs calls any callback option that is not null: leave absent ones out.
   if (opts.lines)
     options.highlightSeriesOpts = { strokeWidth: 2.5 };

@@ -110,29 +110,51 @@ function pointTable(sweep, series) {
     })));
 }
 
-// Speed against accuracy: x the time, y 1 − worst SSIM on a log axis, so
-// that 0.9999 and 0.999 are a decade apart instead of a hair; the exact
-// reference sits on the floor.
+// Speed against accuracy: x the time, y the worst SSIM on -log10(1 - SSIM),
+// as the report's chart has it, so that 0.999, 0.9999 and 0.99999 are a
+// decade apart instead of a hair at the top of 0.99 to 1; exact points
+// (the reference) sit at the top, a decade above the best inexact score.
+function ssimText(ssim) {
+  if (ssim >= 1)
+    return '1 (exact)';
+  const nines = Math.max(2, Math.ceil(-Math.log10(1 - ssim) - 1e-9));
+  return ssim.toFixed(Math.min(8, nines + 1)).replace(/0$/, '');
+}
+
 function speedAccuracy(parent, sweep, series, reference) {
   const rows = (sweep.points || []).filter((r) => r[series] && typeof r[series].median === 'number');
   const losses = rows.map((r) => 1 - r.worst_ssim).filter((v) => Number.isFinite(v) && v > 0);
-  const floor = losses.length ? Math.min(...losses) / 4 : 1e-6;
+  const floor = losses.length ? Math.min(...losses) / 10 : 1e-6;
+  const top = -Math.log10(floor);
   const pts = rows.filter((r) => typeof r.worst_ssim === 'number' || r.technique === reference).map((r) => {
-    const loss = typeof r.worst_ssim === 'number' ? 1 - r.worst_ssim : 0;
+    const ssim = typeof r.worst_ssim === 'number' ? r.worst_ssim : 1;
     return {
-      series: r.technique, x: r[series].median, y: Math.max(loss, floor),
-      label: valuesText(r.values) + (loss <= 0 ? ' (exact)' : ` (SSIM ${num(r.worst_ssim, 6)})`),
+      series: r.technique, x: r[series].median, y: -Math.log10(Math.max(1 - ssim, floor)), ssim,
+      label: `${valuesText(r.values)} (SSIM ${ssimText(ssim)})`,
       onClick: r.job ? () => { location.hash = `#/job/${r.job}`; } : null, job: r.job,
     };
   });
   if (!pts.length)
     return parent.append(el('p.muted', 'No point has both a time and an SSIM yet.'));
   parent.append(el('h3', 'Speed against accuracy'),
-    el('p.muted', `x: median ${series}; y: 1 − worst SSIM, logarithmic (lower is more accurate; the floor stands for exact). Click a point to open its job.`));
+    el('p.muted', `x: median ${series}; y: the worst SSIM on a log scale of 1 − SSIM (higher is more accurate; the top line is exact). Click a point to open its job.`));
+  const bottom = Math.min(2, ...pts.map((p) => p.y));
   return charts.points(parent, pts, {
-    cls: 'speed-accuracy', xlabel: `${series} (ms)`, ylabel: '1 − worst SSIM', logy: true,
-    yformat: (v) => (v <= floor ? 'exact' : `${num(v, 3)} (SSIM ${num(1 - v, 6)})`),
-    yaxis: (v) => (v <= floor * 1.0001 ? 'exact' : Number(v).toExponential(0)),
+    cls: 'speed-accuracy', xlabel: `${series} (ms)`, ylabel: 'worst SSIM',
+    yformat: (v) => ssimText(v >= top - 1e-9 ? 1 : 1 - 10 ** -v),
+    yaxis: (v) => ssimText(v >= top - 1e-9 ? 1 : 1 - 10 ** -v),
+    yticker: () => {
+      const ticks = [];
+      const fine = top - bottom < 3;
+      for (let e = Math.floor(bottom); e <= Math.ceil(top); e++)
+        for (const m of fine ? [5, 2, 1] : [1]) {
+          const v = -Math.log10(m * 10 ** -e);
+          if (v >= bottom - 0.3 && v < top - 0.3)
+            ticks.push({ v, label: ssimText(1 - m * 10 ** -e) });
+        }
+      ticks.push({ v: top, label: '1 (exact)' });
+      return ticks;
+    },
   });
 }
 

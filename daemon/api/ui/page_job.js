@@ -137,9 +137,15 @@ async function captureSection(job, cap, heat) {
   if (heat) {
     const img = el('img.heat', { alt: `light evaluations per pixel, frame ${cap.frame}` });
     api.imageUrl(heat.url).then((u) => { img.src = u; });
+    // One scale for every job and technique where the daemon states it
+    // (heatmap.scale), else the capture's own (scale_max).
+    const scale = job.result.heatmap.scale;
+    const how = scale
+      ? `${scale.kind || 'log'} scale, white = ${num(scale.max)} evaluations, the same for every job and technique` +
+        `${scale.legend ? `; ${scale.legend}` : ''}`
+      : `white = ${num(heat.scale_max)} evaluations (this capture's own scale; ${job.result.heatmap.ramp || ''})`;
     box.append(el('div.heatmap', el('h4', 'Light evaluations per pixel'), img,
-      el('p.muted', `mean ${num(heat.mean)}, max ${num(heat.max)}; white = ${num(heat.scale_max)} evaluations` +
-        ` (${job.result.heatmap.ramp || 'ramp'}, one scale for every technique)`)));
+      el('p.muted', `mean ${num(heat.mean)}, max ${num(heat.max)}; ${how}`)));
   }
   return box;
 }

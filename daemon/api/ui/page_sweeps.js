@@ -176,6 +176,16 @@ function timeVsParam(parent, sweep, series, verdict) {
       onClick: r.job ? () => { location.hash = `#/job/${r.job}`; } : null,
     };
   });
+  // The reference, timed once per workload without the parameter: a level
+  // across the chart, with its interval.
+  const xs2 = pts.map((p) => p.x);
+  for (const r of rows.filter((q) => typeof q.values[param] !== 'number'))
+    for (const x of [Math.min(...xs2), Math.max(...xs2)])
+      pts.push({
+        series: `${r.technique} (reference)`, x, y: r[series].median, lo: (r[series].ci95 || [])[0],
+        hi: (r[series].ci95 || [])[1], label: valuesText(r.values, false),
+        onClick: r.job ? () => { location.hash = `#/job/${r.job}`; } : null,
+      });
   parent.append(el('h3', `Time against ${param}`),
     el('p.muted', `Median ${series} with its 95% interval, a line per technique${logx ? '; x logarithmic' : ''}. Click a point to open its job.`));
   void verdict;

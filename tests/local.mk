@@ -15,6 +15,7 @@ UNIT_TESTS = \
 	tests/unit/test_stats \
 	tests/unit/test_scene \
 	tests/unit/test_scene_asset \
+	tests/unit/test_scene_view \
 	tests/unit/test_osl \
 	tests/unit/test_metrics \
 	tests/unit/test_flicker \
@@ -47,6 +48,7 @@ tests_unit_test_store_LDADD = $(CORE_LIBS)
 tests_unit_test_stats_LDADD = $(CORE_LIBS)
 tests_unit_test_scene_LDADD = $(CORE_LIBS)
 tests_unit_test_scene_asset_LDADD = $(CORE_LIBS) -lm
+tests_unit_test_scene_view_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_osl_LDADD = $(CORE_LIBS)
 tests_unit_test_light_shape_LDADD = $(CORE_LIBS)
 tests_unit_test_metrics_LDADD = $(CORE_LIBS)

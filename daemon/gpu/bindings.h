@@ -64,6 +64,7 @@
 /* Harness-owned units, bound before every frame's passes for the lighting
  * library (look.ibl, look.shadows): techniques leave 10 and up alone. */
 #define SB_TEX_IBL_SOURCE 10      /* setup only: the cube map being filtered */
+#define SB_TEX_ENV_MAP 11         /* the sky pass: an uploaded equirectangular environment */
 #define SB_TEX_IBL_IRRADIANCE 12  /* cube map array: environment, then each probe */
 #define SB_TEX_IBL_PREFILTERED 13 /* cube map array, roughness picks the level */
 #define SB_TEX_IBL_BRDF 14        /* the split sum's (A, B) table */

@@ -26,6 +26,7 @@
 #include "common/clock.h"
 #include "common/fsutil.h"
 #include "common/log.h"
+#include "daemon/scene/environment.h"
 
 /* Free space an upload must leave beside itself, as the store's reserve
  * asks for jobs (store_reserve.h): an asset never takes the room a job's
@@ -443,14 +444,15 @@ static json_t *record_json(const struct store_asset *r, bool full)
      * its numbers as they are. */
     json_t *summary = json_object();
     static const char *const keys[] = {"meshes", "triangles", "vertices", "materials",
-                                       "textures", "images", "lights", "cameras"};
+                                       "textures", "images", "lights", "cameras",
+                                       "kind", "width", "height"};
     for (size_t i = 0; summary && i < sizeof(keys) / sizeof(keys[0]); i++) {
         json_t *v = json_object_get(r->description, keys[i]);
         if (json_is_array(v))
             json_object_set_new(summary, keys[i], json_integer((json_int_t)json_array_size(v)));
         else if (json_is_object(v) && json_is_integer(json_object_get(v, "count")))
             json_object_set(summary, keys[i], json_object_get(v, "count"));
-        else if (json_is_number(v))
+        else if (json_is_number(v) || json_is_string(v))
             json_object_set(summary, keys[i], v);
     }
     json_object_set_new(o, "summary", summary ? summary : json_null());
@@ -723,6 +725,8 @@ static bool has_asset_ext(const char *name, char ext[8])
         return snprintf(ext, 8, "glb"), true;
     if (dot && strcasecmp(dot, ".gltf") == 0)
         return snprintf(ext, 8, "gltf"), true;
+    if (dot && strcasecmp(dot, ".hdr") == 0)
+        return snprintf(ext, 8, "hdr"), true;
     return false;
 }
 
@@ -937,9 +941,12 @@ double assets_answer_wait_s(const struct assets *a)
 
 json_t *assets_info_json(const struct assets *a)
 {
-    return json_pack("{s:I, s:o, s:I, s:I, s:f, s:i, s:i}", "max_asset_bytes",
+    struct environment_limits env;
+    environment_limits_defaults(&env);
+    return json_pack("{s:I, s:o, s:o, s:I, s:I, s:f, s:i, s:i}", "max_asset_bytes",
                      (json_int_t)a->cfg.max_asset_bytes, "limits",
-                     asset_limits_to_json(&a->cfg.limits), "max_memory_bytes",
+                     asset_limits_to_json(&a->cfg.limits), "environment_limits",
+                     environment_limits_to_json(&env), "max_memory_bytes",
                      (json_int_t)a->cfg.run.memory_bytes, "max_cpu_seconds",
                      (json_int_t)a->cfg.run.cpu_s, "timeout_s", a->cfg.run.wall_s,
                      "conversions_at_once", ASSETS_WORKERS, "max_uploads_at_once",
@@ -1100,7 +1107,7 @@ uint64_t assets_upload_finish(struct asset_upload *u, struct assets_error *e)
         goto refuse;
     }
     if (u->bytes == 0) {
-        set_error(e, 400, "body", "the body must be the asset's .glb or .gltf file; it is empty");
+        set_error(e, 400, "body", "the body must be the asset's .glb, .gltf or .hdr file; it is empty");
         goto refuse;
     }
     close(u->fd);
@@ -1119,9 +1126,12 @@ uint64_t assets_upload_finish(struct asset_upload *u, struct assets_error *e)
     hex(digest, t->sha256);
     snprintf(t->name, sizeof(t->name), "%s", u->name);
     snprintf(t->path, sizeof(t->path), "%s", u->tmp);
-    /* A binary glTF starts with its magic; anything else is given to the
-     * converter as JSON glTF. */
-    snprintf(t->ext, sizeof(t->ext), "%s", memcmp(u->magic, "glTF", 4) == 0 ? "glb" : "gltf");
+    /* A binary glTF starts with its magic, a Radiance image with "#?"
+     * (an environment map); anything else is given to the converter as
+     * JSON glTF. */
+    snprintf(t->ext, sizeof(t->ext), "%s", memcmp(u->magic, "glTF", 4) == 0 ? "glb"
+                                           : memcmp(u->magic, "#?", 2) == 0 ? "hdr"
+                                                                             : "gltf");
     t->size = u->bytes;
     pthread_mutex_lock(&a->lock);
     if (a->stopping) {
@@ -1310,39 +1320,76 @@ out:
     return out;
 }
 
-bool assets_resolve(struct assets *a, struct scene_spec *scene, struct assets_error *e)
+/* name's stored hash into sha (pinned: must equal it), when the asset is
+ * of the kind asked for (an environment map or a glTF scene). field and
+ * sha_field name what the job called it. */
+static bool resolve_name(struct assets *a, const char *name, char sha[65], bool environment,
+                         const char *field, const char *sha_field, struct assets_error *e)
 {
-    if (!scene->asset[0])
-        return true;
     pthread_mutex_lock(&a->lock);
-    bool not_ready = dir_not_ready_locked(a, scene->asset, "scene.asset", e);
+    bool not_ready = dir_not_ready_locked(a, name, field, e);
     pthread_mutex_unlock(&a->lock);
     if (not_ready)
         return false;
     struct store_asset r;
-    enum store_found f = store_asset_get(a->store, scene->asset, &r);
+    enum store_found f = store_asset_get(a->store, name, &r);
     bool ok = false;
+    const char *kind = f == STORE_FOUND
+                           ? json_string_value(json_object_get(r.description, "kind"))
+                           : NULL;
+    bool is_environment = kind && strcmp(kind, "environment") == 0;
     if (f == STORE_MISSING)
-        set_error(e, 400, "scene.asset", "no asset of that name; PUT /v1/assets/%s first",
-                  scene->asset);
+        set_error(e, 400, field, "no asset of that name; PUT /v1/assets/%s first", name);
     else if (f == STORE_ERROR)
-        set_error(e, 500, "scene.asset", "cannot read the asset records (see the log)");
-    else if (scene->asset_sha256[0] && strcmp(scene->asset_sha256, r.sha256) != 0)
-        set_error(e, 409, "scene.asset_sha256", "the asset %s is now %s, not the pinned %s",
-                  scene->asset, r.sha256, scene->asset_sha256);
+        set_error(e, 500, field, "cannot read the asset records (see the log)");
+    else if (is_environment != environment)
+        set_error(e, 400, field, environment
+                                     ? "%s is a glTF scene, not an environment map (an "
+                                       "equirectangular .hdr)"
+                                     : "%s is an environment map: name it in "
+                                       "look.ibl.environment {\"asset\": ...}, not scene.asset",
+                  name);
+    else if (sha[0] && strcmp(sha, r.sha256) != 0)
+        set_error(e, 409, sha_field, "the asset %s is now %s, not the pinned %s", name,
+                  r.sha256, sha);
     else {
-        memcpy(scene->asset_sha256, r.sha256, sizeof(scene->asset_sha256));
+        memcpy(sha, r.sha256, 65);
         ok = true;
     }
     store_asset_finish(&r);
     return ok;
 }
 
-bool assets_queue_resolver(void *ctx, struct scene_spec *scene, char *field, size_t field_cap,
+bool assets_resolve(struct assets *a, struct scene_spec *scene, struct assets_error *e)
+{
+    if (!scene->asset[0])
+        return true;
+    return resolve_name(a, scene->asset, scene->asset_sha256, false, "scene.asset",
+                        "scene.asset_sha256", e);
+}
+
+bool assets_resolve_job(struct assets *a, struct job_spec *spec, struct assets_error *e)
+{
+    if (!assets_resolve(a, &spec->scene, e))
+        return false;
+    struct ibl_spec *looks[2] = {&spec->look.ibl, &spec->reference_look.ibl};
+    for (int i = 0; i < 2; i++)
+        if (looks[i]->enabled && looks[i]->environment == IBL_ENV_ASSET &&
+            !resolve_name(a, looks[i]->env_asset, looks[i]->env_sha256, true,
+                          i ? "reference_look.ibl.environment.asset"
+                            : "look.ibl.environment.asset",
+                          i ? "reference_look.ibl.environment.asset_sha256"
+                            : "look.ibl.environment.asset_sha256",
+                          e))
+            return false;
+    return true;
+}
+
+bool assets_queue_resolver(void *ctx, struct job_spec *spec, char *field, size_t field_cap,
                            char *message, size_t message_cap)
 {
     struct assets_error e;
-    if (assets_resolve(ctx, scene, &e))
+    if (assets_resolve_job(ctx, spec, &e))
         return true;
     snprintf(field, field_cap, "%s", e.field);
     snprintf(message, message_cap, "%s", e.message);

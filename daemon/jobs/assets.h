@@ -1,8 +1,9 @@
 #ifndef SHADEBENCH_ASSETS_H
 #define SHADEBENCH_ASSETS_H
 
-/* The assets (issue 21): glTF 2.0 files uploaded over HTTP (PUT
- * /v1/assets/NAME) or provided read-only by the operator (--asset-dir),
+/* The assets (issue 21): glTF 2.0 files and equirectangular Radiance .hdr
+ * environment maps, uploaded over HTTP (PUT /v1/assets/NAME) or provided
+ * read-only by the operator (--asset-dir),
  * each converted once into a cache file the render thread reads
  * (asset_store.h has the paths). The glTF file is never parsed in the
  * daemon: the converter, shadebench-asset, runs as a child process under
@@ -102,10 +103,14 @@ json_t *assets_list(struct assets *a, const char *cursor, int limit, struct asse
 json_t *assets_delete(struct assets *a, const char *name, struct assets_error *e);
 
 /* A job's scene.asset: fills scene->asset_sha256 from the store, or
- * refuses (400 unknown name, 409 pinned hash differs or still converting). */
+ * refuses (400 unknown name or an environment map, 409 pinned hash differs
+ * or still converting). */
 bool assets_resolve(struct assets *a, struct scene_spec *scene, struct assets_error *e);
+/* Every asset a job names: scene.asset, and look.ibl.environment's (and
+ * reference_look's) {"asset": NAME}, which must be an environment map. */
+bool assets_resolve_job(struct assets *a, struct job_spec *spec, struct assets_error *e);
 /* queue_submit's resolver (queue.h), ctx the assets. */
-bool assets_queue_resolver(void *ctx, struct scene_spec *scene, char *field, size_t field_cap,
+bool assets_queue_resolver(void *ctx, struct job_spec *spec, char *field, size_t field_cap,
                            char *message, size_t message_cap);
 
 #endif

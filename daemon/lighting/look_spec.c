@@ -6,7 +6,8 @@
 
 static const char *const lighting_names[] = {"phong", "blinn_phong", "pbr", NULL};
 static const char *const hdr_names[] = {"rgba32f", "rgba16f", NULL};
-static const char *const tonemap_names[] = {"none", "reinhard", "aces", NULL};
+const char *const look_tonemap_names[] = {"none", "reinhard", "aces", "srgb", "pbr_neutral",
+                                          NULL};
 
 static bool parse_post(const json_t *v, const char *field, void *opts, struct job_error *err)
 {
@@ -65,8 +66,10 @@ static const struct opt_field fields[] = {
     {.name = "exposure", .type = OPT_NUMBER, .def = 1.0, .min = 1.0 / 1024.0, .max = 1024.0,
      .summary = "scales the HDR colour in the resolve, before the tone curve",
      .offset = offsetof(struct look_spec, exposure)},
-    {.name = "tonemap", .type = OPT_CHOICE, .def = LOOK_TONEMAP_NONE, .choices = tonemap_names,
-     .summary = "the resolve's tone curve: none clamps; the curves write 8-bit sRGB",
+    {.name = "tonemap", .type = OPT_CHOICE, .def = LOOK_TONEMAP_NONE, .choices = look_tonemap_names,
+     .summary = "the resolve's tone curve: none clamps (linear, no encoding); srgb clamps and "
+                "encodes sRGB; reinhard, aces and pbr_neutral (Khronos PBR Neutral) compress "
+                "highlights, then encode sRGB",
      .offset = offsetof(struct look_spec, tonemap)},
     {.name = "post", .type = OPT_CUSTOM, .hooks = &post_hooks,
      .summary = "post effects run on the HDR output in order (/v1/info's \"effects\")",

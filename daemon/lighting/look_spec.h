@@ -18,8 +18,13 @@
 
 enum look_lighting { LOOK_PHONG, LOOK_BLINN_PHONG, LOOK_PBR };
 enum look_hdr { LOOK_HDR_RGBA32F, LOOK_HDR_RGBA16F };
-/* none: a clamp, no encoding; the curves write 8-bit sRGB. */
-enum look_tonemap { LOOK_TONEMAP_NONE, LOOK_TONEMAP_REINHARD, LOOK_TONEMAP_ACES };
+/* none: a clamp, no encoding; srgb: a clamp and the sRGB encoding, no
+ * curve; the curves write 8-bit sRGB (tone_curves.h). */
+enum look_tonemap {
+    LOOK_TONEMAP_NONE, LOOK_TONEMAP_REINHARD, LOOK_TONEMAP_ACES, LOOK_TONEMAP_SRGB,
+    LOOK_TONEMAP_PBR_NEUTRAL, LOOK_TONEMAP_COUNT
+};
+extern const char *const look_tonemap_names[]; /* the JSON spelling, by enum */
 
 struct look_spec {
     int lighting;    /* enum look_lighting */

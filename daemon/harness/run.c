@@ -401,6 +401,7 @@ static void resolve(const struct harness_run *run)
     glDisable(GL_CULL_FACE);
     glUseProgram(g->resolve_progs[run->look->tonemap]);
     glUniform1f(SB_LOC_EXPOSURE, (float)run->look->exposure);
+    glUniform1f(SB_LOC_GAMMA, run->look->transfer == LOOK_TRANSFER_GAMMA_2_2 ? 2.2f : 0.0f);
     glActiveTexture(GL_TEXTURE0 + SB_TEX_HDR);
     glBindTexture(GL_TEXTURE_2D, run->hdr_resolved);
     glBindVertexArray(g->empty_vao);

@@ -12,7 +12,8 @@ computed by hand (64x64 images, a frame or two each):
 - an uploaded quad seen through an orthographic scene.camera covers exactly
   the pixels its extents say, and the asset's own orthographic camera,
   rolled 90 degrees about its view axis, covers the same quad turned (its
-  up vector and projection honoured);
+  up vector and projection honoured); the culling techniques under an
+  orthographic view agree with forward;
 - environment maps: a Radiance .hdr uploaded as an asset is described, a
   truncated one and one whose header claims 100000 x 50000 pixels are
   refused 422 naming the rule, and a PBR look with look.ibl.environment
@@ -215,6 +216,19 @@ def check_orthographic(d):
     # An asset scene's look is display-referred by default.
     check(done["spec"]["look"]["tonemap"] == "pbr_neutral",
           "an asset scene's tone map defaults to pbr_neutral: %s" % done["spec"]["look"]["tonemap"])
+    # The culling techniques under an orthographic view (their cells are
+    # perspective frusta: every light is binned everywhere) draw what
+    # forward draws: the teapots from above, 80 lights.
+    top = {"eye": [0, 30, 0], "target": [0, 0, 0], "up": [0, 0, -1],
+           "orthographic": {"ymag": 12}}
+    for t in ("tiled_deferred", "clustered_forward"):
+        done = d.run(dict(BASE, technique=t, reference="forward",
+                          scene={"preset": "teapots", "width": 96, "height": 64, "camera": top}))
+        q = done.get("result", {}).get("quality", {})
+        ssim = q.get("worst_ssim", {}).get("value", 0)
+        check(done.get("status") == "done" and ssim >= 0.999 and q.get("pdiff_failed_captures") == 0,
+              "%s under an orthographic camera agrees with forward: SSIM %.5f, PerceptualDiff "
+              "failures %s (%s)" % (t, ssim, q.get("pdiff_failed_captures"), done.get("error")))
 
 
 def check_environment(d):

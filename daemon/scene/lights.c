@@ -92,11 +92,16 @@ bool scene_add_sun(struct scene *s)
         return false;
     s->lights = grown;
     struct scene_light *l = &s->lights[s->light_count++];
+    /* In glTF's terms too (a directional light has no falloff, so the flag
+     * changes no pixel): colour SCENE_SUN_COLOR x light_intensity at pi lux
+     * is the shading colour, for the result's light list. */
     *l = (struct scene_light){.type = SCENE_LIGHT_DIRECTIONAL, .period = 1, .cos_inner = 1.0f,
-                              .cos_outer = 1.0f};
+                              .cos_outer = 1.0f, .falloff = SCENE_FALLOFF_GLTF,
+                              .gltf_intensity = (float)PI};
     for (int k = 0; k < 3; k++) {
         l->direction[k] = SCENE_SUN_DIRECTION[k];
         l->color[k] = SCENE_SUN_COLOR[k] * (float)s->spec.light_intensity;
+        l->gltf_color[k] = l->color[k];
     }
     return true;
 }

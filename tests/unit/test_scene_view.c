@@ -231,6 +231,19 @@ static void test_light_rig(void)
                1e-3);
     json_decref(d);
     scene_finish(&s);
+    /* The sun is listed in glTF's terms too: pi lux of its colour. */
+    build("{\"preset\": \"plane\", \"sun\": true, \"light_rig\": [{\"type\": \"point\", "
+          "\"position\": [0, 2, 0]}]}", &s);
+    d = scene_describe(&s);
+    list = json_object_get(json_object_get(d, "gltf_lights"), "lights");
+    CHECK(json_array_size(list) == 2);
+    json_t *sun = json_array_get(list, 0);
+    CHECK(strcmp(json_string_value(json_object_get(sun, "source")), "sun") == 0);
+    CHECK_NEAR(json_real_value(json_object_get(sun, "intensity")), M_PI, 1e-5);
+    CHECK_NEAR(json_real_value(json_array_get(json_object_get(sun, "color"), 0)),
+               SCENE_SUN_COLOR[0], 1e-6);
+    json_decref(d);
+    scene_finish(&s);
     /* With lights given, the generated ones stay. */
     build("{\"preset\": \"plane\", \"lights\": 2, \"light_rig\": [{\"type\": \"point\", "
           "\"position\": [0, 2, 0]}]}", &s);

@@ -28,12 +28,13 @@ enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *c,
     /* scene.asset: pinned to the stored asset's hash here, so that the
      * answer names the rule (400 unknown, 409 a different pinned hash);
      * queue_submit resolves again, for the sweeps' points. */
-    if (spec.scene.asset[0]) {
+    if (job_spec_names_asset(&spec)) {
         struct assets_error ae;
         if (!s->ctx.assets)
-            return respond_error(c, MHD_HTTP_BAD_REQUEST, "scene.asset",
+            return respond_error(c, MHD_HTTP_BAD_REQUEST,
+                                 spec.scene.asset[0] ? "scene.asset" : "look.ibl.environment",
                                  "this daemon has no asset store");
-        if (!assets_resolve(s->ctx.assets, &spec.scene, &ae))
+        if (!assets_resolve_job(s->ctx.assets, &spec, &ae))
             return respond_asset_error(c, &ae);
     }
     char id[24];

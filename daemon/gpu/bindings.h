@@ -56,6 +56,7 @@
 /* Uniform locations, explicit so that timed code never looks a name up.
  * Arrays take one location per element. */
 #define SB_LOC_EXPOSURE 0     /* resolve: float */
+#define SB_LOC_GAMMA 1        /* resolve: float, 0 for the sRGB curve, else a plain gamma */
 #define SB_LOC_POST_PARAMS 0  /* post effects: vec4 of the effect's options */
 #define SB_LOC_POST_WEIGHTS 1 /* bloom: float[33] Gaussian weights */
 #define SB_LOC_SSAO_NOISE 1   /* ssao: float[16] rotation angles */
@@ -64,6 +65,7 @@
 /* Harness-owned units, bound before every frame's passes for the lighting
  * library (look.ibl, look.shadows): techniques leave 10 and up alone. */
 #define SB_TEX_IBL_SOURCE 10      /* setup only: the cube map being filtered */
+#define SB_TEX_ENV_MAP 11         /* the sky pass: an uploaded equirectangular environment */
 #define SB_TEX_IBL_IRRADIANCE 12  /* cube map array: environment, then each probe */
 #define SB_TEX_IBL_PREFILTERED 13 /* cube map array, roughness picks the level */
 #define SB_TEX_IBL_BRDF 14        /* the split sum's (A, B) table */

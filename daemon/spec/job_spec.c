@@ -327,6 +327,14 @@ static bool parse_labels(const json_t *v, struct job_spec *out, struct job_error
     return true;
 }
 
+/* Whether a job body's scene is drawn through the asset path (scene.asset,
+ * or the textured preset), before the scene itself is parsed. */
+static bool asset_scene_body(const json_t *scene)
+{
+    const char *preset = json_string_value(json_object_get(scene, "preset"));
+    return json_object_get(scene, "asset") || (preset && strcmp(preset, "textured") == 0);
+}
+
 bool job_spec_parse(const json_t *body, const struct technique_catalog *techniques,
                     struct job_spec *out, struct job_error *err)
 {
@@ -404,6 +412,12 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
     out->options_given &= ~(1u << out->technique_index);
     if (out->reference_index >= 0)
         out->options_given &= ~(1u << out->reference_index);
+    /* An asset scene is shown display-referred unless the look says
+     * otherwise (docs/scenes.md, "Asset scenes' defaults"): Khronos PBR
+     * Neutral keeps base colours and compresses what would clip. */
+    bool asset_scene = asset_scene_body(json_object_get(body, "scene"));
+    if (asset_scene)
+        out->look.tonemap = LOOK_TONEMAP_PBR_NEUTRAL;
     json_t *look;
     if (!jf_get_object(body, "look", "look", &look, err) ||
         (look && !look_spec_parse(look, "look", &out->look, err)))
@@ -416,6 +430,8 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
         return false;
     if (ref_look) {
         look_spec_defaults(&out->reference_look);
+        if (asset_scene)
+            out->reference_look.tonemap = LOOK_TONEMAP_PBR_NEUTRAL;
         out->reference_look_given = true;
         /* Probes and shadow maps are made once a run, for both: a
          * reference_look takes the look's, or states them the same. */
@@ -633,3 +649,10 @@ json_t *job_spec_to_json(const struct job_spec *spec)
     return out;
 }
 
+
+bool job_spec_names_asset(const struct job_spec *spec)
+{
+    const struct ibl_spec *a = &spec->look.ibl, *b = &spec->reference_look.ibl;
+    return spec->scene.asset[0] || (a->enabled && a->environment == IBL_ENV_ASSET) ||
+           (b->enabled && b->environment == IBL_ENV_ASSET);
+}

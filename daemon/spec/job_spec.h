@@ -125,6 +125,10 @@ const char *job_spec_aliased(const char *path);
 /* The job as understood, defaults filled in. New reference. */
 json_t *job_spec_to_json(const struct job_spec *spec);
 
+/* True when the job names a stored asset: scene.asset, or an environment
+ * map as look.ibl.environment (or reference_look's) {"asset": NAME}. */
+bool job_spec_names_asset(const struct job_spec *spec);
+
 /* Number of timed frames that get captured. */
 int job_spec_capture_count(const struct job_spec *spec);
 

@@ -24,6 +24,7 @@
 #include "daemon/api/links.h"
 #include "daemon/api/report.h"
 #include "daemon/api/routes.h"
+#include "daemon/reference/fidelity.h"
 #include "daemon/harness/telemetry.h"
 #include "daemon/jobs/job_cost.h"
 #include "daemon/jobs/job_spec.h"
@@ -317,6 +318,7 @@ static json_t *info_json(struct http_server *s)
         json_object_set(limits, "max_asset_bytes", json_object_get(assets, "max_asset_bytes"));
         json_object_set_new(limits, "assets", assets);
     }
+    json_object_set_new(info, "reference", fidelity_info_json(s->ctx.fidelity));
     return info;
 }
 
@@ -498,6 +500,9 @@ static enum MHD_Result respond_metrics(struct http_server *s, struct MHD_Connect
     return respond_text(c, MHD_HTTP_OK, text, len, "text/plain; version=0.0.4; charset=utf-8");
 }
 
+static enum MHD_Result queue_spec(struct http_server *s, struct MHD_Connection *c,
+                                  struct job_spec *sp);
+
 static enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *c,
                                   struct request *req)
 {
@@ -506,20 +511,64 @@ static enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *
     if (!job_spec_parse_text(req->body ? req->body : "", req->len, s->ctx.catalog,
                              &spec, &err))
         return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
+    return queue_spec(s, c, &spec);
+}
+
+/* POST /v1/assets/NAME/fidelity: a fidelity job of the asset (fidelity_spec.h). */
+static enum MHD_Result post_fidelity(struct http_server *s, struct MHD_Connection *c,
+                                     struct request *req)
+{
+    if (req->too_large)
+        return respond_error(c, MHD_HTTP_CONTENT_TOO_LARGE, "body",
+                             "the request must be at most 65536 bytes");
+    if (req->route.asset_too_long)
+        return respond_error(c, MHD_HTTP_BAD_REQUEST, "name", "an asset name is at most 128 bytes");
+    json_t *body = NULL;
+    if (req->len) {
+        json_error_t je;
+        if (!(body = json_loadb(req->body, req->len, JSON_REJECT_DUPLICATES, &je))) {
+            char msg[256];
+            snprintf(msg, sizeof(msg), "malformed JSON at line %d, column %d: %s", je.line,
+                     je.column, je.text);
+            return respond_error(c, MHD_HTTP_BAD_REQUEST, "body", msg);
+        }
+    }
+    struct job_error err = {0};
+    json_t *job = fidelity_job_body(req->route.asset, body, &err);
+    json_decref(body);
+    struct job_spec spec;
+    bool ok = job && job_spec_parse(job, s->ctx.catalog, &spec, &err);
+    json_decref(job);
+    if (!ok)
+        return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
+    return queue_spec(s, c, &spec);
+}
+
+static enum MHD_Result queue_spec(struct http_server *s, struct MHD_Connection *c,
+                                  struct job_spec *sp)
+{
+    /* Refused at once where the Khronos reference is not installed: the
+     * job could only fail. */
+    char why[600];
+    if (sp->fidelity.enabled && !fidelity_available(s->ctx.fidelity, why, sizeof(why))) {
+        char msg[256];
+        snprintf(msg, sizeof(msg), "the Khronos reference is not available: %.200s", why);
+        return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "fidelity", msg);
+    }
     /* scene.asset: pinned to the stored asset's hash here, so that the
      * answer names the rule (400 unknown, 409 a different pinned hash);
      * queue_submit resolves again, for the sweeps' points. */
-    if (job_spec_names_asset(&spec)) {
+    if (job_spec_names_asset(sp)) {
         struct assets_error ae;
         if (!s->ctx.assets)
             return respond_error(c, MHD_HTTP_BAD_REQUEST,
-                                 spec.scene.asset[0] ? "scene.asset" : "look.ibl.environment",
+                                 sp->scene.asset[0] ? "scene.asset" : "look.ibl.environment",
                                  "this daemon has no asset store");
-        if (!assets_resolve_job(s->ctx.assets, &spec, &ae))
+        if (!assets_resolve_job(s->ctx.assets, sp, &ae))
             return respond_asset_error(c, &ae);
     }
     char id[24];
-    switch (queue_submit(s->queue, &spec, NULL, id)) {
+    switch (queue_submit(s->queue, sp, NULL, id)) {
     case QUEUE_OK:
         break;
     case QUEUE_REFUSED: /* the asset changed since: its rule */
@@ -537,9 +586,9 @@ static enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *
     }
     char url[ROUTE_URL_MAX];
     route_job_url(id, url);
-    LOG(LOG_INFO, "queued job %s (%s)", id, spec.technique);
+    LOG(LOG_INFO, "queued job %s (%s)", id, sp->technique);
     struct job_cost cost;
-    job_cost_estimate(&spec, &cost);
+    job_cost_estimate(sp, &cost);
     return respond_json(c, MHD_HTTP_ACCEPTED,
                         json_pack("{s:s, s:s, s:s, s:o}", "id", id, "status", "queued", "url", url,
                                   "cost", job_cost_json(&cost)));
@@ -819,6 +868,13 @@ static enum MHD_Result job_resource(struct http_server *s, struct MHD_Connection
         job_file_path(dir, JOB_FILE_TIMINGS, path, sizeof(path));
         return respond_file(c, path, "text/csv");
     }
+    if (r->kind == ROUTE_JOB_FIDELITY) {
+        snprintf(path, sizeof(path), "%s/fidelity/%s", dir, r->chart);
+        if (access(path, R_OK) != 0)
+            return respond_error(c, MHD_HTTP_NOT_FOUND, "file",
+                                 "no such image: see result.fidelity.channels.*.files");
+        return respond_file(c, path, "image/png");
+    }
     job_image_path(dir, r->image, r->frame, path, sizeof(path));
     if (access(path, R_OK) != 0)
         return respond_error(c, MHD_HTTP_NOT_FOUND, "frame",
@@ -1048,11 +1104,14 @@ static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
     case ROUTE_ASSETS:
     case ROUTE_ASSET:
         return asset_resource(s, c, method, req);
+    case ROUTE_ASSET_FIDELITY:
+        return post_fidelity(s, c, req);
     case ROUTE_JOB:
     case ROUTE_JOB_REPORT:
     case ROUTE_JOB_CHART:
     case ROUTE_JOB_TIMINGS:
     case ROUTE_JOB_IMAGE:
+    case ROUTE_JOB_FIDELITY:
         return job_resource(s, c, method, req);
     case ROUTE_SWEEP:
     case ROUTE_SWEEP_CHART:

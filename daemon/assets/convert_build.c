@@ -6,6 +6,7 @@
  * uv1 charts, from the file or generated. */
 #include "daemon/assets/convert_internal.h"
 #include "daemon/assets/uv_charts.h"
+#include "daemon/assets/uv_overlap.h"
 
 #include <assimp/mesh.h>
 #include <assimp/scene.h>
@@ -64,6 +65,7 @@ bool build_materials(struct ctx *c, struct asset *a)
             t->min_filter = 9987;
             t->mag_filter = 9729;
             t->scale = 1.0f;
+            t->transform = (struct asset_uv_transform)ASSET_UV_IDENTITY;
             json_t *ti = json_object_get(s < 2 ? pbr : m, slots[s]);
             if (!ti)
                 continue;
@@ -73,6 +75,21 @@ bool build_materials(struct ctx *c, struct asset *a)
                 continue;
             t->image = (int32_t)json_integer_value(src);
             json_int_t set = json_integer_value(json_object_get(ti, "texCoord"));
+            /* KHR_texture_transform (checked): offset, rotation, scale, and
+             * a texCoord that overrides the textureInfo's. */
+            json_t *tt = json_object_get(json_object_get(ti, "extensions"), "KHR_texture_transform");
+            if (tt) {
+                double off[2] = {0, 0}, scl[2] = {1, 1};
+                get_floats(c, tt, "offset", field, 2, off);
+                get_floats(c, tt, "scale", field, 2, scl);
+                for (int k = 0; k < 2; k++) {
+                    t->transform.offset[k] = (float)off[k];
+                    t->transform.scale[k] = (float)scl[k];
+                }
+                t->transform.rotation = (float)num_or(tt, "rotation", 0.0);
+                if (json_object_get(tt, "texCoord"))
+                    set = json_integer_value(json_object_get(tt, "texCoord"));
+            }
             if (set > 1) {
                 ignore(c, "texCoord sets above 1 (read as 0)");
                 set = 0;
@@ -199,11 +216,136 @@ static double tri_area2(const float a[2], const float b[2], const float cc[2])
     return fabs((double)(b[0] - a[0]) * (cc[1] - a[1]) - (double)(cc[0] - a[0]) * (b[1] - a[1])) / 2;
 }
 
-/* Vertex v of assimp's mesh in world space (uv1 from the file, when it has
- * one; the caller sets generated charts). */
-static bool fill_vertex(struct ctx *c, const struct aiMesh *am, float *const uvs[2], unsigned v,
-                        const double m[16], const double nm[9], double det, struct asset_vertex *vx,
-                        const char *field)
+/* Component k of element v of a checked accessor as a float: floats as
+ * they are, unsigned bytes and shorts divided by 255 and 65535 where
+ * normalized (glTF's texture coordinates and colours of those types must
+ * be). */
+static float accessor_float(const struct accessor *a, uint64_t v, int k, bool normalized)
+{
+    const uint8_t *e = a->view.data + a->offset + a->stride * v;
+    switch (a->ctype) {
+    case 5126: {
+        float f;
+        memcpy(&f, e + 4 * k, 4);
+        return f;
+    }
+    case 5121:
+        return normalized ? e[k] / 255.0f : (float)e[k];
+    default: {
+        float x = (float)(e[2 * k] | e[2 * k + 1] << 8);
+        return normalized ? x / 65535.0f : x;
+    }
+    }
+}
+
+/* ncomp floats per vertex from accessor index (vertex order as assimp's:
+ * its glTF importer keeps the accessor's, checked by the count). */
+static bool decode_attribute(struct ctx *c, int64_t index, const struct aiMesh *am, int ncomp,
+                             const char *what, const char *field, float **out)
+{
+    struct accessor acc;
+    if (!check_accessor(c, (size_t)index, &acc))
+        return false;
+    if (acc.count != am->mNumVertices)
+        return fail(c, 500, field, "assimp made %u vertices of %" PRIu64 " (%s)", am->mNumVertices,
+                    acc.count, what);
+    if (!(*out = malloc((size_t)am->mNumVertices * (size_t)ncomp * sizeof(float))))
+        return fail(c, 500, field, "out of memory");
+    bool normalized = acc.ctype != 5126;
+    for (unsigned v = 0; v < am->mNumVertices; v++)
+        for (int k = 0; k < ncomp; k++)
+            (*out)[(size_t)v * (size_t)ncomp + (size_t)k] =
+                k < acc.ncomp ? accessor_float(&acc, v, k, normalized) : 1.0f;
+    return true;
+}
+
+/* The uv set the material's normal texture reads (0 without one), as
+ * build_materials resolves it. */
+static int normal_uv_set(struct ctx *c, int material)
+{
+    json_t *ti = material >= 0 ? json_object_get(json_array_get(c->materials, (size_t)material),
+                                                 "normalTexture")
+                               : NULL;
+    if (!ti)
+        return 0;
+    json_t *tt = json_object_get(json_object_get(ti, "extensions"), "KHR_texture_transform");
+    json_t *set = tt && json_object_get(tt, "texCoord") ? json_object_get(tt, "texCoord")
+                                                        : json_object_get(ti, "texCoord");
+    return json_integer_value(set) == 1 ? 1 : 0;
+}
+
+/* Tangents in object space from uv (2 floats per vertex) for a normal
+ * texture that reads a set assimp does not derive them from (it uses
+ * TEXCOORD_0): each triangle's dP/du and dP/dv, summed at its corners, dP/du
+ * made perpendicular to the normal; w makes cross(normal, tangent) * w point
+ * along -dP/dv, up the image as glTF's bitangent does. 4 floats per vertex;
+ * a vertex no triangle gives a direction keeps w = 0 (any tangent). */
+static float *uv_tangents(const struct aiMesh *am, const float *uv, const uint32_t *corners,
+                          uint32_t ntri)
+{
+    size_t nv = am->mNumVertices;
+    double *acc = calloc(nv * 6, sizeof(double));
+    float *out = calloc(nv * 4, sizeof(float));
+    if (!acc || !out) {
+        free(acc);
+        free(out);
+        return NULL;
+    }
+    for (uint32_t t = 0; t < ntri; t++) {
+        const uint32_t *ix = &corners[3 * t];
+        const struct aiVector3D *p0 = &am->mVertices[ix[0]], *p1 = &am->mVertices[ix[1]],
+                                *p2 = &am->mVertices[ix[2]];
+        double e1[3] = {p1->x - p0->x, p1->y - p0->y, p1->z - p0->z};
+        double e2[3] = {p2->x - p0->x, p2->y - p0->y, p2->z - p0->z};
+        double du1 = uv[2 * ix[1]] - uv[2 * ix[0]], dv1 = uv[2 * ix[1] + 1] - uv[2 * ix[0] + 1];
+        double du2 = uv[2 * ix[2]] - uv[2 * ix[0]], dv2 = uv[2 * ix[2] + 1] - uv[2 * ix[0] + 1];
+        double r = du1 * dv2 - du2 * dv1;
+        if (!(fabs(r) > 1e-20) || !isfinite(r))
+            continue;
+        double sdir[3], tdir[3];
+        for (int k = 0; k < 3; k++) {
+            sdir[k] = (e1[k] * dv2 - e2[k] * dv1) / r;
+            tdir[k] = (e2[k] * du1 - e1[k] * du2) / r;
+        }
+        for (int k = 0; k < 3; k++)
+            for (int q = 0; q < 3; q++) {
+                acc[6 * ix[k] + (uint32_t)q] += sdir[q];
+                acc[6 * ix[k] + 3 + (uint32_t)q] += tdir[q];
+            }
+    }
+    for (size_t v = 0; v < nv; v++) {
+        if (!am->mNormals)
+            break;
+        double n[3] = {am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z};
+        double *s = &acc[6 * v], *tv = &acc[6 * v + 3];
+        double d = n[0] * s[0] + n[1] * s[1] + n[2] * s[2];
+        double t[3] = {s[0] - d * n[0], s[1] - d * n[1], s[2] - d * n[2]};
+        double len = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+        if (!(len > 1e-20) || !isfinite(len))
+            continue;
+        double cr[3] = {n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2],
+                        n[0] * t[1] - n[1] * t[0]};
+        for (int k = 0; k < 3; k++)
+            out[4 * v + (size_t)k] = (float)(t[k] / len);
+        out[4 * v + 3] = cr[0] * tv[0] + cr[1] * tv[1] + cr[2] * tv[2] > 0 ? -1.0f : 1.0f;
+    }
+    free(acc);
+    return out;
+}
+
+/* What a mesh's vertices are made from, beside assimp's mesh. */
+struct vertex_sources {
+    float *uvs[2];        /* TEXCOORD_0 and _1, 2 floats per vertex, or NULL */
+    float *colors;        /* COLOR_0, 4 floats per vertex (alpha 1 for VEC3), or NULL */
+    float *uv1_tangents;  /* tangents from TEXCOORD_1 (uv_tangents), or NULL for assimp's */
+    bool uv1_file;        /* uv1 is the file's TEXCOORD_1 */
+};
+
+/* Vertex v of assimp's mesh in world space (uv1 from the file where it is
+ * used; the caller sets generated charts). */
+static bool fill_vertex(struct ctx *c, const struct aiMesh *am, const struct vertex_sources *src,
+                        unsigned v, const double m[16], const double nm[9], double det,
+                        struct asset_vertex *vx, const char *field)
 {
     const float pos[3] = {am->mVertices[v].x, am->mVertices[v].y, am->mVertices[v].z};
     xform_point(m, pos, vx->pos);
@@ -219,17 +361,24 @@ static bool fill_vertex(struct ctx *c, const struct aiMesh *am, float *const uvs
     for (int r = 0; r < 3; r++)
         vx->normal[r] = (float)n[r];
     any_tangent(vx->normal, vx->tangent);
-    if (am->mTangents && am->mBitangents && am->mNormals) {
-        double tin[3] = {am->mTangents[v].x, am->mTangents[v].y, am->mTangents[v].z};
+    /* The tangent in object space and its handedness w. */
+    double tin[3] = {0, 0, 0}, w = 0;
+    if (src->uv1_tangents) {
+        const float *t = &src->uv1_tangents[4 * (size_t)v];
+        tin[0] = t[0], tin[1] = t[1], tin[2] = t[2], w = t[3];
+    } else if (am->mTangents && am->mBitangents && am->mNormals) {
         double nin[3] = {am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z};
         double bin[3] = {am->mBitangents[v].x, am->mBitangents[v].y, am->mBitangents[v].z};
+        tin[0] = am->mTangents[v].x, tin[1] = am->mTangents[v].y, tin[2] = am->mTangents[v].z;
         /* glTF: bitangent = cross(normal, tangent) * w. assimp computed its
          * bitangent on V-flipped coordinates, which points it the way glTF's
          * does (towards decreasing glTF v, up in the image), so the sign of
          * this dot product is w, for tangents from the file or generated. */
         double cr[3] = {nin[1] * tin[2] - nin[2] * tin[1], nin[2] * tin[0] - nin[0] * tin[2],
                         nin[0] * tin[1] - nin[1] * tin[0]};
-        double w = cr[0] * bin[0] + cr[1] * bin[1] + cr[2] * bin[2] < 0 ? -1.0 : 1.0;
+        w = cr[0] * bin[0] + cr[1] * bin[1] + cr[2] * bin[2] < 0 ? -1.0 : 1.0;
+    }
+    if (w != 0) {
         double tw[3];
         xform_dir(m, tin, tw);
         /* Keep it perpendicular to the world normal (a non-uniform scale
@@ -245,15 +394,21 @@ static bool fill_vertex(struct ctx *c, const struct aiMesh *am, float *const uvs
             vx->tangent[3] = (float)(det < 0 ? -w : w);
         }
     }
-    if (uvs[0]) {
-        vx->uv0[0] = uvs[0][2 * v];
-        vx->uv0[1] = uvs[0][2 * v + 1];
+    if (src->uvs[0]) {
+        vx->uv0[0] = src->uvs[0][2 * v];
+        vx->uv0[1] = src->uvs[0][2 * v + 1];
     }
-    if (uvs[1]) {
-        float u = uvs[1][2 * v], w = uvs[1][2 * v + 1];
-        vx->uv1[0] = u < 0 ? 0 : u > 1 ? 1 : u;
-        vx->uv1[1] = w < 0 ? 0 : w > 1 ? 1 : w;
+    if (src->uvs[1]) {
+        float u = src->uvs[1][2 * v], t = src->uvs[1][2 * v + 1];
+        vx->texcoord1[0] = u;
+        vx->texcoord1[1] = t;
+        if (src->uv1_file) {
+            vx->uv1[0] = u < 0 ? 0 : u > 1 ? 1 : u;
+            vx->uv1[1] = t < 0 ? 0 : t > 1 ? 1 : t;
+        }
     }
+    for (int k = 0; k < 4; k++)
+        vx->color[k] = src->colors ? src->colors[4 * (size_t)v + (size_t)k] : 1.0f;
     for (int r = 0; r < 4; r++)
         if (!isfinite(vx->tangent[r]))
             any_tangent(vx->normal, vx->tangent);
@@ -262,6 +417,11 @@ static bool fill_vertex(struct ctx *c, const struct aiMesh *am, float *const uvs
             return fail(c, 400, field, "a vertex is not finite in world space");
     if (!isfinite(vx->uv0[0]) || !isfinite(vx->uv0[1]))
         return fail(c, 400, field, "TEXCOORD_0 is not finite");
+    if (!isfinite(vx->texcoord1[0]) || !isfinite(vx->texcoord1[1]))
+        return fail(c, 400, field, "TEXCOORD_1 is not finite");
+    for (int k = 0; k < 4; k++)
+        if (!isfinite(vx->color[k]))
+            return fail(c, 400, field, "COLOR_0 is not finite");
     return true;
 }
 
@@ -278,64 +438,26 @@ static bool build_mesh(struct ctx *c, const struct aiMesh *am, const double m[16
         ntri += am->mFaces[f].mNumIndices == 3;
     if (!ntri)
         return true; /* points or lines only: already in ignored */
-    /* Both uv sets in glTF's convention (origin top left), from assimp or,
-     * for quantized accessors, which assimp 5.2 copies as raw bytes into
-     * floats, decoded here from the checked accessor. */
-    float *uvs[2] = {NULL, NULL};
+    /* Both uv sets in glTF's convention (origin top left) and COLOR_0,
+     * decoded from the checked accessors (assimp 5.2 copies quantized ones
+     * as raw bytes into floats). */
+    struct vertex_sources src = {{NULL, NULL}, NULL, NULL, false};
     uint32_t *corners = NULL;
     float *world = NULL;
     struct uv_charts charts = {0};
-    bool ok = false, uv1_file = false;
-    for (int set = 0; set < 2; set++) {
-        if (pi->uv_accessor[set] < 0)
-            continue;
-        if (!(uvs[set] = malloc((size_t)am->mNumVertices * 2 * sizeof(float)))) {
-            fail(c, 500, field, "out of memory");
+    bool ok = false;
+    for (int set = 0; set < 2; set++)
+        if (pi->uv_accessor[set] >= 0 &&
+            !decode_attribute(c, pi->uv_accessor[set], am, 2, set ? "TEXCOORD_1" : "TEXCOORD_0",
+                              field, &src.uvs[set]))
             goto done;
-        }
-        struct accessor acc;
-        if (!check_accessor(c, (size_t)pi->uv_accessor[set], &acc))
-            goto done;
-        if (acc.count != am->mNumVertices) {
-            fail(c, 500, field, "assimp made %u vertices of %" PRIu64, am->mNumVertices, acc.count);
-            goto done;
-        }
-        bool normalized = json_is_true(json_object_get(json_array_get(c->accessors,
-                                                                      (size_t)pi->uv_accessor[set]),
-                                                       "normalized"));
-        for (unsigned v = 0; v < am->mNumVertices; v++) {
-            if (acc.ctype == 5126) {
-                if (!am->mTextureCoords[set]) {
-                    fail(c, 500, field, "assimp dropped TEXCOORD_%d", set);
-                    goto done;
-                }
-                uvs[set][2 * v] = am->mTextureCoords[set][v].x;
-                uvs[set][2 * v + 1] = 1.0f - am->mTextureCoords[set][v].y; /* assimp flips V */
-                continue;
-            }
-            const uint8_t *e = acc.view.data + acc.offset + acc.stride * v;
-            for (int k = 0; k < 2; k++) {
-                float x = acc.ctype == 5121 ? e[k] : (float)(e[2 * k] | e[2 * k + 1] << 8);
-                uvs[set][2 * v + k] = normalized ? x / (acc.ctype == 5121 ? 255.0f : 65535.0f) : x;
-            }
-        }
-    }
-    uv1_file = uvs[1] != NULL;
-    for (unsigned v = 0; uv1_file && v < am->mNumVertices; v++) {
-        float u = uvs[1][2 * v], w = uvs[1][2 * v + 1];
-        if (!(u >= -1e-4f && u <= 1.0001f && w >= -1e-4f && w <= 1.0001f))
-            uv1_file = false;
-    }
-    if (uvs[1] && !uv1_file) {
-        ignore(c, "TEXCOORD_1 outside [0, 1] (uv1 generated instead)");
-        free(uvs[1]);
-        uvs[1] = NULL;
-    }
+    if (pi->color_accessor >= 0 &&
+        !decode_attribute(c, pi->color_accessor, am, 4, "COLOR_0", field, &src.colors))
+        goto done;
     /* The triangles' corners, mirrored ones swapped so that front faces
      * stay counter-clockwise after a negative-determinant matrix. */
     corners = malloc((size_t)ntri * 3 * sizeof(uint32_t));
-    world = uv1_file ? NULL : malloc((size_t)am->mNumVertices * 3 * sizeof(float));
-    if (!corners || (!uv1_file && !world)) {
+    if (!corners) {
         fail(c, 500, field, "out of memory");
         goto done;
     }
@@ -354,8 +476,38 @@ static bool build_mesh(struct ctx *c, const struct aiMesh *am, const double m[16
         }
         t++;
     }
+    /* uv1: the file's TEXCOORD_1 where it stays inside [0, 1] and its
+     * charts do not overlap, else generated charts; materials read the
+     * file's sets either way. */
+    enum asset_uv1_origin origin = src.uvs[1] ? ASSET_UV1_FILE : ASSET_UV1_GENERATED_NO_SET;
+    for (unsigned v = 0; origin == ASSET_UV1_FILE && v < am->mNumVertices; v++) {
+        float u = src.uvs[1][2 * v], w = src.uvs[1][2 * v + 1];
+        if (!(u >= -1e-4f && u <= 1.0001f && w >= -1e-4f && w <= 1.0001f))
+            origin = ASSET_UV1_GENERATED_OUTSIDE;
+    }
+    struct uv_coverage cov = {0, 0, 0};
+    if (origin == ASSET_UV1_FILE) {
+        if (!uv_overlap_measure(src.uvs[1], am->mNumVertices, corners, ntri,
+                                UV_OVERLAP_RESOLUTION, &cov)) {
+            fail(c, 500, field, "out of memory");
+            goto done;
+        }
+        out->texcoord1_overlap = (float)uv_coverage_overlap_share(&cov);
+        if (uv_coverage_overlaps(&cov))
+            origin = ASSET_UV1_GENERATED_OVERLAP;
+    }
+    src.uv1_file = origin == ASSET_UV1_FILE;
+    if (src.uvs[1] && normal_uv_set(c, material) == 1 && !pi->has_tangent &&
+        !(src.uv1_tangents = uv_tangents(am, src.uvs[1], corners, ntri))) {
+        fail(c, 500, field, "out of memory");
+        goto done;
+    }
     uint64_t nv = am->mNumVertices;
-    if (!uv1_file) {
+    if (!src.uv1_file) {
+        if (!(world = malloc((size_t)am->mNumVertices * 3 * sizeof(float)))) {
+            fail(c, 500, field, "out of memory");
+            goto done;
+        }
         for (unsigned v = 0; v < am->mNumVertices; v++) {
             const float p3[3] = {am->mVertices[v].x, am->mVertices[v].y, am->mVertices[v].z};
             xform_point(m, p3, world + 3 * (size_t)v);
@@ -384,8 +536,11 @@ static bool build_mesh(struct ctx *c, const struct aiMesh *am, const double m[16
     out->vertex_count = (uint32_t)nv;
     out->index_count = ntri * 3;
     out->material = material;
-    out->uv1_from_file = uv1_file;
+    out->uv1_origin = origin;
     out->tangents_from_file = pi->has_tangent && am->mTangents;
+    out->has_uv0 = src.uvs[0] != NULL;
+    out->has_texcoord1 = src.uvs[1] != NULL;
+    out->has_color = src.colors != NULL;
     const char *nname = json_string_value(json_object_get(node, "name"));
     if (nname && nname[0]) {
         char head[48]; /* room for "/" and the primitive's number */
@@ -397,18 +552,25 @@ static bool build_mesh(struct ctx *c, const struct aiMesh *am, const double m[16
     }
     struct asset_vertex *vs = out->vertices;
     for (uint32_t v = 0; v < out->vertex_count; v++) {
-        if (!fill_vertex(c, am, uvs, uv1_file ? v : charts.source[v], m, nm, det, &vs[v], field))
+        if (!fill_vertex(c, am, &src, src.uv1_file ? v : charts.source[v], m, nm, det, &vs[v], field))
             goto done;
-        if (!uv1_file) {
+        if (!src.uv1_file) {
             vs[v].uv1[0] = charts.uv[v][0];
             vs[v].uv1[1] = charts.uv[v][1];
         }
     }
-    memcpy(out->indices, uv1_file ? corners : charts.indices, (size_t)ntri * 3 * sizeof(uint32_t));
+    memcpy(out->indices, src.uv1_file ? corners : charts.indices, (size_t)ntri * 3 * sizeof(uint32_t));
+    /* The share of uv1's square no triangle covers: the file's charts as
+     * the raster measured them (what is covered, overlaps counted once),
+     * the generated ones (which never overlap) by their area. */
     double covered = 0;
-    for (t = 0; t < ntri; t++) {
-        const uint32_t *ix = &out->indices[t * 3];
-        covered += tri_area2(vs[ix[0]].uv1, vs[ix[1]].uv1, vs[ix[2]].uv1);
+    if (src.uv1_file) {
+        covered = (double)cov.covered / (double)cov.texels;
+    } else {
+        for (t = 0; t < ntri; t++) {
+            const uint32_t *ix = &out->indices[t * 3];
+            covered += tri_area2(vs[ix[0]].uv1, vs[ix[1]].uv1, vs[ix[2]].uv1);
+        }
     }
     double waste = 1.0 - covered;
     out->uv1_waste = (float)(waste < 0 ? 0 : waste > 1 ? 1 : waste);
@@ -425,8 +587,10 @@ static bool build_mesh(struct ctx *c, const struct aiMesh *am, const double m[16
 done:
     free(corners);
     free(world);
-    free(uvs[0]);
-    free(uvs[1]);
+    free(src.uvs[0]);
+    free(src.uvs[1]);
+    free(src.colors);
+    free(src.uv1_tangents);
     uv_charts_free(&charts);
     return ok;
 }

@@ -170,14 +170,15 @@ bool check_asset_and_extensions(struct ctx *c)
         return fail(c, 400, "asset.version", "missing");
     if (version[0] != '2')
         return fail(c, 422, "asset.version", "glTF %s, only 2.x is supported", version);
-    static const char *const handled[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength"};
+    static const char *const handled[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
+                                          "KHR_texture_transform"};
     json_t *req = json_object_get(c->root, "extensionsRequired");
     size_t i;
     json_t *v;
     json_array_foreach(req, i, v) {
         const char *name = json_string_value(v);
         bool ok = name && (strcmp(name, handled[0]) == 0 || strcmp(name, handled[1]) == 0 ||
-                           strcmp(name, "KHR_texture_transform") == 0 ||
+                           strcmp(name, handled[2]) == 0 ||
                            strcmp(name, "KHR_materials_unlit") == 0);
         if (!ok) {
             char field[64];
@@ -187,7 +188,8 @@ bool check_asset_and_extensions(struct ctx *c)
     }
     json_array_foreach(json_object_get(c->root, "extensionsUsed"), i, v) {
         const char *name = json_string_value(v);
-        if (name && strcmp(name, handled[0]) != 0 && strcmp(name, handled[1]) != 0)
+        if (name && strcmp(name, handled[0]) != 0 && strcmp(name, handled[1]) != 0 &&
+            strcmp(name, handled[2]) != 0)
             ignore(c, "extension %s", name);
     }
     if (json_array_size(json_object_get(c->root, "animations")))
@@ -366,8 +368,11 @@ static uint32_t read_index(const struct accessor *a, uint64_t k)
 }
 
 
+/* Attribute name's accessor: one of ctypes, ncomp or ncomp_or components
+ * (ncomp_or 0: ncomp only), vcount elements. */
 static bool check_attribute(struct ctx *c, json_t *attrs, const char *name, const char *field,
-                            uint64_t vcount, const int64_t *ctypes, int ncomp, bool *present)
+                            uint64_t vcount, const int64_t *ctypes, int ncomp, int ncomp_or,
+                            bool *present)
 {
     json_t *v = json_object_get(attrs, name);
     *present = v != NULL;
@@ -384,7 +389,7 @@ static bool check_attribute(struct ctx *c, json_t *attrs, const char *name, cons
     bool ok = false;
     for (int k = 0; ctypes[k]; k++)
         ok |= a.ctype == ctypes[k];
-    if (!ok || a.ncomp != ncomp)
+    if (!ok || (a.ncomp != ncomp && a.ncomp != ncomp_or))
         return fail(c, 400, f, "accessor %" PRId64 " has the wrong type for %s", idx, name);
     if (vcount && a.count != vcount)
         return fail(c, 400, f, "accessor %" PRId64 " has %" PRIu64 " elements, POSITION has %" PRIu64,
@@ -429,15 +434,21 @@ static bool check_primitive(struct ctx *c, size_t m, size_t p, json_t *prim, str
     static const int64_t ANY[] = {5120, 5121, 5122, 5123, 5125, 5126, 0};
     bool present;
     snprintf(f, sizeof(f), "%s.attributes", field);
-    if (!check_attribute(c, attrs, "NORMAL", f, pa.count, FLOAT, 3, &present) ||
-        !check_attribute(c, attrs, "TANGENT", f, pa.count, FLOAT, 4, &pi->has_tangent) ||
-        !check_attribute(c, attrs, "TEXCOORD_0", f, pa.count, UV, 2, &present) ||
-        !check_attribute(c, attrs, "TEXCOORD_1", f, pa.count, UV, 2, &pi->has_uv1))
+    if (!check_attribute(c, attrs, "NORMAL", f, pa.count, FLOAT, 3, 0, &present) ||
+        !check_attribute(c, attrs, "TANGENT", f, pa.count, FLOAT, 4, 0, &pi->has_tangent) ||
+        !check_attribute(c, attrs, "TEXCOORD_0", f, pa.count, UV, 2, 0, &present) ||
+        !check_attribute(c, attrs, "TEXCOORD_1", f, pa.count, UV, 2, 0, &pi->has_uv1))
         return false;
     for (int set = 0; set < 2; set++) {
         json_t *uv = json_object_get(attrs, set ? "TEXCOORD_1" : "TEXCOORD_0");
         pi->uv_accessor[set] = uv ? json_integer_value(uv) : -1;
     }
+    /* COLOR_0: float, or unsigned byte or short (normalized), VEC3 or VEC4. */
+    pi->color_accessor = -1;
+    if (!check_attribute(c, attrs, "COLOR_0", f, pa.count, UV, 3, 4, &present))
+        return false;
+    if (present)
+        pi->color_accessor = json_integer_value(json_object_get(attrs, "COLOR_0"));
     /* The rest are checked for range (assimp reads colours, joints and
      * weights too), whatever their type. */
     const char *key;
@@ -739,8 +750,20 @@ bool check_textures_materials(struct ctx *c)
                 !get_index(c, ti, "index", field, true, json_array_size(c->textures), &idx) ||
                 !get_int(c, ti, "texCoord", field, false, 0, 1 << 20, 0, &set))
                 return false;
-            if (json_object_get(json_object_get(ti, "extensions"), "KHR_texture_transform"))
-                ignore(c, "KHR_texture_transform");
+            json_t *tt = json_object_get(json_object_get(ti, "extensions"), "KHR_texture_transform");
+            if (tt) {
+                char f[160];
+                snprintf(f, sizeof(f), "%s.extensions.KHR_texture_transform", field);
+                double v2[2];
+                json_t *rot = json_object_get(tt, "rotation");
+                if (!json_is_object(tt) || !get_floats(c, tt, "offset", f, 2, v2) ||
+                    !get_floats(c, tt, "scale", f, 2, v2) ||
+                    !get_int(c, tt, "texCoord", f, false, 0, 1 << 20, 0, &set))
+                    return fail(c, 400, f, "must be an object with offset and scale arrays of 2 "
+                                "numbers, a rotation number and a texCoord index");
+                if (rot && (!json_is_number(rot) || !(fabs(json_number_value(rot)) <= 1e30)))
+                    return fail(c, 400, f, "rotation must be a finite number");
+            }
         }
         const char *mode = json_string_value(json_object_get(m, "alphaMode"));
         if (json_object_get(m, "alphaMode") &&

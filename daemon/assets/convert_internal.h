@@ -62,6 +62,7 @@ struct prim_info {
     uint64_t triangles;
     bool has_uv1, has_tangent, triangles_mode;
     int64_t uv_accessor[2]; /* TEXCOORD_0 and _1's accessors, -1 for none */
+    int64_t color_accessor; /* COLOR_0's, -1 for none */
 };
 
 /* ---- the context and JSON helpers (convert_ctx.c) ---- */

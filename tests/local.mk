@@ -38,6 +38,7 @@ UNIT_TESTS = \
 	tests/unit/test_lighting \
 	tests/unit/test_asset \
 	tests/unit/test_uv_charts \
+	tests/unit/test_uv_overlap \
 	tests/unit/test_light_shape
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
@@ -82,6 +83,9 @@ tests_unit_test_asset_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_uv_charts_SOURCES = tests/unit/test_uv_charts.c daemon/assets/uv_charts.c \
 	daemon/assets/uv_charts.h
 tests_unit_test_uv_charts_LDADD = -lm
+tests_unit_test_uv_overlap_SOURCES = tests/unit/test_uv_overlap.c daemon/assets/uv_overlap.c \
+	daemon/assets/uv_overlap.h
+tests_unit_test_uv_overlap_LDADD = -lm
 tests_tools_png_tool_SOURCES = tests/tools/png_tool.c
 tests_tools_png_tool_LDADD = $(CORE_LIBS)
 noinst_HEADERS = tests/unit/check.h tests/unit/catalog_fixture.h tests/fuzz/fuzz.h

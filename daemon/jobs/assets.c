@@ -385,7 +385,8 @@ static bool ensure_cache(struct assets *a, const char *sha, const char *in, json
     char cache[PATH_MAX + 80], desc[PATH_MAX + 80], tmp[PATH_MAX + 120];
     path_of(a, sha, ASSET_CACHE_EXT, cache, sizeof(cache));
     path_of(a, sha, "json", desc, sizeof(desc));
-    if (exists(cache) && (*description = json_load_file(desc, 0, NULL)))
+    /* A cache an older shadebench wrote (another layout) is converted anew. */
+    if (asset_file_is_current(cache) && (*description = json_load_file(desc, 0, NULL)))
         return true;
     snprintf(tmp, sizeof(tmp), "%s/convert-%s.%s", a->dir, sha, ASSET_CACHE_EXT);
     unlink(tmp);

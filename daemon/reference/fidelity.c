@@ -95,7 +95,7 @@ json_t *fidelity_page_request(const struct job_spec *spec, const json_t *view,
                           json_object_get(view, "eye"), "lights",
                           json_object_get(view, "lights"), "exposure", exposure, "tonemap",
                           tonemap, "ibl_intensity", ibl, "environment_file", file,
-                          "environment_rotation_deg", 90, "render_environment", 0, "clear", 0,
+                          "environment_rotation_deg", 90, "render_environment", file, "clear", 0,
                           0, 0, 255, "channels", ch);
     if (!r)
         snprintf(err, errlen, "out of memory for the reference's request");

@@ -4,7 +4,8 @@
 #include <string.h>
 
 const char *const fidelity_channel_names[] = {
-    "lit", "shading_normal", "geometric_normal", "base_color", "metallic", "roughness",
+    "lit", "shading_normal", "geometric_normal", "normal_texture", "tangent", "bitangent",
+    "base_color", "metallic", "roughness",
     "occlusion", "emissive", "uv0", "uv1", "alpha", NULL};
 
 #define ALL_CHANNELS ((1u << FIDELITY_CHANNELS) - 1)
@@ -37,7 +38,7 @@ static bool parse_channels(const json_t *v, unsigned *out, struct job_error *err
             char field[64];
             snprintf(field, sizeof(field), "fidelity.channels[%zu]", i);
             return job_error_set(err, field, "must be one of lit, shading_normal, "
-                                 "geometric_normal, base_color, metallic, roughness, "
+                                 "geometric_normal, normal_texture, tangent, bitangent, base_color, metallic, roughness, "
                                  "occlusion, emissive, uv0, uv1, alpha");
         }
         bits |= 1u << k;

@@ -486,7 +486,8 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
 
     if (!fidelity_spec_parse(json_object_get(body, "fidelity"), &out->fidelity, err) ||
         !fidelity_spec_check_job(&out->fidelity, &out->scene, &out->look, out->reference,
-                                 out->repeat, out->repeat_auto, out->temporal_frames, err))
+                                 out->repeat, out->repeat_auto, out->temporal_frames, out->msaa,
+                                 err))
         return false;
     if (out->fidelity.enabled && out->capture_interval == 0 &&
         !json_object_get(body, "capture_interval"))

@@ -12,6 +12,8 @@
 #include "common/job_files.h"
 #include "common/png_io.h"
 #include "daemon/harness/reference.h"
+#include "daemon/harness/transparent.h"
+#include "daemon/look/look.h"
 #include "daemon/reference/fidelity.h"
 
 static json_t *floats(const float *v, int n)
@@ -69,9 +71,40 @@ static bool debug_look(const struct look_spec *base, const char *name, struct lo
     json_decref(j);
     if (!ok)
         snprintf(why, whylen, "%s: %s", e.field, e.message);
-    /* The environment's pinned hash and the stages stay the job's. */
-    out->ibl = base->ibl;
-    out->shadows = base->shadows;
+    /* A channel needs no lighting: no environment to filter again. */
+    out->ibl.enabled = false;
+    out->shadows.enabled = false;
+    return ok;
+}
+
+/* One channel: the job's technique over the measured run's scene, with the
+ * debug look's own stages (its debug pass) and transparent pass (the
+ * blended meshes' channel), both built with the debug look's defines. */
+static bool draw_channel(struct harness_run *run, const struct look_spec *look, int k,
+                         uint8_t *pixels, enum job_status *status)
+{
+    struct harness_run dbg = *run;
+    dbg.look = look;
+    char defines[sizeof(run->defines)];
+    look_defines(look, defines, sizeof(defines));
+    size_t used = strlen(defines);
+    snprintf(defines + used, sizeof(defines) - used, "#define SCENE_TEXTURED 1\n");
+    memset(&dbg.stages, 0, sizeof(dbg.stages));
+    memset(&dbg.transparent, 0, sizeof(dbg.transparent));
+    struct frame_source src = {0};
+    bool ok = look_stages_init(&dbg.stages, look, &run->scene, &run->gpu, &run->gl->frame_block,
+                               &run->gl->caps, &run->budget, defines, NULL, run->err,
+                               sizeof(run->err)) &&
+              transparent_init(&dbg.transparent, &run->gpu, defines, run->err,
+                               sizeof(run->err)) &&
+              frame_source_open(&dbg, &src, "fidelity channel", run->tech,
+                                job_spec_technique_options(run->spec), look, 1) &&
+              frame_source_frame(&dbg, &src, k, true, pixels, status);
+    frame_source_close(&src);
+    if (!ok && dbg.err[0] && dbg.err != run->err)
+        snprintf(run->err, sizeof(run->err), "%s", dbg.err);
+    transparent_finish(&dbg.transparent);
+    look_stages_finish(&dbg.stages);
     return ok;
 }
 
@@ -117,11 +150,7 @@ json_t *fidelity_render(struct harness_run *run, enum job_status *status)
             json_object_set_new(channels, name, json_pack("{s:s}", "error", why));
             continue;
         }
-        struct frame_source src = {0};
-        ok = frame_source_open(run, &src, "fidelity channel", run->tech,
-                               job_spec_technique_options(spec), &look, 1) &&
-             frame_source_frame(run, &src, k, true, pixels, status);
-        frame_source_close(&src);
+        ok = draw_channel(run, &look, k, pixels, status);
         if (!ok)
             break;
         snprintf(path, sizeof(path), "%s/shadebench-%s.png", dir, name);

@@ -97,7 +97,8 @@ int fidelity_channel_count(const struct fidelity_spec *f)
 
 bool fidelity_spec_check_job(const struct fidelity_spec *f, const struct scene_spec *scene,
                              const struct look_spec *look, const char *reference, int repeat,
-                             bool repeat_auto, int temporal_frames, struct job_error *err)
+                             bool repeat_auto, int temporal_frames, int msaa,
+                             struct job_error *err)
 {
     if (!f->enabled)
         return true;
@@ -113,6 +114,9 @@ bool fidelity_spec_check_job(const struct fidelity_spec *f, const struct scene_s
     if (look->lighting != LOOK_PBR)
         return job_error_set(err, "look.lighting", "must be \"pbr\" with fidelity: the Khronos "
                              "viewer draws glTF's metallic-roughness model");
+    if (msaa != 1)
+        return job_error_set(err, "msaa", "must be 1 with fidelity: the Khronos viewer draws "
+                             "one sample a pixel");
     if (look->tonemap == LOOK_TONEMAP_REINHARD)
         return job_error_set(err, "look.tonemap", "reinhard: the Khronos viewer has no such "
                              "curve (none, srgb, aces or pbr_neutral)");

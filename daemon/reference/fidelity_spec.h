@@ -61,7 +61,8 @@ int fidelity_channel_count(const struct fidelity_spec *f);
 #include "daemon/scene/scene_spec.h"
 bool fidelity_spec_check_job(const struct fidelity_spec *f, const struct scene_spec *scene,
                              const struct look_spec *look, const char *reference, int repeat,
-                             bool repeat_auto, int temporal_frames, struct job_error *err);
+                             bool repeat_auto, int temporal_frames, int msaa,
+                             struct job_error *err);
 
 /* POST /v1/assets/NAME/fidelity's body as a job: {"technique", "width",
  * "height", "camera", "lights" (scene.light_rig), "look", "scene" (more

@@ -352,8 +352,7 @@ static bool fill_vertex(struct ctx *c, const struct aiMesh *am, const struct ver
     double n[3] = {0, 1, 0};
     if (am->mNormals) {
         double in[3] = {am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z};
-        for (int r = 0; r < 3; r++)
-            n[r] = nm[r] * in[0] + nm[3 + r] * in[1] + nm[6 + r] * in[2];
+        xform_normal(nm, in, n);
         normalize3(n);
         if (!(n[0] * n[0] + n[1] * n[1] + n[2] * n[2] > 0.5))
             n[0] = 0, n[1] = 1, n[2] = 0; /* a degenerate normal: any unit one */

@@ -560,10 +560,10 @@ def sphere(rings=12, segments=24, radius=0.8):
 def fidelity_scene(g):
     """The pairs' shared camera and lights (the same in both halves)."""
     g.doc["cameras"] = [{"type": "perspective", "name": "view",
-                         "perspective": {"yfov": 0.7, "znear": 0.1, "zfar": 60, "aspectRatio": 4 / 3}}]
-    g.node(camera=0, name="view", translation=[0.5, 2.2, 8.5], rotation=axis_angle([1, 0, 0], -14))
-    pl = g.light(type="point", name="lamp", color=[1, 0.9, 0.8], intensity=60, range=20)
-    dl = g.light(type="directional", name="sun", color=[0.8, 0.85, 1], intensity=2)
+                         "perspective": {"yfov": 0.75, "znear": 0.1, "zfar": 60, "aspectRatio": 4 / 3}}]
+    g.node(camera=0, name="view", translation=[0.3, 2.4, 9.5], rotation=axis_angle([1, 0, 0], -6))
+    pl = g.light(type="point", name="lamp", color=[1, 0.9, 0.8], intensity=250, range=25)
+    dl = g.light(type="directional", name="sun", color=[0.8, 0.85, 1], intensity=4)
     g.node(name="lamp", translation=[2.5, 4, 4], extensions={"KHR_lights_punctual": {"light": pl}})
     g.node(name="sun", rotation=axis_angle([1, 0.4, 0], -50), extensions={"KHR_lights_punctual": {"light": dl}})
 

@@ -60,7 +60,7 @@ struct accessor {
 struct prim_info {
     uint64_t vertices, indices; /* as the file has them */
     uint64_t triangles;
-    bool has_uv1, has_tangent, triangles_mode;
+    bool has_uv1, has_tangent, has_normal, triangles_mode;
     int64_t uv_accessor[2]; /* TEXCOORD_0 and _1's accessors, -1 for none */
     int64_t color_accessor; /* COLOR_0's, -1 for none */
 };

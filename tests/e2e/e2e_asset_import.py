@@ -17,6 +17,11 @@ look.debug's channels):
   colour factors;
 - KHR_texture_transform (offset, rotation, scale, a texCoord override)
   against the coordinates it produces;
+- a mesh without normals (glTF: flat ones) against its triangles unwelded
+  with their face normals stated;
+- a double-sided, normal-mapped plate seen from behind against the same
+  plate rebuilt to face the viewer with normal, tangent and handedness
+  reversed (glTF reverses a back face's normal, the normal map's too);
 and look.debug's channels are the viewer's encodings at known pixels:
 base_color of a COLOR_0 box, the grey checks where a mesh has no
 TEXCOORD_1, normals as n * 0.5 + 0.5, alpha 1 for opaque materials; a
@@ -91,7 +96,8 @@ def main():
         # The channels behind them, pair by pair.
         channels = {"transforms": ["shading_normal", "geometric_normal", "tangent"],
                     "texcoord1_outside": ["occlusion", "base_color", "emissive"],
-                    "colors": ["base_color"], "texture_transform": ["base_color"]}
+                    "colors": ["base_color"], "texture_transform": ["base_color"],
+                    "flat_normals": ["geometric_normal"], "back_face": ["shading_normal"]}
         for name, chans in channels.items():
             for ch in chans:
                 shots = [frame(d, dict(JOB, look={"debug": ch},

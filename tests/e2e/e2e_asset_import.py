@@ -22,6 +22,7 @@ look.debug's channels):
 - a double-sided, normal-mapped plate seen from behind against the same
   plate rebuilt to face the viewer with normal, tangent and handedness
   reversed (glTF reverses a back face's normal, the normal map's too);
+every technique draws the same channel image (the look's debug pass);
 and look.debug's channels are the viewer's encodings at known pixels:
 base_color of a COLOR_0 box, the grey checks where a mesh has no
 TEXCOORD_1, normals as n * 0.5 + 0.5, alpha 1 for opaque materials; a
@@ -105,6 +106,19 @@ def main():
                 s = ssim(shots[1], shots[0])
                 print("%s, look.debug %s: SSIM %.5f" % (name, ch, s), flush=True)
                 check(s >= PAIR_BOUND, "%s, look.debug %s: the two halves alike: SSIM %.5f" % (name, ch, s))
+
+        # The channels are the shared surface's: every technique draws the
+        # same image of one.
+        techniques = [t["name"] for t in d.json("GET", "/v1/info")[1]["techniques"]]
+        scene = dict(SCENE, asset="back_face_a.glb")
+        ref = frame(d, dict(JOB, look={"debug": "shading_normal"}, scene=scene))
+        for t in techniques:
+            if t == "forward":
+                continue
+            shot = frame(d, dict(JOB, technique=t, look={"debug": "shading_normal"}, scene=scene))
+            diff = testlib.png_diff(ref, shot) if ref and shot else None
+            check(diff is not None and diff["differing_pixels"] == 0,
+                  "%s's shading_normal channel is forward's: %s" % (t, diff))
 
         # The encodings at known pixels. The colours pair's left box is
         # COLOR_0 (200, 120, 60) / 255 over a white and grey checker: its

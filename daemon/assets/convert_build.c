@@ -280,29 +280,87 @@ static int normal_uv_set(struct ctx *c, int material)
     return json_integer_value(set) == 1 ? 1 : 0;
 }
 
+/* A primitive's vertices in object space, as the converter builds the
+ * asset's from them: assimp's mesh and the checked accessors, one entry per
+ * vertex of the file or, where the file has no normals, per triangle
+ * corner (unweld). */
+struct vertex_sources {
+    uint32_t count;
+    float *pos;          /* 3 per vertex */
+    float *normals;      /* 3 per vertex (any unit normal where NULL) */
+    float *tangents;     /* 4 per vertex: direction and handedness w (w 0: none) */
+    float *uvs[2];       /* TEXCOORD_0 and _1, 2 per vertex, or NULL */
+    float *colors;       /* COLOR_0, 4 per vertex (alpha 1 for VEC3), or NULL */
+    bool uv1_file;       /* uv1 is the file's TEXCOORD_1 */
+};
+
+static void sources_free(struct vertex_sources *s)
+{
+    free(s->pos);
+    free(s->normals);
+    free(s->tangents);
+    free(s->uvs[0]);
+    free(s->uvs[1]);
+    free(s->colors);
+    memset(s, 0, sizeof(*s));
+}
+
+/* Positions, normals and tangents from assimp's mesh. assimp's tangents
+ * come with its bitangents, computed on V-flipped coordinates, which point
+ * the way glTF's bitangent does (towards decreasing glTF v, up in the
+ * image); glTF's is cross(normal, tangent) * w, so the sign of that dot
+ * product is w, for tangents from the file or generated. */
+static bool sources_from_assimp(const struct aiMesh *am, bool file_normals, struct vertex_sources *s)
+{
+    size_t n = am->mNumVertices;
+    s->count = am->mNumVertices;
+    s->pos = malloc(n * 3 * sizeof(float));
+    s->tangents = calloc(n * 4, sizeof(float));
+    s->normals = file_normals && am->mNormals ? malloc(n * 3 * sizeof(float)) : NULL;
+    if (!s->pos || !s->tangents || (file_normals && am->mNormals && !s->normals))
+        return false;
+    for (size_t v = 0; v < n; v++) {
+        s->pos[3 * v] = am->mVertices[v].x;
+        s->pos[3 * v + 1] = am->mVertices[v].y;
+        s->pos[3 * v + 2] = am->mVertices[v].z;
+        if (s->normals) {
+            s->normals[3 * v] = am->mNormals[v].x;
+            s->normals[3 * v + 1] = am->mNormals[v].y;
+            s->normals[3 * v + 2] = am->mNormals[v].z;
+        }
+        if (!am->mTangents || !am->mBitangents || !am->mNormals)
+            continue;
+        double t[3] = {am->mTangents[v].x, am->mTangents[v].y, am->mTangents[v].z};
+        double nn[3] = {am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z};
+        double b[3] = {am->mBitangents[v].x, am->mBitangents[v].y, am->mBitangents[v].z};
+        double cr[3] = {nn[1] * t[2] - nn[2] * t[1], nn[2] * t[0] - nn[0] * t[2],
+                        nn[0] * t[1] - nn[1] * t[0]};
+        for (int k = 0; k < 3; k++)
+            s->tangents[4 * v + (size_t)k] = (float)t[k];
+        s->tangents[4 * v + 3] = cr[0] * b[0] + cr[1] * b[1] + cr[2] * b[2] < 0 ? -1.0f : 1.0f;
+    }
+    return true;
+}
+
 /* Tangents in object space from uv (2 floats per vertex) for a normal
  * texture that reads a set assimp does not derive them from (it uses
  * TEXCOORD_0): each triangle's dP/du and dP/dv, summed at its corners, dP/du
  * made perpendicular to the normal; w makes cross(normal, tangent) * w point
- * along -dP/dv, up the image as glTF's bitangent does. 4 floats per vertex;
- * a vertex no triangle gives a direction keeps w = 0 (any tangent). */
-static float *uv_tangents(const struct aiMesh *am, const float *uv, const uint32_t *corners,
-                          uint32_t ntri)
+ * along -dP/dv, up the image as glTF's bitangent does. Written over
+ * s->tangents; a vertex no triangle gives a direction keeps w = 0 (any
+ * tangent). corners: the file's winding. */
+static bool uv_tangents(struct vertex_sources *s, const float *uv, const uint32_t *corners,
+                        uint32_t ntri)
 {
-    size_t nv = am->mNumVertices;
+    size_t nv = s->count;
     double *acc = calloc(nv * 6, sizeof(double));
-    float *out = calloc(nv * 4, sizeof(float));
-    if (!acc || !out) {
-        free(acc);
-        free(out);
-        return NULL;
-    }
+    if (!acc)
+        return false;
     for (uint32_t t = 0; t < ntri; t++) {
         const uint32_t *ix = &corners[3 * t];
-        const struct aiVector3D *p0 = &am->mVertices[ix[0]], *p1 = &am->mVertices[ix[1]],
-                                *p2 = &am->mVertices[ix[2]];
-        double e1[3] = {p1->x - p0->x, p1->y - p0->y, p1->z - p0->z};
-        double e2[3] = {p2->x - p0->x, p2->y - p0->y, p2->z - p0->z};
+        const float *p0 = &s->pos[3 * ix[0]], *p1 = &s->pos[3 * ix[1]], *p2 = &s->pos[3 * ix[2]];
+        double e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+        double e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
         double du1 = uv[2 * ix[1]] - uv[2 * ix[0]], dv1 = uv[2 * ix[1] + 1] - uv[2 * ix[0] + 1];
         double du2 = uv[2 * ix[2]] - uv[2 * ix[0]], dv2 = uv[2 * ix[2] + 1] - uv[2 * ix[0] + 1];
         double r = du1 * dv2 - du2 * dv1;
@@ -320,46 +378,85 @@ static float *uv_tangents(const struct aiMesh *am, const float *uv, const uint32
             }
     }
     for (size_t v = 0; v < nv; v++) {
-        if (!am->mNormals)
-            break;
-        double n[3] = {am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z};
-        double *s = &acc[6 * v], *tv = &acc[6 * v + 3];
-        double d = n[0] * s[0] + n[1] * s[1] + n[2] * s[2];
-        double t[3] = {s[0] - d * n[0], s[1] - d * n[1], s[2] - d * n[2]};
+        s->tangents[4 * v + 3] = 0.0f;
+        if (!s->normals)
+            continue;
+        const float *nf = &s->normals[3 * v];
+        double n[3] = {nf[0], nf[1], nf[2]};
+        double *sd = &acc[6 * v], *td = &acc[6 * v + 3];
+        double d = n[0] * sd[0] + n[1] * sd[1] + n[2] * sd[2];
+        double t[3] = {sd[0] - d * n[0], sd[1] - d * n[1], sd[2] - d * n[2]};
         double len = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
         if (!(len > 1e-20) || !isfinite(len))
             continue;
         double cr[3] = {n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2],
                         n[0] * t[1] - n[1] * t[0]};
         for (int k = 0; k < 3; k++)
-            out[4 * v + (size_t)k] = (float)(t[k] / len);
-        out[4 * v + 3] = cr[0] * tv[0] + cr[1] * tv[1] + cr[2] * tv[2] > 0 ? -1.0f : 1.0f;
+            s->tangents[4 * v + (size_t)k] = (float)(t[k] / len);
+        s->tangents[4 * v + 3] = cr[0] * td[0] + cr[1] * td[1] + cr[2] * td[2] > 0 ? -1.0f : 1.0f;
     }
     free(acc);
-    return out;
+    return true;
 }
 
-/* What a mesh's vertices are made from, beside assimp's mesh. */
-struct vertex_sources {
-    float *uvs[2];        /* TEXCOORD_0 and _1, 2 floats per vertex, or NULL */
-    float *colors;        /* COLOR_0, 4 floats per vertex (alpha 1 for VEC3), or NULL */
-    float *uv1_tangents;  /* tangents from TEXCOORD_1 (uv_tangents), or NULL for assimp's */
-    bool uv1_file;        /* uv1 is the file's TEXCOORD_1 */
-};
+/* Where the file gives no normals, glTF asks for flat ones: every triangle
+ * corner its own vertex, with the triangle's normal (from the file's
+ * winding: mirrored, swapped is 0, 2, 1). corners become 0, 1, 2, ... */
+static bool unweld(struct vertex_sources *s, uint32_t *corners, uint32_t ntri, bool swapped)
+{
+    size_t n = (size_t)ntri * 3;
+    struct vertex_sources f = {(uint32_t)n, NULL, NULL, NULL, {NULL, NULL}, NULL, false};
+    f.pos = malloc(n * 3 * sizeof(float));
+    f.normals = malloc(n * 3 * sizeof(float));
+    f.tangents = malloc(n * 4 * sizeof(float));
+    for (int set = 0; set < 2; set++)
+        f.uvs[set] = s->uvs[set] ? malloc(n * 2 * sizeof(float)) : NULL;
+    f.colors = s->colors ? malloc(n * 4 * sizeof(float)) : NULL;
+    if (!f.pos || !f.normals || !f.tangents || (s->uvs[0] && !f.uvs[0]) ||
+        (s->uvs[1] && !f.uvs[1]) || (s->colors && !f.colors)) {
+        sources_free(&f);
+        return false;
+    }
+    for (uint32_t t = 0; t < ntri; t++) {
+        uint32_t *ix = &corners[3 * t];
+        const float *p0 = &s->pos[3 * ix[0]], *p1 = &s->pos[3 * ix[swapped ? 2 : 1]],
+                    *p2 = &s->pos[3 * ix[swapped ? 1 : 2]];
+        double e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+        double e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+        double fn[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                        e1[0] * e2[1] - e1[1] * e2[0]};
+        normalize3(fn);
+        for (int k = 0; k < 3; k++) {
+            size_t o = 3 * (size_t)t + (size_t)k, v = ix[k];
+            memcpy(&f.pos[3 * o], &s->pos[3 * v], 3 * sizeof(float));
+            for (int q = 0; q < 3; q++)
+                f.normals[3 * o + (size_t)q] = (float)fn[q];
+            memcpy(&f.tangents[4 * o], &s->tangents[4 * v], 4 * sizeof(float));
+            for (int set = 0; set < 2; set++)
+                if (f.uvs[set])
+                    memcpy(&f.uvs[set][2 * o], &s->uvs[set][2 * v], 2 * sizeof(float));
+            if (f.colors)
+                memcpy(&f.colors[4 * o], &s->colors[4 * v], 4 * sizeof(float));
+            ix[k] = (uint32_t)o;
+        }
+    }
+    sources_free(s);
+    *s = f;
+    return true;
+}
 
-/* Vertex v of assimp's mesh in world space (uv1 from the file where it is
+/* Vertex v of the sources in world space (uv1 from the file where it is
  * used; the caller sets generated charts). */
-static bool fill_vertex(struct ctx *c, const struct aiMesh *am, const struct vertex_sources *src,
-                        unsigned v, const double m[16], const double nm[9], double det,
+static bool fill_vertex(struct ctx *c, const struct vertex_sources *src, uint32_t v,
+                        const double m[16], const double nm[9], double det,
                         struct asset_vertex *vx, const char *field)
 {
-    const float pos[3] = {am->mVertices[v].x, am->mVertices[v].y, am->mVertices[v].z};
-    xform_point(m, pos, vx->pos);
+    xform_point(m, &src->pos[3 * (size_t)v], vx->pos);
     double n[3] = {0, 1, 0};
-    if (am->mNormals) {
-        double in[3] = {am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z};
-        for (int r = 0; r < 3; r++)
-            n[r] = nm[r] * in[0] + nm[3 + r] * in[1] + nm[6 + r] * in[2];
+    if (src->normals) {
+        const float *nf = &src->normals[3 * (size_t)v];
+        double in[3] = {nf[0], nf[1], nf[2]};
+        xform_normal(nm, in, n);
         normalize3(n);
         if (!(n[0] * n[0] + n[1] * n[1] + n[2] * n[2] > 0.5))
             n[0] = 0, n[1] = 1, n[2] = 0; /* a degenerate normal: any unit one */
@@ -367,25 +464,9 @@ static bool fill_vertex(struct ctx *c, const struct aiMesh *am, const struct ver
     for (int r = 0; r < 3; r++)
         vx->normal[r] = (float)n[r];
     any_tangent(vx->normal, vx->tangent);
-    /* The tangent in object space and its handedness w. */
-    double tin[3] = {0, 0, 0}, w = 0;
-    if (src->uv1_tangents) {
-        const float *t = &src->uv1_tangents[4 * (size_t)v];
-        tin[0] = t[0], tin[1] = t[1], tin[2] = t[2], w = t[3];
-    } else if (am->mTangents && am->mBitangents && am->mNormals) {
-        double nin[3] = {am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z};
-        double bin[3] = {am->mBitangents[v].x, am->mBitangents[v].y, am->mBitangents[v].z};
-        tin[0] = am->mTangents[v].x, tin[1] = am->mTangents[v].y, tin[2] = am->mTangents[v].z;
-        /* glTF: bitangent = cross(normal, tangent) * w. assimp computed its
-         * bitangent on V-flipped coordinates, which points it the way glTF's
-         * does (towards decreasing glTF v, up in the image), so the sign of
-         * this dot product is w, for tangents from the file or generated. */
-        double cr[3] = {nin[1] * tin[2] - nin[2] * tin[1], nin[2] * tin[0] - nin[0] * tin[2],
-                        nin[0] * tin[1] - nin[1] * tin[0]};
-        w = cr[0] * bin[0] + cr[1] * bin[1] + cr[2] * bin[2] < 0 ? -1.0 : 1.0;
-    }
-    if (w != 0) {
-        double tw[3];
+    const float *tf = &src->tangents[4 * (size_t)v];
+    if (tf[3] != 0.0f) {
+        double tin[3] = {tf[0], tf[1], tf[2]}, tw[3];
         xform_dir(m, tin, tw);
         /* Keep it perpendicular to the world normal (a non-uniform scale
          * skews the two apart). */
@@ -397,15 +478,16 @@ static bool fill_vertex(struct ctx *c, const struct aiMesh *am, const struct ver
             normalize3(tw);
             for (int r = 0; r < 3; r++)
                 vx->tangent[r] = (float)tw[r];
-            vx->tangent[3] = (float)(det < 0 ? -w : w);
+            /* A mirroring matrix turns the frame's handedness. */
+            vx->tangent[3] = det < 0 ? -tf[3] : tf[3];
         }
     }
     if (src->uvs[0]) {
-        vx->uv0[0] = src->uvs[0][2 * v];
-        vx->uv0[1] = src->uvs[0][2 * v + 1];
+        vx->uv0[0] = src->uvs[0][2 * (size_t)v];
+        vx->uv0[1] = src->uvs[0][2 * (size_t)v + 1];
     }
     if (src->uvs[1]) {
-        float u = src->uvs[1][2 * v], t = src->uvs[1][2 * v + 1];
+        float u = src->uvs[1][2 * (size_t)v], t = src->uvs[1][2 * (size_t)v + 1];
         vx->texcoord1[0] = u;
         vx->texcoord1[1] = t;
         if (src->uv1_file) {
@@ -444,14 +526,18 @@ static bool build_mesh(struct ctx *c, const struct aiMesh *am, const double m[16
         ntri += am->mFaces[f].mNumIndices == 3;
     if (!ntri)
         return true; /* points or lines only: already in ignored */
-    /* Both uv sets in glTF's convention (origin top left) and COLOR_0,
-     * decoded from the checked accessors (assimp 5.2 copies quantized ones
-     * as raw bytes into floats). */
-    struct vertex_sources src = {{NULL, NULL}, NULL, NULL, false};
+    struct vertex_sources src = {0, NULL, NULL, NULL, {NULL, NULL}, NULL, false};
     uint32_t *corners = NULL;
     float *world = NULL;
     struct uv_charts charts = {0};
     bool ok = false;
+    if (!sources_from_assimp(am, pi->has_normal, &src)) {
+        fail(c, 500, field, "out of memory");
+        goto done;
+    }
+    /* Both uv sets in glTF's convention (origin top left) and COLOR_0,
+     * decoded from the checked accessors (assimp 5.2 copies quantized ones
+     * as raw bytes into floats). */
     for (int set = 0; set < 2; set++)
         if (pi->uv_accessor[set] >= 0 &&
             !decode_attribute(c, pi->uv_accessor[set], am, 2, set ? "TEXCOORD_1" : "TEXCOORD_0",
@@ -482,19 +568,33 @@ static bool build_mesh(struct ctx *c, const struct aiMesh *am, const double m[16
         }
         t++;
     }
+    if (!pi->has_normal && !unweld(&src, corners, ntri, det < 0)) {
+        fail(c, 500, field, "out of memory");
+        goto done;
+    }
+    /* Tangents the file does not give, from the normal texture's set where
+     * assimp's are not (it derives them from TEXCOORD_0, with the normals it
+     * generates where the file has none, not the flat ones). Swapped
+     * corners give the same sums. */
+    int nset = normal_uv_set(c, material);
+    if (!pi->has_tangent && src.uvs[nset] && (nset == 1 || !pi->has_normal) &&
+        !uv_tangents(&src, src.uvs[nset], corners, ntri)) {
+        fail(c, 500, field, "out of memory");
+        goto done;
+    }
     /* uv1: the file's TEXCOORD_1 where it stays inside [0, 1] and its
      * charts do not overlap, else generated charts; materials read the
      * file's sets either way. */
     enum asset_uv1_origin origin = src.uvs[1] ? ASSET_UV1_FILE : ASSET_UV1_GENERATED_NO_SET;
-    for (unsigned v = 0; origin == ASSET_UV1_FILE && v < am->mNumVertices; v++) {
+    for (uint32_t v = 0; origin == ASSET_UV1_FILE && v < src.count; v++) {
         float u = src.uvs[1][2 * v], w = src.uvs[1][2 * v + 1];
         if (!(u >= -1e-4f && u <= 1.0001f && w >= -1e-4f && w <= 1.0001f))
             origin = ASSET_UV1_GENERATED_OUTSIDE;
     }
     struct uv_coverage cov = {0, 0, 0};
     if (origin == ASSET_UV1_FILE) {
-        if (!uv_overlap_measure(src.uvs[1], am->mNumVertices, corners, ntri,
-                                UV_OVERLAP_RESOLUTION, &cov)) {
+        if (!uv_overlap_measure(src.uvs[1], src.count, corners, ntri, UV_OVERLAP_RESOLUTION,
+                                &cov)) {
             fail(c, 500, field, "out of memory");
             goto done;
         }
@@ -503,24 +603,17 @@ static bool build_mesh(struct ctx *c, const struct aiMesh *am, const double m[16
             origin = ASSET_UV1_GENERATED_OVERLAP;
     }
     src.uv1_file = origin == ASSET_UV1_FILE;
-    if (src.uvs[1] && normal_uv_set(c, material) == 1 && !pi->has_tangent &&
-        !(src.uv1_tangents = uv_tangents(am, src.uvs[1], corners, ntri))) {
-        fail(c, 500, field, "out of memory");
-        goto done;
-    }
-    uint64_t nv = am->mNumVertices;
+    uint64_t nv = src.count;
     if (!src.uv1_file) {
-        if (!(world = malloc((size_t)am->mNumVertices * 3 * sizeof(float)))) {
+        if (!(world = malloc((size_t)src.count * 3 * sizeof(float)))) {
             fail(c, 500, field, "out of memory");
             goto done;
         }
-        for (unsigned v = 0; v < am->mNumVertices; v++) {
-            const float p3[3] = {am->mVertices[v].x, am->mVertices[v].y, am->mVertices[v].z};
-            xform_point(m, p3, world + 3 * (size_t)v);
-        }
+        for (uint32_t v = 0; v < src.count; v++)
+            xform_point(m, &src.pos[3 * (size_t)v], world + 3 * (size_t)v);
         char cerr[128];
-        if (!uv_charts_build(world, am->mNumVertices, corners, ntri, c->lim->max_vertices, &charts,
-                             cerr, sizeof(cerr))) {
+        if (!uv_charts_build(world, src.count, corners, ntri, c->lim->max_vertices, &charts, cerr,
+                             sizeof(cerr))) {
             if (strstr(cerr, "memory"))
                 fail(c, 500, field, "%s", cerr);
             else
@@ -558,7 +651,7 @@ static bool build_mesh(struct ctx *c, const struct aiMesh *am, const double m[16
     }
     struct asset_vertex *vs = out->vertices;
     for (uint32_t v = 0; v < out->vertex_count; v++) {
-        if (!fill_vertex(c, am, &src, src.uv1_file ? v : charts.source[v], m, nm, det, &vs[v], field))
+        if (!fill_vertex(c, &src, src.uv1_file ? v : charts.source[v], m, nm, det, &vs[v], field))
             goto done;
         if (!src.uv1_file) {
             vs[v].uv1[0] = charts.uv[v][0];
@@ -593,10 +686,7 @@ static bool build_mesh(struct ctx *c, const struct aiMesh *am, const double m[16
 done:
     free(corners);
     free(world);
-    free(src.uvs[0]);
-    free(src.uvs[1]);
-    free(src.colors);
-    free(src.uv1_tangents);
+    sources_free(&src);
     uv_charts_free(&charts);
     return ok;
 }

@@ -434,7 +434,7 @@ static bool check_primitive(struct ctx *c, size_t m, size_t p, json_t *prim, str
     static const int64_t ANY[] = {5120, 5121, 5122, 5123, 5125, 5126, 0};
     bool present;
     snprintf(f, sizeof(f), "%s.attributes", field);
-    if (!check_attribute(c, attrs, "NORMAL", f, pa.count, FLOAT, 3, 0, &present) ||
+    if (!check_attribute(c, attrs, "NORMAL", f, pa.count, FLOAT, 3, 0, &pi->has_normal) ||
         !check_attribute(c, attrs, "TANGENT", f, pa.count, FLOAT, 4, 0, &pi->has_tangent) ||
         !check_attribute(c, attrs, "TEXCOORD_0", f, pa.count, UV, 2, 0, &present) ||
         !check_attribute(c, attrs, "TEXCOORD_1", f, pa.count, UV, 2, 0, &pi->has_uv1))
@@ -623,8 +623,9 @@ bool check_meshes(struct ctx *c, int64_t scene_index, struct prim_info ***infos)
                 continue;
             meshes++;
             triangles += pi->triangles;
-            /* Generated uv1 gives each triangle its own three vertices. */
-            vertices += pi->has_uv1 ? pi->vertices : 3 * pi->triangles;
+            /* Generated uv1 gives each triangle its own three vertices, and
+             * so do flat normals where the file has none. */
+            vertices += pi->has_uv1 && pi->has_normal ? pi->vertices : 3 * pi->triangles;
             indices += 3 * pi->triangles;
         }
     }

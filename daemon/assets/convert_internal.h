@@ -60,7 +60,7 @@ struct accessor {
 struct prim_info {
     uint64_t vertices, indices; /* as the file has them */
     uint64_t triangles;
-    bool has_uv1, has_tangent, triangles_mode;
+    bool has_uv1, has_tangent, has_normal, triangles_mode;
     int64_t uv_accessor[2]; /* TEXCOORD_0 and _1's accessors, -1 for none */
     int64_t color_accessor; /* COLOR_0's, -1 for none */
 };
@@ -105,7 +105,10 @@ void node_world(struct ctx *c, int i, double m[16]);
 void xform_point(const double m[16], const float in[3], float out[3]);
 void xform_dir(const double m[16], const double in[3], double out[3]);
 void normalize3(double v[3]);
+/* |det| M^-T of m's upper 3x3, column-major (normals), and m's determinant. */
 double normal_matrix(const double m[16], double n[9]);
+/* n (normal_matrix's) times in: a normal to world space, not renormalised. */
+void xform_normal(const double n[9], const double in[3], double out[3]);
 
 /* ---- images (convert_images.c) ---- */
 

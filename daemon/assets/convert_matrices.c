@@ -91,23 +91,28 @@ void normalize3(double v[3])
             v[i] /= n;
 }
 
-/* The inverse transpose of the upper 3x3 (for normals), and its determinant. */
+/* The normal matrix of m's upper 3x3, |det| M^-T, column-major like m,
+ * and the determinant. M^-T is the cofactor matrix C over det; normals are
+ * renormalised, so the scale does not matter, only the sign: C / sign(det)
+ * keeps it (a mirroring m turns normals with the surface). C[i][j] is
+ * stored at n[3 j + i], the column-major place of row i, column j. */
 double normal_matrix(const double m[16], double n[9])
 {
-    double a = m[0], b = m[4], cc = m[8], d = m[1], e = m[5], f = m[9], g = m[2], h = m[6], k = m[10];
-    double det = a * (e * k - f * h) - b * (d * k - f * g) + cc * (d * h - e * g);
-    /* cofactor matrix = det * inverse transpose; the scale does not matter
-     * since normals are renormalised, only its sign (kept by using the
-     * cofactors divided by |det| where det != 0). */
+    /* Rows of the upper 3x3: (a b c), (d e f), (g h k). */
+    double a = m[0], b = m[4], c = m[8], d = m[1], e = m[5], f = m[9], g = m[2], h = m[6], k = m[10];
+    double det = a * (e * k - f * h) - b * (d * k - f * g) + c * (d * h - e * g);
     double s = det < 0 ? -1.0 : 1.0;
-    n[0] = s * (e * k - f * h);
-    n[1] = s * -(d * k - f * g);
-    n[2] = s * (d * h - e * g);
-    n[3] = s * -(b * k - cc * h);
-    n[4] = s * (a * k - cc * g);
-    n[5] = s * -(a * h - b * g);
-    n[6] = s * (b * f - cc * e);
-    n[7] = s * -(a * f - cc * d);
-    n[8] = s * (a * e - b * d);
+    double cof[3][3] = {{e * k - f * h, -(d * k - f * g), d * h - e * g},
+                        {-(b * k - c * h), a * k - c * g, -(a * h - b * g)},
+                        {b * f - c * e, -(a * f - c * d), a * e - b * d}};
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            n[3 * j + i] = s * cof[i][j];
     return det;
+}
+
+void xform_normal(const double n[9], const double in[3], double out[3])
+{
+    for (int r = 0; r < 3; r++)
+        out[r] = n[r] * in[0] + n[3 + r] * in[1] + n[6 + r] * in[2];
 }

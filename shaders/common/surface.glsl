@@ -135,17 +135,17 @@ TexturedSurface material_surface_grad(int row, vec4 uvs, vec4 dx, vec4 dy, vec3 
     s.T = front ? t0 : -t0;
     s.B = front ? b0 : -b0;
     s.normal_texel = vec3(0.0);
-    // A double-sided material's back face is lit as the side it shows.
-    float facing = (sm.slots.w != 0 && !front) ? -1.0 : 1.0;
-    N *= facing;
     if (material_has(sm, SLOT_NORMAL)) {
-        vec3 t = normalize(tangent.xyz - N * dot(N, tangent.xyz));
-        vec3 b = cross(N, t) * tangent.w * facing;
         vec3 tn = MATERIAL_SAMPLE(u_material_normal, sm, SLOT_NORMAL, uvs, dx, dy).xyz * 2.0 - 1.0;
         tn.xy *= sm.params.z;
         s.normal_texel = normalize(tn);
-        N = normalize(t * tn.x + b * tn.y + N * tn.z);
+        N = normalize(t0 * tn.x + b0 * tn.y + N * tn.z);
     }
+    // A double-sided material's back face is lit as the side it shows:
+    // glTF reverses its normal, the normal-mapped one whole (a bump on the
+    // front is a dent behind).
+    if (sm.slots.w != 0 && !front)
+        N = -N;
     s.N = N;
     s.occlusion = 1.0;
     s.occlusion_texel = 1.0;

@@ -123,15 +123,16 @@ class Gltf:
         return len(self.doc["accessors"]) - 1
 
     def mesh(self, geom, material=None, uv1=True, tangents=False, name=None, mode=None,
-             colors=None):
+             colors=None, normals=True):
         """geom: (positions, normals, uv0, uv1, indices[, tangents]); tangents
         True writes the geometry's own (or (1, 0, 0, 1) where it has none);
         colors: (values, componentType, "VEC3" or "VEC4") for COLOR_0."""
         pos, nrm, uv0, uv1v, idx = geom[:5]
         n = len(pos) // 3
         attrs = {"POSITION": self.accessor(pos, 5126, "VEC3", n),
-                 "NORMAL": self.accessor(nrm, 5126, "VEC3", n),
                  "TEXCOORD_0": self.accessor(uv0, 5126, "VEC2", n)}
+        if normals:
+            attrs["NORMAL"] = self.accessor(nrm, 5126, "VEC3", n)
         if uv1:
             attrs["TEXCOORD_1"] = self.accessor(uv1v, 5126, "VEC2", n)
         if tangents:
@@ -560,10 +561,10 @@ def sphere(rings=12, segments=24, radius=0.8):
 def fidelity_scene(g):
     """The pairs' shared camera and lights (the same in both halves)."""
     g.doc["cameras"] = [{"type": "perspective", "name": "view",
-                         "perspective": {"yfov": 0.7, "znear": 0.1, "zfar": 60, "aspectRatio": 4 / 3}}]
-    g.node(camera=0, name="view", translation=[0.5, 2.2, 8.5], rotation=axis_angle([1, 0, 0], -14))
-    pl = g.light(type="point", name="lamp", color=[1, 0.9, 0.8], intensity=60, range=20)
-    dl = g.light(type="directional", name="sun", color=[0.8, 0.85, 1], intensity=2)
+                         "perspective": {"yfov": 0.75, "znear": 0.1, "zfar": 60, "aspectRatio": 4 / 3}}]
+    g.node(camera=0, name="view", translation=[0.3, 2.4, 9.5], rotation=axis_angle([1, 0, 0], -6))
+    pl = g.light(type="point", name="lamp", color=[1, 0.9, 0.8], intensity=250, range=25)
+    dl = g.light(type="directional", name="sun", color=[0.8, 0.85, 1], intensity=4)
     g.node(name="lamp", translation=[2.5, 4, 4], extensions={"KHR_lights_punctual": {"light": pl}})
     g.node(name="sun", rotation=axis_angle([1, 0.4, 0], -50), extensions={"KHR_lights_punctual": {"light": dl}})
 
@@ -754,6 +755,74 @@ def texture_transform_asset(transformed):
     return g
 
 
+def flat_asset(file_normals):
+    """A sphere whose file gives no normals (glTF: flat ones, a vertex per
+    triangle corner) against the same triangles unwelded with their face
+    normals stated."""
+    g = Gltf()
+    pos, nrm, uv0, uv1, idx, tan = sphere(rings=8, segments=12, radius=1.2)
+
+    def area2(k):
+        a, b, c = (pos[3 * i:3 * i + 3] for i in idx[k:k + 3])
+        e1 = [b[q] - a[q] for q in range(3)]
+        e2 = [c[q] - a[q] for q in range(3)]
+        return sum(x * x for x in (e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                                   e1[0] * e2[1] - e1[1] * e2[0]))
+    # The poles' degenerate triangles left out (no face normal to state).
+    idx = [i for k in range(0, len(idx), 3) if area2(k) > 1e-12 for i in idx[k:k + 3]]
+    if file_normals:
+        p2, n2, u2, idx2 = [], [], [], []
+        for k in range(0, len(idx), 3):
+            a, b, c = (pos[3 * i:3 * i + 3] for i in idx[k:k + 3])
+            e1 = [b[q] - a[q] for q in range(3)]
+            e2 = [c[q] - a[q] for q in range(3)]
+            fn = normalized([e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                             e1[0] * e2[1] - e1[1] * e2[0]])
+            for i in idx[k:k + 3]:
+                idx2.append(len(p2) // 3)
+                p2 += pos[3 * i:3 * i + 3]
+                n2 += fn
+                u2 += uv0[2 * i:2 * i + 2]
+        geom = (p2, n2, u2, list(u2), idx2)
+    else:
+        geom = (pos, nrm, uv0, uv1, idx)
+    mat = g.material(name="matte", pbrMetallicRoughness={"baseColorFactor": [0.8, 0.7, 0.5, 1],
+                                                         "metallicFactor": 0.0, "roughnessFactor": 0.6})
+    g.node(mesh=g.mesh(geom, material=mat, uv1=False, normals=file_normals, name="ball"), name="ball",
+           translation=[0, 1.2, 0])
+    fidelity_scene(g)
+    return g
+
+
+def back_face_asset(double_sided):
+    """A normal-mapped plate seen from behind: double-sided (its back lit as
+    glTF says, the normal reversed, normal map and all), against the same
+    plate rebuilt to face the viewer with its normal, tangent and
+    handedness reversed and its winding turned."""
+    g = Gltf()
+    bumps = g.texture(g.image(pattern_png(64, (128, 128, 255, 255), (200, 140, 210, 255), 8), name="bumps"))
+    mat = g.material(name="plate", doubleSided=True, normalTexture={"index": bumps},
+                     pbrMetallicRoughness={"baseColorFactor": [0.7, 0.75, 0.8, 1], "metallicFactor": 0.0,
+                                           "roughnessFactor": 0.5})
+    pos, nrm, uv0, uv1, idx = grid(6, size=3.0)
+    n = len(pos) // 3
+    geom = (pos, [0.0, 0.0, 1.0] * n, uv0, uv1, idx, [1.0, 0.0, 0.0, 1.0] * n)
+    turn = trs((0, 1.5, 0), axis_angle([0, 1, 0], 180))
+    if double_sided:
+        mesh = g.mesh(geom, material=mat, uv1=False, tangents=True, name="plate")
+        g.node(mesh=mesh, name="plate", translation=[0, 1.5, 0], rotation=axis_angle([0, 1, 0], 180))
+    else:
+        p2, n2, u0, u1, i2, t2 = bake(geom, turn)
+        n2 = [-x for x in n2]
+        t2 = [-x for x in t2]
+        for k in range(0, len(i2), 3):
+            i2[k + 1], i2[k + 2] = i2[k + 2], i2[k + 1]
+        mesh = g.mesh((p2, n2, u0, u1, i2, t2), material=mat, uv1=False, tangents=True, name="plate")
+        g.node(mesh=mesh, name="plate")
+    fidelity_scene(g)
+    return g
+
+
 def fidelity_pairs():
     """{name: (asset, its equivalent)}: what e2e_asset_import renders."""
     return {
@@ -763,6 +832,8 @@ def fidelity_pairs():
         "texcoord1_inside": (texcoord_asset(1, True), texcoord_asset(0, True)),
         "colors": (colors_asset(True), colors_asset(False)),
         "texture_transform": (texture_transform_asset(True), texture_transform_asset(False)),
+        "flat_normals": (flat_asset(False), flat_asset(True)),
+        "back_face": (back_face_asset(True), back_face_asset(False)),
     }
 
 

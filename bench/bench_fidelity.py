@@ -60,6 +60,7 @@ def main():
     bench = benchrun.Run()
     bench.start()
     d = testlib.Daemon()
+    ok = False
     try:
         d.request("PUT", "/v1/assets/sky.hdr", hdr_gen.sky_and_ground())
         for name in a.assets.split(","):
@@ -113,9 +114,12 @@ def main():
                 print("    per channel render ms: " + ", ".join(
                     "%s %.0f" % kv for kv in sorted(c["render_ms"].items())))
         bench.end([r for _, _, _, _, _, r in rows])
+        ok = True
     finally:
         d.stop()
-        d.cleanup()
+        if not ok:
+            print("the daemon's folder, kept: %s" % d.tmp)
+        d.cleanup(keep=not ok)
 
 
 if __name__ == "__main__":

@@ -4,9 +4,9 @@
 # and shadebench-reference, the child that drives headless Chromium.
 libsb_jobs_a_SOURCES += \
 	daemon/reference/fidelity_spec.c daemon/reference/fidelity_spec.h \
-	daemon/reference/reference_files.c daemon/reference/reference_files.h
+	daemon/reference/reference_files.c daemon/reference/reference_files.h \
+	daemon/reference/fidelity.c daemon/reference/fidelity.h
 shadebenchd_SOURCES += \
-	daemon/reference/fidelity.c daemon/reference/fidelity.h \
 	daemon/reference/fidelity_render.c daemon/reference/fidelity_render.h
 
 bin_PROGRAMS += shadebench-reference
@@ -28,3 +28,7 @@ install-data-hook:
 	else echo "make install: no reference-viewer/ here (tools/setup vendors it): the Khronos reference is not installed"; fi
 uninstall-hook:
 	rm -rf '$(DESTDIR)$(pkgdatadir)/reference-viewer'
+
+UNIT_TESTS += tests/unit/test_fidelity
+tests_unit_test_fidelity_LDADD = $(CORE_LIBS) -lm
+E2E_TESTS += tests/e2e/e2e_fidelity.py

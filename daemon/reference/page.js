@@ -157,7 +157,6 @@ window.sbRender = async function (req) {
     p.useIBL = true;
     p.iblIntensity = req.ibl_intensity;
     p.environmentRotation = req.environment_rotation_deg;
-    p.renderEnvironmentMap = !!req.render_environment;
     p.blurEnvironmentMap = false;
     p.useDirectionalLightsWithDisabledIBL = false;
     p.exposure = req.exposure;
@@ -168,6 +167,9 @@ window.sbRender = async function (req) {
     for (const name of req.channels) {
         if (!(name in DEBUG)) throw new Error("no such channel " + name);
         p.debugOutput = DEBUG[name];
+        // shadebench draws an uploaded environment behind the lit image and
+        // black behind a debug channel.
+        p.renderEnvironmentMap = name === "lit" && !!req.render_environment;
         const c0 = performance.now();
         view.renderFrame(state, req.width, req.height);
         const px = new Uint8Array(req.width * req.height * 4);

@@ -113,12 +113,12 @@ void fidelity_cache_key(const json_t *page_request, const struct job_spec *spec,
 {
     struct reference_sampler sampler;
     job_sampler(spec, &sampler);
-    json_t *k = json_pack("{s:s, s:s, s:o, s:s, s:s, s:O}", "viewer",
+    json_t *k = json_pack("{s:s, s:s, s:o, s:s, s:s, s:o}", "viewer",
                           REFERENCE_VIEWER_PACKAGE "@" REFERENCE_VIEWER_VERSION, "page", "1",
                           "ibl_sampler", reference_sampler_to_json(&sampler),
                           "asset", spec->scene.asset_sha256, "environment",
                           spec->look.ibl.enabled ? spec->look.ibl.env_sha256 : "", "request",
-                          page_request);
+                          json_deep_copy(page_request));
     /* Channels are cached one file each: the key leaves them out. */
     json_object_del(json_object_get(k, "request"), "channels");
     char *text = k ? json_dumps(k, JSON_COMPACT | JSON_SORT_KEYS | JSON_REAL_PRECISION(9)) : NULL;
@@ -561,7 +561,7 @@ static bool finish_fidelity(struct fidelity *f, struct task *t, enum job_status 
         json_object_set(costs, json_string_value(json_object_get(c, "name")),
                         json_object_get(c, "render_ms"));
     json_t *fid = json_pack(
-        "{s:s, s:s, s:s, s:b, s:s, s:o, s:{s:O, s:O, s:O, s:O, s:O, s:o, s:b}, s:O, s:O, s:O, s:o}",
+        "{s:s, s:s, s:s, s:b, s:s, s:o, s:{s:O, s:O, s:O, s:O, s:O, s:o, s:b}, s:O, s:O, s:o, s:O, s:o}",
         "renderer", "khronos", "viewer", REFERENCE_VIEWER_PACKAGE "@" REFERENCE_VIEWER_VERSION,
         "browser", json_string_value(json_object_get(cost, "browser")) ?
                        json_string_value(json_object_get(cost, "browser")) : "",

@@ -27,7 +27,7 @@ CHANNEL_MIN_SSIM = {
     "emissive": 0.99, "alpha": 0.99, "geometric_normal": 0.99, "shading_normal": 0.99,
     "uv0": 0.99, "uv1": 0.99,
 }
-LIT_MIN_SSIM = 0.95  # the punctual look's tolerance (docs/assets.md)
+LIT_MIN_SSIM = 0.99  # the punctual look's tolerance (docs/assets.md)
 
 chromium = shutil.which("chromium") or shutil.which("chromium-browser")
 check(chromium is not None, "chromium is installed (tools/setup installs it)")

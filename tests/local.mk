@@ -40,7 +40,8 @@ UNIT_TESTS = \
 	tests/unit/test_uv_charts \
 	tests/unit/test_uv_overlap \
 	tests/unit/test_convert_matrices \
-	tests/unit/test_light_shape
+	tests/unit/test_light_shape \
+	tests/unit/test_fidelity
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
 	tests/fuzz/replay-route tests/fuzz/replay-asset_cache tests/fuzz/replay-asset_convert
@@ -58,6 +59,7 @@ tests_unit_test_flicker_LDADD = $(CORE_LIBS)
 tests_unit_test_sweep_LDADD = $(CORE_LIBS)
 tests_unit_test_effects_LDADD = $(CORE_LIBS)
 tests_unit_test_records_LDADD = $(CORE_LIBS)
+tests_unit_test_fidelity_LDADD = $(CORE_LIBS) -lm
 # The interference module lives with the render thread that samples it, but
 # is GL-free: its test builds it alone.
 tests_unit_test_interference_SOURCES = tests/unit/test_interference.c \
@@ -129,6 +131,7 @@ endif
 # in this order, so the short ones fill in beside the long ones instead of
 # one long test running alone at the end.
 E2E_TESTS = \
+	tests/e2e/e2e_fidelity.py \
 	tests/e2e/e2e_msaa.py \
 	tests/e2e/e2e_fleet.py \
 	tests/e2e/e2e_report.py \

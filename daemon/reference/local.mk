@@ -28,7 +28,3 @@ install-data-hook:
 	else echo "make install: no reference-viewer/ here (tools/setup vendors it): the Khronos reference is not installed"; fi
 uninstall-hook:
 	rm -rf '$(DESTDIR)$(pkgdatadir)/reference-viewer'
-
-UNIT_TESTS += tests/unit/test_fidelity
-tests_unit_test_fidelity_LDADD = $(CORE_LIBS) -lm
-E2E_TESTS += tests/e2e/e2e_fidelity.py

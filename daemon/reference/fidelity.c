@@ -16,7 +16,9 @@
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
+#include <utime.h>
 
 #include "common/clock.h"
 #include "common/fsutil.h"
@@ -287,6 +289,80 @@ static void run_child(struct fidelity *f, struct job *job, const char *request_p
         snprintf(cr->why, sizeof(cr->why), "it died of signal %d", WTERMSIG(st));
 }
 
+/* ---- the cache's bound ---- */
+
+struct cache_entry {
+    char name[80];
+    double mtime;
+};
+
+static int by_mtime(const void *a, const void *b)
+{
+    double x = ((const struct cache_entry *)a)->mtime, y = ((const struct cache_entry *)b)->mtime;
+    return x < y ? -1 : x > y;
+}
+
+static void remove_entry(const char *dir)
+{
+    DIR *d = opendir(dir);
+    struct dirent *e;
+    while (d && (e = readdir(d))) {
+        if (e->d_name[0] == '.')
+            continue;
+        char p[PATH_MAX + 300];
+        snprintf(p, sizeof(p), "%s/%.255s", dir, e->d_name);
+        unlink(p);
+    }
+    if (d)
+        closedir(d);
+    rmdir(dir);
+}
+
+/* At most FIDELITY_CACHE_MAX_KEYS keys: the least recently used go (a hit
+ * touches its folder). Temporary folders of runs cut short go too. */
+static void prune_cache(const struct fidelity *f)
+{
+    char root[PATH_MAX + 40];
+    snprintf(root, sizeof(root), "%s/" FIDELITY_CACHE_DIR, f->state_dir);
+    DIR *d = opendir(root);
+    if (!d)
+        return;
+    size_t n = 0, cap = 0;
+    struct cache_entry *list = NULL;
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        if (e->d_name[0] == '.' || strlen(e->d_name) >= sizeof(list->name))
+            continue;
+        char p[PATH_MAX + 120];
+        snprintf(p, sizeof(p), "%s/%s", root, e->d_name);
+        struct stat st;
+        if (stat(p, &st) != 0 || !S_ISDIR(st.st_mode))
+            continue;
+        if (strstr(e->d_name, ".tmp-") && time(NULL) - st.st_mtime > 3600) {
+            remove_entry(p);
+            continue;
+        }
+        if (n == cap) {
+            struct cache_entry *l = realloc(list, (cap = cap ? cap * 2 : 64) * sizeof(*l));
+            if (!l)
+                break;
+            list = l;
+        }
+        snprintf(list[n].name, sizeof(list[n].name), "%s", e->d_name);
+        list[n++].mtime = (double)st.st_mtime;
+    }
+    closedir(d);
+    if (n > FIDELITY_CACHE_MAX_KEYS) {
+        qsort(list, n, sizeof(*list), by_mtime);
+        for (size_t i = 0; i < n - FIDELITY_CACHE_MAX_KEYS; i++) {
+            char p[PATH_MAX + 120];
+            snprintf(p, sizeof(p), "%s/%s", root, list[i].name);
+            remove_entry(p);
+        }
+    }
+    free(list);
+}
+
 /* ---- comparing ---- */
 
 static bool read_png(const char *path, struct image *img, char *err, size_t errlen)
@@ -501,9 +577,11 @@ static bool finish_fidelity(struct fidelity *f, struct task *t, enum job_status 
         rmdir(tmp);
         cost = answer;
         fs_write_json_atomic(cost_path, cost);
+        prune_cache(f);
     } else {
         json_error_t je;
         cost = json_load_file(cost_path, 0, &je);
+        utime(cache, NULL); /* recently used */
     }
     /* Compare each channel. */
     json_t *channels = json_object();

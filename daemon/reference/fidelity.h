@@ -11,7 +11,8 @@
  * reference's images by what they depend on (STATE/reference-cache/KEY:
  * the viewer's version and IBL sampler, the asset's and the environment's
  * hashes, the size, camera, lights, exposure, tone curve and environment),
- * so that a sweep renders each once; then it compares each channel with
+ * so that a sweep renders each once, keeping the FIDELITY_CACHE_MAX_KEYS
+ * most recently used; then it compares each channel with
  * quality/ (SSIM, FLIP, PerceptualDiff, PSNR; the SSIM and FLIP maps as
  * difference images), writes result.fidelity and finishes the job. The
  * render thread waits for it to be idle before it times the next job, so
@@ -28,6 +29,9 @@
 
 #define FIDELITY_DIR "fidelity" /* in a job's directory */
 #define FIDELITY_CACHE_DIR "reference-cache" /* in the state directory */
+/* Keys the cache keeps: past it the least recently used go (each key is a
+ * folder of one PNG a channel and the run's cost). */
+#define FIDELITY_CACHE_MAX_KEYS 512
 
 struct fidelity_config {
     const char *state_dir;

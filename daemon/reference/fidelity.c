@@ -255,6 +255,10 @@ static void run_child(struct fidelity *f, struct job *job, const char *request_p
         if (atomic_load(&job->cancel)) {
             cr->cancelled = killed = true;
             snprintf(cr->why, sizeof(cr->why), "the job was cancelled");
+        } else if (job_timed_out(job)) {
+            killed = true;
+            snprintf(cr->why, sizeof(cr->why), "the job ran past its timeout_s of %g s",
+                     job->spec.timeout_s);
         } else if (now - t0 > timeout) {
             killed = true;
             snprintf(cr->why, sizeof(cr->why), "it ran past its %.0f s (--reference-timeout)",

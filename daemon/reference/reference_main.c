@@ -325,7 +325,7 @@ int main(int argc, char **argv)
     if (x.environment)
         json_object_set_new(render, "environment_url", json_string("environment.hdr"));
 
-    char profile[] = "/tmp/shadebench-chromium-XXXXXX";
+    char profile[] = "/tmp/shadebench-reference-XXXXXX";
     if (!mkdtemp(profile))
         return fail("mkdtemp %s: %s", profile, strerror(errno));
     int wfd = -1, rfd = -1, rc = 2;

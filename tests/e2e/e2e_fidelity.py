@@ -13,6 +13,7 @@ machine (docs/testing.md)."""
 import os
 import shutil
 import sys
+import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gltf_gen  # noqa: E402
@@ -107,6 +108,28 @@ try:
     bc = f3.get("channels", {}).get("base_color", {})
     check(min(bc.get("ssim", 0), bc.get("ssim_rgb", 0)) >= CHANNEL_MIN_SSIM["base_color"],
           "base_color from the explicit camera: SSIM %s" % bc.get("ssim"))
+
+    # Cancelled while the viewer renders: Chromium is killed with its group
+    # and the job ends cancelled.
+    st, sub4 = d.json("POST", "/v1/assets/box.glb/fidelity",
+                      {"width": W, "height": H, "channels": ["base_color"],
+                       "camera": {"eye": [-2, 1.5, 3], "target": [0, 0, 0], "yfov_deg": 50}})
+    deadline = time.time() + 120
+    phase = None
+    while time.time() < deadline:
+        st, j = d.json("GET", "/v1/jobs/%s" % sub4["id"])
+        phase = j.get("phase")
+        if phase == "fidelity" or j.get("status") not in ("queued", "running"):
+            break
+        time.sleep(0.2)
+    time.sleep(1.0)  # Chromium is starting
+    t0 = time.time()
+    st, _ = d.json("DELETE", "/v1/jobs/%s" % sub4["id"])
+    job4 = d.wait(sub4["id"])
+    check(phase == "fidelity" and job4.get("status") == "cancelled",
+          "a fidelity job cancelled in its fidelity phase ends cancelled (%s, %s: %s)" % (
+              phase, job4.get("status"), job4.get("error")))
+    check(time.time() - t0 < 30, "within 30 s of the DELETE (%.1f s)" % (time.time() - t0))
 finally:
     d.stop()
     d.cleanup()

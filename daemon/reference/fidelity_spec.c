@@ -108,6 +108,10 @@ bool fidelity_spec_check_job(const struct fidelity_spec *f, const struct scene_s
     if (reference[0])
         return job_error_set(err, "reference", "must be left out with fidelity: the Khronos "
                              "viewer is the reference");
+    if (scene->sun)
+        return job_error_set(err, "scene.sun", "must be off with fidelity: the presets' sun "
+                             "has no KHR_lights_punctual statement (state a directional light "
+                             "in scene.light_rig)");
     if (repeat != 1 || repeat_auto || temporal_frames)
         return job_error_set(err, repeat != 1 || repeat_auto ? "repeat" : "temporal",
                              "must be left out with fidelity (one run, compared once)");

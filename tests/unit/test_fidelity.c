@@ -50,6 +50,8 @@ static void test_spec(void)
          "\"fidelity\":{\"ibl_sampler\":{\"texture_size\":100}}}", "fidelity.ibl_sampler.texture_size"},
         {"{\"scene\":{\"asset\":\"a.glb\"},\"look\":{\"lighting\":\"pbr\"},\"reference\":\"forward\","
          "\"fidelity\":true}", "reference"},
+        {"{\"scene\":{\"asset\":\"a.glb\",\"sun\":true},\"look\":{\"lighting\":\"pbr\"},"
+         "\"fidelity\":true}", "scene.sun"},
     };
     for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
         memset(&err, 0, sizeof(err));

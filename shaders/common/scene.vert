@@ -33,7 +33,7 @@ void main()
 #if defined(SCENE_TEXTURED)
     v_tex = a_tex;
     v_tangent = a_tangent; // uniform scale, no rotation, like the normal
-    v_color = a_color;
+    v_color = a_color - 1.0; // surface.glsl adds the 1 back
 #endif
     gl_Position = u_frame.view_proj * vec4(world, 1.0);
 }

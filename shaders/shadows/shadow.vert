@@ -18,7 +18,7 @@ void main()
 #if defined(SCENE_TEXTURED)
     v_tex = a_tex;
     v_tangent = vec4(0.0);
-    v_color = a_color;
+    v_color = a_color - 1.0; // surface.glsl adds the 1 back
 #endif
     gl_Position = u_view_proj * vec4(inst.pos_scale.xyz + inst.pos_scale.w * a_pos, 1.0);
 }

@@ -44,7 +44,8 @@ UNIT_TESTS = \
 	tests/unit/test_fidelity
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
-	tests/fuzz/replay-route tests/fuzz/replay-asset_cache tests/fuzz/replay-asset_convert
+	tests/fuzz/replay-route tests/fuzz/replay-asset_cache tests/fuzz/replay-asset_convert \
+	tests/fuzz/replay-env_convert
 tests_unit_test_job_LDADD = $(CORE_LIBS)
 tests_unit_test_options_LDADD = libsb-common.a $(JANSSON_LIBS) $(LIBS)
 tests_unit_test_store_LDADD = $(CORE_LIBS)
@@ -120,6 +121,10 @@ tests_fuzz_replay_asset_convert_SOURCES = tests/fuzz/fuzz_asset_convert.c tests/
 	$(ASSET_CONVERT_SOURCES)
 tests_fuzz_replay_asset_convert_CFLAGS = $(AM_CFLAGS) $(ASSIMP_CFLAGS) $(JPEG_CFLAGS)
 tests_fuzz_replay_asset_convert_LDADD = $(CORE_LIBS) $(ASSIMP_LIBS) $(JPEG_LIBS) -lm
+tests_fuzz_replay_env_convert_SOURCES = tests/fuzz/fuzz_env_convert.c tests/fuzz/replay.c \
+	daemon/assets/env_convert.c
+tests_fuzz_replay_env_convert_CFLAGS = $(AM_CFLAGS) $(STB_CFLAGS)
+tests_fuzz_replay_env_convert_LDADD = $(CORE_LIBS) $(STB_LIBS) -lm
 if HAVE_SECCOMP
 check_PROGRAMS += tests/tools/sandbox-run
 tests_tools_sandbox_run_SOURCES = tests/tools/sandbox_run.c
@@ -144,6 +149,7 @@ E2E_TESTS = \
 	tests/e2e/e2e_textured.py \
 	tests/e2e/e2e_asset_render.py \
 	tests/e2e/e2e_asset_import.py \
+	tests/e2e/e2e_scene_view.py \
 	tests/e2e/e2e_load.py \
 	tests/e2e/e2e_osl.py \
 	tests/e2e/e2e_ab.py \

@@ -56,6 +56,7 @@
 /* Uniform locations, explicit so that timed code never looks a name up.
  * Arrays take one location per element. */
 #define SB_LOC_EXPOSURE 0     /* resolve: float */
+#define SB_LOC_GAMMA 1        /* resolve: float, 0 for the sRGB curve, else a plain gamma */
 #define SB_LOC_POST_PARAMS 0  /* post effects: vec4 of the effect's options */
 #define SB_LOC_POST_WEIGHTS 1 /* bloom: float[33] Gaussian weights */
 #define SB_LOC_SSAO_NOISE 1   /* ssao: float[16] rotation angles */

@@ -403,6 +403,8 @@ static void resolve(const struct harness_run *run)
     bool raw = run->look->debug != LOOK_DEBUG_NONE;
     glUseProgram(g->resolve_progs[raw ? LOOK_TONEMAP_NONE : run->look->tonemap]);
     glUniform1f(SB_LOC_EXPOSURE, raw ? 1.0f : (float)run->look->exposure);
+    glUniform1f(SB_LOC_GAMMA,
+                !raw && run->look->transfer == LOOK_TRANSFER_GAMMA_2_2 ? 2.2f : 0.0f);
     glActiveTexture(GL_TEXTURE0 + SB_TEX_HDR);
     glBindTexture(GL_TEXTURE_2D, run->hdr_resolved);
     glBindVertexArray(g->empty_vao);

@@ -174,7 +174,7 @@ static void release_files_locked(struct assets *a, const char *sha)
     char job[RECORD_ID_LEN];
     if (store_asset_hash_refs(a->store, sha) != 0 || queue_asset_in_use(a->queue, NULL, sha, job))
         return;
-    static const char *const exts[] = {"glb", "gltf", ASSET_CACHE_EXT, "json"};
+    static const char *const exts[] = {"glb", "gltf", "hdr", ASSET_CACHE_EXT, "json"};
     for (size_t i = 0; i < sizeof(exts) / sizeof(exts[0]); i++) {
         char path[PATH_MAX + 80];
         path_of(a, sha, exts[i], path, sizeof(path));

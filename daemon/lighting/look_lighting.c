@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "common/options.h"
+#include "daemon/scene/scene_spec.h" /* scene_asset_name_valid */
 
 const char *const ibl_environment_names[] = {"sky", "uniform", NULL};
 const char *const shadow_overflow_names[] = {"drop_report", "fail", NULL};
@@ -114,11 +115,7 @@ static bool parse_environment(const json_t *v, const char *field, void *opts,
     const char *name = json_string_value(json_object_get(v, "asset"));
     char f[96];
     snprintf(f, sizeof(f), "%s.asset", field);
-    bool ok = name && name[0] && name[0] != '.' && strlen(name) <= IBL_ENV_ASSET_NAME_MAX;
-    for (const char *p = name; ok && *p; p++)
-        ok = (*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || (*p >= '0' && *p <= '9') ||
-             *p == '.' || *p == '_' || *p == '-';
-    if (!ok)
+    if (!name || !scene_asset_name_valid(name))
         return job_error_set(err, f, "must be the name of a stored environment (GET "
                              "/v1/assets): 1 to %d letters, digits, '.', '_' or '-', not "
                              "starting with '.'", IBL_ENV_ASSET_NAME_MAX);
@@ -126,7 +123,7 @@ static bool parse_environment(const json_t *v, const char *field, void *opts,
     json_t *h = json_object_get(v, "asset_sha256");
     if (h) {
         const char *hex = json_is_string(h) ? json_string_value(h) : "";
-        ok = strlen(hex) == 64;
+        bool ok = strlen(hex) == 64;
         for (int i = 0; ok && i < 64; i++)
             ok = (hex[i] >= '0' && hex[i] <= '9') || (hex[i] >= 'a' && hex[i] <= 'f');
         snprintf(f, sizeof(f), "%s.asset_sha256", field);

@@ -19,7 +19,8 @@ enum ibl_environment {
 };
 extern const char *const ibl_environment_names[]; /* "sky", "uniform" (the strings) */
 
-/* An environment asset's name: as scene.asset's (scene_spec.h). */
+/* An environment asset's name: as scene.asset's (scene_spec.h:
+ * SCENE_ASSET_NAME_MAX, scene_asset_name_valid). */
 #define IBL_ENV_ASSET_NAME_MAX 128
 
 #define IBL_MAX_PROBES 32

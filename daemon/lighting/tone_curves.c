@@ -41,3 +41,9 @@ double srgb_encode(double c)
     c = c < 0 ? 0 : c > 1 ? 1 : c;
     return c <= 0.0031308 ? 12.92 * c : 1.055 * pow(c, 1.0 / 2.4) - 0.055;
 }
+
+double gamma22_encode(double c)
+{
+    c = c < 0 ? 0 : c > 1 ? 1 : c;
+    return pow(c, 1.0 / 2.2);
+}

@@ -12,9 +12,9 @@
  *  - "pbr_neutral" is the Khronos PBR Neutral curve, the same formula;
  *  - "srgb" is no curve, a clamp: the viewer's "None" (linear);
  *  - every curve then encodes with the exact sRGB transfer function
- *    (IEC 61966-2-1), where the viewer raises to 1/2.2: the two agree at 0
- *    and 1 and differ most in the shadows (linear 0.01: sRGB 25.4 of 255,
- *    gamma 2.2 31.3). */
+ *    (IEC 61966-2-1) unless look.transfer is "gamma_2.2", the viewer's
+ *    x^(1/2.2): the two agree at 0 and 1 and differ most in the shadows
+ *    (linear 0.01: sRGB 25.5 of 255, gamma 2.2 31.4). */
 
 /* Tone curves on a linear value (after exposure), to [0, 1]. */
 double tonemap_reinhard(double x);
@@ -25,5 +25,7 @@ double tonemap_aces(double x); /* Narkowicz's 2015 fit of the ACES RRT+ODT */
 void tonemap_pbr_neutral(double rgb[3]);
 /* The sRGB transfer function (IEC 61966-2-1) on [0, 1]. */
 double srgb_encode(double linear);
+/* look.transfer "gamma_2.2": x^(1/2.2) on [0, 1], the glTF Sample Viewer's. */
+double gamma22_encode(double linear);
 
 #endif

@@ -597,7 +597,9 @@ static bool finish_fidelity(struct fidelity *f, struct task *t, enum job_status 
         snprintf(cached, sizeof(cached), "%s/%s.png", cache, names[i]);
         bool lit_channel = strcmp(names[i], "lit") == 0;
         int tm = spec->look.tonemap;
-        bool encoded = lit_channel;
+        /* The viewer writes gamma 2.2: as it is where shadebench does too. */
+        bool encoded = lit_channel && (tm == LOOK_TONEMAP_NONE ||
+                                       spec->look.transfer != LOOK_TRANSFER_GAMMA_2_2);
         if (!(encoded ? reencode_png(cached, theirs, tm == LOOK_TONEMAP_NONE, err, errlen)
                       : copy_file(cached, theirs))) {
             if (!encoded)
@@ -674,6 +676,8 @@ static bool finish_fidelity(struct fidelity *f, struct task *t, enum job_status 
                             json_string(spec->look.tonemap == LOOK_TONEMAP_NONE
                                             ? "the viewer's gamma 2.2 decoded to linear, as "
                                               "tonemap none writes"
+                                        : spec->look.transfer == LOOK_TRANSFER_GAMMA_2_2
+                                            ? "gamma 2.2, both (look.transfer)"
                                             : "the viewer's gamma 2.2 re-encoded as sRGB"));
     json_object_set_new(t->result, "fidelity", fid);
     ok = true;

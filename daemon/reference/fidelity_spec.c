@@ -190,6 +190,9 @@ json_t *fidelity_job_body(const char *asset, const json_t *body, struct job_erro
         json_object_set(scene, "light_rig", json_object_get(body, "lights"));
     if (!json_object_get(look, "lighting"))
         json_object_set_new(look, "lighting", json_string("pbr"));
+    /* The viewer's encoding, so that the lit images compare as they are. */
+    if (!json_object_get(look, "transfer"))
+        json_object_set_new(look, "transfer", json_string("gamma_2.2"));
     json_t *fid = json_object();
     if (json_object_get(body, "channels"))
         json_object_set(fid, "channels", json_object_get(body, "channels"));

@@ -68,8 +68,8 @@ bool fidelity_spec_check_job(const struct fidelity_spec *f, const struct scene_s
  * "height", "camera", "lights" (scene.light_rig), "look", "scene" (more
  * scene keys), "channels", "ibl_sampler", "labels", "timeout_s"}, every key
  * optional, into a job of one captured frame (no warm-up) of scene.asset
- * NAME, 320x240, with look.lighting "pbr" unless the look says otherwise,
- * and "fidelity". A new reference, or NULL with the field and the rule. */
+ * NAME, 320x240, with look.lighting "pbr" and look.transfer "gamma_2.2"
+ * (the viewer's encoding) unless the look says otherwise, and "fidelity". A new reference, or NULL with the field and the rule. */
 #define FIDELITY_DEFAULT_WIDTH 320
 #define FIDELITY_DEFAULT_HEIGHT 240
 json_t *fidelity_job_body(const char *asset, const json_t *body, struct job_error *err);

@@ -12,10 +12,12 @@ static const char MAGIC[8] = {'S', 'B', 'E', 'N', 'V', '0', '0', '1'};
 
 void environment_limits_defaults(struct environment_limits *lim)
 {
-    /* 8192 x 4096 is the largest equirectangular map in common use; 16 Mi
-     * pixels are 192 MiB decoded, within the converter's address space. */
+    /* 4096 x 2048 (8 Mi pixels, 96 MiB decoded, 128 MiB on the GPU with
+     * its mipmaps) is plenty for lighting and a background: a run-length
+     * coded file of one colour that size is a few kilobytes, so the decoded
+     * size is what bounds the cache and the GPU memory an upload may take. */
     lim->max_edge = 8192;
-    lim->max_pixels = 8192ull * 4096ull;
+    lim->max_pixels = 4096ull * 2048ull;
 }
 
 json_t *environment_limits_to_json(const struct environment_limits *lim)

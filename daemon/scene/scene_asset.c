@@ -314,34 +314,58 @@ static void convert_light(const struct scene *s, const struct asset_light *al,
 
 /* Generated lights around and over the asset (docs/scenes.md): the layout
  * picks a point u of the unit cube per light (Halton, hashed, lattice or
- * clusters, as in a preset's volume), taken to a shell outside the asset's
- * bounding sphere (radius R): azimuth 2 pi u0, elevation asin(0.2 + 0.75
- * u1) (12 to 72 degrees), distance R (2 + u2). Every light is then outside
- * the bounds, even circling (its orbit is a few hundredths of R). Each is a
- * glTF point light (or a spot aimed at the centre) of range 4.5 R (every
- * point of the asset within reach; scene.light_radius gives another) and of
- * intensity 30 R^2 / N candela: N lights at about 2.5 R give a white
- * surface facing the light about 0.6 of radiance, so that the image is
- * neither dark nor clipped at exposure 1. */
+ * clusters, as in a preset's volume). u0 and u1 give a direction from the
+ * asset's centre, azimuth 2 pi u0 and elevation asin(0.2 + 0.75 u1) (12 to
+ * 72 degrees up); the light stands beyond the point where that ray leaves
+ * the asset's box, by a gap of (0.15 + 0.35 u2) times its range, and at
+ * least 1.5 times its orbit (0.03 R) beyond that face. So every light is
+ * outside the box, circling too, and a light of small
+ * range (scene.light_radius) hugs the surfaces near it: many small lights
+ * still overlap unevenly over the asset, as the many-lights benchmarks
+ * need. Each is a glTF point light (or a spot aimed at the centre) of range
+ * 5 R ("auto": from its farthest gap, 2.5 R beyond a box inside the sphere
+ * of radius R, every point of the asset within reach) and of intensity
+ * 30 R^2 / N x (range / 5 R)^2 candela for N lights: at "auto" range, N
+ * lights at about 2.5 R give a white surface facing the light about 0.6 of
+ * radiance, neither dark nor clipped at exposure 1; a smaller range scales
+ * the intensity with its square, so the light its nearby surfaces get stays
+ * about the same. */
 static bool place_generated(struct scene *s)
 {
     const struct asset *a = s->asset;
     float c[3], R = asset_sphere(a, c);
     s->light_volume = (struct scene_box){{0, 0, 0}, {1, 1, 1}};
     s->light_orbit_plane = SCENE_ORBIT_XZ;
-    if (!scene_place_lights(s, 0.03f * R))
+    float orbit = 0.03f * R;
+    if (!scene_place_lights(s, orbit))
         return false;
     int n = s->light_count;
-    float intensity = n ? 30.0f * R * R / (float)n : 0.0f;
-    float range = s->spec.light_radius > 0 ? (float)s->spec.light_radius : 4.5f * R;
+    float range = s->spec.light_radius > 0 ? (float)s->spec.light_radius : 5.0f * R;
+    float intensity = n ? 30.0f * R * R / (float)n * powf(range / (5.0f * R), 2.0f) : 0.0f;
     struct scene_box box = {{c[0], c[1], c[2]}, {c[0], c[1], c[2]}};
     for (int i = 0; i < n; i++) {
         struct scene_light *l = &s->lights[i];
         double az = 2.0 * PI * l->centre[0], el = asin(0.2 + 0.75 * l->centre[1]);
-        double d = R * (2.0 + l->centre[2]);
         double dir[3] = {cos(el) * sin(az), sin(el), cos(el) * cos(az)};
+        /* Where the ray from the centre leaves the box, through the face
+         * across axis `face`. */
+        double exit = INFINITY;
+        int face = 1;
         for (int k = 0; k < 3; k++) {
-            l->centre[k] = (float)(c[k] + d * dir[k]);
+            double half = 0.5 * ((double)a->box_max[k] - a->box_min[k]);
+            if (fabs(dir[k]) > 1e-9 && half / fabs(dir[k]) < exit)
+                exit = half / fabs(dir[k]), face = k;
+        }
+        double gap = range * (0.15 + 0.35 * l->centre[2]), p[3];
+        for (int k = 0; k < 3; k++)
+            p[k] = c[k] + (exit + gap) * dir[k];
+        /* At least 1.5 orbits beyond that face, so that circling (which
+         * moves a light by at most one orbit) never takes it inside. */
+        double beyond = gap * fabs(dir[face]), need = 1.5 * orbit;
+        if (beyond < need)
+            p[face] += (dir[face] < 0 ? -1.0 : 1.0) * (need - beyond);
+        for (int k = 0; k < 3; k++) {
+            l->centre[k] = (float)p[k];
             box.min[k] = fminf(box.min[k], l->centre[k]);
             box.max[k] = fmaxf(box.max[k], l->centre[k]);
             if (l->type == SCENE_LIGHT_SPOT)

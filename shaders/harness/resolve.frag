@@ -6,14 +6,20 @@
 // with no curve). TONEMAP_REINHARD, TONEMAP_ACES and TONEMAP_PBR_NEUTRAL
 // (Khronos PBR Neutral): the curve, then the sRGB transfer function, since
 // a tone-mapped image is display-referred.
-// daemon/lighting/tone_curves.c has the same curves in C, unit-tested.
+// The encoding is look.transfer's: the sRGB curve, or a plain gamma (the
+// glTF Sample Viewer's 2.2). daemon/lighting/tone_curves.c has the same
+// curves in C, unit-tested.
 layout(binding = SB_TEX_HDR) uniform sampler2D u_hdr;
 layout(location = SB_LOC_EXPOSURE) uniform float u_exposure;
+// look.transfer: 0 for the sRGB curve, 2.2 for the glTF Sample Viewer's gamma.
+layout(location = SB_LOC_GAMMA) uniform float u_gamma;
 layout(location = 0) out vec4 out_color;
 
 vec3 srgb_encode(vec3 c)
 {
     c = clamp(c, 0.0, 1.0);
+    if (u_gamma > 0.0)
+        return pow(c, vec3(1.0 / u_gamma));
     return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, greaterThan(c, vec3(0.0031308)));
 }
 

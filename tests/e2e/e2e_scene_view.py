@@ -6,17 +6,21 @@ computed by hand (64x64 images, a frame or two each):
   map none), seen straight down through an explicit camera: every checked
   pixel is 0.15 x 0.7 + I / pi / d^2 x 0.7 x cos within one 8-bit level, for
   every technique (OSL within 3); with a range the glTF window
-  clamp(1 - (d / range)^4, 0, 1) multiplies it;
+  clamp(1 - (d / range)^4, 0, 1) multiplies it; the display curves srgb,
+  gamma 2.2 (look.transfer) and pbr_neutral turn the same linear values
+  into the bytes their formulas give;
 - an uploaded quad seen through an orthographic scene.camera covers exactly
   the pixels its extents say, and the asset's own orthographic camera,
   rolled 90 degrees about its view axis, covers the same quad turned (its
-  up vector and projection honoured);
+  up vector and projection honoured); the culling techniques under an
+  orthographic view agree with forward;
 - environment maps: a Radiance .hdr uploaded as an asset is described, a
   truncated one and one whose header claims 100000 x 50000 pixels are
   refused 422 naming the rule, and a PBR look with look.ibl.environment
   {"asset": ...} draws it behind the scene (its hot spot straight ahead
   along +x, its sky above); an environment named as scene.asset (and a
-  glTF named as the environment) is refused naming the field;
+  glTF named as the environment) is refused naming the field; deleted, its
+  files go;
 - an asset scene's look defaults to tonemap pbr_neutral."""
 
 import math
@@ -81,6 +85,22 @@ def light_job(technique, rng=None):
     return job
 
 
+def srgb(v):
+    v = min(max(v, 0.0), 1.0)
+    return 12.92 * v if v <= 0.0031308 else 1.055 * v ** (1 / 2.4) - 0.055
+
+
+def pbr_neutral_grey(v):
+    """Khronos PBR Neutral on a grey (its specification's f, p, p_n, g)."""
+    f = v - v * v / 0.16 if v <= 0.08 else 0.04
+    p = v - f
+    if p <= 0.76:
+        return p
+    pn = 1 - 0.24 ** 2 / (p + 1 - 1.52)
+    g = 1 / (0.15 * (p - pn) + 1)
+    return p * pn / p * g + pn * (1 - g)
+
+
 PIXELS = [(32, 32), (31, 31), (20, 40), (5, 10), (60, 58), (0, 0), (45, 12)]
 
 
@@ -109,6 +129,25 @@ def check_light_rig(d, techniques):
                   and len(cam["projection_matrix"]) == 16,
                   "the result gives the camera as drawn: %s" % {k: cam[k] for k in
                                                                ("source", "up_at_frame_0")})
+    # The display curves on the same linear values: srgb (the sRGB encode
+    # alone), the Sample Viewer's gamma 2.2, and Khronos PBR Neutral.
+    for tonemap, transfer in (("srgb", "srgb"), ("srgb", "gamma_2.2"), ("pbr_neutral", "srgb")):
+        job = light_job("forward")
+        job["look"] = {"lighting": "phong", "tonemap": tonemap, "transfer": transfer}
+        done = d.run(job)
+        if not check(done.get("status") == "done", "%s/%s renders: %s"
+                     % (tonemap, transfer, done.get("error"))):
+            continue
+        px = capture(d, done, "rig-%s-%s" % (tonemap, transfer))
+        worst = 0.0
+        for col, row in PIXELS:
+            v = expected(col, row) / 255
+            if tonemap == "pbr_neutral":
+                v = pbr_neutral_grey(v)
+            v = v ** (1 / 2.2) if transfer == "gamma_2.2" else srgb(v)
+            worst = max(worst, max(abs(g - v * 255) for g in px[row * W + col]))
+        check(worst <= 1, "tonemap %s, transfer %s: the pixels are the curve of the linear "
+              "ones: worst off by %.2f levels" % (tonemap, transfer, worst))
     # The range window.
     done = d.run(light_job("forward", rng=3.0))
     px = capture(d, done, "rig-range")
@@ -177,6 +216,19 @@ def check_orthographic(d):
     # An asset scene's look is display-referred by default.
     check(done["spec"]["look"]["tonemap"] == "pbr_neutral",
           "an asset scene's tone map defaults to pbr_neutral: %s" % done["spec"]["look"]["tonemap"])
+    # The culling techniques under an orthographic view (their cells are
+    # perspective frusta: every light is binned everywhere) draw what
+    # forward draws: the teapots from above, 80 lights.
+    top = {"eye": [0, 30, 0], "target": [0, 0, 0], "up": [0, 0, -1],
+           "orthographic": {"ymag": 12}}
+    for t in ("tiled_deferred", "clustered_forward"):
+        done = d.run(dict(BASE, technique=t, reference="forward",
+                          scene={"preset": "teapots", "width": 96, "height": 64, "camera": top}))
+        q = done.get("result", {}).get("quality", {})
+        ssim = q.get("worst_ssim", {}).get("value", 0)
+        check(done.get("status") == "done" and ssim >= 0.999 and q.get("pdiff_failed_captures") == 0,
+              "%s under an orthographic camera agrees with forward: SSIM %.5f, PerceptualDiff "
+              "failures %s (%s)" % (t, ssim, q.get("pdiff_failed_captures"), done.get("error")))
 
 
 def check_environment(d):
@@ -215,6 +267,13 @@ def check_environment(d):
               "the spec pins the environment's hash: %s" % env)
     testlib.rejects(d, dict(BASE, technique="forward", scene={"asset": "sky.hdr"}),
                     "scene.asset")
+    # Deleted, its files go: the upload, the cache and the description.
+    status, body = d.json("GET", "/v1/assets/sky.hdr")
+    sha = body.get("sha256", "")
+    status, _ = d.json("DELETE", "/v1/assets/sky.hdr")
+    left = [f for f in os.listdir(os.path.join(d.state, "assets")) if f.startswith(sha)]
+    check(status == 200 and sha and not left,
+          "a deleted environment leaves none of its files: %s %s" % (status, left))
     testlib.rejects(d, dict(BASE, technique="forward",
                             look={"lighting": "pbr",
                                   "ibl": {"environment": {"asset": "quad.glb"}}}),

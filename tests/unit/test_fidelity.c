@@ -77,6 +77,8 @@ static void test_body(void)
     CHECK(strcmp(json_string_value(json_object_get(json_object_get(job, "look"), "lighting")),
                  "pbr") == 0);
     CHECK(strcmp(json_string_value(json_object_get(job, "technique")), "forward") == 0);
+    CHECK(strcmp(json_string_value(json_object_get(json_object_get(job, "look"), "transfer")),
+                 "gamma_2.2") == 0);
     struct job_spec spec;
     CHECK(job_spec_parse(job, fixture_catalog(), &spec, &err));
     CHECK(spec.frames == 1 && spec.warmup_frames == 0 && spec.capture_interval == 1);

@@ -5,6 +5,7 @@
  * and name, light conversion, the "auto" light count, errors naming the
  * field, and the scene keys' parsing. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -170,6 +171,32 @@ static void test_user_asset(void)
         CHECK(!inside && c[1] > 0.5f * (a.box_min[1] + a.box_max[1]));
     }
     scene_finish(&s);
+    /* Every layout, lights of small range hugging the surfaces, circling:
+     * at every frame no light is inside the box. */
+    static const char *const layouts[] = {"halton", "uniform", "grid", "clustered"};
+    for (int li = 0; li < 4; li++)
+        for (int small = 0; small < 2; small++) {
+            char json[256];
+            snprintf(json, sizeof(json), "{\"asset\": \"tri\", \"lights\": 64, \"dynamic\": true, "
+                     "\"light_layout\": \"%s\"%s}", layouts[li],
+                     small ? ", \"light_radius\": 0.05" : "");
+            struct scene_spec sp;
+            spec_for(&sp, json);
+            CHECK(scene_build(&s, &sp, &a, err, sizeof(err)) && s.light_count == 64);
+            int inside_count = 0;
+            for (int i = 0; i < s.light_count; i++)
+                for (int64_t f = 0; f < 400; f += 13) {
+                    float p[3];
+                    scene_light_position(&s, i, f, p);
+                    bool inside = true;
+                    for (int k = 0; k < 3; k++)
+                        inside = inside && p[k] >= a.box_min[k] && p[k] <= a.box_max[k];
+                    inside_count += inside;
+                }
+            CHECK(inside_count == 0);
+            CHECK(s.lights[0].range == (small ? 0.05f : 5.0f * sqrtf(2.0f)));
+            scene_finish(&s);
+        }
 
     /* A point light without range, and one with; lights "auto" with asset
      * lights: none generated. */

@@ -289,6 +289,11 @@ static void test_tone_curves(void)
     CHECK_NEAR((h[0] - h[1]) / (h[1] - h[2]), 2.0, 1e-9);
     /* srgb is the curve-less encode. */
     CHECK_NEAR(srgb_encode(0.2140), 0.5, 1e-3);
+    /* The viewer's gamma 2.2 against sRGB: equal at the ends, apart in the
+     * shadows (linear 0.01: 25.5 and 31.4 of 255). */
+    CHECK(gamma22_encode(0) == 0 && gamma22_encode(1) == 1 && gamma22_encode(2) == 1);
+    CHECK_NEAR(255 * srgb_encode(0.01), 25.46, 0.01);
+    CHECK_NEAR(255 * gamma22_encode(0.01), 31.44, 0.01);
 }
 
 int main(void)

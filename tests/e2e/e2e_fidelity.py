@@ -17,7 +17,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gltf_gen  # noqa: E402
-from testlib import Daemon, check, finish, png_info  # noqa: E402
+from testlib import Daemon, check, finish, png_info, stop_and_check  # noqa: E402
 
 W, H = 96, 72
 # What each channel reaches at 96x72 on the generated box whose occlusion
@@ -130,6 +130,7 @@ try:
           "a fidelity job cancelled in its fidelity phase ends cancelled (%s, %s: %s)" % (
               phase, job4.get("status"), job4.get("error")))
     check(time.time() - t0 < 30, "within 30 s of the DELETE (%.1f s)" % (time.time() - t0))
+    stop_and_check(d)  # a clean exit: under the sanitizers, no error and no leak
 finally:
     d.stop()
     d.cleanup()
@@ -150,6 +151,7 @@ for args, what in ((["--chromium", "/nonexistent/chromium"], "Chromium"),
               "%s missing: 503 naming it (%d %s)" % (what, st, e))
         st, _ = d.json("GET", "/healthz")
         check(st == 200, "%s missing: the daemon still serves (%d)" % (what, st))
+        stop_and_check(d)
     finally:
         d.stop()
         d.cleanup()

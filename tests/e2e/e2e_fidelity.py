@@ -8,8 +8,9 @@ the viewer's. Checks each channel's SSIM against the figure measured for it
 downloadable, the reference cached (a second request renders nothing), a
 look the viewer cannot draw refused naming its field, and a daemon without
 Chromium or without the viewer answering 503 naming what is missing (and
-saying so in /v1/info). Small images (96x72): about 60 s on the 2-core
-machine (docs/testing.md)."""
+saying so in /v1/info), and a job cancelled while the viewer renders.
+Small images (96x72): 57 s under make check on the 2-core machine
+(docs/testing.md)."""
 import os
 import shutil
 import sys

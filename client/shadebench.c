@@ -58,7 +58,11 @@ static void usage(FILE *f)
             "  cancel ID           cancel a queued or running job\n"
             "  fetch ID            download a finished job (--out DIR) and judge it\n"
             "  info                the daemon's version, device, techniques, effects and limits\n"
-            "                      (--json: the daemon's whole answer)\n\n"
+            "                      (--json: the daemon's whole answer)\n"
+            "  fidelity ASSET [REQUEST.json]  the asset against the Khronos glTF Sample Viewer,\n"
+            "                      lit and per channel (--channel NAME, repeatable; --out DIR:\n"
+            "                      both renders and the difference images; --min-ssim,\n"
+            "                      --max-flip fail a channel)\n\n"
             "Options:\n"
             "  --server URL        default $SHADEBENCH_SERVER, else http://127.0.0.1:8460\n"
             "  --token-file FILE   bearer token from a file (default $SHADEBENCH_TOKEN_FILE)\n"
@@ -200,6 +204,7 @@ int main(int argc, char **argv)
                         .confidence = 0.95, .noise_tolerance = 0.10, .max_reruns = 10};
     o.labels = json_object();
     o.filters = json_object();
+    o.channels = json_array();
     const char *env_server = getenv("SHADEBENCH_SERVER");
     const char *server = env_server && *env_server ? env_server : "http://127.0.0.1:8460";
     const char *server_b = NULL;
@@ -209,7 +214,7 @@ int main(int argc, char **argv)
            O_RERUNS, O_FAIL_INC, O_ALLOW, O_CONFIDENCE, O_NOISE, O_LABEL, O_FILTER, O_SINCE,
            O_FIGURE, O_SERVER_B, O_NO_FAIL_INC, O_JSON, O_SLURM, O_DEVICES, O_CONSTRAINT,
            O_PARTITION, O_GRES, O_MAX_PARALLEL, O_TIME_LIMIT, O_REQUEUE, O_SHADEBENCHD,
-           O_RESUME };
+           O_RESUME, O_CHANNEL };
     static const struct option longopts[] = {
         {"server", required_argument, NULL, O_SERVER},
         {"token", required_argument, NULL, O_TOKEN},
@@ -249,6 +254,7 @@ int main(int argc, char **argv)
         {"requeue", no_argument, NULL, O_REQUEUE},
         {"shadebenchd", required_argument, NULL, O_SHADEBENCHD},
         {"resume", required_argument, NULL, O_RESUME},
+        {"channel", required_argument, NULL, O_CHANNEL},
         {NULL, 0, NULL, 0},
     };
     /* CI sets the default once for every command; the flags override it. */
@@ -298,6 +304,7 @@ int main(int argc, char **argv)
         case O_REQUEUE: o.fleet.requeue = true; break;
         case O_SHADEBENCHD: o.fleet.shadebenchd = optarg; break;
         case O_RESUME: o.fleet.resume = optarg; break;
+        case O_CHANNEL: json_array_append_new(o.channels, json_string(optarg)); break;
         case O_ALLOW: o.allow_mismatch = true; break;
         case O_LABEL: key_value(optarg, "--label", o.labels); break;
         case O_FILTER: key_value(optarg, "--filter", o.filters); break;
@@ -337,7 +344,7 @@ int main(int argc, char **argv)
         int min, max;
     } commands[] = {
         {"submit", 1, 1}, {"status", 1, 1}, {"cancel", 1, 1}, {"fetch", 1, 1}, {"list", 0, 0},
-        {"info", 0, 0},   {"ab", 1, 2},     {"sweep", 0, 1},  {"history", 0, 0},
+        {"info", 0, 0},   {"ab", 1, 2},     {"sweep", 0, 1},  {"history", 0, 0}, {"fidelity", 1, 2},
         {"gather", 1, 64}, {"compare-devices", 1, 1}, {"plan", 1, 1},
     };
     size_t k = 0;
@@ -436,6 +443,8 @@ int main(int argc, char **argv)
         rc = cmd_plan(&o, arg);
     else if (!strcmp(cmd, "compare-devices"))
         rc = cmd_compare_devices(&o, arg);
+    else if (!strcmp(cmd, "fidelity"))
+        rc = cmd_fidelity(&c, &o, arg, nargs == 2 ? argv[optind + 2] : NULL);
     else
         rc = cmd_history(&c, &o);
     conn_finish(&c);
@@ -444,5 +453,6 @@ int main(int argc, char **argv)
     free(token_text);
     json_decref(o.labels);
     json_decref(o.filters);
+    json_decref(o.channels);
     return rc;
 }

@@ -38,7 +38,10 @@ UNIT_TESTS = \
 	tests/unit/test_lighting \
 	tests/unit/test_asset \
 	tests/unit/test_uv_charts \
-	tests/unit/test_light_shape
+	tests/unit/test_uv_overlap \
+	tests/unit/test_convert_matrices \
+	tests/unit/test_light_shape \
+	tests/unit/test_fidelity
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
 	tests/fuzz/replay-route tests/fuzz/replay-asset_cache tests/fuzz/replay-asset_convert \
@@ -58,6 +61,7 @@ tests_unit_test_sweep_LDADD = $(CORE_LIBS)
 tests_unit_test_effects_LDADD = $(CORE_LIBS)
 tests_unit_test_records_LDADD = $(CORE_LIBS)
 tests_unit_test_interference_LDADD = libsb-status.a $(CORE_LIBS)
+tests_unit_test_fidelity_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_png_LDADD = $(CORE_LIBS)
 tests_unit_test_gate_SOURCES = tests/unit/test_gate.c $(CLIENT_PURE)
 tests_unit_test_gate_LDADD = $(CORE_LIBS) -lm
@@ -79,6 +83,12 @@ tests_unit_test_asset_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_uv_charts_SOURCES = tests/unit/test_uv_charts.c daemon/assets/uv_charts.c \
 	daemon/assets/uv_charts.h
 tests_unit_test_uv_charts_LDADD = -lm
+tests_unit_test_uv_overlap_SOURCES = tests/unit/test_uv_overlap.c daemon/assets/uv_overlap.c \
+	daemon/assets/uv_overlap.h
+tests_unit_test_uv_overlap_LDADD = -lm
+tests_unit_test_convert_matrices_SOURCES = tests/unit/test_convert_matrices.c \
+	daemon/assets/convert_matrices.c daemon/assets/convert_internal.h
+tests_unit_test_convert_matrices_LDADD = $(JANSSON_LIBS) -lm
 tests_tools_png_tool_SOURCES = tests/tools/png_tool.c
 tests_tools_png_tool_LDADD = $(CORE_LIBS)
 noinst_HEADERS = tests/unit/check.h tests/unit/catalog_fixture.h tests/fuzz/fuzz.h
@@ -120,6 +130,7 @@ endif
 # in this order, so the short ones fill in beside the long ones instead of
 # one long test running alone at the end.
 E2E_TESTS = \
+	tests/e2e/e2e_fidelity.py \
 	tests/e2e/e2e_msaa.py \
 	tests/e2e/e2e_fleet.py \
 	tests/e2e/e2e_report.py \
@@ -131,6 +142,7 @@ E2E_TESTS = \
 	tests/e2e/e2e_techniques.py \
 	tests/e2e/e2e_textured.py \
 	tests/e2e/e2e_asset_render.py \
+	tests/e2e/e2e_asset_import.py \
 	tests/e2e/e2e_scene_view.py \
 	tests/e2e/e2e_load.py \
 	tests/e2e/e2e_osl.py \

@@ -117,6 +117,7 @@ void job_spec_defaults(struct job_spec *out, const struct technique_catalog *tec
     out->repeat_auto = false;
     out->reference[0] = '\0';
     out->reference_supersample = 1;
+    fidelity_spec_defaults(&out->fidelity);
     out->temporal_frames = 0;
     metrics_options_defaults(&out->metrics);
     out->timeout_s = default_timeout_s;
@@ -341,7 +342,7 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
     static const char *const fixed[] = {"technique", "frames", "warmup_frames",
                                         "capture_interval", "scene", "look", "reference",
                                         "reference_look", "metrics", "repeat", "labels",
-                                        "timeout_s", "temporal", "msaa"};
+                                        "timeout_s", "temporal", "msaa", "fidelity"};
     enum { NFIXED = sizeof(fixed) / sizeof(fixed[0]) };
     /* Every technique's options live under its own name; an alias is known
      * when the catalogue has the option it stands for. */
@@ -483,6 +484,17 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
         (scene && !scene_spec_parse(scene, &out->scene, err)))
         return false;
 
+    if (!fidelity_spec_parse(json_object_get(body, "fidelity"), &out->fidelity, err) ||
+        !fidelity_spec_check_job(&out->fidelity, &out->scene, &out->look, out->reference,
+                                 out->repeat, out->repeat_auto, out->temporal_frames, out->msaa,
+                                 err))
+        return false;
+    if (out->fidelity.enabled && out->capture_interval == 0 &&
+        !json_object_get(body, "capture_interval"))
+        out->capture_interval = out->frames; /* the last frame is compared */
+    if (out->fidelity.enabled && out->capture_interval == 0)
+        return job_error_set(err, "fidelity", "needs capture_interval > 0: the captured frames "
+                             "are compared");
     /* A reference with no word on captures scores the last frame, as a
      * sweep's point does; an explicit 0 asks for no captures at all. */
     if (out->reference[0] && out->capture_interval == 0 && !json_object_get(body, "capture_interval"))
@@ -642,6 +654,8 @@ json_t *job_spec_to_json(const struct job_spec *spec)
         json_object_set_new(out, "metrics", metrics_to_json(&spec->metrics));
     if (spec->reference_look_given)
         json_object_set_new(out, "reference_look", look_spec_to_json(&spec->reference_look));
+    if (spec->fidelity.enabled)
+        json_object_set_new(out, "fidelity", fidelity_spec_to_json(&spec->fidelity));
     json_t *labels = json_object();
     for (int i = 0; i < spec->nlabels; i++)
         json_object_set_new(labels, spec->labels[i].key, json_string(spec->labels[i].value));

@@ -13,6 +13,7 @@
 #include "common/options.h"
 #include "daemon/lighting/look_spec.h"
 #include "daemon/quality/metrics.h"
+#include "daemon/reference/fidelity_spec.h"
 #include "daemon/scene/scene_spec.h"
 #include "daemon/techniques/catalog.h"
 
@@ -77,6 +78,7 @@ struct job_spec {
     double timeout_s;              /* running time allowed, all phases; 0: no limit */
     int msaa;                      /* samples a pixel of the output (1, 2, 4, 8); the
                                     * reference renders at the same count */
+    struct fidelity_spec fidelity; /* compared with the Khronos viewer (fidelity_spec.h) */
 };
 
 /* The timeout_s a job gets when it names none (--job-timeout). Set once at

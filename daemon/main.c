@@ -28,7 +28,7 @@
 #include "common/log.h"
 #include "daemon/jobs/queue.h"
 #include "daemon/harness/runner.h"
-#include "daemon/reference/fidelity.h"
+#include "daemon/jobs/fidelity.h"
 #include "daemon/service.h"
 #include "daemon/jobs/sweeps.h"
 #include "daemon/jobs/assets.h"
@@ -56,7 +56,7 @@ struct options {
     char asset_dir[1024];      /* --asset-dir: read-only assets; "": none */
     char asset_converter[1024]; /* --asset-converter; "": shadebench-asset beside the daemon */
     double max_asset_bytes;     /* --max-asset-bytes; 0: ASSETS_MAX_BYTES_DEFAULT */
-    /* The Khronos reference (fidelity jobs; daemon/reference/fidelity.h):
+    /* The Khronos reference (fidelity jobs; daemon/jobs/fidelity.h):
      * "": the usual places. */
     char chromium[1024], reference_viewer[1024];
     double reference_timeout, reference_memory_mib; /* 0: the defaults */

@@ -15,7 +15,7 @@
 #include "daemon/api/links.h"
 #include "daemon/reports/report.h"
 #include "daemon/spec/job_cost.h"
-#include "daemon/reference/fidelity.h"
+#include "daemon/jobs/fidelity.h"
 #include "daemon/spec/job_spec.h"
 
 /* A parsed job queued: its assets pinned, its 202 with the cost. */

@@ -11,7 +11,7 @@
 #include "config.h"
 #include "daemon/effects/effect_info.h"
 #include "daemon/quality/metrics.h"
-#include "daemon/reference/fidelity.h"
+#include "daemon/jobs/fidelity.h"
 #include "daemon/spec/job_cost.h"
 #include "daemon/spec/job_spec.h"
 #include "daemon/spec/sweep_spec.h"

@@ -8,7 +8,7 @@
 #include "daemon/gpu/bindings.h"
 #include "daemon/gpu/glutil.h"
 #include "common/clock.h"
-#include "daemon/harness/deadline.h"
+#include "daemon/jobs/deadline.h"
 #include "daemon/status/render_state.h"
 #include "daemon/store/store.h"
 #include "daemon/scene/asset.h"

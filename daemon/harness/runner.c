@@ -1,7 +1,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "daemon/harness/runner.h"
-#include "daemon/reference/fidelity.h"
-#include "daemon/reference/fidelity_render.h"
+#include "daemon/jobs/fidelity.h"
+#include "daemon/harness/fidelity_render.h"
 
 #include <epoxy/gl.h>
 #include <errno.h>
@@ -22,7 +22,7 @@
 #include "daemon/gpu/egl.h"
 #include "daemon/gpu/glutil.h"
 #include "daemon/gpu/targets.h"
-#include "daemon/harness/deadline.h"
+#include "daemon/jobs/deadline.h"
 #include "daemon/harness/measure.h"
 #include "daemon/harness/metrics_stage.h"
 #include "daemon/harness/outputs.h"
@@ -55,7 +55,7 @@ struct runner {
     double idle_rss; /* the resident set once the context was up */
 };
 
-/* The fidelity worker (daemon/reference/fidelity.h), set once before
+/* The fidelity worker (daemon/jobs/fidelity.h), set once before
  * runner_create; NULL: fidelity jobs fail saying so. */
 static struct fidelity *fidelity_worker;
 

@@ -1,19 +1,19 @@
 # The Khronos reference (issue 32; docs/assets.md, "Fidelity against the
-# Khronos viewer"): a job's "fidelity" (GL-free, in the jobs library), the
-# worker that runs the reference and compares, the render thread's channels,
-# and shadebench-reference, the child that drives headless Chromium.
-libsb_spec_a_SOURCES += \
-	daemon/reference/fidelity_spec.c daemon/reference/fidelity_spec.h \
+# Khronos viewer"): shadebench-reference, the child that drives headless
+# Chromium. The daemon's side: a fidelity job's spec in daemon/spec/
+# (fidelity_spec), the worker that runs this child and
+# compares in daemon/jobs/fidelity, the render thread's channels in
+# daemon/harness/fidelity_render.
+
+# The viewer's files, its request and its patch, shared by the child and
+# the daemon's spec (GL-free).
+libsb_reference_a_SOURCES = \
 	daemon/reference/reference_files.c daemon/reference/reference_files.h
-libsb_jobs_a_SOURCES += \
-	daemon/reference/fidelity.c daemon/reference/fidelity.h
-shadebenchd_SOURCES += \
-	daemon/reference/fidelity_render.c daemon/reference/fidelity_render.h
 
 bin_PROGRAMS += shadebench-reference
 shadebench_reference_SOURCES = daemon/reference/reference_main.c \
 	daemon/reference/cdp.c daemon/reference/cdp.h
-shadebench_reference_LDADD = libsb-jobs.a libsb-common.a $(JANSSON_LIBS) $(PNG_LIBS) -lm
+shadebench_reference_LDADD = libsb-reference.a libsb-common.a $(JANSSON_LIBS) $(PNG_LIBS) -lm
 
 # The page the viewer runs in, and the viewer itself: tools/setup unpacks
 # @khronosgroup/gltf-viewer into build/reference-viewer (npm pack; nothing

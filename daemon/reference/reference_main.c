@@ -1,6 +1,6 @@
 #define _GNU_SOURCE /* mkdtemp, pipe2, execvpe */
 /* shadebench-reference: the independent glTF reference renderer, a child
- * process of the daemon (daemon/reference/fidelity.c runs it; docs/assets.md,
+ * process of the daemon (daemon/jobs/fidelity.c runs it; docs/assets.md,
  * "The Khronos reference"). It starts headless Chromium (WebGL 2 in
  * software, SwiftShader) with the DevTools protocol on a pipe, serves it the
  * page (page.html, page.js), the Khronos glTF Sample Viewer vendored by

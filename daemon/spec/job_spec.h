@@ -13,7 +13,7 @@
 #include "common/options.h"
 #include "daemon/lighting/look_spec.h"
 #include "daemon/quality/metrics.h"
-#include "daemon/reference/fidelity_spec.h"
+#include "daemon/spec/fidelity_spec.h"
 #include "daemon/scene/scene_spec.h"
 #include "daemon/techniques/catalog.h"
 

@@ -7,8 +7,8 @@
 #include <string.h>
 
 #include "daemon/spec/job_spec.h"
-#include "daemon/reference/fidelity.h"
-#include "daemon/reference/fidelity_spec.h"
+#include "daemon/jobs/fidelity.h"
+#include "daemon/spec/fidelity_spec.h"
 #include "daemon/reference/reference_files.h"
 #include "daemon/techniques/catalog.h"
 #include "tests/unit/catalog_fixture.h"

@@ -1,4 +1,4 @@
-#include "daemon/reference/fidelity_spec.h"
+#include "daemon/spec/fidelity_spec.h"
 
 #include <stdio.h>
 #include <string.h>

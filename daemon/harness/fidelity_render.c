@@ -1,5 +1,5 @@
 #define _GNU_SOURCE /* M_PI */
-#include "daemon/reference/fidelity_render.h"
+#include "daemon/harness/fidelity_render.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -14,7 +14,7 @@
 #include "daemon/harness/reference.h"
 #include "daemon/harness/transparent.h"
 #include "daemon/look/look.h"
-#include "daemon/reference/fidelity.h"
+#include "daemon/jobs/fidelity.h"
 
 static json_t *floats(const float *v, int n)
 {

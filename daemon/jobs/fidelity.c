@@ -1,5 +1,5 @@
 #define _GNU_SOURCE /* pipe2 */
-#include "daemon/reference/fidelity.h"
+#include "daemon/jobs/fidelity.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -25,10 +25,10 @@
 #include "common/job_files.h"
 #include "common/log.h"
 #include "common/png_io.h"
-#include "daemon/harness/deadline.h"
+#include "daemon/jobs/deadline.h"
 #include "daemon/store/asset_store.h"
 #include "daemon/quality/metrics.h"
-#include "daemon/reference/fidelity_spec.h"
+#include "daemon/spec/fidelity_spec.h"
 #include "daemon/reference/reference_files.h"
 
 struct task {

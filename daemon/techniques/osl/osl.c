@@ -74,7 +74,7 @@ static bool choose_tiles(struct osl *o, const struct technique_env *env, int max
      * 0.9965 at two, 0.9993 at four: the lights preset, 160x120). */
     double density = opt->texel_density;
     if (density == 0)
-        density = env->defines && strstr(env->defines, "LIGHTING_PBR") ? 2.0 : 1.0;
+        density = env->look->lighting == LOOK_PBR ? 2.0 : 1.0;
     for (int i = 0; i < n; i++) {
         if (opt->resolution) {
             sizes[i] = opt->resolution;
@@ -167,15 +167,14 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
     o->budget_blocks = opt->budget_texels > 0 ? opt->budget_texels / 64 : -1;
     o->light_rows = o->schedule.max_period > 0 ? o->schedule.max_period : 1;
     if (o->seen && opt->change_threshold > 0) {
-        const char *defs = env->defines ? env->defines : "";
-        if (strstr(defs, "LIGHTING_PBR"))
+        if (env->look->lighting == LOOK_PBR)
             o->change_why = "the bound covers Phong and Blinn-Phong, not PBR's BRDF";
         else {
             o->change_on = true;
             /* Phong's motion bound; Blinn-Phong's half vector and shadows'
              * visibility have none, so only the range bound holds there. */
             o->change_lipschitz =
-                !strstr(defs, "LIGHTING_BLINN_PHONG") && !strstr(defs, "LOOK_SHADOWS");
+                env->look->lighting == LOOK_PHONG && !env->look->shadows.enabled;
             o->light_rows += OSL_CHANGE_ROWS;
             o->anchor = malloc((size_t)n * sizeof(int64_t));
             if (!o->anchor)

@@ -165,7 +165,7 @@ static void test_dilate(void)
                 p[0] = (float)x, p[1] = (float)y, p[2] = 0.0f, p[3] = 1.0f;
                 n[2] = 1.0f;
             }
-    long first = osl_dilate_geometry(pos, nrm, NULL, 0, S, 1);
+    long first = osl_dilate_geometry(pos, nrm, NULL, 0, S, 1, NULL);
     CHECK(first == 15); /* x + y == 7 (8 texels) and x + y == 8 (7) */
     for (int y = 0; y < S; y++)
         for (int x = 0; x < S; x++) {
@@ -180,10 +180,10 @@ static void test_dilate(void)
     CHECK(pos[(0 * S + 7) * 4 + 0] == 6.0f);
     /* Texel (7, 1)'s only covered neighbour was (6, 0). */
     CHECK(pos[(1 * S + 7) * 4 + 0] == 6.0f && pos[(1 * S + 7) * 4 + 1] == 0.0f);
-    CHECK(osl_dilate_geometry(pos, nrm, NULL, 0, S, 1) == 11); /* x + y == 9 and 10 */
-    CHECK(osl_dilate_geometry(pos, nrm, NULL, 0, S, 8) == 10); /* the rest, then nothing left */
+    CHECK(osl_dilate_geometry(pos, nrm, NULL, 0, S, 1, NULL) == 11); /* x + y == 9 and 10 */
+    CHECK(osl_dilate_geometry(pos, nrm, NULL, 0, S, 8, NULL) == 10); /* the rest, then nothing left */
     float none[S * S * 4] = {0}, none_n[S * S * 4] = {0};
-    CHECK(osl_dilate_geometry(none, none_n, NULL, 0, S, 4) == 0);
+    CHECK(osl_dilate_geometry(none, none_n, NULL, 0, S, 4, NULL) == 0);
 }
 
 /* Phong's radiance at P with normal N from every light at frame (the

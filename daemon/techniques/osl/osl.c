@@ -49,7 +49,8 @@ static bool check_limits(struct osl *o, const struct technique_env *env, int *ma
     /* Worst case: every object shaded in one dispatch. */
     double blocks = 0;
     for (int i = 0; i < o->schedule.count; i++)
-        blocks += (double)(o->tiles[i].size / 8) * (o->tiles[i].size / 8);
+        for (int l = 0; l < osl_tile_levels(o->tiles[i].size, o->levels); l++)
+            blocks += (double)((o->tiles[i].size >> l) / 8) * ((o->tiles[i].size >> l) / 8);
     if (blocks > (double)count[0] * count[1]) {
         snprintf(err, errlen, "osl: %.0f work groups exceed this device's compute "
                  "limit of %dx%d", blocks, count[0], count[1]);
@@ -75,19 +76,46 @@ static bool choose_tiles(struct osl *o, const struct technique_env *env, int max
     double density = opt->texel_density;
     if (density == 0)
         density = env->look->lighting == LOOK_PBR ? 2.0 : 1.0;
+    o->density = density;
+    int largest = 8;
     for (int i = 0; i < n; i++) {
         if (opt->resolution) {
             sizes[i] = opt->resolution;
             continue;
         }
-        double ppu = scene_projected_diameter(s, i) / (2.0 * scene_instance_bound(s, i));
+        double r = scene_instance_bound(s, i);
+        double ppu = scene_projected_diameter(s, i) / (2.0 * r);
+        if (o->levels > 1) {
+            /* Level 0 for the object's nearest point (its bound's), the
+             * coarser levels for what the raster pass finds farther: a
+             * ground that spans near and far gets each at its density. */
+            double dist = scene_instance_distance(s, i);
+            ppu *= dist / fmax(dist - r, 0.05 * dist);
+            /* Twice as fine again: the nearest power of two may be 0.7 of
+             * what a face seen head-on needs, and the levels cost memory,
+             * not shading (the raster pass reads the level it needs). */
+            ppu *= 2.0;
+        }
         const struct mesh *m = &s->meshes[s->instances[i].mesh];
         sizes[i] = osl_auto_tile_size(ppu, m->uv_per_unit / s->instances[i].scale, density);
+        if (sizes[i] > largest)
+            largest = sizes[i];
     }
-    /* The packer counts 4 bytes a texel; an HDR atlas takes 8. */
-    bool ok = osl_atlas_pack(sizes, n, max_tex, OSL_MAX_ATLAS_BYTES / (o->textured ? 2.0 : 1.0),
-                             o->tiles, &o->atlas_w,
-                             &o->atlas_h, err, errlen);
+    if (o->levels > 1)
+        o->levels = osl_tile_levels(largest, 16);
+    /* The packer counts 4 bytes a texel; an HDR atlas takes 8, and the
+     * coarser levels half as much again. */
+    double stack = o->levels > 1 ? 1.5 : 1.0;
+    bool ok = osl_atlas_pack(sizes, n, max_tex,
+                             OSL_MAX_ATLAS_BYTES / (o->textured ? 2.0 : 1.0) / stack, o->tiles,
+                             &o->atlas_w, &o->atlas_h0, err, errlen);
+    o->atlas_h = o->levels > 1 ? o->atlas_h0 + o->atlas_h0 / 2 : o->atlas_h0;
+    if (ok && o->atlas_h > max_tex) {
+        snprintf(err, errlen, "the shading atlas and its levels need %dx%d texels; this device "
+                 "allows at most %dx%d: lower osl.texel_density", o->atlas_w, o->atlas_h,
+                 max_tex, max_tex);
+        ok = false;
+    }
     free(sizes);
     return ok;
 }
@@ -100,6 +128,9 @@ void osl_bind_light_inputs(const struct osl *o, const struct technique_env *env)
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_TILES, o->tile_buffer);
     glBindImageTexture(SB_IMG_OSL_ATLAS, o->atlas, 0, GL_FALSE, 0, GL_WRITE_ONLY,
                        OSL_ATLAS_FORMAT(o));
+    if (o->split)
+        glBindImageTexture(SB_IMG_OSL_ATLAS_SPECULAR, o->atlas_specular, 0, GL_FALSE, 0,
+                           GL_WRITE_ONLY, OSL_ATLAS_FORMAT(o));
     glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_GEO_POSITION);
     glBindTexture(GL_TEXTURE_2D, o->geo_position);
     glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_GEO_NORMAL);
@@ -126,7 +157,7 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
     *state = o;
     o->tiles = calloc((size_t)n, sizeof(*o->tiles));
     o->plan = calloc((size_t)n, sizeof(*o->plan));
-    o->work = calloc((size_t)n * 4, sizeof(GLuint));
+    o->work = calloc((size_t)n * 4 * 16, sizeof(GLuint)); /* an entry per level */
     o->frames = env->frames;
     double *dist = calloc((size_t)n, sizeof(double));
     if (!o->tiles || !o->plan || !o->work || !dist) {
@@ -144,6 +175,10 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
         goto oom;
 
     o->textured = s->asset != NULL;
+    /* Auto tiles get levels, picked per pixel by the raster pass; a fixed
+     * resolution (the thesis's 256) is one level, as the thesis drew it. */
+    o->levels = opt->resolution ? 1 : 2;
+    o->split = o->textured && env->look->lighting != LOOK_PBR;
     int max_tex = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
     if (!choose_tiles(o, env, max_tex, err, errlen) ||
@@ -163,6 +198,7 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
     o->seen_asked = opt->visibility == OSL_VISIBILITY_SEEN;
     o->seen = o->seen_asked && s->spec.dynamic && s->spec.light_speed > 0;
     o->camera_moves = scene_camera_moves(s);
+    o->prepass = o->seen && o->camera_moves;
     /* Whole blocks: a budget under one block still shades what must be. */
     o->budget_blocks = opt->budget_texels > 0 ? opt->budget_texels / 64 : -1;
     o->light_rows = o->schedule.max_period > 0 ? o->schedule.max_period : 1;
@@ -184,16 +220,21 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
         }
     }
     char light_defines[2048];
-    snprintf(light_defines, sizeof(light_defines), "%s%s", env->defines ? env->defines : "",
-             o->seen ? "#define OSL_BLOCK_LIST 1\n" : "");
+    snprintf(light_defines, sizeof(light_defines), "%s%s%s", env->defines ? env->defines : "",
+             o->seen ? "#define OSL_BLOCK_LIST 1\n" : "", o->split ? "#define OSL_SPLIT 1\n" : "");
     /* Asset scenes bake their materials in texture generation and cut the
      * mask's holes in the raster pass, both through surface.glsl: those
      * programs take the scene's defines (SCENE_TEXTURED) there only, so the
      * procedural scenes' programs stay the text they always were. */
     const char *scene_defines = s->asset ? env->defines : NULL;
+    char draw_defines[2048];
+    snprintf(draw_defines, sizeof(draw_defines), "%s%s%s",
+             o->levels > 1 ? "#define OSL_LEVELS 1\n" : "", o->split ? "#define OSL_SPLIT 1\n" : "",
+             scene_defines ? scene_defines : "");
     if (!(o->texgen_prog = gl_program_build("osl texgen", texgen, 2, scene_defines, err, errlen)) ||
         !(light_prog = gl_program_build("osl lighting", light, 1, light_defines, err, errlen)) ||
-        !(draw_prog = gl_program_build("osl draw", draw, 2, scene_defines, err, errlen))) {
+        !(draw_prog = gl_program_build("osl draw", draw, 2,
+                                       draw_defines[0] ? draw_defines : NULL, err, errlen))) {
         glDeleteProgram(light_prog);
         goto fail;
     }
@@ -216,6 +257,8 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
                            SB_TEX_OSL_GEO_SURFACE);
     }
     glProgramUniform1i(draw_prog, glGetUniformLocation(draw_prog, "u_atlas"), SB_TEX_OSL_ATLAS);
+    glProgramUniform1i(light_prog, glGetUniformLocation(light_prog, "u_atlas_h0"), o->atlas_h0);
+    glProgramUniform1i(light_prog, glGetUniformLocation(light_prog, "u_atlas_w"), o->atlas_w);
 
     if (!osl_generate_textures(o, env, err, errlen))
         goto fail;
@@ -226,8 +269,18 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glProgramUniform2f(o->draw.prog, glGetUniformLocation(o->draw.prog, "u_atlas_size"),
-                       (float)o->atlas_w, (float)o->atlas_h);
+    if (o->split) {
+        glGenTextures(1, &o->atlas_specular);
+        glBindTexture(GL_TEXTURE_2D, o->atlas_specular);
+        glTexStorage2D(GL_TEXTURE_2D, 1, OSL_ATLAS_FORMAT(o), o->atlas_w, o->atlas_h);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    }
+    osl_set_draw_uniforms(o, o->draw.prog);
+    glProgramUniform2i(light_prog, glGetUniformLocation(light_prog, "u_geo_size0"), o->geo_w,
+                       o->geo_h0);
 
     GLint *tile_data = calloc((size_t)n * 4, sizeof(GLint));
     if (!tile_data)
@@ -248,8 +301,9 @@ static bool osl_create(const struct technique_env *env, void **state, char *err,
     free(tile_data);
     glGenBuffers(1, &o->work_buffer);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, o->work_buffer);
-    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)((size_t)n * 4 * sizeof(GLuint)),
-                 NULL, GL_STREAM_DRAW);
+    glBufferData(GL_SHADER_STORAGE_BUFFER,
+                 (GLsizeiptr)((size_t)n * (size_t)o->levels * 4 * sizeof(GLuint)), NULL,
+                 GL_STREAM_DRAW);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
     if (o->seen && !osl_seen_create(o, env, err, errlen))
         goto fail;
@@ -266,21 +320,27 @@ fail:
 static double light_pass(struct osl *o, const struct technique_env *env, int64_t frame,
                          int count)
 {
-    int rows = 1;
+    int rows = 1, entries = 0;
     uint32_t blocks = 0;
     double texels = 0;
     for (int k = 0; k < count; k++) {
-        int i = o->plan[k].instance, per_row = o->tiles[i].size / 8;
+        int i = o->plan[k].instance;
         int row = (int)(frame - o->plan[k].time);
         if (row + 1 > rows)
             rows = row + 1;
-        o->work[k * 4 + 0] = (GLuint)i;
-        o->work[k * 4 + 1] = (GLuint)row;
-        o->work[k * 4 + 2] = blocks;
-        o->work[k * 4 + 3] = (GLuint)per_row;
-        blocks += (uint32_t)(per_row * per_row);
-        texels += (double)o->tiles[i].size * o->tiles[i].size;
+        /* One entry per level: the instance with its level above bit 24. */
+        for (int l = 0; l < osl_tile_levels(o->tiles[i].size, o->levels); l++) {
+            int per_row = (o->tiles[i].size >> l) / 8;
+            GLuint *w = &o->work[(size_t)entries++ * 4];
+            w[0] = (GLuint)i | (GLuint)l << 24;
+            w[1] = (GLuint)row;
+            w[2] = blocks;
+            w[3] = (GLuint)per_row;
+            blocks += (uint32_t)(per_row * per_row);
+            texels += 64.0 * per_row * per_row;
+        }
     }
+    count = entries;
     for (int r = 0; r < rows; r++)
         o->rows[r] = frame - r;
     gpu_scene_set_light_rows(env->gpu, o->rows, rows);
@@ -307,6 +367,47 @@ static double light_pass(struct osl *o, const struct technique_env *env, int64_t
     return texels;
 }
 
+void osl_set_draw_uniforms(const struct osl *o, GLuint prog)
+{
+    glProgramUniform1i(prog, glGetUniformLocation(prog, "u_atlas"), SB_TEX_OSL_ATLAS);
+    glProgramUniform1i(prog, glGetUniformLocation(prog, "u_atlas_specular"),
+                       SB_TEX_OSL_ATLAS_SPECULAR);
+    glProgramUniform2f(prog, glGetUniformLocation(prog, "u_atlas_size"), (float)o->atlas_w,
+                       (float)o->atlas_h);
+    glProgramUniform2i(prog, glGetUniformLocation(prog, "u_atlas_size0"), o->atlas_w, o->atlas_h0);
+    glProgramUniform1f(prog, glGetUniformLocation(prog, "u_density"), (float)o->density);
+}
+
+/* The shading atlas (and its specular plane) for the raster pass. */
+static void bind_atlas(const struct osl *o)
+{
+    if (o->split) {
+        glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_ATLAS_SPECULAR);
+        glBindTexture(GL_TEXTURE_2D, o->atlas_specular);
+    }
+    glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_ATLAS);
+    glBindTexture(GL_TEXTURE_2D, o->atlas);
+}
+
+/* A moving camera's marks: every object drawn with this frame's camera,
+ * depth and marks only (osl_draw.frag with OSL_MARK_ONLY), before the
+ * selection reads them. Its cost is counted in the lighting pass. */
+static void mark_pass(struct osl *o, const struct technique_env *env, int64_t frame)
+{
+    gpu_pass_begin(env->passes, PASS_LIGHTING, env->output_fbo, env->width, env->height);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    gpu_scene_bind(env->gpu, &o->draw_mark);
+    glUniform1i(o->draw_frame_loc, (GLint)frame);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_TILES, o->tile_buffer);
+    osl_seen_bind(o);
+    struct gpu_tiles t;
+    for (gpu_tiles_begin(env->budget, env->width, env->height, &t); gpu_tiles_next(env->budget, &t);)
+        gpu_scene_draw(env->gpu, &o->draw_mark);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    gpu_pass_end(env->passes);
+}
+
 static bool osl_render(void *state, const struct technique_env *env, int64_t frame,
                        char *err, size_t errlen)
 {
@@ -314,13 +415,17 @@ static bool osl_render(void *state, const struct technique_env *env, int64_t fra
     if (o->seen) {
         o->pixels = (double)env->width * env->height;
         bool counted = frame >= 1 && frame <= o->frames;
+        if (o->prepass) {
+            osl_seen_count_reads(o, frame);
+            mark_pass(o, env, frame);
+        }
         osl_seen_light_pass(o, env, frame, !o->shaded_once, counted);
         o->timed_frames += counted;
         o->shaded_once = true;
         gpu_pass_begin(env->passes, PASS_RASTER, env->output_fbo, env->width, env->height);
         glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
         glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-        bool mark = o->camera_moves || !o->marked_once;
+        bool mark = !o->prepass && !o->marked_once;
         const struct scene_program *draw = mark ? &o->draw_mark : &o->draw;
         gpu_scene_bind(env->gpu, draw);
         if (mark)
@@ -330,8 +435,7 @@ static bool osl_render(void *state, const struct technique_env *env, int64_t fra
         osl_seen_bind(o);
         o->last_frame = frame;
         o->last_counted = counted; /* a still camera reads its first marks every frame */
-        glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_ATLAS);
-        glBindTexture(GL_TEXTURE_2D, o->atlas);
+        bind_atlas(o);
         struct gpu_tiles t;
         for (gpu_tiles_begin(env->budget, env->width, env->height, &t); gpu_tiles_next(env->budget, &t);)
             gpu_scene_draw(env->gpu, draw);
@@ -363,8 +467,7 @@ static bool osl_render(void *state, const struct technique_env *env, int64_t fra
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     gpu_scene_bind(env->gpu, &o->draw);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_OSL_TILES, o->tile_buffer);
-    glActiveTexture(GL_TEXTURE0 + SB_TEX_OSL_ATLAS);
-    glBindTexture(GL_TEXTURE_2D, o->atlas);
+    bind_atlas(o);
     struct gpu_tiles t;
     for (gpu_tiles_begin(env->budget, env->width, env->height, &t); gpu_tiles_next(env->budget, &t);)
         gpu_scene_draw(env->gpu, &o->draw);
@@ -387,6 +490,7 @@ static void osl_destroy(void *state)
     free(o->geo);
     free(o->geo_entry);
     glDeleteTextures(1, &o->atlas);
+    glDeleteTextures(1, &o->atlas_specular);
     glDeleteBuffers(1, &o->tile_buffer);
     glDeleteBuffers(1, &o->work_buffer);
     glDeleteProgram(o->select_prog);

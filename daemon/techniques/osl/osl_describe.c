@@ -48,17 +48,7 @@ json_t *osl_describe(void *state)
     if (o->seen) {
         /* Counted on the GPU over the timed frames; read once, here, after
          * checking the last frame's reads (the next frame would have). */
-        if (o->last_counted) {
-            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
-            osl_seen_bind(o);
-            glUseProgram(o->select_prog);
-            glUniform1i(o->sel_frame_loc, (GLint)(o->last_frame + 1));
-            glUniform1i(o->sel_count_prev_loc, 1);
-            glUniform1i(o->sel_mode_loc, 2);
-            glDispatchCompute(((GLuint)o->blocks_x * (GLuint)o->blocks_y + 63) / 64, 1, 1);
-            glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-            o->last_counted = false;
-        }
+        osl_seen_count_reads(o, o->last_frame + 1);
         glBindBuffer(GL_SHADER_STORAGE_BUFFER, o->stats_buf);
         glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof(stats), stats);
         glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
@@ -85,7 +75,7 @@ json_t *osl_describe(void *state)
                             json_pack("{s:f, s:f, s:f, s:i}", "texels", o->asset_texels,
                                       "uncovered_share", o->asset_uncovered / o->asset_texels,
                                       "gutter_filled_share", o->asset_filled / o->asset_texels,
-                                      "gutter_texels", OSL_GUTTER_TEXELS));
+                                      "gutter_texels", OSL_GUTTER_TEXELS(o)));
     if (o->seen_asked && !o->seen && d)
         json_object_set_new(d, "visibility",
                             json_pack("{s:s, s:b, s:s}", "mode", "seen", "active", 0, "why",

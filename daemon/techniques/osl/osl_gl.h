@@ -16,10 +16,12 @@
 /* The passes of osl_info, in order. */
 enum { PASS_LIGHTING, PASS_RASTER };
 
-/* Texels filled around an asset's charts: bilinear filtering reaches one
- * texel past a chart's last centre, and the second covers the raster pass's
- * seen-margin of moving cameras at the smallest tiles. */
-#define OSL_GUTTER_TEXELS 2
+/* Texels filled around an asset's charts at one level: bilinear filtering
+ * reaches one texel past a chart's last centre, and the second covers
+ * texels the chart's edge covers only in part. With levels, the raster
+ * pass's box filter reaches up to 2 density texels further (a pixel's
+ * footprint at the level it reads is under 2 density texels). */
+#define OSL_GUTTER_TEXELS(o) ((o)->levels > 1 ? 2 + (int)ceil(2.0 * (o)->density) : 2)
 
 /* The shading atlas: the thesis's 8 bits a channel; asset scenes keep the
  * radiance's range (RGBA16F), since their emissive surfaces, and anything
@@ -53,7 +55,19 @@ struct osl {
      * those the gutter filling shaded from a chart's edge. */
     double asset_texels, asset_uncovered, asset_filled;
     GLuint atlas, tile_buffer, work_buffer;
-    int atlas_w, atlas_h;
+    /* atlas_w x atlas_h is the whole texture; with levels > 1 (resolution
+     * "auto") each tile's coarser levels are stacked below level 0's
+     * atlas_w x atlas_h0 (osl_level_origin), the same for the geometry
+     * atlas (geo_h0), and the raster pass picks each pixel's level from
+     * its footprint at density texels a pixel. */
+    int atlas_w, atlas_h, atlas_h0, geo_h0;
+    int levels;
+    double density;
+    /* Asset scenes under Phong and Blinn-Phong: the atlas holds diffuse
+     * light and atlas_specular the specular, and the raster pass applies
+     * the base colour per pixel (osl_light.comp's shade_split). */
+    bool split;
+    GLuint atlas_specular;
     int groups_x_max;
     struct atlas_tile *tiles;
     struct osl_schedule schedule;
@@ -80,6 +94,10 @@ struct osl {
     bool camera_moves; /* else the first frame's marks stand for every frame */
     bool marked_once;
     struct scene_program draw_mark; /* the raster pass that marks what it reads */
+    /* A moving camera: a marking pass of the frame's own camera runs before
+     * the selection (draw_mark marks only), so the blocks shaded are the
+     * ones this frame reads, at the levels it reads them. */
+    bool prepass;
     GLuint select_prog;
     GLint sel_frame_loc, sel_initial_loc, sel_mode_loc, sel_count_loc, sel_count_prev_loc,
         sel_seen_since_loc, sel_margin_loc, sel_blocks_loc, sel_max_groups_loc, light_blocks_x_loc;
@@ -116,11 +134,37 @@ struct osl {
  * block never shaded). */
 #define OSL_VERSION_UNLIT INT_MAX
 
-/* Blocks around a seen one that are shaded too, for a camera that moves. */
-#define OSL_SEEN_MARGIN(o) ((o)->camera_moves ? 1 : 0)
+/* Blocks around a seen one that are shaded too: none, since a moving
+ * camera marks with its own frame's view before the selection. */
+#define OSL_SEEN_MARGIN(o) 0
+
+/* Where level l of an atlas whose level 0 is w x h0 begins: level 0 at the
+ * origin, the others side by side below it (level 1 at (0, h0), level 2 at
+ * (w/2, h0), level 3 at (3w/4, h0), ...), so the whole takes w x 3h0/2 and
+ * a tile at (x, y) of size s has its level l at origin + (x, y) >> l, of
+ * size s >> l (tiles are aligned to their size). osl_light.comp and
+ * osl_draw.frag compute the same. */
+static inline void osl_level_origin(int l, int w, int h0, int *x, int *y)
+{
+    *x = l == 0 ? 0 : w - (w >> (l - 1));
+    *y = l == 0 ? 0 : h0;
+}
+
+/* The levels of a tile of the given size: down to 8 texels (one block). */
+static inline int osl_tile_levels(int size, int levels)
+{
+    int n = 1;
+    while (n < levels && (size >> n) >= 8)
+        n++;
+    return n;
+}
 
 /* The figures for the result (osl_describe.c). */
 json_t *osl_describe(void *state);
+
+/* The raster pass's uniforms that never change: the atlas's unit, its
+ * sizes and the density its levels are picked by (osl.c). */
+void osl_set_draw_uniforms(const struct osl *o, GLuint prog);
 
 /* The lighting pass's program and inputs (osl.c). */
 void osl_bind_light_inputs(const struct osl *o, const struct technique_env *env);
@@ -135,5 +179,9 @@ void osl_seen_bind(const struct osl *o);
 void osl_seen_light_pass(struct osl *o, const struct technique_env *env, int64_t frame,
                          bool initial, bool count);
 void osl_seen_objects(const struct osl *o, int out[3]);
+/* Counts the reads of frame - 1 (stale, unshaded, their age) when that
+ * was a timed frame rendered just before, from the marks it left: before
+ * a marking pass overwrites them, and once after the last frame. */
+void osl_seen_count_reads(struct osl *o, int64_t frame);
 
 #endif

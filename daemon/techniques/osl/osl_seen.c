@@ -50,10 +50,17 @@ bool osl_seen_create(struct osl *o, const struct technique_env *env, char *err, 
         never[b * 8 + 4] = -1;
         never[b * 8 + 5] = never[b * 8 + 6] = never[b * 8 + 7] = 0;
     }
+    /* Each block's instance, with the level it lies in above bit 24. */
     for (int i = 0; i < n; i++)
-        for (int y = o->tiles[i].y / 8; y < (o->tiles[i].y + o->tiles[i].size) / 8; y++)
-            for (int x = o->tiles[i].x / 8; x < (o->tiles[i].x + o->tiles[i].size) / 8; x++)
-                owner[(size_t)y * (size_t)o->blocks_x + (size_t)x] = (GLuint)i;
+        for (int l = 0; l < osl_tile_levels(o->tiles[i].size, o->levels); l++) {
+            int ox, oy, size = o->tiles[i].size >> l;
+            osl_level_origin(l, o->atlas_w, o->atlas_h0, &ox, &oy);
+            ox += o->tiles[i].x >> l;
+            oy += o->tiles[i].y >> l;
+            for (int y = oy / 8; y < (oy + size) / 8; y++)
+                for (int x = ox / 8; x < (ox + size) / 8; x++)
+                    owner[(size_t)y * (size_t)o->blocks_x + (size_t)x] = (GLuint)i | (GLuint)l << 24;
+        }
     o->block_tile_buf = ssbo((GLsizeiptr)(blocks * sizeof(GLuint)), owner, GL_STATIC_DRAW);
     o->shaded_buf = ssbo((GLsizeiptr)(blocks * 8 * sizeof(GLint)), never, GL_DYNAMIC_DRAW);
     o->version_buf = ssbo((GLsizeiptr)((size_t)n * 2 * sizeof(GLint)), NULL, GL_STREAM_DRAW);
@@ -102,15 +109,16 @@ bool osl_seen_create(struct osl *o, const struct technique_env *env, char *err, 
         {GL_FRAGMENT_SHADER, {"osl_draw.frag"}},
     };
     char mark_defines[2048];
-    snprintf(mark_defines, sizeof(mark_defines), "#define OSL_SEEN 1\n%s",
+    snprintf(mark_defines, sizeof(mark_defines), "#define OSL_SEEN 1\n%s%s%s%s",
+             o->prepass ? "#define OSL_MARK_ONLY 1\n" : "",
+             o->levels > 1 ? "#define OSL_LEVELS 1\n" : "", o->split ? "#define OSL_SPLIT 1\n" : "",
              env->scene->asset ? env->defines : "");
-    GLuint mark_prog = gl_program_build("osl draw (marking)", draw, 2, mark_defines, err, errlen);
+    GLuint mark_prog = gl_program_build(o->prepass ? "osl marks" : "osl draw (marking)", draw, 2,
+                                        mark_defines, err, errlen);
     if (!mark_prog)
         return false;
     o->draw_mark = gpu_scene_program(env->gpu, mark_prog);
-    glProgramUniform1i(mark_prog, glGetUniformLocation(mark_prog, "u_atlas"), SB_TEX_OSL_ATLAS);
-    glProgramUniform2f(mark_prog, glGetUniformLocation(mark_prog, "u_atlas_size"),
-                       (float)o->atlas_w, (float)o->atlas_h);
+    osl_set_draw_uniforms(o, mark_prog);
     o->draw_frame_loc = glGetUniformLocation(mark_prog, "u_frame_index");
     o->sel_seen_since_loc = glGetUniformLocation(sp, "u_seen_since");
     o->sel_margin_loc = glGetUniformLocation(sp, "u_margin");
@@ -191,15 +199,17 @@ void osl_seen_light_pass(struct osl *o, const struct technique_env *env, int64_t
     osl_seen_bind(o);
     glUseProgram(o->select_prog);
     glUniform1i(o->sel_frame_loc, (GLint)frame);
-    glUniform1i(o->sel_initial_loc, initial);
+    /* With no marks yet every block is shaded once, unless a marking pass
+     * of this frame's camera ran. */
+    glUniform1i(o->sel_initial_loc, initial && !o->prepass);
     glUniform1i(o->sel_count_loc, count);
     /* The frame before counts when it was a timed frame rendered just before. */
     glUniform1i(o->sel_count_prev_loc, !initial && o->last_counted && o->last_frame == frame - 1);
     o->last_counted = false;
     glUniform1i(o->sel_mode_loc, 0);
     /* A still camera sees the same blocks every frame: the first frame's
-     * marks stand for all. */
-    glUniform1i(o->sel_seen_since_loc, o->camera_moves ? (GLint)(frame - 1) : INT_MIN + 1);
+     * marks stand for all; a moving one marked this frame's. */
+    glUniform1i(o->sel_seen_since_loc, o->prepass ? (GLint)frame : INT_MIN + 1);
     GLuint blocks = (GLuint)o->blocks_x * (GLuint)o->blocks_y;
     glDispatchCompute((blocks + 63) / 64, 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -267,4 +277,21 @@ done:
     free(shaded);
     free(owner);
     free(flags);
+}
+
+void osl_seen_count_reads(struct osl *o, int64_t frame)
+{
+    bool prev = o->last_counted && o->last_frame == frame - 1;
+    o->last_counted = false;
+    if (!prev)
+        return;
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    osl_seen_bind(o);
+    glUseProgram(o->select_prog);
+    glUniform1i(o->sel_frame_loc, (GLint)frame);
+    glUniform1i(o->sel_count_prev_loc, 1);
+    glUniform1i(o->sel_mode_loc, 2);
+    glUniform1i(o->sel_seen_since_loc, o->prepass ? (GLint)(frame - 1) : INT_MIN + 1);
+    glDispatchCompute(((GLuint)o->blocks_x * (GLuint)o->blocks_y + 63) / 64, 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
 }

@@ -44,18 +44,52 @@ static bool plan_geometry(struct osl *o, const struct scene *s, int **sizes_out,
     return true;
 }
 
+static int rect_cmp(const void *a, const void *b)
+{
+    return memcmp(a, b, 4 * sizeof(float));
+}
+
+/* The distinct chart rectangles of a mesh (mesh_chart_rects), less the
+ * whole square (no clamp, no owner). Returns how many; *out malloc'd. */
+static int mesh_rects(const struct mesh *m, float (**out)[4])
+{
+    float(*r)[4] = malloc((size_t)(m->vertex_count ? m->vertex_count : 1) * sizeof(*r));
+    int n = 0;
+    *out = r;
+    if (!r)
+        return -1;
+    for (uint32_t v = 0; v < m->vertex_count; v++) {
+        const float *c = m->vertices[v].chart;
+        if (!(c[0] == 0.0f && c[1] == 0.0f && c[2] == 1.0f && c[3] == 1.0f))
+            memcpy(r[n++], c, sizeof(*r));
+    }
+    qsort(r, (size_t)n, sizeof(*r), rect_cmp);
+    int k = 0;
+    for (int i = 0; i < n; i++)
+        if (!k || memcmp(r[k - 1], r[i], sizeof(*r)))
+            memcpy(r[k++], r[i], sizeof(*r));
+    return k;
+}
+
 /* An asset's uv1 charts are not whole rectangles (the procedural meshes'
- * are, and the raster pass clamps to them): texels around each chart are
- * filled from the chart's edge, so that bilinear filtering across the edge
- * reads about the same surface. Counts what no triangle covered. */
-static bool dilate_entry(struct osl *o, const GLuint *scratch, int channels, int size)
+ * are): the texels of each chart's rectangle that no triangle covered are
+ * filled from the chart's own edge, out to the raster pass's filter reach,
+ * so that filtering clamped to the rectangle (osl_draw.frag) reads the
+ * chart's surface and never its neighbour's, at every level. Counts what no
+ * triangle covered. */
+static bool dilate_entry(struct osl *o, const struct mesh *mesh, const GLuint *scratch,
+                         int channels, int size)
 {
     size_t texels = (size_t)size * size;
     float *img[OSL_GEO_CHANNELS] = {NULL};
-    bool ok = true;
+    float(*rects)[4] = NULL;
+    int *owner = malloc(texels * sizeof(int));
+    int nrects = mesh_rects(mesh, &rects);
+    bool ok = owner && nrects >= 0;
     for (int c = 0; c < channels; c++)
         ok = ok && (img[c] = malloc(texels * 4 * sizeof(float)));
     if (ok) {
+        osl_chart_owners((const float(*)[4])rects, nrects, size, owner);
         glPixelStorei(GL_PACK_ALIGNMENT, 4);
         glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
         for (int c = 0; c < channels; c++) {
@@ -68,7 +102,7 @@ static bool dilate_entry(struct osl *o, const GLuint *scratch, int channels, int
         o->asset_texels += (double)texels;
         o->asset_uncovered += (double)(texels - covered);
         o->asset_filled += (double)osl_dilate_geometry(img[0], img[1], img + 2, channels - 2, size,
-                                                       OSL_GUTTER_TEXELS);
+                                                       OSL_GUTTER_TEXELS(o), owner);
         for (int c = 0; c < channels; c++) {
             glBindTexture(GL_TEXTURE_2D, scratch[c]);
             glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, size, size, GL_RGBA, GL_FLOAT, img[c]);
@@ -76,6 +110,8 @@ static bool dilate_entry(struct osl *o, const GLuint *scratch, int channels, int
     }
     for (int c = 0; c < channels; c++)
         free(img[c]);
+    free(owner);
+    free(rects);
     return ok;
 }
 
@@ -99,10 +135,18 @@ bool osl_generate_textures(struct osl *o, const struct technique_env *env, char 
     o->geo = calloc((size_t)(o->geo_count ? o->geo_count : 1), sizeof(*o->geo));
     GLint max_tex = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_tex);
-    /* 16 bytes a channel's texel (RGBA32F), against the packer's 4. */
+    /* 16 bytes a channel's texel (RGBA32F), against the packer's 4; the
+     * levels stacked below level 0 take half as much again. */
+    double stack = o->levels > 1 ? 1.5 : 1.0;
     bool ok = o->geo && osl_atlas_pack(sizes, o->geo_count, max_tex,
-                                       1024.0 * 1024.0 * 1024.0 / (4.0 * channels), o->geo,
-                                       &o->geo_w, &o->geo_h, err, errlen);
+                                       1024.0 * 1024.0 * 1024.0 / (4.0 * channels) / stack,
+                                       o->geo, &o->geo_w, &o->geo_h0, err, errlen);
+    o->geo_h = o->levels > 1 ? o->geo_h0 + o->geo_h0 / 2 : o->geo_h0;
+    if (ok && o->geo_h > max_tex) {
+        snprintf(err, errlen, "osl: the geometry atlas and its levels need %dx%d texels; this "
+                 "device allows at most %dx%d", o->geo_w, o->geo_h, max_tex, max_tex);
+        ok = false;
+    }
     if (!ok) {
         if (!o->geo)
             snprintf(err, errlen, "osl: out of memory");
@@ -132,8 +176,15 @@ bool osl_generate_textures(struct osl *o, const struct technique_env *env, char 
                                   GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3};
     glDrawBuffers(channels, bufs);
     int scratch_size = 0;
-    for (int e = 0; e < o->geo_count && ok; e++) {
-        int size = sizes[e], m = mesh[e];
+    for (int k = 0; k < o->geo_count * 16 && ok; k++) {
+        /* Entry e at level l (each level rasterized at its own size). */
+        int e = k / 16, l = k % 16, m = mesh[e];
+        if (l >= osl_tile_levels(sizes[e], o->levels))
+            continue;
+        int size = sizes[e] >> l, gx, gy;
+        osl_level_origin(l, o->geo_w, o->geo_h0, &gx, &gy);
+        gx += o->geo[e].x >> l;
+        gy += o->geo[e].y >> l;
         if (size != scratch_size) {
             glDeleteTextures(channels, scratch);
             glGenTextures(channels, scratch);
@@ -158,14 +209,14 @@ bool osl_generate_textures(struct osl *o, const struct technique_env *env, char 
             gpu_scene_bind_material(env->gpu, m, SB_LOC_MATERIAL);
         glBindVertexArray(env->gpu->vao[m]);
         glDrawElements(GL_TRIANGLES, (GLsizei)s->meshes[m].index_count, GL_UNSIGNED_INT, NULL);
-        if (m >= SCENE_MESH_PROCEDURAL && !dilate_entry(o, scratch, channels, size)) {
+        if (m >= SCENE_MESH_PROCEDURAL && !dilate_entry(o, &s->meshes[m], scratch, channels, size)) {
             snprintf(err, errlen, "osl: out of memory filling gutters");
             ok = false;
             break;
         }
         for (int t = 0; t < channels; t++)
             glCopyImageSubData(scratch[t], GL_TEXTURE_2D, 0, 0, 0, 0, texs[t], GL_TEXTURE_2D, 0,
-                               o->geo[e].x, o->geo[e].y, 0, size, size, 1);
+                               gx, gy, 0, size, size, 1);
     }
     glDeleteTextures(channels, scratch);
     glBindVertexArray(0);

@@ -45,11 +45,27 @@ bool mesh_chart_rects(struct mesh *m, struct mesh_chart_stats *stats)
                 parent[b] = a;
         }
     }
+    /* Charts of the vertices the triangles use (a vertex no triangle uses
+     * is no chart: it keeps the whole square). */
+    for (uint32_t v = 0; v < n; v++)
+        chart[v] = UINT32_MAX;
+    for (uint32_t t = 0; t + 2 < m->index_count; t += 3)
+        for (int k = 0; k < 3; k++)
+            chart[find(parent, m->indices[t + k])] = 0;
     uint32_t charts = 0;
     for (uint32_t v = 0; v < n; v++)
-        chart[v] = find(parent, v) == v ? charts++ : UINT32_MAX;
-    for (uint32_t v = 0; v < n; v++)
-        chart[v] = chart[find(parent, v)];
+        if (find(parent, v) == v && chart[v] == 0)
+            chart[v] = charts++ | 0x80000000u;
+    /* Each vertex takes its root's chart: the others first, then the roots
+     * themselves (which the first pass reads). */
+    for (int roots = 0; roots < 2; roots++)
+        for (uint32_t v = 0; v < n; v++) {
+            uint32_t root = find(parent, v);
+            if ((root == v) != (roots == 1))
+                continue;
+            uint32_t r = chart[root];
+            chart[v] = r == UINT32_MAX || !(r & 0x80000000u) ? UINT32_MAX : r & 0x7fffffffu;
+        }
     rect = malloc((size_t)(charts ? charts : 1) * sizeof(*rect));
     overlap = calloc(charts ? charts : 1, 1);
     keys = malloc((size_t)(charts ? charts : 1) * sizeof(*keys));
@@ -58,6 +74,8 @@ bool mesh_chart_rects(struct mesh *m, struct mesh_chart_stats *stats)
     for (uint32_t c = 0; c < charts; c++)
         rect[c][0] = rect[c][1] = 1.0f, rect[c][2] = rect[c][3] = 0.0f;
     for (uint32_t v = 0; v < n; v++) {
+        if (chart[v] == UINT32_MAX)
+            continue;
         float *r = rect[chart[v]];
         const float *uv = m->vertices[v].uv;
         for (int k = 0; k < 2; k++) {
@@ -84,7 +102,8 @@ bool mesh_chart_rects(struct mesh *m, struct mesh_chart_stats *stats)
         overlapping += overlap[c];
     for (uint32_t v = 0; v < n; v++) {
         static const float whole[4] = {0.0f, 0.0f, 1.0f, 1.0f};
-        memcpy(m->vertices[v].chart, overlap[chart[v]] ? whole : rect[chart[v]], sizeof(whole));
+        memcpy(m->vertices[v].chart,
+               chart[v] == UINT32_MAX || overlap[chart[v]] ? whole : rect[chart[v]], sizeof(whole));
     }
     if (stats) {
         stats->charts = charts;

@@ -206,6 +206,12 @@ int main(void)
     run("sphere", &m, 0, 0, 0.80);
     grid(&m, 64, 0.05);
     run("bumpy grid", &m, 0, 0, 0.80);
+    /* Mirrored halves (a file would often give both the same uv): the
+     * bumps of x < 0 mirror those of x > 0; each half gets its own texels. */
+    grid(&m, 32, 0.05);
+    for (uint32_t v = 0; v < m.nv; v++)
+        m.pos[3 * v + 2] = (float)(0.05 * sin(fabs(m.pos[3 * v]) * 11.0 + m.pos[3 * v + 1] * 5.0));
+    run("mirrored halves", &m, 0, 0, 0.80);
     /* Degenerate triangles (a repeated corner) and a lone triangle. */
     grid(&m, 4, 0);
     m.tri[0] = m.tri[1];

@@ -91,6 +91,7 @@ long osl_dilate_geometry(float *pos, float *nrm, float *const *extra, int extra_
                 int own = owner ? owner[(size_t)y * size + x] : -1;
                 float ps[3] = {0, 0, 0}, ns[4] = {0, 0, 0, 0}, es[4][4] = {{0}};
                 int n = 0;
+                float first[3] = {0, 0, 1}; /* a neighbour's normal, where the mean cancels */
                 for (int dy = -1; dy <= 1; dy++)
                     for (int dx = -1; dx <= 1; dx++) {
                         int qx = x + dx, qy = y + dy;
@@ -104,6 +105,9 @@ long osl_dilate_geometry(float *pos, float *nrm, float *const *extra, int extra_
                             ps[k] += q[k];
                         for (int k = 0; k < 4; k++)
                             ns[k] += nrm[at + k];
+                        if (!n)
+                            for (int k = 0; k < 3; k++)
+                                first[k] = nrm[at + k];
                         for (int e = 0; e < extra_count && e < 4; e++)
                             for (int k = 0; k < 4; k++)
                                 es[e][k] += extra[e][at + k];
@@ -116,7 +120,7 @@ long osl_dilate_geometry(float *pos, float *nrm, float *const *extra, int extra_
                 float *m = &nrm[at];
                 for (int k = 0; k < 3; k++) {
                     p[k] = ps[k] / (float)n;
-                    m[k] = len > 0.0f ? ns[k] / len : 0.0f;
+                    m[k] = len > 1e-6f ? ns[k] / len : first[k];
                 }
                 m[3] = ns[3] / (float)n;
                 for (int e = 0; e < extra_count && e < 4; e++)

@@ -26,6 +26,30 @@ static int age_quantile(const GLuint *age, double q)
     return 63;
 }
 
+/* Pixels the objects cover in the last frame (its depth below the far
+ * plane), for texels per covered pixel; -1 with MSAA (a multisampled depth
+ * is not read back). Outside the timed frames. */
+static double covered_pixels(const struct osl *o)
+{
+    const struct technique_env *env = o->env;
+    if (env->samples > 1)
+        return -1;
+    size_t n = (size_t)env->width * env->height;
+    float *depth = malloc(n * sizeof(float));
+    if (!depth)
+        return -1;
+    glBindTexture(GL_TEXTURE_2D, env->output_depth);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glGetTexImage(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT, GL_FLOAT, depth);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    double covered = 0;
+    for (size_t i = 0; i < n; i++)
+        covered += depth[i] < 1.0f;
+    free(depth);
+    return covered;
+}
+
 json_t *osl_describe(void *state)
 {
     struct osl *o = state;
@@ -45,6 +69,7 @@ json_t *osl_describe(void *state)
     double frames = o->timed_frames ? o->timed_frames : 1;
     GLuint stats[OSL_STATS_HEAD + 64] = {0};
     int objects[3] = {-1, -1, -1};
+    long read_by_level[16] = {0};
     if (o->seen) {
         /* Counted on the GPU over the timed frames; read once, here, after
          * checking the last frame's reads (the next frame would have). */
@@ -55,7 +80,7 @@ json_t *osl_describe(void *state)
         o->texels_sum = 64.0 * stats[4];
         o->texels_max = 64.0 * stats[5];
         o->stale_blocks = stats[6];
-        osl_seen_objects(o, objects);
+        osl_seen_objects(o, objects, read_by_level);
     }
     double texgen_bytes = 2.0 * 16.0 * o->geo_w * o->geo_h;
     json_t *d = json_pack(
@@ -70,6 +95,13 @@ json_t *osl_describe(void *state)
         "tiles_by_size", tiles, "objects_by_period", periods,
         "initial_shading", "objects", o->initial_objects, "texels", o->initial_texels,
         "texgen_bytes", texgen_bytes);
+    if (d && o->levels > 1)
+        json_object_set_new(d, "levels",
+                            json_pack("{s:i, s:f, s:s}", "count", o->levels, "texel_density",
+                                      o->density, "rule",
+                                      "each pixel reads the finest level with texel_density to "
+                                      "twice that texels a pixel along each axis (by area), no "
+                                      "coarser than leaves its chart 4 texels across"));
     if (d && o->asset_texels > 0)
         json_object_set_new(d, "asset_charts",
                             json_pack("{s:f, s:f, s:f, s:i}", "texels", o->asset_texels,
@@ -95,6 +127,16 @@ json_t *osl_describe(void *state)
                                       "blocks", (json_int_t)o->blocks_x * o->blocks_y,
                                       "margin_blocks", OSL_SEEN_MARGIN(o), "block_texels", 64));
         json_t *vis = json_object_get(d, "visibility");
+        double covered = covered_pixels(o);
+        if (covered > 0) {
+            json_object_set_new(vis, "covered_pixels", json_real(covered));
+            json_object_set_new(vis, "texels_per_covered_pixel",
+                                json_real(o->texels_sum / frames / covered));
+        }
+        json_t *levels = json_array();
+        for (int l = 0; l < o->levels; l++)
+            json_array_append_new(levels, json_integer(read_by_level[l]));
+        json_object_set_new(vis, "blocks_read_by_level", levels);
         if (objects[0] >= 0) {
             json_object_set_new(vis, "objects_read", json_integer(objects[0]));
             json_object_set_new(vis, "objects_reshaded", json_integer(objects[1]));

@@ -68,6 +68,7 @@ struct osl {
      * the base colour per pixel (osl_light.comp's shade_split). */
     bool split;
     GLuint atlas_specular;
+    const struct technique_env *env; /* for the output's depth, read by describe */
     int groups_x_max;
     struct atlas_tile *tiles;
     struct osl_schedule schedule;
@@ -178,7 +179,9 @@ bool osl_seen_create(struct osl *o, const struct technique_env *env, char *err, 
 void osl_seen_bind(const struct osl *o);
 void osl_seen_light_pass(struct osl *o, const struct technique_env *env, int64_t frame,
                          bool initial, bool count);
-void osl_seen_objects(const struct osl *o, int out[3]);
+/* Objects read, reshaded, and reshaded unread (out); the blocks the last
+ * frame read at each level (read_by_level). */
+void osl_seen_objects(const struct osl *o, int out[3], long read_by_level[16]);
 /* Counts the reads of frame - 1 (stale, unshaded, their age) when that
  * was a timed frame rendered just before, from the marks it left: before
  * a marking pass overwrites them, and once after the last frame. */

@@ -8,6 +8,61 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
+#ifdef OSL_CULL
+// Per block, the lights that reach it (auto tiles): the covered texels'
+// bounding sphere against each point and spot light's sphere, a bit per
+// light. A light left out reaches none of the block's texels, where its
+// contribution is exactly 0, and the others are summed in light order, so
+// a texel's sum is the one over every light. Beyond OSL_CULL_WORDS * 32
+// lights every light is kept.
+const int OSL_CULL_WORDS = 128;
+shared uint s_mask[OSL_CULL_WORDS];
+shared vec4 s_pos[64]; // world position, w: covered
+shared vec4 s_bound;   // centre, radius (negative: nothing covered)
+
+void cull_lights(vec3 P, bool covered, int row)
+{
+    uint li = gl_LocalInvocationIndex;
+    s_pos[li] = vec4(P, covered ? 1.0 : 0.0);
+    for (uint k = li; k < uint(OSL_CULL_WORDS); k += 64u)
+        s_mask[k] = 0u;
+    barrier();
+    if (li == 0u) {
+        vec3 lo = vec3(1e30), hi = vec3(-1e30);
+        for (int k = 0; k < 64; k++)
+            if (s_pos[k].w > 0.0) {
+                lo = min(lo, s_pos[k].xyz);
+                hi = max(hi, s_pos[k].xyz);
+            }
+        s_bound = all(lessThanEqual(lo, hi)) ? vec4(0.5 * (lo + hi), 0.5 * length(hi - lo)) : vec4(0.0, 0.0, 0.0, -1.0);
+    }
+    barrier();
+    int count = u_frame.counts.y;
+    if (s_bound.w >= 0.0)
+        for (int i = int(li); i < count; i += 64) {
+            bool keep = i >= OSL_CULL_WORDS * 32 || light_type(i) == LIGHT_DIRECTIONAL;
+            if (!keep) {
+                float reach = lights[i].color_radius.w + s_bound.w;
+                keep = distance(light_position(i, row), s_bound.xyz) < reach * 1.0001 + 1e-4;
+            }
+            if (keep && i < OSL_CULL_WORDS * 32)
+                atomicOr(s_mask[i >> 5], 1u << uint(i & 31));
+        }
+    barrier();
+}
+
+// The lights that reach the block, in order (every light beyond the mask's).
+#define FOR_EACH_LIGHT(i)                                                                   \
+    for (int w_ = 0; w_ * 32 < u_frame.counts.y; w_++)                                      \
+        for (uint b_ = w_ < OSL_CULL_WORDS ? s_mask[w_] : 0xffffffffu; b_ != 0u; b_ &= b_ - 1u) { \
+            int i = w_ * 32 + findLSB(b_);                                                  \
+            if (i >= u_frame.counts.y)                                                      \
+                break;
+#else
+#define FOR_EACH_LIGHT(i) for (int i = 0; i < u_frame.counts.y; i++) {
+#endif
+
+
 // x, y, size, and where the object's geometry lies in the geometry atlas
 // (x + 65536 y).
 layout(std430, binding = SB_SSBO_OSL_TILES) readonly buffer TileBuffer { ivec4 tiles[]; };
@@ -45,8 +100,9 @@ vec3 shade_baked(vec3 P, vec3 N, float metallic, vec4 albedo, vec4 surface, int 
     if (two_sided && dot(N, V) < 0.0)
         N = -N;
     vec3 color = surface.a * light_ambient(m, P, N, V);
-    for (int i = 0; i < u_frame.counts.y; i++)
+    FOR_EACH_LIGHT(i)
         color += light_contribution(i, light_position(i, row), P, N, V, m);
+    }
     return color + surface.rgb;
 }
 #endif
@@ -84,7 +140,7 @@ void shade_split(vec3 P, vec3 N, float metallic, vec4 albedo, int row, out vec3 
         N = -N;
     diffuse = vec3(0.0);
     specular = vec3(0.0);
-    for (int i = 0; i < u_frame.counts.y; i++) {
+    FOR_EACH_LIGHT(i)
         int type = light_type(i);
         vec3 L;
         float att;
@@ -184,6 +240,9 @@ void main()
     vec4 p = texelFetch(u_position, geo, 0);
     vec4 n = texelFetch(u_normal, geo, 0);
     vec3 color = vec3(0.0);
+#ifdef OSL_CULL
+    cull_lights(inst.pos_scale.xyz + inst.pos_scale.w * p.xyz, p.w > 0.0, light_row);
+#endif
 #if defined(OSL_SPLIT)
     vec3 specular = vec3(0.0);
     if (p.w > 0.0)
@@ -196,6 +255,14 @@ void main()
 #if defined(SCENE_TEXTURED)
         color = shade_baked(world, normalize(n.xyz), n.w, texelFetch(u_albedo, geo, 0),
                             texelFetch(u_surface, geo, 0), light_row);
+#elif defined(OSL_CULL)
+        // shade_all_lights (lighting.glsl) over the lights that reach the block
+        vec3 N = normalize(n.xyz), V = normalize(u_frame.eye.xyz - world);
+        Material m = instance_material(instance);
+        color = light_ambient(m, world, N, V);
+        FOR_EACH_LIGHT(i)
+            color += light_contribution(i, light_position(i, light_row), world, N, V, m);
+        }
 #else
         color = shade_all_lights(world, normalize(n.xyz), instance_material(instance), light_row);
 #endif

@@ -238,7 +238,7 @@ void osl_seen_light_pass(struct osl *o, const struct technique_env *env, int64_t
  * read: with a still camera, the first frame's reads), and objects with a
  * block shaded in a timed frame, and objects shaded in a timed frame with
  * no block read. Read back once, after the run. */
-void osl_seen_objects(const struct osl *o, int out[3])
+void osl_seen_objects(const struct osl *o, int out[3], long read_by_level[16])
 {
     size_t blocks = (size_t)o->blocks_x * (size_t)o->blocks_y;
     int n = o->schedule.count;
@@ -258,13 +258,19 @@ void osl_seen_objects(const struct osl *o, int out[3])
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, o->block_tile_buf);
     glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(blocks * sizeof(GLuint)), owner);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    for (int l = 0; l < 16; l++)
+        read_by_level[l] = 0;
     for (size_t b = 0; b < blocks; b++) {
-        if (owner[b] >= (GLuint)n)
+        GLuint inst = owner[b] & 0xffffffu, level = owner[b] >> 24;
+        if (owner[b] == 0xffffffffu || inst >= (GLuint)n)
             continue;
+        /* The last frame's reads (a still camera's marks stand for all). */
+        if (marks[b] != INT_MIN && (!o->prepass || marks[b] == (GLint)o->last_frame))
+            read_by_level[level & 15]++;
         if (marks[b] != INT_MIN)
-            flags[owner[b]] |= 1;
+            flags[inst] |= 1;
         if (shaded[b * 8 + 3] >= 1 && shaded[b * 8 + 3] <= o->frames)
-            flags[owner[b]] |= 2;
+            flags[inst] |= 2;
     }
     out[0] = out[1] = out[2] = 0;
     for (int i = 0; i < n; i++) {

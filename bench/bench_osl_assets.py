@@ -94,13 +94,13 @@ try:
             sections = {s: round(v["median"], 1) for s, v in o.get("gpu_sections_ms", {}).items()}
             print("%s, round %d: forward %.1f ms (cpu_work %.1f), osl %.1f ms (cpu_work %.1f): "
                   "x%.3f (cpu_work x%.3f); osl passes %s; worst SSIM %.5f, PerceptualDiff failing "
-                  "%s, largest difference %s; %s texels per covered pixel (%s covered), blocks read "
+                  "%s, largest difference %s; %s texels per covered pixel (%s covered; %s per pixel), blocks read "
                   "by level %s, stale blocks %s, atlas %sx%s" %
                   (name, k + 1, f["frame_ms"]["median"], benchrun.cpu_work_ms(f),
                    o["frame_ms"]["median"], benchrun.cpu_work_ms(o), ratio, cpu, sections,
                    q.get("worst_ssim", {}).get("value", 0),
                    [c["metrics"]["pdiff"]["failing_pixels"] for c in o["captures"]],
-                   max_abs(d, o), vis.get("texels_per_covered_pixel"), vis.get("covered_pixels"),
+                   max_abs(d, o), vis.get("texels_per_covered_pixel"), vis.get("covered_pixels"), vis.get("texels_per_pixel"),
                    vis.get("blocks_read_by_level"), vis.get("stale_blocks"),
                    oo.get("atlas", {}).get("width"), oo.get("atlas", {}).get("height")),
                   flush=True)

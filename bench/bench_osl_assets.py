@@ -12,7 +12,7 @@ blocks; then the medians of the ratios. With --grid also the thesis grid
 with still lights (1080x720), where the raster pass and the resolve are
 OSL's whole frame.
   bench/bench_osl_assets.py [--rounds N] [--frames N] [--lights N] [--width W --height H]
-                            [--osl JSON] [--grid]"""
+                            [--osl JSON] [--grid | --grid-only]"""
 import argparse
 import json
 import os
@@ -34,6 +34,7 @@ ap.add_argument("--width", type=int, default=480)
 ap.add_argument("--height", type=int, default=360)
 ap.add_argument("--osl", default="{}", help="OSL options (JSON), the defaults when left out")
 ap.add_argument("--grid", action="store_true", help="also the thesis grid with still lights")
+ap.add_argument("--grid-only", action="store_true", help="the thesis grid with still lights alone")
 args = ap.parse_args()
 
 ASSET = {"asset": "court.glb", "lights": args.lights, "light_intensity": 0.15, "dynamic": True,
@@ -71,7 +72,8 @@ try:
     if status not in (200, 201):
         sys.exit("upload: %d %s" % (status, up))
     bench.start()
-    sets = [("court, moving lights", ASSET)] + ([("grid, still lights", GRID)] if args.grid else [])
+    sets = ([] if args.grid_only else [("court, moving lights", ASSET)]) + \
+        ([("grid, still lights", GRID)] if args.grid or args.grid_only else [])
     for name, scene in sets:
         ratios, cpu_ratios = [], []
         for k in range(args.rounds):

@@ -92,9 +92,18 @@ void main()
         // Level-0 texels per pixel by area (the footprint's Jacobian's
         // determinant): the finest level with at least u_density texels a
         // pixel along each axis on average, so that a level's texels per
-        // covered pixel lie in [d^2, 4 d^2).
+        // covered pixel lie in [d^2, 4 d^2). Where the whole shading is per
+        // texel (no OSL_SPLIT), along the footprint's shorter axis (the
+        // Jacobian's smaller singular value) instead: a specular highlight
+        // then never spans fewer texels than pixels in any direction.
         vec2 jx = dFdx(v_uv) * size0, jy = dFdy(v_uv) * size0;
-        float rho = sqrt(abs(jx.x * jy.y - jx.y * jy.x));
+        float det = abs(jx.x * jy.y - jx.y * jy.x);
+#if defined(OSL_SPLIT)
+        float rho = sqrt(det);
+#else
+        float s2 = dot(jx, jx) + dot(jy, jy);
+        float rho = det / max(sqrt(0.5 * (s2 + sqrt(max(s2 * s2 - 4.0 * det * det, 0.0)))), 1e-12);
+#endif
         int level = int(floor(log2(max(rho, 1e-6) / u_density)));
         ivec2 chart = ivec2((v_chart.zw - v_chart.xy) * size0);
         int cap = min(findMSB(v_tile.z) - 3, findMSB(max(min(chart.x, chart.y), 4)) - 2);

@@ -146,6 +146,7 @@ E2E_TESTS = \
 	tests/e2e/e2e_scene_view.py \
 	tests/e2e/e2e_load.py \
 	tests/e2e/e2e_osl.py \
+	tests/e2e/e2e_osl_assets.py \
 	tests/e2e/e2e_ab.py \
 	tests/e2e/e2e_sweep.py \
 	tests/e2e/e2e_records.py \

@@ -48,6 +48,7 @@
 #define SB_TEX_OSL_GEO_NORMAL 2   /* and normals */
 #define SB_TEX_OSL_GEO_ALBEDO 3   /* asset scenes: base colour and roughness baked */
 #define SB_TEX_OSL_GEO_SURFACE 4  /* and emissive and occlusion */
+#define SB_TEX_OSL_ATLAS_SPECULAR 1 /* OSL's raster pass, asset scenes under Phong: specular light */
 #define SB_TEX_POST_SRC 0    /* post effects: the colour the effect reads */
 #define SB_TEX_POST_DEPTH 1  /* the technique's depth texture */
 #define SB_TEX_POST_NORMAL 2 /* the technique's g-buffer normals, when it has them */
@@ -101,5 +102,6 @@
 #define SB_IMG_OSL_ATLAS 0
 #define SB_IMG_HEAT 1 /* light evaluations per pixel (r32ui) */
 #define SB_IMG_OSL_MARKS 2 /* per atlas block, the last frame the raster pass sampled it (r32i) */
+#define SB_IMG_OSL_ATLAS_SPECULAR 3 /* OSL, asset scenes under Phong: the specular plane */
 
 #endif

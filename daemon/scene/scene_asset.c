@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "daemon/scene/asset.h"
+#include "daemon/scene/mesh_charts.h"
 #include "daemon/scene/scene_build.h"
 
 static const double PI = 3.14159265358979323846;
@@ -127,11 +128,9 @@ static bool build_mesh(struct mesh *out, const struct asset_mesh *am, const floa
             d2 += o->pos[k] * o->pos[k];
         }
         r2 = fmaxf(r2, d2);
-        /* OSL's unique parametrisation is uv1, one chart over [0, 1]^2: the
-         * converter's charts have their own gutters. */
+        /* OSL's unique parametrisation is uv1; its charts' rectangles are
+         * set below (mesh_chart_rects). */
         o->uv[0] = v->uv1[0], o->uv[1] = v->uv1[1];
-        o->chart[0] = o->chart[1] = 0.0f;
-        o->chart[2] = o->chart[3] = 1.0f;
         o->tex[0] = v->uv0[0], o->tex[1] = v->uv0[1];
         o->tex[2] = v->texcoord1[0], o->tex[3] = v->texcoord1[1];
         memcpy(o->tangent, v->tangent, sizeof(o->tangent));
@@ -156,7 +155,7 @@ static bool build_mesh(struct mesh *out, const struct asset_mesh *am, const floa
                               ((double)p2->uv1[0] - p0->uv1[0]) * ((double)p1->uv1[1] - p0->uv1[1]));
     }
     out->uv_per_unit = area > 0.0 ? (float)sqrt(uv_area / area) : 1.0f;
-    return true;
+    return mesh_chart_rects(out, NULL);
 }
 
 /* The asset camera spec.asset_camera names: "" the first, digits an index,

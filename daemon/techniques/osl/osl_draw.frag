@@ -39,6 +39,7 @@ ivec2 level_origin(int l)
 
 #if defined(SCENE_TEXTURED)
 // The mask's cut-out at the pixel, as every other technique draws it.
+#define SURFACE_VERTEX_COLOR 1 // osl_draw.vert passes COLOR_0
 #include "surface.glsl"
 #endif
 
@@ -126,7 +127,7 @@ void main()
     // material_surface samples them.
     SurfaceMaterial sm = materials[u_material];
     vec4 tdx = dFdx(v_tex), tdy = dFdy(v_tex);
-    vec3 base = sm.base_color.rgb;
+    vec3 base = sm.base_color.rgb * SURFACE_COLOR.rgb;
     if (material_has(sm, SLOT_BASE_COLOR))
         base *= MATERIAL_SAMPLE(u_material_base_color, sm, SLOT_BASE_COLOR, v_tex, tdx, tdy).rgb;
     float occlusion = 1.0;

@@ -153,6 +153,7 @@ E2E_TESTS = \
 	tests/e2e/e2e_history.py \
 	tests/e2e/e2e_compare_alpha.py \
 	tests/e2e/e2e_client_verdicts.py \
+	tests/e2e/e2e_demo.py \
 	tests/e2e/e2e_verdicts.py \
 	tests/e2e/e2e_asset_convert.py \
 	tests/e2e/systemd_sandbox.py \

@@ -52,21 +52,18 @@ int cmd_ab(struct conn *ca, struct conn *cb, const struct options *o, const char
         fprintf(stderr, "shadebench: warning: A and B run on different kinds of device; "
                 "comparing %s\n", series);
     size_t planned = (size_t)(o->runs ? o->runs : 5), target = planned;
-    int budget = o->max_reruns;
-    /* A regression found on the pairs before confirm_from must hold on
-     * confirm_need fresh pairs that enter its verdict (clean, or bounded). */
-    bool confirming = false;
-    size_t confirm_from = 0, confirm_need = 0;
+    struct gate_reruns plan = {.planned = planned, .budget = o->max_reruns, .decide = true,
+                               .unit = "pair"};
     struct gate_verdict v;
     memset(&v, 0, sizeof(v));
-    char stop_reason[200] = "", unconfirmed[640] = "";
+    char stop_reason[200] = "";
     sa.planned = sb.planned = planned;
-    sa.budget = sb.budget = budget;
+    sa.budget = sb.budget = o->max_reruns;
     if (!o->quiet)
         fprintf(stderr, "A: %s on %s\nB: %s on %s\n%zu clean pairs wanted, alternating, judged on "
                 "%s; at most %d extra pairs for noisy pairs, an unclear verdict or confirming "
                 "that B is slower (--max-reruns)\n", file_a, ca->server, file_b, cb->server,
-                planned, series, budget);
+                planned, series, o->max_reruns);
     for (;;) {
         while (sa.n < target && !sa.failed && !sb.failed) {
             /* A B, then B A: the order flips each pair. */
@@ -80,66 +77,23 @@ int cmd_ab(struct conn *ca, struct conn *cb, const struct options *o, const char
             break;
         gate_evaluate_ab(sa.runs, sb.runs, sa.n, o->confidence, o->max_slowdown,
                          o->noise_tolerance, &v);
-        size_t nclean = v.clean_new;
-        size_t confirmed_by = confirming && v.outcome == GATE_REGRESSION
-                                  ? gate_runs_in_verdict(sa.runs, sa.n, confirm_from, v.bounded)
-                                  : 0;
-        bool want_confirm = confirming && v.outcome == GATE_REGRESSION &&
-                            confirmed_by < confirm_need;
-        if (budget <= 0) {
-            if (want_confirm)
-                snprintf(unconfirmed, sizeof(unconfirmed),
-                         "B looked slower (%.400s), but only %zu of the %zu pairs run to confirm it "
-                         "entered the verdict (%zu wanted): the rest were noisy", v.why,
-                         confirmed_by, sa.n - confirm_from, confirm_need);
-            if (nclean < planned || v.outcome == GATE_INCONCLUSIVE || want_confirm ||
-                (v.outcome == GATE_REGRESSION && !confirming))
-                snprintf(stop_reason, sizeof(stop_reason),
-                         "all %d extra pairs (--max-reruns) used", o->max_reruns);
-            break;
-        }
-        size_t batch = planned < (size_t)budget ? planned : (size_t)budget;
-        if (want_confirm) {
-            size_t need = confirm_need - confirmed_by;
-            need = need < (size_t)budget ? need : (size_t)budget;
+        struct gate_step step;
+        gate_next(&plan, sa.runs, sa.n, &v, false, &step);
+        if (step.more) {
             if (!o->quiet)
-                fprintf(stderr, "%zu of the pairs confirming that B is slower were noisy: running "
-                        "%zu more (%d extra left)\n", sa.n - confirm_from - confirmed_by, need,
-                        budget - (int)need);
-            target += need;
-            budget -= (int)need;
+                fprintf(stderr, "%s\n", step.say);
+            target += step.more;
             continue;
         }
-        if (nclean < planned && !(confirming && v.outcome == GATE_REGRESSION)) {
-            size_t need = planned - nclean < (size_t)budget ? planned - nclean : (size_t)budget;
-            if (!o->quiet)
-                fprintf(stderr, "%zu noisy pair(s) left out: running %zu more (%d extra left)\n",
-                        sa.n - nclean, need, budget - (int)need);
-            target += need;
-            budget -= (int)need;
-            continue;
-        }
-        if ((v.outcome == GATE_REGRESSION && !confirming) || v.outcome == GATE_INCONCLUSIVE) {
-            if (!o->quiet)
-                fprintf(stderr, "%s (%s): running %zu more pairs (%d extra left)\n",
-                        v.outcome == GATE_REGRESSION ? "B looks slower" : "inconclusive", v.why,
-                        batch, budget - (int)batch);
-            if (v.outcome == GATE_REGRESSION) {
-                /* Fresh pairs must confirm it: one unlucky set is not enough. */
-                confirming = true;
-                confirm_from = sa.n;
-                confirm_need = batch;
-            }
-            target += batch;
-            budget -= (int)batch;
-            continue;
+        if (step.budget_spent)
+            snprintf(stop_reason, sizeof(stop_reason), "all %d extra pairs (--max-reruns) used",
+                     o->max_reruns);
+        if (step.unconfirmed && v.outcome == GATE_REGRESSION) {
+            /* Not a verdict: what was seen, and why it stands unconfirmed. */
+            v.outcome = GATE_INCONCLUSIVE;
+            snprintf(v.why, sizeof(v.why), "%s", step.unconfirmed_why);
         }
         break;
-    }
-    if (unconfirmed[0] && v.outcome == GATE_REGRESSION) {
-        /* Not a verdict: say what was seen and why it stands unconfirmed. */
-        v.outcome = GATE_INCONCLUSIVE;
-        snprintf(v.why, sizeof(v.why), "%s", unconfirmed);
     }
 
     json_t *ja = sa.n ? json_array_get(sa.jobs, 0) : sa.failed;
@@ -214,7 +168,7 @@ int cmd_ab(struct conn *ca, struct conn *cb, const struct options *o, const char
             t->time_s = clock_mono_s() - t0;
             junit_prop_str(t, "outcome", gate_outcome_name(v.outcome));
             junit_prop_str(t, "series", series);
-            if (v.used_new) {
+            if (v.r.ratio > 0) { /* with pairs 0: all pairs' figure, not a verdict */
                 junit_prop_num(t, "ratio", v.r.ratio);
                 junit_prop_num(t, "ci_low", v.r.lo);
                 junit_prop_num(t, "ci_high", v.r.hi);
@@ -246,7 +200,7 @@ int cmd_ab(struct conn *ca, struct conn *cb, const struct options *o, const char
                             (json_int_t)v.used_new, "clean_pairs", (json_int_t)nclean, "bounded",
                             v.bounded, "confidence", o->confidence, "server_b", cb->server, "runs",
                             pairs);
-        if (summary && v.used_new) {
+        if (summary && v.r.ratio > 0) {
             json_object_set_new(summary, "ratio", json_real(v.r.ratio));
             json_object_set_new(summary, "ci_low", json_real(v.r.lo));
             json_object_set_new(summary, "ci_high", json_real(v.r.hi));

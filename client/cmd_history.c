@@ -17,6 +17,7 @@
 #include "client/trend.h"
 #include "client/workload.h"
 #include "common/fsutil.h"
+#include "common/noise.h"
 #include "common/result_keys.h"
 #include "common/timing_series.h"
 
@@ -90,7 +91,10 @@ static void job_detail(struct conn *c, const char *id, bool by_reference, struct
     json_t *share = json_object_get(inter, "other_cpu_share");
     d->has_share = json_is_number(share);
     d->other_share = d->has_share ? json_number_value(share) : NAN;
-    d->noisy = json_is_true(json_object_get(inter, "noisy"));
+    /* The one noise rule, alone (against an idle machine), as the daemon
+     * applies it; the daemon's flag only where there are no figures. */
+    d->noisy = d->has_share ? noise_exceeds(d->other_share, 0.0, NOISE_TOLERANCE)
+                            : json_is_true(json_object_get(inter, "noisy"));
     json_decref(job);
 }
 

@@ -159,13 +159,10 @@ static int gate_or_runs(struct conn *c, const struct options *o, const char *fil
     struct spec_check sc = {base, o, false};
     struct gate_verdict v;
     memset(&v, 0, sizeof(v));
+    struct gate_reruns plan = {.planned = (size_t)planned, .budget = o->max_reruns,
+                               .decide = base != NULL, .unit = "run"};
     size_t target = (size_t)planned;
-    int budget = o->max_reruns;
-    /* A regression found on the runs before confirm_from must hold on
-     * confirm_need fresh runs that enter its verdict (clean, or bounded). */
-    bool confirming = false;
-    size_t confirm_from = 0, confirm_need = 0;
-    char stop_reason[200] = "", unconfirmed[640] = "";
+    char stop_reason[200] = "";
     s.planned = (size_t)planned;
     s.budget = o->max_reruns;
     if (!o->quiet)
@@ -190,91 +187,28 @@ static int gate_or_runs(struct conn *c, const struct options *o, const char *fil
             bool have = gate_typical_share(s.runs, s.n, &ref);
             gate_mark_noisy(s.runs, s.n, have, ref, o->noise_tolerance);
         }
-        size_t nc_clean = 0;
-        for (size_t i = 0; i < s.n; i++)
-            nc_clean += !s.runs[i].noisy;
-        bool batch_noisy = trailing_noisy(&s) >= (size_t)(planned > 3 ? planned : 3);
-        size_t confirmed_by = confirming && v.outcome == GATE_REGRESSION
-                                  ? gate_runs_in_verdict(s.runs, s.n, confirm_from, v.bounded)
-                                  : 0;
-        bool want_confirm = base && confirming && v.outcome == GATE_REGRESSION &&
-                            confirmed_by < confirm_need;
-        bool wants_more = nc_clean < (size_t)planned || want_confirm ||
-                          (base && (v.outcome == GATE_INCONCLUSIVE ||
-                                    (v.outcome == GATE_REGRESSION && !confirming)));
-        if (wants_more && budget <= 0)
+        size_t trailing = trailing_noisy(&s);
+        bool batch_noisy = trailing >= (size_t)(planned > 3 ? planned : 3);
+        struct gate_step step;
+        gate_next(&plan, s.runs, s.n, &v, batch_noisy, &step);
+        if (step.more) {
+            if (!o->quiet && base)
+                fprintf(stderr, "%s\n", step.say);
+            target += step.more;
+            continue;
+        }
+        if (step.budget_spent)
             snprintf(stop_reason, sizeof(stop_reason), "all %d extra runs (--max-reruns) used",
                      o->max_reruns);
-        else if (wants_more && batch_noisy)
+        else if (batch_noisy && step.wanted_more)
             snprintf(stop_reason, sizeof(stop_reason), "the last %zu runs were all noisy: the "
-                     "machine is busier than when the runs compared were measured",
-                     trailing_noisy(&s));
-        if (!base) {
-            /* Runs for a later baseline: replace disturbed ones. */
-            if (nc_clean < (size_t)planned && budget > 0 && !batch_noisy) {
-                target += 1;
-                budget--;
-                continue;
-            }
-            break;
-        }
-        if (want_confirm && (budget <= 0 || batch_noisy)) {
-            snprintf(unconfirmed, sizeof(unconfirmed),
-                     "a possible regression (%.400s) could not be confirmed: only %zu of the %zu runs "
-                     "made to confirm it entered the verdict (%zu wanted), the rest were noisy",
-                     v.why, confirmed_by, s.n - confirm_from, confirm_need);
-            break;
-        }
-        size_t batch = (size_t)planned < (size_t)budget ? (size_t)planned : (size_t)budget;
-        if (budget <= 0 || batch_noisy)
-            break;
-        if (want_confirm) {
-            size_t need = confirm_need - confirmed_by;
-            need = need < (size_t)budget ? need : (size_t)budget;
-            if (!o->quiet)
-                fprintf(stderr, "%zu of the runs confirming the regression were noisy: running "
-                        "%zu more (%d extra left)\n", s.n - confirm_from - confirmed_by, need,
-                        budget - (int)need);
-            target += need;
-            budget -= (int)need;
-            continue;
-        }
-        if (nc_clean < (size_t)planned && !(confirming && v.outcome == GATE_REGRESSION)) {
-            size_t need = (size_t)planned - nc_clean;
-            need = need < (size_t)budget ? need : (size_t)budget;
-            if (!o->quiet)
-                fprintf(stderr, "%zu noisy run(s) left out: running %zu more (%d extra left)\n",
-                        s.n - nc_clean, need, budget - (int)need);
-            target += need;
-            budget -= (int)need;
-            continue;
-        }
-        if (v.outcome == GATE_REGRESSION && !confirming) {
-            /* A regression must hold on fresh runs too before it fails a
-             * build: one unlucky batch is not enough. */
-            if (!o->quiet)
-                fprintf(stderr, "possible regression (%s): confirming on %zu more runs\n", v.why,
-                        batch);
-            confirming = true;
-            confirm_from = s.n;
-            confirm_need = batch;
-            target += batch;
-            budget -= (int)batch;
-            continue;
-        }
-        if (v.outcome == GATE_INCONCLUSIVE) {
-            if (!o->quiet)
-                fprintf(stderr, "inconclusive (%s): running %zu more (%d extra left)\n", v.why,
-                        batch, budget - (int)batch);
-            target += batch;
-            budget -= (int)batch;
-            continue;
+                     "machine is busier than when the runs compared were measured", trailing);
+        if (step.unconfirmed && v.outcome == GATE_REGRESSION) {
+            /* Not a verdict: what was seen, and why it stands unconfirmed. */
+            v.outcome = GATE_INCONCLUSIVE;
+            snprintf(v.why, sizeof(v.why), "%s", step.unconfirmed_why);
         }
         break;
-    }
-    if (unconfirmed[0] && v.outcome == GATE_REGRESSION) {
-        v.outcome = GATE_INCONCLUSIVE;
-        snprintf(v.why, sizeof(v.why), "%s", unconfirmed);
     }
     size_t nb_clean = v.clean_old, nc_clean = 0;
     for (size_t i = 0; i < s.n; i++)
@@ -338,7 +272,7 @@ static int gate_or_runs(struct conn *c, const struct options *o, const char *fil
             t->time_s = clock_mono_s() - t0;
             junit_prop_str(t, "outcome", gate_outcome_name(v.outcome));
             junit_prop_str(t, "series", series);
-            if (v.used_new) {
+            if (v.r.ratio > 0) { /* with no runs used: all runs' figure, not a verdict */
                 junit_prop_num(t, "ratio", v.r.ratio);
                 junit_prop_num(t, "ci_low", v.r.lo);
                 junit_prop_num(t, "ci_high", v.r.hi);

@@ -12,6 +12,7 @@
 #include "client/junit.h"
 #include "client/workload.h"
 #include "common/fsutil.h"
+#include "common/json_fields.h"
 #include "common/result_keys.h"
 
 /* The point's job as the sweep file states it: its base with the point's
@@ -24,23 +25,8 @@ static json_t *point_spec(const json_t *base, const json_t *row)
         json_object_set_new(spec, "technique", json_string(tech));
     const char *key;
     json_t *v;
-    json_object_foreach(json_object_get(row, "values"), key, v) {
-        json_t *at = spec;
-        char path[128];
-        snprintf(path, sizeof(path), "%s", key);
-        char *part = path, *dot;
-        while ((dot = strchr(part, '.'))) {
-            *dot = '\0';
-            json_t *next = json_object_get(at, part);
-            if (!json_is_object(next)) {
-                next = json_object();
-                json_object_set_new(at, part, next);
-            }
-            at = next;
-            part = dot + 1;
-        }
-        json_object_set(at, part, v);
-    }
+    json_object_foreach(json_object_get(row, "values"), key, v)
+        jf_set_path(spec, key, json_incref(v));
     return spec;
 }
 

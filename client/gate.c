@@ -456,11 +456,71 @@ size_t gate_runs_in_verdict(const struct gate_run *runs, size_t n, size_t from, 
     return k;
 }
 
+void gate_next(struct gate_reruns *r, const struct gate_run *runs, size_t n,
+               const struct gate_verdict *v, bool batch_noisy, struct gate_step *step)
+{
+    memset(step, 0, sizeof(*step));
+    size_t clean = 0;
+    for (size_t i = 0; i < n; i++)
+        clean += !runs[i].noisy;
+    bool regression = r->decide && v->outcome == GATE_REGRESSION;
+    size_t confirmed_by = r->confirming && regression
+                              ? gate_runs_in_verdict(runs, n, r->confirm_from, v->bounded)
+                              : 0;
+    bool want_confirm = r->confirming && regression && confirmed_by < r->confirm_need;
+    bool wants_more = clean < r->planned || want_confirm ||
+                      (r->decide && (v->outcome == GATE_INCONCLUSIVE ||
+                                     (regression && !r->confirming)));
+    size_t budget = r->budget > 0 ? (size_t)r->budget : 0;
+    step->wanted_more = wants_more;
+    step->budget_spent = wants_more && budget == 0;
+    if (want_confirm && (budget == 0 || batch_noisy)) {
+        step->unconfirmed = true;
+        snprintf(step->unconfirmed_why, sizeof(step->unconfirmed_why),
+                 "a possible regression (%.360s) could not be confirmed: only %zu of the %zu %ss "
+                 "made to confirm it entered the verdict (%zu wanted), the rest were noisy",
+                 v->why, confirmed_by, n - r->confirm_from, r->unit, r->confirm_need);
+        return;
+    }
+    if (budget == 0 || batch_noisy || !wants_more)
+        return;
+    size_t batch = r->planned < budget ? r->planned : budget, more;
+    if (want_confirm) {
+        more = r->confirm_need - confirmed_by;
+        more = more < budget ? more : budget;
+        snprintf(step->say, sizeof(step->say),
+                 "%zu of the %ss confirming the regression were noisy: running %zu more (%zu "
+                 "extra left)", n - r->confirm_from - confirmed_by, r->unit, more, budget - more);
+    } else if (clean < r->planned && !(r->confirming && regression)) {
+        more = r->planned - clean < budget ? r->planned - clean : budget;
+        snprintf(step->say, sizeof(step->say),
+                 "%zu noisy %s(s) left out: running %zu more (%zu extra left)", n - clean, r->unit,
+                 more, budget - more);
+    } else if (regression && !r->confirming) {
+        /* A regression must hold on fresh runs too before it fails a
+         * build: one unlucky set is not enough. */
+        more = batch;
+        r->confirming = true;
+        r->confirm_from = n;
+        r->confirm_need = batch;
+        snprintf(step->say, sizeof(step->say), "possible regression (%.600s): confirming on %zu "
+                 "more %ss", v->why, more, r->unit);
+    } else if (r->decide && v->outcome == GATE_INCONCLUSIVE) {
+        more = batch;
+        snprintf(step->say, sizeof(step->say), "inconclusive (%.600s): running %zu more %ss (%zu "
+                 "extra left)", v->why, more, r->unit, budget - more);
+    } else {
+        return;
+    }
+    step->more = more;
+    r->budget -= (int)more;
+}
+
 void gate_basis_text(const struct gate_verdict *v, bool paired, size_t total_old,
                      size_t total_new, char *out, size_t cap)
 {
     if (!v->used_old && !v->used_new) {
-        snprintf(out, cap, "on no interval: too few usable %s", paired ? "pairs" : "runs");
+        snprintf(out, cap, "on too few %s for an interval", paired ? "pairs" : "runs");
         return;
     }
     if (paired) {

@@ -163,10 +163,43 @@ void gate_evaluate_ab(struct gate_run *a, struct gate_run *b, size_t n, double c
  * pair's flag is on both sides. */
 size_t gate_runs_in_verdict(const struct gate_run *runs, size_t n, size_t from, bool bounded);
 
+/* The rerun policy the gate and ab share. After each evaluation: replace
+ * noisy runs (pairs) until `planned` are clean, run another set while the
+ * verdict is unclear, and confirm a regression on a fresh set, which
+ * confirms it only by entering its verdict (gate_runs_in_verdict): noisy
+ * confirming runs are replaced, and a regression whose fresh runs never
+ * entered its verdict when the budget is spent is not confirmed. Without a
+ * verdict to reach (decide false: runs for a later baseline), only noisy
+ * runs are replaced. */
+struct gate_reruns {
+    size_t planned;        /* clean runs (pairs) wanted */
+    int budget;            /* extra runs (pairs) left */
+    bool decide;           /* rerun for unclear verdicts and regressions too */
+    bool confirming;       /* a regression found before confirm_from */
+    size_t confirm_from, confirm_need;
+    const char *unit;      /* "run", "pair" */
+};
+
+struct gate_step {
+    size_t more;             /* to run now; 0: stop */
+    char say[800];           /* the log line for running more, "" when stopping */
+    bool wanted_more;        /* more runs were wanted (stopped short: budget or noise) */
+    bool budget_spent;       /* stopped, or ran short, with more wanted and no budget left */
+    bool unconfirmed;        /* stopped with a regression its fresh runs did not confirm */
+    char unconfirmed_why[600]; /* then: the verdict's sentence in its place */
+};
+
+/* The next step, from the n runs so far (runs: the new side's, or A's for
+ * ab, whose pairs are marked on both sides), the verdict on them, and
+ * whether the last set was all noisy (stop: the machine is busier than
+ * when the compared runs were measured). Updates r (budget, confirming). */
+void gate_next(struct gate_reruns *r, const struct gate_run *runs, size_t n,
+               const struct gate_verdict *v, bool batch_noisy, struct gate_step *step);
+
 /* What a verdict rests on, for its headline: "over 7 pairs (all clean)",
  * "over 7 pairs (3 clean, 4 noisy ones bounded by their CPU change)", "over
- * 5 baseline runs and 4 runs here (1 noisy run left out)", or "on no
- * interval: too few usable runs". */
+ * 5 baseline runs and 4 runs here (1 noisy left out)", or "on too few
+ * pairs for an interval". */
 void gate_basis_text(const struct gate_verdict *v, bool paired, size_t total_old,
                      size_t total_new, char *out, size_t cap);
 

@@ -132,7 +132,7 @@ static void test_ab(void)
     CHECK(v.outcome == GATE_INCONCLUSIVE && v.used_new == 0 && strstr(v.why, "at least 3") &&
           strstr(v.why, "not a verdict"));
     gate_basis_text(&v, true, 2, 2, basis, sizeof(basis));
-    CHECK(strstr(basis, "no interval"));
+    CHECK(!strcmp(basis, "on too few pairs for an interval"));
 
     /* One clean pair of seven: a bounded verdict over all seven says so,
      * never "over 1 pairs". In the noisy six, B's run (then A's, in turn)
@@ -192,9 +192,56 @@ static void test_baseline(void)
     CHECK(gate_runs_in_verdict(cur, 8, 5, v.bounded) == 0);
 }
 
+/* The rerun policy: a regression is confirmed on a fresh set that enters
+ * its verdict; noisy confirming runs are replaced within the budget; with
+ * the budget spent and none entered, it stands unconfirmed. */
+static void test_reruns(void)
+{
+    struct gate_run runs[12];
+    for (size_t i = 0; i < 12; i++)
+        runs[i] = (struct gate_run){.ms = 30, .has_share = true, .other_share = 0.05};
+    struct gate_reruns r = {.planned = 3, .budget = 6, .decide = true, .unit = "run"};
+    struct gate_verdict reg = {.outcome = GATE_REGRESSION};
+    snprintf(reg.why, sizeof(reg.why), "slower by 50.0%%");
+    struct gate_step step;
+    gate_next(&r, runs, 3, &reg, false, &step);
+    CHECK(step.more == 3 && r.confirming && r.confirm_from == 3 && r.budget == 3 &&
+          strstr(step.say, "confirming on 3 more runs"));
+    /* The three confirming runs were all left out as noisy: replaced. */
+    runs[3].noisy = runs[4].noisy = runs[5].noisy = true;
+    gate_next(&r, runs, 6, &reg, false, &step);
+    CHECK(step.more == 3 && r.budget == 0 && strstr(step.say, "3 of the runs confirming") &&
+          !step.unconfirmed);
+    /* Those too: the budget is spent and nothing fresh entered the verdict. */
+    runs[6].noisy = runs[7].noisy = runs[8].noisy = true;
+    gate_next(&r, runs, 9, &reg, false, &step);
+    CHECK(step.more == 0 && step.unconfirmed && step.budget_spent &&
+          strstr(step.unconfirmed_why, "could not be confirmed: only 0 of the 6 runs"));
+    /* Bounded verdicts count every fresh run with figures. */
+    reg.bounded = true;
+    gate_next(&r, runs, 9, &reg, false, &step);
+    CHECK(step.more == 0 && !step.unconfirmed);
+    /* Clean confirming runs confirm it: stop, a regression. */
+    struct gate_reruns r2 = {.planned = 3, .budget = 6, .decide = true, .unit = "pair"};
+    reg.bounded = false;
+    for (size_t i = 0; i < 12; i++)
+        runs[i].noisy = false;
+    gate_next(&r2, runs, 3, &reg, false, &step);
+    gate_next(&r2, runs, 6, &reg, false, &step);
+    CHECK(step.more == 0 && !step.unconfirmed && !step.wanted_more);
+    /* A whole noisy set stops the runs for a later baseline too. */
+    struct gate_reruns r3 = {.planned = 3, .budget = 6, .decide = false, .unit = "run"};
+    runs[1].noisy = true;
+    gate_next(&r3, runs, 3, &reg, false, &step);
+    CHECK(step.more == 1 && strstr(step.say, "1 noisy run(s) left out"));
+    gate_next(&r3, runs, 4, &reg, true, &step);
+    CHECK(step.more == 0 && step.wanted_more == false);
+}
+
 int main(void)
 {
     test_sides();
+    test_reruns();
     test_noise_text();
     test_ab();
     test_baseline();

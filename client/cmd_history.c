@@ -93,8 +93,7 @@ static void job_detail(struct conn *c, const char *id, bool by_reference, struct
     d->other_share = d->has_share ? json_number_value(share) : NAN;
     /* The one noise rule, alone (against an idle machine), as the daemon
      * applies it; the daemon's flag only where there are no figures. */
-    d->noisy = d->has_share ? noise_exceeds(d->other_share, 0.0, NOISE_TOLERANCE)
-                            : json_is_true(json_object_get(inter, "noisy"));
+    d->noisy = noise_interference_noisy(inter);
     json_decref(job);
 }
 

@@ -98,8 +98,7 @@ static void read_interference(const json_t *inter, struct gate_run *run)
     run->daemon_noisy = json_is_true(json_object_get(inter, "noisy"));
     /* Alone, by the one rule; the daemon's flag where there are no figures
      * (a daemon from before the rule had its own). */
-    run->noisy_alone = run->has_share ? noise_exceeds(run->other_share, 0.0, NOISE_TOLERANCE)
-                                      : run->daemon_noisy;
+    run->noisy_alone = noise_interference_noisy(inter);
 }
 
 static double series_median(const json_t *holder, const char *series)
@@ -528,10 +527,10 @@ void gate_basis_text(const struct gate_verdict *v, bool paired, size_t total_old
             snprintf(out, cap, "over %zu pairs (%zu clean, %zu noisy ones bounded by their CPU "
                      "change)", v->used_new, v->clean_new, v->used_new - v->clean_new);
         else if (v->used_new < total_new)
-            snprintf(out, cap, "over %zu clean pairs (%zu noisy left out)", v->used_new,
-                     total_new - v->used_new);
+            snprintf(out, cap, "over %zu pairs (%zu noisy pair%s left out)", v->used_new,
+                     total_new - v->used_new, total_new - v->used_new == 1 ? "" : "s");
         else
-            snprintf(out, cap, "over %zu pairs (all clean)", v->used_new);
+            snprintf(out, cap, "over %zu pairs (none left out)", v->used_new);
         return;
     }
     size_t left_out = v->bounded ? 0 : (total_old - v->used_old) + (total_new - v->used_new);
@@ -540,10 +539,10 @@ void gate_basis_text(const struct gate_verdict *v, bool paired, size_t total_old
                  "their CPU change)", v->used_old, v->used_new,
                  (v->used_old - v->clean_old) + (v->used_new - v->clean_new));
     else if (left_out)
-        snprintf(out, cap, "over %zu baseline runs and %zu runs here (%zu noisy left out)",
-                 v->used_old, v->used_new, left_out);
+        snprintf(out, cap, "over %zu baseline runs and %zu runs here (%zu noisy run%s left out)",
+                 v->used_old, v->used_new, left_out, left_out == 1 ? "" : "s");
     else
-        snprintf(out, cap, "over %zu baseline runs and %zu runs here (all clean)", v->used_old,
+        snprintf(out, cap, "over %zu baseline runs and %zu runs here (none left out)", v->used_old,
                  v->used_new);
 }
 

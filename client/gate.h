@@ -196,9 +196,9 @@ struct gate_step {
 void gate_next(struct gate_reruns *r, const struct gate_run *runs, size_t n,
                const struct gate_verdict *v, bool batch_noisy, struct gate_step *step);
 
-/* What a verdict rests on, for its headline: "over 7 pairs (all clean)",
+/* What a verdict rests on, for its headline: "over 7 pairs (none left out)",
  * "over 7 pairs (3 clean, 4 noisy ones bounded by their CPU change)", "over
- * 5 baseline runs and 4 runs here (1 noisy left out)", or "on too few
+ * 5 baseline runs and 4 runs here (1 noisy run left out)", or "on too few
  * pairs for an interval". */
 void gate_basis_text(const struct gate_verdict *v, bool paired, size_t total_old,
                      size_t total_new, char *out, size_t cap);

@@ -228,7 +228,7 @@ void run_set_line(const struct run_set *s, size_t i, const char *series, char *o
         return;
     if (r->has_share)
         used += snprintf(out + used, cap - (size_t)used, ", others took %.0f%% of the CPU%s",
-                         100 * r->other_share, r->noisy_alone ? " (noisy)" : "");
+                         100 * r->other_share, r->noisy_alone ? " (noisy on its own)" : "");
     else if (r->daemon_noisy)
         used += snprintf(out + used, cap - (size_t)used, ", flagged noisy by the daemon");
     if ((size_t)used < cap && r->elapsed_s > 0)

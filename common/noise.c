@@ -13,3 +13,10 @@ bool noise_exceeds(double share, double reference, double tolerance)
 {
     return fabs(noise_cpu_left_change(share, reference)) > tolerance;
 }
+
+bool noise_interference_noisy(const json_t *interference)
+{
+    json_t *share = json_object_get(interference, "other_cpu_share");
+    return json_is_number(share) ? noise_exceeds(json_number_value(share), 0.0, NOISE_TOLERANCE)
+                                 : json_is_true(json_object_get(interference, "noisy"));
+}

@@ -23,6 +23,7 @@
  * GL-free and free of I/O; any thread. Unit-tested in
  * tests/unit/test_interference.c and test_gate.c. */
 
+#include <jansson.h>
 #include <stdbool.h>
 
 /* 10%: the gate's tolerance since it began marking noise. The daemon used
@@ -46,5 +47,10 @@ double noise_cpu_left_change(double share, double reference);
 /* True when share, against reference, breaks tolerance (NOISE_TOLERANCE
  * unless a caller was asked for another). */
 bool noise_exceeds(double share, double reference, double tolerance);
+
+/* A result's "interference" judged alone by this rule from its
+ * other_cpu_share, so that a result stored under an older rule reads as a
+ * new one does; its own "noisy" flag only where it has no figures. */
+bool noise_interference_noisy(const json_t *interference);
 
 #endif

@@ -157,7 +157,7 @@ try:
     junit = os.path.join(TMP, "unlike.xml")
     out = run(d, "ab", job, unlit, "--runs", "5", "--max-reruns", "0", "--junit", junit)
     check(out.returncode == 0 and re.search(r"^B/A = 0\.\d+, 95% interval \[[0-9.]+, [0-9.]+\] over 5 pairs "
-                                            r"\(all clean\): PASS", out.stderr, re.M),
+                                            r"\(none left out\): PASS", out.stderr, re.M),
           "unlike jobs, each side steady: a pass over all 5 pairs: %s" % out.stderr[-900:])
     ab = [c for c in junit_cases(junit)[1].items() if "B/A" in c[0]]
     check(ab and ab[0][1][2].get("pairs") == "5" and ab[0][1][2].get("noisy_pairs") == "0",
@@ -173,7 +173,7 @@ try:
     out = run(d, "ab", job, job, "--runs", "3", "--max-reruns", "0", "--junit", junit)
     root, cases = cases_by_suffix(junit)
     names = [c.get("name") for c in cases]
-    check(out.returncode == 0 and "over 3 pairs (all clean): PASS" in out.stderr,
+    check(out.returncode == 0 and "over 3 pairs (none left out): PASS" in out.stderr,
           "A against A: a pass over 3 pairs: %s" % out.stderr[-500:])
     check(len(names) == 3 and len(set(names)) == 3 and any(n.endswith(" as A: job") for n in names) and
           any(n.endswith(" as B: job") for n in names),
@@ -216,7 +216,7 @@ try:
               "--junit", junit)
     fails = list(ET.parse(junit).getroot().iter("failure"))
     check(out.returncode == 1 and "confirming on 3 more runs" in out.stderr and d.submitted() == 6 and
-          re.search(r"gate over 3 baseline runs and 6 runs here \(all clean\): REGRESSION", out.stderr) and
+          re.search(r"gate over 3 baseline runs and 6 runs here \(none left out\): REGRESSION", out.stderr) and
           len(fails) == 1 and fails[0].get("type") == "regression",
           "a confirmed regression fails over all 6 runs, type regression: %s" % out.stderr[-700:])
 finally:

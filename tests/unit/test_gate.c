@@ -116,7 +116,7 @@ static void test_ab(void)
     gate_evaluate_ab(a, b, 7, 0.95, 0.05, NOISE_TOLERANCE, &v);
     gate_basis_text(&v, true, 7, 7, basis, sizeof(basis));
     CHECK(v.outcome == GATE_PASS && v.used_new == 7 && v.clean_new == 7 && !v.bounded);
-    CHECK(!strcmp(basis, "over 7 pairs (all clean)"));
+    CHECK(!strcmp(basis, "over 7 pairs (none left out)"));
     CHECK(v.r.ratio > 0.45 && v.r.ratio < 0.55);
     /* One of A's runs disturbed against A's own typical run: that pair
      * alone is left out, and the headline says so. */
@@ -124,7 +124,7 @@ static void test_ab(void)
     gate_evaluate_ab(a, b, 7, 0.95, 0.05, NOISE_TOLERANCE, &v);
     gate_basis_text(&v, true, 7, 7, basis, sizeof(basis));
     CHECK(a[3].noisy && b[3].noisy && !a[2].noisy && strstr(a[3].why, "A's run"));
-    CHECK(v.outcome == GATE_PASS && v.used_new == 6 && !strcmp(basis, "over 6 clean pairs (1 noisy left out)"));
+    CHECK(v.outcome == GATE_PASS && v.used_new == 6 && !strcmp(basis, "over 6 pairs (1 noisy pair left out)"));
 
     /* Too few pairs: no verdict on two, whatever they say. */
     pairs(a, b, 2, 20.0, 20.0, 0.0001, 0.05, 0.05);
@@ -181,14 +181,14 @@ static void test_baseline(void)
     gate_evaluate_baseline(base, 5, cur, 8, 0.95, 0.05, NOISE_TOLERANCE, &v);
     gate_basis_text(&v, false, 5, 8, basis, sizeof(basis));
     CHECK(v.outcome == GATE_PASS && v.used_old == 5 && v.used_new == 8 &&
-          !strcmp(basis, "over 5 baseline runs and 8 runs here (all clean)"));
+          !strcmp(basis, "over 5 baseline runs and 8 runs here (none left out)"));
     /* The last three at 95%: left out against the baseline's 74%. */
     for (size_t i = 5; i < 8; i++)
         cur[i].other_share = 0.95, cur[i].ms *= 1.5;
     gate_evaluate_baseline(base, 5, cur, 8, 0.95, 0.05, NOISE_TOLERANCE, &v);
     gate_basis_text(&v, false, 5, 8, basis, sizeof(basis));
     CHECK(cur[7].noisy && !cur[4].noisy && v.used_new == 5 &&
-          !strcmp(basis, "over 5 baseline runs and 5 runs here (3 noisy left out)"));
+          !strcmp(basis, "over 5 baseline runs and 5 runs here (3 noisy runs left out)"));
     CHECK(gate_runs_in_verdict(cur, 8, 5, v.bounded) == 0);
 }
 

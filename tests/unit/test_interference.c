@@ -104,6 +104,17 @@ int main(void)
     CHECK(!noise_exceeds(0.76, 0.75, NOISE_TOLERANCE) && noise_exceeds(0.80, 0.75, NOISE_TOLERANCE));
     CHECK_NEAR(noise_cpu_left_change(0.85, 0.80), -0.25, 1e-12);
     CHECK(strstr(INTERFERENCE_RULE, "10%") != NULL);
+    /* A result stored under the old rule (5%, or the load average) reads by
+     * this one from its figures; its flag counts only without figures. */
+    json_t *old = json_pack("{s:f, s:b}", "other_cpu_share", 0.07, "noisy", 1);
+    CHECK(!noise_interference_noisy(old));
+    json_object_set_new(old, "other_cpu_share", json_real(0.2));
+    json_object_set_new(old, "noisy", json_false());
+    CHECK(noise_interference_noisy(old));
+    json_object_del(old, "other_cpu_share");
+    json_object_set_new(old, "noisy", json_true());
+    CHECK(noise_interference_noisy(old) && !noise_interference_noisy(NULL));
+    json_decref(old);
 
     /* No time passed: shares are zero, not a division by zero. */
     interference_compute(&a, &a, &f);

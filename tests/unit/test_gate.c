@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "client/gate.h"
+#include "common/timing_series.h"
 #include "tests/unit/check.h"
 
 /* A deterministic normal generator (xorshift + Box-Muller), so that the
@@ -238,9 +239,24 @@ static void test_reruns(void)
     CHECK(step.more == 0 && step.wanted_more == false);
 }
 
+/* The rule "software renderer -> frame_ms", written once and read by the
+ * gate, ab, history and the charts. */
+static void test_series_rule(void)
+{
+    CHECK(!strcmp(timing_series_for_renderer("llvmpipe (LLVM 15.0.6, 256 bits)"), "frame_ms"));
+    CHECK(!strcmp(timing_series_for_renderer("softpipe"), "frame_ms"));
+    CHECK(!strcmp(timing_series_for_renderer("Google SwiftShader"), "frame_ms"));
+    CHECK(!strcmp(timing_series_for_renderer("NVIDIA H100 80GB HBM3/PCIe/SSE2"), "gpu_ms"));
+    CHECK(!strcmp(timing_series_for_renderer(NULL), "frame_ms"));
+    json_t *dev = json_pack("{s:s}", "gl_renderer", "AMD Radeon RX 7900 XTX (radeonsi)");
+    CHECK(!strcmp(gate_default_series(dev), "gpu_ms"));
+    json_decref(dev);
+}
+
 int main(void)
 {
     test_sides();
+    test_series_rule();
     test_reruns();
     test_noise_text();
     test_ab();

@@ -268,6 +268,16 @@ size_t gate_noise_text(const struct gate_run *runs, size_t n, const char *what,
     return noisy;
 }
 
+/* How much more (> 0) or less CPU B's run of a pair had left than A's,
+ * each relative to its side's typical share (ra, rb). */
+static double ab_pair_change(const struct gate_run *a, double ra, const struct gate_run *b,
+                             double rb)
+{
+    double left_a = (1.0 - a->other_share) / fmax(1.0 - ra, 0.01);
+    double left_b = (1.0 - b->other_share) / fmax(1.0 - rb, 0.01);
+    return left_b / fmax(left_a, 0.01) - 1.0;
+}
+
 /* Tries to settle an undecided comparison on every run with figures, each
  * bounded by its CPU change against its reference (what_old and what_new:
  * the typical shares), new runs down and old ones up for a regression, the
@@ -283,11 +293,16 @@ static bool bounded_verdict(const struct gate_run *old, size_t nold, bool have_o
     for (int upper = 0; ov && nv && upper <= 1 && !settled; upper++) {
         size_t no = 0, nn = 0;
         if (paired) {
+            /* B's run bounded by its CPU change against A's run, each from
+             * its side's typical share: a CPU-bound renderer at most slows
+             * down in proportion. */
             for (size_t i = 0; i < nold && i < ncur; i++) {
                 if (!old[i].has_share || !cur[i].has_share || !have_old || !have_new)
                     continue;
-                ov[no++] = gate_run_bound_ms(&old[i], have_old, ref_old, !upper);
-                nv[nn++] = gate_run_bound_ms(&cur[i], have_new, ref_new, upper);
+                double scaled =
+                    cur[i].ms * (1.0 + ab_pair_change(&old[i], ref_old, &cur[i], ref_new));
+                ov[no++] = old[i].ms;
+                nv[nn++] = upper ? fmax(cur[i].ms, scaled) : fmin(cur[i].ms, scaled);
             }
         } else {
             if (!have_old && !have_new)
@@ -315,9 +330,10 @@ static bool bounded_verdict(const struct gate_run *old, size_t nold, bool have_o
         size_t used = strlen(v->why);
         if (paired)
             snprintf(v->why + used, sizeof(v->why) - used,
-                     " (over all %zu pairs, noisy ones included, each run's time %s by as much as "
-                     "its CPU change against its side's typical share could explain)", no,
-                     upper ? "A's lowered and B's raised" : "A's raised and B's lowered");
+                     " (over all %zu pairs, noisy ones included, each B's time %s by as much as "
+                     "the CPU its run %s against A's, each from its side's typical run, could "
+                     "explain)", no, upper ? "raised" : "lowered",
+                     upper ? "had in excess" : "lacked");
         else
             snprintf(v->why + used, sizeof(v->why) - used,
                      " (over all runs, noisy ones included, each bounded by as much as its "
@@ -388,23 +404,35 @@ void gate_evaluate_ab(struct gate_run *a, struct gate_run *b, size_t n, double c
         a[i].noisy = b[i].noisy = false;
         a[i].why[0] = b[i].why[0] = '\0';
     }
-    /* Each side against its own typical run: the pairs alternate on one
-     * machine, so both sides meet the same neighbours, but a longer job
-     * measures a different share of them than a shorter one. */
+    /* The two runs of a pair against each other, each measured from its
+     * own side's typical run: the pairs alternate on one machine, so both
+     * sides meet the same neighbours, but a longer job measures a different
+     * share of them than a shorter one (A steady at 10% and B at 50% is
+     * like with like), and a drift of the whole machine moves both runs of
+     * a pair alike. A pair is noisy when B's run had more than the
+     * tolerance more or less CPU left than A's, relative to their sides. */
     double ra = 0, rb = 0;
     bool ha = gate_typical_share(a, n, &ra), hb = gate_typical_share(b, n, &rb);
-    gate_mark_noisy(a, n, ha, ra, tolerance);
-    gate_mark_noisy(b, n, hb, rb, tolerance);
     double *va = malloc((n + 1) * sizeof(double)), *vb = malloc((n + 1) * sizeof(double));
     size_t k = 0;
     for (size_t i = 0; i < n; i++) {
-        if (a[i].noisy || b[i].noisy) {
-            char why[200];
-            snprintf(why, sizeof(why), "%s's run: %s", a[i].noisy ? "A" : "B",
-                     a[i].noisy ? a[i].why : b[i].why);
-            snprintf(a[i].why, sizeof(a[i].why), "%s", why);
-            snprintf(b[i].why, sizeof(b[i].why), "%s", why);
+        bool figures = a[i].has_share && b[i].has_share && ha && hb;
+        double rel = figures ? ab_pair_change(&a[i], ra, &b[i], rb) : 0.0;
+        if (figures && fabs(rel) > tolerance) {
+            snprintf(a[i].why, sizeof(a[i].why),
+                     "B's run had %.0f%% %s CPU left than A's, each against its side's typical "
+                     "run (others took %.0f%% during A's, typically %.0f%%; %.0f%% during B's, "
+                     "typically %.0f%%; tolerance %.0f%%)", 100 * fabs(rel),
+                     rel < 0 ? "less" : "more", 100 * a[i].other_share, 100 * ra,
+                     100 * b[i].other_share, 100 * rb, 100 * tolerance);
             a[i].noisy = b[i].noisy = true;
+        } else if (!figures && (a[i].daemon_noisy || b[i].daemon_noisy)) {
+            snprintf(a[i].why, sizeof(a[i].why), "the daemon marked %s's run noisy (no CPU "
+                     "figures to compare)", a[i].daemon_noisy ? "A" : "B");
+            a[i].noisy = b[i].noisy = true;
+        }
+        if (a[i].noisy) {
+            snprintf(b[i].why, sizeof(b[i].why), "%s", a[i].why);
         } else if (va && vb) {
             va[k] = a[i].ms;
             vb[k++] = b[i].ms;

@@ -144,16 +144,17 @@ void gate_evaluate_baseline(struct gate_run *base, size_t nb, struct gate_run *r
                             double confidence, double min_effect, double tolerance,
                             struct gate_verdict *v);
 
-/* ab on n pairs (a[i] and b[i] run side by side, alternately): each side's
- * runs marked against that side's typical share (a short and a long job see
- * different shares of the same neighbours; comparing one side's share with
- * the other's would call every pair of unlike jobs noisy), a pair left out
- * when either run is noisy, then the paired interval over the clean pairs,
- * at least GATE_MIN_PAIRS of them. With fewer, or an interval too wide
- * while pairs were left out, every pair with figures may decide bounded:
- * each A raised and each B lowered by its CPU change against its side's
- * typical share for a regression, the other way for a pass. Fewer than
- * GATE_MIN_PAIRS in all: inconclusive, saying so. */
+/* ab on n pairs (a[i] and b[i] run side by side, alternately): a pair is
+ * noisy when B's run had more than the tolerance more or less CPU left
+ * than A's, each measured from its own side's typical share (a short and a
+ * long job see different shares of the same neighbours, so comparing the
+ * raw shares called every pair of unlike jobs noisy; a drift of the whole
+ * machine moves both runs of a pair alike and leaves it clean). Then the
+ * paired interval over the clean pairs, at least GATE_MIN_PAIRS of them.
+ * With fewer, or an interval too wide while pairs were left out, every
+ * pair with figures may decide bounded: each B lowered (a regression) or
+ * raised (a pass) by as much as that relative CPU change could explain.
+ * Fewer than GATE_MIN_PAIRS in all: inconclusive, saying so. */
 void gate_evaluate_ab(struct gate_run *a, struct gate_run *b, size_t n, double confidence,
                       double min_effect, double tolerance, struct gate_verdict *v);
 

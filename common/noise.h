@@ -14,9 +14,11 @@
  *   - alone (the daemon's flag, history, reports, one job): against an
  *     idle machine, so other processes took more than 10% of the machine's
  *     CPU time;
- *   - compared (the gate, ab): against the typical run of its own side, so
- *     that runs measured under like conditions are compared, whatever those
- *     conditions were.
+ *   - compared (the gate, ab): against what it is compared with, so that
+ *     runs measured under like conditions are compared, whatever those
+ *     conditions were: in the gate a new run against the baseline's
+ *     typical run; in ab B's run of a pair against A's, each from its own
+ *     side's typical run.
  * One threshold, one measure (the relative change of the CPU left), two
  * references, each named where a verdict is printed.
  *
@@ -36,7 +38,7 @@
 #define NOISE_RULE                                                                             \
     "noisy when the CPU other processes left the timed region differs by more than 10% from "  \
     "the CPU left to what it is measured against: alone, an idle machine (other_cpu_share > "   \
-    "0.10); in the client's gate and ab, the typical run of the same side"
+    "0.10); in the client's gate, the baseline's typical run; in ab, the other run of the pair"
 
 /* How much more (> 0) or less (< 0) CPU other processes left than in the
  * reference, relatively: (1 - share) / (1 - reference) - 1. 0.85 against

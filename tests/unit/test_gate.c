@@ -124,8 +124,20 @@ static void test_ab(void)
     a[3].other_share = 0.60;
     gate_evaluate_ab(a, b, 7, 0.95, 0.05, NOISE_TOLERANCE, &v);
     gate_basis_text(&v, true, 7, 7, basis, sizeof(basis));
-    CHECK(a[3].noisy && b[3].noisy && !a[2].noisy && strstr(a[3].why, "A's run"));
+    CHECK(a[3].noisy && b[3].noisy && !a[2].noisy && strstr(a[3].why, "during A's"));
     CHECK(v.outcome == GATE_PASS && v.used_new == 6 && !strcmp(basis, "over 6 pairs (1 noisy pair left out)"));
+
+    /* A drift of the whole machine: in the last four pairs the neighbours
+     * leave both sides half the CPU they left before (A 45% instead of 90%,
+     * B 25% instead of 50%), and both run twice as long. Both runs of each
+     * pair met it alike: no pair is left out. */
+    pairs(a, b, 9, 20.0, 10.0, 0.01, 0.10, 0.50);
+    for (size_t i = 5; i < 9; i++) {
+        a[i].other_share = 0.55, b[i].other_share = 0.75;
+        a[i].ms *= 2.0, b[i].ms *= 2.0;
+    }
+    gate_evaluate_ab(a, b, 9, 0.95, 0.05, NOISE_TOLERANCE, &v);
+    CHECK(v.outcome == GATE_PASS && v.used_new == 9 && !v.bounded);
 
     /* Too few pairs: no verdict on two, whatever they say. */
     pairs(a, b, 2, 20.0, 20.0, 0.0001, 0.05, 0.05);

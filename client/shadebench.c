@@ -18,6 +18,7 @@
 #include "client/suggest.h"
 #include "common/fsutil.h"
 #include "config.h"
+#include "common/noise.h"
 #include "common/result_keys.h"
 
 static void die_usage(const char *fmt, ...) __attribute__((format(printf, 1, 2), noreturn));
@@ -73,12 +74,14 @@ static void usage(FILE *f)
             "                      DIR, which must be empty or new (or hold this same job)\n"
             "  --junit FILE        write JUnit XML\n"
             "  --label KEY=VALUE   add a label to the submitted jobs (repeatable)\n"
-            "  --min-ssim X        a capture fails below this SSIM (needs a reference)\n"
-            "  --max-flip X        a capture fails above this mean FLIP (needs a reference)\n\n"
+            "  --min-ssim X        a capture fails below this SSIM (the job must name a\n"
+            "                      reference and capture frames: checked before it runs)\n"
+            "  --max-flip X        a capture fails above this mean FLIP (likewise)\n\n"
             "Timing gate (submit --wait --baseline) and ab:\n"
             "  --baseline FILE     result.json (or job.json) of earlier runs to compare with\n"
             "  --runs N            clean runs kept on each side (default: the job's repeat, else 5)\n"
-            "  --max-slowdown P    the smallest slowdown that counts, e.g. 5%% or 0.05 (default 5%%)\n"
+            "  --max-slowdown P%%   the smallest slowdown that counts (default 5%%); percentages\n"
+            "                      take their sign: 5 alone is refused\n"
             "  --max-reruns N      at most N extra runs (ab: pairs) for noisy runs, unclear\n"
             "                      verdicts and confirming a regression (default 10)\n"
             "  --fail-inconclusive exit 3 when still too noisy to tell (default: exit 0 with a\n"
@@ -88,8 +91,8 @@ static void usage(FILE *f)
             "  --allow-mismatch    compare with a baseline of another job or device\n"
             "  --series NAME       frame_ms, gpu_ms or cpu_ms (default: frame_ms on software\n"
             "                      renderers such as llvmpipe, gpu_ms on GPUs)\n"
-            "  --confidence P      of the intervals (default 95%%)\n"
-            "  --noise-tolerance P a run left by other processes more than P more or less CPU\n"
+            "  --confidence P%%     of the intervals (default 95%%)\n"
+            "  --noise-tolerance P%% a run left by other processes more than P%% more or less CPU\n"
             "                      than the runs it is compared with is noisy and rerun\n"
             "                      (default 10%%; off: never)\n"
             "  --server-b URL      ab: the second daemon\n\n"
@@ -113,6 +116,8 @@ static void usage(FILE *f)
             "  --resume DIR        complete a fleet folder: resubmit only the missing points\n\n"
             "  --timeout S         give up waiting after S seconds\n"
             "  --quiet             no progress or verdict lines on stderr\n\n"
+            "On a terminal the verdicts are in colour (not with NO_COLOR set) and a bar shows\n"
+            "each job's progress; a pipe gets plain lines, stdout line-buffered.\n\n"
             "Exit status: 0 pass, 1 regression or quality failure (or a failed job),\n"
             "2 usage, server or baseline-mismatch error, 3 a timing verdict too noisy to\n"
             "reach with --fail-inconclusive (and nothing failed).\n");
@@ -144,15 +149,21 @@ static void key_value(const char *arg, const char *flag, json_t *into)
     json_object_set_new(into, key, json_string(eq + 1));
 }
 
-static double fraction(const char *arg, const char *flag, double lo, double hi)
+/* A percentage option: a number with its percent sign ("5%", "2.5%"),
+ * returned as a fraction. A bare number is refused, whatever its size:
+ * "5" could mean 5% or 500% and "0.05" 0.05% or 5%, and a gate that reads
+ * the wrong one passes everything (a slowdown over 500% is ruled out). */
+static double percentage(const char *arg, const char *flag, double lo, double hi)
 {
     char *end;
     double v = strtod(arg, &end);
-    if (*end == '%')
-        v /= 100.0, end++;
-    if (end == arg || *end || !(v >= lo && v <= hi))
-        die_usage("%s must be like 5%% or 0.05 (from %g to %g)", flag, lo, hi);
-    return v;
+    if (end != arg && !*end && isfinite(v))
+        die_usage("%s takes a percentage with its sign: %s%%, not %s (a bare number could be a "
+                  "fraction or a percentage)", flag, v > 0 && v < 1 ? "e.g. 5" : arg, arg);
+    if (end == arg || *end != '%' || end[1] || !(v / 100.0 >= lo && v / 100.0 <= hi))
+        die_usage("%s takes a percentage from %g%% to %g%%, e.g. 5%%; got \"%s\"", flag, 100 * lo,
+                  100 * hi, arg);
+    return v / 100.0;
 }
 
 static int count(const char *arg, const char *flag, int lo, int hi)
@@ -200,8 +211,12 @@ static void die_option(const struct option *longopts, const char *arg, bool miss
 
 int main(int argc, char **argv)
 {
+    /* One line at a time into a pipe too: a CI log that takes stdout and
+     * stderr together must not see a table row split by a log line. */
+    setvbuf(stdout, NULL, _IOLBF, 0);
     struct options o = {.max_slowdown = 0.05, .min_ssim = NAN, .max_flip = NAN,
-                        .confidence = 0.95, .noise_tolerance = 0.10, .max_reruns = 10};
+                        .confidence = 0.95, .noise_tolerance = NOISE_TOLERANCE,
+                        .max_reruns = 10};
     o.labels = json_object();
     o.filters = json_object();
     o.channels = json_array();
@@ -283,11 +298,11 @@ int main(int argc, char **argv)
                 die_usage("--max-flip must be a number from 0 to 1");
             break;
         case O_BASELINE: o.baseline = optarg; break;
-        case O_SLOWDOWN: o.max_slowdown = fraction(optarg, "--max-slowdown", 0, 100); break;
-        case O_CONFIDENCE: o.confidence = fraction(optarg, "--confidence", 0.5, 0.999); break;
+        case O_SLOWDOWN: o.max_slowdown = percentage(optarg, "--max-slowdown", 0, 100); break;
+        case O_CONFIDENCE: o.confidence = percentage(optarg, "--confidence", 0.5, 0.999); break;
         case O_NOISE:
             o.noise_tolerance = !strcmp(optarg, "off") ? INFINITY
-                                : fraction(optarg, "--noise-tolerance", 0, 100);
+                                : percentage(optarg, "--noise-tolerance", 0, 100);
             break;
         case O_RUNS: o.runs = count(optarg, "--runs", 1, 100); break;
         case O_RERUNS: o.max_reruns = count(optarg, "--max-reruns", 0, 1000); break;
@@ -390,6 +405,10 @@ int main(int argc, char **argv)
         die_usage("--filter, --since and --figure belong to history");
     if (raw_json && strcmp(cmd, "info") != 0)
         die_usage("--json belongs to info");
+    if ((!isnan(o.min_ssim) || !isnan(o.max_flip)) && strcmp(cmd, "submit") != 0 &&
+        strcmp(cmd, "fetch") != 0 && (strcmp(cmd, "sweep") != 0 || fl->slurm))
+        die_usage("--min-ssim and --max-flip judge captures against a reference: they belong to "
+                  "submit, fetch and sweep");
 
     /* The token: a file or the environment, so that it need not show in
      * the process list; --token still works, with a warning. */

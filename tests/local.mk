@@ -166,6 +166,9 @@ E2E_TESTS = \
 	tests/e2e/e2e_persist.py \
 	tests/e2e/ssim_skimage.py \
 	tests/e2e/e2e_history.py \
+	tests/e2e/e2e_compare_alpha.py \
+	tests/e2e/e2e_client_verdicts.py \
+	tests/e2e/e2e_demo.py \
 	tests/e2e/e2e_verdicts.py \
 	tests/e2e/e2e_asset_convert.py \
 	tests/e2e/systemd_sandbox.py \
@@ -195,7 +198,8 @@ SANITIZER_TESTS = $(UNIT_TESTS) \
 	tests/e2e/e2e_assets.py \
 	tests/e2e/e2e_persist.py \
 	tests/e2e/e2e_badinput.py \
-	tests/e2e/e2e_asset_convert.py
+	tests/e2e/e2e_asset_convert.py \
+	tests/e2e/e2e_compare_alpha.py
 check-sanitizers:
 if SANITIZERS
 	$(MAKE) $(AM_MAKEFLAGS) check TESTS='$(SANITIZER_TESTS)'

@@ -28,6 +28,7 @@
 #include "common/log.h"
 #include "daemon/jobs/queue.h"
 #include "daemon/harness/runner.h"
+#include "daemon/jobs/fidelity.h"
 #include "daemon/service.h"
 #include "daemon/jobs/sweeps.h"
 #include "daemon/jobs/assets.h"
@@ -55,6 +56,10 @@ struct options {
     char asset_dir[1024];      /* --asset-dir: read-only assets; "": none */
     char asset_converter[1024]; /* --asset-converter; "": shadebench-asset beside the daemon */
     double max_asset_bytes;     /* --max-asset-bytes; 0: ASSETS_MAX_BYTES_DEFAULT */
+    /* The Khronos reference (fidelity jobs; daemon/jobs/fidelity.h):
+     * "": the usual places. */
+    char chromium[1024], reference_viewer[1024];
+    double reference_timeout, reference_memory_mib; /* 0: the defaults */
     bool list_devices;
     bool gl_debug;
 };
@@ -112,6 +117,15 @@ static void usage(FILE *f)
             "  --asset-converter PATH\n"
             "                       the glTF converter (default: shadebench-asset beside this\n"
             "                       executable)\n"
+            "  --chromium PATH      Chromium for the Khronos reference (default: chromium or\n"
+            "                       chromium-browser on PATH)\n"
+            "  --reference-viewer DIR\n"
+            "                       the vendored Khronos glTF Sample Viewer (default:\n"
+            "                       reference-viewer beside this executable, else\n"
+            "                       ../share/shadebench/reference-viewer)\n"
+            "  --reference-timeout S  wall clock the reference may take (default 300)\n"
+            "  --reference-memory MIB resident memory of Chromium and its helpers\n"
+            "                       (default 4096)\n"
             "  --config FILE        settings file (default " DEFAULT_CONFIG " if present)\n"
             "  --port-file FILE     write the bound port to FILE once listening\n"
             "  --list-devices       print the EGL devices and exit\n"
@@ -125,14 +139,16 @@ static void usage(FILE *f)
             "\"key = value\": listen, state-dir, device, queue-size, token, keep-jobs,\n"
             "keep-days, job-timeout, max-job-seconds, stall-seconds, memory-budget,\n"
             "max-connections, max-connections-per-ip, max-asset-bytes, asset-dir,\n"
-            "asset-converter, log-level), the environment\n"
+            "asset-converter, chromium, reference-viewer, reference-timeout,\n"
+            "reference-memory, log-level), the environment\n"
             "(SHADEBENCH_LISTEN, SHADEBENCH_STATE_DIR, SHADEBENCH_DEVICE,\n"
             "SHADEBENCH_QUEUE_SIZE, SHADEBENCH_TOKEN_FILE, SHADEBENCH_KEEP_JOBS,\n"
             "SHADEBENCH_KEEP_DAYS, SHADEBENCH_JOB_TIMEOUT, SHADEBENCH_MAX_JOB_SECONDS,\n"
             "SHADEBENCH_STALL_SECONDS, SHADEBENCH_MEMORY_BUDGET,\n"
             "SHADEBENCH_MAX_CONNECTIONS, SHADEBENCH_MAX_CONNECTIONS_PER_IP,\n"
             "SHADEBENCH_MAX_ASSET_BYTES, SHADEBENCH_ASSET_DIR, SHADEBENCH_ASSET_CONVERTER,\n"
-            "SHADEBENCH_LOG_LEVEL), the flags.\n");
+            "SHADEBENCH_CHROMIUM, SHADEBENCH_REFERENCE_VIEWER, SHADEBENCH_REFERENCE_TIMEOUT,\n"
+            "SHADEBENCH_REFERENCE_MEMORY, SHADEBENCH_LOG_LEVEL), the flags.\n");
 }
 
 static bool parse_int(const char *s, int min, int max, int *out)
@@ -204,6 +220,16 @@ static bool apply_setting(struct options *o, const char *key, const char *value,
         snprintf(o->asset_dir, sizeof(o->asset_dir), "%s", value);
     } else if (strcmp(key, "asset-converter") == 0) {
         snprintf(o->asset_converter, sizeof(o->asset_converter), "%s", value);
+    } else if (strcmp(key, "chromium") == 0) {
+        snprintf(o->chromium, sizeof(o->chromium), "%s", value);
+    } else if (strcmp(key, "reference-viewer") == 0) {
+        snprintf(o->reference_viewer, sizeof(o->reference_viewer), "%s", value);
+    } else if (strcmp(key, "reference-timeout") == 0) {
+        if (!parse_number(value, 1, 86400, &o->reference_timeout))
+            rule = "must be a number of seconds from 1 to 86400";
+    } else if (strcmp(key, "reference-memory") == 0) {
+        if (!parse_number(value, 64, 1e7, &o->reference_memory_mib))
+            rule = "must be a number of MiB from 64 to 10000000";
     } else if (strcmp(key, "log-level") == 0) {
         static const char *const levels[] = {"debug", "info", "warn", "error"};
         rule = "must be debug, info, warn or error";
@@ -265,7 +291,9 @@ static bool load_environment(struct options *o)
                                        "token-file", "keep-jobs", "keep-days", "job-timeout",
                                        "max-job-seconds", "stall-seconds", "memory-budget", "max-connections",
                                        "max-connections-per-ip", "max-asset-bytes", "asset-dir",
-                                       "asset-converter", "log-level", NULL};
+                                       "asset-converter", "chromium", "reference-viewer",
+                                       "reference-timeout", "reference-memory", "log-level",
+                                       NULL};
     for (const char *const *k = keys; *k; k++) {
         char name[64] = "SHADEBENCH_";
         size_t n = strlen(name);
@@ -637,6 +665,7 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
     int rc = 1;
     struct queue *q = NULL;
     struct runner *r = NULL;
+    struct fidelity *fidelity = NULL;
     struct assets *assets = NULL;
     struct sweeps *sweeps = NULL;
     struct http_server *http = NULL;
@@ -660,6 +689,17 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
     }
     if (loaded > 0)
         LOG(LOG_INFO, "%d job(s) in %s/%s", loaded, state_dir, STORE_FILE);
+    /* Before the render thread: it hands fidelity jobs to this worker. */
+    const struct fidelity_config fcfg = {
+        .state_dir = state_dir, .chromium = o->chromium, .viewer_dir = o->reference_viewer,
+        .timeout_s = o->reference_timeout,
+        .memory_bytes = (uint64_t)(o->reference_memory_mib * 1048576.0)};
+    fidelity = fidelity_create(&fcfg, q);
+    if (!fidelity) {
+        LOG(LOG_ERROR, "cannot start the fidelity worker");
+        goto out;
+    }
+    runner_use_fidelity(fidelity);
     r = runner_create(q, o->device, o->gl_debug, err, sizeof(err));
     if (!r) {
         LOG(LOG_ERROR, "%s", err);
@@ -693,7 +733,7 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
         goto out;
     }
     const struct http_context http_ctx = {.catalog = catalog, .queue = q, .sweeps = sweeps,
-                                          .assets = assets,
+                                          .assets = assets, .fidelity = fidelity,
                                           .render_state = render_state,
                                           .device_json = render_device_json, .render = r,
                                           .stall_s = o->stall_s, .memory_budget_bytes = budget,
@@ -746,6 +786,7 @@ out:
         _exit(0);
     }
     runner_destroy(r);
+    fidelity_destroy(fidelity);
     queue_destroy(q);
     store_close(store);
     return rc;
@@ -775,7 +816,7 @@ int main(int argc, char **argv)
                         .keep_jobs = KEEP_JOBS_DEFAULT, .keep_days = KEEP_DAYS_DEFAULT};
     snprintf(o.listen, sizeof(o.listen), "127.0.0.1:8460");
     enum { OPT_LISTEN = 256, OPT_STATE, OPT_DEVICE, OPT_QUEUE, OPT_TOKEN, OPT_KEEP_JOBS,
-           OPT_KEEP_DAYS, OPT_JOB_TIMEOUT, OPT_MAX_JOB, OPT_STALL, OPT_MEMORY, OPT_MAX_CONN, OPT_MAX_CONN_IP, OPT_MAX_ASSET, OPT_ASSET_DIR, OPT_ASSET_CONV, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_ONCE, OPT_OUT, OPT_DEBUG,
+           OPT_KEEP_DAYS, OPT_JOB_TIMEOUT, OPT_MAX_JOB, OPT_STALL, OPT_MEMORY, OPT_MAX_CONN, OPT_MAX_CONN_IP, OPT_MAX_ASSET, OPT_ASSET_DIR, OPT_ASSET_CONV, OPT_CHROMIUM, OPT_REF_VIEWER, OPT_REF_TIMEOUT, OPT_REF_MEMORY, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_ONCE, OPT_OUT, OPT_DEBUG,
            OPT_LOG, OPT_VERSION, OPT_HELP };
     static const struct option longopts[] = {
         {"listen", required_argument, NULL, OPT_LISTEN},
@@ -794,6 +835,10 @@ int main(int argc, char **argv)
         {"max-asset-bytes", required_argument, NULL, OPT_MAX_ASSET},
         {"asset-dir", required_argument, NULL, OPT_ASSET_DIR},
         {"asset-converter", required_argument, NULL, OPT_ASSET_CONV},
+        {"chromium", required_argument, NULL, OPT_CHROMIUM},
+        {"reference-viewer", required_argument, NULL, OPT_REF_VIEWER},
+        {"reference-timeout", required_argument, NULL, OPT_REF_TIMEOUT},
+        {"reference-memory", required_argument, NULL, OPT_REF_MEMORY},
         {"config", required_argument, NULL, OPT_CONFIG},
         {"port-file", required_argument, NULL, OPT_PORT_FILE},
         {"list-devices", no_argument, NULL, OPT_LIST},
@@ -830,6 +875,10 @@ int main(int argc, char **argv)
         case OPT_MAX_ASSET: key = "max-asset-bytes"; break;
         case OPT_ASSET_DIR: key = "asset-dir"; break;
         case OPT_ASSET_CONV: key = "asset-converter"; break;
+        case OPT_CHROMIUM: key = "chromium"; break;
+        case OPT_REF_VIEWER: key = "reference-viewer"; break;
+        case OPT_REF_TIMEOUT: key = "reference-timeout"; break;
+        case OPT_REF_MEMORY: key = "reference-memory"; break;
         case OPT_LOG: key = "log-level"; break;
         case OPT_CONFIG: config = optarg; config_required = true; break;
         case OPT_PORT_FILE: o.port_file = optarg; break;

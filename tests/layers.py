@@ -26,7 +26,7 @@ LAYERS = [
     ["daemon/lighting"],
     ["daemon/effects"],
     ["daemon/gpu"],
-    ["daemon/assets", "daemon/service"],
+    ["daemon/assets", "daemon/reference", "daemon/service"],
     ["daemon/quality", "daemon/scene"],
     ["common"],
 ]

@@ -15,6 +15,7 @@ UNIT_TESTS = \
 	tests/unit/test_stats \
 	tests/unit/test_scene \
 	tests/unit/test_scene_asset \
+	tests/unit/test_scene_view \
 	tests/unit/test_osl \
 	tests/unit/test_metrics \
 	tests/unit/test_flicker \
@@ -38,16 +39,21 @@ UNIT_TESTS = \
 	tests/unit/test_lighting \
 	tests/unit/test_asset \
 	tests/unit/test_uv_charts \
-	tests/unit/test_light_shape
+	tests/unit/test_uv_overlap \
+	tests/unit/test_convert_matrices \
+	tests/unit/test_light_shape \
+	tests/unit/test_fidelity
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
-	tests/fuzz/replay-route tests/fuzz/replay-asset_cache tests/fuzz/replay-asset_convert
+	tests/fuzz/replay-route tests/fuzz/replay-asset_cache tests/fuzz/replay-asset_convert \
+	tests/fuzz/replay-env_convert
 tests_unit_test_job_LDADD = $(CORE_LIBS)
 tests_unit_test_options_LDADD = libsb-common.a $(JANSSON_LIBS) $(LIBS)
 tests_unit_test_store_LDADD = $(CORE_LIBS)
 tests_unit_test_stats_LDADD = $(CORE_LIBS)
 tests_unit_test_scene_LDADD = $(CORE_LIBS)
 tests_unit_test_scene_asset_LDADD = $(CORE_LIBS) -lm
+tests_unit_test_scene_view_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_osl_LDADD = $(CORE_LIBS)
 tests_unit_test_light_shape_LDADD = $(CORE_LIBS)
 tests_unit_test_metrics_LDADD = $(CORE_LIBS)
@@ -56,6 +62,7 @@ tests_unit_test_sweep_LDADD = $(CORE_LIBS)
 tests_unit_test_effects_LDADD = $(CORE_LIBS)
 tests_unit_test_records_LDADD = $(CORE_LIBS)
 tests_unit_test_interference_LDADD = libsb-status.a $(CORE_LIBS)
+tests_unit_test_fidelity_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_png_LDADD = $(CORE_LIBS)
 tests_unit_test_gate_SOURCES = tests/unit/test_gate.c $(CLIENT_PURE)
 tests_unit_test_gate_LDADD = $(CORE_LIBS) -lm
@@ -79,6 +86,12 @@ tests_unit_test_asset_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_uv_charts_SOURCES = tests/unit/test_uv_charts.c daemon/assets/uv_charts.c \
 	daemon/assets/uv_charts.h
 tests_unit_test_uv_charts_LDADD = -lm
+tests_unit_test_uv_overlap_SOURCES = tests/unit/test_uv_overlap.c daemon/assets/uv_overlap.c \
+	daemon/assets/uv_overlap.h
+tests_unit_test_uv_overlap_LDADD = -lm
+tests_unit_test_convert_matrices_SOURCES = tests/unit/test_convert_matrices.c \
+	daemon/assets/convert_matrices.c daemon/assets/convert_internal.h
+tests_unit_test_convert_matrices_LDADD = $(JANSSON_LIBS) -lm
 tests_tools_png_tool_SOURCES = tests/tools/png_tool.c
 tests_tools_png_tool_LDADD = $(CORE_LIBS)
 noinst_HEADERS = tests/unit/check.h tests/unit/catalog_fixture.h tests/fuzz/fuzz.h
@@ -106,6 +119,10 @@ tests_fuzz_replay_asset_convert_SOURCES = tests/fuzz/fuzz_asset_convert.c tests/
 	$(ASSET_CONVERT_SOURCES)
 tests_fuzz_replay_asset_convert_CFLAGS = $(AM_CFLAGS) $(ASSIMP_CFLAGS) $(JPEG_CFLAGS)
 tests_fuzz_replay_asset_convert_LDADD = $(CORE_LIBS) $(ASSIMP_LIBS) $(JPEG_LIBS) -lm
+tests_fuzz_replay_env_convert_SOURCES = tests/fuzz/fuzz_env_convert.c tests/fuzz/replay.c \
+	daemon/assets/env_convert.c
+tests_fuzz_replay_env_convert_CFLAGS = $(AM_CFLAGS) $(STB_CFLAGS)
+tests_fuzz_replay_env_convert_LDADD = $(CORE_LIBS) $(STB_LIBS) -lm
 if HAVE_SECCOMP
 check_PROGRAMS += tests/tools/sandbox-run
 tests_tools_sandbox_run_SOURCES = tests/tools/sandbox_run.c
@@ -117,6 +134,7 @@ endif
 # in this order, so the short ones fill in beside the long ones instead of
 # one long test running alone at the end.
 E2E_TESTS = \
+	tests/e2e/e2e_fidelity.py \
 	tests/e2e/e2e_msaa.py \
 	tests/e2e/e2e_fleet.py \
 	tests/e2e/e2e_report.py \
@@ -129,8 +147,11 @@ E2E_TESTS = \
 	tests/e2e/e2e_techniques.py \
 	tests/e2e/e2e_textured.py \
 	tests/e2e/e2e_asset_render.py \
+	tests/e2e/e2e_asset_import.py \
+	tests/e2e/e2e_scene_view.py \
 	tests/e2e/e2e_load.py \
 	tests/e2e/e2e_osl.py \
+	tests/e2e/e2e_osl_assets.py \
 	tests/e2e/e2e_ab.py \
 	tests/e2e/e2e_sweep.py \
 	tests/e2e/e2e_records.py \
@@ -150,6 +171,9 @@ E2E_TESTS = \
 	tests/e2e/e2e_persist.py \
 	tests/e2e/ssim_skimage.py \
 	tests/e2e/e2e_history.py \
+	tests/e2e/e2e_compare_alpha.py \
+	tests/e2e/e2e_client_verdicts.py \
+	tests/e2e/e2e_demo.py \
 	tests/e2e/e2e_verdicts.py \
 	tests/e2e/e2e_asset_convert.py \
 	tests/e2e/systemd_sandbox.py \
@@ -179,7 +203,8 @@ SANITIZER_TESTS = $(UNIT_TESTS) \
 	tests/e2e/e2e_assets.py \
 	tests/e2e/e2e_persist.py \
 	tests/e2e/e2e_badinput.py \
-	tests/e2e/e2e_asset_convert.py
+	tests/e2e/e2e_asset_convert.py \
+	tests/e2e/e2e_compare_alpha.py
 check-sanitizers:
 if SANITIZERS
 	$(MAKE) $(AM_MAKEFLAGS) check TESTS='$(SANITIZER_TESTS)'

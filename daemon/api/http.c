@@ -318,12 +318,15 @@ static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
     case ROUTE_ASSETS:
     case ROUTE_ASSET:
         return asset_resource(s, c, method, req);
+    case ROUTE_ASSET_FIDELITY:
+        return post_fidelity(s, c, req);
     case ROUTE_JOB:
     case ROUTE_JOB_REPORT:
     case ROUTE_JOB_CHART:
     case ROUTE_JOB_TIMINGS:
     case ROUTE_JOB_IMAGE:
     case ROUTE_JOB_PDIFF:
+    case ROUTE_JOB_FIDELITY:
         return job_resource(s, c, method, req);
     case ROUTE_SWEEP:
     case ROUTE_SWEEP_CHART:

@@ -15,25 +15,32 @@
 #include "daemon/api/links.h"
 #include "daemon/reports/report.h"
 #include "daemon/spec/job_cost.h"
+#include "daemon/jobs/fidelity.h"
 #include "daemon/spec/job_spec.h"
 
-enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *c,
-                           struct request *req)
+/* A parsed job queued: its assets pinned, its 202 with the cost. */
+static enum MHD_Result queue_spec(struct http_server *s, struct MHD_Connection *c,
+                                  struct job_spec *sp)
 {
-    struct job_spec spec;
-    struct job_error err;
-    if (!job_spec_parse_text(req->body ? req->body : "", req->len, s->ctx.catalog,
-                             &spec, &err))
-        return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
+    /* Refused at once where the Khronos reference is not installed: the
+     * job could only fail. */
+    char why[600];
+    if (sp->fidelity.enabled && !fidelity_available(s->ctx.fidelity, why, sizeof(why))) {
+        char msg[256];
+        snprintf(msg, sizeof(msg), "the Khronos reference is not available: %.200s", why);
+        return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "fidelity", msg);
+    }
+    struct job_spec spec = *sp;
     /* scene.asset: pinned to the stored asset's hash here, so that the
      * answer names the rule (400 unknown, 409 a different pinned hash);
      * queue_submit resolves again, for the sweeps' points. */
-    if (spec.scene.asset[0]) {
+    if (job_spec_names_asset(&spec)) {
         struct assets_error ae;
         if (!s->ctx.assets)
-            return respond_error(c, MHD_HTTP_BAD_REQUEST, "scene.asset",
+            return respond_error(c, MHD_HTTP_BAD_REQUEST,
+                                 spec.scene.asset[0] ? "scene.asset" : "look.ibl.environment",
                                  "this daemon has no asset store");
-        if (!assets_resolve(s->ctx.assets, &spec.scene, &ae))
+        if (!assets_resolve_job(s->ctx.assets, &spec, &ae))
             return respond_asset_error(c, &ae);
     }
     char id[24];
@@ -61,6 +68,47 @@ enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *c,
     return respond_json(c, MHD_HTTP_ACCEPTED,
                         json_pack("{s:s, s:s, s:s, s:o}", "id", id, "status", "queued", "url", url,
                                   "cost", job_cost_json(&cost)));
+}
+
+enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *c,
+                           struct request *req)
+{
+    struct job_spec spec;
+    struct job_error err;
+    if (!job_spec_parse_text(req->body ? req->body : "", req->len, s->ctx.catalog,
+                             &spec, &err))
+        return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
+    return queue_spec(s, c, &spec);
+}
+
+/* POST /v1/assets/NAME/fidelity: a fidelity job of the asset (fidelity_spec.h). */
+enum MHD_Result post_fidelity(struct http_server *s, struct MHD_Connection *c,
+                              struct request *req)
+{
+    if (req->too_large)
+        return respond_error(c, MHD_HTTP_CONTENT_TOO_LARGE, "body",
+                             "the request must be at most 65536 bytes");
+    if (req->route.asset_too_long)
+        return respond_error(c, MHD_HTTP_BAD_REQUEST, "name", "an asset name is at most 128 bytes");
+    json_t *body = NULL;
+    if (req->len) {
+        json_error_t je;
+        if (!(body = json_loadb(req->body, req->len, JSON_REJECT_DUPLICATES, &je))) {
+            char msg[256];
+            snprintf(msg, sizeof(msg), "malformed JSON at line %d, column %d: %s", je.line,
+                     je.column, je.text);
+            return respond_error(c, MHD_HTTP_BAD_REQUEST, "body", msg);
+        }
+    }
+    struct job_error err = {0};
+    json_t *job = fidelity_job_body(req->route.asset, body, &err);
+    json_decref(body);
+    struct job_spec spec;
+    bool ok = job && job_spec_parse(job, s->ctx.catalog, &spec, &err);
+    json_decref(job);
+    if (!ok)
+        return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
+    return queue_spec(s, c, &spec);
 }
 
 struct list_args {
@@ -194,6 +242,13 @@ enum MHD_Result job_resource(struct http_server *s, struct MHD_Connection *c,
     }
     if (r->kind == ROUTE_JOB_PDIFF)
         return respond_pdiff_mask(s, c, r, dir);
+    if (r->kind == ROUTE_JOB_FIDELITY) {
+        snprintf(path, sizeof(path), "%s/fidelity/%s", dir, r->chart);
+        if (access(path, R_OK) != 0)
+            return respond_error(c, MHD_HTTP_NOT_FOUND, "file",
+                                 "no such image: see result.fidelity.channels.*.files");
+        return respond_file(c, path, "image/png");
+    }
     job_image_path(dir, r->image, r->frame, path, sizeof(path));
     if (access(path, R_OK) != 0)
         return respond_error(c, MHD_HTTP_NOT_FOUND, "frame",

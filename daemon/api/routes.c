@@ -29,6 +29,9 @@ static const struct {
     [ROUTE_ASSET] = {"/v1/assets/{name}", "GET, HEAD, PUT, DELETE",
                      "use PUT to upload the asset's file as the body, GET or DELETE"},
     [ROUTE_UI] = {"/ui", "GET, HEAD", "use GET"},
+    [ROUTE_JOB_FIDELITY] = {"/v1/jobs/{id}/fidelity/{file}", "GET, HEAD", "use GET"},
+    [ROUTE_ASSET_FIDELITY] = {"/v1/assets/{name}/fidelity", "POST",
+                              "use POST to compare the asset with the Khronos viewer"},
 };
 
 
@@ -118,6 +121,19 @@ static bool job_routes(const char *rest, struct route *r)
         r->kind = ROUTE_JOB_PDIFF;
         return true;
     }
+    if (strncmp(sub, "fidelity/", 9) == 0) {
+        const char *f = sub + 9;
+        size_t n = strlen(f);
+        bool ok = n > 4 && n < sizeof(r->chart) && strcmp(f + n - 4, ".png") == 0;
+        for (size_t i = 0; ok && i < n - 4; i++)
+            ok = (f[i] >= 'a' && f[i] <= 'z') || (f[i] >= '0' && f[i] <= '9') || f[i] == '_' ||
+                 f[i] == '-';
+        if (!ok)
+            return none(r, "file", "fidelity images are NAME.png (see result.fidelity)");
+        memcpy(r->chart, f, n + 1);
+        r->kind = ROUTE_JOB_FIDELITY;
+        return true;
+    }
     for (int k = 0; k < JOB_IMAGE_COUNT; k++) {
         const char *folder = job_image_kind((enum job_image)k)->folder;
         size_t len = strlen(folder);
@@ -194,15 +210,17 @@ bool route_parse(const char *url, struct route *r)
     else if (strncmp(url, "/v1/assets/", 11) == 0) {
         /* One path segment; its rules are the handler's (a 400 naming it). */
         const char *name = url + 11;
-        if (strchr(name, '/'))
-            return none(r, "url", "no such resource: an asset is /v1/assets/NAME");
-        size_t len = strlen(name);
+        const char *slash = strchr(name, '/');
+        if (slash && (strcmp(slash, "/fidelity") != 0 || slash == name))
+            return none(r, "url", "no such resource: an asset is /v1/assets/NAME (and "
+                        "/v1/assets/NAME/fidelity)");
+        size_t len = slash ? (size_t)(slash - name) : strlen(name);
         r->asset_too_long = len > ROUTE_ASSET_NAME_MAX;
         if (r->asset_too_long)
             len = ROUTE_ASSET_NAME_MAX;
         memcpy(r->asset, name, len);
         r->asset[len] = '\0';
-        r->kind = ROUTE_ASSET;
+        r->kind = slash ? ROUTE_ASSET_FIDELITY : ROUTE_ASSET;
     }
     else
         return none(r, "url", "no such route");
@@ -241,9 +259,9 @@ bool route_method_ok(enum route_kind kind, const char *method, const char **allo
     *allow = KINDS[kind].allow;
     *rule = KINDS[kind].rule;
     if (strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0)
-        return true;
+        return kind != ROUTE_ASSET_FIDELITY;
     if (strcmp(method, "POST") == 0)
-        return kind == ROUTE_JOBS || kind == ROUTE_SWEEPS;
+        return kind == ROUTE_JOBS || kind == ROUTE_SWEEPS || kind == ROUTE_ASSET_FIDELITY;
     if (strcmp(method, "DELETE") == 0)
         return kind == ROUTE_JOB || kind == ROUTE_SWEEP || kind == ROUTE_ASSET;
     if (strcmp(method, "PUT") == 0)

@@ -32,6 +32,8 @@ enum route_kind {
     ROUTE_ASSETS, /* /v1/assets */
     ROUTE_ASSET,  /* /v1/assets/{name} */
     ROUTE_UI,     /* / and /ui/...: the dashboard's files, served without the token */
+    ROUTE_ASSET_FIDELITY, /* /v1/assets/{name}/fidelity: a fidelity job */
+    ROUTE_JOB_FIDELITY,   /* /v1/jobs/{id}/fidelity/{file}.png: its images */
     ROUTE_COUNT
 };
 
@@ -41,7 +43,8 @@ enum route_kind {
 struct route {
     enum route_kind kind;
     char id[24];       /* jobs and sweeps: digits and dashes, 1 to 23 of them */
-    char chart[32];    /* charts: the name without its extension */
+    char chart[32];    /* charts: the name without its extension; ROUTE_JOB_FIDELITY:
+                        * the file's name, [a-z0-9_-] and ".png" */
     bool chart_png;    /* charts: .png (else .svg) */
     enum job_image image; /* images: which kind (common/job_files.h) */
     int frame;         /* images and PerceptualDiff masks: 1 to 999999999 */

@@ -108,6 +108,9 @@ enum MHD_Result suspend_request(struct http_server *s, struct MHD_Connection *c,
 /* /v1/jobs (job_handlers.c). */
 enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *c,
                            struct request *req);
+/* POST /v1/assets/NAME/fidelity (job_handlers.c). */
+enum MHD_Result post_fidelity(struct http_server *s, struct MHD_Connection *c,
+                              struct request *req);
 enum MHD_Result job_resource(struct http_server *s, struct MHD_Connection *c,
                              const char *method, struct request *req);
 /* GET /v1/jobs and GET /v1/sweeps: a page, with the link to the next one. */

@@ -11,6 +11,7 @@
 #include "config.h"
 #include "daemon/effects/effect_info.h"
 #include "daemon/quality/metrics.h"
+#include "daemon/jobs/fidelity.h"
 #include "daemon/spec/job_cost.h"
 #include "daemon/spec/job_spec.h"
 #include "daemon/spec/sweep_spec.h"
@@ -96,6 +97,7 @@ json_t *info_json(struct http_server *s)
         json_object_set_new(limits, "assets", assets);
     }
     json_object_set_new(info, "maps", maps_json());
+    json_object_set_new(info, "reference", fidelity_info_json(s->ctx.fidelity));
     return info;
 }
 

@@ -7,7 +7,7 @@
 
 #include "common/clock.h"
 #include "daemon/gpu/glutil.h"
-#include "daemon/harness/deadline.h"
+#include "daemon/jobs/deadline.h"
 #include "daemon/harness/outputs.h"
 #include "daemon/status/render_state.h"
 #include "daemon/status/telemetry.h"

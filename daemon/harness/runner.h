@@ -14,6 +14,11 @@
 
 struct runner;
 
+/* The fidelity worker fidelity jobs are handed to (daemon/reference/
+ * fidelity.h); call before runner_create. */
+struct fidelity;
+void runner_use_fidelity(struct fidelity *f);
+
 /* Starts the render thread and waits until its context is up (or failed). */
 struct runner *runner_create(struct queue *q, int device, bool gl_debug,
                              char *err, size_t errlen);

@@ -116,6 +116,8 @@ static bool has_asset_ext(const char *name, char ext[8])
         return snprintf(ext, 8, "glb"), true;
     if (dot && strcasecmp(dot, ".gltf") == 0)
         return snprintf(ext, 8, "gltf"), true;
+    if (dot && strcasecmp(dot, ".hdr") == 0)
+        return snprintf(ext, 8, "hdr"), true;
     return false;
 }
 

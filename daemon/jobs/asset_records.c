@@ -39,7 +39,7 @@ void asset_release_files_locked(struct assets *a, const char *sha)
     char job[RECORD_ID_LEN];
     if (store_asset_hash_refs(a->store, sha) != 0 || queue_asset_in_use(a->queue, NULL, sha, job))
         return;
-    static const char *const exts[] = {"glb", "gltf", ASSET_CACHE_EXT, "json"};
+    static const char *const exts[] = {"glb", "gltf", "hdr", ASSET_CACHE_EXT, "json"};
     for (size_t i = 0; i < sizeof(exts) / sizeof(exts[0]); i++) {
         char path[PATH_MAX + 80];
         asset_path(a, sha, exts[i], path, sizeof(path));
@@ -65,14 +65,15 @@ static json_t *record_json(const struct store_asset *r, bool full)
      * its numbers as they are. */
     json_t *summary = json_object();
     static const char *const keys[] = {"meshes", "triangles", "vertices", "materials",
-                                       "textures", "images", "lights", "cameras"};
+                                       "textures", "images", "lights", "cameras",
+                                       "kind", "width", "height"};
     for (size_t i = 0; summary && i < sizeof(keys) / sizeof(keys[0]); i++) {
         json_t *v = json_object_get(r->description, keys[i]);
         if (json_is_array(v))
             json_object_set_new(summary, keys[i], json_integer((json_int_t)json_array_size(v)));
         else if (json_is_object(v) && json_is_integer(json_object_get(v, "count")))
             json_object_set(summary, keys[i], json_object_get(v, "count"));
-        else if (json_is_number(v))
+        else if (json_is_number(v) || json_is_string(v))
             json_object_set(summary, keys[i], v);
     }
     json_object_set_new(o, "summary", summary ? summary : json_null());
@@ -231,42 +232,77 @@ out:
     return out;
 }
 
-bool assets_resolve(struct assets *a, struct scene_spec *scene, struct assets_error *e)
+/* name's stored hash into sha (pinned: must equal it), when the asset is
+ * of the kind asked for (an environment map or a glTF scene). field and
+ * sha_field name what the job called it. */
+static bool resolve_name(struct assets *a, const char *name, char sha[65], bool environment,
+                         const char *field, const char *sha_field, struct assets_error *e)
 {
-    if (!scene->asset[0])
-        return true;
     pthread_mutex_lock(&a->lock);
-    bool not_ready = dir_not_ready_locked(a, scene->asset, "scene.asset", e);
+    bool not_ready = dir_not_ready_locked(a, name, field, e);
     pthread_mutex_unlock(&a->lock);
     if (not_ready)
         return false;
     struct store_asset r;
-    enum store_found f = store_asset_get(a->store, scene->asset, &r);
+    enum store_found f = store_asset_get(a->store, name, &r);
     bool ok = false;
+    const char *kind = f == STORE_FOUND
+                           ? json_string_value(json_object_get(r.description, "kind"))
+                           : NULL;
+    bool is_environment = kind && strcmp(kind, "environment") == 0;
     if (f == STORE_MISSING)
-        asset_refuse(e, ASSETS_INVALID, "scene.asset",
-                     "no asset of that name; PUT /v1/assets/%s first",
-                     scene->asset);
+        asset_refuse(e, ASSETS_INVALID, field, "no asset of that name; PUT /v1/assets/%s first",
+                     name);
     else if (f == STORE_ERROR)
-        asset_refuse(e, ASSETS_INTERNAL, "scene.asset",
-                     "cannot read the asset records (see the log)");
-    else if (scene->asset_sha256[0] && strcmp(scene->asset_sha256, r.sha256) != 0)
-        asset_refuse(e, ASSETS_CONFLICT, "scene.asset_sha256",
-                     "the asset %s is now %s, not the pinned %s",
-                     scene->asset, r.sha256, scene->asset_sha256);
+        asset_refuse(e, ASSETS_INTERNAL, field, "cannot read the asset records (see the log)");
+    else if (is_environment != environment)
+        asset_refuse(e, ASSETS_INVALID, field,
+                     environment ? "%s is a glTF scene, not an environment map (an "
+                                   "equirectangular .hdr)"
+                                 : "%s is an environment map: name it in "
+                                   "look.ibl.environment {\"asset\": ...}, not scene.asset",
+                     name);
+    else if (sha[0] && strcmp(sha, r.sha256) != 0)
+        asset_refuse(e, ASSETS_CONFLICT, sha_field, "the asset %s is now %s, not the pinned %s",
+                     name, r.sha256, sha);
     else {
-        memcpy(scene->asset_sha256, r.sha256, sizeof(scene->asset_sha256));
+        memcpy(sha, r.sha256, 65);
         ok = true;
     }
     store_asset_finish(&r);
     return ok;
 }
 
-bool assets_queue_resolver(void *ctx, struct scene_spec *scene, char *field, size_t field_cap,
+bool assets_resolve(struct assets *a, struct scene_spec *scene, struct assets_error *e)
+{
+    if (!scene->asset[0])
+        return true;
+    return resolve_name(a, scene->asset, scene->asset_sha256, false, "scene.asset",
+                        "scene.asset_sha256", e);
+}
+
+bool assets_resolve_job(struct assets *a, struct job_spec *spec, struct assets_error *e)
+{
+    if (!assets_resolve(a, &spec->scene, e))
+        return false;
+    struct ibl_spec *looks[2] = {&spec->look.ibl, &spec->reference_look.ibl};
+    for (int i = 0; i < 2; i++)
+        if (looks[i]->enabled && looks[i]->environment == IBL_ENV_ASSET &&
+            !resolve_name(a, looks[i]->env_asset, looks[i]->env_sha256, true,
+                          i ? "reference_look.ibl.environment.asset"
+                            : "look.ibl.environment.asset",
+                          i ? "reference_look.ibl.environment.asset_sha256"
+                            : "look.ibl.environment.asset_sha256",
+                          e))
+            return false;
+    return true;
+}
+
+bool assets_queue_resolver(void *ctx, struct job_spec *spec, char *field, size_t field_cap,
                            char *message, size_t message_cap)
 {
     struct assets_error e;
-    if (assets_resolve(ctx, scene, &e))
+    if (assets_resolve_job(ctx, spec, &e))
         return true;
     snprintf(field, field_cap, "%s", e.field);
     snprintf(message, message_cap, "%s", e.message);

@@ -178,7 +178,7 @@ uint64_t assets_upload_finish(struct asset_upload *u, struct assets_error *e)
     }
     if (u->bytes == 0) {
         asset_refuse(e, ASSETS_INVALID, "body",
-                     "the body must be the asset's .glb or .gltf file; it is empty");
+                     "the body must be the asset's .glb, .gltf or .hdr file; it is empty");
         goto refuse;
     }
     close(u->fd);
@@ -197,9 +197,12 @@ uint64_t assets_upload_finish(struct asset_upload *u, struct assets_error *e)
     sha256_hex(digest, t->sha256);
     snprintf(t->name, sizeof(t->name), "%s", u->name);
     snprintf(t->path, sizeof(t->path), "%s", u->tmp);
-    /* A binary glTF starts with its magic; anything else is given to the
-     * converter as JSON glTF. */
-    snprintf(t->ext, sizeof(t->ext), "%s", memcmp(u->magic, "glTF", 4) == 0 ? "glb" : "gltf");
+    /* A binary glTF starts with its magic, a Radiance image with "#?"
+     * (an environment map); anything else is given to the converter as
+     * JSON glTF. */
+    snprintf(t->ext, sizeof(t->ext), "%s", memcmp(u->magic, "glTF", 4) == 0 ? "glb"
+                                           : memcmp(u->magic, "#?", 2) == 0 ? "hdr"
+                                                                             : "gltf");
     t->size = u->bytes;
     pthread_mutex_lock(&a->lock);
     if (a->stopping) {

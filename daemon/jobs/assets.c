@@ -3,6 +3,7 @@
 /* The assets (assets.h): the lifetime, the worker thread that converts one
  * task at a time, the start-up sweep of leftover files, /v1/info's limits. */
 #include "daemon/jobs/assets_impl.h"
+#include "daemon/scene/environment.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -220,9 +221,12 @@ double assets_answer_wait_s(const struct assets *a)
 
 json_t *assets_info_json(const struct assets *a)
 {
-    return json_pack("{s:I, s:o, s:I, s:I, s:f, s:i, s:i}", "max_asset_bytes",
+    struct environment_limits env;
+    environment_limits_defaults(&env);
+    return json_pack("{s:I, s:o, s:o, s:I, s:I, s:f, s:i, s:i}", "max_asset_bytes",
                      (json_int_t)a->cfg.max_asset_bytes, "limits",
-                     asset_limits_to_json(&a->cfg.limits), "max_memory_bytes",
+                     asset_limits_to_json(&a->cfg.limits), "environment_limits",
+                     environment_limits_to_json(&env), "max_memory_bytes",
                      (json_int_t)a->cfg.run.memory_bytes, "max_cpu_seconds",
                      (json_int_t)a->cfg.run.cpu_s, "timeout_s", a->cfg.run.wall_s,
                      "conversions_at_once", ASSETS_WORKERS, "max_uploads_at_once",

@@ -137,8 +137,11 @@ bool assets_list(struct assets *a, const char *cursor, int limit, struct assets_
  * refuses (ASSETS_INVALID: an unknown name; ASSETS_CONFLICT: the pinned hash
  * differs, or it is still converting). */
 bool assets_resolve(struct assets *a, struct scene_spec *scene, struct assets_error *e);
+/* Every asset a job names: scene.asset, and look.ibl.environment's (and
+ * reference_look's) {"asset": NAME}, which must be an environment map. */
+bool assets_resolve_job(struct assets *a, struct job_spec *spec, struct assets_error *e);
 /* queue_submit's resolver (queue.h), ctx the assets. */
-bool assets_queue_resolver(void *ctx, struct scene_spec *scene, char *field, size_t field_cap,
+bool assets_queue_resolver(void *ctx, struct job_spec *spec, char *field, size_t field_cap,
                            char *message, size_t message_cap);
 
 #endif

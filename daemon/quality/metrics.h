@@ -115,7 +115,11 @@ bool flip_compute(const struct image *ref, const struct image *test, double ppd,
 
 /* Computes the chosen metrics of test against ref and returns them as JSON
  * (see README, "metrics"); writes the SSIM and FLIP maps where a path is
- * given. NULL on failure with err filled. */
+ * given. NULL on failure with err filled. An image with alpha
+ * (shadebench-compare's translucent PNGs) is judged premultiplied:
+ * PerceptualDiff premultiplies in float before its gamma, as perceptualdiff
+ * does, and SSIM, PSNR and FLIP see each pixel's colour times its alpha,
+ * rounded to 8 bits (the image composited over black). */
 json_t *metrics_compare(const struct image *ref, const struct image *test,
                         const struct metrics_options *o, const char *ssim_map_path,
                         const char *flip_map_path, const struct metrics_stop *stop, char *err,
@@ -124,6 +128,10 @@ json_t *metrics_compare(const struct image *ref, const struct image *test,
 /* The most memory metrics_compare uses on width x height images with the
  * given FLIP pixels per degree, the two images included. */
 double metrics_memory_bytes(int width, int height, double flip_ppd);
+
+/* What translucent images add to metrics_memory_bytes: their alpha planes
+ * and the premultiplied copies SSIM, PSNR and FLIP read. */
+double metrics_alpha_memory_bytes(int width, int height);
 
 /* Each metric's share of metrics_memory_bytes (images excluded). */
 size_t ssim_memory_bytes(int width, int height);

@@ -3,6 +3,7 @@
 #include "daemon/reports/charts.h"
 #include "common/result_keys.h"
 #include "common/axis.h"
+#include "common/timing_series.h"
 #include "daemon/reports/sweep_verdict.h"
 
 #include <cairo-svg.h>
@@ -91,14 +92,7 @@ struct chart {
 
 const char *charts_default_series(const json_t *device)
 {
-    const char *r = json_string_value(json_object_get(device, "gl_renderer"));
-    if (!r)
-        return RK_FRAME_MS;
-    static const char *const software[] = {"llvmpipe", "softpipe", "SwiftShader", NULL};
-    for (const char *const *s = software; *s; s++)
-        if (strstr(r, *s))
-            return RK_FRAME_MS;
-    return RK_GPU_MS;
+    return timing_series_for_renderer(json_string_value(json_object_get(device, "gl_renderer")));
 }
 
 static bool software_device(const json_t *device)

@@ -685,9 +685,9 @@ static json_t *with_interference(const json_t *sweep, report_job_dir_fn job_dir,
         json_t *inter = json_object_get(result, RK_INTERFERENCE);
         if (inter)
             json_object_set_new(row, RK_INTERFERENCE,
-                                json_pack("{s:O, s:O}", "other_cpu_share",
+                                json_pack("{s:O, s:b}", "other_cpu_share",
                                           json_object_get(inter, "other_cpu_share"), "noisy",
-                                          json_object_get(inter, "noisy")));
+                                          noise_interference_noisy(inter)));
         json_decref(result);
     }
     return copy;
@@ -805,8 +805,8 @@ char *report_sweep_html(const json_t *posted, const json_t *device, report_job_d
         json_t *inter = json_object_get(row, RK_INTERFERENCE);
         json_t *share = json_object_get(inter, "other_cpu_share");
         if (json_is_number(share))
-            add(&h, "<td class=\"%s\">%s%.0f%%</td>", json_is_true(json_object_get(inter, "noisy"))
-                ? "noisy" : "", json_is_true(json_object_get(inter, "noisy")) ? "noisy: " : "",
+            add(&h, "<td class=\"%s\">%s%.0f%%</td>", noise_interference_noisy(inter)
+                ? "noisy" : "", noise_interference_noisy(inter) ? "noisy: " : "",
                 100 * json_number_value(share));
         else
             add(&h, "<td>-</td>");
@@ -820,7 +820,8 @@ char *report_sweep_html(const json_t *posted, const json_t *device, report_job_d
             planned - (long long)json_array_size(points) == 1 ? "" : "s", str(sweep, "status"));
     add(&h, "</table><p>Intervals are 95%%; a lower end below zero is shown as 0 (times are "
             "never negative). Others' CPU: the share of the machine's CPU time other processes "
-            "took during the point's timed frames; the daemon's rule: %s.</p><h2>Charts</h2>",
+            "took during the point's timed frames; the noise rule, the same for the daemon, the "
+            "client and reports: %s.</p><h2>Charts</h2>",
         INTERFERENCE_RULE);
     struct chart_options o = {.device = device};
     chart(&h, sweep, "speed_accuracy", true, &o, "speed against accuracy (SSIM)");
@@ -967,7 +968,7 @@ static void runs_table(struct html *h, const json_t *r)
 
 /* What disturbed the run, where people look first: the CPU other processes
  * took during the timed frames and the load, and whether that makes the
- * run noisy by the daemon's rule. */
+ * run noisy by the noise rule (common/noise.h). */
 static void noise_html(struct html *h, const json_t *inter)
 {
     json_t *share = json_object_get(inter, "other_cpu_share");
@@ -979,7 +980,7 @@ static void noise_html(struct html *h, const json_t *inter)
         }
         return;
     }
-    bool noisy = json_is_true(json_object_get(inter, "noisy"));
+    bool noisy = noise_interference_noisy(inter);
     json_t *ls = json_object_get(inter, "loadavg_start"), *le = json_object_get(inter, "loadavg_end");
     add(h, "<p class=\"%s\">%s other processes took <b>%.0f%%</b> of the machine's CPU time "
            "during the timed frames (1-minute load %.2f to %.2f on %lld CPUs)",
@@ -988,8 +989,8 @@ static void noise_html(struct html *h, const json_t *inter)
         json_number_value(json_array_get(le, 0)),
         (long long)json_integer_value(json_object_get(inter, "cpus")));
     add(h, noisy ? "; its times may be inflated by them, so compare them with care (the "
-                   "daemon's rule: %s).</p>"
-                 : " (the daemon's rule: %s).</p>",
+                   "noise rule, the same for the daemon, the client and reports: %s).</p>"
+                 : " (the noise rule, the same for the daemon, the client and reports: %s).</p>",
         INTERFERENCE_RULE);
 }
 

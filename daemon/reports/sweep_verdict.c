@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "common/noise.h"
 #include "common/result_keys.h"
 
 static double num(const json_t *v, double fallback)
@@ -133,7 +134,7 @@ bool sweep_view_init(struct sweep_view *v, const json_t *sweep, const char *seri
         p->judged = json_is_integer(pf);
         p->pdiff_pass = p->judged && json_integer_value(pf) == 0;
         json_t *inter = json_object_get(row, RK_INTERFERENCE);
-        p->noisy = json_is_true(json_object_get(inter, "noisy"));
+        p->noisy = noise_interference_noisy(inter);
         p->other_share = num(json_object_get(inter, "other_cpu_share"), NAN);
         v->not_done += strcmp(p->status, "done") != 0;
     }

@@ -117,6 +117,7 @@ void job_spec_defaults(struct job_spec *out, const struct technique_catalog *tec
     out->repeat_auto = false;
     out->reference[0] = '\0';
     out->reference_supersample = 1;
+    fidelity_spec_defaults(&out->fidelity);
     out->temporal_frames = 0;
     metrics_options_defaults(&out->metrics);
     out->timeout_s = default_timeout_s;
@@ -327,13 +328,21 @@ static bool parse_labels(const json_t *v, struct job_spec *out, struct job_error
     return true;
 }
 
+/* Whether a job body's scene is drawn through the asset path (scene.asset,
+ * or the textured preset), before the scene itself is parsed. */
+static bool asset_scene_body(const json_t *scene)
+{
+    const char *preset = json_string_value(json_object_get(scene, "preset"));
+    return json_object_get(scene, "asset") || (preset && strcmp(preset, "textured") == 0);
+}
+
 bool job_spec_parse(const json_t *body, const struct technique_catalog *techniques,
                     struct job_spec *out, struct job_error *err)
 {
     static const char *const fixed[] = {"technique", "frames", "warmup_frames",
                                         "capture_interval", "scene", "look", "reference",
                                         "reference_look", "metrics", "repeat", "labels",
-                                        "timeout_s", "temporal", "msaa"};
+                                        "timeout_s", "temporal", "msaa", "fidelity"};
     enum { NFIXED = sizeof(fixed) / sizeof(fixed[0]) };
     /* Every technique's options live under its own name; an alias is known
      * when the catalogue has the option it stands for. */
@@ -404,6 +413,12 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
     out->options_given &= ~(1u << out->technique_index);
     if (out->reference_index >= 0)
         out->options_given &= ~(1u << out->reference_index);
+    /* An asset scene is shown display-referred unless the look says
+     * otherwise (docs/scenes.md, "Asset scenes' defaults"): Khronos PBR
+     * Neutral keeps base colours and compresses what would clip. */
+    bool asset_scene = asset_scene_body(json_object_get(body, "scene"));
+    if (asset_scene)
+        out->look.tonemap = LOOK_TONEMAP_PBR_NEUTRAL;
     json_t *look;
     if (!jf_get_object(body, "look", "look", &look, err) ||
         (look && !look_spec_parse(look, "look", &out->look, err)))
@@ -416,6 +431,8 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
         return false;
     if (ref_look) {
         look_spec_defaults(&out->reference_look);
+        if (asset_scene)
+            out->reference_look.tonemap = LOOK_TONEMAP_PBR_NEUTRAL;
         out->reference_look_given = true;
         /* Probes and shadow maps are made once a run, for both: a
          * reference_look takes the look's, or states them the same. */
@@ -467,6 +484,17 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
         (scene && !scene_spec_parse(scene, &out->scene, err)))
         return false;
 
+    if (!fidelity_spec_parse(json_object_get(body, "fidelity"), &out->fidelity, err) ||
+        !fidelity_spec_check_job(&out->fidelity, &out->scene, &out->look, out->reference,
+                                 out->repeat, out->repeat_auto, out->temporal_frames, out->msaa,
+                                 err))
+        return false;
+    if (out->fidelity.enabled && out->capture_interval == 0 &&
+        !json_object_get(body, "capture_interval"))
+        out->capture_interval = out->frames; /* the last frame is compared */
+    if (out->fidelity.enabled && out->capture_interval == 0)
+        return job_error_set(err, "fidelity", "needs capture_interval > 0: the captured frames "
+                             "are compared");
     /* A reference with no word on captures scores the last frame, as a
      * sweep's point does; an explicit 0 asks for no captures at all. */
     if (out->reference[0] && out->capture_interval == 0 && !json_object_get(body, "capture_interval"))
@@ -626,6 +654,8 @@ json_t *job_spec_to_json(const struct job_spec *spec)
         json_object_set_new(out, "metrics", metrics_to_json(&spec->metrics));
     if (spec->reference_look_given)
         json_object_set_new(out, "reference_look", look_spec_to_json(&spec->reference_look));
+    if (spec->fidelity.enabled)
+        json_object_set_new(out, "fidelity", fidelity_spec_to_json(&spec->fidelity));
     json_t *labels = json_object();
     for (int i = 0; i < spec->nlabels; i++)
         json_object_set_new(labels, spec->labels[i].key, json_string(spec->labels[i].value));
@@ -633,3 +663,10 @@ json_t *job_spec_to_json(const struct job_spec *spec)
     return out;
 }
 
+
+bool job_spec_names_asset(const struct job_spec *spec)
+{
+    const struct ibl_spec *a = &spec->look.ibl, *b = &spec->reference_look.ibl;
+    return spec->scene.asset[0] || (a->enabled && a->environment == IBL_ENV_ASSET) ||
+           (b->enabled && b->environment == IBL_ENV_ASSET);
+}

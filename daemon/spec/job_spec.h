@@ -13,6 +13,7 @@
 #include "common/options.h"
 #include "daemon/lighting/look_spec.h"
 #include "daemon/quality/metrics.h"
+#include "daemon/spec/fidelity_spec.h"
 #include "daemon/scene/scene_spec.h"
 #include "daemon/techniques/catalog.h"
 
@@ -77,6 +78,7 @@ struct job_spec {
     double timeout_s;              /* running time allowed, all phases; 0: no limit */
     int msaa;                      /* samples a pixel of the output (1, 2, 4, 8); the
                                     * reference renders at the same count */
+    struct fidelity_spec fidelity; /* compared with the Khronos viewer (fidelity_spec.h) */
 };
 
 /* The timeout_s a job gets when it names none (--job-timeout). Set once at
@@ -124,6 +126,10 @@ const char *job_spec_aliased(const char *path);
 
 /* The job as understood, defaults filled in. New reference. */
 json_t *job_spec_to_json(const struct job_spec *spec);
+
+/* True when the job names a stored asset: scene.asset, or an environment
+ * map as look.ibl.environment (or reference_look's) {"asset": NAME}. */
+bool job_spec_names_asset(const struct job_spec *spec);
 
 /* Number of timed frames that get captured. */
 int job_spec_capture_count(const struct job_spec *spec);

@@ -17,6 +17,8 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "common/noise.h"
+
 /* The aggregate "cpu" line of /proc/stat, in clock ticks summed over all
  * CPUs: total counts every state but guest time (already inside user time),
  * idle counts idle and iowait. Steal time is busy: another guest used the
@@ -57,13 +59,9 @@ struct interference_figures {
     bool noisy;
 };
 
-#define INTERFERENCE_OTHER_SHARE_LIMIT 0.05
-#define INTERFERENCE_LOAD_PER_CPU_LIMIT 2.0
-#define INTERFERENCE_RULE                                                                     \
-    "noisy when other processes took more than 5% of the machine's CPU time during the "     \
-    "timed region (other_cpu_share > 0.05), or when the 1-minute load average at its start " \
-    "was above twice the number of CPUs (loadavg_start[0] > 2 x cpus); the daemon's own "    \
-    "threads count in the load average but never in other_cpu_share"
+/* noisy follows the one noise rule (common/noise.h): other processes took
+ * more than NOISE_TOLERANCE of the machine's CPU during the timed region. */
+#define INTERFERENCE_RULE NOISE_RULE
 
 void interference_compute(const struct interference_sample *start,
                           const struct interference_sample *end, struct interference_figures *f);

@@ -7,7 +7,8 @@
  *
  *   STATE_DIR/assets/SHA256.sbasset   the converter's cache (asset.h), what
  *                                     the render thread reads
- *   STATE_DIR/assets/SHA256.glb       the uploaded file as sent (or .gltf)
+ *   STATE_DIR/assets/SHA256.glb       the uploaded file as sent (or .gltf, or
+ *                                     .hdr for an environment map)
  *
  * Several names may point at one hash; the files go when none does. A job's
  * spec carries scene.asset_sha256 (filled when it is accepted), so the
@@ -34,7 +35,8 @@ bool asset_store_sha256_valid(const char *sha256);
  * fit or the hash is not 64 lowercase hex digits (so that no spec can make
  * the render thread open another path). */
 bool asset_store_cache_path(const char *state_dir, const char *sha256, char *out, size_t cap);
-/* STATE_DIR/assets/SHA256.EXT, ext "glb" or "gltf". */
+/* STATE_DIR/assets/SHA256.EXT, ext "glb", "gltf" or "hdr" (an environment
+ * map: its cache file holds the decoded image, daemon/scene/environment.h). */
 bool asset_store_original_path(const char *state_dir, const char *sha256, const char *ext,
                                char *out, size_t cap);
 /* STATE_DIR/assets. */

@@ -268,6 +268,9 @@ try:
     b.wait("location.hash === '#/asset/cube.glb' && document.body.dataset.ready === location.hash", 120,
            "the uploaded asset's page")
     check(b.eval("document.querySelector('main h1').textContent") == "Asset cube.glb", "the asset's page")
+    reference = d.json("GET", "/v1/info")[1].get("reference", {})
+    check(b.eval("!!document.getElementById('fidelity-form')") == bool(reference.get("available")),
+          "the asset's page offers the Khronos comparison exactly when the daemon has the reference")
     ready(b, d.base + "/#/assets", "the assets")
     check(b.eval("[...document.querySelectorAll('#asset-list tbody tr')].map((r) => r.dataset.name)") == ["cube.glb"],
           "the list shows the upload")

@@ -64,9 +64,40 @@ export async function render(main, name) {
         clear(msg).append(errorBox(err));
       }
     };
+  // Its fidelity against the Khronos glTF Sample Viewer, where the daemon
+  // has the reference (POST /v1/assets/NAME/fidelity: a job).
+  const info = await api.info().catch(() => ({}));
+  const ref = info.reference || {};
+  const fidelity = el('section.fidelity-form', el('h2', 'Fidelity against the Khronos glTF Sample Viewer'));
+  if (ref.available) {
+    const form = el('form.filters#fidelity-form',
+      el('label', 'size ', el('input', { name: 'width', type: 'number', value: 320, min: 16, max: 4096, size: 5 }),
+        ' × ', el('input', { name: 'height', type: 'number', value: 240, min: 16, max: 4096, size: 5 })),
+      el('label', 'channels ', el('select', { name: 'channels' },
+        el('option', { value: 'all' }, 'all'), el('option', { value: 'lit' }, 'the lit image only'))),
+      el('button', { type: 'submit' }, 'Compare'));
+    const note = el('span');
+    form.onsubmit = async (ev) => {
+      ev.preventDefault();
+      const body = { width: Number(form.width.value), height: Number(form.height.value) };
+      if (form.channels.value !== 'all')
+        body.channels = ['lit'];
+      try {
+        const { body: job } = await api.send('POST', `/v1/assets/${encodeURIComponent(name)}/fidelity`, body);
+        location.hash = `#/job/${job.id}`;
+      } catch (err) {
+        clear(note).append(errorBox(err));
+      }
+    };
+    fidelity.append(el('p.muted', `${ref.viewer || 'the viewer'} in headless Chromium draws the asset with the same camera, ` +
+      'lights and look, lit and in its debug channels; the job compares each with shadebench\'s ' +
+      '(its page shows them in the image comparison).'), form, note);
+  } else {
+    fidelity.append(el('p.muted', `This daemon has no reference renderer${ref.missing ? `: ${ref.missing}` : ''}.`));
+  }
   main.append(el('h1', `Asset ${a.name}`),
     el('p', `${num(a.size)} bytes, ${a.format || ''}, SHA-256 `, el('code', a.sha256 || ''), ' ', del, msg),
     el('p', 'Render it: ', el('code', `curl -d '{"technique":"forward","scene":{"asset":"${a.name}"}}' $S/v1/jobs`),
       ' · ', el('a', { href: `#/jobs?technique=&labels=` }, 'jobs')),
-    el('h2', 'What the converter found'), valueTable(a.description || {}));
+    el('h2', 'What the converter found'), valueTable(a.description || {}), fidelity);
 }

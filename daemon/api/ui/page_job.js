@@ -12,7 +12,7 @@ const POLL_MS = 1000;
 // Sections of the result that are not the technique's and have their own place.
 const HARNESS_KEYS = new Set(['frames', 'warmup_frames', 'gpu_ms', 'cpu_ms', 'frame_ms', 'runs', 'repeat',
   'gpu_sections_ms', 'captures', 'heatmap', 'quality', 'interference', 'device', 'technique', 'wall_s',
-  'wall_s_including_captures', 'fps', 'capture_policy', 'timing_method', 'started_unix']);
+  'wall_s_including_captures', 'fps', 'capture_policy', 'timing_method', 'started_unix', 'fidelity']);
 
 export function seriesFor(result) {
   const r = ((result && result.device) || {}).gl_renderer || '';
@@ -150,6 +150,43 @@ async function captureSection(job, cap, heat) {
   return box;
 }
 
+// A fidelity job's comparison with the Khronos glTF Sample Viewer
+// (result.fidelity): each channel's figures, and its two images in the
+// image comparison with the channel's SSIM and FLIP maps.
+async function fidelitySection(job) {
+  const f = job.result.fidelity;
+  const channels = Object.entries(f.channels || {});
+  const box = el('section.fidelity', el('h2', 'Fidelity against the Khronos glTF Sample Viewer'),
+    el('p.muted', `${f.viewer || f.renderer || ''} in ${f.browser || 'Chromium'} (${f.webgl_renderer || 'WebGL'}); ` +
+      `the viewer's image is B, the reference of every figure${f.cache_hit ? '; from the cache' : ''}.`),
+    el('table.list#fidelity-channels',
+      el('thead', el('tr', ['channel', 'SSIM', 'worst window', 'FLIP mean', 'PerceptualDiff', 'PSNR',
+        'pixels off by > 8', '> 32', 'largest difference'].map((h) => el('th', h)))),
+      el('tbody', channels.map(([name, c]) => el('tr', { dataset: { channel: name } }, el('td', name),
+        c.error ? el('td.bad', { colSpan: 8 }, c.error) : [
+          el('td.num', num(c.ssim, 6)), el('td.num', c.ssim_min ? num(c.ssim_min.value, 4) : '–'),
+          el('td.num', num((c.flip || {}).mean, 4)),
+          el('td', c.pdiff ? `${c.pdiff.pass ? 'passes' : 'fails'}, ${c.pdiff.failing_pixels} failing` : '–'),
+          el('td.num', c.psnr ? (c.psnr.overall === null ? '∞' : `${num(c.psnr.overall, 4)} dB`) : '–'),
+          el('td.num', num(c.pixels_over_8)), el('td.num', num(c.pixels_over_32)), el('td.num', num(c.max_difference)),
+        ])))));
+  for (const [name, c] of channels) {
+    if (c.error || !c.files)
+      continue;
+    const url = (file) => `${job.url}/${file}`;
+    const sub = el('section.capture', { dataset: { channel: name } }, el('h3', name));
+    box.append(sub);
+    await new ImageCompare({
+      a: { url: url(c.files.shadebench), label: `shadebench ${job.technique}` },
+      b: { url: url(c.files.khronos), label: 'Khronos viewer' },
+      maps: { ssim: c.files.ssim_map && url(c.files.ssim_map), flip: c.files.flip_map && url(c.files.flip_map) },
+      worst: c.ssim_min && c.ssim_min.x !== undefined ? c.ssim_min : undefined,
+      pdiffCount: c.pdiff ? c.pdiff.failing_pixels : undefined,
+    }).mount(sub);
+  }
+  return box;
+}
+
 export async function render(main, id) {
   let job = await api.json(`/v1/jobs/${id}`);
   const head = el('div.job-head');
@@ -243,6 +280,8 @@ export async function render(main, id) {
       for (const cap of r.captures)
         caps.append(await captureSection(job, cap, heat.get(cap.frame)));
     }
+    if (r.fidelity)
+      body.append(await fidelitySection(job));
     // The technique's own figures, then the rest of the result.
     const own = r[job.technique];
     if (own && typeof own === 'object')

@@ -177,7 +177,8 @@ static void test_technique_sweep(const json_t *llvmpipe)
      * linear 0.99 to 1. */
     json_t *yr = json_object_get(l, "y_range");
     double ylo = json_real_value(json_array_get(yr, 0)), yhi = json_real_value(json_array_get(yr, 1));
-    CHECK(strcmp(json_string_value(json_object_get(l, "y_scale")), "one_minus_log") == 0);
+    const char *scale = json_string_value(json_object_get(l, "y_scale"));
+    CHECK(scale && strcmp(scale, "one_minus_log") == 0);
     CHECK(ylo <= 0.99 && yhi > 0.999995 && yhi < 1.0);
     double spread = (log10(1 - 0.99997) - log10(1 - 0.99998)) / (log10(1 - ylo) - log10(1 - yhi));
     CHECK(spread > 0.04);

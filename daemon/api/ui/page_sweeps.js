@@ -10,6 +10,13 @@ import { clear, el, errorBox, fill, hashQuery, interval, num, pct, statusBadge, 
 
 const POLL_MS = 2000;
 
+// An id is the UTC second of its submission and a serial:
+// 20261121-113512-0003.
+function idTime(id) {
+  const m = /^(\d{4})(\d\d)(\d\d)-(\d\d)(\d\d)(\d\d)/.exec(id || '');
+  return m ? `${m[1]}-${m[2]}-${m[3]}T${m[4]}:${m[5]}:${m[6]}Z` : null;
+}
+
 export async function renderList(main) {
   const q = hashQuery();
   const url = `/v1/sweeps?order=newest&limit=50${q.get('cursor') ? `&cursor=${encodeURIComponent(q.get('cursor'))}` : ''}`;
@@ -19,13 +26,12 @@ export async function renderList(main) {
     el('p.muted', 'Start one with ', el('code', 'curl -d @examples/sweep-async.json $S/v1/sweeps'), ' or ',
       el('code', 'shadebench sweep'), '.'),
     el('table.list#sweep-list',
-      el('thead', el('tr', ['sweep', 'status', 'kind', 'points', 'created', 'varies'].map((h) => el('th', h)))),
+      el('thead', el('tr', ['sweep', 'status', 'kind', 'points', 'submitted'].map((h) => el('th', h)))),
       el('tbody', sweeps.map((s) => el('tr', { dataset: { id: s.id } },
         el('td', el('a', { href: `#/sweep/${s.id}` }, s.id)), el('td', statusBadge(s.status)),
         el('td', s.preset || s.kind || ''),
         el('td', `${(s.progress || {}).points_done ?? ''}/${(s.progress || {}).points_total ?? ''}`),
-        el('td', when(s.created)),
-        el('td', Object.keys(((s.spec || {}).vary) || {}).join(', ')))))));
+        el('td', when(s.created || idTime(s.id))))))));
   if (!sweeps.length)
     main.append(el('p.muted', 'No sweep yet.'));
   if (page.next) {

@@ -88,6 +88,10 @@
  * mesh's index into the material buffer, set by gpu_scene_draw (and the
  * shadow pass) per asset mesh. */
 #define SB_LOC_MATERIAL 5         /* int */
+/* The same, look.debug's programs only: which of the file's vertex
+ * attributes the drawn mesh has (bit 0 TEXCOORD_0, 1 TEXCOORD_1, 2 COLOR_0),
+ * set by gpu_scene_draw where the program reads it. */
+#define SB_LOC_MESH_ATTRIBUTES 6  /* int */
 #define SB_LOC_IBL_FACE 0         /* filters: int, the cube face written */
 #define SB_LOC_IBL_PARAMS 1       /* filters: vec4 (roughness or lod, 1 / size, samples, source size) */
 

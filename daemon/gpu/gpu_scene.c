@@ -64,8 +64,9 @@ static GLuint image_texture(const struct asset_image *im, bool srgb)
     return t;
 }
 
-/* std430 SurfaceMaterial (shaders/common/surface.glsl): 16 floats. */
-enum { MATERIAL_FLOATS = 16 };
+/* std430 SurfaceMaterial (shaders/common/surface.glsl): 16 floats, then
+ * each slot's texture transform as two rows of 4. */
+enum { MATERIAL_FLOATS = 16 + ASSET_TEX_SLOTS * 8 };
 
 static void material_row(const struct asset_material *m, bool normal_maps, float *o)
 {
@@ -73,8 +74,9 @@ static void material_row(const struct asset_material *m, bool normal_maps, float
      * metallic 1, roughness 1), no textures, opaque, one-sided. */
     static const struct asset_material none = {
         .base_color = {1, 1, 1, 1}, .metallic = 1, .roughness = 1, .alpha_cutoff = 0.5f,
-        .tex = {{-1, 0, 0, 0, 0, 0, 1}, {-1, 0, 0, 0, 0, 0, 1}, {-1, 0, 0, 0, 0, 0, 1},
-                {-1, 0, 0, 0, 0, 0, 1}, {-1, 0, 0, 0, 0, 0, 1}}};
+        .tex = {{-1, 0, 0, 0, 0, 0, 1, ASSET_UV_IDENTITY}, {-1, 0, 0, 0, 0, 0, 1, ASSET_UV_IDENTITY},
+                {-1, 0, 0, 0, 0, 0, 1, ASSET_UV_IDENTITY}, {-1, 0, 0, 0, 0, 0, 1, ASSET_UV_IDENTITY},
+                {-1, 0, 0, 0, 0, 0, 1, ASSET_UV_IDENTITY}}};
     if (!m)
         m = &none;
     memcpy(&o[0], m->base_color, 4 * sizeof(float));
@@ -92,6 +94,13 @@ static void material_row(const struct asset_material *m, bool normal_maps, float
         bits[1] |= (m->tex[t].uv_set == 1) << t;
     }
     memcpy(&o[12], bits, sizeof(bits));
+    for (int t = 0; t < ASSET_TEX_SLOTS; t++) {
+        float x[6];
+        asset_uv_transform_matrix(&m->tex[t].transform, x);
+        float *row = &o[16 + 8 * t];
+        row[0] = x[0], row[1] = x[1], row[2] = x[2], row[3] = 0.0f;
+        row[4] = x[3], row[5] = x[4], row[6] = x[5], row[7] = 0.0f;
+    }
 }
 
 static bool materials_init(struct gpu_scene *g, const struct scene *s, char *err, size_t errlen)
@@ -148,6 +157,8 @@ static bool materials_init(struct gpu_scene *g, const struct scene *s, char *err
             continue;
         int mat = a->meshes[am].material;
         mm->material = mat >= 0 ? mat : (int)a->material_count;
+        mm->attributes = (a->meshes[am].has_uv0 ? 1 : 0) | (a->meshes[am].has_texcoord1 ? 2 : 0) |
+                         (a->meshes[am].has_color ? 4 : 0);
         if (mat < 0)
             continue;
         mm->double_sided = a->materials[mat].double_sided;
@@ -200,12 +211,17 @@ bool gpu_scene_init(struct gpu_scene *g, const struct scene *s, char *err, size_
         glEnableVertexAttribArray(3);
         glVertexAttribPointer(3, 4, GL_FLOAT, GL_FALSE, stride,
                               (void *)offsetof(struct mesh_vertex, chart));
+        /* The file's two uv sets in one vec4 (a program that declares a
+         * vec2 there reads TEXCOORD_0). */
         glEnableVertexAttribArray(4);
-        glVertexAttribPointer(4, 2, GL_FLOAT, GL_FALSE, stride,
+        glVertexAttribPointer(4, 4, GL_FLOAT, GL_FALSE, stride,
                               (void *)offsetof(struct mesh_vertex, tex));
         glEnableVertexAttribArray(5);
         glVertexAttribPointer(5, 4, GL_FLOAT, GL_FALSE, stride,
                               (void *)offsetof(struct mesh_vertex, tangent));
+        glEnableVertexAttribArray(6);
+        glVertexAttribPointer(6, 4, GL_FLOAT, GL_FALSE, stride,
+                              (void *)offsetof(struct mesh_vertex, color));
     }
     glBindVertexArray(0);
 
@@ -329,7 +345,8 @@ struct scene_program gpu_scene_program(const struct gpu_scene *g, GLuint prog)
 {
     (void)g;
     struct scene_program p = {prog, glGetUniformLocation(prog, "u_instance_base"),
-                              glGetUniformLocation(prog, "u_material"), false};
+                              glGetUniformLocation(prog, "u_material"), false,
+                              glGetUniformLocation(prog, "u_mesh_attributes")};
     return p;
 }
 
@@ -365,6 +382,8 @@ static void draw_mesh(const struct gpu_scene *g, const struct scene_program *p, 
     bool uncull = false;
     if (g->mesh_material) {
         gpu_scene_bind_material(g, m, p->material);
+        if (p->mesh_attributes >= 0)
+            glUniform1i(p->mesh_attributes, g->mesh_material[m].attributes);
         /* Double-sided: both faces drawn (the shaders flip the normal of
          * back faces); the pass's culling state comes back after. */
         uncull = g->mesh_material[m].double_sided && glIsEnabled(GL_CULL_FACE);

@@ -37,6 +37,7 @@ struct gpu_scene {
     struct gpu_mesh_material {
         int material; /* index into the buffer (the default material last) */
         bool double_sided;
+        int attributes; /* the file's: bit 0 TEXCOORD_0, 1 TEXCOORD_1, 2 COLOR_0 */
         GLuint tex[5], sampler[5];
     } *mesh_material; /* per scene mesh; NULL without an asset */
 };
@@ -65,6 +66,9 @@ struct scene_program {
      * the depth the pre-pass kept, never passes the early tests (which
      * would mark the stencil before the discard). Set by the technique. */
     bool after_prepass;
+    /* SB_LOC_MESH_ATTRIBUTES where the program reads it (look.debug's),
+     * else -1. */
+    GLint mesh_attributes;
 };
 
 /* Looks up prog's per-draw uniform once, so that frames only bind: no

@@ -140,7 +140,7 @@ bool run_setup_passes(struct harness_run *run, const void *options, int64_t time
 {
     const struct technique *tech = run->tech;
     int post_passes = post_spec_pass_names(&run->look->post, NULL, 0);
-    int look_passes = (run->stages.shadows != NULL) + run->stages.sky_on +
+    int look_passes = (run->stages.shadows != NULL) + run->stages.sky_on + run->stages.debug_on +
                       (run->transparent.count > 0);
     run->timer = gpu_timer_create(technique_pass_count(tech) + look_passes + post_passes + 1 +
                                       (run->env.samples > 1),
@@ -371,8 +371,10 @@ static void resolve(const struct harness_run *run)
                    run->env.height);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
-    glUseProgram(g->resolve_progs[run->look->tonemap]);
-    glUniform1f(SB_LOC_EXPOSURE, (float)run->look->exposure);
+    /* look.debug's channels are written as they are: no exposure, no curve. */
+    bool raw = run->look->debug != LOOK_DEBUG_NONE;
+    glUseProgram(g->resolve_progs[raw ? LOOK_TONEMAP_NONE : run->look->tonemap]);
+    glUniform1f(SB_LOC_EXPOSURE, raw ? 1.0f : (float)run->look->exposure);
     glActiveTexture(GL_TEXTURE0 + SB_TEX_HDR);
     glBindTexture(GL_TEXTURE_2D, run->hdr_resolved);
     glBindVertexArray(g->empty_vao);

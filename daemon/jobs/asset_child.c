@@ -221,7 +221,8 @@ bool asset_ensure_cache(struct assets *a, const char *sha, const char *in, json_
     char cache[PATH_MAX + 80], desc[PATH_MAX + 80], tmp[PATH_MAX + 120];
     asset_path(a, sha, ASSET_CACHE_EXT, cache, sizeof(cache));
     asset_path(a, sha, "json", desc, sizeof(desc));
-    if (file_exists(cache) && (*description = json_load_file(desc, 0, NULL)))
+    /* A cache an older shadebench wrote (another layout) is converted anew. */
+    if (asset_file_is_current(cache) && (*description = json_load_file(desc, 0, NULL)))
         return true;
     snprintf(tmp, sizeof(tmp), "%s/convert-%s.%s", a->dir, sha, ASSET_CACHE_EXT);
     unlink(tmp);

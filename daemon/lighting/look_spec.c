@@ -7,6 +7,11 @@
 static const char *const lighting_names[] = {"phong", "blinn_phong", "pbr", NULL};
 static const char *const hdr_names[] = {"rgba32f", "rgba16f", NULL};
 static const char *const tonemap_names[] = {"none", "reinhard", "aces", NULL};
+const char *const look_debug_names[] = {"none",           "shading_normal", "geometric_normal",
+                                        "normal_texture", "tangent",        "bitangent",
+                                        "base_color",     "metallic",       "roughness",
+                                        "occlusion",      "emissive",       "uv0",
+                                        "uv1",            "alpha",          NULL};
 
 static bool parse_post(const json_t *v, const char *field, void *opts, struct job_error *err)
 {
@@ -77,6 +82,10 @@ static const struct opt_field fields[] = {
     {.name = "shadows", .type = OPT_CUSTOM, .hooks = &shadow_hooks,
      .summary = "omni shadow maps for the point lights",
      .offset = offsetof(struct look_spec, shadows)},
+    {.name = "debug", .type = OPT_CHOICE, .def = LOOK_DEBUG_NONE, .choices = look_debug_names,
+     .summary = "a surface channel in place of the lit image, encoded as the Khronos glTF "
+                "Sample Viewer's debug output of that name (no exposure, tone curve or post)",
+     .offset = offsetof(struct look_spec, debug)},
     {0},
 };
 
@@ -88,6 +97,13 @@ static bool check(void *opts, const char *prefix, struct job_error *err)
         char field[64];
         snprintf(field, sizeof(field), "%s.ibl", prefix);
         return job_error_set(err, field, "needs %s.lighting \"pbr\"", prefix);
+    }
+    /* A channel is written as it is: an effect would change it. */
+    if (look->debug != LOOK_DEBUG_NONE && look->post.count > 0) {
+        char field[64];
+        snprintf(field, sizeof(field), "%s.post", prefix);
+        return job_error_set(err, field, "must be empty with %s.debug \"%s\" (a channel is "
+                             "written as it is)", prefix, look_debug_names[look->debug]);
     }
     return true;
 }
@@ -103,4 +119,12 @@ bool look_spec_parse(const json_t *v, const char *field, struct look_spec *look,
     return opt_parse(&table, v, field, look, err);
 }
 
-json_t *look_spec_to_json(const struct look_spec *look) { return opt_to_json(&table, look); }
+json_t *look_spec_to_json(const struct look_spec *look)
+{
+    json_t *out = opt_to_json(&table, look);
+    /* A lit job's look reads as it did before debug channels existed, so
+     * that its records and workload keys stay comparable with older ones. */
+    if (out && look->debug == LOOK_DEBUG_NONE)
+        json_object_del(out, "debug");
+    return out;
+}

@@ -20,6 +20,27 @@ enum look_lighting { LOOK_PHONG, LOOK_BLINN_PHONG, LOOK_PBR };
 enum look_hdr { LOOK_HDR_RGBA32F, LOOK_HDR_RGBA16F };
 /* none: a clamp, no encoding; the curves write 8-bit sRGB. */
 enum look_tonemap { LOOK_TONEMAP_NONE, LOOK_TONEMAP_REINHARD, LOOK_TONEMAP_ACES };
+/* A surface channel drawn in place of the lit image (none: the lit image),
+ * each encoded as the Khronos glTF Sample Viewer writes its debug output
+ * of the same name (docs/api.md, "look.debug"), so that the two compare
+ * pixel for pixel. */
+enum look_debug {
+    LOOK_DEBUG_NONE,
+    LOOK_DEBUG_SHADING_NORMAL,   /* world space, normal map applied: n * 0.5 + 0.5 */
+    LOOK_DEBUG_GEOMETRIC_NORMAL, /* the interpolated vertex normal: n * 0.5 + 0.5 */
+    LOOK_DEBUG_NORMAL_TEXTURE,   /* the normal map's texel, scaled: n * 0.5 + 0.5 */
+    LOOK_DEBUG_TANGENT,          /* world space: t * 0.5 + 0.5 */
+    LOOK_DEBUG_BITANGENT,        /* world space: b * 0.5 + 0.5 */
+    LOOK_DEBUG_BASE_COLOR,       /* factor x texture x COLOR_0, linear to gamma 2.2 */
+    LOOK_DEBUG_METALLIC,         /* grey */
+    LOOK_DEBUG_ROUGHNESS,        /* grey, perceptual (before squaring) */
+    LOOK_DEBUG_OCCLUSION,        /* the occlusion map's red, strength not applied */
+    LOOK_DEBUG_EMISSIVE,         /* factor x strength x texture, linear to gamma 2.2 */
+    LOOK_DEBUG_UV0,              /* TEXCOORD_0 in red and green */
+    LOOK_DEBUG_UV1,              /* TEXCOORD_1 in red and green */
+    LOOK_DEBUG_ALPHA,            /* base colour alpha (1 for opaque materials), grey */
+};
+extern const char *const look_debug_names[]; /* "none", "shading_normal", ... */
 
 struct look_spec {
     int lighting;    /* enum look_lighting */
@@ -29,6 +50,7 @@ struct look_spec {
     struct post_spec post;      /* effects the harness runs on the HDR output, in order */
     struct ibl_spec ibl;        /* image-based lighting (needs lighting pbr) */
     struct shadow_spec shadows; /* omni shadow maps for the point lights */
+    int debug;       /* enum look_debug */
 };
 
 /* A Phong image in 32-bit floats, clamped, without effects, image-based

@@ -32,6 +32,15 @@ void look_defines(const struct look_spec *look, char *out, size_t cap)
     if (look->ibl.enabled && used > 0 && (size_t)used < cap)
         used += snprintf(out + used, cap - (size_t)used,
                          "#define LOOK_IBL 1\n#define IBL_MAX_BLEND %d\n", IBL_MAX_BLEND);
+    if (look->debug != LOOK_DEBUG_NONE && used > 0 && (size_t)used < cap) {
+        char name[48];
+        size_t k = 0;
+        for (const char *p = look_debug_names[look->debug]; *p && k + 1 < sizeof(name); p++)
+            name[k++] = (char)(*p >= 'a' && *p <= 'z' ? *p - 'a' + 'A' : *p);
+        name[k] = '\0';
+        used += snprintf(out + used, cap - (size_t)used, "#define LOOK_DEBUG 1\n#define LOOK_DEBUG_%s 1\n",
+                         name);
+    }
     if (look->shadows.enabled && used > 0 && (size_t)used < cap) {
         const struct shadow_spec *s = &look->shadows;
         glsl_float(bias, sizeof(bias), s->bias);
@@ -54,9 +63,13 @@ bool look_stages_init(struct look_stages *l, const struct look_spec *look,
     l->budget = budget;
     l->look = look;
     l->scene = scene;
+    l->gpu = gpu;
     double t0 = clock_mono_s();
-    l->sky_on = scene->sky;
+    l->debug_on = look->debug != LOOK_DEBUG_NONE;
+    l->sky_on = scene->sky && !l->debug_on;
     if ((l->sky_on || look->ibl.enabled) && !look_sky_init(&l->sky, defines, err, errlen))
+        goto fail;
+    if (l->debug_on && !look_debug_init(&l->debug, gpu, defines, err, errlen))
         goto fail;
     if (look->ibl.enabled) {
         struct look_ibl_env env = {&look->ibl, scene, gpu, frame_block, &l->sky, budget};
@@ -80,6 +93,7 @@ void look_stages_finish(struct look_stages *l)
     look_shadows_destroy(l->shadows);
     look_ibl_destroy(l->ibl);
     look_sky_finish(&l->sky);
+    look_debug_finish(&l->debug);
     memset(l, 0, sizeof(*l));
 }
 
@@ -90,6 +104,8 @@ bool look_stages_add_passes(const struct look_stages *l, struct gpu_passes *pass
     if (l->shadows && (*shadow_pass = gpu_passes_add(passes, "shadows")) < 0)
         return false;
     if (l->sky_on && (*sky_pass = gpu_passes_add(passes, "sky")) < 0)
+        return false;
+    if (l->debug_on && (*sky_pass = gpu_passes_add(passes, "debug")) < 0)
         return false;
     return true;
 }
@@ -108,10 +124,13 @@ bool look_stages_before(struct look_stages *l, const struct gpu_passes *passes, 
 void look_stages_after(struct look_stages *l, const struct gpu_passes *passes, int sky_pass,
                         GLuint output_fbo, int width, int height)
 {
-    if (!l->sky_on || sky_pass < 0)
+    if ((!l->sky_on && !l->debug_on) || sky_pass < 0)
         return;
     gpu_pass_begin(passes, sky_pass, output_fbo, width, height);
-    look_sky_draw(&l->sky);
+    if (l->debug_on)
+        look_debug_draw(&l->debug, l->gpu);
+    else
+        look_sky_draw(&l->sky);
     gpu_pass_end(passes);
 }
 

@@ -5,7 +5,8 @@
  * technique only calls the lighting library: the #defines of the look, the
  * image-based lighting's setup and per-frame binding (ibl.h), the shadow
  * pass before the technique's passes (shadows.h), the sky pass after them
- * (sky.h, for scenes with a sky). Render thread only. */
+ * (sky.h, for scenes with a sky), or look.debug's pass in its place
+ * (debug.h). Render thread only. */
 
 #include <epoxy/gl.h>
 #include <jansson.h>
@@ -16,6 +17,7 @@
 #include "daemon/gpu/caps.h"
 #include "daemon/gpu/gpu_scene.h"
 #include "daemon/gpu/pass.h"
+#include "daemon/look/debug.h"
 #include "daemon/look/ibl.h"
 #include "daemon/look/shadows.h"
 #include "daemon/look/sky.h"
@@ -31,8 +33,11 @@ struct look_stages {
     struct gpu_budget *budget;
     const struct look_spec *look;
     const struct scene *scene;
+    const struct gpu_scene *gpu;
     bool sky_on;
     struct look_sky sky;
+    bool debug_on; /* look.debug: its pass takes the sky's place */
+    struct look_debug_pass debug;
     struct look_ibl *ibl;
     struct look_shadows *shadows;
     double setup_ms; /* everything before the first frame, image-based lighting's captures included */
@@ -50,8 +55,9 @@ bool look_stages_init(struct look_stages *l, const struct look_spec *look,
 void look_stages_finish(struct look_stages *l);
 
 /* The passes the look adds to a frame, appended to passes (after the
- * technique's): "shadows" (run first) and "sky" (run after the technique);
- * -1 where the look has none. False when the passes are full. */
+ * technique's): "shadows" (run first) and "sky" or "debug" (run after the
+ * technique, in sky_pass); -1 where the look has none. False when the
+ * passes are full. */
 bool look_stages_add_passes(const struct look_stages *l, struct gpu_passes *passes,
                              int *shadow_pass, int *sky_pass);
 
@@ -60,7 +66,8 @@ bool look_stages_add_passes(const struct look_stages *l, struct gpu_passes *pass
  * under overflow "fail". `timed`: the frame counts in the figures. */
 bool look_stages_before(struct look_stages *l, const struct gpu_passes *passes, int shadow_pass,
                          int64_t frame, bool timed, char *err, size_t errlen);
-/* After them: the sky pass into the technique's output. Timed. */
+/* After them: the sky pass, or look.debug's, into the technique's output.
+ * Timed. */
 void look_stages_after(struct look_stages *l, const struct gpu_passes *passes, int sky_pass,
                         GLuint output_fbo, int width, int height);
 

@@ -24,6 +24,31 @@ const char *const asset_texture_slot_names[] = {"base_color", "metallic_roughnes
                                                 "occlusion", "emissive"};
 const char *const asset_alpha_mode_names[] = {"opaque", "mask", "blend"};
 const char *const asset_light_type_names[] = {"point", "spot", "directional"};
+const char *const asset_uv1_origin_reasons[] = {
+    "", "the file has no TEXCOORD_1", "the file's TEXCOORD_1 leaves [0, 1]",
+    "the file's TEXCOORD_1 charts overlap"};
+
+bool asset_uv_transform_used(const struct asset_uv_transform *t)
+{
+    return t->offset[0] != 0.0f || t->offset[1] != 0.0f || t->rotation != 0.0f ||
+           t->scale[0] != 1.0f || t->scale[1] != 1.0f;
+}
+
+void asset_uv_transform_matrix(const struct asset_uv_transform *t, float m[6])
+{
+    /* KHR_texture_transform: translation * rotation * scale, the rotation
+     * u' = cos u + sin v, v' = -sin u + cos v as the Khronos sample viewer,
+     * three.js and the extension's example (offset [0, 1], rotation pi/2,
+     * scale 0.5: the lower left quadrant) have it; the GLSL snippet in the
+     * extension's text turns the other way. */
+    double c = cos((double)t->rotation), s = sin((double)t->rotation);
+    m[0] = (float)(c * t->scale[0]);
+    m[1] = (float)(s * t->scale[1]);
+    m[2] = t->offset[0];
+    m[3] = (float)(-s * t->scale[0]);
+    m[4] = (float)(c * t->scale[1]);
+    m[5] = t->offset[1];
+}
 
 void asset_limits_defaults(struct asset_limits *lim)
 {
@@ -107,34 +132,78 @@ json_t *asset_describe(const struct asset *a)
     if (!root || !meshes || !mats || !texs || !cams || !ign || !lights)
         goto oom;
     uint64_t tris = 0, verts = 0, pixels = 0;
-    uint32_t from_file = 0;
+    uint32_t from_file = 0, colored = 0, why[ASSET_UV1_GENERATED_OVERLAP + 1] = {0};
     double waste_weighted = 0;
     for (uint32_t i = 0; i < a->mesh_count; i++) {
         const struct asset_mesh *m = &a->meshes[i];
         tris += m->index_count / 3;
         verts += m->vertex_count;
-        from_file += m->uv1_from_file;
+        from_file += m->uv1_origin == ASSET_UV1_FILE;
+        colored += m->has_color;
+        why[m->uv1_origin <= ASSET_UV1_GENERATED_OVERLAP ? m->uv1_origin : 0]++;
         waste_weighted += (double)m->uv1_waste * (m->index_count / 3);
-        if (json_array_append_new(meshes, json_pack("{so si sI sI ss sf ss}", "name", name_json(m->name),
+        json_t *attrs = json_pack("[s]", "POSITION");
+        json_t *o = json_pack("{so si sI sI ss sf ss}", "name", name_json(m->name),
                 "material", (int)m->material, "vertices", (json_int_t)m->vertex_count,
                 "triangles", (json_int_t)(m->index_count / 3),
-                "uv1", m->uv1_from_file ? "file" : "generated", "uv1_waste", (double)m->uv1_waste,
-                "tangents", m->tangents_from_file ? "file" : "generated")))
+                "uv1", m->uv1_origin == ASSET_UV1_FILE ? "file" : "generated",
+                "uv1_waste", (double)m->uv1_waste,
+                "tangents", m->tangents_from_file ? "file" : "generated");
+        if (!o || !attrs || json_array_append_new(meshes, o)) {
+            json_decref(attrs);
             goto oom;
+        }
+        if (m->uv1_origin != ASSET_UV1_FILE && m->uv1_origin <= ASSET_UV1_GENERATED_OVERLAP)
+            json_object_set_new(o, "uv1_reason", json_string(asset_uv1_origin_reasons[m->uv1_origin]));
+        if (m->has_texcoord1 && m->uv1_origin != ASSET_UV1_GENERATED_OUTSIDE)
+            json_object_set_new(o, "texcoord1_overlap", json_real(m->texcoord1_overlap));
+        if (m->has_uv0)
+            json_array_append_new(attrs, json_string("TEXCOORD_0"));
+        if (m->has_texcoord1)
+            json_array_append_new(attrs, json_string("TEXCOORD_1"));
+        if (m->has_color)
+            json_array_append_new(attrs, json_string("COLOR_0"));
+        json_object_set_new(o, "attributes", attrs);
     }
     for (uint32_t i = 0; i < a->material_count; i++) {
         const struct asset_material *m = &a->materials[i];
         json_t *slots = json_array();
         if (!slots)
             goto oom;
-        for (int s = 0; s < ASSET_TEX_SLOTS; s++)
-            if (m->tex[s].image >= 0)
-                json_array_append_new(slots, json_string(asset_texture_slot_names[s]));
-        json_t *o = json_pack("{so ss sb so}", "name", name_json(m->name),
-                              "alpha_mode", asset_alpha_mode_names[m->alpha_mode],
-                              "double_sided", m->double_sided, "textures", slots);
-        if (!o || json_array_append_new(mats, o))
+        json_t *sets = json_object(), *xforms = json_object();
+        if (!sets || !xforms) {
+            json_decref(slots);
+            json_decref(sets);
+            json_decref(xforms);
             goto oom;
+        }
+        for (int s = 0; s < ASSET_TEX_SLOTS; s++) {
+            const struct asset_texture_ref *t = &m->tex[s];
+            if (t->image < 0)
+                continue;
+            json_array_append_new(slots, json_string(asset_texture_slot_names[s]));
+            json_object_set_new(sets, asset_texture_slot_names[s], json_integer(t->uv_set));
+            if (asset_uv_transform_used(&t->transform))
+                json_object_set_new(xforms, asset_texture_slot_names[s],
+                                    json_pack("{s[ff] sf s[ff]}", "offset",
+                                              (double)t->transform.offset[0],
+                                              (double)t->transform.offset[1], "rotation",
+                                              (double)t->transform.rotation, "scale",
+                                              (double)t->transform.scale[0],
+                                              (double)t->transform.scale[1]));
+        }
+        json_t *o = json_pack("{so ss sb so so}", "name", name_json(m->name),
+                              "alpha_mode", asset_alpha_mode_names[m->alpha_mode],
+                              "double_sided", m->double_sided, "textures", slots,
+                              "texcoord", sets);
+        if (!o || json_array_append_new(mats, o)) {
+            json_decref(xforms);
+            goto oom;
+        }
+        if (json_object_size(xforms))
+            json_object_set_new(o, "texture_transforms", xforms);
+        else
+            json_decref(xforms);
         if (m->alpha_mode == ASSET_ALPHA_MASK)
             json_object_set_new(o, "alpha_cutoff", json_real(m->alpha_cutoff));
     }
@@ -163,8 +232,12 @@ json_t *asset_describe(const struct asset *a)
                          : from_file == a->mesh_count ? "file"
                          : from_file == 0 ? "generated" : "mixed";
     json_t *bounds = json_pack("{so so}", "min", vec3(a->box_min), "max", vec3(a->box_max));
-    json_t *uv1 = json_pack("{ss si si sf}", "origin", origin, "from_file", (int)from_file,
-                            "generated", (int)(a->mesh_count - from_file), "waste", waste);
+    json_t *uv1 = json_pack("{ss si si sf s{si si si}}", "origin", origin, "from_file",
+                            (int)from_file, "generated", (int)(a->mesh_count - from_file),
+                            "waste", waste, "generated_because", "no_texcoord1",
+                            (int)why[ASSET_UV1_GENERATED_NO_SET], "texcoord1_outside",
+                            (int)why[ASSET_UV1_GENERATED_OUTSIDE], "texcoord1_overlap",
+                            (int)why[ASSET_UV1_GENERATED_OVERLAP]);
     if (!bounds || !uv1)
         goto oom;
     if (json_object_set_new(root, "meshes", json_integer(a->mesh_count)) ||
@@ -178,6 +251,7 @@ json_t *asset_describe(const struct asset *a)
         json_object_set_new(root, "cameras", cams) ||
         json_object_set_new(root, "bounds", bounds) ||
         json_object_set_new(root, "uv1", uv1) ||
+        json_object_set_new(root, "vertex_colors", json_integer(colored)) ||
         json_object_set_new(root, "ignored", ign))
         goto oom_after;
     return root;
@@ -196,37 +270,43 @@ oom_after:
 /* ---- the cache file ----
  *
  * Little-endian throughout (the reader refuses to run on a big-endian
- * host rather than byte-swap). Layout, version 1:
+ * host rather than byte-swap). Layout, version 2 (1 had no TEXCOORD_1,
+ * COLOR_0 or texture transforms: a version 1 file is refused, and the
+ * daemon converts the upload again, docs/assets.md):
  *   header   "SBASSET\0", u32 version, u32 header bytes (HEADER_SIZE),
  *            u32 counts: meshes, materials, images, lights, cameras, ignored,
  *            f32 box_min[3], box_max[3]
  *   ignored  IGNORED_SIZE bytes each, NUL-terminated
- *   materials, lights, cameras: fixed-size records (MATERIAL_SIZE...)
+ *   materials, lights, cameras: fixed-size records (MATERIAL_SIZE...); a
+ *            material's texture slot: i32 image, i32 uv set, u32 wrap s and t,
+ *            min and mag filter, f32 scale, f32 offset[2], rotation, scale[2]
  *   images   name[64], u32 width, u32 height, width*height*4 bytes
  *   meshes   name[64], i32 material, u32 vertex_count, u32 index_count,
- *            u32 flags (1 uv1 from file, 2 tangents from file),
- *            f32 box_min[3], box_max[3], f32 uv1_waste,
- *            vertex_count * 14 f32, index_count * u32
+ *            u32 flags (1 tangents from file, 2 TEXCOORD_0, 4 TEXCOORD_1,
+ *            8 COLOR_0), u32 uv1 origin (enum asset_uv1_origin),
+ *            f32 box_min[3], box_max[3], f32 uv1_waste, f32 texcoord1_overlap,
+ *            vertex_count * 20 f32 (struct asset_vertex), index_count * u32
  *   trailer  "SBEND\0\0\0" (a file cut at a record boundary is still refused)
  * Strings are fixed-size and must hold their NUL. */
 
 #define MAGIC "SBASSET"
 #define TRAILER "SBEND\0\0"
 enum {
-    VERSION = 1,
+    VERSION = 2,
     HEADER_SIZE = 8 + 4 + 4 + 6 * 4 + 6 * 4,
     IGNORED_SIZE = 128,
-    TEXREF_SIZE = 7 * 4,
+    TEXREF_SIZE = 12 * 4,
     MATERIAL_SIZE = ASSET_NAME_MAX + 4 * 4 + 2 * 4 + 3 * 4 + 4 + 4 + 4 + ASSET_TEX_SLOTS * TEXREF_SIZE,
     LIGHT_SIZE = ASSET_NAME_MAX + 4 + 3 * 4 + 4 * 4 + 6 * 4,
     CAMERA_SIZE = ASSET_NAME_MAX + 4 + 4 * 4 + 9 * 4,
     IMAGE_HEAD_SIZE = ASSET_NAME_MAX + 8,
-    MESH_HEAD_SIZE = ASSET_NAME_MAX + 4 * 4 + 6 * 4 + 4,
-    VERTEX_FLOATS = 14,
+    MESH_HEAD_SIZE = ASSET_NAME_MAX + 5 * 4 + 6 * 4 + 2 * 4,
+    VERTEX_FLOATS = 20,
     VERTEX_SIZE = VERTEX_FLOATS * 4,
     TRAILER_SIZE = 8,
 };
-_Static_assert(sizeof(struct asset_vertex) == VERTEX_SIZE, "asset_vertex is 14 packed floats");
+_Static_assert(sizeof(struct asset_vertex) == VERTEX_SIZE, "asset_vertex is 20 packed floats");
+enum { MESH_FLAGS_ALL = 15 };
 
 static bool host_is_little_endian(void)
 {
@@ -307,6 +387,9 @@ static void write_body(struct writer *w, const struct asset *a)
             w_u32(w, t->min_filter);
             w_u32(w, t->mag_filter);
             w_f32(w, t->scale);
+            w_fs(w, t->transform.offset, 2);
+            w_f32(w, t->transform.rotation);
+            w_fs(w, t->transform.scale, 2);
         }
     }
     for (uint32_t i = 0; i < a->light_count; i++) {
@@ -346,10 +429,13 @@ static void write_body(struct writer *w, const struct asset *a)
         w_i32(w, m->material);
         w_u32(w, m->vertex_count);
         w_u32(w, m->index_count);
-        w_u32(w, (m->uv1_from_file ? 1u : 0u) | (m->tangents_from_file ? 2u : 0u));
+        w_u32(w, (m->tangents_from_file ? 1u : 0u) | (m->has_uv0 ? 2u : 0u) |
+                     (m->has_texcoord1 ? 4u : 0u) | (m->has_color ? 8u : 0u));
+        w_u32(w, (uint32_t)m->uv1_origin);
         w_fs(w, m->box_min, 3);
         w_fs(w, m->box_max, 3);
         w_f32(w, m->uv1_waste);
+        w_f32(w, m->texcoord1_overlap);
         /* Little-endian host (checked): the arrays go out as they are. */
         w_bytes(w, m->vertices, (size_t)m->vertex_count * VERTEX_SIZE);
         w_bytes(w, m->indices, (size_t)m->index_count * 4);
@@ -530,7 +616,8 @@ bool asset_file_parse(struct asset *out, const void *data, size_t len,
     }
     uint32_t version = r_u32(&r, "version");
     if (!r.failed && version != VERSION) {
-        r_fail(&r, "version %u, this reader knows %d", version, VERSION);
+        r_fail(&r, "version %u, this reader knows %d (a cache from another shadebench: upload the "
+               "asset again to convert it anew)", version, VERSION);
         goto fail;
     }
     uint32_t hsize = r_u32(&r, "header size");
@@ -633,6 +720,9 @@ bool asset_file_parse(struct asset *out, const void *data, size_t len,
             t->min_filter = r_u32(&r, what);
             t->mag_filter = r_u32(&r, what);
             t->scale = r_f32(&r, what);
+            r_fs(&r, t->transform.offset, 2, what);
+            t->transform.rotation = r_f32(&r, what);
+            r_fs(&r, t->transform.scale, 2, what);
             if (r.failed)
                 break;
             if (t->image < -1 || (t->image >= 0 && (uint32_t)t->image >= nimg))
@@ -738,18 +828,25 @@ bool asset_file_parse(struct asset *out, const void *data, size_t len,
         snprintf(what, sizeof(what), "meshes[%u]", i);
         r_str(&r, m->name, ASSET_NAME_MAX, what);
         int32_t mat = (int32_t)r_u32(&r, what);
-        uint32_t nv = r_u32(&r, what), ni = r_u32(&r, what), flags = r_u32(&r, what);
+        uint32_t nv = r_u32(&r, what), ni = r_u32(&r, what), flags = r_u32(&r, what),
+                 origin = r_u32(&r, what);
         r_fs(&r, m->box_min, 3, what);
         r_fs(&r, m->box_max, 3, what);
         m->uv1_waste = r_f32(&r, what);
+        m->texcoord1_overlap = r_f32(&r, what);
         if (r.failed)
             goto fail;
         if (mat < -1 || (mat >= 0 && (uint32_t)mat >= nmat)) {
             r_fail(&r, "meshes[%u]: material %d out of range (%u materials)", i, mat, nmat);
             goto fail;
         }
-        if (flags > 3 || !in_unit(m->uv1_waste)) {
-            r_fail(&r, "meshes[%u]: flags %u or uv1 waste out of range", i, flags);
+        if (flags > MESH_FLAGS_ALL || !in_unit(m->uv1_waste) || !in_unit(m->texcoord1_overlap)) {
+            r_fail(&r, "meshes[%u]: flags %u, uv1 waste or overlap out of range", i, flags);
+            goto fail;
+        }
+        if (origin > ASSET_UV1_GENERATED_OVERLAP || ((origin == ASSET_UV1_FILE) && !(flags & 4))) {
+            r_fail(&r, "meshes[%u]: uv1 origin %u out of range (or from a TEXCOORD_1 it lacks)", i,
+                   origin);
             goto fail;
         }
         if (nv == 0 || ni == 0 || ni % 3) {
@@ -792,8 +889,11 @@ bool asset_file_parse(struct asset *out, const void *data, size_t len,
         m->material = mat;
         m->vertex_count = nv;
         m->index_count = ni;
-        m->uv1_from_file = flags & 1;
-        m->tangents_from_file = flags & 2;
+        m->uv1_origin = (enum asset_uv1_origin)origin;
+        m->tangents_from_file = flags & 1;
+        m->has_uv0 = flags & 2;
+        m->has_texcoord1 = flags & 4;
+        m->has_color = flags & 8;
         for (uint32_t k = 0; k < ni; k++)
             if (m->indices[k] >= nv) {
                 r_fail(&r, "meshes[%u]: index %u is %u, not below the %u vertices", i, k,
@@ -831,6 +931,18 @@ fail:
         r_fail(&r, "malformed");
     asset_finish(out);
     return false;
+}
+
+bool asset_file_is_current(const char *path)
+{
+    uint8_t head[12];
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0)
+        return false;
+    bool ok = read(fd, head, sizeof(head)) == (ssize_t)sizeof(head) && memcmp(head, MAGIC, 8) == 0 &&
+              (head[8] | head[9] << 8 | head[10] << 16 | (uint32_t)head[11] << 24) == VERSION;
+    close(fd);
+    return ok;
 }
 
 bool asset_file_read(struct asset *out, const char *path, const struct asset_limits *lim,

@@ -17,9 +17,15 @@
  *    world space by the node's matrix (normals by its inverse transpose,
  *    tangents by the matrix; handedness kept in tangent w): an asset mesh is
  *    one object drawn once, at the origin, scale 1;
- *  - uv0 the material's texture coordinates (TEXCOORD_0), uv1 a unique
- *    parametrisation in [0, 1] for object-space shading: the file's
- *    TEXCOORD_1 when it has one, else charts the converter packed;
+ *  - the file's texture coordinate sets as it gives them, uv0 (TEXCOORD_0)
+ *    and texcoord1 (TEXCOORD_1), each texture slot naming the set it reads
+ *    (its texCoord, KHR_texture_transform's override applied) and its
+ *    KHR_texture_transform; apart from them uv1, a unique parametrisation
+ *    in [0, 1] for object-space shading that no material reads: the file's
+ *    TEXCOORD_1 where its charts stay inside [0, 1] and do not overlap,
+ *    else charts the converter packed (uv1_origin says which, and why);
+ *  - COLOR_0 as linear RGBA (1 where the file has none), multiplying the
+ *    base colour;
  *  - images decoded to 8-bit RGBA, the colour space chosen by the slot that
  *    samples them (base colour and emissive sRGB, the rest linear);
  *  - KHR_lights_punctual lights and the cameras in world space.
@@ -48,21 +54,39 @@ extern const char *const asset_light_type_names[];   /* "point", "spot", "direct
 enum { ASSET_NAME_MAX = 64 };
 
 struct asset_vertex {
-    float pos[3];     /* world space */
-    float normal[3];  /* world space, unit */
-    float tangent[4]; /* world space xyz, handedness w (+-1) */
-    float uv0[2];     /* TEXCOORD_0: the material's */
-    float uv1[2];     /* the unique parametrisation, in [0, 1] */
+    float pos[3];       /* world space */
+    float normal[3];    /* world space, unit */
+    float tangent[4];   /* world space xyz, handedness w (+-1) */
+    float uv0[2];       /* TEXCOORD_0 as the file gives it (0 where absent) */
+    float uv1[2];       /* the unique parametrisation, in [0, 1]: object-space shading's */
+    float texcoord1[2]; /* TEXCOORD_1 as the file gives it (0 where absent) */
+    float color[4];     /* COLOR_0, linear RGBA (1 where absent) */
 };
+
+/* KHR_texture_transform: uv' = T(offset) R(rotation) S(scale) uv, the
+ * identity where a texture has none. */
+struct asset_uv_transform {
+    float offset[2];
+    float rotation; /* radians, counter-clockwise in uv */
+    float scale[2];
+};
+#define ASSET_UV_IDENTITY {{0.0f, 0.0f}, 0.0f, {1.0f, 1.0f}} /* an initialiser */
 
 /* glTF sampler values (GL enums): wrap 33071 clamp, 33648 mirrored, 10497
  * repeat; filters 9728 nearest, 9729 linear, 9984..9987 mipmap ones. */
 struct asset_texture_ref {
     int32_t image;   /* index into images, -1 when the slot has no texture */
-    int32_t uv_set;  /* 0 or 1: which vertex uv the slot reads */
+    int32_t uv_set;  /* 0 or 1: the file's set the slot reads (uv0 or texcoord1) */
     uint32_t wrap_s, wrap_t, min_filter, mag_filter;
     float scale;     /* normal: normalTexture.scale; occlusion: strength; else 1 */
+    struct asset_uv_transform transform;
 };
+
+/* True where t is not the identity. */
+bool asset_uv_transform_used(const struct asset_uv_transform *t);
+/* The transform as the 2x3 matrix uv' = (m[0] u + m[1] v + m[2],
+ * m[3] u + m[4] v + m[5]), as KHR_texture_transform composes it. */
+void asset_uv_transform_matrix(const struct asset_uv_transform *t, float m[6]);
 
 struct asset_material {
     char name[ASSET_NAME_MAX];
@@ -81,19 +105,38 @@ struct asset_image {
     uint8_t *rgba; /* width * height * 4 bytes, rows top to bottom as stored in the file */
 };
 
+/* Where a mesh's uv1 comes from: the file's TEXCOORD_1, or charts the
+ * converter generated because the file has no TEXCOORD_1, or its
+ * TEXCOORD_1 leaves [0, 1], or its charts overlap (two triangles on the
+ * same texels: object-space shading would light both with one texel). */
+enum asset_uv1_origin {
+    ASSET_UV1_FILE,
+    ASSET_UV1_GENERATED_NO_SET,
+    ASSET_UV1_GENERATED_OUTSIDE,
+    ASSET_UV1_GENERATED_OVERLAP,
+};
+extern const char *const asset_uv1_origin_reasons[]; /* a phrase each, "" for the file's */
+
 struct asset_mesh {
     char name[ASSET_NAME_MAX];
     int32_t material; /* index into materials; -1: glTF's default material */
     uint32_t vertex_count, index_count;
     struct asset_vertex *vertices;
     uint32_t *indices; /* triangles; every index < vertex_count */
-    bool uv1_from_file;      /* else the converter's charts */
-    bool tangents_from_file; /* else generated (assimp's CalcTangentSpace from uv0, or any
-                              * unit tangent perpendicular to the normal where there is no uv0) */
+    enum asset_uv1_origin uv1_origin;
+    bool tangents_from_file; /* else generated (assimp's CalcTangentSpace from uv0, the
+                              * converter's from TEXCOORD_1 where the normal texture reads
+                              * set 1, or any unit tangent perpendicular to the normal where
+                              * there is no uv set) */
+    bool has_uv0, has_texcoord1, has_color; /* the file gives TEXCOORD_0, TEXCOORD_1, COLOR_0 */
     float box_min[3], box_max[3];
     /* uv1's share of [0, 1]^2 that no triangle covers (gutters, chart
      * packing): the texels object-space shading allocates and never uses. */
     float uv1_waste;
+    /* The file's TEXCOORD_1, where it has one inside [0, 1]: the share of
+     * the texels its triangles cover that more than one covers (0 where it
+     * was not measured). */
+    float texcoord1_overlap;
 };
 
 struct asset_light {
@@ -151,6 +194,9 @@ bool asset_file_write(const struct asset *a, const char *path, char *err, size_t
 /* Reads a cache file, checking it against lim; out is finished on failure. */
 bool asset_file_read(struct asset *out, const char *path, const struct asset_limits *lim,
                      char *err, size_t errlen);
+/* False when path is missing or was written in another layout than this
+ * reader's (an older shadebench's cache: its upload is converted again). */
+bool asset_file_is_current(const char *path);
 /* The same from memory (the fuzz target's entry). */
 bool asset_file_parse(struct asset *out, const void *data, size_t len,
                       const struct asset_limits *lim, char *err, size_t errlen);

@@ -74,6 +74,8 @@ static bool quad(struct builder *b, const float o[3], const float eu[3], const f
         v->uv0[1] = uv0[3] + t * (uv0[1] - uv0[3]); /* up the surface is up the image */
         v->uv1[0] = chart[0] + s * (chart[2] - chart[0]);
         v->uv1[1] = chart[1] + t * (chart[3] - chart[1]);
+        v->texcoord1[0] = v->uv1[0], v->texcoord1[1] = v->uv1[1];
+        v->color[0] = v->color[1] = v->color[2] = v->color[3] = 1.0f;
     }
     /* Counter-clockwise seen from n. */
     bool ccw = (eu[1] * ev[2] - eu[2] * ev[1]) * n[0] + (eu[2] * ev[0] - eu[0] * ev[2]) * n[1] +
@@ -134,8 +136,9 @@ static bool sphere(struct builder *b, const float c[3], float r, int seg)
             }
             vx->tangent[0] = (float)-sin(phi), vx->tangent[1] = 0.0f;
             vx->tangent[2] = (float)-cos(phi), vx->tangent[3] = 1.0f;
-            vx->uv0[0] = vx->uv1[0] = (float)u;
-            vx->uv0[1] = vx->uv1[1] = (float)v;
+            vx->uv0[0] = vx->uv1[0] = vx->texcoord1[0] = (float)u;
+            vx->uv0[1] = vx->uv1[1] = vx->texcoord1[1] = (float)v;
+            vx->color[0] = vx->color[1] = vx->color[2] = vx->color[3] = 1.0f;
         }
     for (int j = 0; j < rings; j++)
         for (int i = 0; i < seg; i++) {
@@ -151,7 +154,9 @@ static void finish_mesh(struct asset_mesh *m, const char *name, int material)
 {
     snprintf(m->name, sizeof(m->name), "%s", name);
     m->material = material;
-    m->uv1_from_file = true;
+    /* As a file with TEXCOORD_0 and a TEXCOORD_1 that is its uv1. */
+    m->uv1_origin = ASSET_UV1_FILE;
+    m->has_uv0 = m->has_texcoord1 = true;
     m->tangents_from_file = true;
     for (int k = 0; k < 3; k++) {
         m->box_min[k] = INFINITY;
@@ -225,7 +230,7 @@ static struct asset_texture_ref tex(int image, bool repeat)
 {
     uint32_t wrap = repeat ? GL_REPEAT_ : GL_CLAMP_;
     return (struct asset_texture_ref){image, 0, wrap, wrap, GL_LINEAR_MIPMAP_LINEAR_,
-                                      GL_LINEAR_, 1.0f};
+                                      GL_LINEAR_, 1.0f, ASSET_UV_IDENTITY};
 }
 
 static void materials(struct asset *a)
@@ -240,7 +245,8 @@ static void materials(struct asset *a)
         m->alpha_cutoff = 0.5f;
         for (int s = 0; s < ASSET_TEX_SLOTS; s++)
             m->tex[s] = (struct asset_texture_ref){-1, 0, GL_REPEAT_, GL_REPEAT_,
-                                                   GL_LINEAR_MIPMAP_LINEAR_, GL_LINEAR_, 1.0f};
+                                                   GL_LINEAR_MIPMAP_LINEAR_, GL_LINEAR_, 1.0f,
+                                                   ASSET_UV_IDENTITY};
     }
     struct asset_material *m = &a->materials[MAT_GROUND];
     snprintf(m->name, sizeof(m->name), "ground");
@@ -258,7 +264,7 @@ static void materials(struct asset *a)
     m->tex[ASSET_TEX_BASE_COLOR] = tex(IMG_CHECKER, true);
     m->tex[ASSET_TEX_NORMAL] = tex(IMG_NORMAL, true);
     m->tex[ASSET_TEX_NORMAL].scale = 1.5f;
-    /* The normal map read through the unique parametrisation: uv set 1. */
+    /* The normal map read through uv set 1 (the same values as uv1 here). */
     m->tex[ASSET_TEX_NORMAL].uv_set = 1;
 
     m = &a->materials[MAT_METAL];

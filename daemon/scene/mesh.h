@@ -19,11 +19,13 @@ struct mesh_vertex {
     float normal[3];
     float uv[2];
     float chart[4]; /* u0, v0, u1, v1 of the chart this vertex belongs to */
-    /* The material's texture coordinates and tangent frame (an asset's
-     * TEXCOORD_0 and TANGENT, handedness in w); the procedural meshes have
-     * no textures and leave them 0. */
-    float tex[2];
+    /* The material's texture coordinates, tangent frame and vertex colour
+     * (an asset's TEXCOORD_0 in xy and TEXCOORD_1 in zw, TANGENT with its
+     * handedness in w, COLOR_0); the procedural meshes have no textures and
+     * leave them 0. */
+    float tex[4];
     float tangent[4];
+    float color[4];
 };
 
 struct mesh {

@@ -134,7 +134,9 @@ static bool build_mesh(struct mesh *out, const struct asset_mesh *am, const floa
         o->chart[0] = o->chart[1] = 0.0f;
         o->chart[2] = o->chart[3] = 1.0f;
         o->tex[0] = v->uv0[0], o->tex[1] = v->uv0[1];
+        o->tex[2] = v->texcoord1[0], o->tex[3] = v->texcoord1[1];
         memcpy(o->tangent, v->tangent, sizeof(o->tangent));
+        memcpy(o->color, v->color, sizeof(o->color));
     }
     out->bound_radius = sqrtf(r2);
     mesh_compute_box(out); /* the scene's bounds are computed before the procedural meshes exist */

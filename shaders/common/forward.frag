@@ -1,5 +1,6 @@
 // Thesis ForwardProg: every light evaluated for every fragment.
 #include "lighting.glsl"
+#define SURFACE_VERTEX_COLOR 1 // the vertex stage passes COLOR_0
 #include "surface.glsl"
 in vec3 v_world;
 in vec3 v_normal;

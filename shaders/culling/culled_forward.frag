@@ -2,6 +2,7 @@
 // the depth pre-pass, each visible fragment loops over its cell's lights.
 #include "light_grid.glsl"
 #include "heat.glsl"
+#define SURFACE_VERTEX_COLOR 1 // the vertex stage passes COLOR_0
 #include "surface.glsl"
 // The heat map's image writes would otherwise make the driver run the
 // shader before the depth test, shading every hidden fragment the pre-pass

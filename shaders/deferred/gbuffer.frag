@@ -3,6 +3,7 @@
 // output's depth texture.
 #include "gbuffer.glsl"
 #include "scene_data.glsl"
+#define SURFACE_VERTEX_COLOR 1 // the vertex stage passes COLOR_0
 #include "surface.glsl"
 in vec3 v_world;
 in vec3 v_normal;

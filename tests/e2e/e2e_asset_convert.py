@@ -1,7 +1,9 @@
 """The glTF converter (shadebench-asset) over every asset gltf_gen.py makes:
 exit codes, the refusals' status and field, the descriptions (meshes,
 triangles, textures and their sizes, lights by type, cameras, uv1 from the
-file or generated with its waste, ignored features), decoded texels read
+file or generated with its waste and why, a TEXCOORD_1 whose charts
+overlap caught, each texture's uv set and transform, the vertex
+attributes, COLOR_0, ignored features), decoded texels read
 back from the cache file, no cache left by a refusal, and the process
 limits. No daemon, no GL."""
 
@@ -28,7 +30,7 @@ def read_cache_images(path):
     if data[:8] != b"SBASSET\0":
         return None
     nmesh, nmat, nimg, nlight, ncam, nign = struct.unpack_from("<6I", data, 16)
-    off = 64 + nign * 128 + nmat * 252 + nlight * 120 + ncam * 120
+    off = 64 + nign * 128 + nmat * 352 + nlight * 120 + ncam * 120
     images = []
     for _ in range(nimg):
         w, h = struct.unpack_from("<II", data, off + 64)
@@ -36,6 +38,15 @@ def read_cache_images(path):
         images.append((w, h, data[off:off + w * h * 4]))
         off += w * h * 4
     return images
+
+
+def flat(v):
+    """The numbers of a JSON value, keys sorted."""
+    if isinstance(v, dict):
+        return [x for k in sorted(v) for x in flat(v[k])]
+    if isinstance(v, list):
+        return [x for i in v for x in flat(i)]
+    return [float(v)]
 
 
 def texel(images, spec):
@@ -81,6 +92,23 @@ def check_good(name, entry, doc, cache):
             check(m["uv1"] == e["uv1"], "%s: mesh %s uv1 %s" % (name, m["name"], m["uv1"]))
             check(0 < m["uv1_waste"] < 1, "%s: mesh %s uv1 waste %s in (0, 1)"
                   % (name, m["name"], m["uv1_waste"]))
+            if "uv1_reason" in e:
+                check(e["uv1_reason"] in m.get("uv1_reason", ""), "%s: mesh %s uv1 generated because %s"
+                      % (name, m["name"], m.get("uv1_reason")))
+    if "attributes" in e:
+        for m in doc["mesh_list"]:
+            check(m["attributes"] == e["attributes"], "%s: mesh %s attributes %s, expected %s"
+                  % (name, m["name"], m["attributes"], e["attributes"]))
+    if "vertex_colors" in e:
+        check(doc["vertex_colors"] == e["vertex_colors"], "%s: %s meshes with COLOR_0"
+              % (name, doc["vertex_colors"]))
+    for key in ("texcoord", "texture_transforms"):
+        if key in e:
+            got = doc["materials"][0].get(key, {})
+            want = json.loads(json.dumps(e[key]))
+            close = json.dumps(got, sort_keys=True) == json.dumps(want, sort_keys=True) or all(
+                abs(a - b) < 1e-6 for a, b in zip(flat(got), flat(want))) and len(flat(got)) == len(flat(want))
+            check(close, "%s: material %s %s, expected %s" % (name, key, got, want))
     if "slots" in e:
         check(doc["materials"][0]["textures"] == e["slots"], "%s: slots %s, expected %s"
               % (name, doc["materials"][0]["textures"], e["slots"]))

@@ -122,19 +122,29 @@ class Gltf:
         self.doc["accessors"].append(acc)
         return len(self.doc["accessors"]) - 1
 
-    def mesh(self, geom, material=None, uv1=True, tangents=False, name=None, mode=None):
-        pos, nrm, uv0, uv1v, idx = geom
+    def mesh(self, geom, material=None, uv1=True, tangents=False, name=None, mode=None,
+             colors=None, normals=True):
+        """geom: (positions, normals, uv0, uv1, indices[, tangents]); tangents
+        True writes the geometry's own (or (1, 0, 0, 1) where it has none);
+        colors: (values, componentType, "VEC3" or "VEC4") for COLOR_0."""
+        pos, nrm, uv0, uv1v, idx = geom[:5]
         n = len(pos) // 3
         attrs = {"POSITION": self.accessor(pos, 5126, "VEC3", n),
-                 "NORMAL": self.accessor(nrm, 5126, "VEC3", n),
                  "TEXCOORD_0": self.accessor(uv0, 5126, "VEC2", n)}
+        if normals:
+            attrs["NORMAL"] = self.accessor(nrm, 5126, "VEC3", n)
         if uv1:
             attrs["TEXCOORD_1"] = self.accessor(uv1v, 5126, "VEC2", n)
         if tangents:
-            tan = []
-            for i in range(n):
-                tan += [1.0, 0.0, 0.0, 1.0]
+            tan = list(geom[5]) if len(geom) > 5 else [1.0, 0.0, 0.0, 1.0] * n
             attrs["TANGENT"] = self.accessor(tan, 5126, "VEC4", n)
+        if colors:
+            values, ctype, atype = colors
+            if ctype != 5126:
+                values = list(values) + [0] * (-len(values) % 4)
+            attrs["COLOR_0"] = self.accessor(values, ctype, atype, n)
+            if ctype != 5126:
+                self.doc["accessors"][attrs["COLOR_0"]]["normalized"] = True
         prim = {"attributes": attrs,
                 "indices": self.accessor(idx, 5125 if n > 65535 else 5123, "SCALAR", len(idx))}
         if material is not None:
@@ -289,8 +299,9 @@ def alpha_asset():
 
 
 def extras_asset():
-    """What the converter ignores: an animation, an unknown extension, a
-    points primitive, an orthographic camera, a texture transform."""
+    """What the converter ignores (an animation, an unknown extension, a
+    points primitive, an orthographic camera) and a texture transform it
+    takes."""
     g = Gltf()
     t = g.texture(g.image(base_color_png()))
     m = g.material(name="m", pbrMetallicRoughness={"baseColorTexture": {
@@ -428,6 +439,404 @@ def skinned_asset():
     return g
 
 
+# ---- import fidelity: pairs a correct importer renders alike ----
+#
+# Each pair states one thing two ways: a node transform and the same
+# transform baked into the vertices, a material's uv set 1 and the same
+# values as set 0, COLOR_0 and the same colour as a factor, a texture
+# transform and the coordinates it produces. tests/e2e/e2e_asset_import.py
+# renders both halves of each pair and compares.
+
+def quat_matrix(q):
+    """A unit quaternion (x, y, z, w) as a 3x3 rotation, rows."""
+    x, y, z, w = q
+    n = math.sqrt(x * x + y * y + z * z + w * w)
+    x, y, z, w = x / n, y / n, z / n, w / n
+    return [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+
+
+def axis_angle(axis, degrees):
+    n = math.sqrt(sum(a * a for a in axis))
+    h = math.radians(degrees) / 2
+    return [axis[0] / n * math.sin(h), axis[1] / n * math.sin(h), axis[2] / n * math.sin(h), math.cos(h)]
+
+
+def trs(t=(0, 0, 0), r=(0, 0, 0, 1), s=(1, 1, 1)):
+    """(3x3 rows, translation) of translation * rotation * scale."""
+    rm = quat_matrix(r)
+    return [[rm[i][j] * s[j] for j in range(3)] for i in range(3)], list(t)
+
+
+def compose(a, b):
+    """a then applied after b: a * b."""
+    (ma, ta), (mb, tb) = a, b
+    m = [[sum(ma[i][k] * mb[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
+    t = [sum(ma[i][k] * tb[k] for k in range(3)) + ta[i] for i in range(3)]
+    return m, t
+
+
+def det3(m):
+    return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
+
+
+def inverse_transpose(m):
+    """The cofactor matrix over the determinant: M^-T."""
+    d = det3(m)
+    c = [[m[(i + 1) % 3][(j + 1) % 3] * m[(i + 2) % 3][(j + 2) % 3]
+          - m[(i + 1) % 3][(j + 2) % 3] * m[(i + 2) % 3][(j + 1) % 3] for j in range(3)] for i in range(3)]
+    return [[c[i][j] / d for j in range(3)] for i in range(3)]
+
+
+def normalized(v):
+    n = math.sqrt(sum(x * x for x in v))
+    return [x / n for x in v]
+
+
+def bake(geom, xf):
+    """geom (positions, normals, uv0, uv1, indices, tangents) with the
+    transform xf = (3x3, translation) applied as an importer must: points by
+    the matrix, normals by its inverse transpose, tangents by the matrix with
+    w turned and the winding reversed where it mirrors."""
+    pos, nrm, uv0, uv1, idx, tan = geom
+    m, t = xf
+    nm = inverse_transpose(m)
+    mirror = det3(m) < 0
+    p2, n2, t2 = [], [], []
+    for v in range(len(pos) // 3):
+        p = pos[3 * v:3 * v + 3]
+        p2 += [sum(m[i][k] * p[k] for k in range(3)) + t[i] for i in range(3)]
+        n = nrm[3 * v:3 * v + 3]
+        n2 += normalized([sum(nm[i][k] * n[k] for k in range(3)) for i in range(3)])
+        tv = tan[4 * v:4 * v + 4]
+        t2 += normalized([sum(m[i][k] * tv[k] for k in range(3)) for i in range(3)])
+        t2.append(-tv[3] if mirror else tv[3])
+    i2 = list(idx)
+    if mirror:
+        for k in range(0, len(i2), 3):
+            i2[k + 1], i2[k + 2] = i2[k + 2], i2[k + 1]
+    return p2, n2, list(uv0), list(uv1), i2, t2
+
+
+def cube_tangents(size=1.0):
+    """cube() with its tangents: each face's u direction, w = 1 (its faces
+    are u x v = n, and uv0's v runs down the face)."""
+    faces = [((0, 0, -1)), ((0, 0, 1)), ((1, 0, 0)), ((1, 0, 0)), ((1, 0, 0)), ((-1, 0, 0))]
+    tan = []
+    for u in faces:
+        tan += (list(map(float, u)) + [1.0]) * 4
+    return cube(size) + (tan,)
+
+
+def sphere(rings=12, segments=24, radius=0.8):
+    """A uv sphere with smooth normals and tangents: uv0 (longitude,
+    latitude from the top), uv1 the same squeezed into [0.05, 0.95]^2."""
+    pos, nrm, uv0, uv1, idx, tan = [], [], [], [], [], []
+    for j in range(rings + 1):
+        th = math.pi * j / rings
+        for i in range(segments + 1):
+            ph = 2 * math.pi * i / segments
+            n = [math.sin(th) * math.cos(ph), math.cos(th), -math.sin(th) * math.sin(ph)]
+            pos += [radius * x for x in n]
+            nrm += n
+            u, v = i / segments, j / rings
+            uv0 += [u, v]
+            uv1 += [0.05 + 0.9 * u, 0.05 + 0.9 * v]
+            t = [-math.sin(ph), 0.0, -math.cos(ph)]  # dP/du, along increasing longitude
+            dpdv = [math.cos(th) * math.cos(ph), -math.sin(th), -math.cos(th) * math.sin(ph)]
+            cr = [n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2], n[0] * t[1] - n[1] * t[0]]
+            w = -1.0 if sum(cr[k] * dpdv[k] for k in range(3)) > 0 else 1.0
+            tan += t + [w]
+    for j in range(rings):
+        for i in range(segments):
+            a = j * (segments + 1) + i
+            b = a + segments + 1
+            idx += [a, b, a + 1, a + 1, b, b + 1]
+    return pos, nrm, uv0, uv1, idx, tan
+
+
+def fidelity_scene(g):
+    """The pairs' shared camera and lights (the same in both halves)."""
+    g.doc["cameras"] = [{"type": "perspective", "name": "view",
+                         "perspective": {"yfov": 0.75, "znear": 0.1, "zfar": 60, "aspectRatio": 4 / 3}}]
+    g.node(camera=0, name="view", translation=[0.3, 2.4, 9.5], rotation=axis_angle([1, 0, 0], -6))
+    pl = g.light(type="point", name="lamp", color=[1, 0.9, 0.8], intensity=250, range=25)
+    dl = g.light(type="directional", name="sun", color=[0.8, 0.85, 1], intensity=4)
+    g.node(name="lamp", translation=[2.5, 4, 4], extensions={"KHR_lights_punctual": {"light": pl}})
+    g.node(name="sun", rotation=axis_angle([1, 0.4, 0], -50), extensions={"KHR_lights_punctual": {"light": dl}})
+
+
+# Node transforms: rotated (a quarter turn about x, as a helmet exported
+# z-up), non-uniformly scaled and rotated, mirrored (a negative scale) and
+# rotated, and a child's scale under its parent's rotation.
+NODE_CASES = [
+    ("rotated", "sphere", False, [trs((-2.6, 0.9, 0), axis_angle([1, 0, 0], 90))]),
+    ("scaled", "cube", True, [trs((-0.8, 0.9, 0), axis_angle([1, 1, 0], 35), (1.0, 2.2, 0.6))]),
+    ("mirrored", "sphere", True, [trs((1.2, 0.9, 0), axis_angle([0, 1, 0.3], 40), (-1, 1, 1))]),
+    ("mirrored_cube", "cube", False, [trs((3.0, 0.9, 0), axis_angle([0.2, 1, 0], -30), (1, -1.3, 1))]),
+    ("nested", "cube", True, [trs((0.5, 2.9, -1), axis_angle([0, 0, 1], 60)),
+                              trs((0, 0, 0), axis_angle([1, 0, 0], 20), (0.5, 1.4, 0.8))]),
+]
+
+
+def transforms_asset(baked):
+    """NODE_CASES drawn with a normal-mapped material through their nodes'
+    transforms (baked False) or with the transforms baked into the vertices
+    and identity nodes (baked True). Tangents from the file where the case
+    says, else the importer's."""
+    g = Gltf()
+    bumps = g.texture(g.image(pattern_png(64, (128, 128, 255, 255), (190, 150, 215, 255), 8), name="bumps"))
+    tiles = g.texture(g.image(pattern_png(64, (210, 180, 150, 255), (90, 110, 140, 255), 16), name="tiles"))
+    mat = g.material(name="bumpy", pbrMetallicRoughness={
+        "baseColorTexture": {"index": tiles}, "metallicFactor": 0.1, "roughnessFactor": 0.5},
+        normalTexture={"index": bumps, "scale": 1.0})
+    shapes = {"sphere": sphere(), "cube": cube_tangents(1.2)}
+    for name, shape, file_tangents, chain in NODE_CASES:
+        geom = shapes[shape]
+        if baked:
+            xf = chain[0]
+            for inner in chain[1:]:
+                xf = compose(xf, inner)
+            mesh = g.mesh(bake(geom, xf), material=mat, uv1=False, tangents=file_tangents, name=name)
+            g.node(mesh=mesh, name=name)
+            continue
+        mesh = g.mesh(geom, material=mat, uv1=False, tangents=file_tangents, name=name)
+        parent = None
+        for depth, (m, t) in enumerate(chain):
+            # Column-major, as glTF stores a node's matrix.
+            node = {"name": "%s%d" % (name, depth),
+                    "matrix": [m[0][0], m[1][0], m[2][0], 0, m[0][1], m[1][1], m[2][1], 0,
+                               m[0][2], m[1][2], m[2][2], 0, t[0], t[1], t[2], 1]}
+            if depth == len(chain) - 1:
+                node["mesh"] = mesh
+            i = g.node(root=parent is None, **node)
+            if parent is not None:
+                g.doc["nodes"][parent].setdefault("children", []).append(i)
+            parent = i
+    fidelity_scene(g)
+    return g
+
+
+def transforms_trs_asset():
+    """The first NODE_CASES as translation, rotation and scale properties
+    rather than matrices (the node graph's other spelling), unbaked."""
+    g = transforms_asset(False)
+    for node in g.doc["nodes"]:
+        if node.get("name") == "rotated0":
+            del node["matrix"]
+            node["translation"] = [-2.6, 0.9, 0]
+            node["rotation"] = axis_angle([1, 0, 0], 90)
+        if node.get("name") == "mirrored0":
+            del node["matrix"]
+            node["translation"] = [1.2, 0.9, 0]
+            node["rotation"] = axis_angle([0, 1, 0.3], 40)
+            node["scale"] = [-1, 1, 1]
+    return g
+
+
+def texcoord_asset(set_index, inside):
+    """Base colour, occlusion and emissive maps reading uv set set_index, on
+    a cube whose TEXCOORD_0 and TEXCOORD_1 hold the same values: inside
+    [0, 1], or spread over [-0.5, 1.5] (repeating)."""
+    g = Gltf()
+    g._list("samplers").append({"wrapS": 10497, "wrapT": 10497})
+    base = g.texture(g.image(pattern_png(32, (230, 200, 90, 255), (60, 90, 160, 255), 4), name="base"), 0)
+    occl = g.texture(g.image(pattern_png(32, (255, 255, 255, 255), (40, 40, 40, 255), 8), name="occlusion"), 0)
+    glow = g.texture(g.image(pattern_png(32, (0, 0, 0, 255), (90, 40, 10, 255), 16), name="glow"), 0)
+    mat = g.material(name="sets", emissiveFactor=[1, 1, 1],
+                     emissiveTexture={"index": glow, "texCoord": set_index},
+                     occlusionTexture={"index": occl, "texCoord": set_index, "strength": 1.0},
+                     pbrMetallicRoughness={"baseColorTexture": {"index": base, "texCoord": set_index},
+                                           "metallicFactor": 0.0})
+    pos, nrm, uv0, _, idx = cube(1.6)
+    if not inside:
+        uv0 = [2 * x - 0.5 for x in uv0]
+    # Squeezed per face into a sixth of the square so that set 1 inside
+    # [0, 1] is a valid unique parametrisation too.
+    if inside:
+        sq = []
+        for v in range(len(uv0) // 2):
+            f = v // 4
+            sq += [(f % 3 + 0.1 + 0.8 * uv0[2 * v]) / 3, (f // 3 + 0.1 + 0.8 * uv0[2 * v + 1]) / 2]
+        uv0 = sq
+    mesh = g.mesh((pos, nrm, uv0, list(uv0), idx), material=mat, uv1=True, name="sets")
+    g.node(mesh=mesh, name="box", translation=[0, 0.9, 0], rotation=axis_angle([0, 1, 0], 30))
+    fidelity_scene(g)
+    return g
+
+
+def overlap_asset(overlap):
+    """Two halves of a plane whose TEXCOORD_1 stays inside [0, 1]: mirrored
+    onto the same texels (overlap True: the converter must not take it as
+    uv1) or side by side."""
+    g = Gltf()
+    pos, nrm, uv0, uv1, idx = [], [], [], [], []
+    for half in (0, 1):
+        base = len(pos) // 3
+        for j in range(5):
+            for i in range(5):
+                x = (i / 4 - (1.0 if half == 0 else 0.0)) * 1.5
+                pos += [x, j / 4 * 1.5, 0.0]
+                nrm += [0.0, 0.0, 1.0]
+                uv0 += [i / 4, 1 - j / 4]
+                u = i / 4 if half == 0 else 1 - i / 4  # the right half mirrors the left
+                if overlap:
+                    uv1 += [0.1 + 0.8 * u, 0.1 + 0.8 * (1 - j / 4)]
+                else:
+                    uv1 += [0.05 + 0.4 * (i / 4) + 0.5 * half, 0.1 + 0.8 * (1 - j / 4)]
+        for j in range(4):
+            for i in range(4):
+                a = base + j * 5 + i
+                idx += [a, a + 1, a + 6, a, a + 6, a + 5]
+    g.node(mesh=g.mesh((pos, nrm, uv0, uv1, idx), uv1=True, name="halves"), name="halves")
+    return g
+
+
+def colors_asset(as_attribute):
+    """Two boxes, one coloured by an unsigned-byte VEC4 COLOR_0 and one by a
+    float VEC3 COLOR_0 (as_attribute), or by the same colours as base colour
+    factors."""
+    g = Gltf()
+    tex = g.texture(g.image(pattern_png(16, (255, 255, 255, 255), (160, 160, 160, 255), 4), name="grey"))
+    rgba8 = (200, 120, 60, 255)
+    rgbf = (0.2, 0.5, 0.9)
+    for k, (name, color) in enumerate((("bytes", [c / 255 for c in rgba8]), ("floats", list(rgbf) + [1.0]))):
+        pbr = {"baseColorTexture": {"index": tex}, "metallicFactor": 0.0}
+        if not as_attribute:
+            pbr["baseColorFactor"] = color
+        mat = g.material(name=name, pbrMetallicRoughness=pbr)
+        geom = cube(1.3)
+        n = len(geom[0]) // 3
+        cols = None
+        if as_attribute:
+            cols = (list(rgba8) * n, 5121, "VEC4") if k == 0 else (list(rgbf) * n, 5126, "VEC3")
+        g.node(mesh=g.mesh(geom, material=mat, uv1=False, colors=cols, name=name), name=name,
+               translation=[-1.2 + 2.4 * k, 0.9, 0])
+    fidelity_scene(g)
+    return g
+
+
+# KHR_texture_transform's matrix as the sample viewer applies it.
+TEX_TRANSFORM = {"offset": [0.2, -0.1], "rotation": 0.6, "scale": [1.5, 0.7]}
+
+
+def tex_transform_uv(u, v, t=TEX_TRANSFORM):
+    c, s = math.cos(t["rotation"]), math.sin(t["rotation"])
+    su, sv = u * t["scale"][0], v * t["scale"][1]
+    return c * su + s * sv + t["offset"][0], -s * su + c * sv + t["offset"][1]
+
+
+def texture_transform_asset(transformed):
+    """A base colour map through KHR_texture_transform (offset, rotation,
+    scale, and a texCoord override naming set 1, TEXCOORD_0 holding other
+    coordinates) when transformed, or plain over TEXCOORD_0 holding the
+    coordinates the transform produces."""
+    g = Gltf()
+    g._list("samplers").append({"wrapS": 10497, "wrapT": 10497})
+    base = g.texture(g.image(pattern_png(32, (230, 200, 90, 255), (60, 90, 160, 255), 4), name="base"), 0)
+    pos, nrm, uv0, _, idx = cube(1.6)
+    if transformed:
+        info = {"index": base, "texCoord": 0, "extensions": {"KHR_texture_transform": dict(TEX_TRANSFORM, texCoord=1)}}
+        geom = (pos, nrm, [0.5 * x for x in uv0], list(uv0), idx)
+        g.doc["extensionsUsed"] = ["KHR_texture_transform"]
+    else:
+        info = {"index": base}
+        moved = []
+        for k in range(0, len(uv0), 2):
+            moved += list(tex_transform_uv(uv0[k], uv0[k + 1]))
+        geom = (pos, nrm, moved, list(uv0), idx)
+    mat = g.material(name="moved", pbrMetallicRoughness={"baseColorTexture": info, "metallicFactor": 0.0})
+    g.node(mesh=g.mesh(geom, material=mat, uv1=True, name="moved"), name="box",
+           translation=[0, 0.9, 0], rotation=axis_angle([0, 1, 0], 30))
+    fidelity_scene(g)
+    return g
+
+
+def flat_asset(file_normals):
+    """A sphere whose file gives no normals (glTF: flat ones, a vertex per
+    triangle corner) against the same triangles unwelded with their face
+    normals stated."""
+    g = Gltf()
+    pos, nrm, uv0, uv1, idx, tan = sphere(rings=8, segments=12, radius=1.2)
+
+    def area2(k):
+        a, b, c = (pos[3 * i:3 * i + 3] for i in idx[k:k + 3])
+        e1 = [b[q] - a[q] for q in range(3)]
+        e2 = [c[q] - a[q] for q in range(3)]
+        return sum(x * x for x in (e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                                   e1[0] * e2[1] - e1[1] * e2[0]))
+    # The poles' degenerate triangles left out (no face normal to state).
+    idx = [i for k in range(0, len(idx), 3) if area2(k) > 1e-12 for i in idx[k:k + 3]]
+    if file_normals:
+        p2, n2, u2, idx2 = [], [], [], []
+        for k in range(0, len(idx), 3):
+            a, b, c = (pos[3 * i:3 * i + 3] for i in idx[k:k + 3])
+            e1 = [b[q] - a[q] for q in range(3)]
+            e2 = [c[q] - a[q] for q in range(3)]
+            fn = normalized([e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                             e1[0] * e2[1] - e1[1] * e2[0]])
+            for i in idx[k:k + 3]:
+                idx2.append(len(p2) // 3)
+                p2 += pos[3 * i:3 * i + 3]
+                n2 += fn
+                u2 += uv0[2 * i:2 * i + 2]
+        geom = (p2, n2, u2, list(u2), idx2)
+    else:
+        geom = (pos, nrm, uv0, uv1, idx)
+    mat = g.material(name="matte", pbrMetallicRoughness={"baseColorFactor": [0.8, 0.7, 0.5, 1],
+                                                         "metallicFactor": 0.0, "roughnessFactor": 0.6})
+    g.node(mesh=g.mesh(geom, material=mat, uv1=False, normals=file_normals, name="ball"), name="ball",
+           translation=[0, 1.2, 0])
+    fidelity_scene(g)
+    return g
+
+
+def back_face_asset(double_sided):
+    """A normal-mapped plate seen from behind: double-sided (its back lit as
+    glTF says, the normal reversed, normal map and all), against the same
+    plate rebuilt to face the viewer with its normal, tangent and
+    handedness reversed and its winding turned."""
+    g = Gltf()
+    bumps = g.texture(g.image(pattern_png(64, (128, 128, 255, 255), (200, 140, 210, 255), 8), name="bumps"))
+    mat = g.material(name="plate", doubleSided=True, normalTexture={"index": bumps},
+                     pbrMetallicRoughness={"baseColorFactor": [0.7, 0.75, 0.8, 1], "metallicFactor": 0.0,
+                                           "roughnessFactor": 0.5})
+    pos, nrm, uv0, uv1, idx = grid(6, size=3.0)
+    n = len(pos) // 3
+    geom = (pos, [0.0, 0.0, 1.0] * n, uv0, uv1, idx, [1.0, 0.0, 0.0, 1.0] * n)
+    turn = trs((0, 1.5, 0), axis_angle([0, 1, 0], 180))
+    if double_sided:
+        mesh = g.mesh(geom, material=mat, uv1=False, tangents=True, name="plate")
+        g.node(mesh=mesh, name="plate", translation=[0, 1.5, 0], rotation=axis_angle([0, 1, 0], 180))
+    else:
+        p2, n2, u0, u1, i2, t2 = bake(geom, turn)
+        n2 = [-x for x in n2]
+        t2 = [-x for x in t2]
+        for k in range(0, len(i2), 3):
+            i2[k + 1], i2[k + 2] = i2[k + 2], i2[k + 1]
+        mesh = g.mesh((p2, n2, u0, u1, i2, t2), material=mat, uv1=False, tangents=True, name="plate")
+        g.node(mesh=mesh, name="plate")
+    fidelity_scene(g)
+    return g
+
+
+def fidelity_pairs():
+    """{name: (asset, its equivalent)}: what e2e_asset_import renders."""
+    return {
+        "transforms": (transforms_asset(False), transforms_asset(True)),
+        "transforms_trs": (transforms_trs_asset(), transforms_asset(True)),
+        "texcoord1_outside": (texcoord_asset(1, False), texcoord_asset(0, False)),
+        "texcoord1_inside": (texcoord_asset(1, True), texcoord_asset(0, True)),
+        "colors": (colors_asset(True), colors_asset(False)),
+        "texture_transform": (texture_transform_asset(True), texture_transform_asset(False)),
+        "flat_normals": (flat_asset(False), flat_asset(True)),
+        "back_face": (back_face_asset(True), back_face_asset(False)),
+    }
+
+
 # ---- bad assets ----
 
 def bad_accessor_oob():
@@ -531,9 +940,10 @@ def build_all(out, realistic=False, big_maps=False):
                   "cameras": [], "uv1": "generated"})
     write("extras.glb", extras_asset().glb(), exit=0,
           expect={"meshes": 1, "triangles": 12, "cameras": ["plan"], "uv1": "generated",
-                  "ignored": ["animations", "extension KHR_texture_transform",
-                              "extension KHR_materials_clearcoat", "points and lines primitives",
-                              "orthographic cameras (drawn as perspective)", "KHR_texture_transform"]})
+                  "ignored": ["animations", "extension KHR_materials_clearcoat",
+                              "points and lines primitives",
+                              "orthographic cameras (drawn as perspective)"],
+                  "texture_transforms": {"base_color": {"offset": [0, 0], "rotation": 0, "scale": [2, 2]}}})
     write("quantized.glb", quantized_asset().glb(), exit=0,
           expect={"meshes": 1, "triangles": 12, "vertices": 24, "uv1": "file"})
     write("skinned.glb", skinned_asset().glb(), exit=0,
@@ -556,6 +966,25 @@ def build_all(out, realistic=False, big_maps=False):
         m = g.material(pbrMetallicRoughness={"baseColorTexture": {"index": t}})
         g.node(mesh=g.mesh(cube(), material=m, uv1=False))
         write("bad_jpeg.glb", g.glb(), exit=2, status=400, field="images[0]")
+    # The import-fidelity pairs (e2e_asset_import renders them) and what
+    # the converter says of them.
+    pairs = fidelity_pairs()
+    for name, (a, b) in pairs.items():
+        write("fid_%s_a.glb" % name, a.glb(), exit=0, expect={})
+        write("fid_%s_b.glb" % name, b.glb(), exit=0, expect={})
+    write("uv1_overlap.glb", overlap_asset(True).glb(), exit=0,
+          expect={"uv1": "generated", "uv1_reason": "overlap", "triangles": 64})
+    write("uv1_apart.glb", overlap_asset(False).glb(), exit=0,
+          expect={"uv1": "file", "triangles": 64})
+    write("texcoord1_outside.glb", texcoord_asset(1, False).glb(), exit=0,
+          expect={"uv1": "generated", "uv1_reason": "leaves",
+                  "texcoord": {"base_color": 1, "occlusion": 1, "emissive": 1},
+                  "attributes": ["POSITION", "TEXCOORD_0", "TEXCOORD_1"]})
+    write("vertex_colors.glb", colors_asset(True).glb(), exit=0,
+          expect={"vertex_colors": 2, "attributes": ["POSITION", "TEXCOORD_0", "COLOR_0"]})
+    write("texture_transform.glb", texture_transform_asset(True).glb(), exit=0,
+          expect={"texcoord": {"base_color": 1}, "ignored": [],
+                  "texture_transforms": {"base_color": TEX_TRANSFORM}})
     if realistic:
         data = realistic_asset(big_maps).glb()
         write("realistic_2k.glb" if big_maps else "realistic.glb", data, exit=0,

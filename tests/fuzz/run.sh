@@ -82,7 +82,7 @@ fuzz_one() {
     # converter links (assimp, libjpeg), not instrumented themselves.
     extra=""
     if [ "$t" = asset_convert ]; then
-        extra="daemon/assets/asset_convert.c daemon/assets/uv_charts.c $(pkg-config --cflags --libs assimp libjpeg)"
+        extra="daemon/assets/asset_convert.c daemon/assets/convert_*.c daemon/assets/uv_charts.c daemon/assets/uv_overlap.c $(pkg-config --cflags --libs assimp libjpeg)"
     fi
     # shellcheck disable=SC2086
     if ! "$cc" $flags -fsanitize=fuzzer "tests/fuzz/fuzz_$t.c" $extra $objs $libs -o "$bin" 2>"$out/$t.build.log"; then

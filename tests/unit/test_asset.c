@@ -40,7 +40,11 @@ static void make_asset(struct asset *a)
         m->tex[s].min_filter = 9987;
         m->tex[s].mag_filter = 9729;
         m->tex[s].scale = 1.0f;
+        m->tex[s].transform = (struct asset_uv_transform)ASSET_UV_IDENTITY;
     }
+    m->tex[ASSET_TEX_BASE_COLOR].transform.offset[0] = 0.25f;
+    m->tex[ASSET_TEX_BASE_COLOR].transform.rotation = 0.5f;
+    m->tex[ASSET_TEX_BASE_COLOR].transform.scale[1] = -2.0f;
     a->image_count = 1;
     a->images = calloc(1, sizeof(*a->images));
     snprintf(a->images[0].name, ASSET_NAME_MAX, "base");
@@ -88,8 +92,14 @@ static void make_asset(struct asset *a)
             me->vertices[v].uv0[0] = (float)v * 0.5f;
             me->vertices[v].uv1[0] = (float)(v & 1);
             me->vertices[v].uv1[1] = (float)(v >> 1);
+            me->vertices[v].texcoord1[0] = (float)v * 2.0f; /* outside [0, 1] is the file's */
+            for (int c = 0; c < 4; c++)
+                me->vertices[v].color[c] = k == 1 ? 0.25f * (float)c : 1.0f;
         }
-        me->uv1_from_file = k == 0;
+        me->uv1_origin = k == 0 ? ASSET_UV1_FILE : ASSET_UV1_GENERATED_OVERLAP;
+        me->texcoord1_overlap = k == 0 ? 0.0f : 0.25f;
+        me->has_uv0 = me->has_texcoord1 = true;
+        me->has_color = k == 1;
         me->tangents_from_file = k == 1;
         me->box_max[0] = 1.0f + (float)k;
         me->box_max[1] = 1;
@@ -130,7 +140,7 @@ static void put_u32(unsigned char *p, uint32_t v)
 
 /* Offsets in make_asset's file (the layout in asset.c). */
 enum {
-    HDR = 64, IGN = 128, MAT = 252, LIGHT = 120, CAM = 120,
+    HDR = 64, IGN = 128, MAT = 352, LIGHT = 120, CAM = 120, MESH_HEAD = 116, VERTEX = 80,
     OFF_MESH_COUNT = 16, OFF_MAT_COUNT = 20, OFF_IMG_COUNT = 24, OFF_IGN_COUNT = 36,
     OFF_MAT = HDR + IGN,
     OFF_IMG = OFF_MAT + MAT + 2 * LIGHT + CAM,
@@ -177,7 +187,10 @@ int main(void)
             CHECK(memcmp(b.meshes[k].vertices, a.meshes[k].vertices, 4 * sizeof(struct asset_vertex)) == 0);
             CHECK(memcmp(b.meshes[k].indices, a.meshes[k].indices, 6 * 4) == 0);
             CHECK(b.meshes[k].material == a.meshes[k].material);
-            CHECK(b.meshes[k].uv1_from_file == (k == 0) && b.meshes[k].tangents_from_file == (k == 1));
+            CHECK(b.meshes[k].uv1_origin == a.meshes[k].uv1_origin &&
+                  b.meshes[k].tangents_from_file == (k == 1));
+            CHECK(b.meshes[k].has_uv0 && b.meshes[k].has_texcoord1 && b.meshes[k].has_color == (k == 1));
+            CHECK(b.meshes[k].texcoord1_overlap == a.meshes[k].texcoord1_overlap);
             CHECK(b.meshes[k].uv1_waste == 0.5f && b.meshes[k].box_max[0] == a.meshes[k].box_max[0]);
         }
         CHECK(strcmp(b.ignored[0], "animations") == 0);
@@ -200,6 +213,38 @@ int main(void)
     CHECK(strcmp(json_string_value(json_object_get(json_array_get(json_object_get(d, "cameras"), 0), "name")), "main") == 0);
     json_t *uv1 = json_object_get(d, "uv1");
     CHECK(strcmp(json_string_value(json_object_get(uv1, "origin")), "mixed") == 0);
+    json_t *because = json_object_get(uv1, "generated_because");
+    CHECK(json_integer_value(json_object_get(because, "texcoord1_overlap")) == 1 &&
+          json_integer_value(json_object_get(because, "no_texcoord1")) == 0);
+    json_t *mesh1 = json_array_get(json_object_get(d, "mesh_list"), 1);
+    CHECK(strstr(json_string_value(json_object_get(mesh1, "uv1_reason")), "overlap") != NULL);
+    CHECK(fabs(json_real_value(json_object_get(mesh1, "texcoord1_overlap")) - 0.25) < 1e-6);
+    CHECK(json_array_size(json_object_get(mesh1, "attributes")) == 4);
+    CHECK(json_integer_value(json_object_get(d, "vertex_colors")) == 1);
+    CHECK(json_integer_value(json_object_get(json_object_get(mat0, "texcoord"), "base_color")) == 0);
+    json_t *xf = json_object_get(json_object_get(mat0, "texture_transforms"), "base_color");
+    CHECK(xf && fabs(json_real_value(json_object_get(xf, "rotation")) - 0.5) < 1e-6 &&
+          json_object_size(json_object_get(mat0, "texture_transforms")) == 1);
+    /* The transform's matrix: T R S as the sample viewer composes it. */
+    float mx[6];
+    asset_uv_transform_matrix(&a.materials[0].tex[ASSET_TEX_BASE_COLOR].transform, mx);
+    CHECK_NEAR(mx[0], cosf(0.5f), 1e-6);
+    CHECK_NEAR(mx[1], sinf(0.5f) * -2.0f, 1e-6);
+    CHECK_NEAR(mx[2], 0.25f, 1e-7);
+    CHECK_NEAR(mx[3], -sinf(0.5f), 1e-6);
+    CHECK_NEAR(mx[4], cosf(0.5f) * -2.0f, 1e-6);
+    CHECK(mx[5] == 0.0f);
+    CHECK(asset_uv_transform_used(&a.materials[0].tex[0].transform) &&
+          !asset_uv_transform_used(&a.materials[0].tex[1].transform));
+    /* The extension's example: offset (0, 1), a quarter turn, half scale
+     * maps the unit square onto the lower left quadrant. */
+    struct asset_uv_transform ex = {{0.0f, 1.0f}, 1.5707963f, {0.5f, 0.5f}};
+    asset_uv_transform_matrix(&ex, mx);
+    for (int corner = 0; corner < 4; corner++) {
+        float u = (float)(corner & 1), v = (float)(corner >> 1);
+        float u2 = mx[0] * u + mx[1] * v + mx[2], v2 = mx[3] * u + mx[4] * v + mx[5];
+        CHECK(u2 > -1e-6f && u2 < 0.5f + 1e-6f && v2 > 0.5f - 1e-6f && v2 < 1.0f + 1e-6f);
+    }
     CHECK(fabs(json_real_value(json_object_get(uv1, "waste")) - 0.5) < 1e-6);
     CHECK(json_array_size(json_object_get(d, "ignored")) == 1);
     json_decref(d);
@@ -209,7 +254,7 @@ int main(void)
     /* Damage. */
     size_t len = 0;
     unsigned char *good = check_slurp(path, &len);
-    CHECK(good && len == (size_t)OFF_MESH + 2 * (64 + 16 + 24 + 4 + 4 * 56 + 24) + 8);
+    CHECK(good && len == (size_t)OFF_MESH + 2 * (MESH_HEAD + 4 * VERTEX + 24) + 8);
     unsigned char *buf = malloc(len + 16);
     /* Every cut, from empty to one byte short. */
     int cuts_refused = 0;
@@ -232,7 +277,7 @@ int main(void)
         CHECK(refused(buf, len, needle));             \
     } while (0)
     DAMAGE(0, 0x12345678, "magic");
-    DAMAGE(8, 2, "version");
+    DAMAGE(8, 1, "version");                                             /* the old layout */
     DAMAGE(12, 60, "header size");
     DAMAGE(OFF_MESH_COUNT, 0xFFFFFFFF, "meshes");
     DAMAGE(OFF_MESH_COUNT, 65536, "truncated");
@@ -253,11 +298,16 @@ int main(void)
     DAMAGE(OFF_MESH + 68, 0xFFFFFFF0, "vertices");                       /* vertex count */
     DAMAGE(OFF_MESH + 72, 7, "triangles");                               /* index count % 3 */
     DAMAGE(OFF_MESH + 72, 0xFFFFFFF0, NULL);                             /* index count */
-    DAMAGE(OFF_MESH + 76, 8, "flags");
-    DAMAGE(OFF_MESH + 104, 0x40000000, "waste");                         /* waste 2.0 */
-    DAMAGE(OFF_MESH + 108 + 4 * 56 + 8, 4, "index");                     /* index 2 = 4 */
-    DAMAGE(OFF_MESH + 108, 0x7F800000, "non-finite");                    /* pos inf */
-    DAMAGE(OFF_MESH + 108 + 48, 0x40000000, "uv1");                      /* uv1 x 2.0 */
+    DAMAGE(OFF_MESH + 76, 16, "flags");
+    DAMAGE(OFF_MESH + 76, 3, "TEXCOORD_1");                              /* uv1 from a set it lacks */
+    DAMAGE(OFF_MESH + 80, 4, "origin");
+    DAMAGE(OFF_MESH + 108, 0x40000000, "waste");                         /* waste 2.0 */
+    DAMAGE(OFF_MESH + 112, 0xBF800000, "overlap");                       /* overlap -1 */
+    DAMAGE(OFF_MESH + MESH_HEAD + 4 * VERTEX + 8, 4, "index");           /* index 2 = 4 */
+    DAMAGE(OFF_MESH + MESH_HEAD, 0x7F800000, "non-finite");              /* pos inf */
+    DAMAGE(OFF_MESH + MESH_HEAD + 48, 0x40000000, "uv1");                /* uv1 x 2.0 */
+    DAMAGE(OFF_MESH + MESH_HEAD + 64, 0x7FC00000, "non-finite");         /* colour NaN */
+    DAMAGE(OFF_MAT + 64 + 48 + 28, 0x7FC00000, "finite");                /* transform offset NaN */
     DAMAGE(len - 8, 0, "trailer");
     /* Unterminated name. */
     memcpy(buf, good, len);

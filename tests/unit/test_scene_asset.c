@@ -51,13 +51,16 @@ static void test_textured_preset(void)
             CHECK_NEAR(in->pos[k], 0.5f * (src->box_min[k] + src->box_max[k]), 1e-5f);
             CHECK_NEAR(m->box_min[k], -m->box_max[k], 1e-4f);
         }
-        /* Vertices: world position = instance + object position; tex uv0,
-         * uv uv1, one chart, tangent copied. */
+        /* Vertices: world position = instance + object position; tex the
+         * file's TEXCOORD_0 and _1, uv uv1, one chart, tangent and colour
+         * copied. */
         CHECK(m->vertex_count == src->vertex_count && m->index_count == src->index_count);
         for (uint32_t v = 0; v < m->vertex_count; v += 7) {
             for (int k = 0; k < 3; k++)
                 CHECK_NEAR(m->vertices[v].pos[k] + in->pos[k], src->vertices[v].pos[k], 1e-5f);
             CHECK(m->vertices[v].tex[0] == src->vertices[v].uv0[0]);
+            CHECK(m->vertices[v].tex[3] == src->vertices[v].texcoord1[1]);
+            CHECK(m->vertices[v].color[2] == src->vertices[v].color[2]);
             CHECK(m->vertices[v].uv[1] == src->vertices[v].uv1[1]);
             CHECK(m->vertices[v].chart[2] == 1.0f && m->vertices[v].chart[0] == 0.0f);
             CHECK(m->vertices[v].tangent[3] == src->vertices[v].tangent[3]);
@@ -118,9 +121,9 @@ static void test_textured_preset(void)
 
 /* A one-triangle asset, for the error and default paths. */
 static struct asset_vertex tri_v[3] = {
-    {{0, 0, 0}, {0, 0, 1}, {1, 0, 0, 1}, {0, 0}, {0, 0}},
-    {{2, 0, 0}, {0, 0, 1}, {1, 0, 0, 1}, {1, 0}, {1, 0}},
-    {{0, 2, 0}, {0, 0, 1}, {1, 0, 0, 1}, {0, 1}, {0, 1}},
+    {{0, 0, 0}, {0, 0, 1}, {1, 0, 0, 1}, {0, 0}, {0, 0}, {0, 0}, {1, 1, 1, 1}},
+    {{2, 0, 0}, {0, 0, 1}, {1, 0, 0, 1}, {1, 0}, {1, 0}, {1, 0}, {1, 1, 1, 1}},
+    {{0, 2, 0}, {0, 0, 1}, {1, 0, 0, 1}, {0, 1}, {0, 1}, {0, 1}, {1, 1, 1, 1}},
 };
 static uint32_t tri_i[3] = {0, 1, 2};
 

@@ -1,6 +1,7 @@
 // The cost floor: same geometry and passes, flat per-object colour, no lights.
 #include "frame.glsl"
 #include "scene_data.glsl"
+#define SURFACE_VERTEX_COLOR 1 // the vertex stage passes COLOR_0
 #include "surface.glsl"
 in vec3 v_world;
 in vec3 v_normal;

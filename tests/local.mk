@@ -39,6 +39,7 @@ UNIT_TESTS = \
 	tests/unit/test_uv_charts \
 	tests/unit/test_uv_overlap \
 	tests/unit/test_convert_matrices \
+	tests/unit/test_convert_checks \
 	tests/unit/test_light_shape
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
@@ -84,6 +85,10 @@ tests_unit_test_uv_overlap_LDADD = -lm
 tests_unit_test_convert_matrices_SOURCES = tests/unit/test_convert_matrices.c \
 	daemon/assets/convert_matrices.c daemon/assets/convert_internal.h
 tests_unit_test_convert_matrices_LDADD = $(JANSSON_LIBS) -lm
+# The converter's checks, on documents of up to a million nodes.
+tests_unit_test_convert_checks_SOURCES = tests/unit/test_convert_checks.c $(ASSET_CONVERT_SOURCES)
+tests_unit_test_convert_checks_CFLAGS = $(AM_CFLAGS) $(ASSIMP_CFLAGS) $(JPEG_CFLAGS)
+tests_unit_test_convert_checks_LDADD = $(CORE_LIBS) $(ASSIMP_LIBS) $(JPEG_LIBS) -lm
 tests_tools_png_tool_SOURCES = tests/tools/png_tool.c
 tests_tools_png_tool_LDADD = $(CORE_LIBS)
 noinst_HEADERS = tests/unit/check.h tests/unit/catalog_fixture.h tests/fuzz/fuzz.h

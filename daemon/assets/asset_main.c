@@ -5,7 +5,8 @@
  *
  *   shadebench-asset convert IN_FILE OUT_CACHE [--max-file-bytes N]
  *       [--max-vertices N] [--max-indices N] [--max-texture-pixels N]
- *       [--max-texture-edge N] [--max-memory BYTES] [--max-cpu-seconds S]
+ *       [--max-texture-edge N] [--max-nodes N] [--max-memory BYTES]
+ *       [--max-cpu-seconds S]
  *
  * Exit 0: OUT_CACHE written, stdout one JSON object (asset_describe). Exit
  * 2: the asset is refused, stdout {"status": 400|422, "field", "message"}.
@@ -28,7 +29,8 @@ static int usage(void)
 {
     fprintf(stderr, "usage: shadebench-asset convert IN_FILE OUT_CACHE [--max-file-bytes N] "
                     "[--max-vertices N] [--max-indices N] [--max-texture-pixels N] "
-                    "[--max-texture-edge N] [--max-memory BYTES] [--max-cpu-seconds S]\n");
+                    "[--max-texture-edge N] [--max-nodes N] [--max-memory BYTES] "
+                    "[--max-cpu-seconds S]\n");
     return 1;
 }
 
@@ -141,6 +143,8 @@ int main(int argc, char **argv)
             lim.max_texture_pixels = v;
         else if (!strcmp(argv[i], "--max-texture-edge") && v <= UINT32_MAX)
             lim.max_texture_edge = (uint32_t)v;
+        else if (!strcmp(argv[i], "--max-nodes") && v <= UINT32_MAX)
+            lim.max_nodes = (uint32_t)v;
         else if (!strcmp(argv[i], "--max-memory"))
             max_memory = v;
         else if (!strcmp(argv[i], "--max-cpu-seconds"))

@@ -180,6 +180,7 @@ struct asset_limits {
     uint64_t max_texture_pixels;       /* all images together */
     uint32_t max_texture_edge;         /* one image's width or height */
     uint32_t max_meshes, max_materials, max_images, max_lights, max_cameras;
+    uint32_t max_nodes; /* the file's nodes (assimp takes about 2.4 KB for each) */
 };
 
 /* The daemon's defaults: 256 MiB files, 16 M vertices and 48 M indices,

@@ -161,6 +161,7 @@ E2E_TESTS = \
 	tests/e2e/e2e_history.py \
 	tests/e2e/e2e_verdicts.py \
 	tests/e2e/e2e_asset_convert.py \
+	tests/e2e/e2e_orphans.py \
 	tests/e2e/systemd_sandbox.py \
 	tests/e2e/systemd_unit.sh
 

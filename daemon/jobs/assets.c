@@ -16,6 +16,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "common/child.h"
 #include "common/fsutil.h"
 #include "common/log.h"
 
@@ -175,10 +176,8 @@ void assets_destroy(struct assets *a)
         return;
     pthread_mutex_lock(&a->lock);
     a->stopping = true;
-    if (a->child > 0) {
-        kill(-a->child, SIGKILL);
-        kill(a->child, SIGKILL);
-    }
+    if (a->child > 0)
+        child_kill(a->child);
     pthread_cond_broadcast(&a->work);
     pthread_mutex_unlock(&a->lock);
     for (int i = 0; i < a->nworkers; i++)

@@ -162,6 +162,7 @@ E2E_TESTS = \
 	tests/e2e/e2e_verdicts.py \
 	tests/e2e/e2e_asset_convert.py \
 	tests/e2e/e2e_orphans.py \
+	tests/e2e/e2e_asset_pins.py \
 	tests/e2e/systemd_sandbox.py \
 	tests/e2e/systemd_unit.sh
 
@@ -189,7 +190,8 @@ SANITIZER_TESTS = $(UNIT_TESTS) \
 	tests/e2e/e2e_assets.py \
 	tests/e2e/e2e_persist.py \
 	tests/e2e/e2e_badinput.py \
-	tests/e2e/e2e_asset_convert.py
+	tests/e2e/e2e_asset_convert.py \
+	tests/e2e/e2e_asset_pins.py
 check-sanitizers:
 if SANITIZERS
 	$(MAKE) $(AM_MAKEFLAGS) check TESTS='$(SANITIZER_TESTS)'

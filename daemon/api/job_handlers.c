@@ -25,22 +25,35 @@ enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *c,
     if (!job_spec_parse_text(req->body ? req->body : "", req->len, s->ctx.catalog,
                              &spec, &err))
         return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
-    /* scene.asset: pinned to the stored asset's hash here, so that the
-     * answer names the rule (400 unknown, 409 a different pinned hash);
-     * queue_submit resolves again, for the sweeps' points. */
+    /* scene.asset: resolved and pinned to the stored asset's hash in one
+     * step here, so that the answer names the rule (400 unknown, 409 a
+     * different pinned hash) and the asset's memory is charged to the job
+     * (job_cost.h); queue_submit pins it again until the job is live, and
+     * this pin goes after it. */
+    bool pinned = false;
     if (spec.scene.asset[0]) {
         struct assets_error ae;
         if (!s->ctx.assets)
             return respond_error(c, MHD_HTTP_BAD_REQUEST, "scene.asset",
                                  "this daemon has no asset store");
-        if (!assets_resolve(s->ctx.assets, &spec.scene, &ae))
+        if (!assets_pin(s->ctx.assets, &spec.scene, false, &ae))
             return respond_asset_error(c, &ae);
+        pinned = true;
+        struct job_cost cost;
+        job_cost_estimate(&spec, &cost);
+        if (!job_cost_admit(&cost, &err)) {
+            assets_unpin(s->ctx.assets, &spec.scene);
+            return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
+        }
     }
     char id[24];
-    switch (queue_submit(s->queue, &spec, NULL, id)) {
+    enum queue_submit_result submitted = queue_submit(s->queue, &spec, NULL, id);
+    if (pinned)
+        assets_unpin(s->ctx.assets, &spec.scene);
+    switch (submitted) {
     case QUEUE_OK:
         break;
-    case QUEUE_REFUSED: /* the asset changed since: its rule */
+    case QUEUE_REFUSED: /* held by the pin above: only an internal failure */
         return respond_error(c, MHD_HTTP_CONFLICT, "scene.asset", queue_submit_error());
     case QUEUE_FULL: {
         char msg[96];

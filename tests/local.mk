@@ -163,6 +163,7 @@ E2E_TESTS = \
 	tests/e2e/e2e_asset_convert.py \
 	tests/e2e/e2e_orphans.py \
 	tests/e2e/e2e_asset_pins.py \
+	tests/e2e/e2e_full_disk.py \
 	tests/e2e/systemd_sandbox.py \
 	tests/e2e/systemd_unit.sh
 
@@ -191,7 +192,8 @@ SANITIZER_TESTS = $(UNIT_TESTS) \
 	tests/e2e/e2e_persist.py \
 	tests/e2e/e2e_badinput.py \
 	tests/e2e/e2e_asset_convert.py \
-	tests/e2e/e2e_asset_pins.py
+	tests/e2e/e2e_asset_pins.py \
+	tests/e2e/e2e_full_disk.py
 check-sanitizers:
 if SANITIZERS
 	$(MAKE) $(AM_MAKEFLAGS) check TESTS='$(SANITIZER_TESTS)'

@@ -95,10 +95,12 @@ static json_t *render_json(const struct render_state *st, double stall_s)
                      st->since_progress_s, "stall_seconds", stall_s);
 }
 
-/* GET /healthz: cheap (no store, no lock), and true: 503 when the render
+/* GET /healthz: cheap (no store query), and true: 503 when the render
  * thread has stopped, or has made no progress for longer than the bound
  * while a job is on it, which no other endpoint would show (a job that
- * holds the GPU for minutes still left every other answer quick). */
+ * holds the GPU for minutes still left every other answer quick); 200
+ * "disk full" while the state directory's disk is (reads served, writes
+ * refused until there is room). */
 enum MHD_Result respond_healthz(struct http_server *s, struct MHD_Connection *c)
 {
     struct render_state st;
@@ -117,6 +119,17 @@ enum MHD_Result respond_healthz(struct http_server *s, struct MHD_Connection *c)
                             json_pack("{s:s, s:s, s:o}", "status", "stalled", "message", msg,
                                       "render", render));
     }
+    /* A full disk: the daemon serves what it has (reads, results) but
+     * accepts nothing new until there is room, which it finds by itself. */
+    struct store *store = queue_store(s->queue);
+    if (store_disk_full(store) && !store_has_room(store))
+        return respond_json(
+            c, MHD_HTTP_OK,
+            json_pack("{s:s, s:s, s:o}", "status", "disk full", "message",
+                      "the state directory's disk is full: results are served, but jobs, "
+                      "sweeps and assets are refused (507) until there is room again; "
+                      "free some space and it recovers by itself",
+                      "render", render));
     return respond_json(c, MHD_HTTP_OK, json_pack("{s:s, s:o}", "status", "ok", "render", render));
 }
 

@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include <sys/statvfs.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -62,6 +63,16 @@ static void convert(struct assets *a, const char *in, const char *out, struct co
     add_arg(argv, &argc, nums, "--max-indices", l->max_indices);
     add_arg(argv, &argc, nums, "--max-texture-pixels", l->max_texture_pixels);
     add_arg(argv, &argc, nums, "--max-texture-edge", l->max_texture_edge);
+    add_arg(argv, &argc, nums, "--max-nodes", l->max_nodes);
+    add_arg(argv, &argc, nums, "--max-cache-bytes", l->max_cache_bytes);
+    /* The room the cache may take: the disk's free space less what is kept
+     * for jobs (ASSETS_HEADROOM), as an upload's own bytes are checked. */
+    struct statvfs vfs;
+    if (statvfs(a->dir, &vfs) == 0) {
+        uint64_t avail = (uint64_t)vfs.f_bavail * vfs.f_frsize;
+        add_arg(argv, &argc, nums, "--disk-room-bytes",
+                avail > ASSETS_HEADROOM ? avail - ASSETS_HEADROOM : 0);
+    }
     if (a->cfg.run.memory_bytes)
         add_arg(argv, &argc, nums, "--max-memory", a->cfg.run.memory_bytes);
     add_arg(argv, &argc, nums, "--max-cpu-seconds", a->cfg.run.cpu_s);
@@ -234,8 +245,11 @@ bool asset_ensure_cache(struct assets *a, const char *sha, const char *in, json_
         json_int_t st = json_integer_value(json_object_get(c.out, "status"));
         const char *field = json_string_value(json_object_get(c.out, "field"));
         const char *message = json_string_value(json_object_get(c.out, "message"));
-        asset_refuse(e, st == 400 ? ASSETS_INVALID : ASSETS_UNCONVERTIBLE, field ? field : "body",
-                     "%s", message ? message : "the converter refused the asset");
+        enum assets_cause cause = st == 400   ? ASSETS_INVALID
+                                  : st == 507 ? ASSETS_NO_SPACE
+                                              : ASSETS_UNCONVERTIBLE;
+        asset_refuse(e, cause, field ? field : "body", "%s",
+                     message ? message : "the converter refused the asset");
         json_decref(c.out);
         unlink(tmp);
         return false;

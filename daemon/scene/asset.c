@@ -65,11 +65,12 @@ void asset_limits_defaults(struct asset_limits *lim)
     /* A million empty nodes (10 MB of GLB) took the converter 2.4 GB in
      * assimp's node tree: 2^18 of them take at most about 630 MB. */
     lim->max_nodes = 1u << 18;
+    lim->max_cache_bytes = 2ull << 30;
 }
 
 json_t *asset_limits_to_json(const struct asset_limits *lim)
 {
-    return json_pack("{sI sI sI sI sI sI sI sI sI sI sI}",
+    return json_pack("{sI sI sI sI sI sI sI sI sI sI sI sI}",
                      "max_file_bytes", (json_int_t)lim->max_file_bytes,
                      "max_vertices", (json_int_t)lim->max_vertices,
                      "max_indices", (json_int_t)lim->max_indices,
@@ -80,7 +81,8 @@ json_t *asset_limits_to_json(const struct asset_limits *lim)
                      "max_images", (json_int_t)lim->max_images,
                      "max_lights", (json_int_t)lim->max_lights,
                      "max_cameras", (json_int_t)lim->max_cameras,
-                     "max_nodes", (json_int_t)lim->max_nodes);
+                     "max_nodes", (json_int_t)lim->max_nodes,
+                     "max_cache_bytes", (json_int_t)lim->max_cache_bytes);
 }
 
 void asset_finish(struct asset *a)
@@ -323,13 +325,15 @@ static bool host_is_little_endian(void)
 /* -- writing: a FILE with a sticky error -- */
 
 struct writer {
-    FILE *f;
+    FILE *f; /* NULL: count the bytes only (asset_file_size) */
     bool failed;
+    uint64_t bytes;
 };
 
 static void w_bytes(struct writer *w, const void *p, size_t n)
 {
-    if (!w->failed && n && fwrite(p, 1, n, w->f) != n)
+    w->bytes += n;
+    if (w->f && !w->failed && n && fwrite(p, 1, n, w->f) != n)
         w->failed = true;
 }
 static void w_u32(struct writer *w, uint32_t v)
@@ -447,6 +451,13 @@ static void write_body(struct writer *w, const struct asset *a)
     w_bytes(w, TRAILER, TRAILER_SIZE);
 }
 
+uint64_t asset_file_size(const struct asset *a)
+{
+    struct writer w = {NULL, false, 0};
+    write_body(&w, a);
+    return w.bytes;
+}
+
 bool asset_file_write(const struct asset *a, const char *path, char *err, size_t errlen)
 {
     if (!host_is_little_endian()) {
@@ -474,7 +485,7 @@ bool asset_file_write(const struct asset *a, const char *path, char *err, size_t
         close(fd);
         goto fail;
     }
-    struct writer w = {fdopen(fd, "wb"), false};
+    struct writer w = {fdopen(fd, "wb"), false, 0};
     if (!w.f) {
         snprintf(err, errlen, "asset cache: %s: %s", tmp, strerror(errno));
         close(fd);
@@ -507,9 +518,11 @@ bool asset_file_write(const struct asset *a, const char *path, char *err, size_t
     }
     free(tmp);
     return true;
-fail:
+fail:;
+    int saved = errno; /* the writer's, for the caller (ENOSPC: no room) */
     unlink(tmp);
     free(tmp);
+    errno = saved;
     return false;
 }
 

@@ -181,6 +181,7 @@ struct asset_limits {
     uint32_t max_texture_edge;         /* one image's width or height */
     uint32_t max_meshes, max_materials, max_images, max_lights, max_cameras;
     uint32_t max_nodes; /* the file's nodes (assimp takes about 2.4 KB for each) */
+    uint64_t max_cache_bytes; /* the cache file the conversion writes (and a job reads whole) */
 };
 
 /* The daemon's defaults: 256 MiB files, 16 M vertices and 48 M indices,
@@ -192,6 +193,9 @@ json_t *asset_limits_to_json(const struct asset_limits *lim);
 /* The cache file: writes a into path (through a temporary and a rename, so
  * a reader never sees half a file). */
 bool asset_file_write(const struct asset *a, const char *path, char *err, size_t errlen);
+/* The bytes asset_file_write would write, counted without writing: the
+ * converter checks them against its limit and the disk's room first. */
+uint64_t asset_file_size(const struct asset *a);
 /* Reads a cache file, checking it against lim; out is finished on failure. */
 bool asset_file_read(struct asset *out, const char *path, const struct asset_limits *lim,
                      char *err, size_t errlen);

@@ -164,6 +164,7 @@ E2E_TESTS = \
 	tests/e2e/e2e_orphans.py \
 	tests/e2e/e2e_asset_pins.py \
 	tests/e2e/e2e_full_disk.py \
+	tests/e2e/e2e_upload_slots.py \
 	tests/e2e/systemd_sandbox.py \
 	tests/e2e/systemd_unit.sh
 
@@ -193,7 +194,8 @@ SANITIZER_TESTS = $(UNIT_TESTS) \
 	tests/e2e/e2e_badinput.py \
 	tests/e2e/e2e_asset_convert.py \
 	tests/e2e/e2e_asset_pins.py \
-	tests/e2e/e2e_full_disk.py
+	tests/e2e/e2e_full_disk.py \
+	tests/e2e/e2e_upload_slots.py
 check-sanitizers:
 if SANITIZERS
 	$(MAKE) $(AM_MAKEFLAGS) check TESTS='$(SANITIZER_TESTS)'

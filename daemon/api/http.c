@@ -34,6 +34,9 @@ void http_limits_defaults(struct http_limits *l)
     l->header_timeout_s = 10;
     l->body_timeout_s = 30;
     l->idle_timeout_s = 30;
+    l->uploads_per_ip = HTTP_UPLOADS_PER_IP;
+    l->upload_min_rate = CONNECTIONS_UPLOAD_MIN_RATE;
+    l->upload_window_s = CONNECTIONS_UPLOAD_WINDOW_S;
 }
 
 /* Compares in time that depends on the expected token's length only, never
@@ -79,6 +82,18 @@ bool http_server_set_token(struct http_server *s, const char *token)
  * of a wait, not an error (2,000 waits hung up made 2,000 warnings). */
 static _Thread_local bool closing_gone_client;
 
+/* The next 429's Retry-After on this thread (respond_retry), else
+ * RETRY_AFTER_DEFAULT_S. */
+static _Thread_local double next_retry_s;
+#define RETRY_AFTER_DEFAULT_S 5
+
+enum MHD_Result respond_retry(struct MHD_Connection *c, const char *field, const char *message,
+                              double retry_s)
+{
+    next_retry_s = retry_s;
+    return respond_error(c, MHD_HTTP_TOO_MANY_REQUESTS, field, message);
+}
+
 enum MHD_Result respond_text(struct MHD_Connection *c, unsigned status,
                              char *text, size_t len, const char *type)
 {
@@ -94,6 +109,14 @@ enum MHD_Result respond_text(struct MHD_Connection *c, unsigned status,
         MHD_add_response_header(resp, "Connection", "close"); /* gives the reserve slot back */
     if (status == MHD_HTTP_UNAUTHORIZED)
         MHD_add_response_header(resp, "WWW-Authenticate", "Bearer realm=\"shadebench\"");
+    if (status == MHD_HTTP_TOO_MANY_REQUESTS) {
+        /* RFC 9110: when to come back, in whole seconds. */
+        char after[24];
+        double wait = next_retry_s > 0 ? next_retry_s : RETRY_AFTER_DEFAULT_S;
+        snprintf(after, sizeof(after), "%.0f", wait < 1 ? 1 : wait + 0.5);
+        MHD_add_response_header(resp, "Retry-After", after);
+    }
+    next_retry_s = 0;
     connections_set_status(connections_of(c), status);
     enum MHD_Result ret = MHD_queue_response(c, status, resp);
     MHD_destroy_response(resp);
@@ -454,6 +477,7 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
         return MHD_YES;
     }
     if (*upload_data_size && req->upload) {
+        connections_upload_bytes(s->conns, req->conn, *upload_data_size);
         assets_upload_write(req->upload, upload_data, *upload_data_size);
         *upload_data_size = 0;
         /* Past the limit (a chunked body, whose length was not known), the
@@ -636,7 +660,10 @@ struct http_server *http_server_create(const char *listen, const struct http_lim
     pthread_mutex_init(&s->token_lock, NULL);
     struct connections_config cc = {.header_s = limits->header_timeout_s,
                                     .body_s = limits->body_timeout_s,
-                                    .per_ip = limits->max_connections_per_ip};
+                                    .per_ip = limits->max_connections_per_ip,
+                                    .uploads_per_ip = limits->uploads_per_ip,
+                                    .upload_min_rate = limits->upload_min_rate,
+                                    .upload_window_s = limits->upload_window_s};
     s->conns = connections_create(&cc, wait_done, s, err, errlen);
     if (!s->conns) {
         freeaddrinfo(ai);

@@ -77,6 +77,10 @@ json_t *info_json(struct http_server *s)
     if (limits && s->ctx.assets) {
         json_t *assets = assets_info_json(s->ctx.assets);
         json_object_set(limits, "max_asset_bytes", json_object_get(assets, "max_asset_bytes"));
+        /* What an upload's client must keep to its slot (connections.h). */
+        json_object_set_new(assets, "max_uploads_per_address", json_integer(l->uploads_per_ip));
+        json_object_set_new(assets, "upload_min_bytes_per_s", json_real(l->upload_min_rate));
+        json_object_set_new(assets, "upload_rate_window_s", json_real(l->upload_window_s));
         json_object_set_new(limits, "assets", assets);
     }
     return info;
@@ -242,6 +246,13 @@ enum MHD_Result respond_metrics(struct http_server *s, struct MHD_Connection *c)
                "shadebench_http_connections_cut_total{phase=\"headers\"} %llu\n"
                "shadebench_http_connections_cut_total{phase=\"body\"} %llu\n",
             cs.header_timeouts, cs.body_timeouts);
+    fprintf(f, "# HELP shadebench_http_uploads Uploads holding a slot (streaming or converting).\n"
+               "# TYPE shadebench_http_uploads gauge\n"
+               "shadebench_http_uploads %zu\n"
+               "# HELP shadebench_http_uploads_slow_total Uploads cut for bringing their body "
+               "slower than the minimum rate.\n"
+               "# TYPE shadebench_http_uploads_slow_total counter\n"
+               "shadebench_http_uploads_slow_total %llu\n", cs.uploads, cs.slow_uploads);
     fprintf(f, "# HELP shadebench_http_waits_abandoned_total Waits ended because their client hung up.\n"
                "# TYPE shadebench_http_waits_abandoned_total counter\n"
                "shadebench_http_waits_abandoned_total %llu\n", cs.waits_gone);

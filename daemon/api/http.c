@@ -55,8 +55,16 @@ static bool authorized(struct http_server *s, struct MHD_Connection *c)
     pthread_mutex_lock(&s->token_lock);
     bool ok = !s->token || s->token[0] == '\0';
     if (!ok) {
+        /* RFC 9110: the scheme is case-insensitive ("bearer" too), and one
+         * or more spaces part it from the token. */
         const char *auth = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Authorization");
-        ok = auth && strncmp(auth, "Bearer ", 7) == 0 && token_matches(auth + 7, s->token);
+        ok = auth && strncasecmp(auth, "Bearer ", 7) == 0;
+        if (ok) {
+            auth += 7;
+            while (*auth == ' ')
+                auth++;
+            ok = token_matches(auth, s->token);
+        }
     }
     pthread_mutex_unlock(&s->token_lock);
     return ok;
@@ -355,7 +363,7 @@ static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
 
 struct header_scan {
     size_t bytes;
-    int content_length, transfer_encoding;
+    int content_length, transfer_encoding, host;
 };
 
 static enum MHD_Result scan_header(void *cls, enum MHD_ValueKind kind, const char *key,
@@ -368,6 +376,8 @@ static enum MHD_Result scan_header(void *cls, enum MHD_ValueKind kind, const cha
         h->content_length++;
     else if (strcasecmp(key, "Transfer-Encoding") == 0)
         h->transfer_encoding++;
+    else if (strcasecmp(key, "Host") == 0)
+        h->host++;
     (void)value;
     return MHD_YES;
 }
@@ -396,6 +406,12 @@ static bool refuse_early(struct http_server *s, struct MHD_Connection *c, const 
         (te && strcasecmp(te, "chunked") != 0)) {
         *ret = respond_error(c, MHD_HTTP_BAD_REQUEST, "Transfer-Encoding",
                              "must be \"chunked\" alone, once, and without Content-Length");
+        return true;
+    }
+    /* RFC 9112: a request with more than one Host is a 400 (which one a
+     * proxy routed by is anyone's guess). */
+    if (h.host > 1) {
+        *ret = respond_error(c, MHD_HTTP_BAD_REQUEST, "Host", "must appear at most once");
         return true;
     }
     /* RFC 9112: an HTTP/1.1 request without Host is a 400 (a proxy's

@@ -51,6 +51,10 @@ enum MHD_Result post_sweep(struct http_server *s, struct MHD_Connection *c,
     }
     struct sweep_spec spec;
     struct job_error err;
+    if (!jf_check_numbers(req->body ? req->body : "", req->len, &err)) {
+        json_decref(body);
+        return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
+    }
     if (!sweep_spec_parse(body, s->ctx.catalog, &spec, &err)) {
         sweep_spec_finish(&spec);
         json_decref(body);

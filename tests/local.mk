@@ -6,6 +6,7 @@
 #                                   with --enable-sanitizers (build-asan/)
 #   make distcheck-quick            the tarball is complete and builds
 #   make fuzz [FUZZ_SECONDS=300]    each libFuzzer target (tests/fuzz/run.sh)
+#   make fuzz-long [FUZZ_LONG_SECONDS=1800]   the converter, routes, jobs, sweeps
 
 # GL-free unit tests in C, end-to-end tests in Python 3 (standard library
 # only) against a real daemon on a free loopback port.
@@ -216,7 +217,13 @@ distcheck-quick:
 FUZZ_SECONDS = 300
 fuzz:
 	$(SHELL) $(srcdir)/tests/fuzz/run.sh $(FUZZ_SECONDS)
-.PHONY: check-sanitizers distcheck-quick fuzz
+# The longer run (issue 34): the converter's checks, the HTTP routing and
+# the job and sweep parsers, FUZZ_LONG_SECONDS each (default 30 minutes,
+# two at a time: an hour), for a quiet machine, not CI.
+FUZZ_LONG_SECONDS = 1800
+fuzz-long:
+	$(SHELL) $(srcdir)/tests/fuzz/run.sh $(FUZZ_LONG_SECONDS) asset_convert route job sweep
+.PHONY: check-sanitizers distcheck-quick fuzz fuzz-long
 # Under --enable-sanitizers every test (and the daemons the end-to-end tests
 # start) stops at the first error; leaks inside the GL driver, LLVM and
 # fontconfig, which the daemon cannot free, are suppressed by name.

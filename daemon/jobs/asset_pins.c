@@ -1,3 +1,5 @@
+/* PATH_MAX (limits.h) under -std=c11, as the assets' other files. */
+#define _GNU_SOURCE
 /* The assets: pins (assets.h). A job or sweep naming an asset is pinned to
  * the asset's hash in the step that resolves the name, under the assets'
  * lock, so that a DELETE or a replacing PUT can never come between the two:

@@ -148,6 +148,8 @@ json_t *asset_describe(const struct asset *a)
         colored += m->has_color;
         why[m->uv1_origin <= ASSET_UV1_GENERATED_OVERLAP ? m->uv1_origin : 0]++;
         waste_weighted += (double)m->uv1_waste * (m->index_count / 3);
+        if (i >= ASSET_DESCRIBE_LIST_MAX)
+            continue; /* counted above, listed no further */
         json_t *attrs = json_pack("[s]", "POSITION");
         json_t *o = json_pack("{so si sI sI ss sf ss}", "name", name_json(m->name),
                 "material", (int)m->material, "vertices", (json_int_t)m->vertex_count,
@@ -171,7 +173,7 @@ json_t *asset_describe(const struct asset *a)
             json_array_append_new(attrs, json_string("COLOR_0"));
         json_object_set_new(o, "attributes", attrs);
     }
-    for (uint32_t i = 0; i < a->material_count; i++) {
+    for (uint32_t i = 0; i < a->material_count && i < ASSET_DESCRIBE_LIST_MAX; i++) {
         const struct asset_material *m = &a->materials[i];
         json_t *slots = json_array();
         if (!slots)
@@ -216,7 +218,8 @@ json_t *asset_describe(const struct asset *a)
     for (uint32_t i = 0; i < a->image_count; i++) {
         const struct asset_image *im = &a->images[i];
         pixels += (uint64_t)im->width * im->height;
-        if (json_array_append_new(texs, json_pack("{so sI sI}", "name", name_json(im->name),
+        if (i < ASSET_DESCRIBE_LIST_MAX &&
+            json_array_append_new(texs, json_pack("{so sI sI}", "name", name_json(im->name),
                                                   "width", (json_int_t)im->width,
                                                   "height", (json_int_t)im->height)))
             goto oom;
@@ -260,6 +263,16 @@ json_t *asset_describe(const struct asset *a)
         json_object_set_new(root, "vertex_colors", json_integer(colored)) ||
         json_object_set_new(root, "ignored", ign))
         goto oom_after;
+    /* What the lists leave out (counted in the totals above). */
+    if (a->mesh_count > ASSET_DESCRIBE_LIST_MAX)
+        json_object_set_new(root, "mesh_list_omitted",
+                            json_integer(a->mesh_count - ASSET_DESCRIBE_LIST_MAX));
+    if (a->material_count > ASSET_DESCRIBE_LIST_MAX)
+        json_object_set_new(root, "materials_omitted",
+                            json_integer(a->material_count - ASSET_DESCRIBE_LIST_MAX));
+    if (a->image_count > ASSET_DESCRIBE_LIST_MAX)
+        json_object_set_new(root, "textures_omitted",
+                            json_integer(a->image_count - ASSET_DESCRIBE_LIST_MAX));
     return root;
 oom:
     json_decref(meshes);

@@ -212,8 +212,14 @@ void asset_finish(struct asset *a);
 /* What the loader found, for PUT and GET /v1/assets/NAME: meshes,
  * triangles, vertices, materials (alpha modes, which slots have textures),
  * textures and their sizes, lights by type, cameras by name, bounds, uv1
- * (from the file or generated, and the texel waste), ignored features. New
+ * (from the file or generated, and the texel waste), ignored features. The
+ * per-mesh, per-material and per-texture lists hold the first
+ * ASSET_DESCRIBE_LIST_MAX (the rest counted in the totals and in
+ * mesh_list_omitted, materials_omitted, textures_omitted), so that the
+ * description of an asset within the limits stays small (60,000 meshes
+ * made 11 MB, past what the daemon reads of the converter's answer). New
  * reference, or NULL when out of memory. */
+#define ASSET_DESCRIBE_LIST_MAX 1024
 json_t *asset_describe(const struct asset *a);
 
 #endif

@@ -153,6 +153,13 @@ def main():
                 continue
             if rc == 0:
                 check(os.path.exists(cache), "%s: cache written" % name)
+                # The daemon reads at most 1 MiB of it (ASSETS_MAX_STDOUT).
+                check(len(out) < (1 << 20), "%s: the description is %d bytes, under 1 MiB"
+                      % (name, len(out)))
+                if doc and doc.get("meshes", 0) > 1024:
+                    check(len(doc.get("mesh_list", [])) == 1024 and
+                          doc.get("mesh_list_omitted") == doc["meshes"] - 1024,
+                          "%s: the mesh list holds 1024 meshes and counts the rest" % name)
                 check_good(name, entry, doc, cache)
             else:
                 check(doc is not None and set(doc) == {"status", "field", "message"},

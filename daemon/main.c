@@ -726,12 +726,16 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
         LOG(LOG_ERROR, "%s", err);
         goto out;
     }
-    queue_set_asset_resolver(q, assets_queue_resolver, assets);
+    struct queue_asset_hooks hooks;
+    assets_queue_hooks(assets, &hooks);
+    queue_set_asset_hooks(q, &hooks);
     sweeps = sweeps_create(q, catalog);
     if (!sweeps) {
         LOG(LOG_ERROR, "cannot start the sweep thread");
         goto out;
     }
+    /* The resumed sweeps hold their hashes now: what nothing holds goes. */
+    assets_release_unused(assets);
     const struct http_context http_ctx = {.catalog = catalog, .queue = q, .sweeps = sweeps,
                                           .assets = assets, .fidelity = fidelity,
                                           .render_state = render_state,
@@ -774,7 +778,7 @@ out:
     http_server_destroy(http);
     sweeps_destroy(sweeps);
     if (assets)
-        queue_set_asset_resolver(q, NULL, NULL);
+        queue_set_asset_hooks(q, NULL); /* the render thread may still end a job */
     assets_destroy(assets);
     /* A stop (not a failed start): within a few seconds whatever runs
      * (systemd's stop timeout is longer): the running job is back in the

@@ -6,6 +6,7 @@
 #                                   with --enable-sanitizers (build-asan/)
 #   make distcheck-quick            the tarball is complete and builds
 #   make fuzz [FUZZ_SECONDS=300]    each libFuzzer target (tests/fuzz/run.sh)
+#   make fuzz-long [FUZZ_LONG_SECONDS=1800]   the converter, routes, jobs, sweeps
 
 # GL-free unit tests in C, end-to-end tests in Python 3 (standard library
 # only) against a real daemon on a free loopback port.
@@ -41,6 +42,7 @@ UNIT_TESTS = \
 	tests/unit/test_uv_charts \
 	tests/unit/test_uv_overlap \
 	tests/unit/test_convert_matrices \
+	tests/unit/test_convert_checks \
 	tests/unit/test_light_shape \
 	tests/unit/test_fidelity
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
@@ -92,6 +94,10 @@ tests_unit_test_uv_overlap_LDADD = -lm
 tests_unit_test_convert_matrices_SOURCES = tests/unit/test_convert_matrices.c \
 	daemon/assets/convert_matrices.c daemon/assets/convert_internal.h
 tests_unit_test_convert_matrices_LDADD = $(JANSSON_LIBS) -lm
+# The converter's checks, on documents of up to a million nodes.
+tests_unit_test_convert_checks_SOURCES = tests/unit/test_convert_checks.c $(ASSET_CONVERT_SOURCES)
+tests_unit_test_convert_checks_CFLAGS = $(AM_CFLAGS) $(ASSIMP_CFLAGS) $(JPEG_CFLAGS)
+tests_unit_test_convert_checks_LDADD = $(CORE_LIBS) $(ASSIMP_LIBS) $(JPEG_LIBS) -lm
 tests_tools_png_tool_SOURCES = tests/tools/png_tool.c
 tests_tools_png_tool_LDADD = $(CORE_LIBS)
 noinst_HEADERS = tests/unit/check.h tests/unit/catalog_fixture.h tests/fuzz/fuzz.h
@@ -176,6 +182,10 @@ E2E_TESTS = \
 	tests/e2e/e2e_demo.py \
 	tests/e2e/e2e_verdicts.py \
 	tests/e2e/e2e_asset_convert.py \
+	tests/e2e/e2e_orphans.py \
+	tests/e2e/e2e_asset_pins.py \
+	tests/e2e/e2e_full_disk.py \
+	tests/e2e/e2e_upload_slots.py \
 	tests/e2e/systemd_sandbox.py \
 	tests/e2e/systemd_unit.sh
 
@@ -204,7 +214,10 @@ SANITIZER_TESTS = $(UNIT_TESTS) \
 	tests/e2e/e2e_persist.py \
 	tests/e2e/e2e_badinput.py \
 	tests/e2e/e2e_asset_convert.py \
-	tests/e2e/e2e_compare_alpha.py
+	tests/e2e/e2e_compare_alpha.py \
+	tests/e2e/e2e_asset_pins.py \
+	tests/e2e/e2e_full_disk.py \
+	tests/e2e/e2e_upload_slots.py
 check-sanitizers:
 if SANITIZERS
 	$(MAKE) $(AM_MAKEFLAGS) check TESTS='$(SANITIZER_TESTS)'
@@ -225,7 +238,13 @@ distcheck-quick:
 FUZZ_SECONDS = 300
 fuzz:
 	$(SHELL) $(srcdir)/tests/fuzz/run.sh $(FUZZ_SECONDS)
-.PHONY: check-sanitizers distcheck-quick fuzz
+# The longer run (issue 34): the converter's checks, the HTTP routing and
+# the job and sweep parsers, FUZZ_LONG_SECONDS each (default 30 minutes,
+# two at a time: an hour), for a quiet machine, not CI.
+FUZZ_LONG_SECONDS = 1800
+fuzz-long:
+	$(SHELL) $(srcdir)/tests/fuzz/run.sh $(FUZZ_LONG_SECONDS) asset_convert route job sweep
+.PHONY: check-sanitizers distcheck-quick fuzz fuzz-long
 # Under --enable-sanitizers every test (and the daemons the end-to-end tests
 # start) stops at the first error; leaks inside the GL driver, LLVM and
 # fontconfig, which the daemon cannot free, are suppressed by name.

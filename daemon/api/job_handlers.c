@@ -31,23 +31,37 @@ static enum MHD_Result queue_spec(struct http_server *s, struct MHD_Connection *
         return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "fidelity", msg);
     }
     struct job_spec spec = *sp;
-    /* scene.asset: pinned to the stored asset's hash here, so that the
-     * answer names the rule (400 unknown, 409 a different pinned hash);
-     * queue_submit resolves again, for the sweeps' points. */
+    struct job_error err;
+    /* Its assets (scene.asset, an environment map): resolved and pinned to
+     * the stored hashes in one step here, so that the answer names the rule
+     * (400 unknown, 409 a different pinned hash) and the asset's memory is
+     * charged to the job (job_cost.h); queue_submit pins them again until
+     * the job is live, and this pin goes after it. */
+    bool pinned = false;
     if (job_spec_names_asset(&spec)) {
         struct assets_error ae;
         if (!s->ctx.assets)
             return respond_error(c, MHD_HTTP_BAD_REQUEST,
                                  spec.scene.asset[0] ? "scene.asset" : "look.ibl.environment",
                                  "this daemon has no asset store");
-        if (!assets_resolve_job(s->ctx.assets, &spec, &ae))
+        if (!assets_pin(s->ctx.assets, &spec, false, &ae))
             return respond_asset_error(c, &ae);
+        pinned = true;
+        struct job_cost cost;
+        job_cost_estimate(&spec, &cost);
+        if (!job_cost_admit(&cost, &err)) {
+            assets_unpin(s->ctx.assets, &spec);
+            return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
+        }
     }
     char id[24];
-    switch (queue_submit(s->queue, &spec, NULL, id)) {
+    enum queue_submit_result submitted = queue_submit(s->queue, &spec, NULL, id);
+    if (pinned)
+        assets_unpin(s->ctx.assets, &spec);
+    switch (submitted) {
     case QUEUE_OK:
         break;
-    case QUEUE_REFUSED: /* the asset changed since: its rule */
+    case QUEUE_REFUSED: /* held by the pin above: only an internal failure */
         return respond_error(c, MHD_HTTP_CONFLICT, "scene.asset", queue_submit_error());
     case QUEUE_FULL: {
         char msg[96];

@@ -6,10 +6,13 @@
  *
  *   shadebench-asset convert IN_FILE OUT_CACHE [--max-file-bytes N]
  *       [--max-vertices N] [--max-indices N] [--max-texture-pixels N]
- *       [--max-texture-edge N] [--max-memory BYTES] [--max-cpu-seconds S]
+ *       [--max-texture-edge N] [--max-nodes N] [--max-cache-bytes N]
+ *       [--disk-room-bytes N] [--max-memory BYTES] [--max-cpu-seconds S]
  *
  * Exit 0: OUT_CACHE written, stdout one JSON object (asset_describe). Exit
- * 2: the asset is refused, stdout {"status": 400|422, "field", "message"}.
+ * 2: the asset is refused, stdout {"status": 400|422|507, "field",
+ * "message"} (507: the cache does not fit the room --disk-room-bytes says
+ * the disk has, or the disk filled while it was written).
  * Anything else (1 for usage or the converter's own failures, a signal from
  * the limits): the loader failed. */
 #include <errno.h>
@@ -30,7 +33,8 @@ static int usage(void)
 {
     fprintf(stderr, "usage: shadebench-asset convert IN_FILE OUT_CACHE [--max-file-bytes N] "
                     "[--max-vertices N] [--max-indices N] [--max-texture-pixels N] "
-                    "[--max-texture-edge N] [--max-memory BYTES] [--max-cpu-seconds S]\n");
+                    "[--max-texture-edge N] [--max-nodes N] [--max-cache-bytes N] "
+                    "[--disk-room-bytes N] [--max-memory BYTES] [--max-cpu-seconds S]\n");
     return 1;
 }
 
@@ -162,7 +166,8 @@ int main(int argc, char **argv)
     const char *in = argv[2], *out = argv[3];
     struct asset_limits lim;
     asset_limits_defaults(&lim);
-    uint64_t max_memory = 0, max_cpu = 0;
+    uint64_t max_memory = 0, max_cpu = 0, disk_room = 0;
+    bool have_room = false;
     for (int i = 4; i < argc; i += 2) {
         uint64_t v;
         if (i + 1 >= argc || !parse_u64(argv[i + 1], &v)) {
@@ -179,6 +184,12 @@ int main(int argc, char **argv)
             lim.max_texture_pixels = v;
         else if (!strcmp(argv[i], "--max-texture-edge") && v <= UINT32_MAX)
             lim.max_texture_edge = (uint32_t)v;
+        else if (!strcmp(argv[i], "--max-nodes") && v <= UINT32_MAX)
+            lim.max_nodes = (uint32_t)v;
+        else if (!strcmp(argv[i], "--max-cache-bytes"))
+            lim.max_cache_bytes = v;
+        else if (!strcmp(argv[i], "--disk-room-bytes"))
+            disk_room = v, have_room = true;
         else if (!strcmp(argv[i], "--max-memory"))
             max_memory = v;
         else if (!strcmp(argv[i], "--max-cpu-seconds"))
@@ -247,11 +258,34 @@ int main(int argc, char **argv)
         fprintf(stderr, "shadebench-asset: %s: %s\n", cerr.field, cerr.message);
         return 1;
     }
+    /* The cache's size, known before a byte of it is written: over the
+     * limit, or over the room the daemon says the disk has for it (its free
+     * space less what it keeps for jobs), it is refused, not written until
+     * the disk fills. */
+    uint64_t size = asset_file_size(&a);
+    char msg[320];
+    if (size > lim.max_cache_bytes || (have_room && size > disk_room)) {
+        bool limit = size > lim.max_cache_bytes;
+        if (limit)
+            snprintf(msg, sizeof(msg), "the cache would take %" PRIu64 " bytes (its images "
+                     "decoded, its vertices expanded), the limit is %" PRIu64, size,
+                     lim.max_cache_bytes);
+        else
+            snprintf(msg, sizeof(msg), "the cache would take %" PRIu64 " bytes; the state "
+                     "directory's disk has room for %" PRIu64 " (its free space less what is "
+                     "kept for jobs)", size, disk_room);
+        asset_finish(&a);
+        free(out_abs);
+        return refuse(limit ? 422 : 507, limit ? "limits.max_cache_bytes" : "state_dir", msg);
+    }
     char err[512];
     if (!asset_file_write(&a, out_abs, err, sizeof(err))) {
+        int saved = errno;
         fprintf(stderr, "shadebench-asset: %s\n", err);
         asset_finish(&a);
         free(out_abs);
+        if (saved == ENOSPC || saved == EDQUOT)
+            return refuse(507, "state_dir", err);
         return 1;
     }
     free(out_abs);

@@ -97,9 +97,12 @@ void job_cost_estimate(const struct job_spec *spec, struct job_cost *out)
     }
     out->series_bytes = (double)spec->frames * job_spec_runs(spec) * SERIES_DOUBLES_PER_FRAME *
                         sizeof(double);
+    /* The asset's decoded textures and geometry, what its upload's size
+     * says nothing of (a 2 KB file can decode to gigabytes). */
+    out->asset_bytes = spec->scene.asset_bytes;
     out->memory_bytes = out->targets_bytes + out->look_bytes + out->captures_bytes +
                         out->reference_bytes + out->metrics_bytes + out->series_bytes +
-                        out->temporal_bytes;
+                        out->temporal_bytes + out->asset_bytes;
     out->frames_total = (double)(spec->frames + spec->warmup_frames) * job_spec_runs(spec);
     out->pixel_frames = pixels * out->frames_total;
     /* "auto" (an asset scene's default) is counted at the most it can be. */
@@ -125,6 +128,7 @@ void job_cost_estimate(const struct job_spec *spec, struct job_cost *out)
          spec->reference_supersample > 1 ? "reference.supersample" : "reference"},
         {out->temporal_bytes, "temporal.frames"},
         {out->series_bytes, "frames"},
+        {out->asset_bytes, "scene.asset"},
     };
     out->memory_field = parts[0].field;
     double most = parts[0].bytes;
@@ -148,6 +152,8 @@ json_t *job_cost_json(const struct job_cost *c)
                           c->metric_pixels);
     if (c->temporal_bytes > 0)
         json_object_set_new(o, "temporal_bytes", json_real(c->temporal_bytes));
+    if (c->asset_bytes > 0)
+        json_object_set_new(o, "asset_bytes", json_real(c->asset_bytes));
     return o;
 }
 
@@ -158,9 +164,11 @@ bool job_cost_admit(const struct job_cost *c, struct job_error *err)
         return true;
     return job_error_set(err, c->memory_field,
                          "the job would take about %.0f MiB (framebuffers %.0f, captures %.0f, "
-                         "shadows and probes %.0f, reference and metrics %.0f), more than the "
-                         "%.0f MiB a job may take (/v1/info: memory.job_bytes)",
+                         "shadows and probes %.0f, reference and metrics %.0f, the asset's "
+                         "textures and geometry %.0f), more than the %.0f MiB a job may take "
+                         "(/v1/info: memory.job_bytes)",
                          c->memory_bytes / 1048576.0, c->targets_bytes / 1048576.0,
                          c->captures_bytes / 1048576.0, c->look_bytes / 1048576.0,
-                         (c->reference_bytes + c->metrics_bytes) / 1048576.0, limit / 1048576.0);
+                         (c->reference_bytes + c->metrics_bytes) / 1048576.0,
+                         c->asset_bytes / 1048576.0, limit / 1048576.0);
 }

@@ -567,6 +567,11 @@ bool job_spec_parse_text(const char *text, size_t len,
         return job_error_set(err, "body", "malformed JSON at line %d, column %d: %s",
                     jerr.line, jerr.column, jerr.text);
     }
+    if (!jf_check_numbers(text, len, err)) {
+        json_decref(body);
+        job_spec_defaults(out, techniques);
+        return false;
+    }
     bool ok = job_spec_parse(body, techniques, out, err);
     json_decref(body);
     return ok;

@@ -914,7 +914,139 @@ def bad_mode(mode):
     return g.glb()
 
 
-def build_all(out, realistic=False, big_maps=False):
+# ---- hostile assets (issue 34): what a red team sent ----
+
+def lying_jpeg(edge=8192):
+    """The 16x16 JPEG whose frame header declares edge x edge: libjpeg pads
+    the missing scans, so a 2 KB file would decode to edge^2 x 4 bytes."""
+    jpg = bytearray(SOLID16_JPEG)
+    sof = jpg.index(b"\xff\xc0")
+    jpg[sof + 5:sof + 9] = struct.pack(">HH", edge, edge)
+    return bytes(jpg)
+
+
+def lying_png(edge=8192):
+    """A PNG whose IHDR declares edge x edge over one row of data."""
+    def chunk(kind, data):
+        body = kind + data
+        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body) & 0xFFFFFFFF)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", edge, edge, 8, 6, 0, 0, 0))
+            + chunk(b"IDAT", zlib.compress(b"\0" * (edge * 4 + 1), 9)) + chunk(b"IEND", b""))
+
+
+def image_asset(images, mime):
+    """A cube whose material names each of images (bytes) as a texture."""
+    g = Gltf()
+    slots = ["baseColorTexture", "metallicRoughnessTexture"]
+    pbr = {}
+    extra = {}
+    for k, data in enumerate(images):
+        t = g.texture(g.image(data, mime=mime))
+        if k < 2:
+            pbr[slots[k]] = {"index": t}
+        elif k == 2:
+            extra["emissiveTexture"] = {"index": t}
+        else:
+            extra["occlusionTexture"] = {"index": t}
+    m = g.material(pbrMetallicRoughness=pbr, **extra)
+    g.node(mesh=g.mesh(cube(), material=m, uv1=False))
+    return g
+
+
+def unused_mesh_asset():
+    """A valid glTF with a mesh no node uses (glTF allows it)."""
+    g = Gltf()
+    g.node(mesh=g.mesh(cube(), uv1=False, name="used"))
+    g.mesh(grid(2), uv1=False, name="spare")
+    return g
+
+
+def node_chain_asset(levels):
+    """A mesh at the bottom of a chain of levels nodes (the root is level 1)."""
+    g = Gltf()
+    mesh = g.mesh(cube(), uv1=False)
+    g.node(root=True)
+    for i in range(1, levels):
+        g.node(root=False)
+        g.doc["nodes"][i - 1]["children"] = [i]
+    g.doc["nodes"][levels - 1]["mesh"] = mesh
+    return g
+
+
+def data_uri_asset(mutate):
+    """The textured-less cube as .gltf with its buffer as a data URI; mutate
+    (doc) changes it."""
+    g = Gltf()
+    g.node(mesh=g.mesh(cube(), uv1=False))
+    doc = json.loads(g.gltf_data_uri())
+    mutate(doc)
+    return json.dumps(doc).encode()
+
+
+def bad_base64_unpadded(doc):
+    uri = doc["buffers"][0]["uri"]
+    doc["buffers"][0]["uri"] = uri.rstrip("=") + "A"  # a length no base64 text has
+
+
+def bad_base64_inner_pad(doc):
+    head, data = doc["buffers"][0]["uri"].split(",", 1)
+    doc["buffers"][0]["uri"] = head + "," + data[:8] + "=" + data[9:]
+
+
+def data_longer_than_bytelength(doc):
+    head, data = doc["buffers"][0]["uri"].split(",", 1)
+    doc["buffers"][0]["uri"] = head + "," + base64.b64encode(base64.b64decode(data) +
+                                                             b"\0" * 16).decode()
+
+
+def many_nodes_asset(roots, mesh_nodes=1):
+    """mesh_nodes root nodes instancing one triangle, then empty root nodes
+    up to roots in all; the JSON written directly (a million nodes)."""
+    tri = struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0)
+    doc = {"asset": {"version": "2.0"}, "scene": 0,
+           "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+           "buffers": [{"byteLength": len(tri)}],
+           "bufferViews": [{"buffer": 0, "byteLength": len(tri)}],
+           "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                          "min": [0, 0, 0], "max": [1, 1, 0]}]}
+    head = json.dumps(doc, separators=(",", ":"))[:-1]
+    nodes = ",".join(['{"mesh":0,"translation":[%d,0,0]}' % i for i in range(mesh_nodes)] +
+                     ["{}"] * (roots - mesh_nodes))
+    scene = ",".join(str(i) for i in range(roots))
+    js = ('%s,"nodes":[%s],"scenes":[{"nodes":[%s]}]}' % (head, nodes, scene)).encode()
+    return rebuild_glb_json(js, tri)
+
+
+def rebuild_glb_json(js, binary):
+    js += b" " * (-len(js) % 4)
+    binary = bytes(binary) + b"\0" * (-len(binary) % 4)
+    out = struct.pack("<I I", len(js), 0x4E4F534A) + js
+    out += struct.pack("<I I", len(binary), 0x004E4942) + binary
+    return b"glTF" + struct.pack("<I I", 2, 12 + len(out)) + out
+
+
+def hostile_all(write):
+    """The hostile files of issue 34 that are small enough for every run;
+    write(name, data, **expect) as build_all's."""
+    write("lying_jpeg.glb", image_asset([lying_jpeg()], "image/jpeg").glb(), exit=2, status=400,
+          field="images[0]")
+    write("lying_jpeg4.glb", image_asset([lying_jpeg()] * 4, "image/jpeg").glb(), exit=2,
+          status=400, field="images[0]")
+    write("lying_png.glb", image_asset([lying_png()], "image/png").glb(), exit=2, status=400,
+          field="images[0]")
+    write("unused_mesh.glb", unused_mesh_asset().glb(), exit=0,
+          expect={"meshes": 1, "triangles": 12})
+    write("chain_256.glb", node_chain_asset(256).glb(), exit=0, expect={"meshes": 1})
+    write("chain_257.glb", node_chain_asset(257).glb(), exit=2, status=422, field="nodes[256]")
+    write("base64_unpadded.gltf", data_uri_asset(bad_base64_unpadded), exit=2, status=400,
+          field="buffers[0].uri")
+    write("base64_inner_pad.gltf", data_uri_asset(bad_base64_inner_pad), exit=2, status=400,
+          field="buffers[0].uri")
+    write("data_longer.gltf", data_uri_asset(data_longer_than_bytelength), exit=2, status=400,
+          field="buffers[0].byteLength")
+
+
+def build_all(out, realistic=False, big_maps=False, hostile_big=False, cpu_seconds=60):
     os.makedirs(out, exist_ok=True)
     manifest = []
 
@@ -1018,6 +1150,16 @@ def build_all(out, realistic=False, big_maps=False):
           args=["--max-vertices", "10"])
     write("over_file_bytes.glb", good, exit=2, status=422, field="limits.max_file_bytes",
           args=["--max-file-bytes", "100"])
+    hostile_all(write)
+    if hostile_big:
+        # Checked in time linear in the nodes (issue 34: each took the old
+        # converter minutes, quadratic in nodes times roots), under a CPU
+        # limit that minutes would run past.
+        cpu = ["--max-cpu-seconds", str(cpu_seconds)]
+        write("roots_1m.glb", many_nodes_asset(1000000), exit=2, status=422,
+              field="limits.max_nodes", args=cpu)
+        write("mesh_nodes_60k.glb", many_nodes_asset(60000, 60000), exit=0,
+              expect={"meshes": 60000, "triangles": 60000}, args=cpu)
     with open(os.path.join(out, "manifest.json"), "w") as f:
         json.dump(manifest, f, indent=1)
     return manifest

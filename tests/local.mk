@@ -37,7 +37,8 @@ UNIT_TESTS = \
 	tests/unit/test_lighting \
 	tests/unit/test_asset \
 	tests/unit/test_uv_charts \
-	tests/unit/test_light_shape
+	tests/unit/test_light_shape \
+	tests/unit/test_tile_plan
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
 	tests/fuzz/replay-route tests/fuzz/replay-asset_cache tests/fuzz/replay-asset_convert
@@ -59,6 +60,10 @@ tests_unit_test_records_LDADD = $(CORE_LIBS)
 tests_unit_test_interference_SOURCES = tests/unit/test_interference.c \
 	daemon/harness/interference.c daemon/harness/interference.h
 tests_unit_test_interference_LDADD = $(CORE_LIBS)
+# The measuring run's tiles: GL-free logic in the GL toolkit's folder.
+tests_unit_test_tile_plan_SOURCES = tests/unit/test_tile_plan.c daemon/gpu/tile_plan.c \
+	daemon/gpu/tile_plan.h
+tests_unit_test_tile_plan_LDADD = -lm
 tests_unit_test_png_LDADD = $(CORE_LIBS)
 tests_unit_test_gate_SOURCES = tests/unit/test_gate.c $(CLIENT_PURE)
 tests_unit_test_gate_LDADD = $(CORE_LIBS) -lm
@@ -124,6 +129,10 @@ E2E_TESTS = \
 	tests/e2e/e2e_report.py \
 	tests/e2e/e2e_faults.py \
 	tests/e2e/e2e_runaway.py \
+	tests/e2e/e2e_timing_rule.py \
+	tests/e2e/e2e_cancel_drain.py \
+	tests/e2e/e2e_pass_times.py \
+	tests/e2e/e2e_guardrails.py \
 	tests/e2e/e2e_hardening.py \
 	tests/e2e/e2e_many_lights.py \
 	tests/e2e/e2e_light_types.py \

@@ -26,6 +26,7 @@
 #include "daemon/api/routes.h"
 #include "daemon/harness/telemetry.h"
 #include "daemon/jobs/job_cost.h"
+#include "daemon/jobs/job_eta.h"
 #include "daemon/jobs/job_spec.h"
 #include "daemon/quality/metrics.h"
 #include "daemon/api/job_filter.h"
@@ -312,6 +313,9 @@ static json_t *info_json(struct http_server *s)
     /* The asset limits (assets.h): the upload's body limit, the converter's
      * limits on what an asset may hold, and its memory, CPU and time. */
     json_t *limits = json_object_get(info, "limits");
+    /* The bound on one whole frame (measure.c): over it, a job fails before
+     * timing unless it accepts sliced timing. */
+    json_object_set_new(limits, "max_frame_seconds", json_real(job_spec_max_frame_seconds()));
     if (limits && s->ctx.assets) {
         json_t *assets = assets_info_json(s->ctx.assets);
         json_object_set(limits, "max_asset_bytes", json_object_get(assets, "max_asset_bytes"));
@@ -327,8 +331,12 @@ static json_t *render_json(const struct render_state *st, double stall_s)
         return json_pack("{s:s}", "state", "stopped");
     if (!st->busy)
         return json_pack("{s:s, s:f}", "state", "idle", "idle_s", st->since_progress_s);
+    /* A job that ended early is drained, not rendered: its state is final. */
     return json_pack("{s:s, s:s, s:s, s:f, s:f, s:f}", "state",
-                     render_state_stalled(st, stall_s) ? "stalled" : "busy", "job", st->job,
+                     render_state_stalled(st, stall_s) ? "stalled"
+                     : render_state_draining(st)        ? "draining"
+                                                        : "busy",
+                     "job", st->job,
                      "phase", st->phase, "busy_s", st->busy_s, "since_progress_s",
                      st->since_progress_s, "stall_seconds", stall_s);
 }
@@ -517,6 +525,13 @@ static enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *
         if (!assets_resolve(s->ctx.assets, &spec.scene, &ae))
             return respond_asset_error(c, &ae);
     }
+    /* Its duration on this device, where a job of its technique has run: a
+     * projection far past its timeout_s (or a frame far past the frame
+     * bound) is refused with the figures (job_eta.h). */
+    struct job_eta eta;
+    job_eta_estimate(&spec, &eta);
+    if (!job_eta_admit(&spec, &eta, &err))
+        return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
     char id[24];
     switch (queue_submit(s->queue, &spec, NULL, id)) {
     case QUEUE_OK:
@@ -540,8 +555,9 @@ static enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *
     struct job_cost cost;
     job_cost_estimate(&spec, &cost);
     return respond_json(c, MHD_HTTP_ACCEPTED,
-                        json_pack("{s:s, s:s, s:s, s:o}", "id", id, "status", "queued", "url", url,
-                                  "cost", job_cost_json(&cost)));
+                        json_pack("{s:s, s:s, s:s, s:o, s:o}", "id", id, "status", "queued", "url",
+                                  url, "cost", job_cost_json(&cost), "estimate",
+                                  job_eta_json(&eta)));
 }
 
 static bool parse_wait(struct MHD_Connection *c, double *wait)

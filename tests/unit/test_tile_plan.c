@@ -1,0 +1,148 @@
+/* The measuring run's tiles (daemon/gpu/tile_plan.h) on simulated pieces:
+ * every unit drawn once, no tile far over a slice where a costly region
+ * lies under a cheap one (the 16-tile measure of before drew a sixteenth of
+ * a frame of 15 s, and one tile over the objects held the render thread for
+ * 88 s after a timeout), the cost whole with the fixed cost counted once,
+ * and few tiles where the piece is cheap. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "daemon/gpu/tile_plan.h"
+#include "tests/unit/check.h"
+
+/* A piece: what every tile pays, and each unit's cost. */
+struct sim {
+    int w, h;
+    double fixed; /* the submission's cost (a software renderer's vertex work) */
+    double (*cost)(const struct sim *s, int x, int y);
+    double param;
+};
+
+static double uniform(const struct sim *s, int x, int y)
+{
+    (void)x, (void)y;
+    return s->param;
+}
+
+/* A cheap sky over the top rows, costly objects under it (forward with
+ * 16,384 lights at 128x128: about 4.5 ms a pixel on a loaded 2-core box). */
+static double sky_then_objects(const struct sim *s, int x, int y)
+{
+    (void)x;
+    return y < s->h / 6 ? 1e-7 : s->param;
+}
+
+/* One costly object in a corner of a cheap frame. */
+static double corner_object(const struct sim *s, int x, int y)
+{
+    return x > s->w * 7 / 8 && y > s->h * 7 / 8 ? s->param : 2e-8;
+}
+
+struct outcome {
+    int tiles, overdrawn, missed;
+    double worst_tile_s, whole_s, true_whole_s;
+};
+
+static struct outcome run(const struct sim *s, double slice)
+{
+    struct outcome o = {0};
+    unsigned char *drawn = calloc((size_t)s->w * s->h, 1);
+    struct tile_plan p;
+    tile_plan_init(&p, s->w, s->h, slice);
+    struct tile_rect r;
+    o.true_whole_s = s->fixed;
+    for (int y = 0; y < s->h; y++)
+        for (int x = 0; x < s->w; x++)
+            o.true_whole_s += s->cost(s, x, y);
+    unsigned seed = 7;
+    while (tile_plan_next(&p, &r) && o.tiles < 1000000) {
+        double t = s->fixed, work = 0;
+        CHECK(r.x >= 0 && r.y >= 0 && r.w >= 1 && r.h >= 1 && r.x + r.w <= s->w &&
+              r.y + r.h <= s->h);
+        for (int y = r.y; y < r.y + r.h; y++)
+            for (int x = r.x; x < r.x + r.w; x++) {
+                if (drawn[(size_t)y * s->w + x]++)
+                    o.overdrawn++;
+                work += s->cost(s, x, y);
+            }
+        t += work;
+        if (t > o.worst_tile_s)
+            o.worst_tile_s = t;
+        /* A loaded machine preempts the submission now and then. */
+        seed = seed * 1103515245u + 12345u;
+        double preempted = (seed >> 16) % 4 == 0 ? 0.05 : 0.0;
+        tile_plan_done(&p, s->fixed + preempted, work + 1e-5);
+        o.tiles++;
+    }
+    for (size_t i = 0; i < (size_t)s->w * s->h; i++)
+        o.missed += drawn[i] == 0;
+    o.whole_s = tile_plan_whole_s(&p);
+    free(drawn);
+    return o;
+}
+
+static void report(const char *what, const struct outcome *o)
+{
+    printf("%-40s %6d tiles, worst %.3f s, whole %.3f s (true %.3f s)\n", what, o->tiles,
+           o->worst_tile_s, o->whole_s, o->true_whole_s);
+}
+
+int main(void)
+{
+    const double slice = 0.2;
+
+    /* The runaway test's frame: no tile far over a slice, every unit once. */
+    struct sim heavy = {128, 128, 0.005, sky_then_objects, 4.5e-3};
+    struct outcome o = run(&heavy, slice);
+    report("sky over objects, 128x128, 4.5 ms/px", &o);
+    CHECK(o.overdrawn == 0 && o.missed == 0);
+    CHECK(o.worst_tile_s < 2.5 * slice);
+    CHECK(fabs(o.whole_s - o.true_whole_s) < 0.01 * o.true_whole_s);
+
+    /* 65,536 lights at 256x256 (241 s a frame unloaded, 3.7 ms a pixel). */
+    struct sim many = {256, 256, 0.01, uniform, 3.7e-3};
+    o = run(&many, slice);
+    report("65,536 lights, 256x256", &o);
+    CHECK(o.overdrawn == 0 && o.missed == 0 && o.worst_tile_s < 2.5 * slice);
+
+    /* A geometry-bound pass: the fixed cost counted once, not once a tile. */
+    struct sim geometry = {640, 480, 0.04, uniform, 1e-9};
+    o = run(&geometry, slice);
+    report("geometry-bound, 640x480, 40 ms a tile", &o);
+    CHECK(o.overdrawn == 0 && o.missed == 0 && o.tiles < 25);
+    CHECK(o.whole_s < 1.2 * o.true_whole_s && o.whole_s > 0.9 * o.true_whole_s);
+
+    /* A cheap 1080x720 frame: few tiles. */
+    struct sim cheap = {1080, 720, 0.002, uniform, 3e-8};
+    o = run(&cheap, slice);
+    report("cheap, 1080x720", &o);
+    CHECK(o.overdrawn == 0 && o.missed == 0 && o.tiles < 25);
+    CHECK(fabs(o.whole_s - o.true_whole_s) < 0.2 * o.true_whole_s);
+
+    /* A moderate frame (forward, 256 lights at 1080x720 on llvmpipe). */
+    struct sim moderate = {1080, 720, 0.003, uniform, 2.6e-6};
+    o = run(&moderate, slice);
+    report("moderate, 1080x720, 2 s whole", &o);
+    CHECK(o.overdrawn == 0 && o.missed == 0 && o.worst_tile_s < 2.5 * slice);
+    CHECK(fabs(o.whole_s - o.true_whole_s) < 0.02 * o.true_whole_s);
+
+    /* A costly object in a corner of a cheap frame. */
+    struct sim corner = {512, 512, 0.002, corner_object, 1e-4};
+    o = run(&corner, slice);
+    report("costly corner, 512x512", &o);
+    CHECK(o.overdrawn == 0 && o.missed == 0 && o.worst_tile_s < 3.0 * slice);
+
+    /* A range of work items (a dispatch's groups), and tiny pieces. */
+    struct sim range = {100000, 1, 0.0005, uniform, 5e-5};
+    o = run(&range, slice);
+    report("range of 100,000 items", &o);
+    CHECK(o.overdrawn == 0 && o.missed == 0 && o.worst_tile_s < 2.5 * slice);
+    int sizes[][2] = {{1, 1}, {3, 1}, {1, 5}, {7, 3}, {64, 48}, {5, 200}};
+    for (size_t i = 0; i < sizeof(sizes) / sizeof(sizes[0]); i++) {
+        struct sim tiny = {sizes[i][0], sizes[i][1], 0.001, uniform, 1e-6};
+        o = run(&tiny, slice);
+        CHECK(o.overdrawn == 0 && o.missed == 0 && o.tiles >= 1);
+    }
+    return check_finish("test_tile_plan");
+}

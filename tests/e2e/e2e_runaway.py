@@ -28,6 +28,7 @@ cancel, timeout and SIGTERM act within about a second.
 
 import calendar
 import os
+import re
 import time
 
 import testlib
@@ -136,11 +137,17 @@ try:
           % (took, job.get("status"), err))
     next_job_is_quick(d, "a cancel")
 
-    # DELETE acts inside image-based lighting's set-up.
+    # DELETE acts inside image-based lighting's set-up: where it was (the
+    # probe it was capturing or filtering, of 32), not once the set-up is
+    # done. Asserted by the probe, with a wall bound only against a hang: on
+    # 2 cores at a load of 22 a DELETE here took 1.7 to 3.6 s before and
+    # after the probes' faces were drawn in tiles (each wait for the GPU
+    # then waits for the scheduler too).
     status, job, took = cancel_running(d, IBL, "the IBL job")
     err = job.get("error") or ""
+    probe = re.search(r"probe (\d+) of 32", err)
     check(job.get("status") == "cancelled" and "set-up" in err and "look.ibl" in err and
-          took < 1.5 * S,
+          probe and int(probe.group(1)) < 32 and took < 10 * S,
           "DELETE ends a job in image-based lighting's set-up (%.2f s): %s" % (took, err))
     next_job_is_quick(d, "a cancel in the set-up")
 

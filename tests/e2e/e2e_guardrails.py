@@ -34,7 +34,8 @@ def job(w, h, frames, lights=10):
             "scene": {"preset": "grid", "width": w, "height": h, "lights": lights}}
 
 
-d = testlib.Daemon()
+# The production frame bound: the 8000x8000 job is refused by it.
+d = testlib.Daemon("--max-frame-seconds", "2")
 try:
     info = d.json("GET", "/v1/info")[1]
     check(info.get("limits", {}).get("default_job_timeout_s") == 1800,

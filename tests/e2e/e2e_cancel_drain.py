@@ -99,13 +99,9 @@ try:
     status, answer = d.json("DELETE", "/v1/jobs/" + job_id, headers={})
     code = d.stop()
     check(code == 0, "SIGTERM after the DELETE exits 0: %s" % code)
-    state = d.state
 finally:
-    if d.alive():
-        d.stop()
-
-first = d
-d = testlib.Daemon("--state-dir", state)
+    first = d
+    d = first.restarted()
 try:
     job = d.json("GET", "/v1/jobs/" + job_id)[1]
     check(job.get("status") == "cancelled",

@@ -159,14 +159,10 @@ try:
     code = d.stop()
     took = time.time() - t0
     check(code == 0 and took < 5 * S, "SIGTERM during a frame of seconds exits 0 in %.2f s" % took)
-    state = d.state
 finally:
-    if d.alive():
-        d.stop()
-
-# A fresh daemon over the stopped one's state: the job comes back queued.
-first = d
-d = testlib.Daemon("--state-dir", state)
+    # A fresh daemon over the stopped one's state: the job comes back queued.
+    first = d
+    d = first.restarted()
 try:
     job = d.json("GET", "/v1/jobs/" + job_id)[1]
     check(job.get("status") in ("queued", "running"),

@@ -105,6 +105,13 @@ class Daemon:
         self.log.close()
         return self.proc.returncode
 
+    def restarted(self, *args, **kw):
+        """A fresh daemon over this one's state directory (stopped first, if
+        it still runs); this one's files stay until its cleanup."""
+        if self.alive():
+            self.stop()
+        return Daemon("--state-dir", self.state, *args, **kw)
+
     def cleanup(self, keep=False):
         if not keep:
             shutil.rmtree(self.tmp, ignore_errors=True)

@@ -155,8 +155,9 @@ static void begin(struct gpu_budget *b, const char *site, int w, int h, bool ran
     if (p->unit_s < 0.0) {
         /* Measured alone: what earlier passes left in flight is not its cost. */
         t->sliced = t->measuring = true;
-        tile_plan_init(&t->plan, w, h, slice_s);
-        if (b->use_queries && !t->range)
+        bool query = b->use_queries && !range;
+        tile_plan_init(&t->plan, w, h, slice_s, !query);
+        if (query)
             glGenQueries(1, &t->query);
         gpu_budget_sync(b);
         t->begun = clock_mono_s();

@@ -15,9 +15,10 @@
 
 enum { PROBE, SAMPLES, REST, DONE };
 
-void tile_plan_init(struct tile_plan *p, int w, int h, double slice_s)
+void tile_plan_init(struct tile_plan *p, int w, int h, double slice_s, bool noisy)
 {
     memset(p, 0, sizeof(*p));
+    p->noisy = noisy;
     p->w = w > 0 ? w : 0;
     p->h = h > 0 ? h : 0;
     p->slice_s = slice_s;
@@ -56,7 +57,7 @@ void tile_plan_init(struct tile_plan *p, int w, int h, double slice_s)
 double tile_plan_unit_max_s(const struct tile_plan *p)
 {
     double mean = p->units > 0 ? p->work_s / p->units : 0.0;
-    return p->unit_max_s > mean ? p->unit_max_s : mean;
+    return p->unit_max_s > mean && !p->noisy ? p->unit_max_s : mean;
 }
 
 double tile_plan_fixed_s(const struct tile_plan *p)

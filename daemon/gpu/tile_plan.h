@@ -46,6 +46,7 @@ struct tile_plan {
     double work_s;     /* every tile's GPU time above the least so far, summed */
     double units;      /* units of the tiles after the probe */
     int measured;      /* tiles done */
+    bool noisy;        /* wall-clock times: size by the mean */
     int phase;         /* 0 probe, 1 samples, 2 the rest, 3 done */
     int stage_units, stage_next;
     double stage_max_work;
@@ -60,7 +61,11 @@ struct tile_plan {
     int tiles;
 };
 
-void tile_plan_init(struct tile_plan *p, int w, int h, double slice_s);
+/* noisy: the GPU times handed in are the wall clock's (no query could run),
+ * each carrying a round trip's wait that a loaded machine stretches by tens
+ * of milliseconds: tiles are then sized by the mean cost of a unit, not by
+ * the dearest, which a wait on a small tile would inflate. */
+void tile_plan_init(struct tile_plan *p, int w, int h, double slice_s, bool noisy);
 /* The next tile to draw; false once every unit is drawn. */
 bool tile_plan_next(struct tile_plan *p, struct tile_rect *r);
 /* What the tile tile_plan_next last handed out took: its submission on the

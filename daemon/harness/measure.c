@@ -215,7 +215,12 @@ static bool decide(struct harness_run *run, int64_t k, int run_index, enum job_s
             continue;
         }
         rule->estimate_s[m] = whole_estimate(b, took);
-        rule->fixed_share = rule->estimate_s[m] > 0 ? b->frame.fixed_s / rule->estimate_s[m] : 0;
+        /* The pixels' work: the measured pieces' cost above what every tile
+         * pays; the rest of the frame (submission, geometry, loops of draws,
+         * the waits between) does not grow with the pixels. */
+        rule->pixel_share = rule->estimate_s[m] > 0
+                                ? (b->frame.whole_s - b->frame.fixed_s) / rule->estimate_s[m]
+                                : 1.0;
         whole = limit <= 0 || rule->estimate_s[m] <= limit;
     }
     b->give_up_s = 0;

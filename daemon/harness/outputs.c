@@ -246,8 +246,8 @@ static json_t *outputs_timing_json(const struct harness_run *run)
         "marked sliced); a measure over the limit is taken again once; decided once a job, for "
         "all its runs");
     /* For the duration estimate (job_eta.h): what of a frame scales with
-     * its pixels and what does not. */
-    json_object_set_new(o, "fixed_share", json_real(rule->fixed_share));
+     * its pixels. */
+    json_object_set_new(o, "pixel_share", json_real(rule->pixel_share));
     json_object_set_new(o, "largest_piece",
                         json_pack("{s:s, s:f}", "pass", rule->largest[0] ? rule->largest : "",
                                   "whole_s", rule->largest_s));

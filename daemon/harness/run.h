@@ -75,7 +75,7 @@ struct run_timing_rule {
     int measuring_frames;       /* frames drawn in slices to measure it (1 or 2) */
     double estimate_s[2];       /* each measuring frame's cost drawn whole; -1: none */
     double whole_frame_s;       /* the deciding frame, drawn whole; -1: none drawn */
-    double fixed_share;         /* of the last measured frame's cost, what no pixel pays for */
+    double pixel_share;         /* of the last measured frame's cost, the pixels' work */
     char largest[64];           /* the dearest piece's pass, by the measure */
     double largest_s;
     /* The measures of the first run's pieces, lent to the later runs. */

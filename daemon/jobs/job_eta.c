@@ -43,7 +43,7 @@ static struct technique_samples *find(const char *technique, bool add)
 }
 
 void job_eta_observe(const char *technique, double pixels, int lights, double frame_s,
-                     double fixed_share, double frames_drawn, double run_s)
+                     double pixel_share, double frames_drawn, double run_s)
 {
     if (!technique || pixels <= 0 || !(frame_s > 0) || !(run_s > 0))
         return;
@@ -51,9 +51,9 @@ void job_eta_observe(const char *technique, double pixels, int lights, double fr
     struct technique_samples *t = find(technique, true);
     if (t) {
         double overhead = run_s - frame_s * (frames_drawn + MEASURING_FRAMES);
-        double share = fixed_share > 0 ? (fixed_share < 1 ? fixed_share : 1) : 0;
+        double share = pixel_share > 0 ? (pixel_share < 1 ? pixel_share : 1) : 0;
         t->s[t->next] = (struct sample){pixels, frame_s, overhead > 0 ? overhead : 0,
-                                        frame_s * share, lights};
+                                        frame_s * (1.0 - share), lights};
         t->next = (t->next + 1) % JOB_ETA_SAMPLES;
         if (t->count < JOB_ETA_SAMPLES)
             t->count++;
@@ -126,9 +126,9 @@ json_t *job_eta_json(const struct job_eta *e)
                      e->basis_lights, "overhead_s", e->basis_overhead_s, "rule",
                      "from the job of this technique nearest in pixels and lights (log scale) "
                      "of the last 32 that ended done on this device: its median frame, of "
-                     "which the part no pixel pays for (its measuring frame's fixed costs) "
-                     "stays and the rest scales with the pixels and the square root of the "
-                     "lights' ratio, times this job's frames (3 measuring frames a run and the "
+                     "which the pixels' share (result.timing.pixel_share: its measuring "
+                     "frame's tiled work) scales with the pixels and the square root of the "
+                     "lights' ratio and the rest stays, times this job's frames (3 measuring frames a run and the "
                      "reference's included), plus the time that job took beyond its frames");
 }
 
@@ -174,8 +174,9 @@ void job_eta_observe_result(const struct job_spec *spec, const json_t *result, d
         return;
     json_t *lights = json_object_get(result, "lights");
     double frames = (double)(spec->frames + spec->warmup_frames) * job_spec_runs(spec);
-    double share = json_number_value(json_object_get(json_object_get(result, "timing"),
-                                                     "fixed_share"));
+    /* Without the measure's split (older results), all of it scales. */
+    json_t *split = json_object_get(json_object_get(result, "timing"), "pixel_share");
+    double share = json_is_number(split) ? json_number_value(split) : 1.0;
     job_eta_observe(spec->technique, (double)spec->scene.width * spec->scene.height,
                     json_is_integer(lights) ? (int)json_integer_value(lights) : lights_of(spec),
                     frame_ms / 1e3, share, frames, run_s);

@@ -6,10 +6,9 @@
  * (the median timed frame) for its technique, pixels and lights, and what
  * its run took beyond its frames (set-up, measuring frames, reference,
  * metrics). A new job is estimated from the finished job of its technique
- * nearest in pixels and lights: its frame time, of which the part no pixel
- * pays for stays (the measuring frame tells it apart: the geometry, the
- * shadow maps) and the rest scales linearly by pixels and by the square
- * root of the light ratio (forward's loop is linear in lights, the
+ * nearest in pixels and lights: its frame time, of which the pixels' share
+ * (the measuring frame tells it apart) scales linearly by pixels and by the
+ * square root of the light ratio while the rest stays (forward's loop is linear in lights, the
  * light-culling techniques far less: the square root sits between), times
  * its frames, plus the time that job took beyond its frames. No estimate
  * before the device has run a job of that technique.
@@ -43,11 +42,13 @@ struct job_eta {
 };
 
 /* A done job: its technique, pixels, lights, the median frame (seconds)
- * and the share of it no pixel pays for (result.timing.fixed_share: the
- * geometry, the shadow maps), the frames it drew in all (warm-up and timed,
- * every run) and how long its run took from start to end. */
+ * and the pixels' share of it (result.timing.pixel_share: the measuring
+ * frame's tiled work above what every tile pays; the geometry, the shadow
+ * maps and the frame's own overhead do not grow with the pixels), the
+ * frames it drew in all (warm-up and timed, every run) and how long its run
+ * took from start to end. */
 void job_eta_observe(const char *technique, double pixels, int lights, double frame_s,
-                     double fixed_share, double frames_drawn, double run_s);
+                     double pixel_share, double frames_drawn, double run_s);
 /* Forgets every observation (tests). */
 void job_eta_reset(void);
 

@@ -140,8 +140,8 @@ static void test_eta(void)
     job_eta_estimate(&spec, &e);
     CHECK(!e.known && json_is_null(job_eta_json(&e)) && job_eta_admit(&spec, &e, &err));
     /* 10,000 pixels and 10 lights at 10 ms a frame; 103 frames drawn in 1.5 s. */
-    job_eta_observe("forward", 1e4, 10, 0.010, 0.0, 100, 1.5);
-    job_eta_observe("deferred", 1e4, 10, 0.5, 0.0, 100, 60);
+    job_eta_observe("forward", 1e4, 10, 0.010, 1.0, 100, 1.5);
+    job_eta_observe("deferred", 1e4, 10, 0.5, 1.0, 100, 60);
     job_eta_estimate(&spec, &e);
     CHECK(e.known && fabs(e.frame_s - 0.010) < 1e-12);
     /* 100 frames and 3 measuring ones, and the 0.47 s beyond them. */

@@ -49,7 +49,7 @@ static struct outcome run(const struct sim *s, double slice)
     struct outcome o = {0};
     unsigned char *drawn = calloc((size_t)s->w * s->h, 1);
     struct tile_plan p;
-    tile_plan_init(&p, s->w, s->h, slice);
+    tile_plan_init(&p, s->w, s->h, slice, false);
     struct tile_rect r;
     o.true_whole_s = s->fixed;
     for (int y = 0; y < s->h; y++)
@@ -123,6 +123,26 @@ int main(void)
         CHECK(o.worst_tile_s < cases[i].worst * slice);
         CHECK(!cases[i].tiles || o.tiles < cases[i].tiles);
         CHECK(!cases[i].error || fabs(o.whole_s - o.true_whole_s) < cases[i].error * o.true_whole_s);
+    }
+    /* Wall-clock times (no query: a dispatch, set-up work): a loaded
+     * machine adds tens of milliseconds to a tile now and then. Sized by
+     * the mean, a cheap piece stays in few tiles (by the dearest tile, the
+     * waits read as costly pixels cut it into hundreds). */
+    for (int noisy = 0; noisy < 2; noisy++) {
+        struct tile_plan p;
+        struct tile_rect r;
+        tile_plan_init(&p, 256, 256, slice, noisy);
+        unsigned seed = 11;
+        int tiles = 0;
+        while (tile_plan_next(&p, &r) && tiles < 100000) {
+            seed = seed * 1103515245u + 12345u;
+            double wait = (seed >> 16) % 3 == 0 ? 0.06 : 0.002;
+            tile_plan_done(&p, 0.0, wait + (double)r.w * r.h * 3e-8);
+            tiles++;
+        }
+        printf("cheap 256x256 with waits, sized by the %s: %d tiles\n", noisy ? "mean" : "dearest",
+               tiles);
+        CHECK(noisy ? tiles < 40 : tiles > 100);
     }
     int sizes[][2] = {{1, 1}, {3, 1}, {1, 5}, {7, 3}, {64, 48}, {5, 200}};
     for (size_t i = 0; i < sizeof(sizes) / sizeof(sizes[0]); i++) {

@@ -174,12 +174,12 @@ void gpu_timer_drain(struct gpu_timer *t)
         read_slot(t, &t->ring[i]);
 }
 
-void gpu_timer_restart(struct gpu_timer *t)
+void gpu_timer_restart(struct gpu_timer *t, int64_t next)
 {
     gpu_timer_drain(t);
     memset(t->ms, 0, (size_t)t->frames * (size_t)t->sections * sizeof(double));
     memset(t->implausible, 0, (size_t)t->frames);
-    t->next_frame = 0;
+    t->next_frame = next > 0 ? next : 0;
     t->stalls = 0;
 }
 

@@ -39,9 +39,9 @@ void gpu_timer_end_frame(struct gpu_timer *t);
 /* Reads every outstanding query (call after glFinish). */
 void gpu_timer_drain(struct gpu_timer *t);
 /* Forgets the frames timed so far (after a glFinish): the next frame is
- * frame 0 again. For frames drawn before the ones the timer counts (the
- * harness's measuring frames). */
-void gpu_timer_restart(struct gpu_timer *t);
+ * frame `next` (the harness's measuring frames, untimed, may stand for the
+ * first warm-up frames). */
+void gpu_timer_restart(struct gpu_timer *t, int64_t next);
 
 /* Milliseconds of frame f (0-based, in submission order), section s or the
  * whole frame with s < 0. */

@@ -168,23 +168,34 @@ static bool refuse_whole(struct harness_run *run, bool gave_up)
     return false;
 }
 
-/* Before a run's warm-up: its first frame drawn in slices (every piece
- * measured, so that nothing in it, OSL's first shading or a frame of many
- * lights included, holds the render thread past about a slice), and, in
- * the job's first run, the decision of how its timed frames are drawn:
- * whole when a frame drawn whole, after the measure said it may be, took
- * no more than the bound; else, if the job accepts it, in the tiles the
- * measure gives, and otherwise the job fails here. A measuring frame
- * over the bound is measured again once (a slow first frame, a moment of
- * load, must not decide), and one far over it (4 times) ends the measure
- * at once. Later runs borrow the first run's measures and follow its rule. */
-static bool decide(struct harness_run *run, int64_t k, int run_index, enum job_status *status)
+/* A run's first frames, which decide how its timed frames are drawn: its
+ * first warm-up frame drawn in slices (every piece measured, so that
+ * nothing in it, OSL's first shading or a frame of many lights included,
+ * holds the render thread past about a slice), and, in the job's first run,
+ * its second warm-up frame drawn whole, exactly as the timed frames will
+ * be, and timed alone, when the measure says it fits the bound. A job with
+ * fewer warm-up frames gets that many more frames of the harness's own
+ * before its timed frames (of the first warm-up frame's content, or of
+ * frame 0). The timed frames are drawn whole when that whole frame took no
+ * more than the bound; else, if the job accepts it, in the tiles the
+ * measure gives, and otherwise the job fails here. A measure over the bound
+ * is taken again once, however far over it (a slow first frame, a moment
+ * of load, must not decide), and a measure far over it (4 times) ends at
+ * once, the technique made anew after it (the frame was abandoned). Later
+ * runs borrow the first run's measures and follow its rule. *consumed gets
+ * the job's warm-up frames these frames were (0 to 2). */
+static bool decide(struct harness_run *run, int run_index, int *consumed,
+                   enum job_status *status)
 {
     struct gpu_budget *b = &run->budget;
     struct run_timing_rule *rule = run->rule;
+    int w0 = run->spec->warmup_frames;
+    int64_t k = 1 - (w0 > 1 ? w0 : 1);
     double took;
+    *consumed = 0;
     if (rule->decided) {
         memcpy(b->piece, rule->pieces, sizeof(b->piece));
+        *consumed = w0 >= 1;
         return harness_frame(run, k, run_index, &took, status);
     }
     double limit = rule->limit_s = job_spec_max_frame_seconds();
@@ -192,13 +203,8 @@ static bool decide(struct harness_run *run, int64_t k, int run_index, enum job_s
     b->give_up_s = limit > 0 && !run->spec->accept_sliced_timing ? 4 * limit : 0;
     bool whole = false, gave_up = false;
     for (int m = 0; m < 2 && !whole; m++) {
-        if (m == 1) {
-            /* Far over the bound, measured to the end: no moment of load
-             * explains that. */
-            if (!gave_up && rule->estimate_s[0] > 4 * limit)
-                break;
+        if (m == 1 && !gave_up)
             gpu_budget_forget(b);
-        }
         bool ok = harness_frame(run, k, run_index, &took, status);
         note_largest(run);
         rule->measuring_frames = m + 1;
@@ -212,8 +218,16 @@ static bool decide(struct harness_run *run, int64_t k, int run_index, enum job_s
             rule->estimate_s[m] = b->frame.whole_s;
             b->stopped = b->over = false;
             gave_up = true;
+            /* The frame was abandoned: what it left half-done (OSL's first
+             * shading) must not pass for done in the next. */
+            if (!gpu_budget_sync(b))
+                return keep_going(run, k, run_index, status);
+            if (!run_recreate_technique(run))
+                return false;
             continue;
         }
+        /* The first is the job's first warm-up frame, if it has one. */
+        *consumed = w0 >= 1;
         rule->estimate_s[m] = whole_estimate(b, took);
         /* The pixels' work: the measured pieces' cost above what every tile
          * pays; the rest of the frame (submission, geometry, loops of draws,
@@ -225,10 +239,13 @@ static bool decide(struct harness_run *run, int64_t k, int run_index, enum job_s
     }
     b->give_up_s = 0;
     if (whole) {
-        /* The deciding frame: drawn exactly as the timed frames will be. */
+        /* The deciding frame, drawn exactly as the timed frames will be:
+         * the second warm-up frame, or one more of the first's. */
         b->mode = GPU_BUDGET_WHOLE;
-        if (!harness_frame(run, k, run_index, &took, status))
+        if (!harness_frame(run, w0 >= 2 ? k + 1 : k, run_index, &took, status))
             return false;
+        if (w0 >= 2)
+            *consumed = 2;
         rule->whole_frame_s = took;
         whole = limit <= 0 || took <= limit;
     }
@@ -240,18 +257,17 @@ static bool decide(struct harness_run *run, int64_t k, int run_index, enum job_s
     return true;
 }
 
-static bool measure_first_frames(struct harness_run *run, int run_index, enum job_status *status)
+static bool measure_first_frames(struct harness_run *run, int run_index, int *consumed,
+                                 enum job_status *status)
 {
     struct gpu_budget *b = &run->budget;
-    int w0 = run->spec->warmup_frames;
-    int64_t k = 1 - (w0 > 1 ? w0 : 1);
     b->timer = run->timer;
     b->mode = GPU_BUDGET_ADAPTIVE;
     /* The pass timer rests: the measured tiles time themselves. */
     gpu_timer_pause(run->timer, true);
     b->use_queries = true;
     run->measuring = true;
-    bool ok = decide(run, k, run_index, status);
+    bool ok = decide(run, run_index, consumed, status);
     run->measuring = false;
     b->use_queries = false;
     gpu_timer_pause(run->timer, false);
@@ -266,14 +282,15 @@ bool measure_run(struct harness_run *run, int run_index, enum job_status *status
     double wall_start = 0, frame_begin = 0, fastest_s = INFINITY;
     run->capture_s = 0;
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    if (!measure_first_frames(run, run_index, status))
+    int consumed;
+    if (!measure_first_frames(run, run_index, &consumed, status))
         return false;
-    /* The measuring frames are not the timer's: its frame 0 is the first
-     * warm-up frame. */
-    gpu_timer_restart(run->timer);
+    /* The measuring frames are not the timer's: its frame i is the warm-up
+     * or timed frame drawn i-th, as ever. */
+    gpu_timer_restart(run->timer, consumed);
     budget->mode = run->rule->mode;
     int64_t sliced_before = 0;
-    for (int seq = 0; seq < w0 + n; seq++) {
+    for (int seq = consumed; seq < w0 + n; seq++) {
         int64_t k = (int64_t)seq - w0 + 1;
         if (!keep_going(run, k, run_index, status))
             return false;

@@ -238,13 +238,14 @@ static json_t *outputs_timing_json(const struct harness_run *run)
         "second_estimate_s", rule->estimate_s[1] >= 0 ? json_real(rule->estimate_s[1]) : json_null(),
         "whole_frame_s", rule->whole_frame_s >= 0 ? json_real(rule->whole_frame_s) : json_null(),
         "how",
-        "before its warm-up, the job's first run draws its first frame in slices (each piece "
-        "measured: a one-pixel probe for what every tile pays, then growing tiles) and, when "
-        "that says a whole frame fits limit_s, once whole (whole_frame_s); the timed frames are "
-        "drawn whole when that took at most limit_s (the guard then adds nothing to them), and "
-        "else, only with accept_sliced_timing, in the tiles the measure gives (every figure "
-        "marked sliced); a measure over the limit is taken again once; decided once a job, for "
-        "all its runs");
+        "the job's first run draws its first warm-up frame in slices (each piece measured: a "
+        "one-pixel probe for what every tile pays, samples, then tiles sized by the dearest "
+        "pixel) and, when that says a whole frame fits limit_s, its second warm-up frame whole "
+        "(whole_frame_s; with fewer warm-up frames, frames of the harness's own stand in); the "
+        "timed frames are drawn whole when that took at most limit_s (the guard then adds "
+        "nothing to them), and else, only with accept_sliced_timing, in the tiles the measure "
+        "gives (every figure marked sliced); a measure over the limit is taken again once; "
+        "decided once a job, for all its runs");
     /* For the duration estimate (job_eta.h): what of a frame scales with
      * its pixels. */
     json_object_set_new(o, "pixel_share", json_real(rule->pixel_share));

@@ -317,6 +317,16 @@ bool run_prepare(struct harness_run *run, bool capture)
     return true;
 }
 
+bool run_recreate_technique(struct harness_run *run)
+{
+    run->tech->destroy(run->state);
+    run->state = NULL;
+    /* Its planes come from the target pool by name: the post chain's and
+     * the captures' views of them stay valid. */
+    memset(&run->products, 0, sizeof(run->products));
+    return run->tech->create(&run->env, &run->state, run->err, sizeof(run->err));
+}
+
 void run_finish(struct harness_run *run)
 {
     if (run->tech && run->state)

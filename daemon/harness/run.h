@@ -160,6 +160,10 @@ struct harness_run {
 bool run_prepare(struct harness_run *run, bool capture);
 /* Frees what run_prepare and the frames made. Takes a run in any state. */
 void run_finish(struct harness_run *run);
+/* The technique made anew (a frame it was abandoned in may have left its
+ * state half-updated: OSL's first shading cut short would read as done).
+ * False with run->err. */
+bool run_recreate_technique(struct harness_run *run);
 
 /* The output targets and the technique's env for run->look over the run's
  * scene (the reference calls it with the measured run's scene). */

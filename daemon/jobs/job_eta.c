@@ -7,9 +7,15 @@
 #include "common/result_keys.h"
 #include "daemon/jobs/job_spec.h"
 
-/* Frames the harness draws before a run's warm-up (measure.c): one in
- * slices, which costs more than a whole frame, and one whole. */
-#define MEASURING_FRAMES 3.0
+/* Frames the harness draws of its own before a run's timed frames
+ * (measure.c): the first warm-up frame is measured in slices and the second
+ * drawn whole to decide; a job with fewer warm-up frames gets that many
+ * more. The measured frame costs more than a whole one: count it twice. */
+static double extra_frames(int warmup_frames)
+{
+    int missing = 2 - warmup_frames;
+    return 1.0 + (missing > 0 ? missing : 0);
+}
 
 struct sample {
     double pixels, frame_s, overhead_s;
@@ -50,7 +56,7 @@ void job_eta_observe(const char *technique, double pixels, int lights, double fr
     pthread_mutex_lock(&lock);
     struct technique_samples *t = find(technique, true);
     if (t) {
-        double overhead = run_s - frame_s * (frames_drawn + MEASURING_FRAMES);
+        double overhead = run_s - frame_s * frames_drawn;
         double share = pixel_share > 0 ? (pixel_share < 1 ? pixel_share : 1) : 0;
         t->s[t->next] = (struct sample){pixels, frame_s, overhead > 0 ? overhead : 0,
                                         frame_s * (1.0 - share), lights};
@@ -107,8 +113,8 @@ void job_eta_estimate(const struct job_spec *spec, struct job_eta *out)
     double scale = pixels / out->basis_pixels;
     out->frame_s = out->basis_fixed_s + (out->basis_frame_s - out->basis_fixed_s) * scale *
                                             sqrt((lights + 1.0) / (out->basis_lights + 1.0));
-    double frames = (double)(spec->frames + spec->warmup_frames) * job_spec_runs(spec) +
-                    MEASURING_FRAMES * job_spec_runs(spec);
+    double frames = (spec->frames + spec->warmup_frames + extra_frames(spec->warmup_frames)) *
+                    (double)job_spec_runs(spec);
     /* The reference renders each capture once more (about a frame each). */
     if (spec->reference[0])
         frames += job_spec_capture_count(spec) *
@@ -128,8 +134,9 @@ json_t *job_eta_json(const struct job_eta *e)
                      "of the last 32 that ended done on this device: its median frame, of "
                      "which the pixels' share (result.timing.pixel_share: its measuring "
                      "frame's tiled work) scales with the pixels and the square root of the "
-                     "lights' ratio and the rest stays, times this job's frames (3 measuring frames a run and the "
-                     "reference's included), plus the time that job took beyond its frames");
+                     "lights' ratio and the rest stays, times this job's frames (the harness's "
+                     "measuring frames and the reference's included), plus the time that job "
+                     "took beyond its frames");
 }
 
 bool job_eta_admit(const struct job_spec *spec, const struct job_eta *e, struct job_error *err)
@@ -173,7 +180,8 @@ void job_eta_observe_result(const struct job_spec *spec, const json_t *result, d
     if (!(frame_ms > 0) || json_is_true(json_object_get(result, "sliced")))
         return;
     json_t *lights = json_object_get(result, "lights");
-    double frames = (double)(spec->frames + spec->warmup_frames) * job_spec_runs(spec);
+    double frames = (spec->frames + spec->warmup_frames + extra_frames(spec->warmup_frames)) *
+                    (double)job_spec_runs(spec);
     /* Without the measure's split (older results), all of it scales. */
     json_t *split = json_object_get(json_object_get(result, "timing"), "pixel_share");
     double share = json_is_number(split) ? json_number_value(split) : 1.0;

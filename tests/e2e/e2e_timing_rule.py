@@ -69,15 +69,42 @@ try:
         timing = (b.get("result") or {}).get("timing") or {}
         check(timing.get("measuring_runs", 0) >= 1 and timing.get("whole_frame_s", -1) > 0,
               "warmup %d: the result states the measure that decided it: %s" % (warmup, timing))
+    # A first frame so slow that its measure gives up (past 4 times the
+    # bound): measured again, timed whole, and the same pixels, OSL's first
+    # shading included (cut short, it must not pass for done).
+    OSL = {"technique": "osl", "frames": 2, "warmup_frames": 1, "capture_interval": 2,
+           "scene": {"preset": "grid", "width": 64, "height": 48}}
+    very = testlib.Daemon("--max-frame-seconds", "2",
+                          env={"SHADEBENCH_DEBUG_STALL_FIRST_FRAME_MS": "3000"})
+    try:
+        a, b = calm.run(OSL), very.run(OSL)
+        timing = (b.get("result") or {}).get("timing") or {}
+        print("OSL, first frame stalled 3 s a wait: %s" % {k: timing.get(k) for k in (
+            "rule", "measuring_runs", "first_frame_estimate_s", "second_estimate_s")})
+        check(b.get("status") == "done" and timing.get("rule") == "whole" and
+              timing.get("measuring_runs") == 2,
+              "a first frame far over the bound is measured again and timed whole: %s %s"
+              % (b.get("error"), timing))
+        if a.get("status") == "done" and b.get("status") == "done":
+            diff = testlib.png_diff(os.path.join(calm.state, "jobs", a["id"], "frame-000002.png"),
+                                    os.path.join(very.state, "jobs", b["id"], "frame-000002.png"))
+            check(diff is not None and diff["differing_pixels"] == 0,
+                  "and renders the same pixels as the calm daemon: %s" % diff)
+    finally:
+        testlib.stop_and_check(very)
 finally:
     testlib.stop_and_check(calm)
     testlib.stop_and_check(stalled)
 
 # A frame over the bound: refused before timing with its figures, or, once
 # the job accepts it, timed in slices and marked so.
+# A frame of tens of milliseconds against a bound of 20 ms; with
+# SHADEBENCH_SLICE_MS every piece that is cut at all is cut in at least 4
+# tiles (slices of a second: few tiles, since on a loaded box every tile
+# costs a round trip of tens of milliseconds whatever its size).
 BIG = {"technique": "forward", "frames": 3, "warmup_frames": 1,
-       "scene": {"preset": "grid", "width": 160, "height": 120, "lights": 1024}}
-d = testlib.Daemon("--max-frame-seconds", "0.02")
+       "scene": {"preset": "grid", "width": 96, "height": 64, "lights": 256}}
+d = testlib.Daemon("--max-frame-seconds", "0.02", env={"SHADEBENCH_SLICE_MS": "1000"})
 try:
     info = d.json("GET", "/v1/info")[1]
     check((info.get("limits") or {}).get("max_frame_seconds") == 0.02,

@@ -51,6 +51,7 @@ struct options {
     int max_connections_per_ip;
     double job_timeout;
     double max_job_s;
+    double max_frame_s;
     double stall_s;
     double memory_budget_mib; /* 0: the driver, the connections, and half the RAM for a job */
     char asset_dir[1024];      /* --asset-dir: read-only assets; "": none */
@@ -76,6 +77,13 @@ struct options {
  * step the harness takes between two progress marks (a frame, a slice of
  * GPU work, a metric tile), far below what an operator would wait. */
 #define STALL_SECONDS_DEFAULT 60
+/* The running time a job gets when it names none: half an hour, far above
+ * what the default job takes on a 2-core CPU renderer (docs/api.md) and
+ * what every bench script's jobs take, far below the day it was, which let
+ * one mistaken job hold the render thread, and every job queued behind it,
+ * for a day. */
+#define JOB_TIMEOUT_DEFAULT 1800
+#define JOB_TIMEOUT_TEXT "1800"
 #define STALL_SECONDS_TEXT "60"
 
 static void usage(FILE *f)
@@ -96,10 +104,15 @@ static void usage(FILE *f)
             "  --keep-days D        remove finished jobs (and sweeps) older than D days\n"
             "                       (default " KEEP_DAYS_TEXT "; 0: keep all)\n"
             "  --job-timeout S      running time a job may take when it gives no timeout_s\n"
-            "                       (default 86400; 0: no limit)\n"
+            "                       (default " JOB_TIMEOUT_TEXT "; 0: no limit)\n"
             "  --max-job-seconds S  running time any job may take: a larger timeout_s is\n"
             "                       refused, and the default is capped to it (default 0: no\n"
             "                       limit but each job's timeout_s)\n"
+            "  --max-frame-seconds S\n"
+            "                       the longest one whole frame may hold the render thread:\n"
+            "                       a job whose frame measures more fails before timing\n"
+            "                       unless it sets accept_sliced_timing (default 2; 0: no\n"
+            "                       bound)\n"
             "  --stall-seconds S    /healthz answers 503 when the render thread, busy with a\n"
             "                       job, has made no progress for S seconds (default "
             STALL_SECONDS_TEXT "; 0: never)\n"
@@ -137,13 +150,14 @@ static void usage(FILE *f)
             "  --version, --help\n\n"
             "Settings come from, in rising order: defaults, the config file (lines of\n"
             "\"key = value\": listen, state-dir, device, queue-size, token, keep-jobs,\n"
-            "keep-days, job-timeout, max-job-seconds, stall-seconds, memory-budget,\n"
-            "max-connections, max-connections-per-ip, max-asset-bytes, asset-dir,\n"
-            "asset-converter, chromium, reference-viewer, reference-timeout,\n"
+            "keep-days, job-timeout, max-job-seconds, max-frame-seconds, stall-seconds,\n"
+            "memory-budget, max-connections, max-connections-per-ip, max-asset-bytes,\n"
+            "asset-dir, asset-converter, chromium, reference-viewer, reference-timeout,\n"
             "reference-memory, log-level), the environment\n"
             "(SHADEBENCH_LISTEN, SHADEBENCH_STATE_DIR, SHADEBENCH_DEVICE,\n"
             "SHADEBENCH_QUEUE_SIZE, SHADEBENCH_TOKEN_FILE, SHADEBENCH_KEEP_JOBS,\n"
             "SHADEBENCH_KEEP_DAYS, SHADEBENCH_JOB_TIMEOUT, SHADEBENCH_MAX_JOB_SECONDS,\n"
+            "SHADEBENCH_MAX_FRAME_SECONDS, "
             "SHADEBENCH_STALL_SECONDS, SHADEBENCH_MEMORY_BUDGET,\n"
             "SHADEBENCH_MAX_CONNECTIONS, SHADEBENCH_MAX_CONNECTIONS_PER_IP,\n"
             "SHADEBENCH_MAX_ASSET_BYTES, SHADEBENCH_ASSET_DIR, SHADEBENCH_ASSET_CONVERTER,\n"
@@ -197,6 +211,9 @@ static bool apply_setting(struct options *o, const char *key, const char *value,
     } else if (strcmp(key, "job-timeout") == 0) {
         if (!parse_number(value, 0, 1e7, &o->job_timeout))
             rule = "must be a number of seconds from 0 (no limit) to 10000000";
+    } else if (strcmp(key, "max-frame-seconds") == 0) {
+        if (!parse_number(value, 0, 1e6, &o->max_frame_s))
+            rule = "must be a number of seconds from 0 (no bound) to 1000000";
     } else if (strcmp(key, "max-job-seconds") == 0) {
         if (!parse_number(value, 0, 1e7, &o->max_job_s))
             rule = "must be a number of seconds from 0 (no limit) to 10000000";
@@ -289,7 +306,7 @@ static bool load_environment(struct options *o)
 {
     static const char *const keys[] = {"listen", "state-dir", "device", "queue-size",
                                        "token-file", "keep-jobs", "keep-days", "job-timeout",
-                                       "max-job-seconds", "stall-seconds", "memory-budget", "max-connections",
+                                       "max-job-seconds", "max-frame-seconds", "stall-seconds", "memory-budget", "max-connections",
                                        "max-connections-per-ip", "max-asset-bytes", "asset-dir",
                                        "asset-converter", "chromium", "reference-viewer",
                                        "reference-timeout", "reference-memory", "log-level",
@@ -785,6 +802,7 @@ out:
      * queue once the render thread stops it, and a frame still draining on
      * the GPU is not waited for. */
     if (rc == 0 && !runner_stop(r, STOP_RENDER_WAIT_S)) {
+        queue_store_abandoned(q);
         LOG(LOG_WARN, "the render thread is still draining GPU work after %d s; exiting without "
             "it (every job's state is stored)", STOP_RENDER_WAIT_S);
         _exit(0);
@@ -815,12 +833,13 @@ int main(int argc, char **argv)
      * jobs before it, for at most 128 MiB of free heap kept. */
     mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
     mallopt(M_TRIM_THRESHOLD, 128 * 1024 * 1024);
-    struct options o = {.device = -1, .queue_size = 64, .job_timeout = 86400,
+    struct options o = {.device = -1, .queue_size = 64, .job_timeout = JOB_TIMEOUT_DEFAULT,
+                        .max_frame_s = JOB_DEFAULT_MAX_FRAME_S,
                         .stall_s = STALL_SECONDS_DEFAULT,
                         .keep_jobs = KEEP_JOBS_DEFAULT, .keep_days = KEEP_DAYS_DEFAULT};
     snprintf(o.listen, sizeof(o.listen), "127.0.0.1:8460");
     enum { OPT_LISTEN = 256, OPT_STATE, OPT_DEVICE, OPT_QUEUE, OPT_TOKEN, OPT_KEEP_JOBS,
-           OPT_KEEP_DAYS, OPT_JOB_TIMEOUT, OPT_MAX_JOB, OPT_STALL, OPT_MEMORY, OPT_MAX_CONN, OPT_MAX_CONN_IP, OPT_MAX_ASSET, OPT_ASSET_DIR, OPT_ASSET_CONV, OPT_CHROMIUM, OPT_REF_VIEWER, OPT_REF_TIMEOUT, OPT_REF_MEMORY, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_ONCE, OPT_OUT, OPT_DEBUG,
+           OPT_KEEP_DAYS, OPT_JOB_TIMEOUT, OPT_MAX_JOB, OPT_MAX_FRAME, OPT_STALL, OPT_MEMORY, OPT_MAX_CONN, OPT_MAX_CONN_IP, OPT_MAX_ASSET, OPT_ASSET_DIR, OPT_ASSET_CONV, OPT_CHROMIUM, OPT_REF_VIEWER, OPT_REF_TIMEOUT, OPT_REF_MEMORY, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_ONCE, OPT_OUT, OPT_DEBUG,
            OPT_LOG, OPT_VERSION, OPT_HELP };
     static const struct option longopts[] = {
         {"listen", required_argument, NULL, OPT_LISTEN},
@@ -832,6 +851,7 @@ int main(int argc, char **argv)
         {"keep-days", required_argument, NULL, OPT_KEEP_DAYS},
         {"job-timeout", required_argument, NULL, OPT_JOB_TIMEOUT},
         {"max-job-seconds", required_argument, NULL, OPT_MAX_JOB},
+        {"max-frame-seconds", required_argument, NULL, OPT_MAX_FRAME},
         {"stall-seconds", required_argument, NULL, OPT_STALL},
         {"memory-budget", required_argument, NULL, OPT_MEMORY},
         {"max-connections", required_argument, NULL, OPT_MAX_CONN},
@@ -872,6 +892,7 @@ int main(int argc, char **argv)
         case OPT_KEEP_DAYS: key = "keep-days"; break;
         case OPT_JOB_TIMEOUT: key = "job-timeout"; break;
         case OPT_MAX_JOB: key = "max-job-seconds"; break;
+        case OPT_MAX_FRAME: key = "max-frame-seconds"; break;
         case OPT_STALL: key = "stall-seconds"; break;
         case OPT_MEMORY: key = "memory-budget"; break;
         case OPT_MAX_CONN: key = "max-connections"; break;
@@ -914,6 +935,7 @@ int main(int argc, char **argv)
     }
     job_spec_set_default_timeout(o.job_timeout);
     job_spec_set_max_seconds(o.max_job_s);
+    job_spec_set_max_frame_seconds(o.max_frame_s);
     if (o.list_devices)
         return list_devices();
     if (o.once) {

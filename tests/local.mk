@@ -44,7 +44,8 @@ UNIT_TESTS = \
 	tests/unit/test_convert_matrices \
 	tests/unit/test_convert_checks \
 	tests/unit/test_light_shape \
-	tests/unit/test_fidelity
+	tests/unit/test_fidelity \
+	tests/unit/test_tile_plan
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
 	tests/fuzz/replay-route tests/fuzz/replay-asset_cache tests/fuzz/replay-asset_convert \
@@ -65,6 +66,10 @@ tests_unit_test_effects_LDADD = $(CORE_LIBS)
 tests_unit_test_records_LDADD = $(CORE_LIBS)
 tests_unit_test_interference_LDADD = libsb-status.a $(CORE_LIBS)
 tests_unit_test_fidelity_LDADD = $(CORE_LIBS) -lm
+# The measuring run's tiles: GL-free logic in the GL toolkit's folder.
+tests_unit_test_tile_plan_SOURCES = tests/unit/test_tile_plan.c daemon/gpu/tile_plan.c \
+	daemon/gpu/tile_plan.h
+tests_unit_test_tile_plan_LDADD = -lm
 tests_unit_test_png_LDADD = $(CORE_LIBS)
 tests_unit_test_gate_SOURCES = tests/unit/test_gate.c $(CLIENT_PURE)
 tests_unit_test_gate_LDADD = $(CORE_LIBS) -lm
@@ -147,6 +152,10 @@ E2E_TESTS = \
 	tests/e2e/e2e_dashboard.py \
 	tests/e2e/e2e_faults.py \
 	tests/e2e/e2e_runaway.py \
+	tests/e2e/e2e_timing_rule.py \
+	tests/e2e/e2e_cancel_drain.py \
+	tests/e2e/e2e_pass_times.py \
+	tests/e2e/e2e_guardrails.py \
 	tests/e2e/e2e_hardening.py \
 	tests/e2e/e2e_many_lights.py \
 	tests/e2e/e2e_light_types.py \

@@ -16,6 +16,7 @@
 #include "daemon/reports/report.h"
 #include "daemon/spec/job_cost.h"
 #include "daemon/jobs/fidelity.h"
+#include "daemon/jobs/job_eta.h"
 #include "daemon/spec/job_spec.h"
 
 /* A parsed job queued: its assets pinned, its 202 with the cost. */
@@ -54,6 +55,16 @@ static enum MHD_Result queue_spec(struct http_server *s, struct MHD_Connection *
             return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
         }
     }
+    /* Its duration on this device, where a job of its technique has run: a
+     * projection far past its timeout_s (or a frame far past the frame
+     * bound) is refused with the figures (job_eta.h). */
+    struct job_eta eta;
+    job_eta_estimate(&spec, &eta);
+    if (!job_eta_admit(&spec, &eta, &err)) {
+        if (pinned)
+            assets_unpin(s->ctx.assets, &spec);
+        return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
+    }
     char id[24];
     enum queue_submit_result submitted = queue_submit(s->queue, &spec, NULL, id);
     if (pinned)
@@ -80,8 +91,9 @@ static enum MHD_Result queue_spec(struct http_server *s, struct MHD_Connection *
     struct job_cost cost;
     job_cost_estimate(&spec, &cost);
     return respond_json(c, MHD_HTTP_ACCEPTED,
-                        json_pack("{s:s, s:s, s:s, s:o}", "id", id, "status", "queued", "url", url,
-                                  "cost", job_cost_json(&cost)));
+                        json_pack("{s:s, s:s, s:s, s:o, s:o}", "id", id, "status", "queued", "url",
+                                  url, "cost", job_cost_json(&cost), "estimate",
+                                  job_eta_json(&eta)));
 }
 
 enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *c,

@@ -91,6 +91,9 @@ json_t *info_json(struct http_server *s)
     /* The asset limits (assets.h): the upload's body limit, the converter's
      * limits on what an asset may hold, and its memory, CPU and time. */
     json_t *limits = json_object_get(info, "limits");
+    /* The bound on one whole frame (measure.c): over it, a job fails before
+     * timing unless it accepts sliced timing. */
+    json_object_set_new(limits, "max_frame_seconds", json_real(job_spec_max_frame_seconds()));
     if (limits && s->ctx.assets) {
         json_t *assets = assets_info_json(s->ctx.assets);
         json_object_set(limits, "max_asset_bytes", json_object_get(assets, "max_asset_bytes"));
@@ -112,8 +115,12 @@ static json_t *render_json(const struct render_state *st, double stall_s)
         return json_pack("{s:s}", "state", "stopped");
     if (!st->busy)
         return json_pack("{s:s, s:f}", "state", "idle", "idle_s", st->since_progress_s);
+    /* A job that ended early is drained, not rendered: its state is final. */
     return json_pack("{s:s, s:s, s:s, s:f, s:f, s:f}", "state",
-                     render_state_stalled(st, stall_s) ? "stalled" : "busy", "job", st->job,
+                     render_state_stalled(st, stall_s) ? "stalled"
+                     : render_state_draining(st)        ? "draining"
+                                                        : "busy",
+                     "job", st->job,
                      "phase", st->phase, "busy_s", st->busy_s, "since_progress_s",
                      st->since_progress_s, "stall_seconds", stall_s);
 }

@@ -156,7 +156,7 @@ static bool repeat_runs(struct runner *r, struct harness_run *first, json_t *res
     int done = 1;
     while (ok && done < planned && !(spec->repeat_auto && stats_is_stable(med, (size_t)done, 0.025))) {
         struct harness_run extra = {.gl = &r->gl, .queue = r->queue, .job = first->job, .spec = spec,
-                            .tech = first->tech};
+                            .tech = first->tech, .rule = first->rule};
         ok = prepare_and_measure(&extra, false, done, status);
         if (ok) {
             for (int i = 0; i < n; i++)
@@ -190,6 +190,8 @@ static bool repeat_runs(struct runner *r, struct harness_run *first, json_t *res
         json_object_set_new(result, RK_REPEAT, rep);
         json_object_set_new(result, RK_RUNS, runs);
         runs = NULL;
+        if (first->rule->mode == GPU_BUDGET_SLICED)
+            outputs_mark_sliced(result);
         queue_progress(r->queue, first->job, planned * n);
         char path[PATH_MAX + 16];
         job_file_path(first->job->dir, JOB_FILE_RESULT, path, sizeof(path));
@@ -204,9 +206,31 @@ static bool repeat_runs(struct runner *r, struct harness_run *first, json_t *res
     return ok;
 }
 
+/* A job that ended early (cancelled, stopped, failed) may leave work on
+ * the GPU: the frames in flight of a whole frame, a tile of a sliced one.
+ * It finishes here, before the job's objects go and the next job starts;
+ * /healthz shows the thread draining that job, not rendering it, and the
+ * wait is bounded by the frame bound (measure.c), well within the stall
+ * bound. */
+static void drain(const char *id, enum job_status status)
+{
+    render_state_phase(status == JOB_CANCELLED ? RENDER_PHASE_DRAINING_CANCELLED
+                                               : RENDER_PHASE_DRAINING_FAILED);
+    double t0 = clock_mono_s();
+    GLsync fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    glClientWaitSync(fence, GL_SYNC_FLUSH_COMMANDS_BIT, UINT64_MAX);
+    glDeleteSync(fence);
+    double took = clock_mono_s() - t0;
+    LOG(took > 0.5 ? LOG_INFO : LOG_DEBUG, "job %s: the GPU finished its last work %.2f s after "
+        "it ended", id, took);
+}
+
 static void run_job(struct runner *r, struct job *job)
 {
-    struct harness_run run = {.gl = &r->gl, .queue = r->queue, .job = job, .spec = &job->spec};
+    /* Decided in the first run, followed by the others (measure.c). */
+    struct run_timing_rule rule = {0};
+    struct harness_run run = {.gl = &r->gl, .queue = r->queue, .job = job, .spec = &job->spec,
+                              .rule = &rule};
     const struct job_spec *spec = &job->spec;
     enum job_status status = JOB_FAILED;
     json_t *result = NULL, *fidelity_view = NULL;
@@ -270,6 +294,7 @@ done:;
          * next job starts. */
         LOG(LOG_WARN, "job %s %s: %s", id, job_status_name(status), run.err);
         queue_finish(r->queue, job, status, run.err, result);
+        drain(id, status);
         run_finish(&run);
     } else {
         LOG(LOG_INFO, "job %s rendered", id);
@@ -414,11 +439,15 @@ struct runner *runner_create(struct queue *q, int device, bool gl_debug,
     }
     r->device = device;
     r->gl_debug = gl_debug;
-    /* Tests draw everything in tiles of a tiny slice, however cheap: the
-     * pixels must not change. */
+    /* Tests cut every piece that is drawn in tiles into tiles of a tiny
+     * slice, at least four, however cheap (with a job that accepts sliced
+     * timing, every piece of its timed frames): the pixels must not change. */
     const char *slice_ms = getenv("SHADEBENCH_SLICE_MS");
     if (slice_ms && atof(slice_ms) > 0)
-        gpu_budget_configure(atof(slice_ms) / 1e3, 0.0, 0.25);
+        gpu_budget_configure(atof(slice_ms) / 1e3, 0.25);
+    const char *stall_ms = getenv("SHADEBENCH_DEBUG_STALL_FIRST_FRAME_MS");
+    if (stall_ms && atof(stall_ms) > 0)
+        gpu_budget_debug_stall(atof(stall_ms) / 1e3);
     atomic_init(&r->alive, false);
     pthread_mutex_init(&r->lock, NULL);
     pthread_cond_init(&r->ready_cond, NULL);

@@ -7,10 +7,12 @@
 #include "common/result_keys.h"
 #include "daemon/spec/job_cost.h"
 #include "daemon/spec/job_figures.h"
+#include "daemon/jobs/job_eta.h"
 #include "daemon/store/job_dir.h"
 #include "daemon/store/store_reserve.h"
 
 #include <errno.h>
+#include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -291,6 +293,7 @@ static struct job *job_new(void)
         return NULL;
     atomic_init(&job->cancel, false);
     atomic_init(&job->frames_done, 0);
+    atomic_init(&job->frames_began, 0.0);
     return job;
 }
 
@@ -554,6 +557,8 @@ void queue_progress(struct queue *q, struct job *job, int frames_done)
 {
     (void)q;
     atomic_store_explicit(&job->frames_done, frames_done, memory_order_relaxed);
+    if (frames_done > 0 && atomic_load_explicit(&job->frames_began, memory_order_relaxed) == 0)
+        atomic_store_explicit(&job->frames_began, clock_unix_s(), memory_order_relaxed);
 }
 
 void queue_set_phase(struct queue *q, struct job *job, const char *phase)
@@ -601,6 +606,7 @@ void queue_finish(struct queue *q, struct job *job, enum job_status status,
         job->started = 0;
         job->error[0] = '\0';
         atomic_store(&job->frames_done, 0);
+        atomic_store(&job->frames_began, 0.0);
         atomic_store(&job->cancel, false);
         job->requeue_on_stop = false;
         json_decref(result);
@@ -608,6 +614,8 @@ void queue_finish(struct queue *q, struct job *job, enum job_status status,
     } else {
         job->status = status;
         job->finished = next.finished;
+        if (status == JOB_DONE && result && job->started > 0)
+            job_eta_observe_result(&job->spec, result, next.finished - job->started);
         if (error)
             snprintf(job->error, sizeof(job->error), "%s", error);
         json_decref(job->result);
@@ -649,6 +657,40 @@ void queue_stop(struct queue *q)
     pthread_cond_broadcast(&q->changed);
     NOTIFY_LISTENER(q);
     pthread_mutex_unlock(&q->lock);
+}
+
+void queue_store_abandoned(struct queue *q)
+{
+    struct snapshot snaps[8];
+    int n = 0;
+    pthread_mutex_lock(&q->lock);
+    for (size_t i = 0; i < q->live.count && n < 8; i++) {
+        struct job *job = q->live.items[i];
+        if (job->status != JOB_RUNNING)
+            continue;
+        /* What queue_finish would store: a DELETE's cancel stays cancelled,
+         * a job stopped by the daemon goes back to the queue. */
+        struct job_state next = state_of(job);
+        if (job->user_cancel) {
+            next.status = JOB_CANCELLED;
+            next.finished = clock_unix_s();
+            next.error = "cancelled (the daemon stopped while its render thread was still "
+                         "letting go of it)";
+        } else {
+            next.status = JOB_QUEUED;
+            next.phase = NULL;
+            next.started = 0;
+            next.error = "";
+            next.frames_done = 0;
+        }
+        snaps[n].job = job;
+        snaps[n].seq = store_version_take(&job->version);
+        row_of(job, &next, NULL, &snaps[n].row);
+        n++;
+    }
+    pthread_mutex_unlock(&q->lock);
+    for (int i = 0; i < n; i++)
+        write_snapshot(q, &snaps[i], NULL, 0);
 }
 
 enum queue_cancel_result queue_cancel(struct queue *q, const char *id)
@@ -726,10 +768,41 @@ static json_t *state_json(const char *id, const char *technique, double created,
     return o;
 }
 
+/* A queued or running job's estimate (job_eta.h): the whole job's, and
+ * while it runs the time left by the frames it has drawn. */
+static json_t *estimate_json(const struct job *job, const struct job_state *st)
+{
+    struct job_eta e;
+    job_eta_estimate(&job->spec, &e);
+    json_t *o = json_pack("{s:o}", "estimate", job_eta_json(&e));
+    if (st->status != JOB_RUNNING)
+        return o;
+    double began = atomic_load(&job->frames_began), now = clock_unix_s();
+    int done = st->frames_done;
+    /* The first counted frame marks when frames began: the rate is over
+     * the frames after it. */
+    double left = began > 0 ? job_eta_left(done - 1, job->frames_total - 1, now - began) : -1;
+    if (left >= 0)
+        json_object_set_new(o, "seconds_left",
+                            json_pack("{s:f, s:s}", "frames", left, "rule",
+                                      "the frames left of every run at the rate of the frames "
+                                      "drawn since the first; the reference and metrics, if "
+                                      "any, come on top"));
+    else if (e.known && st->started > 0)
+        json_object_set_new(o, "seconds_left",
+                            json_pack("{s:f, s:s}", "estimate",
+                                      fmax(0.0, e.duration_s - (now - st->started)), "rule",
+                                      "before its first frame: the estimate less the time it "
+                                      "has run"));
+    return o;
+}
+
 static json_t *live_json_locked(const struct job *job, bool full)
 {
     struct job_state st = state_of(job);
     json_t *o = state_json(job->id, job->spec.technique, job->created, &st, job->frames_total);
+    if (o && (st.status == JOB_QUEUED || st.status == JOB_RUNNING))
+        json_object_update_new(o, estimate_json(job, &st));
     if (o && full) {
         json_object_set_new(o, "spec", job_spec_to_json(&job->spec));
         if (job->result)

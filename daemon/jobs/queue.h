@@ -39,6 +39,9 @@ struct job {
     enum job_status status;
     const char *phase; /* while running: "rendering", "reference" or "metrics" */
     atomic_int frames_done;
+    /* When its first frame was counted done (clock_unix_s; 0 before): the
+     * time left is read from the frames drawn since (job_eta_left). */
+    _Atomic double frames_began;
     int frames_total;
     atomic_bool cancel;
     char error[1024];
@@ -113,7 +116,8 @@ bool queue_room_to_accept(struct queue *q, const char *what);
 /* Render thread: blocks until a job is queued (marks it running) or the
  * queue is stopping (returns NULL). */
 struct job *queue_next(struct queue *q);
-/* Render thread, from the timed loop: an atomic store, no lock. */
+/* Render thread, from the timed loop: an atomic store, no lock (and, at
+ * the first frame counted, the time, once). */
 void queue_progress(struct queue *q, struct job *job, int frames_done);
 /* phase must be a string literal. */
 void queue_set_phase(struct queue *q, struct job *job, const char *phase);
@@ -125,6 +129,13 @@ void queue_finish(struct queue *q, struct job *job, enum job_status status,
 /* No more jobs start; a running job is asked to stop at its next frame and
  * will be requeued, unless a DELETE had already asked to cancel it. */
 void queue_stop(struct queue *q);
+
+/* At exit, when the render thread has not let go of its job in time (after
+ * queue_stop): stores the running job as it would have ended, cancelled
+ * when a DELETE asked for it, else queued again, so that a restart does not
+ * find it running and call it interrupted. The render thread may still
+ * finish it meanwhile: the store keeps the newer of the two. */
+void queue_store_abandoned(struct queue *q);
 
 enum queue_cancel_result { CANCEL_DONE, CANCEL_REQUESTED, CANCEL_FINISHED, CANCEL_NOT_FOUND };
 enum queue_cancel_result queue_cancel(struct queue *q, const char *id);

@@ -186,8 +186,9 @@ void shade_split(vec3 P, vec3 N, float metallic, vec4 albedo, int row, out vec3 
 
 uniform int u_work_count;
 uniform int u_groups_x;
-// The dispatch may cover a range of the blocks only (bounded submissions,
-// daemon/gpu/budget.h): groups [u_group_base, u_group_end).
+// The dispatch may cover a range of the blocks (or, with OSL_BLOCK_LIST, of
+// the listed slots) only (bounded submissions, daemon/gpu/budget.h): groups
+// [u_group_base, u_group_end).
 uniform uint u_group_base;
 uniform uint u_group_end;
 
@@ -201,8 +202,10 @@ uniform int u_blocks_x; // the atlas's width in blocks
 void main()
 {
 #ifdef OSL_BLOCK_LIST
-    uint slot = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
-    if (slot >= dispatch.w)
+    // Whole: u_group_base 0, u_group_end past every slot; in ranges where
+    // the harness slices (gpu_dispatch_indirect, daemon/gpu/budget.h).
+    uint slot = u_group_base + gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+    if (slot >= dispatch.w || slot >= u_group_end)
         return;
     uvec2 entry = list[slot];
     uint owner = block_instance[entry.x];

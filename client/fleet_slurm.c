@@ -255,7 +255,10 @@ static bool write_task_script(const char *dir, const char *daemon, char *err, si
     sh_quote(f, dir);
     fputs("\nexec ", f);
     sh_quote(f, daemon);
-    fputs(" --once \"$fleet/plan/$i.json\" --out \"$fleet/tasks/$class/$i\" >/dev/null\n", f);
+    /* The GPU Slurm gave the task, whatever the order of EGL's devices; the
+     * result's device.selection says which it opened and why. */
+    fputs(" --device allocated --once \"$fleet/plan/$i.json\" --out \"$fleet/tasks/$class/$i\" "
+          ">/dev/null\n", f);
     bool ok = fclose(f) == 0 && fs_write_atomic(path, text, len) && chmod(path, 0755) == 0;
     free(text);
     if (!ok)

@@ -37,7 +37,8 @@ UNIT_TESTS = \
 	tests/unit/test_lighting \
 	tests/unit/test_asset \
 	tests/unit/test_uv_charts \
-	tests/unit/test_light_shape
+	tests/unit/test_light_shape \
+	tests/unit/test_devices
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
 	tests/fuzz/replay-route tests/fuzz/replay-asset_cache tests/fuzz/replay-asset_convert
@@ -60,6 +61,9 @@ tests_unit_test_interference_SOURCES = tests/unit/test_interference.c \
 	daemon/harness/interference.c daemon/harness/interference.h
 tests_unit_test_interference_LDADD = $(CORE_LIBS)
 tests_unit_test_png_LDADD = $(CORE_LIBS)
+# The GPU's names and the scheduler's choice, over fake sysfs trees.
+tests_unit_test_devices_SOURCES = tests/unit/test_devices.c $(GPU_DEVICE_SOURCES)
+tests_unit_test_devices_LDADD = $(CORE_LIBS)
 tests_unit_test_gate_SOURCES = tests/unit/test_gate.c $(CLIENT_PURE)
 tests_unit_test_gate_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_client_SOURCES = tests/unit/test_client.c $(CLIENT_PURE)

@@ -40,7 +40,7 @@
 struct runner {
     struct queue *queue;
     struct metrics_worker *metrics;
-    int device;
+    struct device_spec device;
     bool gl_debug;
     pthread_t thread;
     pthread_mutex_t lock;
@@ -70,6 +70,7 @@ static json_t *collect_device(struct egl_context *egl, const struct gpu_caps *ca
                           "max_texture_size", caps->max_texture_size, "max_renderbuffer_size",
                           caps->max_renderbuffer_size);
     json_object_set_new(d, "caps", gpu_caps_json(caps));
+    egl_context_describe(egl, d);
     return d;
 }
 
@@ -290,7 +291,7 @@ static bool give_back_memory(struct runner *r, struct egl_context **egl, char *e
         double t0 = clock_mono_s();
         harness_gl_finish(&r->gl);
         egl_context_destroy(*egl);
-        *egl = egl_context_create(r->device, r->gl_debug, err, errlen);
+        *egl = egl_context_create(&r->device, r->gl_debug, err, errlen);
         if (!*egl || !harness_gl_init(&r->gl, err, errlen))
             return false;
         renew_s = clock_mono_s() - t0;
@@ -309,7 +310,7 @@ static void *runner_main(void *arg)
 {
     struct runner *r = arg;
     char err[512] = "";
-    struct egl_context *egl = egl_context_create(r->device, r->gl_debug, err, sizeof(err));
+    struct egl_context *egl = egl_context_create(&r->device, r->gl_debug, err, sizeof(err));
     pthread_mutex_lock(&r->lock);
     if (egl && !harness_gl_init(&r->gl, err, sizeof(err))) {
         egl_context_destroy(egl);
@@ -359,7 +360,7 @@ static void *runner_main(void *arg)
     return NULL;
 }
 
-struct runner *runner_create(struct queue *q, int device, bool gl_debug,
+struct runner *runner_create(struct queue *q, const struct device_spec *device, bool gl_debug,
                              char *err, size_t errlen)
 {
     struct runner *r = calloc(1, sizeof(*r));
@@ -374,7 +375,7 @@ struct runner *runner_create(struct queue *q, int device, bool gl_debug,
         free(r);
         return NULL;
     }
-    r->device = device;
+    r->device = *device;
     r->gl_debug = gl_debug;
     /* Tests draw everything in tiles of a tiny slice, however cheap: the
      * pixels must not change. */

@@ -9,13 +9,15 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "daemon/gpu/device_names.h"
 #include "daemon/harness/render_state.h"
 #include "daemon/jobs/queue.h"
 
 struct runner;
 
-/* Starts the render thread and waits until its context is up (or failed). */
-struct runner *runner_create(struct queue *q, int device, bool gl_debug,
+/* Starts the render thread and waits until its context is up on the
+ * device that device names (egl.h), or failed. */
+struct runner *runner_create(struct queue *q, const struct device_spec *device, bool gl_debug,
                              char *err, size_t errlen);
 /* Stops the queue and waits up to wait_s for the render thread to end: the
  * running job stops at once and is put back in the queue, but what the GPU

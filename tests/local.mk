@@ -38,7 +38,8 @@ UNIT_TESTS = \
 	tests/unit/test_asset \
 	tests/unit/test_uv_charts \
 	tests/unit/test_light_shape \
-	tests/unit/test_devices
+	tests/unit/test_devices \
+	tests/unit/test_gpu_memory
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
 	tests/fuzz/replay-route tests/fuzz/replay-asset_cache tests/fuzz/replay-asset_convert
@@ -64,6 +65,9 @@ tests_unit_test_png_LDADD = $(CORE_LIBS)
 # The GPU's names and the scheduler's choice, over fake sysfs trees.
 tests_unit_test_devices_SOURCES = tests/unit/test_devices.c $(GPU_DEVICE_SOURCES)
 tests_unit_test_devices_LDADD = $(CORE_LIBS)
+tests_unit_test_gpu_memory_SOURCES = tests/unit/test_gpu_memory.c daemon/gpu/gpu_memory.c \
+	daemon/gpu/gpu_memory.h
+tests_unit_test_gpu_memory_LDADD = $(CORE_LIBS)
 tests_unit_test_gate_SOURCES = tests/unit/test_gate.c $(CLIENT_PURE)
 tests_unit_test_gate_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_client_SOURCES = tests/unit/test_client.c $(CLIENT_PURE)
@@ -124,6 +128,7 @@ endif
 # one long test running alone at the end.
 E2E_TESTS = \
 	tests/e2e/e2e_msaa.py \
+	tests/e2e/e2e_gpu.py \
 	tests/e2e/e2e_fleet.py \
 	tests/e2e/e2e_report.py \
 	tests/e2e/e2e_faults.py \

@@ -71,6 +71,10 @@ static json_t *collect_device(struct egl_context *egl, const struct gpu_caps *ca
                           caps->max_renderbuffer_size);
     json_object_set_new(d, "caps", gpu_caps_json(caps));
     egl_context_describe(egl, d);
+    struct gpu_memory_sample memory;
+    gpu_memory_sample_gl(&memory);
+    json_object_set_new(d, "gpu_memory_at_start",
+                        gpu_memory_sample_json(&memory, json_is_true(json_object_get(d, "software"))));
     return d;
 }
 
@@ -79,10 +83,21 @@ static bool prepare_and_measure(struct harness_run *run, bool capture, int run_i
                                 enum job_status *status)
 {
     render_state_phase("setup");
-    if (run_prepare(run, capture)) {
+    /* The costs beside the frame times (glutil.h, gpu_memory.h): the
+     * programs built in the set-up and warm-up, and GPU memory around them. */
+    gpu_memory_sample_gl(&run->gpu_memory[0]);
+    gl_build_log_begin(&run->builds);
+    bool prepared = run_prepare(run, capture), measured = false;
+    if (prepared) {
+        gpu_memory_sample_gl(&run->gpu_memory[1]);
         render_state_phase("rendering");
-        return measure_run(run, run_index, status);
+        measured = measure_run(run, run_index, status);
+        gpu_memory_sample_gl(&run->gpu_memory[2]);
     }
+    gl_build_timed_region(false);
+    gl_build_log_end();
+    if (prepared)
+        return measured;
     /* Told to stop while the look's set-up (image-based lighting's probes)
      * ran: say why, as the timed loop would. */
     bool cancelled = atomic_load(&run->job->cancel);
@@ -143,6 +158,9 @@ static bool repeat_runs(struct runner *r, struct harness_run *first, json_t *res
     if (ok)
         json_object_set_new(json_array_get(runs, 0), RK_INTERFERENCE,
                             json_deep_copy(json_object_get(result, RK_INTERFERENCE)));
+    if (ok)
+        json_object_set_new(json_array_get(runs, 0), "compile_ms",
+                            json_real(first->builds.compile_ms + first->builds.link_ms));
     int done = 1;
     while (ok && done < planned && !(spec->repeat_auto && stats_is_stable(med, (size_t)done, 0.025))) {
         struct harness_run extra = {.gl = &r->gl, .queue = r->queue, .job = first->job, .spec = spec,
@@ -160,6 +178,8 @@ static bool repeat_runs(struct runner *r, struct harness_run *first, json_t *res
             json_array_append_new(runs, run_summary(done + 1, extra.wall_s, f, g, c));
             json_object_set_new(json_array_get(runs, done), RK_INTERFERENCE,
                                 interference_json(&extra.interference[0], &extra.interference[1]));
+            json_object_set_new(json_array_get(runs, done), "compile_ms",
+                                json_real(extra.builds.compile_ms + extra.builds.link_ms));
             done++;
         } else {
             char why[900];

@@ -600,7 +600,7 @@ int cmd_plan(const struct options *o, const char *sweep_file)
         return EXIT_ERROR;
     size_t n = json_array_size(json_object_get(plan, "points"));
     printf("%zu points in %s/plan; run each on a runner labelled LABEL with\n"
-           "  shadebenchd --once %s/plan/N.json --out %s/tasks/LABEL/N\n"
+           "  shadebenchd --device allocated --once %s/plan/N.json --out %s/tasks/LABEL/N\n"
            "for N from 0 to %zu, then: shadebench gather DIR...\n",
            n, o->out_dir, o->out_dir, o->out_dir, n ? n - 1 : 0);
     json_decref(plan);

@@ -259,9 +259,9 @@ static bool open_auto(struct egl_context *ctx, EGLDeviceEXT *devices, bool debug
                 continue;
             if (try_device(ctx, devices[i], i, debug, why, whylen)) {
                 snprintf(ctx->why + strlen(ctx->why), sizeof(ctx->why) - strlen(ctx->why),
-                         "%sthe first %s EGL device that gave an OpenGL 4.3 core context",
-                         ctx->why[0] ? ": " : "", pass ? "software (no hardware device did)"
-                                                       : "hardware");
+                         "%sthe first %s EGL device that gave an OpenGL 4.3 core context%s",
+                         ctx->why[0] ? ": " : "", pass ? "software" : "hardware",
+                         pass ? " (no hardware device did)" : "");
                 return true;
             }
         }

@@ -1,12 +1,15 @@
 """The GPU as a lab names it, and the costs a GPU user asks for (issue 38),
-on llvmpipe: --list-devices (text and JSON); --device by index, and by a
-node, a PCI bus id, a UUID or an index that match nothing (a clear start-up
-error listing the devices); /v1/info's devices and selection; --device
+on the machine at hand (llvmpipe in CI; bench/gpu_run.py runs it on a GPU):
+--list-devices (text and JSON); --device by every name the first device
+has (the index alone on llvmpipe; a GPU's node, bus id and UUID too), and by
+a node, a PCI bus id, a UUID or an index that match nothing (a clear
+start-up error listing the devices); /v1/info's devices and selection; --device
 allocated under Slurm's variables on a box without GPUs (the default choice,
 with the reason) and with a fake NVIDIA driver (the GPU it names, which EGL
 lacks: an error); compile time per program in every result, outside the
-timed region, programs seen before on a second job; GPU memory absent with
-the reason beside the target pool's bytes."""
+timed region, programs seen before on a second job; GPU memory where the
+driver reports it, else absent with the reason, beside the target pool's
+bytes."""
 
 import json
 import os
@@ -45,50 +48,89 @@ def load(path):
         return json.load(f)
 
 
-# --list-devices: each device with its names.
-r = run("--list-devices")
-check(r.returncode == 0 and "0: llvmpipe" in r.stdout and "(software)" in r.stdout,
-      "--list-devices names llvmpipe: %s" % r.stdout)
-for line in ("DRM node     -", "PCI bus id   -", "UUID         -", "--device     0"):
-    check(line in r.stdout, "--list-devices shows %r: %s" % (line, r.stdout))
+# --list-devices: each device with its names (llvmpipe here; a GPU box's
+# devices there: bench/gpu_run.py runs this test on one).
 r = run("--list-devices", "--json")
 devs = json.loads(r.stdout)["devices"] if r.returncode == 0 else []
-check(len(devs) >= 1 and devs[0]["index"] == 0 and devs[0]["software"] is True and
-      "llvmpipe" in devs[0]["renderer"] and devs[0]["opens"] is True and
-      devs[0]["gl_version"].startswith("4."), "--list-devices --json: %s" % devs)
-check(all(devs and devs[0][k] is None for k in ("drm_node", "render_node", "bus_id", "uuid")),
-      "llvmpipe has a name but no node, bus id or UUID: %s" % devs)
+check(len(devs) >= 1 and [x["index"] for x in devs] == list(range(len(devs))),
+      "--list-devices --json lists the EGL devices: %s" % devs)
+opened = [x for x in devs if x.get("opens")]
+check(len(opened) >= 1 and all(x["gl_version"].startswith(("4.", "5.")) and x["renderer"]
+                                for x in opened), "a device opens with its renderer: %s" % devs)
+dev0 = opened[0] if opened else {"index": 0, "software": True}
+SOFTWARE = dev0.get("software", True)
+if SOFTWARE:
+    check("llvmpipe" in dev0.get("renderer", "") and
+          all(dev0.get(k, "x") is None for k in ("drm_node", "render_node", "bus_id", "uuid")),
+          "llvmpipe has a name but no node, bus id or UUID: %s" % dev0)
+r = run("--list-devices")
+check(r.returncode == 0 and ("%d: %s" % (dev0["index"], dev0.get("renderer"))) in r.stdout and
+      ("--device     %d" % dev0["index"]) in r.stdout,
+      "--list-devices names each device and how to pick it: %s" % r.stdout)
+for label, key in (("DRM node", "render_node"), ("PCI bus id", "bus_id"), ("UUID", "uuid")):
+    check(("    %-12s %s" % (label, dev0.get(key) or "-")) in r.stdout,
+          "--list-devices shows the %s: %s" % (label, r.stdout))
 check(run("--json").returncode == 2, "--json alone is refused")
 
 # A name that matches nothing: the daemon does not start, and says what exists.
-for name, what in (("/dev/dri/renderD128", "the device node /dev/dri/renderD128"),
-                   ("0000:41:00.0", "the PCI bus id 0000:41:00.0"),
-                   ("GPU-8c5f3b1e-5d2a-4c6f-9b7e-1a2b3c4d5e6f",
-                    "the UUID 8c5f3b1e-5d2a-4c6f-9b7e-1a2b3c4d5e6f"),
-                   ("9", "the index 9")):
+for name, what in (("/dev/dri/renderD250", "the device node /dev/dri/renderD250"),
+                   ("00ff:fe:1f.7", "the PCI bus id 00ff:fe:1f.7"),
+                   ("GPU-ffffffff-ffff-ffff-ffff-fffffffffffe",
+                    "the UUID ffffffff-ffff-ffff-ffff-fffffffffffe"),
+                   (str(len(devs) + 3), "the index %d" % (len(devs) + 3))):
     r = run("--device", name, "--listen", "127.0.0.1:0", "--state-dir", os.path.join(tmp, "st"))
     check(r.returncode == 1 and ("no EGL device has %s" % what) in r.stderr and
-          "0: llvmpipe" in r.stderr and "node -, bus id -, uuid -" in r.stderr,
+          ("%d EGL device(s): 0: " % len(devs)) in r.stderr and
+          ("%d: %s" % (dev0["index"], dev0.get("renderer"))) in r.stderr,
           "--device %s fails at start naming the devices: %d %s" % (name, r.returncode, r.stderr))
+if SOFTWARE:
+    r = run("--device", "/dev/dri/renderD128", "--listen", "127.0.0.1:0")
+    check("0: llvmpipe" in r.stderr and "[software], node -, bus id -, uuid -" in r.stderr,
+          "llvmpipe is listed with no node, bus id or UUID: %s" % r.stderr)
 r = run("--device", "llvmpipe", "--list-devices")
 check(r.returncode == 2 and '"llvmpipe" names no device' in r.stderr and "allocated" in r.stderr,
       "a --device that is no name at all is refused with the forms: %s" % r.stderr)
 
+# Every name the first device that opens has picks it (the index alone on
+# llvmpipe; a GPU's node, bus id, UUID and /dev/nvidiaN too).
+names = [(str(dev0["index"]), "index")]
+for key, kind in (("render_node", "node"), ("drm_node", "node"), ("bus_id", "bus_id")):
+    if dev0.get(key):
+        names.append((dev0[key], kind))
+if dev0.get("uuid"):
+    names.append(("GPU-" + dev0["uuid"], "uuid"))
+if dev0.get("nvidia_minor") is not None:
+    names.append(("/dev/nvidia%d" % dev0["nvidia_minor"], "node"))
+for k, (name, kind) in enumerate(names):
+    r, out = once("by-%d" % k, "--device", name)
+    sel = load(os.path.join(out, "result.json"))["device"] if r.returncode == 0 else {}
+    check(sel.get("egl_device_index") == dev0["index"] and
+          sel.get("selection", {}).get("matched_by") == kind and
+          sel["selection"]["asked"] == name,
+          "--device %s opens device %d: %d %s %s" % (name, dev0["index"], r.returncode,
+                                                     sel.get("selection"), r.stderr[-300:]))
+
 # By index: /v1/info lists the devices and says which was opened and why.
-d = testlib.Daemon("--device", "0")
+d = testlib.Daemon("--device", str(dev0["index"]))
 try:
     status, info = d.json("GET", "/v1/info")
     dev = info.get("device", {})
     sel = dev.get("selection", {})
-    check(sel.get("asked") == "0" and sel.get("matched_by") == "index" and
-          "EGL device 0" in sel.get("why", ""), "device.selection: %s" % sel)
-    check(dev.get("egl_device_index") == 0 and dev.get("software") is True and
-          dev.get("bus_id") is None and len(dev.get("egl_devices", [])) >= 1 and
-          dev["egl_devices"][0]["selected"] is True and
-          "llvmpipe" in dev["egl_devices"][0]["renderer"], "device names: %s" % dev)
+    i = dev0["index"]
+    check(sel.get("asked") == str(i) and sel.get("matched_by") == "index" and
+          ("EGL device %d" % i) in sel.get("why", ""), "device.selection: %s" % sel)
+    listed = dev.get("egl_devices", [])
+    check(dev.get("egl_device_index") == i and dev.get("software") == SOFTWARE and
+          dev.get("bus_id") == dev0.get("bus_id") and len(listed) == len(devs) and
+          [x["selected"] for x in listed] == [x["index"] == i for x in devs] and
+          listed[i]["renderer"] == dev0["renderer"], "device names: %s" % dev)
     mem = dev.get("gpu_memory_at_start", {})
-    check("source" in mem and mem["source"] is None and "GL_NVX_gpu_memory_info" in mem["reason"],
-          "memory at start absent with a reason: %s" % mem)
+    if mem.get("source"):
+        check(mem["source"] in ("GL_NVX_gpu_memory_info", "GL_ATI_meminfo") and
+              mem.get("available_kib", 0) > 0, "memory at start where the driver reports it: %s" % mem)
+    else:
+        check("source" in mem and "GL_NVX_gpu_memory_info" in mem.get("reason", ""),
+              "memory at start absent with a reason: %s" % mem)
 
     # Compile time in the result, outside the timed region.
     first = d.run(JOB)
@@ -107,13 +149,23 @@ try:
     check(comp.get("in_timed_region") == 0, "no program built in the timed region: %s" %
           comp.get("in_timed_region"))
     cache = comp.get("cache", {})
-    check(cache.get("driver") == "mesa" and cache.get("disk_cache") in ("on", "off") and
-          "mesa_shader_cache" in cache.get("dir", "") and "dir_exists" in cache,
+    check(cache.get("driver") in ("mesa", "nvidia") and cache.get("disk_cache") in ("on", "off") and
+          ("mesa_shader_cache" in cache.get("dir", "") or "GLCache" in cache.get("dir", "") or
+           cache["driver"] == "nvidia") and "dir_exists" in cache,
           "the driver's shader cache is stated: %s" % cache)
     gm = res.get("gpu_memory", {})
-    check(gm.get("source", "x") is None and "neither" in gm.get("reason", "") and
-          gm.get("pool_bytes") == res.get("targets_bytes") and res.get("targets_bytes", 0) > 0,
-          "GPU memory absent with a reason, beside the pool's bytes: %s" % gm)
+    check(gm.get("pool_bytes") == res.get("targets_bytes") and res.get("targets_bytes", 0) > 0,
+          "the pool's own bytes beside the driver's figures: %s" % gm)
+    if gm.get("source"):
+        av = gm.get("available_kib", {})
+        check(all(isinstance(av.get(k), int) and av[k] > 0 for k in
+                  ("before_setup", "after_setup", "after_frames")) and
+              gm.get("setup_kib") == av["before_setup"] - av["after_setup"],
+              "GPU memory where the driver reports it: %s" % gm)
+    else:
+        check("source" in gm and "neither" in gm.get("reason", "") and
+              ("software" in gm["reason"]) == SOFTWARE,
+              "GPU memory absent with a reason: %s" % gm)
     # The same job again: every program is one this process built before.
     again = d.run(dict(JOB, repeat=2)).get("result", {})
     comp2 = again.get("compile", {})
@@ -154,7 +206,7 @@ with open(os.path.join(nv, "information"), "w") as f:
 r, out = once("alloc-nv", "--device", "allocated",
               env=dict(slurm_env, SHADEBENCH_SYSFS_ROOT=os.path.join(tmp, "nvidia-root")))
 check(r.returncode == 1 and "--device allocated: no EGL device has the device node /dev/nvidia0"
-      in r.stderr and "0: llvmpipe" in r.stderr and not os.path.exists(out),
+      in r.stderr and "EGL device(s): 0: " in r.stderr and not os.path.exists(out),
       "Slurm's GPU that EGL does not have fails the task clearly: %d %s" % (r.returncode, r.stderr))
 
 shutil.rmtree(tmp, ignore_errors=True)

@@ -1,10 +1,8 @@
-#define _GNU_SOURCE /* dl_iterate_phdr, RTLD_NODELETE */
+#define _POSIX_C_SOURCE 200809L
 #include <dirent.h>
-#include <dlfcn.h>
 #include <errno.h>
 #include <sys/stat.h>
 #include <getopt.h>
-#include <link.h>
 #include <limits.h>
 #include <malloc.h>
 #include <signal.h>
@@ -329,28 +327,6 @@ static rlim_t raise_fd_limit(void)
     return rl.rlim_cur;
 }
 
-#ifdef SHADEBENCH_SANITIZERS
-static int pin_module(struct dl_phdr_info *info, size_t size, void *data)
-{
-    (void)size, (void)data;
-    if (info->dlpi_name && info->dlpi_name[0])
-        dlopen(info->dlpi_name, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
-    return 0;
-}
-#endif
-
-/* Sanitizer builds only: Mesa unloads its driver when the GL context goes,
- * and memory that only the driver's globals pointed to then looks leaked,
- * with no module to name in a suppression. Marking every library loaded by
- * now (the driver and LLVM included) as never to be unloaded keeps it
- * reachable, so LeakSanitizer reports the daemon's own leaks only. */
-static void pin_loaded_modules(void)
-{
-#ifdef SHADEBENCH_SANITIZERS
-    dl_iterate_phdr(pin_module, NULL);
-#endif
-}
-
 /* --list-devices: each EGL device with the names --device takes, opened
  * briefly for its GL renderer and version; as text or JSON. */
 static int list_devices(bool as_json)
@@ -367,7 +343,6 @@ static int list_devices(bool as_json)
     for (int i = 0; i < n; i++) {
         char why[512] = "", version[128] = "";
         bool opened = egl_probe_device(i, &devs[i], version, sizeof(version), why, sizeof(why));
-        pin_loaded_modules();
         json_t *j = device_names_json(&devs[i]);
         json_object_set_new(j, "gl_version", opened ? json_string(version) : json_null());
         json_object_set_new(j, "opens", json_boolean(opened));
@@ -549,7 +524,6 @@ static int run_once(const struct options *o, const struct technique_catalog *cat
         record_remove_dir(partial);
         return 1;
     }
-    pin_loaded_modules();
     char id[24];
     int rc = 1;
     if (queue_submit(q, &spec, partial, id) == QUEUE_OK) {
@@ -703,7 +677,6 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
         store_close(store);
         return 1;
     }
-    pin_loaded_modules();
     set_max_msaa(r);
     double budget, driver;
     if (!set_memory_budget(o, &limits, &budget, &driver, err, sizeof(err))) {

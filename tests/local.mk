@@ -185,7 +185,8 @@ SANITIZER_TESTS = $(UNIT_TESTS) \
 	tests/e2e/e2e_assets.py \
 	tests/e2e/e2e_persist.py \
 	tests/e2e/e2e_badinput.py \
-	tests/e2e/e2e_asset_convert.py
+	tests/e2e/e2e_asset_convert.py \
+	tests/e2e/e2e_gpu.py
 check-sanitizers:
 if SANITIZERS
 	$(MAKE) $(AM_MAKEFLAGS) check TESTS='$(SANITIZER_TESTS)'

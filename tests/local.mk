@@ -45,7 +45,9 @@ UNIT_TESTS = \
 	tests/unit/test_convert_checks \
 	tests/unit/test_light_shape \
 	tests/unit/test_fidelity \
-	tests/unit/test_tile_plan
+	tests/unit/test_tile_plan \
+	tests/unit/test_devices \
+	tests/unit/test_gpu_memory
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
 	tests/fuzz/replay-route tests/fuzz/replay-asset_cache tests/fuzz/replay-asset_convert \
@@ -71,6 +73,12 @@ tests_unit_test_tile_plan_SOURCES = tests/unit/test_tile_plan.c daemon/gpu/tile_
 	daemon/gpu/tile_plan.h
 tests_unit_test_tile_plan_LDADD = -lm
 tests_unit_test_png_LDADD = $(CORE_LIBS)
+# The GPU's names and the scheduler's choice, over fake sysfs trees.
+tests_unit_test_devices_SOURCES = tests/unit/test_devices.c $(GPU_DEVICE_SOURCES)
+tests_unit_test_devices_LDADD = $(CORE_LIBS)
+tests_unit_test_gpu_memory_SOURCES = tests/unit/test_gpu_memory.c daemon/gpu/gpu_memory.c \
+	daemon/gpu/gpu_memory.h
+tests_unit_test_gpu_memory_LDADD = $(CORE_LIBS)
 tests_unit_test_gate_SOURCES = tests/unit/test_gate.c $(CLIENT_PURE)
 tests_unit_test_gate_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_client_SOURCES = tests/unit/test_client.c $(CLIENT_PURE)
@@ -147,6 +155,7 @@ endif
 E2E_TESTS = \
 	tests/e2e/e2e_fidelity.py \
 	tests/e2e/e2e_msaa.py \
+	tests/e2e/e2e_gpu.py \
 	tests/e2e/e2e_fleet.py \
 	tests/e2e/e2e_report.py \
 	tests/e2e/e2e_dashboard.py \
@@ -226,7 +235,8 @@ SANITIZER_TESTS = $(UNIT_TESTS) \
 	tests/e2e/e2e_compare_alpha.py \
 	tests/e2e/e2e_asset_pins.py \
 	tests/e2e/e2e_full_disk.py \
-	tests/e2e/e2e_upload_slots.py
+	tests/e2e/e2e_upload_slots.py \
+	tests/e2e/e2e_gpu.py
 check-sanitizers:
 if SANITIZERS
 	$(MAKE) $(AM_MAKEFLAGS) check TESTS='$(SANITIZER_TESTS)'

@@ -299,6 +299,7 @@ bool measure_run(struct harness_run *run, int run_index, enum job_status *status
             if (!gpu_budget_sync(budget))
                 return keep_going(run, k, run_index, status);
             interference_sample(&run->interference[0]);
+            gl_build_timed_region(true);
             wall_start = clock_mono_s();
             sliced_before = budget->pieces_sliced;
         }
@@ -352,6 +353,7 @@ bool measure_run(struct harness_run *run, int run_index, enum job_status *status
     if (!gpu_budget_sync(budget))
         return keep_going(run, n, run_index, status);
     double wall_end = clock_mono_s();
+    gl_build_timed_region(false);
     interference_sample(&run->interference[1]);
     run->frame_ms[n - 1] += (wall_end - frame_begin) * 1e3;
     run->wall_s = wall_end - wall_start;

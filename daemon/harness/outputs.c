@@ -416,6 +416,11 @@ json_t *outputs_write(struct harness_run *run)
     json_object_set_new(result, RK_NONFINITE, nonfinite_summary(run));
     look_stages_describe(&run->stages, result);
     json_object_set_new(result, "targets_bytes", json_real(gpu_targets_bytes(run->gl->targets)));
+    bool software = json_is_true(json_object_get(run->gl->device_json, "software"));
+    json_object_set_new(result, "compile", gl_build_log_json(&run->builds));
+    json_object_set_new(result, "gpu_memory",
+                        gpu_memory_run_json(run->gpu_memory, gpu_targets_bytes(run->gl->targets),
+                                            software));
     json_object_set_new(result, "msaa", run_msaa_json(run));
     json_object_set_new(result, RK_STARTED_UNIX, json_real(run->job->started));
     if (heatmap)

@@ -361,6 +361,7 @@ void run_finish(struct harness_run *run)
     run->state = NULL;
     look_stages_finish(&run->stages);
     transparent_finish(&run->transparent);
+    gl_build_log_free(&run->builds);
     free(run->hdr_scratch);
     post_chain_destroy(run->post);
     gpu_timer_destroy(run->timer);

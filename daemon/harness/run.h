@@ -17,6 +17,7 @@
 #include "daemon/effects/post_chain.h"
 #include "daemon/gpu/caps.h"
 #include "daemon/gpu/gpu_scene.h"
+#include "daemon/gpu/glutil.h"
 #include "daemon/gpu/gpu_timer.h"
 #include "daemon/gpu/pass.h"
 #include "daemon/scene/environment.h"
@@ -153,6 +154,11 @@ struct harness_run {
     double *frame_ms;
     double wall_s, capture_s;
     struct interference_sample interference[2]; /* start and end of the timed region */
+    /* The costs beside the frame times: the programs the set-up and warm-up
+     * built (glutil.h), and GPU memory before the set-up, after it and
+     * after the frames (gpu_memory.h). */
+    struct gl_build_log builds;
+    struct gpu_memory_sample gpu_memory[3];
     GLsync fences[RUN_FRAMES_IN_FLIGHT];
     char err[1024];
 };

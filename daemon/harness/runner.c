@@ -42,7 +42,7 @@
 struct runner {
     struct queue *queue;
     struct metrics_worker *metrics;
-    int device;
+    struct device_spec device;
     bool gl_debug;
     pthread_t thread;
     pthread_mutex_t lock;
@@ -81,6 +81,11 @@ static json_t *collect_device(struct egl_context *egl, const struct gpu_caps *ca
                           "max_texture_size", caps->max_texture_size, "max_renderbuffer_size",
                           caps->max_renderbuffer_size);
     json_object_set_new(d, "caps", gpu_caps_json(caps));
+    egl_context_describe(egl, d);
+    struct gpu_memory_sample memory;
+    gpu_memory_sample_gl(&memory);
+    json_object_set_new(d, "gpu_memory_at_start",
+                        gpu_memory_sample_json(&memory, json_is_true(json_object_get(d, "software"))));
     return d;
 }
 
@@ -89,10 +94,21 @@ static bool prepare_and_measure(struct harness_run *run, bool capture, int run_i
                                 enum job_status *status)
 {
     render_state_phase("setup");
-    if (run_prepare(run, capture)) {
+    /* The costs beside the frame times (glutil.h, gpu_memory.h): the
+     * programs built in the set-up and warm-up, and GPU memory around them. */
+    gpu_memory_sample_gl(&run->gpu_memory[0]);
+    gl_build_log_begin(&run->builds);
+    bool prepared = run_prepare(run, capture), measured = false;
+    if (prepared) {
+        gpu_memory_sample_gl(&run->gpu_memory[1]);
         render_state_phase("rendering");
-        return measure_run(run, run_index, status);
+        measured = measure_run(run, run_index, status);
+        gpu_memory_sample_gl(&run->gpu_memory[2]);
     }
+    gl_build_timed_region(false);
+    gl_build_log_end();
+    if (prepared)
+        return measured;
     /* Told to stop while the look's set-up (image-based lighting's probes)
      * ran: say why, as the timed loop would. */
     bool cancelled = atomic_load(&run->job->cancel);
@@ -153,6 +169,9 @@ static bool repeat_runs(struct runner *r, struct harness_run *first, json_t *res
     if (ok)
         json_object_set_new(json_array_get(runs, 0), RK_INTERFERENCE,
                             json_deep_copy(json_object_get(result, RK_INTERFERENCE)));
+    if (ok)
+        json_object_set_new(json_array_get(runs, 0), "compile_ms",
+                            json_real(first->builds.compile_ms + first->builds.link_ms));
     int done = 1;
     while (ok && done < planned && !(spec->repeat_auto && stats_is_stable(med, (size_t)done, 0.025))) {
         struct harness_run extra = {.gl = &r->gl, .queue = r->queue, .job = first->job, .spec = spec,
@@ -170,6 +189,8 @@ static bool repeat_runs(struct runner *r, struct harness_run *first, json_t *res
             json_array_append_new(runs, run_summary(done + 1, extra.wall_s, f, g, c));
             json_object_set_new(json_array_get(runs, done), RK_INTERFERENCE,
                                 interference_json(&extra.interference[0], &extra.interference[1]));
+            json_object_set_new(json_array_get(runs, done), "compile_ms",
+                                json_real(extra.builds.compile_ms + extra.builds.link_ms));
             done++;
         } else {
             char why[900];
@@ -352,7 +373,7 @@ static bool give_back_memory(struct runner *r, struct egl_context **egl, char *e
         double t0 = clock_mono_s();
         harness_gl_finish(&r->gl);
         egl_context_destroy(*egl);
-        *egl = egl_context_create(r->device, r->gl_debug, err, errlen);
+        *egl = egl_context_create(&r->device, r->gl_debug, err, errlen);
         if (!*egl || !harness_gl_init(&r->gl, err, errlen))
             return false;
         renew_s = clock_mono_s() - t0;
@@ -371,7 +392,7 @@ static void *runner_main(void *arg)
 {
     struct runner *r = arg;
     char err[512] = "";
-    struct egl_context *egl = egl_context_create(r->device, r->gl_debug, err, sizeof(err));
+    struct egl_context *egl = egl_context_create(&r->device, r->gl_debug, err, sizeof(err));
     pthread_mutex_lock(&r->lock);
     if (egl && !harness_gl_init(&r->gl, err, sizeof(err))) {
         egl_context_destroy(egl);
@@ -422,7 +443,7 @@ static void *runner_main(void *arg)
     return NULL;
 }
 
-struct runner *runner_create(struct queue *q, int device, bool gl_debug,
+struct runner *runner_create(struct queue *q, const struct device_spec *device, bool gl_debug,
                              char *err, size_t errlen)
 {
     struct runner *r = calloc(1, sizeof(*r));
@@ -437,7 +458,7 @@ struct runner *runner_create(struct queue *q, int device, bool gl_debug,
         free(r);
         return NULL;
     }
-    r->device = device;
+    r->device = *device;
     r->gl_debug = gl_debug;
     /* Tests cut every piece that is drawn in tiles into tiles of a tiny
      * slice, at least four, however cheap (with a job that accepts sliced

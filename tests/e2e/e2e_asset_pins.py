@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Pins that hold (issue 34, items 1, 2 and 7), with the real converter:
 
-- a DELETE, or a replacing PUT, racing a job's submission over many rounds:
+- a DELETE, or a replacing PUT, racing a job's submission over many rounds
+  (and a DELETE of an environment map a job's look names):
   every job answered 202 ends done, never failed for want of its asset
   (before: 37 in 100 with a DELETE 0 to 4 ms after the POST, 20 in 80 with
   a PUT);
@@ -28,6 +29,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gltf_gen  # noqa: E402
+import hdr_gen  # noqa: E402
 import testlib  # noqa: E402
 from testlib import Daemon, check, stop_and_check  # noqa: E402
 from e2e_assets import converter_path, glb, put  # noqa: E402
@@ -47,13 +49,23 @@ def asset_files(state, sha):
     return [n for n in os.listdir(os.path.join(state, "assets")) if n.startswith(sha)]
 
 
-def race(d, rounds, other, lo, hi):
-    """Each round: a job on race.glb, and other(d) offset seconds after it
-    (uniform in [lo, hi]; before it when negative), on two threads. Returns
-    the ids of the jobs answered 202 and the answers' codes."""
+def env_job(name):
+    """A tiny PBR job lit by the environment map uploaded as name."""
+    return {"frames": 1, "warmup_frames": 0, "technique": "forward",
+            "look": {"lighting": "pbr", "ibl": {"environment": {"asset": name}, "probes": 0,
+                                                "resolution": 16, "samples": 8}},
+            "scene": {"preset": "sphere", "width": 16, "height": 16}}
+
+
+def race(d, rounds, other, lo, hi, name="race.glb", upload=lambda: glb(1.0), job=tiny_job,
+         field="scene.asset"):
+    """Each round: a job on name (job(name); upload() its bytes, put first),
+    and other(d) offset seconds after it (uniform in [lo, hi]; before it when
+    negative), on two threads. Returns the ids of the jobs answered 202 and
+    the answers' codes."""
     accepted, codes = [], {}
     for _ in range(rounds):
-        code, _ = put(d, "race.glb", glb(1.0))
+        code, _ = put(d, name, upload())
         if code not in (200, 201):
             check(False, "upload before a round: %d" % code)
             continue
@@ -62,7 +74,7 @@ def race(d, rounds, other, lo, hi):
 
         def submit():
             time.sleep(max(0.0, -offset))
-            result["job"] = d.json("POST", "/v1/jobs", tiny_job("race.glb"))
+            result["job"] = d.json("POST", "/v1/jobs", job(name))
 
         def interfere():
             time.sleep(max(0.0, offset))
@@ -78,7 +90,7 @@ def race(d, rounds, other, lo, hi):
             accepted.append(body["id"])
         else:
             check(code in (400, 409) and body.get("error", {}).get("field", "").startswith(
-                "scene.asset"), "a refused job names scene.asset (%d %s)" % (code, body))
+                field), "a refused job names %s (%d %s)" % (field, code, body))
     return accepted, codes
 
 
@@ -124,6 +136,17 @@ def main():
         print("DELETE race: job answers %s" % codes)
         check(accepted, "some jobs were accepted in the DELETE race")
         all_done(d, accepted, "DELETE racing the POST")
+
+        # The same with an environment map a job's look names: pinned with
+        # the scene's asset, in the same step.
+        accepted, codes = race(d, ROUNDS // 3,
+                               lambda d: d.json("DELETE", "/v1/assets/race.hdr")[0],
+                               -0.003, 0.008, name="race.hdr", upload=hdr_gen.sky_and_ground,
+                               job=env_job, field="look.ibl.environment.asset")
+        print("DELETE race on an environment: job answers %s" % codes)
+        check(accepted, "some jobs were accepted in the environment's DELETE race")
+        all_done(d, accepted, "DELETE of the environment racing the POST")
+        d.json("DELETE", "/v1/assets/race.hdr")  # its cache is not counted below
 
         # A replacing PUT racing the submission: the job runs on either hash.
         # The PUT starts first, by up to its own time (a conversion), so

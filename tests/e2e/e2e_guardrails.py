@@ -72,7 +72,10 @@ try:
           "the estimate is within a factor of 3 of the measured time: %s"
           % ["%.2f" % r for r in ratios])
 
-    # The time left, while it runs.
+    # The time left, while it runs: from the frames left and the rate so
+    # far, so it falls as frames are drawn. 240 frames of 400 on, under
+    # half the frames are left: the rate would have to slow 2.5 times
+    # (a machine's load changing while it runs) for the figure not to fall.
     job_id = d.submit(job(64, 48, 400))
     lefts = []
     deadline = time.time() + 300 * S
@@ -83,13 +86,13 @@ try:
         left = (j.get("seconds_left") or {}).get("frames")
         if j.get("status") == "running" and left is not None:
             lefts.append((j["progress"]["frames_done"], left))
-            if lefts[-1][0] >= lefts[0][0] + 40:
+            if lefts[-1][0] >= lefts[0][0] + 240:
                 break
         time.sleep(0.2)
     d.json("DELETE", "/v1/jobs/" + job_id)
-    check(len(lefts) >= 2 and lefts[-1][0] >= lefts[0][0] + 40 and lefts[-1][1] < lefts[0][1]
+    check(len(lefts) >= 2 and lefts[-1][0] >= lefts[0][0] + 240 and lefts[-1][1] < lefts[0][1]
           and all(l >= 0 for _, l in lefts),
-          "a running job states the seconds it has left, from its frames, fewer 40 frames on: "
+          "a running job states the seconds it has left, from its frames, fewer 240 frames on: "
           "%s .. %s" % (lefts[:1], lefts[-1:]))
 
     # Refused with the figures: past its timeout_s, and the 8000x8000 job.

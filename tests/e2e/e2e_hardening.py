@@ -496,7 +496,7 @@ try:
           order.index(named[0]) >= order.index(seen[-1]),
           "a timeout names the phase the job was in (%s): %s" % (seen, body.get("error")))
     status, info = d.json("GET", "/v1/info")
-    check(info["limits"].get("default_job_timeout_s") == 86400, "the default timeout is in /v1/info")
+    check(info["limits"].get("default_job_timeout_s") == 1800, "the default timeout (1800 s) is in /v1/info")
 finally:
     testlib.stop_and_check(d)
 testlib.finish("e2e_hardening")

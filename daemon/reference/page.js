@@ -104,6 +104,57 @@ function setLights(json, lights) {
     json.extensions.KHR_lights_punctual = { lights: list };
 }
 
+// The viewer reads a node's matrix as translation, rotation and scale
+// (gltfNode.applyMatrix: gl-matrix's getScaling, the columns' lengths, then
+// getRotation of what is left), so a matrix whose determinant is negative,
+// a mirror, loses its reflection: the scale comes back positive and the
+// rotation is read from an improper matrix (KhronosGroup/glTF-Sample-Viewer
+// issue 351). glTF says such a matrix MUST be decomposable into TRS: a
+// negative scale. So each mirrored matrix is handed to the viewer as the
+// same transform spelt as translation, rotation and a scale whose x is
+// negative (the product is the matrix; which axis carries the sign does not
+// change it). Returns the indices of the nodes restated.
+function restateMirroredMatrices(json) {
+    const restated = [];
+    (json.nodes || []).forEach((node, i) => {
+        const m = node.matrix;
+        if (!m || m.length !== 16 || m[3] !== 0 || m[7] !== 0 || m[11] !== 0 || m[15] !== 1)
+            return;
+        const c = [[m[0], m[1], m[2]], [m[4], m[5], m[6]], [m[8], m[9], m[10]]];
+        const det = c[0][0] * (c[1][1] * c[2][2] - c[1][2] * c[2][1])
+                  - c[1][0] * (c[0][1] * c[2][2] - c[0][2] * c[2][1])
+                  + c[2][0] * (c[0][1] * c[1][2] - c[0][2] * c[1][1]);
+        if (!(det < 0)) return;
+        const s = c.map((col) => Math.hypot(col[0], col[1], col[2]));
+        if (!(s[0] > 0 && s[1] > 0 && s[2] > 0)) return;
+        s[0] = -s[0];
+        // r[row][col], a proper rotation.
+        const r = [0, 1, 2].map((row) => [0, 1, 2].map((col) => c[col][row] / s[col]));
+        const tr = r[0][0] + r[1][1] + r[2][2];
+        let q;
+        if (tr > 0) {
+            const k = 0.5 / Math.sqrt(tr + 1);
+            q = [(r[2][1] - r[1][2]) * k, (r[0][2] - r[2][0]) * k, (r[1][0] - r[0][1]) * k, 0.25 / k];
+        } else if (r[0][0] > r[1][1] && r[0][0] > r[2][2]) {
+            const k = 2 * Math.sqrt(1 + r[0][0] - r[1][1] - r[2][2]);
+            q = [0.25 * k, (r[0][1] + r[1][0]) / k, (r[0][2] + r[2][0]) / k, (r[2][1] - r[1][2]) / k];
+        } else if (r[1][1] > r[2][2]) {
+            const k = 2 * Math.sqrt(1 + r[1][1] - r[0][0] - r[2][2]);
+            q = [(r[0][1] + r[1][0]) / k, 0.25 * k, (r[1][2] + r[2][1]) / k, (r[0][2] - r[2][0]) / k];
+        } else {
+            const k = 2 * Math.sqrt(1 + r[2][2] - r[0][0] - r[1][1]);
+            q = [(r[0][2] + r[2][0]) / k, (r[1][2] + r[2][1]) / k, 0.25 * k, (r[1][0] - r[0][1]) / k];
+        }
+        const ql = Math.hypot(q[0], q[1], q[2], q[3]);
+        delete node.matrix;
+        node.translation = [m[12], m[13], m[14]];
+        node.rotation = q.map((v) => v / ql);
+        node.scale = s;
+        restated.push(i);
+    });
+    return restated;
+}
+
 // A Radiance picture of constant radiance 1 (RGBE 128,128,128,129), for a
 // uniform environment: the viewer needs one even to light with none.
 function uniformHdr() {
@@ -136,6 +187,7 @@ window.sbRender = async function (req) {
     const parts = req.asset.endsWith(".gltf")
         ? { json: JSON.parse(new TextDecoder().decode(file)), bin: undefined } : glbSplit(file);
     setLights(parts.json, req.lights);
+    const restated = restateMirroredMatrices(parts.json);
     state.gltf = await loader.loadGltf(glbJoin(parts.json, parts.bin));
     state.sceneIndex = state.gltf.scene === undefined ? 0 : state.gltf.scene;
     gl.finish();
@@ -177,6 +229,8 @@ window.sbRender = async function (req) {
         out.push({ name, render_ms: performance.now() - c0, rgba: base64(px) });
     }
     return { load_ms: t1 - t0, environment_ms: t2 - t1, channels: out,
+             mirrored_matrices_restated: restated,
+             subpixel_bits: gl.getParameter(gl.SUBPIXEL_BITS),
              renderer: gl.getParameter(gl.RENDERER), version: gl.getParameter(gl.VERSION) };
 };
 window.sbReady = true;

@@ -518,10 +518,13 @@ static bool finish_fidelity(struct fidelity *f, struct task *t, enum job_status 
                      "directory", spec->scene.asset, spec->scene.asset_sha256);
             goto out;
         }
+        /* The Radiance file: the upload, or an OpenEXR upload's copy. */
         if (spec->look.ibl.enabled && spec->look.ibl.environment == IBL_ENV_ASSET &&
-            !asset_store_original_path(f->state_dir, spec->look.ibl.env_sha256, "hdr", env,
-                                       sizeof(env))) {
-            snprintf(err, errlen, "look.ibl.environment: no file for %s", spec->look.ibl.env_sha256);
+            (!asset_store_original_path(f->state_dir, spec->look.ibl.env_sha256, "hdr", env,
+                                        sizeof(env)) ||
+             access(env, R_OK) != 0)) {
+            snprintf(err, errlen, "look.ibl.environment: no Radiance file of %s for the viewer "
+                     "(%s)", spec->look.ibl.env_sha256, env);
             goto out;
         }
         json_object_set(page, "channels", todo);

@@ -116,7 +116,7 @@ void fidelity_cache_key(const json_t *page_request, const struct job_spec *spec,
     struct reference_sampler sampler;
     job_sampler(spec, &sampler);
     json_t *k = json_pack("{s:s, s:s, s:o, s:s, s:s, s:o}", "viewer",
-                          REFERENCE_VIEWER_PACKAGE "@" REFERENCE_VIEWER_VERSION, "page", "2",
+                          REFERENCE_VIEWER_PACKAGE "@" REFERENCE_VIEWER_VERSION, "page", "3",
                           "ibl_sampler", reference_sampler_to_json(&sampler),
                           "asset", spec->scene.asset_sha256, "environment",
                           spec->look.ibl.enabled ? spec->look.ibl.env_sha256 : "", "request",
@@ -675,11 +675,15 @@ static bool finish_fidelity(struct fidelity *f, struct task *t, enum job_status 
                                       json_object_get(page, "environment_file"), "ibl_sampler",
                                       reference_sampler_to_json(&sampler)));
     /* The nodes whose mirrored matrix the page restated for the viewer
-     * (page.js: restateMirroredMatrices), and each rasteriser's sub-pixel
+     * (page.js: restateMirroredMatrices), what it changed in the viewer
+     * (page.js: viewer_patches), and each rasteriser's sub-pixel
      * precision. */
     json_t *restated = json_object_get(cost, "mirrored_matrices_restated");
     json_object_set_new(fid, "mirrored_matrices_restated",
                         json_is_array(restated) ? json_incref(restated) : json_array());
+    json_t *patches = json_object_get(cost, "viewer_patches");
+    json_object_set_new(fid, "viewer_patches",
+                        json_is_array(patches) ? json_incref(patches) : json_array());
     json_object_set_new(fid, "subpixel_bits",
                         json_pack("{s:O, s:O}", "shadebench",
                                   json_object_get(t->view, "subpixel_bits") ?

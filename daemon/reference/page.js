@@ -155,6 +155,12 @@ function restateMirroredMatrices(json) {
     return restated;
 }
 
+// The viewer's world bitangent (its vertex shader, 1.1.0), and the same
+// turned by the model matrix's handedness (sbRender's shaderSource).
+const BITANGENT_W = "vec3 bitangentW=cross(normalW,tangentW)*a_tangent.w;";
+const BITANGENT_W_MIRRORED = "vec3 bitangentW=cross(normalW,tangentW)*a_tangent.w" +
+    "*(determinant(mat3(u_ModelMatrix))<0.0?-1.0:1.0);";
+
 // A Radiance picture of constant radiance 1 (RGBE 128,128,128,129), for a
 // uniform environment: the viewer needs one even to light with none.
 function uniformHdr() {
@@ -180,6 +186,36 @@ window.sbRender = async function (req) {
     const gl = canvas.getContext("webgl2", { antialias: false, alpha: false, depth: true,
                                              preserveDrawingBuffer: true, powerPreference: "default" });
     if (!gl) throw new Error("no WebGL 2 context");
+    // No anisotropic filtering: the viewer asks for 16x on every mipmapped
+    // texture, shadebench never (its sample pattern is each driver's own),
+    // and textures seen at an angle would differ by the filter alone.
+    // Each change made to the viewer is listed in the answer (viewer_patches).
+    const patches = [];
+    const getExtension = gl.getExtension.bind(gl);
+    gl.getExtension = (name) => {
+        if (name !== "EXT_texture_filter_anisotropic") return getExtension(name);
+        if (!patches.includes("no_anisotropic_filtering")) patches.push("no_anisotropic_filtering");
+        return null;
+    };
+    // The tangent frame of a mirrored node. glTF states the bitangent of
+    // the mesh's own attributes, cross(normal, tangent.xyz) * tangent.w,
+    // a direction in the mesh's space that the node's matrix M carries
+    // like the tangent: M * B. The viewer's vertex shader takes the cross
+    // of the normal and tangent already in world space, which under a
+    // mirror (det M < 0) is -M * B: the normal map's green channel turned
+    // over, unlike the same mesh with the node baked into its vertices
+    // (MikkTSpace's handedness turns with the mirrored UV layout; the
+    // viewer draws that one as M * B). So the world cross is multiplied by
+    // the sign of the model matrix's determinant, as shadebench's
+    // converter turns w (convert_build.c).
+    const shaderSource = gl.shaderSource.bind(gl);
+    gl.shaderSource = (shader, src) => {
+        if (src.includes(BITANGENT_W)) {
+            src = src.replace(BITANGENT_W, BITANGENT_W_MIRRORED);
+            if (!patches.includes("mirrored_bitangent")) patches.push("mirrored_bitangent");
+        }
+        shaderSource(shader, src);
+    };
     const view = new GltfView(gl);
     const state = view.createState();
     const loader = new ResourceLoader(view, "./viewer/libs/");
@@ -229,7 +265,7 @@ window.sbRender = async function (req) {
         out.push({ name, render_ms: performance.now() - c0, rgba: base64(px) });
     }
     return { load_ms: t1 - t0, environment_ms: t2 - t1, channels: out,
-             mirrored_matrices_restated: restated,
+             mirrored_matrices_restated: restated, viewer_patches: patches,
              subpixel_bits: gl.getParameter(gl.SUBPIXEL_BITS),
              renderer: gl.getParameter(gl.RENDERER), version: gl.getParameter(gl.VERSION) };
 };

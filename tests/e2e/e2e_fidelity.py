@@ -26,6 +26,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gltf_gen  # noqa: E402
+import hdr_gen  # noqa: E402
 from testlib import Daemon, check, finish, png_info, png_pixels, stop_and_check  # noqa: E402
 
 COMPARE = os.environ.get("SHADEBENCH_COMPARE", "./shadebench-compare")
@@ -67,6 +68,15 @@ OBJECT_MIN_SSIM = {
 }
 for _ch in CHANNELS:
     OBJECT_MIN_SSIM.setdefault(("transforms.nested0", _ch), 0.982)
+
+
+def white_ball():
+    """A white rough sphere, nothing else: it shows where light comes from."""
+    g = gltf_gen.Gltf()
+    mat = g.material(name="white", pbrMetallicRoughness={
+        "baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0.0, "roughnessFactor": 1.0})
+    g.node(mesh=g.mesh(gltf_gen.sphere()[:5], material=mat, uv1=False, name="ball"), name="ball")
+    return g
 
 
 def crop(image, rect, out):
@@ -194,6 +204,34 @@ try:
     bc = f3.get("channels", {}).get("base_color", {})
     s = min(bc.get("ssim", 0), bc.get("ssim_rgb", 0))
     check(s >= 0.99, "base_color from that camera, 96x72: SSIM %.5f >= 0.99" % s)
+
+    # An uploaded environment, oriented as shadebench maps it: a white ball
+    # under hdr_gen.sky_and_ground (its hot spot at +x) is brighter on its
+    # right in both images, seen from +z (the viewer's default rotation of
+    # 90 degrees put the hot spot at +z: lit SSIM 0.808, left and right
+    # alike). Small sampler sizes: the orientation, not the filtering.
+    d.request("PUT", "/v1/assets/sky.hdr", hdr_gen.sky_and_ground())
+    st, _, _ = d.request("PUT", "/v1/assets/ball.glb", white_ball().glb())
+    st, sub5 = d.json("POST", "/v1/assets/ball.glb/fidelity", {
+        "width": 48, "height": 48, "channels": ["base_color"], "lights": [],
+        "scene": {"asset_lights": False},
+        "camera": {"eye": [0, 0, 3], "target": [0, 0, 0], "yfov_deg": 40},
+        "look": {"tonemap": "pbr_neutral", "ibl": {"environment": {"asset": "sky.hdr"}}},
+        "ibl_sampler": {"texture_size": 32, "ggx_samples": 16, "lambertian_samples": 64}})
+    job5 = d.wait(sub5["id"]) if st == 202 else {}
+    lit5 = job5.get("result", {}).get("fidelity", {}).get("channels", {}).get("lit", {})
+    sides = {}
+    for kind in ("shadebench", "khronos"):
+        path = os.path.join(d.tmp, "ball-%s.png" % kind)
+        if lit5.get("files", {}).get(kind) and d.download(
+                "/v1/jobs/%s/%s" % (sub5["id"], lit5["files"][kind]), path) == 200:
+            w, h, px = png_pixels(path)
+            sides[kind] = (px[(h // 2) * w + w // 2 - 10][0], px[(h // 2) * w + w // 2 + 10][0])
+    check(len(sides) == 2 and all(right > left + 8 for left, right in sides.values()),
+          "the environment's hot spot (+x) lights the ball's right in both (left, right: %s)" % sides)
+    s = min(lit5.get("ssim", 0), lit5.get("ssim_rgb", 0))
+    check(s >= 0.92, "the ball under the environment: lit SSIM %.5f >= 0.92 (%s: %s)" % (
+        s, job5.get("status"), job5.get("error")))
 
     # Cancelled while the viewer renders: Chromium is killed with its group
     # and the job ends cancelled.

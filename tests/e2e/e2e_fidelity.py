@@ -14,9 +14,10 @@ whole images too. Then: the images downloadable, the reference cached (a
 second request renders nothing), another camera another key, a look the
 viewer cannot draw refused naming its field, a daemon without Chromium or
 without the viewer answering 503 naming what is missing (and saying so in
-/v1/info), and a job cancelled while the viewer renders.
-256x192 (objects of 30 to 50 pixels): about 60 s under make check on the
-2-core machine (docs/testing.md)."""
+/v1/info), an uploaded environment oriented as shadebench maps it (a white
+ball lit from +x by it in both), and a job cancelled while the viewer
+renders. 256x192 (objects of 30 to 50 pixels): 61 s at load average 8 on
+the 2-core machine (docs/testing.md)."""
 import json
 import os
 import shutil

@@ -60,13 +60,10 @@ LOOKS = {
 def crop_ssim(ref, test, rect, tmp, compare):
     """The lower of luma and RGB SSIM of rect in two png_pixels images."""
     paths = []
-    for k, (w, _, px) in enumerate((ref, test)):
-        x0, y0, x1, y1 = rect
-        rows = [bytes(c for x in range(x0, x1) for c in (*px[y * w + x][:3], 255))
-                for y in range(y0, y1)]
+    for k, image in enumerate((ref, test)):
         paths.append(os.path.join(tmp, "crop%d.png" % k))
         with open(paths[-1], "wb") as f:
-            f.write(gltf_gen.png_bytes(x1 - x0, y1 - y0, rows))
+            f.write(gltf_gen.crop_png(image, rect))
     r = subprocess.run([compare] + paths + ["--metrics", "ssim"], capture_output=True, text=True)
     o = json.loads(r.stdout)
     return min(o["ssim"], o["ssim_rgb"])

@@ -80,21 +80,12 @@ def white_ball():
     return g
 
 
-def crop(image, rect, out):
-    """rect (x0, y0, x1, y1) of image (png_pixels' answer) as an opaque PNG."""
-    w, h, px = image
-    x0, y0, x1, y1 = rect
-    rows = [bytes(c for x in range(x0, x1) for c in (*px[y * w + x][:3], 255))
-            for y in range(y0, y1)]
-    with open(out, "wb") as f:
-        f.write(gltf_gen.png_bytes(x1 - x0, y1 - y0, rows))
-
-
 def crop_ssim(ref, test, rect, tmp):
     """The lower of luma and RGB SSIM of rect in the two images."""
     a, b = os.path.join(tmp, "crop-ref.png"), os.path.join(tmp, "crop-test.png")
-    crop(ref, rect, a)
-    crop(test, rect, b)
+    for image, path in ((ref, a), (test, b)):
+        with open(path, "wb") as f:
+            f.write(gltf_gen.crop_png(image, rect))
     r = subprocess.run([COMPARE, a, b, "--metrics", "ssim"], capture_output=True, text=True)
     o = json.loads(r.stdout) if r.returncode in (0, 1) and r.stdout else {}
     return min(o.get("ssim", 0), o.get("ssim_rgb", 0))

@@ -1015,6 +1015,16 @@ def project_box(box, width, height, camera=FIDELITY_SET_CAMERA, pad=1):
             min(width, int(math.ceil(max(xs))) + pad), min(height, int(math.ceil(max(ys))) + pad))
 
 
+def crop_png(image, rect):
+    """An opaque PNG of rect (x0, y0, x1, y1, exclusive ends) of image, a
+    (width, height, pixels) as testlib.png_pixels reads one."""
+    w, _, px = image
+    x0, y0, x1, y1 = rect
+    rows = [bytes(c for x in range(x0, x1) for c in (*px[y * w + x][:3], 255))
+            for y in range(y0, y1)]
+    return png_bytes(x1 - x0, y1 - y0, rows)
+
+
 def fidelity_set_rects(width, height, camera=FIDELITY_SET_CAMERA):
     """{feature name: pixel rectangle} of fidelity_set_asset's objects."""
     boxes = world_boxes(fidelity_set_asset())

@@ -139,9 +139,9 @@ tests_fuzz_replay_asset_convert_SOURCES = tests/fuzz/fuzz_asset_convert.c tests/
 tests_fuzz_replay_asset_convert_CFLAGS = $(AM_CFLAGS) $(ASSIMP_CFLAGS) $(JPEG_CFLAGS)
 tests_fuzz_replay_asset_convert_LDADD = $(CORE_LIBS) $(ASSIMP_LIBS) $(JPEG_LIBS) -lm
 tests_fuzz_replay_env_convert_SOURCES = tests/fuzz/fuzz_env_convert.c tests/fuzz/replay.c \
-	daemon/assets/env_convert.c
-tests_fuzz_replay_env_convert_CFLAGS = $(AM_CFLAGS) $(STB_CFLAGS)
-tests_fuzz_replay_env_convert_LDADD = $(CORE_LIBS) $(STB_LIBS) -lm
+	$(ENV_CONVERT_SOURCES)
+tests_fuzz_replay_env_convert_CFLAGS = $(AM_CFLAGS) $(STB_CFLAGS) $(OPENEXR_CFLAGS)
+tests_fuzz_replay_env_convert_LDADD = $(CORE_LIBS) $(STB_LIBS) $(OPENEXR_LIBS) -lm
 if HAVE_SECCOMP
 check_PROGRAMS += tests/tools/sandbox-run
 tests_tools_sandbox_run_SOURCES = tests/tools/sandbox_run.c

@@ -46,7 +46,8 @@ static void add_arg(char **argv, int *argc, char (*store)[32], const char *flag,
  * SIGKILL leaves no converter running), nice 10 (so the render thread
  * keeps its core) and no file descriptor of the daemon's but stdin
  * (/dev/null), stdout (the pipe) and stderr (the log): common/child.h. */
-static void convert(struct assets *a, const char *in, const char *out, struct conversion *c)
+static void convert(struct assets *a, const char *in, const char *out, const char *radiance_copy,
+                    struct conversion *c)
 {
     memset(c, 0, sizeof(*c));
     c->outcome = CONV_FAILED;
@@ -76,6 +77,8 @@ static void convert(struct assets *a, const char *in, const char *out, struct co
     if (a->cfg.run.memory_bytes)
         add_arg(argv, &argc, nums, "--max-memory", a->cfg.run.memory_bytes);
     add_arg(argv, &argc, nums, "--max-cpu-seconds", a->cfg.run.cpu_s);
+    argv[argc++] = "--radiance-copy";
+    argv[argc++] = (char *)radiance_copy;
     argv[argc] = NULL;
 
     int pipefd[2] = {-1, -1};
@@ -229,6 +232,7 @@ bool asset_ensure_cache(struct assets *a, const char *sha, const char *in, json_
                         struct assets_error *e)
 {
     char cache[PATH_MAX + 80], desc[PATH_MAX + 80], tmp[PATH_MAX + 120];
+    char copy[PATH_MAX + 80], tmp_copy[PATH_MAX + 120];
     asset_path(a, sha, ASSET_CACHE_EXT, cache, sizeof(cache));
     asset_path(a, sha, "json", desc, sizeof(desc));
     /* A cache an older shadebench wrote (another layout) is converted anew. */
@@ -236,9 +240,13 @@ bool asset_ensure_cache(struct assets *a, const char *sha, const char *in, json_
         return true;
     snprintf(tmp, sizeof(tmp), "%s/convert-%s.%s", a->dir, sha, ASSET_CACHE_EXT);
     unlink(tmp);
+    /* The converter writes an OpenEXR environment's Radiance copy (the
+     * Khronos viewer reads only .hdr) here; it becomes SHA256.hdr. */
+    snprintf(tmp_copy, sizeof(tmp_copy), "%s/convert-%s.hdr", a->dir, sha);
+    unlink(tmp_copy);
     struct conversion c;
     double t0 = clock_mono_s();
-    convert(a, in, tmp, &c);
+    convert(a, in, tmp, tmp_copy, &c);
     LOG(LOG_INFO, "assets: converted %s in %.2f s: %s", in, clock_mono_s() - t0,
         c.outcome == CONV_OK ? "ok" : c.outcome == CONV_BAD ? "refused" : c.why);
     if (c.outcome == CONV_BAD) {
@@ -252,6 +260,7 @@ bool asset_ensure_cache(struct assets *a, const char *sha, const char *in, json_
                      message ? message : "the converter refused the asset");
         json_decref(c.out);
         unlink(tmp);
+        unlink(tmp_copy);
         return false;
     }
     if (c.outcome == CONV_FAILED) {
@@ -259,13 +268,18 @@ bool asset_ensure_cache(struct assets *a, const char *sha, const char *in, json_
                      "the asset loader failed on this file (%s)", c.why);
         unlink(tmp);
         remove_partial_cache(a, sha);
+        unlink(tmp_copy);
         return false;
     }
-    if (!file_exists(tmp) || rename(tmp, cache) != 0) {
+    /* The copy first: the cache file is what says the work is done. */
+    asset_path(a, sha, "hdr", copy, sizeof(copy));
+    if (!file_exists(tmp) || (file_exists(tmp_copy) && rename(tmp_copy, copy) != 0) ||
+        rename(tmp, cache) != 0) {
         asset_refuse(e, ASSETS_UNCONVERTIBLE, "body",
                      "the asset loader said it succeeded but wrote no cache file");
         json_decref(c.out);
         unlink(tmp);
+        unlink(tmp_copy);
         return false;
     }
     if (!fs_write_json_atomic(desc, c.out)) {

@@ -39,7 +39,7 @@ void asset_release_files_locked(struct assets *a, const char *sha)
     char job[RECORD_ID_LEN];
     if (store_asset_hash_refs(a->store, sha) != 0 || queue_asset_in_use(a->queue, NULL, sha, job))
         return;
-    static const char *const exts[] = {"glb", "gltf", "hdr", ASSET_CACHE_EXT, "json"};
+    static const char *const exts[] = {"glb", "gltf", "hdr", "exr", ASSET_CACHE_EXT, "json"};
     for (size_t i = 0; i < sizeof(exts) / sizeof(exts[0]); i++) {
         char path[PATH_MAX + 80];
         asset_path(a, sha, exts[i], path, sizeof(path));
@@ -264,7 +264,7 @@ static bool resolve_name(struct assets *a, const char *name, char sha[65], bool 
     else if (is_environment != environment)
         asset_refuse(e, ASSETS_INVALID, field,
                      environment ? "%s is a glTF scene, not an environment map (an "
-                                   "equirectangular .hdr)"
+                                   "equirectangular .hdr or .exr)"
                                  : "%s is an environment map: name it in "
                                    "look.ibl.environment {\"asset\": ...}, not scene.asset",
                      name);

@@ -41,11 +41,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             FUZZ_ASSERT((*p >= '0' && *p <= '9') || *p == '-');
         bool has_id = r.kind != ROUTE_HEALTHZ && r.kind != ROUTE_METRICS && r.kind != ROUTE_INFO &&
                       r.kind != ROUTE_JOBS && r.kind != ROUTE_SWEEPS && r.kind != ROUTE_ASSETS &&
-                      r.kind != ROUTE_ASSET;
+                      r.kind != ROUTE_ASSET && r.kind != ROUTE_ASSET_FIDELITY &&
+                      r.kind != ROUTE_UI;
         /* An asset's name is what the request named, for the handler to
          * judge (scene_asset_name_valid); it is never empty and never holds
          * a path separator. */
-        if (r.kind == ROUTE_ASSET)
+        if (r.kind == ROUTE_ASSET || r.kind == ROUTE_ASSET_FIDELITY)
             FUZZ_ASSERT(r.asset[0] != '\0' && strchr(r.asset, '/') == NULL);
         FUZZ_ASSERT(has_id == (r.id[0] != '\0'));
         if (r.kind == ROUTE_JOB_IMAGE)

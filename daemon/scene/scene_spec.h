@@ -53,6 +53,7 @@ enum {
     SCENE_LIGHTS_AUTO = -1,
     SCENE_ASSET_DEFAULT_LIGHTS = 16,
     SCENE_ASSET_CAMERA_MAX = 64,
+    SCENE_MAX_MOVER_PERIOD = 1000000,
 };
 
 struct scene_spec {
@@ -93,6 +94,12 @@ struct scene_spec {
     char asset_camera[SCENE_ASSET_CAMERA_MAX + 1];
     bool asset_lights;
     bool normal_maps;
+    /* "mover": a sphere that slides to and fro across the objects, once
+     * there and back every mover_period frames (daemon/scene/mover.c):
+     * object motion, for motion vectors and TAA's ghosting. Procedural
+     * presets only. */
+    bool mover;
+    int mover_period;
 };
 
 /* True when the scene is built through the asset path (scene.asset, or

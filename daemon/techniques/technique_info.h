@@ -13,6 +13,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "common/frame_needs.h"
 #include "common/options.h"
 
 /* Bytes of one technique's options struct, stored inline in a job spec. */
@@ -43,6 +44,10 @@ struct technique_info {
      * check names fields under the prefix it is handed, "<name>". */
     struct opt_table options;
     unsigned flags; /* enum technique_flag */
+    /* Optional: what the technique with these options needs of time
+     * (common/frame_needs.h: history frames, jitter, motion vectors), as
+     * effects declare it; NULL for none (every frame drawn afresh). */
+    void (*needs)(const void *opts, struct frame_needs *out);
 };
 
 /* Every registered technique's info, in registry order (the order of

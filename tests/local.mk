@@ -39,7 +39,8 @@ UNIT_TESTS = \
 	tests/unit/test_uv_charts \
 	tests/unit/test_uv_overlap \
 	tests/unit/test_convert_matrices \
-	tests/unit/test_light_shape
+	tests/unit/test_light_shape \
+	tests/unit/test_temporal
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
 	tests/fuzz/replay-route tests/fuzz/replay-asset_cache tests/fuzz/replay-asset_convert
@@ -55,6 +56,7 @@ tests_unit_test_metrics_LDADD = $(CORE_LIBS)
 tests_unit_test_flicker_LDADD = $(CORE_LIBS)
 tests_unit_test_sweep_LDADD = $(CORE_LIBS)
 tests_unit_test_effects_LDADD = $(CORE_LIBS)
+tests_unit_test_temporal_LDADD = $(CORE_LIBS)
 tests_unit_test_records_LDADD = $(CORE_LIBS)
 # The interference module lives with the render thread that samples it, but
 # is GL-free: its test builds it alone.

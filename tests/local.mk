@@ -154,6 +154,8 @@ E2E_TESTS = \
 	tests/e2e/e2e_assets.py \
 	tests/e2e/e2e_scene.py \
 	tests/e2e/e2e_post.py \
+	tests/e2e/e2e_taa.py \
+	tests/e2e/e2e_visibility.py \
 	tests/e2e/e2e_badinput.py \
 	tests/e2e/e2e_pbr.py \
 	tests/e2e/e2e_client.py \

@@ -117,8 +117,12 @@ void main()
 #elif defined(TAA_CLAMP_VARIANCE)
     vec3 mean = m1 / 9.0;
     vec3 sigma = sqrt(max(m2 / 9.0 - mean * mean, vec3(0.0)));
-    history = clip_box(max(mean - u_params.y * sigma, lo), min(mean + u_params.y * sigma, hi),
-                       history);
+    // The box of mean +- gamma sigma, within the neighbourhood's, and
+    // always holding this frame's own sample: where the pixel stands out
+    // from its neighbours (a highlight) the box would otherwise pull a
+    // history equal to it towards their mean, and dim it.
+    history = clip_box(min(max(mean - u_params.y * sigma, lo), now),
+                       max(min(mean + u_params.y * sigma, hi), now), history);
 #endif
     vec3 blended = mix(history, now, u_params.x);
     out_color = vec4(untonemap(max(from_ycocg(blended), vec3(0.0))), 1.0);

@@ -15,7 +15,6 @@ per timed frame (result.interference): on llvmpipe, where all the work is on
 the CPU, the figure other processes' load does not inflate. The run's commit, command, date and load (/proc/loadavg at
 the start and the end, and the jobs' result.interference) are printed."""
 
-import argparse
 import json
 import os
 import statistics
@@ -24,11 +23,10 @@ import sys
 import tempfile
 import time
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
-import testlib  # noqa: E402
-import benchrun  # noqa: E402
+import benchrun
+from benchrun import testlib
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap = benchrun.parser()
 ap.add_argument("--frames", type=int, default=60)
 ap.add_argument("--warmup", type=int, default=10)
 ap.add_argument("--repeat", type=int, default=3)

@@ -18,7 +18,6 @@ Medians over the repeats, with min and max.
 
   bench/bench_assets.py [--repeat R] [--no-noise] [--width W --height H]"""
 
-import argparse
 import os
 import random
 import statistics
@@ -34,7 +33,7 @@ import benchrun  # noqa: E402
 import gltf_gen  # noqa: E402
 import testlib  # noqa: E402
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap = benchrun.parser()
 ap.add_argument("--repeat", type=int, default=3)
 ap.add_argument("--no-noise", action="store_true", help="leave out the ~100 MB noise asset")
 ap.add_argument("--width", type=int, default=320)

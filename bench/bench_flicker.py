@@ -10,16 +10,12 @@ flicker against the async distance (one line per OSL resolution).
   bench/bench_flicker.py [--distances 0,1,2,4,8,16,32] [--resolutions auto,64]
       [--temporal 8] [--frames 8] [--width 320 --height 240] [--svg FILE] [--json FILE]"""
 
-import argparse
-import json
-import os
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
-import testlib  # noqa: E402
-import benchrun  # noqa: E402
+import benchrun
+from benchrun import testlib
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap = benchrun.parser()
 ap.add_argument("--distances", default="0,1,2,4,8,16,32")
 ap.add_argument("--resolutions", default="auto,64")
 ap.add_argument("--temporal", type=int, default=8)
@@ -103,7 +99,6 @@ if args.svg:
     svg_chart({"OSL %s" % r: [(dist, figures[(str(r), dist)][0]) for dist in distances]
                for r in resolutions}, args.svg)
     print("chart: %s" % args.svg)
-if args.json:
-    with open(args.json, "w") as f:
-        json.dump({"%s/%d" % k: {"flicker": v[0], "ssim": v[1]} for k, v in figures.items()}, f, indent=1)
+benchrun.write_json(args.json, {"%s/%d" % k: {"flicker": v[0], "ssim": v[1]} for k, v in figures.items()},
+                    indent=1)
 bench.end([])

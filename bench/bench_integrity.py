@@ -14,19 +14,16 @@ started after A finished (it must, by construction), and each B run's
 result.interference, so a noisy round can be told from a real effect.
 Needs a built daemon: SHADEBENCHD=build/shadebenchd."""
 
-import argparse
 import datetime
 import json
-import os
 import statistics
 import sys
 import time
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
-import testlib  # noqa: E402
-import benchrun  # noqa: E402
+import benchrun
+from benchrun import testlib
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap = benchrun.parser()
 ap.add_argument("--pairs", type=int, default=6, help="rounds of (B alone, A then B); at least 4")
 ap.add_argument("--frames", type=int, default=40, help="B's timed frames")
 ap.add_argument("--warmup", type=int, default=10)

@@ -19,18 +19,15 @@ CPU) other processes' load does not inflate. Interleaved: each repeat runs
 every count and technique in turn (A, B, A, B over --repeat rounds). The
 run's commit, command, date and load are printed."""
 
-import argparse
 import json
-import os
 import statistics
 import sys
 import time
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
-import testlib  # noqa: E402
-import benchrun  # noqa: E402
+import benchrun
+from benchrun import testlib
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap = benchrun.parser()
 ap.add_argument("--counts", default="16,256,4096", help="comma-separated light counts")
 ap.add_argument("--techniques", default="forward,unlit")
 ap.add_argument("--frames", type=int, default=3)

@@ -9,15 +9,13 @@ PerceptualDiff, FLIP, PSNR), on the thesis grid and the lights preset.
 
 Prints a Markdown table (the README's accuracy table comes from it)."""
 
-import argparse
 import json
-import os
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
-import testlib  # noqa: E402
+import benchrun
+from benchrun import testlib
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap = benchrun.parser()
 ap.add_argument("--width", type=int, default=540)
 ap.add_argument("--height", type=int, default=360)
 ap.add_argument("--scenes", default="grid:10,lights:256", help="preset:lights,...")
@@ -73,6 +71,4 @@ for preset, lights, tech, opts, ssim, ok, fail, flip, psnr in rows:
     print("| %s, %s lights | %s | %s | %.6f | %s (%d) | %.5f | %s |"
           % (preset, lights, tech, opts.replace('"', ""), ssim, "pass" if ok else "FAIL", fail, flip,
              "identical" if psnr is None else "%.1f" % psnr))
-if args.json:
-    with open(args.json, "w") as f:
-        json.dump(everything, f)
+benchrun.write_json(args.json, everything)

@@ -40,7 +40,6 @@ repeats of the job medians and ratios are ratios of those medians. The
 run's commit, command, date and load (/proc/loadavg at the start and the
 end, and the jobs' result.interference) are printed with them."""
 
-import argparse
 import json
 import math
 import os
@@ -48,11 +47,10 @@ import statistics
 import sys
 import time
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
-import testlib  # noqa: E402
-import benchrun  # noqa: E402
+import benchrun
+from benchrun import testlib
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap = benchrun.parser()
 ap.add_argument("--counts", default="16,64,256,1024,4096,16384")
 ap.add_argument("--techniques", default="unlit,forward,deferred,tiled_deferred,tiled_deferred_cpu,"
                 "forward_plus,clustered_forward,clustered_deferred")

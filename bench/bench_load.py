@@ -10,8 +10,6 @@ Loopback only; the clients come from 40 addresses of 127.0.1.0/24 (one
 address may hold 64 connections). Exits 1 when the loaded median moves by
 more than --max-change (default 5%)."""
 
-import argparse
-import os
 import re
 import resource
 import shutil
@@ -22,10 +20,10 @@ import sys
 import threading
 import time
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
-import testlib  # noqa: E402
+import benchrun
+from benchrun import testlib
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap = benchrun.parser()
 ap.add_argument("--repeat", type=int, default=3)
 ap.add_argument("--frames", type=int, default=200)
 ap.add_argument("--width", type=int, default=512)

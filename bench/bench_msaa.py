@@ -19,18 +19,15 @@ Levels above the device's limit (/v1/info device.caps.max_msaa) are left
 out and said so. On llvmpipe GL_TIME_ELAPSED covers rasterisation only, so
 frame_ms (and cpu_work_ms) compare techniques there; on a GPU gpu_ms does."""
 
-import argparse
 import json
-import os
 import statistics
 import sys
 import time
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
-import testlib  # noqa: E402
-import benchrun  # noqa: E402
+import benchrun
+from benchrun import testlib
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap = benchrun.parser()
 ap.add_argument("--counts", default="16,256,1024")
 ap.add_argument("--levels", default="1,2,4,8")
 ap.add_argument("--techniques", default="", help="default: every registered technique")

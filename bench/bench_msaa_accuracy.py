@@ -15,16 +15,11 @@ At msaa > 1 the reference renders at the job's msaa too (the harness's
 rule), so both levels are scored against a truth of N x N or more samples a
 pixel."""
 
-import argparse
-import json
-import os
-import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
-import testlib  # noqa: E402
-import benchrun  # noqa: E402
+import benchrun
+from benchrun import testlib
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap = benchrun.parser()
 ap.add_argument("--techniques", default="", help="default: every registered technique")
 ap.add_argument("--supersample", type=int, default=4)
 ap.add_argument("--preset", default="lights")
@@ -78,7 +73,5 @@ for tech in techs:
     better = b["ssim"] > a["ssim"] and b["flip"] < a["flip"]
     print("| %s | %.5f | %.5f | %.5f | %.5f | %s |"
           % (tech, a["ssim"], b["ssim"], a["flip"], b["flip"], "yes" if better else "**no**"))
-if args.json:
-    with open(args.json, "w") as f:
-        json.dump({"%s/%d" % k: v for k, v in results.items()}, f, indent=1)
+benchrun.write_json(args.json, {"%s/%d" % k: v for k, v in results.items()}, indent=1)
 bench.end([])

@@ -32,17 +32,14 @@ log scale, beside the thesis's own factors (dynamic scene, GPUs, d 20:
 On llvmpipe GL_TIME_ELAPSED covers rasterisation only, so frame_ms (and
 cpu_work_ms) compare techniques there; on a GPU gpu_ms does."""
 
-import argparse
-import json
 import os
 import statistics
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
-import testlib  # noqa: E402
-import benchrun  # noqa: E402
+import benchrun
+from benchrun import testlib
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap = benchrun.parser()
 ap.add_argument("--distances", default="1,5,20,60")
 ap.add_argument("--frames", type=int, default=20)
 ap.add_argument("--warmup", type=int, default=3)
@@ -291,6 +288,4 @@ if flickers:
     print("worst flicker against forward over %d frames, d 20, moving lights: " % args.temporal +
           ", ".join("%s %.5f" % (c[2], v) for c, v in flickers.items()))
 bench.end(results)
-if args.json:
-    with open(args.json, "w") as f:
-        json.dump(results, f)
+benchrun.write_json(args.json, results)

@@ -14,16 +14,13 @@ the medians of the ratios.
 
 --frames and --warmup default to the job's defaults (left out of the job)."""
 
-import argparse
-import os
 import statistics
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
-import testlib  # noqa: E402
-import benchrun  # noqa: E402
+import benchrun
+from benchrun import testlib
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap = benchrun.parser()
 ap.add_argument("--rounds", type=int, default=2)
 ap.add_argument("--frames", type=int)
 ap.add_argument("--warmup", type=int)

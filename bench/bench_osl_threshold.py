@@ -10,15 +10,12 @@ their shading; the run's length caps it) and the worst SSIM.
   bench/bench_osl_threshold.py [--thresholds 0,0.02,0.1,0.3,1] [--frames N]
       [--warmup N] [--width W --height H]"""
 
-import argparse
-import os
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
-import testlib  # noqa: E402
-import benchrun  # noqa: E402
+import benchrun
+from benchrun import testlib
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap = benchrun.parser()
 ap.add_argument("--thresholds", default="0,0.02,0.1,0.3,1")
 ap.add_argument("--frames", type=int, default=10)
 ap.add_argument("--warmup", type=int, default=3)

@@ -24,18 +24,15 @@ frame_ms (present to present) is the figure to read on llvmpipe; gpu_ms and
 the per-pass gpu_sections_ms cover rasterization only there (vertex work and
 binning run at draw time on the CPU), and both are printed."""
 
-import argparse
 import json
-import os
 import statistics
 import sys
 import time
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
-import testlib  # noqa: E402
-import benchrun  # noqa: E402
+import benchrun
+from benchrun import testlib
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap = benchrun.parser()
 ap.add_argument("--frames", type=int, default=3)
 ap.add_argument("--warmup", type=int, default=1)
 ap.add_argument("--repeat", type=int, default=3)

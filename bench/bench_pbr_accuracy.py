@@ -15,17 +15,16 @@
 
   bench/bench_pbr_accuracy.py [--width W --height H] [--json FILE]"""
 
-import argparse
 import json
 import math
 import os
 import subprocess
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
-import testlib  # noqa: E402
+import benchrun
+from benchrun import testlib
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap = benchrun.parser()
 ap.add_argument("--width", type=int, default=320)
 ap.add_argument("--height", type=int, default=240)
 ap.add_argument("--json")
@@ -195,6 +194,4 @@ finally:
     d.stop()
     d.cleanup()
 
-if args.json:
-    with open(args.json, "w") as f:
-        json.dump(out, f, indent=1)
+benchrun.write_json(args.json, out, indent=1)

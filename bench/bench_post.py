@@ -25,18 +25,15 @@ beside them. The run's commit, command, date and load (/proc/loadavg at the
 start and the end, and the jobs' result.interference) are printed first and
 last."""
 
-import argparse
-import json
 import os
 import statistics
 import sys
 import time
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
-import testlib  # noqa: E402
-import benchrun  # noqa: E402
+import benchrun
+from benchrun import testlib
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap = benchrun.parser()
 ap.add_argument("--frames", type=int, default=10)
 ap.add_argument("--warmup", type=int, default=2)
 ap.add_argument("--repeat", type=int, default=2)
@@ -226,9 +223,7 @@ try:
         chain_table()
     if "toon" in PARTS:
         toon_table()
-    if args.json:
-        with open(args.json, "w") as f:
-            json.dump({"repeats": results, "toon": toon_results}, f, indent=1)
+    benchrun.write_json(args.json, {"repeats": results, "toon": toon_results}, indent=1)
 finally:
     d.stop()
     d.cleanup()

@@ -17,17 +17,13 @@ per non-empty cell, and the load the run ran under.
 On llvmpipe GL_TIME_ELAPSED covers rasterisation only, so frame_ms (and
 cpu_work_ms) compare techniques there; on a GPU gpu_ms does."""
 
-import argparse
-import json
-import os
 import statistics
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "e2e"))
-import testlib  # noqa: E402
-import benchrun  # noqa: E402
+import benchrun
+from benchrun import testlib
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap = benchrun.parser()
 ap.add_argument("--lights", type=int, default=256)
 ap.add_argument("--radius", type=float, default=6.0)
 ap.add_argument("--angle", type=float, default=30.0, help="spots' outer half-angle, degrees")
@@ -95,6 +91,4 @@ for tech in techs:
                  "%.3f" % (f[0] / fig["point"][0]) if ratio else "",
                  "%.3f" % (f[1] / fig["point"][1]) if ratio else ""))
 bench.end([r for rs in runs.values() for r in rs])
-if args.json:
-    with open(args.json, "w") as f:
-        json.dump({"%s/%s" % k: v for k, v in runs.items()}, f)
+benchrun.write_json(args.json, {"%s/%s" % k: v for k, v in runs.items()})

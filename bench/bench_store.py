@@ -28,7 +28,6 @@ import os
 import random
 import shutil
 import signal
-import sqlite3
 import statistics
 import subprocess
 import sys
@@ -50,7 +49,6 @@ SHADEBENCHD = os.environ.get("SHADEBENCHD", "./shadebenchd")
 GOALS = {"start_s": 2.0, "rss_mb": 200.0, "p99_ms": 50.0}
 TINY = {"technique": "unlit", "frames": 1, "warmup_frames": 0, "scene": {"width": 32, "height": 32},
         "labels": {"commit": "c00000", "branch": "main"}}
-TECHNIQUES = ["forward", "unlit", "osl", "deferred"]
 tmp = tempfile.mkdtemp(prefix="bench-store-")
 
 
@@ -119,12 +117,10 @@ def line(name, values, goal=None):
     print("  %-44s p50 %7.2f ms  p99 %7.2f ms  (%d requests)%s" % (name, p50, p99, len(values), verdict))
 
 
-def stamp_id(t, serial):
-    return time.strftime("%Y%m%d-%H%M%S", time.gmtime(t)) + "-%04d" % (serial % 10000)
-
-
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import benchrun  # noqa: E402
+import storefill  # noqa: E402
+from storefill import stamp_id  # noqa: E402
 bench = benchrun.Run()
 bench.start()
 
@@ -143,51 +139,11 @@ template_id = json.loads(body)["id"]
 while json.loads(d.get("/v1/jobs/%s?wait=60" % template_id)[1])["status"] in ("queued", "running"):
     pass
 d.stop()
-db = sqlite3.connect(os.path.join(state, "store.db"))
-db.row_factory = sqlite3.Row
-template = dict(db.execute("SELECT * FROM records WHERE id = ?", (template_id,)).fetchone())
-with open(os.path.join(state, "jobs", template_id, "result.json")) as f:
-    result_text = f.read()
-with open(os.path.join(state, "jobs", template_id, "spec.json")) as f:
-    spec_template = json.load(f)["spec"]  # a finished job's row has none: its spec.json has it
-
-# 2. The fill: --jobs rows in the store's own format, one transaction.
 t_fill = time.monotonic()
-now = time.time()
-rng = random.Random(20)
-start = now - args.jobs * 5.0  # one job every 5 s, up to now
-columns = [k for k in template.keys()]
-rows, labels, ids = [], [], []
-jobs_root = os.path.join(state, "jobs")
-for i in range(args.jobs):
-    created = start + i * 5.0
-    job_id = stamp_id(created, i)
-    ids.append(job_id)
-    technique = TECHNIQUES[i % len(TECHNIQUES)]
-    lab = {"commit": "c%05d" % (i // 10), "branch": "main" if i % 3 else "topic"}
-    row = dict(template, id=job_id, technique=technique, created=created, started=created + 1,
-               finished=created + 2 + rng.random(), labels=json.dumps(lab, separators=(",", ":")))
-    rows.append(tuple(row[c] for c in columns))
-    labels += [(0, job_id, k, v) for k, v in lab.items()]
-with db:
-    db.execute("DELETE FROM records")
-    db.execute("DELETE FROM labels")
-    db.executemany("INSERT INTO records (%s) VALUES (%s)" % (", ".join(columns), ", ".join("?" * len(columns))), rows)
-    db.executemany("INSERT INTO labels (kind, id, key, value) VALUES (?, ?, ?, ?)", labels)
-db.close()
-shutil.rmtree(jobs_root)
-os.mkdir(jobs_root)
-with_result = set(rng.sample(range(args.jobs), min(args.with_results, args.jobs)))
-for i, job_id in enumerate(ids):
-    os.mkdir(os.path.join(jobs_root, job_id))
-    if i in with_result:
-        with open(os.path.join(jobs_root, job_id, "result.json"), "w") as f:
-            f.write(result_text)
-        with open(os.path.join(jobs_root, job_id, "spec.json"), "w") as f:
-            json.dump({"id": job_id, "created_unix": start + i * 5.0,
-                       "spec": dict(spec_template, technique=TECHNIQUES[i % len(TECHNIQUES)])}, f)
-del rows, labels
-db_mb = sum(os.path.getsize(os.path.join(state, f)) for f in os.listdir(state) if f.startswith("store.db")) / 1e6
+filled = storefill.fill(state, template_id, args.jobs, args.with_results)
+ids, start, spec_template = filled["ids"], filled["start"], filled["spec"]
+result_text, with_result, db_mb = filled["result_text"], filled["with_result"], filled["db_mb"]
+rng = random.Random(21)
 print("filled %d finished jobs in %.1f s: store.db %.1f MB, %d job directories (%d with result.json)"
       % (args.jobs, time.monotonic() - t_fill, db_mb, args.jobs, len(with_result)))
 

@@ -5,7 +5,9 @@ start and the end, and the jobs' own `result.interference`: the 1-minute
 load when each job's timed region began and the share of the CPUs other
 processes took during it)."""
 
+import argparse
 import datetime
+import json
 import os
 import shlex
 import statistics
@@ -13,6 +15,23 @@ import subprocess
 import sys
 
 _ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
+# The end-to-end tests' helpers (a daemon on a free port, its jobs), which
+# every bench drives the daemon with: `from benchrun import testlib`.
+sys.path.insert(0, os.path.join(_ROOT, "tests", "e2e"))
+import testlib  # noqa: E402,F401
+
+
+def parser():
+    """The bench's argument parser, its help the script's own docstring."""
+    return argparse.ArgumentParser(description=sys.modules["__main__"].__doc__,
+                                   formatter_class=argparse.RawDescriptionHelpFormatter)
+
+
+def write_json(path, value, **kw):
+    """Writes value to path (--json) when one was given."""
+    if path:
+        with open(path, "w") as f:
+            json.dump(value, f, **kw)
 
 
 def _loadavg():

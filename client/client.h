@@ -36,6 +36,7 @@ struct options {
     bool wait, quiet, allow_mismatch, fail_inconclusive;
     json_t *labels;           /* --label KEY=VALUE, added to submitted jobs */
     json_t *filters;          /* history: --filter KEY=VALUE, as query arguments */
+    json_t *channels;         /* fidelity: --channel NAME (repeatable) */
     const char *since;
     const char *figure;       /* history: frame_ms, gpu_ms, cpu_ms or worst_ssim */
     struct fleet_options fleet; /* sweep --slurm */
@@ -129,5 +130,7 @@ int cmd_ab(struct conn *a, struct conn *b, const struct options *o, const char *
            const char *file_b);
 int cmd_sweep(struct conn *c, const struct options *o, const char *file);
 int cmd_history(struct conn *c, const struct options *o);
+int cmd_fidelity(struct conn *c, const struct options *o, const char *asset,
+                 const char *request_file);
 
 #endif

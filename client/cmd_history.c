@@ -12,11 +12,14 @@
 #include <time.h>
 
 #include "client/client.h"
+#include "client/suggest.h"
 #include "client/verdicts.h"
 #include "client/trend.h"
 #include "client/workload.h"
 #include "common/fsutil.h"
+#include "common/noise.h"
 #include "common/result_keys.h"
+#include "common/timing_series.h"
 
 /* The figure of one list entry: its value and interval. */
 static bool figure_of(const json_t *entry, const char *figure, double *y, double *lo, double *hi)
@@ -88,7 +91,9 @@ static void job_detail(struct conn *c, const char *id, bool by_reference, struct
     json_t *share = json_object_get(inter, "other_cpu_share");
     d->has_share = json_is_number(share);
     d->other_share = d->has_share ? json_number_value(share) : NAN;
-    d->noisy = json_is_true(json_object_get(inter, "noisy"));
+    /* The one noise rule, alone (against an idle machine), as the daemon
+     * applies it; the daemon's flag only where there are no figures. */
+    d->noisy = noise_interference_noisy(inter);
     json_decref(job);
 }
 
@@ -108,8 +113,7 @@ static bool history_render(struct conn *c, const struct options *o, json_t *jobs
         json_array_foreach(jobs, i, e) {
             const char *r = json_string_value(json_object_get(json_object_get(e, "figures"), "gl_renderer"));
             if (r) {
-                figure = strstr(r, "llvmpipe") || strstr(r, "softpipe") || strstr(r, "SwiftShader")
-                             ? RK_FRAME_MS : RK_GPU_MS;
+                figure = timing_series_for_renderer(r);
                 break;
             }
         }
@@ -230,6 +234,42 @@ static bool history_render(struct conn *c, const struct options *o, json_t *jobs
     return ok;
 }
 
+/* A technique filter that matched no job: a typo ("fowrard") must not read
+ * as an empty history. True when the daemon knows the technique (it has
+ * merely no finished job yet); else the error, with the nearest name. A
+ * technique the daemon no longer has still matches its old jobs, so this
+ * is asked only when nothing matched. */
+static bool known_technique(struct conn *c, const char *tech)
+{
+    json_t *info = conn_json(c, "GET", "/v1/info", NULL, NULL);
+    if (!info)
+        return false;
+    json_t *list = json_object_get(info, "techniques");
+    const char *names[64];
+    size_t n = 0, i;
+    json_t *t;
+    bool known = false;
+    json_array_foreach(list, i, t) {
+        const char *name = json_string_value(json_object_get(t, "name"));
+        if (name && n < 64)
+            names[n++] = name;
+        known = known || (name && !strcmp(name, tech));
+    }
+    if (!known) {
+        const char *near = suggest_nearest(tech, names, n);
+        char all[1024] = "";
+        for (size_t k = 0; k < n; k++) {
+            size_t used = strlen(all);
+            snprintf(all + used, sizeof(all) - used, "%s%s", k ? ", " : "", names[k]);
+        }
+        fprintf(stderr, "shadebench: --filter technique=%s matches no job and no technique the "
+                "daemon knows%s%s%s (it knows %s)\n", tech, near ? "; did you mean " : "",
+                near ? near : "", near ? "?" : "", all);
+    }
+    json_decref(info);
+    return known;
+}
+
 int cmd_history(struct conn *c, const struct options *o)
 {
     /* The whole history, page after page (the daemon's pages unless
@@ -268,6 +308,11 @@ int cmd_history(struct conn *c, const struct options *o)
     if (!list)
         return EXIT_ERROR;
     json_t *jobs = json_object_get(list, "jobs");
+    const char *tech = json_string_value(json_object_get(o->filters, "technique"));
+    if (!json_array_size(jobs) && tech && !known_technique(c, tech)) {
+        json_decref(list);
+        return EXIT_ERROR;
+    }
     bool ok = history_render(c, o, jobs, list);
     json_decref(list);
     if (!ok) {

@@ -8,7 +8,9 @@
 #include "client/client.h"
 #include "client/gate.h"
 #include "client/junit.h"
+#include "client/term.h"
 #include "client/verdicts.h"
+#include "client/workload.h"
 #include "common/fsutil.h"
 #include "common/result_keys.h"
 
@@ -107,87 +109,6 @@ static int default_runs(const char *file)
     return n > 1 ? (n > 100 ? 100 : n) : 5;
 }
 
-/* With too few clean runs to decide, all the runs still decide when the CPU the noisy
- * ones lacked or had in excess cannot explain the difference: a regression
- * if it holds with the new runs bounded down and the baseline's up (each by
- * its CPU change against the reference share), a pass if it holds the other
- * way round. bv and cv (nb and s->n long) are scratch. */
-static bool bounded_verdict(const struct options *o, const struct gate_run *base, size_t nb,
-                            const struct run_set *s, bool have, double ref, double *bv,
-                            double *cv, struct gate_verdict *v)
-{
-    for (int upper = 0; upper <= 1; upper++) {
-        for (size_t i = 0; i < nb; i++)
-            bv[i] = gate_run_bound_ms(&base[i], have, ref, !upper);
-        for (size_t i = 0; i < s->n; i++)
-            cv[i] = gate_run_bound_ms(&s->runs[i], have, ref, upper);
-        struct ratio_interval r;
-        if (!have || s->n < 2 || nb + s->n < 3 ||
-            !welch_log_ratio(bv, nb, cv, s->n, o->confidence, &r))
-            return false;
-        struct gate_verdict bounded;
-        gate_decide(&r, o->max_slowdown, &bounded);
-        if (bounded.outcome == (upper ? GATE_PASS : GATE_REGRESSION)) {
-            *v = bounded;
-            size_t used = strlen(v->why);
-            snprintf(v->why + used, sizeof(v->why) - used,
-                     " (over all runs, noisy ones included, each bounded by as much as its "
-                     "CPU change against the typical %.0f%% taken by other processes could "
-                     "explain)", 100 * ref);
-            return true;
-        }
-    }
-    return false;
-}
-
-/* Marks noise on both sides and compares. The candidate runs are judged
- * against the baseline's typical other-process CPU share when it has one,
- * else against their own. */
-static void evaluate(const struct options *o, struct gate_run *base, size_t nb, struct run_set *s,
-                     struct gate_verdict *v, size_t *nb_clean, size_t *nc_clean)
-{
-    double ref = 0;
-    bool have = gate_typical_share(base, nb, &ref);
-    gate_mark_noisy(base, nb, have, ref, o->noise_tolerance);
-    for (size_t i = 0; i < s->n; i++) {
-        s->runs[i].noisy = false;
-        s->runs[i].why[0] = '\0';
-    }
-    if (!have)
-        have = gate_typical_share(s->runs, s->n, &ref);
-    gate_mark_noisy(s->runs, s->n, have, ref, o->noise_tolerance);
-    double *bv = malloc((nb + 1) * sizeof(double)), *cv = malloc((s->n + 1) * sizeof(double));
-    *nb_clean = bv ? gate_clean_values(base, nb, bv) : 0;
-    *nc_clean = cv ? gate_clean_values(s->runs, s->n, cv) : 0;
-    gate_compare(bv, *nb_clean, cv, *nc_clean, o->confidence, o->max_slowdown, v);
-    /* Too few clean runs for an interval, or an interval too wide to
-     * decide while noisy runs were left out: the bounded runs may settle it. */
-    bool undecided = v->outcome == GATE_INCONCLUSIVE && bv && cv;
-    bool too_few = undecided && v->r.ratio == 0;
-    bool left_out = *nb_clean < nb || *nc_clean < s->n;
-    bool settled = undecided && (too_few || left_out) &&
-                   bounded_verdict(o, base, nb, s, have, ref, bv, cv, v);
-    if (too_few && !settled) {
-        /* Too few clean runs to decide: still report what all the runs,
-         * noisy ones included, say, so that the log is not empty. */
-        for (size_t i = 0; i < nb; i++)
-            bv[i] = base[i].ms;
-        for (size_t i = 0; i < s->n; i++)
-            cv[i] = s->runs[i].ms;
-        struct ratio_interval all;
-        if (welch_log_ratio(bv, nb, cv, s->n, o->confidence, &all)) {
-            v->r = all;
-            size_t used = strlen(v->why);
-            snprintf(v->why + used, sizeof(v->why) - used,
-                     "; over all runs, noisy ones included: %+.1f%% (%.0f%% interval %+.1f%% to "
-                     "%+.1f%%), not a verdict", 100 * (all.ratio - 1), 100 * o->confidence,
-                     100 * (all.lo - 1), 100 * (all.hi - 1));
-        }
-    }
-    free(bv);
-    free(cv);
-}
-
 /* Consecutive noisy runs at the end: when a whole batch was disturbed, the
  * machine's conditions differ from the baseline's and more runs will not
  * help. */
@@ -238,10 +159,10 @@ static int gate_or_runs(struct conn *c, const struct options *o, const char *fil
     struct spec_check sc = {base, o, false};
     struct gate_verdict v;
     memset(&v, 0, sizeof(v));
-    size_t nb_clean = 0, nc_clean = 0, target = (size_t)planned;
-    int budget = o->max_reruns;
-    bool confirmed = false;
-    char stop_reason[160] = "";
+    struct gate_reruns plan = {.planned = (size_t)planned, .budget = o->max_reruns,
+                               .decide = base != NULL, .unit = "run"};
+    size_t target = (size_t)planned;
+    char stop_reason[200] = "";
     s.planned = (size_t)planned;
     s.budget = o->max_reruns;
     if (!o->quiet)
@@ -255,67 +176,49 @@ static int gate_or_runs(struct conn *c, const struct options *o, const char *fil
         }
         if (s.failed)
             break;
-        evaluate(o, brun, nb, &s, &v, &nb_clean, &nc_clean);
-        bool batch_noisy = trailing_noisy(&s) >= (size_t)(planned > 3 ? planned : 3);
-        bool wants_more = nc_clean < (size_t)planned ||
-                          (base && (v.outcome == GATE_INCONCLUSIVE ||
-                                    (v.outcome == GATE_REGRESSION && !confirmed)));
-        if (wants_more && budget <= 0)
+        if (base) {
+            gate_evaluate_baseline(brun, nb, s.runs, s.n, o->confidence, o->max_slowdown,
+                                   o->noise_tolerance, &v);
+        } else {
+            /* Runs for a later baseline: marked against their own typical run. */
+            double ref;
+            for (size_t i = 0; i < s.n; i++)
+                s.runs[i].noisy = false, s.runs[i].why[0] = '\0';
+            bool have = gate_typical_share(s.runs, s.n, &ref);
+            gate_mark_noisy(s.runs, s.n, have, ref, o->noise_tolerance);
+        }
+        size_t trailing = trailing_noisy(&s);
+        bool batch_noisy = trailing >= (size_t)(planned > 3 ? planned : 3);
+        struct gate_step step;
+        gate_next(&plan, s.runs, s.n, &v, batch_noisy, &step);
+        if (step.more) {
+            if (!o->quiet && base)
+                fprintf(stderr, "%s\n", step.say);
+            target += step.more;
+            continue;
+        }
+        if (step.budget_spent)
             snprintf(stop_reason, sizeof(stop_reason), "all %d extra runs (--max-reruns) used",
                      o->max_reruns);
-        else if (wants_more && batch_noisy)
+        else if (batch_noisy && step.wanted_more)
             snprintf(stop_reason, sizeof(stop_reason), "the last %zu runs were all noisy: the "
-                     "machine is busier than when the runs compared were measured",
-                     trailing_noisy(&s));
-        if (!base) {
-            /* Runs for a later baseline: replace disturbed ones. */
-            if (nc_clean < (size_t)planned && budget > 0 && !batch_noisy) {
-                target += 1;
-                budget--;
-                continue;
-            }
-            break;
-        }
-        size_t batch = (size_t)planned < (size_t)budget ? (size_t)planned : (size_t)budget;
-        if (budget <= 0 || batch_noisy)
-            break;
-        if (nc_clean < (size_t)planned) {
-            size_t need = (size_t)planned - nc_clean;
-            need = need < (size_t)budget ? need : (size_t)budget;
-            if (!o->quiet)
-                fprintf(stderr, "%zu noisy run(s) left out: running %zu more (%d extra left)\n",
-                        s.n - nc_clean, need, budget - (int)need);
-            target += need;
-            budget -= (int)need;
-            continue;
-        }
-        if (v.outcome == GATE_REGRESSION && !confirmed) {
-            /* A regression must hold on fresh runs too before it fails a
-             * build: one unlucky batch is not enough. */
-            if (!o->quiet)
-                fprintf(stderr, "possible regression (%s): confirming on %zu more runs\n", v.why,
-                        batch);
-            confirmed = true;
-            target += batch;
-            budget -= (int)batch;
-            continue;
-        }
-        if (v.outcome == GATE_INCONCLUSIVE) {
-            if (!o->quiet)
-                fprintf(stderr, "inconclusive (%s): running %zu more (%d extra left)\n", v.why,
-                        batch, budget - (int)batch);
-            target += batch;
-            budget -= (int)batch;
-            continue;
+                     "machine is busier than when the runs compared were measured", trailing);
+        if (step.unconfirmed && v.outcome == GATE_REGRESSION) {
+            /* Not a verdict: what was seen, and why it stands unconfirmed. */
+            v.outcome = GATE_INCONCLUSIVE;
+            snprintf(v.why, sizeof(v.why), "%s", step.unconfirmed_why);
         }
         break;
     }
+    size_t nb_clean = v.clean_old, nc_clean = 0;
+    for (size_t i = 0; i < s.n; i++)
+        nc_clean += !s.runs[i].noisy;
 
     /* The verdicts. Names come from the job file as the user wrote it, so
      * that a default the daemon adds later renames nothing. */
     json_t *first = s.n ? json_array_get(s.jobs, 0) : s.failed;
     json_t *user_spec = json_loads(text, 0, NULL);
-    char name[320], classname[96];
+    char name[400], classname[96];
     junit_job_name(user_spec, name, sizeof(name));
     job_classname(user_spec, classname, sizeof(classname));
     json_decref(user_spec);
@@ -361,30 +264,34 @@ static int gate_or_runs(struct conn *c, const struct options *o, const char *fil
             if (noise_base[0])
                 fprintf(stderr, "noise: %s\n", noise_base);
         }
-        char cname[400];
+        char cname[460], basis[200];
         snprintf(cname, sizeof(cname), "%s: median %s against the baseline", name, series);
+        gate_basis_text(&v, false, nb, s.n, basis, sizeof(basis));
         struct junit_case *t = junit_add(&j, classname, cname);
         if (t) {
             t->time_s = clock_mono_s() - t0;
             junit_prop_str(t, "outcome", gate_outcome_name(v.outcome));
             junit_prop_str(t, "series", series);
-            junit_prop_num(t, "ratio", v.r.ratio);
-            junit_prop_num(t, "ci_low", v.r.lo);
-            junit_prop_num(t, "ci_high", v.r.hi);
+            if (v.r.ratio > 0) { /* with no runs used: all runs' figure, not a verdict */
+                junit_prop_num(t, "ratio", v.r.ratio);
+                junit_prop_num(t, "ci_low", v.r.lo);
+                junit_prop_num(t, "ci_high", v.r.hi);
+            }
             junit_prop_num(t, "confidence", o->confidence);
             junit_prop_num(t, "allowed_slowdown", o->max_slowdown);
             junit_prop_num(t, "baseline_runs", (double)nb_clean);
             junit_prop_num(t, "runs", (double)nc_clean);
             junit_prop_num(t, "noisy_runs", (double)(s.n - nc_clean + nb - nb_clean));
             junit_prop_num(t, "extra_runs", (double)(s.n > (size_t)planned ? s.n - (size_t)planned : 0));
-            junit_out(t, "%s: %s", gate_outcome_name(v.outcome), v.why);
+            junit_prop_str(t, "bounded", v.bounded ? "yes" : "no");
+            junit_out(t, "%s %s: %s", gate_outcome_name(v.outcome), basis, v.why);
             junit_out(t, "%zu baseline runs and %zu runs here compared (%zu and %zu left out as "
                       "noisy)", nb_clean, nc_clean, nb - nb_clean, s.n - nc_clean);
             for (size_t i = 0; i < s.n; i++)
                 if (s.runs[i].noisy)
                     junit_out(t, "run %s left out: %s", s.runs[i].job, s.runs[i].why);
             if (v.outcome == GATE_REGRESSION)
-                junit_fail(t, "%s", v.why);
+                junit_fail(t, JUNIT_REGRESSION, "%s: %s", basis, v.why);
             else if (v.outcome == GATE_INCONCLUSIVE)
                 junit_inconclusive(t, o->fail_inconclusive, "inconclusive%s: %s%s%s%s%s%s%s",
                                    o->fail_inconclusive ? " (--fail-inconclusive)" : "", v.why,
@@ -392,9 +299,15 @@ static int gate_or_runs(struct conn *c, const struct options *o, const char *fil
                                    noise_base, stop_reason[0] ? "; stopped: " : "", stop_reason);
         }
         if (!o->quiet) {
-            fprintf(stderr, "gate: %s: %s\n", v.outcome == GATE_REGRESSION ? "REGRESSION"
-                                              : v.outcome == GATE_PASS ? "PASS" : "INCONCLUSIVE",
-                    v.why);
+            bool color = term_color(stderr);
+            fprintf(stderr, "gate %s: %s%s%s: %s\n", basis,
+                    !color ? "" : v.outcome == GATE_REGRESSION ? TERM_RED
+                                : v.outcome == GATE_PASS       ? TERM_GREEN
+                                                               : TERM_YELLOW,
+                    v.outcome == GATE_REGRESSION ? "REGRESSION"
+                    : v.outcome == GATE_PASS     ? "PASS"
+                                                 : "INCONCLUSIVE",
+                    color ? TERM_RESET : "", v.why);
             if (v.outcome == GATE_INCONCLUSIVE)
                 fprintf(stderr, "shadebench: warning: the timing gate could not decide within "
                         "%d extra runs%s%s%s%s\n", o->max_reruns, noise_new[0] ? "; " : "",
@@ -405,6 +318,10 @@ static int gate_or_runs(struct conn *c, const struct options *o, const char *fil
                               "ci_low", v.r.lo, "ci_high", v.r.hi, "confidence", o->confidence,
                               "allowed_slowdown", o->max_slowdown, "baseline_runs",
                               (json_int_t)nb_clean, "runs", (json_int_t)nc_clean, "why", v.why);
+        if (gate_json) {
+            json_object_set_new(gate_json, "basis", json_string(basis));
+            json_object_set_new(gate_json, "bounded", json_boolean(v.bounded));
+        }
         if (gate_json && noise_new[0])
             json_object_set_new(gate_json, "noise", json_string(noise_new));
     }
@@ -455,11 +372,25 @@ static int finish_single(struct conn *c, const struct options *o, json_t *job,
     struct junit j;
     junit_init(&j);
     const json_t *spec = user_spec ? user_spec : json_object_get(job, "spec");
-    char name[320], classname[96];
+    char name[400], classname[96];
     junit_job_name(spec, name, sizeof(name));
     job_classname(spec, classname, sizeof(classname));
-    job_case(&j, classname, name, job, time_s);
+    struct junit_case *jc = job_case(&j, classname, name, job, time_s);
     json_t *result = json_object_get(job, RK_RESULT);
+    struct gate_run run;
+    if (jc && !jc->failure[0] && result) {
+        /* Its timing figures judged alone by the noise rule: a run disturbed
+         * by other processes is not a clean measurement, so it is no PASS. */
+        gate_run_from_result(result, NULL, RK_FRAME_MS, &run);
+        if (run.noisy_alone && run.has_share)
+            junit_skip(jc, "NOISY", "its timing figures are not a clean measurement: other "
+                       "processes took %.0f%% of the CPU during its timed frames (noisy: more than "
+                       "%.0f%% less CPU left than an idle machine's)", 100 * run.other_share,
+                       100 * NOISE_TOLERANCE);
+        else if (run.noisy_alone)
+            junit_skip(jc, "NOISY", "its timing figures are not a clean measurement: the "
+                       "daemon marked the run noisy");
+    }
     if (result)
         quality_cases(o, result, classname, name, &j);
     int verdict = junit_conclude(o, &j, name, time_s);
@@ -485,6 +416,19 @@ int cmd_submit(struct conn *c, const struct options *o, const char *file)
     if (o->out_dir && !out_dir_claim(o->out_dir, "job.json", NULL, err, sizeof(err))) {
         fprintf(stderr, "shadebench: %s\n", err);
         return EXIT_ERROR;
+    }
+    if (!isnan(o->min_ssim) || !isnan(o->max_flip)) {
+        /* A quality check that cannot judge anything is a usage error, found
+         * before a job runs, not a failure found after it. */
+        json_t *job = load_json_file("job file", file, err, sizeof(err));
+        char why[300];
+        bool judged = !job || workload_quality_judged(job, why, sizeof(why));
+        json_decref(job);
+        if (!judged) {
+            fprintf(stderr, "shadebench: %s cannot be judged by %s: %s\n", file,
+                    !isnan(o->min_ssim) ? "--min-ssim" : "--max-flip", why);
+            return EXIT_ERROR;
+        }
     }
     struct baseline base;
     if (o->baseline && !baseline_load(o->baseline, &base))

@@ -10,37 +10,61 @@
 #include "client/fleet.h"
 #include "client/verdicts.h"
 #include "client/junit.h"
+#include "client/workload.h"
 #include "common/fsutil.h"
+#include "common/json_fields.h"
 #include "common/result_keys.h"
 
-/* "osl async_distance=5 scene.lights=8": the point's content, stable from
- * build to build. */
-static void point_name(const json_t *row, char *out, size_t cap)
+/* The point's job as the sweep file states it: its base with the point's
+ * values set at their dotted paths ("scene.lights": 8). New reference. */
+static json_t *point_spec(const json_t *base, const json_t *row)
 {
+    json_t *spec = json_is_object(base) ? json_deep_copy(base) : json_object();
     const char *tech = json_string_value(json_object_get(row, "technique"));
-    snprintf(out, cap, "%s", tech ? tech : "?");
+    if (tech)
+        json_object_set_new(spec, "technique", json_string(tech));
     const char *key;
     json_t *v;
+    json_object_foreach(json_object_get(row, "values"), key, v)
+        jf_set_path(spec, key, json_incref(v));
+    return spec;
+}
+
+/* "forward grid 160x120 8 lights #3f2a91c0, 20 frames [scene.lights=8]":
+ * the point's workload (named as a job is, with the hash history prints for
+ * it), so that two sweeps in one pipeline never share a case, and its
+ * swept values, which the name may otherwise only carry in its hash. */
+static void point_name(const json_t *base, const json_t *row, char *out, size_t cap)
+{
+    json_t *spec = point_spec(base, row);
+    junit_job_name(spec, out, cap);
+    json_decref(spec);
+    const char *key;
+    json_t *v;
+    const char *sep = " [";
     json_object_foreach(json_object_get(row, "values"), key, v) {
-        if (!strcmp(key, "technique"))
-            continue;
         char *text = json_dumps(v, JSON_ENCODE_ANY | JSON_COMPACT);
         size_t used = strlen(out);
-        snprintf(out + used, cap - used, " %s=%s", key, text ? text : "?");
+        snprintf(out + used, cap - used, "%s%s=%s", sep, key, text ? text : "?");
         free(text);
+        sep = " ";
+    }
+    if (strcmp(sep, " [") != 0) {
+        size_t used = strlen(out);
+        snprintf(out + used, cap - used, "]");
     }
 }
 
 static void point_cases(struct conn *c, const struct options *o, const json_t *sweep,
-                        struct junit *j)
+                        const json_t *base, const char *sweep_name, struct junit *j)
 {
     bool find = !strcmp(json_string_value(json_object_get(sweep, "kind")) ?
                         json_string_value(json_object_get(sweep, "kind")) : "", "find");
     size_t i;
     json_t *row;
-    char name[400], cname[440];
+    char name[480], cname[760];
     json_array_foreach(json_object_get(sweep, "points"), i, row) {
-        point_name(row, name, sizeof(name));
+        point_name(base, row, name, sizeof(name));
         snprintf(cname, sizeof(cname), "%s: job", name);
         struct junit_case *t = junit_add(j, "shadebench.sweep", cname);
         if (!t)
@@ -62,7 +86,7 @@ static void point_cases(struct conn *c, const struct options *o, const json_t *s
         t->time_s = isfinite(span) && span > 0 ? span : 0;
         if (!status || strcmp(status, "done") != 0) {
             const char *error = json_string_value(json_object_get(row, "error"));
-            junit_fail(t, "point job %s: %s", status ? status : "?", error ? error : "");
+            junit_fail(t, JUNIT_JOB_FAILED, "point job %s: %s", status ? status : "?", error ? error : "");
             continue;
         }
         static const char *const series[] = {RK_FRAME_MS, RK_GPU_MS, RK_CPU_MS};
@@ -95,20 +119,20 @@ static void point_cases(struct conn *c, const struct options *o, const json_t *s
              * verdicts are output, the breaking point is the case. */
             junit_out(q, "criterion %s", json_is_true(holds) ? "holds" : "fails");
         } else if (json_integer_value(pf) > 0) {
-            junit_fail(q, "PerceptualDiff failed on %lld captures",
+            junit_fail(q, JUNIT_QUALITY, "PerceptualDiff failed on %lld captures",
                        (long long)json_integer_value(pf));
         }
         if (!find && !isnan(o->min_ssim) && json_is_number(ssim) &&
             json_number_value(ssim) < o->min_ssim)
-            junit_fail(q, "worst SSIM %.6f below %.6f", json_number_value(ssim), o->min_ssim);
+            junit_fail(q, JUNIT_QUALITY, "worst SSIM %.6f below %.6f", json_number_value(ssim), o->min_ssim);
         if (!find && !isnan(o->max_flip) && json_is_number(flip) &&
             json_number_value(flip) > o->max_flip)
-            junit_fail(q, "worst FLIP mean %.6f above %.6f", json_number_value(flip), o->max_flip);
+            junit_fail(q, JUNIT_QUALITY, "worst FLIP mean %.6f above %.6f", json_number_value(flip), o->max_flip);
     }
     json_t *result = json_object_get(sweep, RK_RESULT);
     json_t *bp = json_object_get(result, "breaking_point");
     if (bp) {
-        snprintf(cname, sizeof(cname), "breaking point of %s while %s",
+        snprintf(cname, sizeof(cname), "%s: breaking point of %s while %s", sweep_name,
                  json_string_value(json_object_get(bp, "param")),
                  json_string_value(json_object_get(bp, "criterion")));
         struct junit_case *t = junit_add(j, "shadebench.sweep", cname);
@@ -124,7 +148,7 @@ static void point_cases(struct conn *c, const struct options *o, const json_t *s
                   v ? v : "?");
         free(v);
         if (!outcome || !strcmp(outcome, "fails everywhere") || !strcmp(outcome, "aborted"))
-            junit_fail(t, "no value holds the criterion (%s)", outcome ? outcome : "no outcome");
+            junit_fail(t, JUNIT_QUALITY, "no value holds the criterion (%s)", outcome ? outcome : "no outcome");
     }
     /* The largest passing value means something along a numeric field
      * only; a sweep over techniques judges each point in its quality case. */
@@ -135,7 +159,7 @@ static void point_cases(struct conn *c, const struct options *o, const json_t *s
                                  json_object_get(row, "values"),
                                  json_string_value(json_object_get(largest, "param"))));
     if (largest && numeric) {
-        snprintf(cname, sizeof(cname), "largest %s passing PerceptualDiff",
+        snprintf(cname, sizeof(cname), "%s: largest %s passing PerceptualDiff", sweep_name,
                  json_string_value(json_object_get(largest, "param")));
         struct junit_case *t = junit_add(j, "shadebench.sweep", cname);
         if (!t)
@@ -192,6 +216,28 @@ void sweep_add_labels(json_t *body, const json_t *labels)
     json_object_update(into, (json_t *)labels);
 }
 
+/* "sweep of forward grid 160x120 #3f2a91c0, 20 frames over scene.lights,
+ * technique": the sweep's case, unique to what it sweeps. */
+static void sweep_case_name(const json_t *body, char *out, size_t cap)
+{
+    char base[400];
+    junit_job_name(json_object_get(body, "base"), base, sizeof(base));
+    snprintf(out, cap, "sweep of %s over", base);
+    const char *key;
+    json_t *v;
+    const char *sep = " ";
+    json_object_foreach(json_object_get(body, "vary"), key, v) {
+        size_t used = strlen(out);
+        snprintf(out + used, cap - used, "%s%s", sep, key);
+        sep = ", ";
+    }
+    const char *param = json_string_value(json_object_get(json_object_get(body, "find"), "param"));
+    if (param) {
+        size_t used = strlen(out);
+        snprintf(out + used, cap - used, "%s%s (find)", sep, param);
+    }
+}
+
 int cmd_sweep(struct conn *c, const struct options *o, const char *file)
 {
     char err[600];
@@ -209,8 +255,22 @@ int cmd_sweep(struct conn *c, const struct options *o, const char *file)
         json_decref(body);
         return EXIT_ERROR;
     }
+    char why[300];
+    if ((!isnan(o->min_ssim) || !isnan(o->max_flip)) &&
+        !workload_quality_judged(json_object_get(body, "base"), why, sizeof(why)) &&
+        !json_object_get(json_object_get(body, "vary"), "reference")) {
+        fprintf(stderr, "shadebench: the sweep's points cannot be judged by %s: its base job: "
+                "%s\n", !isnan(o->min_ssim) ? "--min-ssim" : "--max-flip", why);
+        json_decref(body);
+        return EXIT_ERROR;
+    }
     sweep_add_labels(body, o->labels);
     char *text = json_dumps(body, JSON_COMPACT);
+    /* Case names from the file as written: the base job's workload and
+     * what the sweep varies. */
+    json_t *base = json_incref(json_object_get(body, "base"));
+    char sweep_name[600];
+    sweep_case_name(body, sweep_name, sizeof(sweep_name));
     json_decref(body);
     double t0 = clock_mono_s();
     json_t *reply = text ? conn_json(c, "POST", "/v1/sweeps", text, NULL) : NULL;
@@ -230,7 +290,7 @@ int cmd_sweep(struct conn *c, const struct options *o, const char *file)
     struct junit j;
     junit_init(&j);
     const char *status = json_string_value(json_object_get(sweep, "status"));
-    struct junit_case *t = junit_add(&j, "shadebench.sweep", "sweep");
+    struct junit_case *t = junit_add(&j, "shadebench.sweep", sweep_name);
     if (t) {
         t->time_s = clock_mono_s() - t0;
         junit_prop_str(t, "sweep", id);
@@ -242,12 +302,12 @@ int cmd_sweep(struct conn *c, const struct options *o, const char *file)
         junit_prop_num(t, "points_total", (double)total);
         if (!status || strcmp(status, "done") != 0) {
             const char *error = json_string_value(json_object_get(sweep, "error"));
-            junit_fail(t, "sweep %s after %lld of %lld points (a partial sweep)%s%s",
+            junit_fail(t, JUNIT_JOB_FAILED, "sweep %s after %lld of %lld points (a partial sweep)%s%s",
                        status ? status : "?", done, total, error ? ": " : "", error ? error : "");
         }
     }
-    point_cases(c, o, sweep, &j);
-    int rc = junit_conclude(o, &j, "sweep", clock_mono_s() - t0);
+    point_cases(c, o, sweep, base, sweep_name, &j);
+    int rc = junit_conclude(o, &j, sweep_name, clock_mono_s() - t0);
     if (o->out_dir) {
         if (!download_all(c, sweep, o->out_dir))
             rc = EXIT_ERROR;
@@ -256,5 +316,6 @@ int cmd_sweep(struct conn *c, const struct options *o, const char *file)
     }
     junit_finish(&j);
     json_decref(sweep);
+    json_decref(base);
     return rc;
 }

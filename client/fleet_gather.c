@@ -18,10 +18,10 @@
 #include "client/junit.h" /* xml_escaped */
 #include "common/fsutil.h"
 #include "common/result_keys.h"
-#include "daemon/api/charts.h"
-#include "daemon/api/report.h"
-#include "daemon/api/sweep_verdict.h"
-#include "daemon/jobs/sweep_table.h"
+#include "daemon/reports/charts.h"
+#include "daemon/reports/report.h"
+#include "daemon/reports/sweep_verdict.h"
+#include "daemon/spec/sweep_table.h"
 
 /* A device class's points as the report's job_dir callback finds them. */
 struct class_dirs {

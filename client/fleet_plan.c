@@ -11,7 +11,7 @@
 
 #include "client/fleet.h"
 #include "common/fsutil.h"
-#include "daemon/jobs/sweep_spec.h"
+#include "daemon/spec/sweep_spec.h"
 #include "daemon/techniques/catalog.h"
 
 bool fleet_plan_write(const json_t *body, const char *dir, char *err, size_t cap)

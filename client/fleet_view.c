@@ -10,8 +10,8 @@
 
 #include "client/fleet.h"
 #include "common/result_keys.h"
-#include "daemon/api/charts.h"
-#include "daemon/api/sweep_verdict.h"
+#include "daemon/reports/charts.h"
+#include "daemon/reports/sweep_verdict.h"
 
 /* "technique|{values}": a point's identity across devices. */
 static char *point_key(const json_t *row, bool with_technique)

@@ -23,14 +23,26 @@
 #include <stddef.h>
 
 #include "client/stats_test.h"
+#include "common/noise.h"
 
 enum gate_outcome { GATE_PASS, GATE_REGRESSION, GATE_INCONCLUSIVE };
+
+/* The fewest pairs an ab verdict may rest on: below it the paired interval
+ * has 1 degree of freedom or none, and a "pass" over 1 pair says nothing. */
+#define GATE_MIN_PAIRS 3
 
 struct gate_verdict {
     enum gate_outcome outcome;
     struct ratio_interval r;
     double min_effect; /* 0.05: slower by more than 5% counts */
-    char why[512];     /* one sentence: why this outcome */
+    char why[640];     /* one sentence: why this outcome */
+    /* What it rests on: the runs of each side (ab: pairs, both the same)
+     * that entered the interval, and whether noisy ones entered it bounded
+     * by their CPU change (else only clean ones did). 0 and 0 when no
+     * interval could be made. */
+    size_t used_old, used_new;
+    size_t clean_old, clean_new;
+    bool bounded;
 };
 
 const char *gate_outcome_name(enum gate_outcome o);
@@ -66,8 +78,11 @@ struct gate_run {
     double other_share;  /* other processes' share of the machine's CPU, 0..1 */
     double load_start, load_end; /* 1-minute load average, NAN when absent */
     bool daemon_noisy;   /* the daemon's own flag */
-    bool noisy;          /* excluded from the comparison */
-    char why[160];       /* why it is noisy */
+    bool noisy_alone;    /* noisy against an idle machine (common/noise.h): what
+                            history, reports and a single job call noisy */
+    bool noisy;          /* left out of the comparison: noisy against what it is
+                            compared with */
+    char why[200];       /* why it is left out */
     double elapsed_s;    /* submission to end (runs the client ran), else 0 */
 };
 
@@ -87,16 +102,9 @@ bool gate_run_from_result(const json_t *result, const char *job_id, const char *
  * when none has interference figures. */
 bool gate_typical_share(const struct gate_run *runs, size_t n, double *share);
 
-/* How much more (> 0) or less (< 0) CPU other processes left than in the
- * reference, relatively: (1 - share) / (1 - reference) - 1. A CPU-bound
- * renderer on a shared machine slows down with the CPU left to it, so 0.85
- * against 0.80 (15% left instead of 20%) is -25%, while 0.05 against 0.02
- * is -3%. */
-double gate_cpu_left_change(double share, double reference);
-
 /* A run's time as it might have been with the reference's CPU share: a
  * renderer is at most CPU-bound, so its time scales by at most
- * (1 + gate_cpu_left_change(share, reference)). upper = false gives the
+ * (1 + noise_cpu_left_change(share, reference)). upper = false gives the
  * smaller of the measured and the fully scaled time, upper = true the
  * larger: a slowdown that survives the new runs bounded down and the
  * baseline bounded up is one the CPU difference cannot explain. Without
@@ -104,15 +112,12 @@ double gate_cpu_left_change(double share, double reference);
 double gate_run_bound_ms(const struct gate_run *r, bool have_reference, double reference,
                          bool upper);
 
-/* The same for B's run of a pair, against the share A's run had. */
-double gate_pair_bound_ms(const struct gate_run *a, const struct gate_run *b, bool upper);
-
-/* Marks runs noisy when the CPU other processes left them differs from the
- * reference's by more than tolerance (0.10: by more than 10%, either way):
- * such a run was measured under other conditions than the runs it is
- * compared with. Without a reference share, a run the daemon flagged noisy
- * is marked. Runs without figures are kept (older results). Returns the
- * noisy count. */
+/* Marks runs noisy (left out) by the noise rule (common/noise.h) against
+ * what they are compared with: the CPU other processes left them differs
+ * from the reference's by more than tolerance (NOISE_TOLERANCE, or
+ * --noise-tolerance), either way. Without a reference share, a run the
+ * daemon flagged noisy is marked. Runs without figures are kept (older
+ * results). Returns the noisy count. */
 size_t gate_mark_noisy(struct gate_run *runs, size_t n, bool have_reference, double reference,
                        double tolerance);
 
@@ -127,6 +132,77 @@ size_t gate_clean_values(const struct gate_run *runs, size_t n, double *values);
  * and returns 0 when none was noisy; returns the noisy count. */
 size_t gate_noise_text(const struct gate_run *runs, size_t n, const char *what,
                        double reference, char *out, size_t cap);
+
+/* The baseline gate on the runs so far: the baseline's runs marked against
+ * their own typical share, the new runs against the baseline's (the
+ * conditions the baseline was measured under; their own without figures),
+ * then Welch on the clean ones. When too few are clean, or the interval is
+ * too wide while noisy ones were left out, all the runs still decide if the
+ * CPU difference cannot explain the result: new runs bounded down and the
+ * baseline's up for a regression, the other way for a pass (bounded). */
+void gate_evaluate_baseline(struct gate_run *base, size_t nb, struct gate_run *runs, size_t n,
+                            double confidence, double min_effect, double tolerance,
+                            struct gate_verdict *v);
+
+/* ab on n pairs (a[i] and b[i] run side by side, alternately): a pair is
+ * noisy when B's run had more than the tolerance more or less CPU left
+ * than A's, each measured from its own side's typical share (a short and a
+ * long job see different shares of the same neighbours, so comparing the
+ * raw shares called every pair of unlike jobs noisy; a drift of the whole
+ * machine moves both runs of a pair alike and leaves it clean). Then the
+ * paired interval over the clean pairs, at least GATE_MIN_PAIRS of them.
+ * With fewer, or an interval too wide while pairs were left out, every
+ * pair with figures may decide bounded: each B lowered (a regression) or
+ * raised (a pass) by as much as that relative CPU change could explain.
+ * Fewer than GATE_MIN_PAIRS in all: inconclusive, saying so. */
+void gate_evaluate_ab(struct gate_run *a, struct gate_run *b, size_t n, double confidence,
+                      double min_effect, double tolerance, struct gate_verdict *v);
+
+/* How many of runs[from..n) the verdict rests on: the clean ones, or when
+ * it came from bounds every one with figures. A regression is confirmed
+ * only by fresh runs that entered its verdict. For ab, runs are A's and a
+ * pair's flag is on both sides. */
+size_t gate_runs_in_verdict(const struct gate_run *runs, size_t n, size_t from, bool bounded);
+
+/* The rerun policy the gate and ab share. After each evaluation: replace
+ * noisy runs (pairs) until `planned` are clean, run another set while the
+ * verdict is unclear, and confirm a regression on a fresh set, which
+ * confirms it only by entering its verdict (gate_runs_in_verdict): noisy
+ * confirming runs are replaced, and a regression whose fresh runs never
+ * entered its verdict when the budget is spent is not confirmed. Without a
+ * verdict to reach (decide false: runs for a later baseline), only noisy
+ * runs are replaced. */
+struct gate_reruns {
+    size_t planned;        /* clean runs (pairs) wanted */
+    int budget;            /* extra runs (pairs) left */
+    bool decide;           /* rerun for unclear verdicts and regressions too */
+    bool confirming;       /* a regression found before confirm_from */
+    size_t confirm_from, confirm_need;
+    const char *unit;      /* "run", "pair" */
+};
+
+struct gate_step {
+    size_t more;             /* to run now; 0: stop */
+    char say[800];           /* the log line for running more, "" when stopping */
+    bool wanted_more;        /* more runs were wanted (stopped short: budget or noise) */
+    bool budget_spent;       /* stopped, or ran short, with more wanted and no budget left */
+    bool unconfirmed;        /* stopped with a regression its fresh runs did not confirm */
+    char unconfirmed_why[600]; /* then: the verdict's sentence in its place */
+};
+
+/* The next step, from the n runs so far (runs: the new side's, or A's for
+ * ab, whose pairs are marked on both sides), the verdict on them, and
+ * whether the last set was all noisy (stop: the machine is busier than
+ * when the compared runs were measured). Updates r (budget, confirming). */
+void gate_next(struct gate_reruns *r, const struct gate_run *runs, size_t n,
+               const struct gate_verdict *v, bool batch_noisy, struct gate_step *step);
+
+/* What a verdict rests on, for its headline: "over 7 pairs (none left out)",
+ * "over 7 pairs (3 clean, 4 noisy ones bounded by their CPU change)", "over
+ * 5 baseline runs and 4 runs here (1 noisy run left out)", or "on too few
+ * pairs for an interval". */
+void gate_basis_text(const struct gate_verdict *v, bool paired, size_t total_old,
+                     size_t total_new, char *out, size_t cap);
 
 /* Fields of a job spec that never change what is timed: labels (tags),
  * repeat (how many runs, the gate chooses), capture_interval (captures are

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "client/gate.h"
+#include "client/workload.h"
 
 void junit_init(struct junit *j) { memset(j, 0, sizeof(*j)); }
 
@@ -21,6 +22,14 @@ void junit_finish(struct junit *j)
     memset(j, 0, sizeof(*j));
 }
 
+static bool has_name(const struct junit *j, const char *classname, const char *name)
+{
+    for (size_t i = 0; i < j->count; i++)
+        if (!strcmp(j->cases[i].name, name) && !strcmp(j->cases[i].classname, classname))
+            return true;
+    return false;
+}
+
 struct junit_case *junit_add(struct junit *j, const char *classname, const char *name)
 {
     if (j->count == j->cap) {
@@ -31,10 +40,14 @@ struct junit_case *junit_add(struct junit *j, const char *classname, const char 
         j->cases = grown;
         j->cap = cap;
     }
+    char unique[sizeof(j->cases[0].name)];
+    snprintf(unique, sizeof(unique), "%s", name);
+    for (int k = 2; has_name(j, classname, unique) && k < 10000; k++)
+        snprintf(unique, sizeof(unique), "%.380s (%d)", name, k);
     struct junit_case *c = &j->cases[j->count++];
     memset(c, 0, sizeof(*c));
     snprintf(c->classname, sizeof(c->classname), "%s", classname);
-    snprintf(c->name, sizeof(c->name), "%s", name);
+    snprintf(c->name, sizeof(c->name), "%s", unique);
     c->properties = json_object();
     return c;
 }
@@ -46,10 +59,12 @@ static void vappend(char *dst, size_t cap, const char *fmt, va_list ap)
         vsnprintf(dst + used, cap - used, fmt, ap);
 }
 
-void junit_fail(struct junit_case *c, const char *fmt, ...)
+void junit_fail(struct junit_case *c, const char *type, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
+    if (!c->failure[0] || c->inconclusive)
+        snprintf(c->failure_type, sizeof(c->failure_type), "%s", type);
     if (c->failure[0] && strlen(c->failure) + 3 < sizeof(c->failure))
         strcat(c->failure, "; ");
     vappend(c->failure, sizeof(c->failure), fmt, ap);
@@ -63,9 +78,22 @@ void junit_inconclusive(struct junit_case *c, bool fail, const char *fmt, ...)
     c->inconclusive = true;
     char *dst = fail ? c->failure : c->skipped;
     size_t cap = fail ? sizeof(c->failure) : sizeof(c->skipped);
+    if (fail && !c->failure[0])
+        snprintf(c->failure_type, sizeof(c->failure_type), "%s", JUNIT_INCONCLUSIVE);
     if (dst[0] && strlen(dst) + 3 < cap)
         strcat(dst, "; ");
     vappend(dst, cap, fmt, ap);
+    va_end(ap);
+}
+
+void junit_skip(struct junit_case *c, const char *tag, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    snprintf(c->skip_tag, sizeof(c->skip_tag), "%s", tag);
+    if (c->skipped[0] && strlen(c->skipped) + 3 < sizeof(c->skipped))
+        strcat(c->skipped, "; ");
+    vappend(c->skipped, sizeof(c->skipped), fmt, ap);
     va_end(ap);
 }
 
@@ -112,6 +140,14 @@ size_t junit_undecided(const struct junit *j)
     size_t n = 0;
     for (size_t i = 0; i < j->count; i++)
         n += j->cases[i].inconclusive;
+    return n;
+}
+
+size_t junit_judged_nothing(const struct junit *j)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < j->count; i++)
+        n += j->cases[i].skip_tag[0] && !j->cases[i].failure[0] && !j->cases[i].inconclusive;
     return n;
 }
 
@@ -184,7 +220,7 @@ bool junit_write(const struct junit *j, const char *path, const char *suite, dou
         }
         if (c->failure[0]) {
             fprintf(f, "      <failure type=\"");
-            xml_escaped(f, c->inconclusive ? "inconclusive" : c->classname);
+            xml_escaped(f, c->failure_type[0] ? c->failure_type : JUNIT_JOB_FAILED);
             fprintf(f, "\" message=\"");
             xml_escaped(f, c->failure);
             fprintf(f, "\"/>\n");
@@ -204,13 +240,31 @@ bool junit_write(const struct junit *j, const char *path, const char *suite, dou
     return fclose(f) == 0;
 }
 
-void junit_print(const struct junit *j, FILE *f)
+/* The case's word in the log, and its colour: green, red, yellow. */
+static const char *case_tag(const struct junit_case *c, const char **color)
+{
+    if (c->failure[0]) {
+        *color = "\033[1;31m";
+        return c->inconclusive ? "INCONCLUSIVE" : "FAIL";
+    }
+    *color = "\033[1;33m";
+    if (c->inconclusive)
+        return "INCONCLUSIVE";
+    if (c->skip_tag[0])
+        return c->skip_tag;
+    *color = "\033[1;32m";
+    return "PASS";
+}
+
+void junit_print(const struct junit *j, FILE *f, bool color)
 {
     char text[256];
     for (size_t i = 0; i < j->count; i++) {
         const struct junit_case *c = &j->cases[i];
-        const char *tag = c->inconclusive ? "INCONCLUSIVE" : c->failure[0] ? "FAIL" : "PASS";
-        fprintf(f, "%s %s (%.2f s)", tag, c->name, c->time_s);
+        const char *on;
+        const char *tag = case_tag(c, &on);
+        fprintf(f, "%s%s%s %s (%.2f s)", color ? on : "", tag, color ? "\033[0m" : "", c->name,
+                c->time_s);
         const char *key;
         json_t *v;
         const char *sep = ": ";
@@ -221,9 +275,9 @@ void junit_print(const struct junit *j, FILE *f)
         }
         fputc('\n', f);
         if (c->failure[0])
-            fprintf(f, "    failure: %s\n", c->failure);
+            fprintf(f, "    failure (%s): %s\n", c->failure_type, c->failure);
         else if (c->skipped[0])
-            fprintf(f, "    not decided: %s\n", c->skipped);
+            fprintf(f, "    %s: %s\n", c->inconclusive ? "not decided" : "not judged", c->skipped);
         if (c->output[0])
             fprintf(f, "    %s\n", c->output);
     }
@@ -337,26 +391,14 @@ void junit_job_name(const json_t *spec, char *out, size_t cap)
         if (json_is_boolean(dyn))
             put(name, ncap, " %s", json_is_true(dyn) ? "moving" : "still");
     }
-    /* The rest of the scene (layout, camera, materials, ...) and the look
-     * change the workload too, but spelled out they would bury the name:
-     * they go in as a short hash of their sorted JSON, stable across runs. */
-    json_t *rest = json_object();
-    if (json_is_object(scene)) {
-        json_t *s2 = json_deep_copy(scene);
-        static const char *const shown[] = {"preset", "width", "height", "lights", "dynamic"};
-        for (size_t i = 0; i < sizeof(shown) / sizeof(shown[0]); i++)
-            json_object_del(s2, shown[i]);
-        json_object_set_new(rest, "scene", s2);
-    }
-    if (json_object_get(spec, "look"))
-        json_object_set(rest, "look", json_object_get(spec, "look"));
-    char *text_rest = json_dumps(rest, JSON_SORT_KEYS | JSON_COMPACT);
-    uint32_t h = 2166136261u; /* FNV-1a */
-    for (const char *p = text_rest; p && *p; p++)
-        h = (h ^ (unsigned char)*p) * 16777619u;
-    put(name, ncap, " #%08x", h);
-    free(text_rest);
-    json_decref(rest);
+    /* The rest (layout, camera, materials, the look, warm-up, ...) changes
+     * the workload too, but spelled out it would bury the name: it goes in
+     * as the workload's hash, the one history and the gate print for it
+     * (workload_key, over the whole workload, stable across runs). */
+    char key[96];
+    workload_key(spec, key, sizeof(key));
+    const char *hash = strchr(key, '#');
+    put(name, ncap, " #%.8s", hash ? hash + 1 : "00000000");
     json_t *frames = json_object_get(spec, "frames");
     if (json_is_number(frames))
         put(name, ncap, ", %g frames", json_number_value(frames));

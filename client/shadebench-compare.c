@@ -1,9 +1,11 @@
 /* shadebench-compare: the daemon's image-quality metrics on any two PNGs.
  * Prints JSON; exits 0 when PerceptualDiff passes, 1 when it fails, 2 on bad
  * input (unreadable file, size mismatch, not 8-bit RGB/RGBA), like
- * perceptualdiff, so CI scripts can use it directly. */
+ * perceptualdiff, so CI scripts can use it directly. Translucent PNGs are
+ * judged premultiplied by their alpha, as perceptualdiff judges them. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <stdint.h>
 #include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -29,7 +31,15 @@ static void usage(FILE *f)
             "  --color-factor F        PerceptualDiff colour test weight (default 1)\n"
             "  --luminance-only        PerceptualDiff without the colour test\n"
             "  --ppd P                 FLIP pixels per degree (default 67.02)\n"
-            "  --diff-out DIR          write DIR/ssim.png and DIR/flip.png\n");
+            "  --diff-out DIR          write DIR/ssim.png and DIR/flip.png\n"
+            "  --swap-red-blue         read red as blue and blue as red, as perceptualdiff 2.x\n"
+            "                          does on little-endian machines (FreeImage's byte order),\n"
+            "                          to reproduce its figures\n\n"
+            "An RGBA image is judged premultiplied by its alpha, as perceptualdiff judges\n"
+            "it: PerceptualDiff multiplies each channel by alpha before its gamma; SSIM,\n"
+            "PSNR and FLIP compare the colours times alpha, rounded to 8 bits (the image\n"
+            "over black). A difference of alpha alone does not show where the colour is\n"
+            "black.\n");
 }
 
 static bool number(const char *s, double min, double max, double *out)
@@ -48,8 +58,9 @@ int main(int argc, char **argv)
     struct metrics_options o;
     metrics_options_defaults(&o);
     const char *diff_out = NULL;
+    bool swap_red_blue = false;
     enum { O_METRICS = 256, O_FOV, O_THRESHOLD, O_GAMMA, O_LUM, O_COLOR, O_LUMONLY, O_PPD,
-           O_DIFF, O_HELP };
+           O_DIFF, O_SWAP, O_HELP };
     static const struct option longopts[] = {
         {"metrics", required_argument, NULL, O_METRICS},
         {"fov", required_argument, NULL, O_FOV},
@@ -60,6 +71,7 @@ int main(int argc, char **argv)
         {"luminance-only", no_argument, NULL, O_LUMONLY},
         {"ppd", required_argument, NULL, O_PPD},
         {"diff-out", required_argument, NULL, O_DIFF},
+        {"swap-red-blue", no_argument, NULL, O_SWAP},
         {"help", no_argument, NULL, O_HELP},
         {NULL, 0, NULL, 0},
     };
@@ -94,6 +106,7 @@ int main(int argc, char **argv)
         case O_LUMONLY: o.pdiff.luminance_only = true; break;
         case O_PPD: if (!number(optarg, 1, 1000, &o.flip_ppd)) bad = "--ppd must be 1 to 1000"; break;
         case O_DIFF: diff_out = optarg; break;
+        case O_SWAP: swap_red_blue = true; break;
         case O_HELP: usage(stdout); return 0;
         default: usage(stderr); return 2;
         }
@@ -109,15 +122,24 @@ int main(int argc, char **argv)
     const char *ref_path = argv[optind], *test_path = argv[optind + 1];
     struct image ref, test;
     char err[512];
-    if (!png_read_rgb(ref_path, &ref, err, sizeof(err))) {
+    if (!png_read_rgba(ref_path, &ref, err, sizeof(err))) {
         fprintf(stderr, "shadebench-compare: %s\n", err);
         return 2;
     }
-    if (!png_read_rgb(test_path, &test, err, sizeof(err))) {
+    if (!png_read_rgba(test_path, &test, err, sizeof(err))) {
         fprintf(stderr, "shadebench-compare: %s\n", err);
         image_finish(&ref);
         return 2;
     }
+    if (swap_red_blue)
+        for (int k = 0; k < 2; k++) {
+            struct image *img = k ? &test : &ref;
+            for (size_t i = 0; i < (size_t)img->width * (size_t)img->height; i++) {
+                uint8_t r = img->rgb[3 * i];
+                img->rgb[3 * i] = img->rgb[3 * i + 2];
+                img->rgb[3 * i + 2] = r;
+            }
+        }
     char ssim_path[4096], flip_path[4096];
     if (diff_out) {
         if (mkdir(diff_out, 0755) != 0 && errno != EEXIST) {
@@ -137,8 +159,12 @@ int main(int argc, char **argv)
         json_object_set_new(result, "test", json_string(test_path));
         json_object_set_new(result, "width", json_integer(ref.width));
         json_object_set_new(result, "height", json_integer(ref.height));
+        bool translucent = ref.alpha || test.alpha;
+        json_object_set_new(result, "alpha", json_string(translucent ? "premultiplied" : "opaque"));
         json_object_set_new(result, "memory_budget_bytes",
-                            json_real(metrics_memory_bytes(ref.width, ref.height, o.flip_ppd)));
+                            json_real(metrics_memory_bytes(ref.width, ref.height, o.flip_ppd) +
+                                      (translucent ? metrics_alpha_memory_bytes(ref.width, ref.height)
+                                                   : 0.0)));
         json_dumpf(result, stdout, JSON_INDENT(2) | JSON_REAL_PRECISION(10));
         putchar('\n');
         json_t *pdiff = json_object_get(result, "pdiff");

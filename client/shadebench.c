@@ -18,6 +18,7 @@
 #include "client/suggest.h"
 #include "common/fsutil.h"
 #include "config.h"
+#include "common/noise.h"
 #include "common/result_keys.h"
 
 static void die_usage(const char *fmt, ...) __attribute__((format(printf, 1, 2), noreturn));
@@ -58,7 +59,11 @@ static void usage(FILE *f)
             "  cancel ID           cancel a queued or running job\n"
             "  fetch ID            download a finished job (--out DIR) and judge it\n"
             "  info                the daemon's version, device, techniques, effects and limits\n"
-            "                      (--json: the daemon's whole answer)\n\n"
+            "                      (--json: the daemon's whole answer)\n"
+            "  fidelity ASSET [REQUEST.json]  the asset against the Khronos glTF Sample Viewer,\n"
+            "                      lit and per channel (--channel NAME, repeatable; --out DIR:\n"
+            "                      both renders and the difference images; --min-ssim,\n"
+            "                      --max-flip fail a channel)\n\n"
             "Options:\n"
             "  --server URL        default $SHADEBENCH_SERVER, else http://127.0.0.1:8460\n"
             "  --token-file FILE   bearer token from a file (default $SHADEBENCH_TOKEN_FILE)\n"
@@ -69,12 +74,14 @@ static void usage(FILE *f)
             "                      DIR, which must be empty or new (or hold this same job)\n"
             "  --junit FILE        write JUnit XML\n"
             "  --label KEY=VALUE   add a label to the submitted jobs (repeatable)\n"
-            "  --min-ssim X        a capture fails below this SSIM (needs a reference)\n"
-            "  --max-flip X        a capture fails above this mean FLIP (needs a reference)\n\n"
+            "  --min-ssim X        a capture fails below this SSIM (the job must name a\n"
+            "                      reference and capture frames: checked before it runs)\n"
+            "  --max-flip X        a capture fails above this mean FLIP (likewise)\n\n"
             "Timing gate (submit --wait --baseline) and ab:\n"
             "  --baseline FILE     result.json (or job.json) of earlier runs to compare with\n"
             "  --runs N            clean runs kept on each side (default: the job's repeat, else 5)\n"
-            "  --max-slowdown P    the smallest slowdown that counts, e.g. 5%% or 0.05 (default 5%%)\n"
+            "  --max-slowdown P%%   the smallest slowdown that counts (default 5%%); percentages\n"
+            "                      take their sign: 5 alone is refused\n"
             "  --max-reruns N      at most N extra runs (ab: pairs) for noisy runs, unclear\n"
             "                      verdicts and confirming a regression (default 10)\n"
             "  --fail-inconclusive exit 3 when still too noisy to tell (default: exit 0 with a\n"
@@ -84,8 +91,8 @@ static void usage(FILE *f)
             "  --allow-mismatch    compare with a baseline of another job or device\n"
             "  --series NAME       frame_ms, gpu_ms or cpu_ms (default: frame_ms on software\n"
             "                      renderers such as llvmpipe, gpu_ms on GPUs)\n"
-            "  --confidence P      of the intervals (default 95%%)\n"
-            "  --noise-tolerance P a run left by other processes more than P more or less CPU\n"
+            "  --confidence P%%     of the intervals (default 95%%)\n"
+            "  --noise-tolerance P%% a run left by other processes more than P%% more or less CPU\n"
             "                      than the runs it is compared with is noisy and rerun\n"
             "                      (default 10%%; off: never)\n"
             "  --server-b URL      ab: the second daemon\n\n"
@@ -109,6 +116,8 @@ static void usage(FILE *f)
             "  --resume DIR        complete a fleet folder: resubmit only the missing points\n\n"
             "  --timeout S         give up waiting after S seconds\n"
             "  --quiet             no progress or verdict lines on stderr\n\n"
+            "On a terminal the verdicts are in colour (not with NO_COLOR set) and a bar shows\n"
+            "each job's progress; a pipe gets plain lines, stdout line-buffered.\n\n"
             "Exit status: 0 pass, 1 regression or quality failure (or a failed job),\n"
             "2 usage, server or baseline-mismatch error, 3 a timing verdict too noisy to\n"
             "reach with --fail-inconclusive (and nothing failed).\n");
@@ -140,15 +149,21 @@ static void key_value(const char *arg, const char *flag, json_t *into)
     json_object_set_new(into, key, json_string(eq + 1));
 }
 
-static double fraction(const char *arg, const char *flag, double lo, double hi)
+/* A percentage option: a number with its percent sign ("5%", "2.5%"),
+ * returned as a fraction. A bare number is refused, whatever its size:
+ * "5" could mean 5% or 500% and "0.05" 0.05% or 5%, and a gate that reads
+ * the wrong one passes everything (a slowdown over 500% is ruled out). */
+static double percentage(const char *arg, const char *flag, double lo, double hi)
 {
     char *end;
     double v = strtod(arg, &end);
-    if (*end == '%')
-        v /= 100.0, end++;
-    if (end == arg || *end || !(v >= lo && v <= hi))
-        die_usage("%s must be like 5%% or 0.05 (from %g to %g)", flag, lo, hi);
-    return v;
+    if (end != arg && !*end && isfinite(v))
+        die_usage("%s takes a percentage with its sign: %s%%, not %s (a bare number could be a "
+                  "fraction or a percentage)", flag, v > 0 && v < 1 ? "e.g. 5" : arg, arg);
+    if (end == arg || *end != '%' || end[1] || !(v / 100.0 >= lo && v / 100.0 <= hi))
+        die_usage("%s takes a percentage from %g%% to %g%%, e.g. 5%%; got \"%s\"", flag, 100 * lo,
+                  100 * hi, arg);
+    return v / 100.0;
 }
 
 static int count(const char *arg, const char *flag, int lo, int hi)
@@ -196,10 +211,15 @@ static void die_option(const struct option *longopts, const char *arg, bool miss
 
 int main(int argc, char **argv)
 {
+    /* One line at a time into a pipe too: a CI log that takes stdout and
+     * stderr together must not see a table row split by a log line. */
+    setvbuf(stdout, NULL, _IOLBF, 0);
     struct options o = {.max_slowdown = 0.05, .min_ssim = NAN, .max_flip = NAN,
-                        .confidence = 0.95, .noise_tolerance = 0.10, .max_reruns = 10};
+                        .confidence = 0.95, .noise_tolerance = NOISE_TOLERANCE,
+                        .max_reruns = 10};
     o.labels = json_object();
     o.filters = json_object();
+    o.channels = json_array();
     const char *env_server = getenv("SHADEBENCH_SERVER");
     const char *server = env_server && *env_server ? env_server : "http://127.0.0.1:8460";
     const char *server_b = NULL;
@@ -209,7 +229,7 @@ int main(int argc, char **argv)
            O_RERUNS, O_FAIL_INC, O_ALLOW, O_CONFIDENCE, O_NOISE, O_LABEL, O_FILTER, O_SINCE,
            O_FIGURE, O_SERVER_B, O_NO_FAIL_INC, O_JSON, O_SLURM, O_DEVICES, O_CONSTRAINT,
            O_PARTITION, O_GRES, O_MAX_PARALLEL, O_TIME_LIMIT, O_REQUEUE, O_SHADEBENCHD,
-           O_RESUME };
+           O_RESUME, O_CHANNEL };
     static const struct option longopts[] = {
         {"server", required_argument, NULL, O_SERVER},
         {"token", required_argument, NULL, O_TOKEN},
@@ -249,6 +269,7 @@ int main(int argc, char **argv)
         {"requeue", no_argument, NULL, O_REQUEUE},
         {"shadebenchd", required_argument, NULL, O_SHADEBENCHD},
         {"resume", required_argument, NULL, O_RESUME},
+        {"channel", required_argument, NULL, O_CHANNEL},
         {NULL, 0, NULL, 0},
     };
     /* CI sets the default once for every command; the flags override it. */
@@ -277,11 +298,11 @@ int main(int argc, char **argv)
                 die_usage("--max-flip must be a number from 0 to 1");
             break;
         case O_BASELINE: o.baseline = optarg; break;
-        case O_SLOWDOWN: o.max_slowdown = fraction(optarg, "--max-slowdown", 0, 100); break;
-        case O_CONFIDENCE: o.confidence = fraction(optarg, "--confidence", 0.5, 0.999); break;
+        case O_SLOWDOWN: o.max_slowdown = percentage(optarg, "--max-slowdown", 0, 100); break;
+        case O_CONFIDENCE: o.confidence = percentage(optarg, "--confidence", 0.5, 0.999); break;
         case O_NOISE:
             o.noise_tolerance = !strcmp(optarg, "off") ? INFINITY
-                                : fraction(optarg, "--noise-tolerance", 0, 100);
+                                : percentage(optarg, "--noise-tolerance", 0, 100);
             break;
         case O_RUNS: o.runs = count(optarg, "--runs", 1, 100); break;
         case O_RERUNS: o.max_reruns = count(optarg, "--max-reruns", 0, 1000); break;
@@ -298,6 +319,7 @@ int main(int argc, char **argv)
         case O_REQUEUE: o.fleet.requeue = true; break;
         case O_SHADEBENCHD: o.fleet.shadebenchd = optarg; break;
         case O_RESUME: o.fleet.resume = optarg; break;
+        case O_CHANNEL: json_array_append_new(o.channels, json_string(optarg)); break;
         case O_ALLOW: o.allow_mismatch = true; break;
         case O_LABEL: key_value(optarg, "--label", o.labels); break;
         case O_FILTER: key_value(optarg, "--filter", o.filters); break;
@@ -337,7 +359,7 @@ int main(int argc, char **argv)
         int min, max;
     } commands[] = {
         {"submit", 1, 1}, {"status", 1, 1}, {"cancel", 1, 1}, {"fetch", 1, 1}, {"list", 0, 0},
-        {"info", 0, 0},   {"ab", 1, 2},     {"sweep", 0, 1},  {"history", 0, 0},
+        {"info", 0, 0},   {"ab", 1, 2},     {"sweep", 0, 1},  {"history", 0, 0}, {"fidelity", 1, 2},
         {"gather", 1, 64}, {"compare-devices", 1, 1}, {"plan", 1, 1},
     };
     size_t k = 0;
@@ -383,6 +405,10 @@ int main(int argc, char **argv)
         die_usage("--filter, --since and --figure belong to history");
     if (raw_json && strcmp(cmd, "info") != 0)
         die_usage("--json belongs to info");
+    if ((!isnan(o.min_ssim) || !isnan(o.max_flip)) && strcmp(cmd, "submit") != 0 &&
+        strcmp(cmd, "fetch") != 0 && (strcmp(cmd, "sweep") != 0 || fl->slurm))
+        die_usage("--min-ssim and --max-flip judge captures against a reference: they belong to "
+                  "submit, fetch and sweep");
 
     /* The token: a file or the environment, so that it need not show in
      * the process list; --token still works, with a warning. */
@@ -436,6 +462,8 @@ int main(int argc, char **argv)
         rc = cmd_plan(&o, arg);
     else if (!strcmp(cmd, "compare-devices"))
         rc = cmd_compare_devices(&o, arg);
+    else if (!strcmp(cmd, "fidelity"))
+        rc = cmd_fidelity(&c, &o, arg, nargs == 2 ? argv[optind + 2] : NULL);
     else
         rc = cmd_history(&c, &o);
     conn_finish(&c);
@@ -444,5 +472,6 @@ int main(int argc, char **argv)
     free(token_text);
     json_decref(o.labels);
     json_decref(o.filters);
+    json_decref(o.channels);
     return rc;
 }

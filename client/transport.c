@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "client/client.h"
+#include "client/term.h"
 #include "common/fsutil.h"
 
 bool conn_init(struct conn *c, const char *server, const char *token)
@@ -156,7 +157,7 @@ json_t *conn_follow_job(struct conn *c, const char *id, const char *what, bool q
 {
     char path[256];
     snprintf(path, sizeof(path), "/v1/jobs/%s?wait=2", id);
-    bool tty = isatty(STDERR_FILENO);
+    bool tty = term_is_tty(stderr), drawn = false;
     double start = clock_mono_s(), first_running = 0, last_line = 0;
     int first_frames = 0;
     char last_phase[32] = "";
@@ -168,8 +169,12 @@ json_t *conn_follow_job(struct conn *c, const char *id, const char *what, bool q
         const char *status = json_string_value(json_object_get(job, "status"));
         status = status ? status : "?";
         if (strcmp(status, "queued") != 0 && strcmp(status, "running") != 0) {
-            if (tty && !quiet)
-                fputc('\n', stderr);
+            /* The bar goes: the line that reports the run takes its place,
+             * rather than a bar frozen at its last poll above it. */
+            if (tty && !quiet && drawn) {
+                fputs(TERM_CLEAR_LINE, stderr);
+                fflush(stderr);
+            }
             return job;
         }
         json_t *progress = json_object_get(job, "progress");
@@ -189,10 +194,11 @@ json_t *conn_follow_job(struct conn *c, const char *id, const char *what, bool q
             snprintf(eta, sizeof(eta), "ETA %.0f s", (total - done) / rate);
         if (!quiet && tty) {
             int width = 30, fill = total > 0 ? (int)((double)done / total * width) : 0;
-            fprintf(stderr, "\r%s [%.*s%*s] %d/%d frames %3d%%  %-12s %-10s", what, fill,
-                    "##############################", width - fill, "", done, total,
+            fprintf(stderr, TERM_CLEAR_LINE "%s [%.*s%*s] %d/%d frames %3d%%  %-12s %-10s", what,
+                    fill, "##############################", width - fill, "", done, total,
                     total > 0 ? 100 * done / total : 0, eta, phase);
             fflush(stderr);
+            drawn = true;
         } else if (!quiet && (t - last_line >= 5 || strcmp(phase, last_phase) != 0)) {
             fprintf(stderr, "%s: %s, %d/%d frames%s%s\n", what, phase, done, total,
                     eta[0] ? ", " : "", eta);
@@ -201,6 +207,8 @@ json_t *conn_follow_job(struct conn *c, const char *id, const char *what, bool q
         snprintf(last_phase, sizeof(last_phase), "%s", phase);
         json_decref(job);
         if (timeout_s > 0 && t - start > timeout_s) {
+            if (drawn)
+                fputs(TERM_CLEAR_LINE, stderr);
             fprintf(stderr, "shadebench: job %s did not end within %.0f s\n", id, timeout_s);
             return NULL;
         }

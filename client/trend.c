@@ -1,5 +1,6 @@
 #define _POSIX_C_SOURCE 200809L
 #include "client/trend.h"
+#include "common/axis.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -62,12 +63,6 @@ static void escaped(struct out *o, const char *s)
 }
 
 bool trend_log_axis(double lo, double hi) { return lo > 0 && hi / lo > 10.0; }
-
-static double tick_step(double span)
-{
-    double raw = span / 6.0, mag = pow(10.0, floor(log10(raw))), f = raw / mag;
-    return (f < 1.5 ? 1 : f < 3 ? 2 : f < 7 ? 5 : 10) * mag;
-}
 
 int trend_time_ticks(double tmin, double tmax, double *ticks, char (*labels)[24], int cap,
                      double *step)
@@ -201,7 +196,7 @@ char *trend_svg(const struct trend_point *pts, size_t n, const char *title, cons
                     x0, x1, MAPY(v), MAPY(v), x0 - 8, MAPY(v) + 4, v);
             }
     } else {
-        double step = tick_step(yhi - ylo);
+        double step = axis_tick_step(yhi - ylo);
         for (double v = ceil(ylo / step) * step; v <= yhi; v += step)
             add(&o, "<line x1=\"%g\" x2=\"%g\" y1=\"%.1f\" y2=\"%.1f\" stroke=\"#e0e0e0\"/>"
                     "<text x=\"%g\" y=\"%.1f\" font-size=\"12\" text-anchor=\"end\">%g</text>\n",

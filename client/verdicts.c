@@ -8,6 +8,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "client/term.h"
 #include "common/fsutil.h"
 #include "common/result_keys.h"
 
@@ -45,9 +46,10 @@ void quality_cases(const struct options *o, const json_t *result, const char *cl
         json_t *m = json_object_get(capture, "metrics");
         if (!m) {
             if (!isnan(o->min_ssim) || !isnan(o->max_flip))
-                junit_fail(t, "no metrics: submit the job with a \"reference\" technique");
+                junit_fail(t, JUNIT_QUALITY, "no metrics: submit the job with a \"reference\" "
+                           "technique");
             else
-                junit_out(t, "no reference technique: nothing judged");
+                junit_skip(t, "SKIP", "no reference technique: nothing judged");
             continue;
         }
         t->time_s = json_number_value(json_object_get(json_object_get(m, "timing_ms"), "total")) / 1e3;
@@ -55,14 +57,14 @@ void quality_cases(const struct options *o, const json_t *result, const char *cl
         json_t *ssim = json_object_get(m, "ssim");
         json_t *flip = json_object_get(json_object_get(m, "flip"), "mean");
         if (pdiff && !json_is_true(json_object_get(pdiff, "pass")))
-            junit_fail(t, "PerceptualDiff failed: %lld pixels at %g degrees",
+            junit_fail(t, JUNIT_QUALITY, "PerceptualDiff failed: %lld pixels at %g degrees",
                        (long long)json_integer_value(json_object_get(pdiff, "failing_pixels")),
                        json_number_value(json_object_get(pdiff, "fov")));
         if (!isnan(o->min_ssim) && (!ssim || json_number_value(ssim) < o->min_ssim))
-            junit_fail(t, "SSIM %.6f below %.6f", ssim ? json_number_value(ssim) : 0.0,
+            junit_fail(t, JUNIT_QUALITY, "SSIM %.6f below %.6f", ssim ? json_number_value(ssim) : 0.0,
                        o->min_ssim);
         if (!isnan(o->max_flip) && (!flip || json_number_value(flip) > o->max_flip))
-            junit_fail(t, "FLIP mean %.6f above %.6f", flip ? json_number_value(flip) : 1.0,
+            junit_fail(t, JUNIT_QUALITY, "FLIP mean %.6f above %.6f", flip ? json_number_value(flip) : 1.0,
                        o->max_flip);
         if (ssim)
             junit_prop_num(t, "ssim", json_number_value(ssim));
@@ -94,7 +96,7 @@ struct junit_case *job_case(struct junit *j, const char *classname, const char *
     junit_prop_str(t, "job", id);
     if (!status || strcmp(status, "done") != 0) {
         const char *error = json_string_value(json_object_get(job, "error"));
-        junit_fail(t, "job %s %s: %s", id ? id : "?", status ? status : "unknown",
+        junit_fail(t, JUNIT_JOB_FAILED, "job %s %s: %s", id ? id : "?", status ? status : "unknown",
                    error ? error : "");
         return t;
     }
@@ -156,7 +158,7 @@ bool run_set_add(struct run_set *s, const struct options *o, const char *text,
     json_t *reply = conn_json(s->conn, "POST", "/v1/jobs", text, NULL);
     if (!reply)
         return false;
-    char id[64], path[128], what[96];
+    char id[64], path[128], what[128];
     snprintf(id, sizeof(id), "%s", json_string_value(json_object_get(reply, "id")) ?
                                        json_string_value(json_object_get(reply, "id")) : "");
     json_decref(reply);
@@ -165,7 +167,7 @@ bool run_set_add(struct run_set *s, const struct options *o, const char *text,
     snprintf(path, sizeof(path), "/v1/jobs/%s", id);
     /* A terminal gets the progress bar; a CI log gets one line a run, at
      * its end, instead of progress lines that would bury it. */
-    bool bar = !o->quiet && isatty(STDERR_FILENO);
+    bool bar = !o->quiet && term_is_tty(stderr);
     if (check) {
         json_t *queued = conn_json(s->conn, "GET", path, NULL, NULL);
         bool ok = queued && check(json_object_get(queued, "spec"), ctx);
@@ -175,7 +177,12 @@ bool run_set_add(struct run_set *s, const struct options *o, const char *text,
             return false;
         }
     }
-    snprintf(what, sizeof(what), "%s %zu %s", s->what, s->n + 1, id);
+    /* "run 7 of up to 15": where this run stands in what may be run. */
+    if (s->planned)
+        snprintf(what, sizeof(what), "%s %zu of up to %zu, job %s", s->what, s->n + 1,
+                 s->planned + (size_t)(s->budget > 0 ? s->budget : 0), id);
+    else
+        snprintf(what, sizeof(what), "%s %zu, job %s", s->what, s->n + 1, id);
     json_t *job = conn_follow_job(s->conn, id, what, !bar, o->timeout_s);
     if (!job)
         return false;
@@ -220,8 +227,8 @@ void run_set_line(const struct run_set *s, size_t i, const char *series, char *o
     if (used < 0 || (size_t)used >= cap)
         return;
     if (r->has_share)
-        used += snprintf(out + used, cap - (size_t)used, ", others took %.0f%% of the CPU",
-                         100 * r->other_share);
+        used += snprintf(out + used, cap - (size_t)used, ", others took %.0f%% of the CPU%s",
+                         100 * r->other_share, r->noisy_alone ? " (noisy on its own)" : "");
     else if (r->daemon_noisy)
         used += snprintf(out + used, cap - (size_t)used, ", flagged noisy by the daemon");
     if ((size_t)used < cap && r->elapsed_s > 0)
@@ -283,11 +290,13 @@ void run_set_print(const struct run_set *s, const char *series, FILE *f)
 int junit_conclude(const struct options *o, struct junit *j, const char *suite, double time_s)
 {
     size_t failed = junit_real_failures(j), undecided = junit_undecided(j);
+    size_t nothing = junit_judged_nothing(j);
     int rc = failed ? EXIT_FAIL : undecided && o->fail_inconclusive ? EXIT_INCONCLUSIVE : EXIT_PASS;
     if (!o->quiet) {
-        junit_print(j, stderr);
-        fprintf(stderr, "%zu checks: %zu passed, %zu failed, %zu inconclusive\n", j->count,
-                j->count - failed - undecided, failed, undecided);
+        junit_print(j, stderr, term_color(stderr));
+        fprintf(stderr, "%zu checks: %zu passed, %zu failed, %zu inconclusive, %zu judged "
+                "nothing\n", j->count, j->count - failed - undecided - nothing, failed, undecided,
+                nothing);
         if (undecided && !failed)
             fprintf(stderr, "shadebench: warning: %zu check%s could not decide (too noisy to "
                     "tell); %s\n", undecided, undecided == 1 ? "" : "s",
@@ -295,6 +304,10 @@ int junit_conclude(const struct options *o, struct junit *j, const char *suite, 
                         ? "exit status 3 (--fail-inconclusive or SHADEBENCH_FAIL_INCONCLUSIVE=1)"
                         : "exit status 0, but not a pass: JUnit marks it skipped "
                           "(--fail-inconclusive or SHADEBENCH_FAIL_INCONCLUSIVE=1 exits 3)");
+        if (nothing)
+            fprintf(stderr, "shadebench: warning: %zu check%s judged nothing (JUnit marks %s "
+                    "skipped, not passed)\n", nothing, nothing == 1 ? "" : "s",
+                    nothing == 1 ? "it" : "them");
     }
     if (o->junit && !junit_write(j, o->junit, suite, time_s)) {
         fprintf(stderr, "shadebench: cannot write %s\n", o->junit);

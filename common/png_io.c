@@ -99,6 +99,9 @@ bool png_write_gl_rgba(const char *path, const uint8_t *rgba, int width,
     return png_write_by_rows(path, width, height, gl_row, &g, err, errlen);
 }
 
+static bool read_stream(FILE *f, const char *path, long long max_pixels, bool keep_alpha,
+                        struct image *out, char *err, size_t errlen);
+
 bool png_read_rgb_limit(const char *path, long long max_pixels, struct image *out, char *err,
                         size_t errlen)
 {
@@ -115,6 +118,44 @@ bool png_read_rgb_limit(const char *path, long long max_pixels, struct image *ou
 
 bool png_read_rgb_stream(FILE *f, const char *path, long long max_pixels, struct image *out,
                          char *err, size_t errlen)
+{
+    return read_stream(f, path, max_pixels, false, out, err, errlen);
+}
+
+bool png_read_rgba(const char *path, struct image *out, char *err, size_t errlen)
+{
+    memset(out, 0, sizeof(*out));
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, errlen, "%s: cannot open", path);
+        return false;
+    }
+    bool ok = read_stream(f, path, IMAGE_MAX_PIXELS, true, out, err, errlen);
+    fclose(f);
+    return ok;
+}
+
+/* Splits RGBA pixels, in place, into RGB (the buffer's first 3 n bytes) and
+ * alpha: pixel i's colour moves to 3 i, at or before where it was (4 i), so
+ * that no pixel is overwritten before it is read. Returns the alpha plane,
+ * or NULL when every pixel is opaque (or out of memory: *oom set). */
+static uint8_t *split_alpha(uint8_t *rgba, size_t n, bool *oom)
+{
+    bool opaque = true;
+    for (size_t i = 0; i < n && opaque; i++)
+        opaque = rgba[4 * i + 3] == 255;
+    uint8_t *alpha = opaque ? NULL : malloc(n ? n : 1);
+    *oom = !opaque && !alpha;
+    for (size_t i = 0; i < n; i++) {
+        if (alpha)
+            alpha[i] = rgba[4 * i + 3];
+        memmove(rgba + 3 * i, rgba + 4 * i, 3);
+    }
+    return alpha;
+}
+
+static bool read_stream(FILE *f, const char *path, long long max_pixels, bool keep_alpha,
+                        struct image *out, char *err, size_t errlen)
 {
     memset(out, 0, sizeof(*out));
     struct png_errors perr = {""};
@@ -145,20 +186,33 @@ bool png_read_rgb_stream(FILE *f, const char *path, long long max_pixels, struct
                  (unsigned)w, (unsigned)h, (long long)w * (long long)h, max_pixels);
         goto fail;
     }
-    if (type == PNG_COLOR_TYPE_RGBA)
+    bool rgba = type == PNG_COLOR_TYPE_RGBA && keep_alpha;
+    if (type == PNG_COLOR_TYPE_RGBA && !keep_alpha)
         png_set_strip_alpha(png);
     png_set_interlace_handling(png);
     png_read_update_info(png, info);
+    size_t channels = rgba ? 4 : 3;
     rows = malloc((size_t)h * sizeof(*rows));
-    out->rgb = malloc((size_t)w * (size_t)h * 3);
+    out->rgb = malloc((size_t)w * (size_t)h * channels);
     if (!rows || !out->rgb) {
         snprintf(err, errlen, "%s: out of memory", path);
         goto fail;
     }
     for (png_uint_32 y = 0; y < h; y++)
-        rows[y] = out->rgb + (size_t)y * (size_t)w * 3;
+        rows[y] = out->rgb + (size_t)y * (size_t)w * channels;
     png_read_image(png, rows);
     png_read_end(png, NULL);
+    if (rgba) {
+        bool oom;
+        out->alpha = split_alpha(out->rgb, (size_t)w * (size_t)h, &oom);
+        uint8_t *shrunk = realloc(out->rgb, (size_t)w * (size_t)h * 3 + 1);
+        if (shrunk)
+            out->rgb = shrunk;
+        if (oom) {
+            snprintf(err, errlen, "%s: out of memory", path);
+            goto fail;
+        }
+    }
     out->width = (int)w;
     out->height = (int)h;
     png_destroy_read_struct(&png, &info, NULL);
@@ -181,6 +235,7 @@ void image_finish(struct image *img)
     if (!img)
         return;
     free(img->rgb);
+    free(img->alpha);
     memset(img, 0, sizeof(*img));
 }
 

@@ -10,7 +10,10 @@
 
 struct image {
     int width, height;
-    uint8_t *rgb; /* width * height * 3, top row first */
+    uint8_t *rgb;   /* width * height * 3, top row first */
+    uint8_t *alpha; /* width * height straight (not premultiplied) alpha, top row
+                       first, or NULL: opaque. Only png_read_rgba keeps it; the
+                       daemon's frames are opaque. */
 };
 
 /* Writes an 8-bit RGB PNG from RGBA pixels as glReadPixels returns them
@@ -38,6 +41,10 @@ bool png_read_rgb(const char *path, struct image *out, char *err, size_t errlen)
 /* The same from an open stream (left open); path only names it in errors. */
 bool png_read_rgb_stream(FILE *f, const char *path, long long max_pixels, struct image *out,
                          char *err, size_t errlen);
+/* The same, keeping an RGBA PNG's alpha in img->alpha (NULL when every
+ * pixel is opaque), for shadebench-compare: the metrics judge a translucent
+ * image as perceptualdiff does, premultiplied by its alpha. */
+bool png_read_rgba(const char *path, struct image *out, char *err, size_t errlen);
 void image_finish(struct image *img);
 
 /* Encodes img, shrunk by a box filter to at most max_width pixels wide, as a

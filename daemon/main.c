@@ -20,14 +20,15 @@
 #include "daemon/gpu/egl.h"
 #include "common/fsutil.h"
 #include "common/clock.h"
-#include "daemon/jobs/records.h"
+#include "daemon/store/records.h"
 #include "daemon/api/http.h"
-#include "daemon/harness/telemetry.h"
-#include "daemon/jobs/job_cost.h"
-#include "daemon/jobs/job_spec.h"
+#include "daemon/status/telemetry.h"
+#include "daemon/spec/job_cost.h"
+#include "daemon/spec/job_spec.h"
 #include "common/log.h"
 #include "daemon/jobs/queue.h"
 #include "daemon/harness/runner.h"
+#include "daemon/jobs/fidelity.h"
 #include "daemon/service.h"
 #include "daemon/jobs/sweeps.h"
 #include "daemon/jobs/assets.h"
@@ -55,6 +56,10 @@ struct options {
     char asset_dir[1024];      /* --asset-dir: read-only assets; "": none */
     char asset_converter[1024]; /* --asset-converter; "": shadebench-asset beside the daemon */
     double max_asset_bytes;     /* --max-asset-bytes; 0: ASSETS_MAX_BYTES_DEFAULT */
+    /* The Khronos reference (fidelity jobs; daemon/jobs/fidelity.h):
+     * "": the usual places. */
+    char chromium[1024], reference_viewer[1024];
+    double reference_timeout, reference_memory_mib; /* 0: the defaults */
     bool list_devices;
     bool gl_debug;
 };
@@ -112,6 +117,15 @@ static void usage(FILE *f)
             "  --asset-converter PATH\n"
             "                       the glTF converter (default: shadebench-asset beside this\n"
             "                       executable)\n"
+            "  --chromium PATH      Chromium for the Khronos reference (default: chromium or\n"
+            "                       chromium-browser on PATH)\n"
+            "  --reference-viewer DIR\n"
+            "                       the vendored Khronos glTF Sample Viewer (default:\n"
+            "                       reference-viewer beside this executable, else\n"
+            "                       ../share/shadebench/reference-viewer)\n"
+            "  --reference-timeout S  wall clock the reference may take (default 300)\n"
+            "  --reference-memory MIB resident memory of Chromium and its helpers\n"
+            "                       (default 4096)\n"
             "  --config FILE        settings file (default " DEFAULT_CONFIG " if present)\n"
             "  --port-file FILE     write the bound port to FILE once listening\n"
             "  --list-devices       print the EGL devices and exit\n"
@@ -125,14 +139,16 @@ static void usage(FILE *f)
             "\"key = value\": listen, state-dir, device, queue-size, token, keep-jobs,\n"
             "keep-days, job-timeout, max-job-seconds, stall-seconds, memory-budget,\n"
             "max-connections, max-connections-per-ip, max-asset-bytes, asset-dir,\n"
-            "asset-converter, log-level), the environment\n"
+            "asset-converter, chromium, reference-viewer, reference-timeout,\n"
+            "reference-memory, log-level), the environment\n"
             "(SHADEBENCH_LISTEN, SHADEBENCH_STATE_DIR, SHADEBENCH_DEVICE,\n"
             "SHADEBENCH_QUEUE_SIZE, SHADEBENCH_TOKEN_FILE, SHADEBENCH_KEEP_JOBS,\n"
             "SHADEBENCH_KEEP_DAYS, SHADEBENCH_JOB_TIMEOUT, SHADEBENCH_MAX_JOB_SECONDS,\n"
             "SHADEBENCH_STALL_SECONDS, SHADEBENCH_MEMORY_BUDGET,\n"
             "SHADEBENCH_MAX_CONNECTIONS, SHADEBENCH_MAX_CONNECTIONS_PER_IP,\n"
             "SHADEBENCH_MAX_ASSET_BYTES, SHADEBENCH_ASSET_DIR, SHADEBENCH_ASSET_CONVERTER,\n"
-            "SHADEBENCH_LOG_LEVEL), the flags.\n");
+            "SHADEBENCH_CHROMIUM, SHADEBENCH_REFERENCE_VIEWER, SHADEBENCH_REFERENCE_TIMEOUT,\n"
+            "SHADEBENCH_REFERENCE_MEMORY, SHADEBENCH_LOG_LEVEL), the flags.\n");
 }
 
 static bool parse_int(const char *s, int min, int max, int *out)
@@ -204,6 +220,16 @@ static bool apply_setting(struct options *o, const char *key, const char *value,
         snprintf(o->asset_dir, sizeof(o->asset_dir), "%s", value);
     } else if (strcmp(key, "asset-converter") == 0) {
         snprintf(o->asset_converter, sizeof(o->asset_converter), "%s", value);
+    } else if (strcmp(key, "chromium") == 0) {
+        snprintf(o->chromium, sizeof(o->chromium), "%s", value);
+    } else if (strcmp(key, "reference-viewer") == 0) {
+        snprintf(o->reference_viewer, sizeof(o->reference_viewer), "%s", value);
+    } else if (strcmp(key, "reference-timeout") == 0) {
+        if (!parse_number(value, 1, 86400, &o->reference_timeout))
+            rule = "must be a number of seconds from 1 to 86400";
+    } else if (strcmp(key, "reference-memory") == 0) {
+        if (!parse_number(value, 64, 1e7, &o->reference_memory_mib))
+            rule = "must be a number of MiB from 64 to 10000000";
     } else if (strcmp(key, "log-level") == 0) {
         static const char *const levels[] = {"debug", "info", "warn", "error"};
         rule = "must be debug, info, warn or error";
@@ -265,7 +291,9 @@ static bool load_environment(struct options *o)
                                        "token-file", "keep-jobs", "keep-days", "job-timeout",
                                        "max-job-seconds", "stall-seconds", "memory-budget", "max-connections",
                                        "max-connections-per-ip", "max-asset-bytes", "asset-dir",
-                                       "asset-converter", "log-level", NULL};
+                                       "asset-converter", "chromium", "reference-viewer",
+                                       "reference-timeout", "reference-memory", "log-level",
+                                       NULL};
     for (const char *const *k = keys; *k; k++) {
         char name[64] = "SHADEBENCH_";
         size_t n = strlen(name);
@@ -634,16 +662,22 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
     signal(SIGPIPE, SIG_IGN);
 
     char err[PATH_MAX + 300];
+    int rc = 1;
+    struct queue *q = NULL;
+    struct runner *r = NULL;
+    struct fidelity *fidelity = NULL;
+    struct assets *assets = NULL;
+    struct sweeps *sweeps = NULL;
+    struct http_server *http = NULL;
     struct store *store = store_open(state_dir, err, sizeof(err));
     if (!store) {
         LOG(LOG_ERROR, "%s", err);
         return 1;
     }
-    struct queue *q = queue_create(store, o->queue_size);
+    q = queue_create(store, o->queue_size);
     if (!q) {
         LOG(LOG_ERROR, "out of memory");
-        store_close(store);
-        return 1;
+        goto out;
     }
     queue_set_retention(q, o->keep_jobs, o->keep_days);
     /* Earlier jobs first: finished ones are served from the store, queued
@@ -651,28 +685,32 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
     int loaded = queue_load(q, catalog, err, sizeof(err));
     if (loaded < 0) {
         LOG(LOG_ERROR, "%s", err);
-        queue_destroy(q);
-        store_close(store);
-        return 1;
+        goto out;
     }
     if (loaded > 0)
         LOG(LOG_INFO, "%d job(s) in %s/%s", loaded, state_dir, STORE_FILE);
-    struct runner *r = runner_create(q, o->device, o->gl_debug, err, sizeof(err));
+    /* Before the render thread: it hands fidelity jobs to this worker. */
+    const struct fidelity_config fcfg = {
+        .state_dir = state_dir, .chromium = o->chromium, .viewer_dir = o->reference_viewer,
+        .timeout_s = o->reference_timeout,
+        .memory_bytes = (uint64_t)(o->reference_memory_mib * 1048576.0)};
+    fidelity = fidelity_create(&fcfg, q);
+    if (!fidelity) {
+        LOG(LOG_ERROR, "cannot start the fidelity worker");
+        goto out;
+    }
+    runner_use_fidelity(fidelity);
+    r = runner_create(q, o->device, o->gl_debug, err, sizeof(err));
     if (!r) {
         LOG(LOG_ERROR, "%s", err);
-        queue_destroy(q);
-        store_close(store);
-        return 1;
+        goto out;
     }
     pin_loaded_modules();
     set_max_msaa(r);
     double budget, driver;
     if (!set_memory_budget(o, &limits, &budget, &driver, err, sizeof(err))) {
         LOG(LOG_ERROR, "%s", err);
-        runner_destroy(r);
-        queue_destroy(q);
-        store_close(store);
-        return 1;
+        goto out;
     }
     /* After queue_load: a queued job's pinned asset keeps its files. */
     struct assets_config acfg = {.state_dir = state_dir, .asset_dir = o->asset_dir,
@@ -683,33 +721,27 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
     asset_limits_defaults(&acfg.limits);
     acfg.limits.max_file_bytes = acfg.max_asset_bytes;
     asset_run_limits_defaults(&acfg.run);
-    struct assets *assets = assets_create(&acfg, store, q, err, sizeof(err));
+    assets = assets_create(&acfg, store, q, err, sizeof(err));
     if (!assets) {
         LOG(LOG_ERROR, "%s", err);
-        runner_destroy(r);
-        queue_destroy(q);
-        store_close(store);
-        return 1;
+        goto out;
     }
     queue_set_asset_resolver(q, assets_queue_resolver, assets);
-    struct sweeps *sweeps = sweeps_create(q, catalog);
+    sweeps = sweeps_create(q, catalog);
+    if (!sweeps) {
+        LOG(LOG_ERROR, "cannot start the sweep thread");
+        goto out;
+    }
     const struct http_context http_ctx = {.catalog = catalog, .queue = q, .sweeps = sweeps,
-                                          .assets = assets,
+                                          .assets = assets, .fidelity = fidelity,
                                           .render_state = render_state,
                                           .device_json = render_device_json, .render = r,
                                           .stall_s = o->stall_s, .memory_budget_bytes = budget,
                                           .driver_bytes = driver};
-    struct http_server *http =
-        sweeps ? http_server_create(o->listen, &limits, &http_ctx, err, sizeof(err)) : NULL;
+    http = http_server_create(o->listen, &limits, &http_ctx, err, sizeof(err));
     if (!http) {
-        LOG(LOG_ERROR, "%s", sweeps ? err : "cannot start the sweep thread");
-        sweeps_destroy(sweeps);
-        queue_set_asset_resolver(q, NULL, NULL);
-        assets_destroy(assets);
-        runner_destroy(r);
-        queue_destroy(q);
-        store_close(store);
-        return 1;
+        LOG(LOG_ERROR, "%s", err);
+        goto out;
     }
     LOG(LOG_INFO, "shadebenchd %s listening on %s (port %d), state in %s", PACKAGE_VERSION,
         o->listen, http_server_port(http), state_dir);
@@ -737,22 +769,27 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
     }
     LOG(LOG_INFO, "signal %d: stopping", sig);
     service_stopping();
+    rc = 0;
+out:
     http_server_destroy(http);
     sweeps_destroy(sweeps);
-    queue_set_asset_resolver(q, NULL, NULL);
+    if (assets)
+        queue_set_asset_resolver(q, NULL, NULL);
     assets_destroy(assets);
-    /* Within a few seconds whatever runs (systemd's stop timeout is longer):
-     * the running job is back in the queue once the render thread stops
-     * it, and a frame still draining on the GPU is not waited for. */
-    if (!runner_stop(r, STOP_RENDER_WAIT_S)) {
+    /* A stop (not a failed start): within a few seconds whatever runs
+     * (systemd's stop timeout is longer): the running job is back in the
+     * queue once the render thread stops it, and a frame still draining on
+     * the GPU is not waited for. */
+    if (rc == 0 && !runner_stop(r, STOP_RENDER_WAIT_S)) {
         LOG(LOG_WARN, "the render thread is still draining GPU work after %d s; exiting without "
             "it (every job's state is stored)", STOP_RENDER_WAIT_S);
         _exit(0);
     }
     runner_destroy(r);
+    fidelity_destroy(fidelity);
     queue_destroy(q);
     store_close(store);
-    return 0;
+    return rc;
 }
 
 int main(int argc, char **argv)
@@ -779,7 +816,7 @@ int main(int argc, char **argv)
                         .keep_jobs = KEEP_JOBS_DEFAULT, .keep_days = KEEP_DAYS_DEFAULT};
     snprintf(o.listen, sizeof(o.listen), "127.0.0.1:8460");
     enum { OPT_LISTEN = 256, OPT_STATE, OPT_DEVICE, OPT_QUEUE, OPT_TOKEN, OPT_KEEP_JOBS,
-           OPT_KEEP_DAYS, OPT_JOB_TIMEOUT, OPT_MAX_JOB, OPT_STALL, OPT_MEMORY, OPT_MAX_CONN, OPT_MAX_CONN_IP, OPT_MAX_ASSET, OPT_ASSET_DIR, OPT_ASSET_CONV, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_ONCE, OPT_OUT, OPT_DEBUG,
+           OPT_KEEP_DAYS, OPT_JOB_TIMEOUT, OPT_MAX_JOB, OPT_STALL, OPT_MEMORY, OPT_MAX_CONN, OPT_MAX_CONN_IP, OPT_MAX_ASSET, OPT_ASSET_DIR, OPT_ASSET_CONV, OPT_CHROMIUM, OPT_REF_VIEWER, OPT_REF_TIMEOUT, OPT_REF_MEMORY, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_ONCE, OPT_OUT, OPT_DEBUG,
            OPT_LOG, OPT_VERSION, OPT_HELP };
     static const struct option longopts[] = {
         {"listen", required_argument, NULL, OPT_LISTEN},
@@ -798,6 +835,10 @@ int main(int argc, char **argv)
         {"max-asset-bytes", required_argument, NULL, OPT_MAX_ASSET},
         {"asset-dir", required_argument, NULL, OPT_ASSET_DIR},
         {"asset-converter", required_argument, NULL, OPT_ASSET_CONV},
+        {"chromium", required_argument, NULL, OPT_CHROMIUM},
+        {"reference-viewer", required_argument, NULL, OPT_REF_VIEWER},
+        {"reference-timeout", required_argument, NULL, OPT_REF_TIMEOUT},
+        {"reference-memory", required_argument, NULL, OPT_REF_MEMORY},
         {"config", required_argument, NULL, OPT_CONFIG},
         {"port-file", required_argument, NULL, OPT_PORT_FILE},
         {"list-devices", no_argument, NULL, OPT_LIST},
@@ -834,6 +875,10 @@ int main(int argc, char **argv)
         case OPT_MAX_ASSET: key = "max-asset-bytes"; break;
         case OPT_ASSET_DIR: key = "asset-dir"; break;
         case OPT_ASSET_CONV: key = "asset-converter"; break;
+        case OPT_CHROMIUM: key = "chromium"; break;
+        case OPT_REF_VIEWER: key = "reference-viewer"; break;
+        case OPT_REF_TIMEOUT: key = "reference-timeout"; break;
+        case OPT_REF_MEMORY: key = "reference-memory"; break;
         case OPT_LOG: key = "log-level"; break;
         case OPT_CONFIG: config = optarg; config_required = true; break;
         case OPT_PORT_FILE: o.port_file = optarg; break;

@@ -15,6 +15,7 @@ UNIT_TESTS = \
 	tests/unit/test_stats \
 	tests/unit/test_scene \
 	tests/unit/test_scene_asset \
+	tests/unit/test_scene_view \
 	tests/unit/test_osl \
 	tests/unit/test_metrics \
 	tests/unit/test_flicker \
@@ -29,6 +30,7 @@ UNIT_TESTS = \
 	tests/unit/test_http \
 	tests/unit/test_routes \
 	tests/unit/test_charts \
+	tests/unit/test_history \
 	tests/unit/test_fleet \
 	tests/unit/test_culling \
 	tests/unit/test_effects \
@@ -40,16 +42,19 @@ UNIT_TESTS = \
 	tests/unit/test_uv_overlap \
 	tests/unit/test_convert_matrices \
 	tests/unit/test_light_shape \
-	tests/unit/test_temporal
+	tests/unit/test_temporal \
+	tests/unit/test_fidelity
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
-	tests/fuzz/replay-route tests/fuzz/replay-asset_cache tests/fuzz/replay-asset_convert
+	tests/fuzz/replay-route tests/fuzz/replay-asset_cache tests/fuzz/replay-asset_convert \
+	tests/fuzz/replay-env_convert
 tests_unit_test_job_LDADD = $(CORE_LIBS)
 tests_unit_test_options_LDADD = libsb-common.a $(JANSSON_LIBS) $(LIBS)
 tests_unit_test_store_LDADD = $(CORE_LIBS)
 tests_unit_test_stats_LDADD = $(CORE_LIBS)
 tests_unit_test_scene_LDADD = $(CORE_LIBS)
 tests_unit_test_scene_asset_LDADD = $(CORE_LIBS) -lm
+tests_unit_test_scene_view_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_osl_LDADD = $(CORE_LIBS)
 tests_unit_test_light_shape_LDADD = $(CORE_LIBS)
 tests_unit_test_metrics_LDADD = $(CORE_LIBS)
@@ -58,11 +63,8 @@ tests_unit_test_sweep_LDADD = $(CORE_LIBS)
 tests_unit_test_effects_LDADD = $(CORE_LIBS)
 tests_unit_test_temporal_LDADD = $(CORE_LIBS)
 tests_unit_test_records_LDADD = $(CORE_LIBS)
-# The interference module lives with the render thread that samples it, but
-# is GL-free: its test builds it alone.
-tests_unit_test_interference_SOURCES = tests/unit/test_interference.c \
-	daemon/harness/interference.c daemon/harness/interference.h
-tests_unit_test_interference_LDADD = $(CORE_LIBS)
+tests_unit_test_interference_LDADD = libsb-status.a $(CORE_LIBS)
+tests_unit_test_fidelity_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_png_LDADD = $(CORE_LIBS)
 tests_unit_test_gate_SOURCES = tests/unit/test_gate.c $(CLIENT_PURE)
 tests_unit_test_gate_LDADD = $(CORE_LIBS) -lm
@@ -73,6 +75,8 @@ tests_unit_test_job_filter_SOURCES = tests/unit/test_job_filter.c daemon/api/job
 tests_unit_test_job_filter_LDADD = $(CORE_LIBS)
 tests_unit_test_charts_SOURCES = tests/unit/test_charts.c
 tests_unit_test_charts_LDADD = $(REPORT_LIBS)
+tests_unit_test_history_SOURCES = tests/unit/test_history.c
+tests_unit_test_history_LDADD = $(REPORT_LIBS)
 # The fleet's device view, with the client's CSV and the reports it reads.
 tests_unit_test_fleet_SOURCES = tests/unit/test_fleet.c client/fleet_view.c
 tests_unit_test_fleet_LDADD = $(REPORT_LIBS)
@@ -98,10 +102,9 @@ tests_unit_test_routes_LDADD = $(CORE_LIBS)
 # The HTTP layer without GL: the API's sources, the store and the real
 # catalogue, with the test as the render thread.
 tests_unit_test_http_SOURCES = tests/unit/test_http.c $(API_SOURCES) \
-	daemon/jobs/sweeps.c daemon/jobs/sweeps.h \
-	daemon/harness/telemetry.c daemon/harness/telemetry.h \
-	daemon/harness/render_state.c daemon/harness/render_state.h
-tests_unit_test_http_LDADD = $(REPORT_LIBS) $(MHD_LIBS)
+	daemon/jobs/sweeps.c daemon/jobs/sweeps.h
+nodist_tests_unit_test_http_SOURCES = daemon/api/ui_files.c
+tests_unit_test_http_LDADD = $(API_LIBS) $(MHD_LIBS)
 # The fuzz targets, replayed over their corpora in make check (tests/fuzz/run.sh
 # builds them with clang and libFuzzer instead).
 tests_fuzz_replay_job_SOURCES = tests/fuzz/fuzz_job.c tests/fuzz/replay.c
@@ -118,6 +121,10 @@ tests_fuzz_replay_asset_convert_SOURCES = tests/fuzz/fuzz_asset_convert.c tests/
 	$(ASSET_CONVERT_SOURCES)
 tests_fuzz_replay_asset_convert_CFLAGS = $(AM_CFLAGS) $(ASSIMP_CFLAGS) $(JPEG_CFLAGS)
 tests_fuzz_replay_asset_convert_LDADD = $(CORE_LIBS) $(ASSIMP_LIBS) $(JPEG_LIBS) -lm
+tests_fuzz_replay_env_convert_SOURCES = tests/fuzz/fuzz_env_convert.c tests/fuzz/replay.c \
+	daemon/assets/env_convert.c
+tests_fuzz_replay_env_convert_CFLAGS = $(AM_CFLAGS) $(STB_CFLAGS)
+tests_fuzz_replay_env_convert_LDADD = $(CORE_LIBS) $(STB_LIBS) -lm
 if HAVE_SECCOMP
 check_PROGRAMS += tests/tools/sandbox-run
 tests_tools_sandbox_run_SOURCES = tests/tools/sandbox_run.c
@@ -129,9 +136,11 @@ endif
 # in this order, so the short ones fill in beside the long ones instead of
 # one long test running alone at the end.
 E2E_TESTS = \
+	tests/e2e/e2e_fidelity.py \
 	tests/e2e/e2e_msaa.py \
 	tests/e2e/e2e_fleet.py \
 	tests/e2e/e2e_report.py \
+	tests/e2e/e2e_dashboard.py \
 	tests/e2e/e2e_faults.py \
 	tests/e2e/e2e_runaway.py \
 	tests/e2e/e2e_hardening.py \
@@ -141,8 +150,10 @@ E2E_TESTS = \
 	tests/e2e/e2e_textured.py \
 	tests/e2e/e2e_asset_render.py \
 	tests/e2e/e2e_asset_import.py \
+	tests/e2e/e2e_scene_view.py \
 	tests/e2e/e2e_load.py \
 	tests/e2e/e2e_osl.py \
+	tests/e2e/e2e_osl_assets.py \
 	tests/e2e/e2e_ab.py \
 	tests/e2e/e2e_sweep.py \
 	tests/e2e/e2e_records.py \
@@ -164,12 +175,19 @@ E2E_TESTS = \
 	tests/e2e/e2e_persist.py \
 	tests/e2e/ssim_skimage.py \
 	tests/e2e/e2e_history.py \
+	tests/e2e/e2e_compare_alpha.py \
+	tests/e2e/e2e_client_verdicts.py \
+	tests/e2e/e2e_demo.py \
 	tests/e2e/e2e_verdicts.py \
 	tests/e2e/e2e_asset_convert.py \
 	tests/e2e/systemd_sandbox.py \
 	tests/e2e/systemd_unit.sh
 
+# The folders' layers (docs/architecture.md), read from the includes.
+STATIC_TESTS = tests/layers.py
+
 TESTS = $(UNIT_TESTS) \
+	$(STATIC_TESTS) \
 	tests/fuzz/replay.sh \
 	$(E2E_TESTS)
 
@@ -189,7 +207,8 @@ SANITIZER_TESTS = $(UNIT_TESTS) \
 	tests/e2e/e2e_assets.py \
 	tests/e2e/e2e_persist.py \
 	tests/e2e/e2e_badinput.py \
-	tests/e2e/e2e_asset_convert.py
+	tests/e2e/e2e_asset_convert.py \
+	tests/e2e/e2e_compare_alpha.py
 check-sanitizers:
 if SANITIZERS
 	$(MAKE) $(AM_MAKEFLAGS) check TESTS='$(SANITIZER_TESTS)'

@@ -15,61 +15,16 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "config.h"
 #include "common/clock.h"
-#include "common/job_files.h"
 #include "common/log.h"
-#include "daemon/api/charts.h"
-#include "daemon/api/connections.h"
-#include "daemon/api/links.h"
-#include "daemon/api/report.h"
-#include "daemon/api/routes.h"
-#include "daemon/harness/telemetry.h"
-#include "daemon/jobs/job_cost.h"
-#include "daemon/jobs/job_spec.h"
-#include "daemon/quality/metrics.h"
-#include "daemon/api/job_filter.h"
-#include "daemon/jobs/sweep_spec.h"
+#include "daemon/api/server.h"
+#include "daemon/reports/charts.h"
+#include "daemon/spec/job_spec.h"
 #include "common/result_keys.h"
 
-#ifndef MHD_HTTP_CONTENT_TOO_LARGE
-#define MHD_HTTP_CONTENT_TOO_LARGE 413
-#endif
-#ifndef MHD_HTTP_REQUEST_HEADER_FIELDS_TOO_LARGE
-#define MHD_HTTP_REQUEST_HEADER_FIELDS_TOO_LARGE 431
-#endif
-
-enum {
-    MAX_WAIT_S = 3600,
-    /* Headers beyond this are answered 431 here, as JSON; beyond
-     * CONNECTION_MEMORY (libmicrohttpd's per-connection pool) it answers
-     * 431 itself, as HTML. */
-    MAX_HEADER_BYTES = 8192,
-    CONNECTION_MEMORY = 32 * 1024,
-    /* A DELETE of a running job waits this long for the job to stop, so
-     * that the answer usually shows its final state. */
-    CANCEL_WAIT_S = 5,
-    /* SIGTERM: how long the "stopping" answers of ended waits may take. */
-    STOP_GRACE_S = 2,
-};
-
 /* The status codes the request counters of /metrics keep apart. */
-static const unsigned COUNTED_CODES[] = {200, 201, 202, 400, 401, 403, 404, 405, 409, 413,
-                                         422, 429, 431, 500, 503, 507, 0 /* other */};
-enum { NCODES = sizeof(COUNTED_CODES) / sizeof(COUNTED_CODES[0]) };
-
-struct http_server {
-    struct MHD_Daemon *mhd;
-    struct connections *conns;
-    struct http_context ctx;
-    struct queue *queue; /* ctx.queue and ctx.sweeps, the handlers' most used */
-    struct sweeps *sweeps;
-    struct http_limits limits;
-    int port;
-    pthread_mutex_t token_lock;
-    char *token;
-    atomic_ullong requests[ROUTE_COUNT][NCODES];
-};
+const unsigned COUNTED_CODES[NCODES] = {200, 201, 202, 400, 401, 403, 404, 405, 409, 413,
+                                        422, 429, 431, 500, 503, 507, 0 /* other */};
 
 void http_limits_defaults(struct http_limits *l)
 {
@@ -118,34 +73,14 @@ bool http_server_set_token(struct http_server *s, const char *token)
     return true;
 }
 
-/* One request: the route, its body, and what a resumed wait answers. */
-struct request {
-    struct conn *conn;
-    struct route route;
-    char *body;
-    size_t len;
-    bool started;         /* the access handler has seen its headers */
-    bool too_large;
-    bool waiting;         /* suspended; the next call is the resume */
-    unsigned wait_status; /* 200 for ?wait=, 202 for a DELETE that waits */
-    /* What the raw request target showed (on_uri): a refusal to answer
-     * once the headers are in, and the query's size. */
-    const char *target_field, *target_rule;
-    size_t query_args;
-    /* PUT /v1/assets/NAME: the body streams into the upload; once it is in,
-     * the request waits (suspended) on the conversion's ticket. */
-    struct asset_upload *upload;
-    uint64_t ticket;
-};
-
 /* Set by answer_waited just before it closes the connection of a client
  * that hung up, and read by on_mhd_log, which libmicrohttpd calls at once
  * on the same thread: its "internal error" line is then the expected end
  * of a wait, not an error (2,000 waits hung up made 2,000 warnings). */
 static _Thread_local bool closing_gone_client;
 
-static enum MHD_Result respond_text(struct MHD_Connection *c, unsigned status,
-                                    char *text, size_t len, const char *type)
+enum MHD_Result respond_text(struct MHD_Connection *c, unsigned status,
+                             char *text, size_t len, const char *type)
 {
     struct MHD_Response *resp =
         MHD_create_response_from_buffer(len, text, MHD_RESPMEM_MUST_FREE);
@@ -167,7 +102,7 @@ static enum MHD_Result respond_text(struct MHD_Connection *c, unsigned status,
 
 /* Takes ownership of body. A body that cannot be built or printed still
  * gets an answer: a fixed 500. */
-static enum MHD_Result respond_json(struct MHD_Connection *c, unsigned status, json_t *body)
+enum MHD_Result respond_json(struct MHD_Connection *c, unsigned status, json_t *body)
 {
     char *text = body ? json_dumps(body, JSON_COMPACT) : NULL;
     json_decref(body);
@@ -190,22 +125,13 @@ static enum MHD_Result respond_json(struct MHD_Connection *c, unsigned status, j
     return respond_text(c, status, with_nl, len + 1, "application/json");
 }
 
-static enum MHD_Result respond_error(struct MHD_Connection *c, unsigned status,
-                                     const char *field, const char *message)
+enum MHD_Result respond_error(struct MHD_Connection *c, unsigned status,
+                              const char *field, const char *message)
 {
     struct job_error e;
     snprintf(e.field, sizeof(e.field), "%s", field);
     snprintf(e.message, sizeof(e.message), "%s", message);
     return respond_json(c, status, job_error_to_json(&e));
-}
-
-/* An asset's refusal (assets.h): its message may be longer than a job
- * error's 256 bytes (it can name a path). */
-static enum MHD_Result respond_asset_error(struct MHD_Connection *c, const struct assets_error *e)
-{
-    return respond_json(c, e->status ? e->status : MHD_HTTP_INTERNAL_SERVER_ERROR,
-                        json_pack("{s:{s:s, s:s}}", "error", "field", e->field[0] ? e->field : "body",
-                                  "message", e->message));
 }
 
 static enum MHD_Result respond_405(struct MHD_Connection *c, const char *allow, const char *rule)
@@ -232,8 +158,8 @@ static enum MHD_Result respond_405(struct MHD_Connection *c, const char *allow, 
     return ret;
 }
 
-static enum MHD_Result respond_file(struct MHD_Connection *c, const char *path,
-                                    const char *type)
+enum MHD_Result respond_file(struct MHD_Connection *c, const char *path,
+                             const char *type)
 {
     int fd = open(path, O_RDONLY | O_CLOEXEC);
     struct stat st;
@@ -254,297 +180,7 @@ static enum MHD_Result respond_file(struct MHD_Connection *c, const char *path,
     return ret;
 }
 
-double http_memory_bytes(const struct http_limits *l)
-{
-    /* libmicrohttpd's per-connection pool plus a body buffer, per
-     * connection, at the connection limit (a health check's reserve too). */
-    return (double)l->max_connections * (CONNECTION_MEMORY + JOB_MAX_BODY_BYTES);
-}
-
-/* The daemon's memory budget (--memory-budget), by part: the driver and
- * libraries as measured at start, the connections at their limit, and what
- * is left for one job, which each job's estimate must fit (job_cost.h);
- * rss_bytes is the resident set now, the driver's allocations included. */
-static json_t *memory_json(const struct http_server *s, double *total)
-{
-    const double side = 8192.0, frame = side * side * 4.0;
-    double http = http_memory_bytes(&s->limits), job = job_cost_memory_limit();
-    *total = s->ctx.memory_budget_bytes > 0 ? s->ctx.memory_budget_bytes
-                                            : s->ctx.driver_bytes + http + job;
-    /* What the API's own limits let a job's buffers reach, for scale: its
-     * captures (bounded per job), a read-back frame and its per-frame
-     * series, and the metrics stage at the largest image. */
-    double captures = JOB_MAX_CAPTURE_BYTES, render = frame + 1e6 * 3 * sizeof(double);
-    double metrics = metrics_memory_bytes(8192, 8192, 1000.0);
-    return json_pack("{s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:f, s:s}", "budget_bytes", *total,
-                     "driver_bytes", s->ctx.driver_bytes, "http_bytes", http, "job_bytes", job,
-                     "rss_bytes", telemetry_rss_bytes(), "captures_bytes", captures,
-                     "render_bytes", render, "metrics_bytes", metrics, "rule",
-                     "budget_bytes = driver_bytes (the daemon's resident set at start, the GL "
-                     "context up: driver, shader compiler, libraries) + http_bytes (every "
-                     "connection's buffers) + job_bytes (what one job may take: a job whose "
-                     "estimate, its answer's cost.memory_bytes, is over it is refused)");
-}
-
-static json_t *info_json(struct http_server *s)
-{
-    double total;
-    json_t *memory = memory_json(s, &total);
-    /* From the GL-free catalogue: HTTP threads never touch GL. */
-    json_t *techs = technique_catalog_json(s->ctx.catalog);
-    const struct http_limits *l = &s->limits;
-    json_t *info = json_pack("{s:s, s:s, s:s, s:o, s:o, s:o, s:o, s:o, s:{s:i, s:i, s:i, s:I, s:I, s:f, "
-                     "s:f, s:I, s:f, s:f, s:I, s:I}}",
-                     "name", "shadebenchd", "version", PACKAGE_VERSION, "api", "v1", "memory",
-                     memory, "device",
-                     s->ctx.device_json(s->ctx.render), "techniques", techs,
-                     "effects", effect_catalog_json(), /* post hook: look.post's effects */
-                     "sweepable", sweep_params_json(s->ctx.catalog), "limits",
-                     "max_body_bytes", JOB_MAX_BODY_BYTES, "max_queued_jobs",
-                     queue_max_queued(s->queue), "max_wait_s", MAX_WAIT_S, "max_connections",
-                     (json_int_t)l->max_connections, "max_connections_per_ip",
-                     (json_int_t)l->max_connections_per_ip, "header_timeout_s",
-                     l->header_timeout_s, "body_timeout_s", l->body_timeout_s,
-                     "max_token_bytes", (json_int_t)HTTP_MAX_TOKEN_BYTES, "default_job_timeout_s",
-                     job_spec_default_timeout(), "max_job_seconds", job_spec_max_seconds(),
-                     "max_captures",
-                     (json_int_t)JOB_MAX_CAPTURES, "max_image_pixels", (json_int_t)IMAGE_MAX_PIXELS);
-    /* The asset limits (assets.h): the upload's body limit, the converter's
-     * limits on what an asset may hold, and its memory, CPU and time. */
-    json_t *limits = json_object_get(info, "limits");
-    if (limits && s->ctx.assets) {
-        json_t *assets = assets_info_json(s->ctx.assets);
-        json_object_set(limits, "max_asset_bytes", json_object_get(assets, "max_asset_bytes"));
-        json_object_set_new(limits, "assets", assets);
-    }
-    return info;
-}
-
-/* The render thread's state as /healthz shows it. */
-static json_t *render_json(const struct render_state *st, double stall_s)
-{
-    if (!st->alive)
-        return json_pack("{s:s}", "state", "stopped");
-    if (!st->busy)
-        return json_pack("{s:s, s:f}", "state", "idle", "idle_s", st->since_progress_s);
-    return json_pack("{s:s, s:s, s:s, s:f, s:f, s:f}", "state",
-                     render_state_stalled(st, stall_s) ? "stalled" : "busy", "job", st->job,
-                     "phase", st->phase, "busy_s", st->busy_s, "since_progress_s",
-                     st->since_progress_s, "stall_seconds", stall_s);
-}
-
-/* GET /healthz: cheap (no store, no lock), and true: 503 when the render
- * thread has stopped, or has made no progress for longer than the bound
- * while a job is on it, which no other endpoint would show (a job that
- * holds the GPU for minutes still left every other answer quick). */
-static enum MHD_Result respond_healthz(struct http_server *s, struct MHD_Connection *c)
-{
-    struct render_state st;
-    s->ctx.render_state(s->ctx.render, &st);
-    json_t *render = render_json(&st, s->ctx.stall_s);
-    if (!st.alive)
-        return respond_json(c, MHD_HTTP_SERVICE_UNAVAILABLE,
-                            json_pack("{s:s, s:o}", "status", "render thread is not running",
-                                      "render", render));
-    if (render_state_stalled(&st, s->ctx.stall_s)) {
-        char msg[256];
-        snprintf(msg, sizeof(msg), "the render thread has made no progress for %.0f s (more "
-                 "than --stall-seconds %g) on job %s, phase %s", st.since_progress_s,
-                 s->ctx.stall_s, st.job, st.phase);
-        return respond_json(c, MHD_HTTP_SERVICE_UNAVAILABLE,
-                            json_pack("{s:s, s:s, s:o}", "status", "stalled", "message", msg,
-                                      "render", render));
-    }
-    return respond_json(c, MHD_HTTP_OK, json_pack("{s:s, s:o}", "status", "ok", "render", render));
-}
-
-/* Label values in the text format: a backslash, a quote and a newline are
- * escaped. A job id and a phase have none, but say so in one place. */
-static void prometheus_label(FILE *f, const char *v)
-{
-    for (; v && *v; v++) {
-        if (*v == '\\' || *v == '"')
-            fputc('\\', f);
-        if (*v == '\n')
-            fputs("\\n", f);
-        else
-            fputc(*v, f);
-    }
-}
-
-static void render_metrics(struct http_server *s, FILE *f)
-{
-    struct render_state st;
-    s->ctx.render_state(s->ctx.render, &st);
-    fprintf(f, "# HELP shadebench_render_up Whether the render thread runs.\n"
-               "# TYPE shadebench_render_up gauge\n"
-               "shadebench_render_up %d\n", st.alive);
-    fprintf(f, "# HELP shadebench_render_busy Whether a job is on the render thread.\n"
-               "# TYPE shadebench_render_busy gauge\n"
-               "shadebench_render_busy %d\n", st.busy);
-    fprintf(f, "# HELP shadebench_render_seconds_since_progress Seconds since the render thread "
-               "last made progress (a frame, a slice of GPU work, a metric tile, a phase); 0 "
-               "while idle.\n"
-               "# TYPE shadebench_render_seconds_since_progress gauge\n"
-               "shadebench_render_seconds_since_progress %.3f\n",
-            st.busy ? st.since_progress_s : 0.0);
-    fprintf(f, "# HELP shadebench_render_stalled Whether /healthz reports the render thread "
-               "stalled (busy, no progress for longer than shadebench_render_stall_seconds).\n"
-               "# TYPE shadebench_render_stalled gauge\n"
-               "shadebench_render_stalled %d\n"
-               "# HELP shadebench_render_stall_seconds The stall bound (--stall-seconds; 0: "
-               "none).\n"
-               "# TYPE shadebench_render_stall_seconds gauge\n"
-               "shadebench_render_stall_seconds %g\n",
-            render_state_stalled(&st, s->ctx.stall_s), s->ctx.stall_s);
-    if (st.busy) {
-        fprintf(f, "# HELP shadebench_render_job The job on the render thread and its phase.\n"
-                   "# TYPE shadebench_render_job gauge\n"
-                   "shadebench_render_job{job=\"");
-        prometheus_label(f, st.job);
-        fprintf(f, "\",phase=\"");
-        prometheus_label(f, st.phase);
-        fprintf(f, "\"} 1\n");
-    }
-}
-
-/* GET /metrics: Prometheus text format 0.0.4. */
-static enum MHD_Result respond_metrics(struct http_server *s, struct MHD_Connection *c)
-{
-    char *text = NULL;
-    size_t len = 0;
-    FILE *f = open_memstream(&text, &len);
-    if (!f)
-        return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "metrics", "out of memory");
-    size_t counts[JOB_STATUS_COUNT];
-    if (!queue_counts(s->queue, counts)) {
-        fclose(f);
-        free(text);
-        return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "metrics",
-                             "cannot read the store (see the log)");
-    }
-    fprintf(f, "# HELP shadebench_jobs Jobs in the store, by status.\n"
-               "# TYPE shadebench_jobs gauge\n");
-    for (int k = JOB_QUEUED; k <= JOB_INTERRUPTED; k++)
-        fprintf(f, "shadebench_jobs{status=\"%s\"} %zu\n", job_status_name((enum job_status)k),
-                counts[k]);
-    fprintf(f, "# HELP shadebench_queue_depth Jobs waiting for the render thread.\n"
-               "# TYPE shadebench_queue_depth gauge\n"
-               "shadebench_queue_depth %zu\n", counts[JOB_QUEUED]);
-    fprintf(f, "# HELP shadebench_queue_capacity Jobs that may wait at once.\n"
-               "# TYPE shadebench_queue_capacity gauge\n"
-               "shadebench_queue_capacity %d\n", queue_max_queued(s->queue));
-    fprintf(f, "# HELP shadebench_state_disk_full Whether the state directory's disk is full: "
-               "no job starts and none is accepted until there is room (docs/store.md).\n"
-               "# TYPE shadebench_state_disk_full gauge\n"
-               "shadebench_state_disk_full %d\n", store_disk_full(queue_store(s->queue)));
-    struct telemetry t;
-    telemetry_read(&t);
-    fprintf(f, "# HELP shadebench_frames_rendered_total Frames rendered for jobs (warm-up and timed).\n"
-               "# TYPE shadebench_frames_rendered_total counter\n"
-               "shadebench_frames_rendered_total %llu\n", t.frames);
-    render_metrics(s, f);
-    fprintf(f, "# HELP shadebench_render_busy_seconds_total Seconds the render thread spent on jobs.\n"
-               "# TYPE shadebench_render_busy_seconds_total counter\n"
-               "shadebench_render_busy_seconds_total %.6f\n", t.render_busy_s);
-    fprintf(f, "# HELP shadebench_metrics_seconds_total Seconds the metrics stage spent scoring captures.\n"
-               "# TYPE shadebench_metrics_seconds_total counter\n"
-               "shadebench_metrics_seconds_total %.6f\n", t.metrics_s);
-    fprintf(f, "# HELP shadebench_metrics_captures_total Captures scored against their reference.\n"
-               "# TYPE shadebench_metrics_captures_total counter\n"
-               "shadebench_metrics_captures_total %llu\n", t.captures_scored);
-    struct connections_stats cs;
-    connections_stats(s->conns, &cs);
-    fprintf(f, "# HELP shadebench_http_long_polls Requests suspended in a wait (?wait= or a cancel).\n"
-               "# TYPE shadebench_http_long_polls gauge\n"
-               "shadebench_http_long_polls %zu\n", cs.waiting);
-    fprintf(f, "# HELP shadebench_http_connections Open HTTP connections.\n"
-               "# TYPE shadebench_http_connections gauge\n"
-               "shadebench_http_connections %zu\n", cs.open);
-    fprintf(f, "# HELP shadebench_http_connections_cut_total Connections shut for headers or a body "
-               "later than their deadline.\n"
-               "# TYPE shadebench_http_connections_cut_total counter\n"
-               "shadebench_http_connections_cut_total{phase=\"headers\"} %llu\n"
-               "shadebench_http_connections_cut_total{phase=\"body\"} %llu\n",
-            cs.header_timeouts, cs.body_timeouts);
-    fprintf(f, "# HELP shadebench_http_waits_abandoned_total Waits ended because their client hung up.\n"
-               "# TYPE shadebench_http_waits_abandoned_total counter\n"
-               "shadebench_http_waits_abandoned_total %llu\n", cs.waits_gone);
-    fprintf(f, "# HELP shadebench_http_requests_total HTTP requests answered, by route and status code.\n"
-               "# TYPE shadebench_http_requests_total counter\n");
-    for (int r = 0; r < ROUTE_COUNT; r++)
-        for (size_t k = 0; k < NCODES; k++) {
-            unsigned long long n = atomic_load(&s->requests[r][k]);
-            if (n == 0)
-                continue;
-            char code[8];
-            snprintf(code, sizeof(code), COUNTED_CODES[k] ? "%u" : "other", COUNTED_CODES[k]);
-            fprintf(f, "shadebench_http_requests_total{route=\"%s\",code=\"%s\"} %llu\n",
-                    route_label((enum route_kind)r), code, n);
-        }
-    double budget;
-    json_decref(memory_json(s, &budget));
-    fprintf(f, "# HELP shadebench_memory_budget_bytes The daemon's memory budget (parts in /v1/info).\n"
-               "# TYPE shadebench_memory_budget_bytes gauge\n"
-               "shadebench_memory_budget_bytes %.0f\n"
-               "# HELP shadebench_memory_rss_bytes The daemon's resident set (the GL driver's "
-               "allocations included).\n"
-               "# TYPE shadebench_memory_rss_bytes gauge\n"
-               "shadebench_memory_rss_bytes %.0f\n", budget, telemetry_rss_bytes());
-    if (fclose(f) != 0 || !text) {
-        free(text);
-        return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "metrics", "out of memory");
-    }
-    return respond_text(c, MHD_HTTP_OK, text, len, "text/plain; version=0.0.4; charset=utf-8");
-}
-
-static enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *c,
-                                  struct request *req)
-{
-    struct job_spec spec;
-    struct job_error err;
-    if (!job_spec_parse_text(req->body ? req->body : "", req->len, s->ctx.catalog,
-                             &spec, &err))
-        return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
-    /* scene.asset: pinned to the stored asset's hash here, so that the
-     * answer names the rule (400 unknown, 409 a different pinned hash);
-     * queue_submit resolves again, for the sweeps' points. */
-    if (spec.scene.asset[0]) {
-        struct assets_error ae;
-        if (!s->ctx.assets)
-            return respond_error(c, MHD_HTTP_BAD_REQUEST, "scene.asset",
-                                 "this daemon has no asset store");
-        if (!assets_resolve(s->ctx.assets, &spec.scene, &ae))
-            return respond_asset_error(c, &ae);
-    }
-    char id[24];
-    switch (queue_submit(s->queue, &spec, NULL, id)) {
-    case QUEUE_OK:
-        break;
-    case QUEUE_REFUSED: /* the asset changed since: its rule */
-        return respond_error(c, MHD_HTTP_CONFLICT, "scene.asset", queue_submit_error());
-    case QUEUE_FULL: {
-        char msg[96];
-        snprintf(msg, sizeof(msg), "the queue is full (%d jobs waiting); retry later",
-                 queue_max_queued(s->queue));
-        return respond_error(c, MHD_HTTP_TOO_MANY_REQUESTS, "body", msg);
-    }
-    case QUEUE_STOPPING:
-        return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "body", "the daemon is stopping");
-    default: /* QUEUE_IO_ERROR: not persisted, so not accepted */
-        return respond_error(c, MHD_HTTP_INSUFFICIENT_STORAGE, "state_dir", queue_submit_error());
-    }
-    char url[ROUTE_URL_MAX];
-    route_job_url(id, url);
-    LOG(LOG_INFO, "queued job %s (%s)", id, spec.technique);
-    struct job_cost cost;
-    job_cost_estimate(&spec, &cost);
-    return respond_json(c, MHD_HTTP_ACCEPTED,
-                        json_pack("{s:s, s:s, s:s, s:o}", "id", id, "status", "queued", "url", url,
-                                  "cost", job_cost_json(&cost)));
-}
-
-static bool parse_wait(struct MHD_Connection *c, double *wait)
+bool parse_wait(struct MHD_Connection *c, double *wait)
 {
     const char *v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "wait");
     *wait = 0;
@@ -559,8 +195,8 @@ static bool parse_wait(struct MHD_Connection *c, double *wait)
     return true;
 }
 
-static enum MHD_Result respond_chart(struct MHD_Connection *c, const json_t *subject,
-                                     const struct route *r, bool is_sweep, const json_t *device)
+enum MHD_Result respond_chart(struct MHD_Connection *c, const json_t *subject,
+                              const struct route *r, bool is_sweep, const json_t *device)
 {
     enum chart_format format = r->chart_png ? CHART_PNG : CHART_SVG;
     struct chart_options o = {.device = device};
@@ -580,100 +216,11 @@ static enum MHD_Result respond_chart(struct MHD_Connection *c, const json_t *sub
     return respond_text(c, MHD_HTTP_OK, data, len, r->chart_png ? "image/png" : "image/svg+xml");
 }
 
-struct list_args {
-    struct store_query query;
-    struct job_error err;
-    bool ok;
-};
-
-static enum MHD_Result list_arg(void *cls, enum MHD_ValueKind kind, const char *key,
-                                const char *value)
-{
-    (void)kind;
-    struct list_args *a = cls;
-    a->ok = a->ok && job_filter_add(&a->query, key, value, &a->err);
-    return a->ok ? MHD_YES : MHD_NO;
-}
-
-/* GET /v1/jobs and GET /v1/sweeps: a page, with the link to the next one.
- * Jobs take filters (?technique=&status=&label.KEY=VALUE&since=), both
- * take ?limit=&cursor= (daemon/api/job_filter.h). */
-static enum MHD_Result respond_list(struct http_server *s, struct MHD_Connection *c,
-                                    enum route_kind route)
-{
-    struct list_args *a = calloc(1, sizeof(*a));
-    if (!a)
-        return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "url", "out of memory");
-    a->ok = true;
-    job_filter_init(&a->query, route == ROUTE_SWEEPS ? STORE_SWEEPS : STORE_JOBS);
-    MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, list_arg, a);
-    if (!a->ok) {
-        json_t *body = job_error_to_json(&a->err);
-        free(a);
-        return respond_json(c, MHD_HTTP_BAD_REQUEST, body);
-    }
-    /* The error goes in a 256-byte message (respond_error): logged whole. */
-    char next[RECORD_ID_LEN], err[240];
-    json_t *list = route == ROUTE_SWEEPS
-                       ? sweeps_list_page(s->sweeps, &a->query, next, err, sizeof(err))
-                       : queue_list_page(s->queue, &a->query, next, err, sizeof(err));
-    if (!list) {
-        free(a);
-        return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "store", err);
-    }
-    if (route == ROUTE_SWEEPS)
-        links_add_sweep_list(list);
-    else
-        links_add_job_list(list);
-    links_add_next(list, route, &a->query, next);
-    free(a);
-    return respond_json(c, MHD_HTTP_OK, list);
-}
-
-static bool point_job_dir(void *ctx, const char *job_id, char *dir, size_t cap, int *last_frame)
-{
-    struct http_server *s = ctx;
-    enum job_status status;
-    if (!queue_job_dir(s->queue, job_id, dir, cap, &status))
-        return false;
-    json_t *job = queue_job_json(s->queue, job_id, 0);
-    json_t *caps = json_object_get(json_object_get(job, RK_RESULT), RK_CAPTURES);
-    *last_frame = (int)json_integer_value(json_object_get(json_array_get(caps, json_array_size(caps) - 1), "frame"));
-    json_decref(job);
-    return true;
-}
-
-static enum MHD_Result respond_html(struct MHD_Connection *c, char *html, size_t len)
+enum MHD_Result respond_html(struct MHD_Connection *c, char *html, size_t len)
 {
     if (!html)
         return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "report", "out of memory");
     return respond_text(c, MHD_HTTP_OK, html, len, "text/html; charset=utf-8");
-}
-
-/* A job or sweep as the API serves it: the stored JSON plus its URLs. */
-static json_t *served_job(struct http_server *s, const char *id)
-{
-    json_t *job = queue_job_json(s->queue, id, 0);
-    links_add_job(job);
-    return job;
-}
-
-static json_t *served_sweep(struct http_server *s, const char *id)
-{
-    json_t *sw = sweeps_json(s->sweeps, id, 0);
-    links_add_sweep(sw);
-    return sw;
-}
-
-static bool finished_status(enum job_status st)
-{
-    return st != JOB_QUEUED && st != JOB_RUNNING;
-}
-
-static bool sweep_finished(const json_t *sw)
-{
-    const char *st = json_string_value(json_object_get(sw, "status"));
-    return !st || (strcmp(st, "queued") != 0 && strcmp(st, "running") != 0);
 }
 
 /* The watcher's question: may a wait on kind/id end now? */
@@ -685,10 +232,10 @@ static bool wait_done(void *ctx, enum wait_kind kind, const char *id)
     if (kind == WAIT_JOB) {
         char dir[PATH_MAX];
         enum job_status st;
-        return !queue_job_dir(s->queue, id, dir, sizeof(dir), &st) || finished_status(st);
+        return !queue_job_dir(s->queue, id, dir, sizeof(dir), &st) || job_status_finished(st);
     }
     json_t *sw = sweeps_json(s->sweeps, id, 0);
-    bool done = sweep_finished(sw);
+    bool done = sweep_json_finished(sw);
     json_decref(sw);
     return done;
 }
@@ -700,9 +247,9 @@ static void on_queue_change(void *ctx)
 
 /* Holds the request without a thread until the job or sweep finishes or
  * wait_s pass (answered by answer_waited once resumed). */
-static enum MHD_Result suspend(struct http_server *s, struct MHD_Connection *c,
-                               struct request *req, enum wait_kind kind, double wait_s,
-                               unsigned status)
+enum MHD_Result suspend_request(struct http_server *s, struct MHD_Connection *c,
+                                struct request *req, enum wait_kind kind, double wait_s,
+                                unsigned status)
 {
     if (!connections_suspend(s->conns, req->conn, kind, req->route.id, wait_s))
         return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "wait",
@@ -723,19 +270,8 @@ static enum MHD_Result answer_waited(struct http_server *s, struct MHD_Connectio
         closing_gone_client = true;
         return MHD_NO;
     }
-    if (req->ticket) {
-        unsigned status;
-        json_t *body;
-        if (s->ctx.assets && assets_ticket_take(s->ctx.assets, req->ticket, &status, &body)) {
-            req->ticket = 0;
-            return respond_json(c, status, body);
-        }
-        return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "body",
-                             why == WAKE_TIMEOUT ? "the conversion is still waiting or running "
-                                                   "past its time; GET /v1/assets/NAME later"
-                                                 : "the daemon is stopping: the upload was not "
-                                                   "converted; upload it again once it is back");
-    }
+    if (req->ticket)
+        return answer_upload(s, c, req, why);
     if (why == WAKE_STOPPING && req->wait_status == MHD_HTTP_OK)
         return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "wait",
                              "the daemon is stopping: the wait ended early; ask again once it "
@@ -745,275 +281,6 @@ static enum MHD_Result answer_waited(struct http_server *s, struct MHD_Connectio
     if (!body)
         return respond_error(c, MHD_HTTP_NOT_FOUND, "id", sweep ? "no such sweep" : "no such job");
     return respond_json(c, req->wait_status, body);
-}
-
-static enum MHD_Result job_resource(struct http_server *s, struct MHD_Connection *c,
-                                    const char *method, struct request *req)
-{
-    const struct route *r = &req->route;
-    bool get = strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
-    char dir[PATH_MAX], path[PATH_MAX + 64];
-    enum job_status status;
-
-    if (r->kind == ROUTE_JOB && get) {
-        double wait;
-        if (!parse_wait(c, &wait))
-            return respond_error(c, MHD_HTTP_BAD_REQUEST, "wait",
-                                 "must be a number of seconds from 0 to 3600");
-        if (!queue_job_dir(s->queue, r->id, dir, sizeof(dir), &status))
-            return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
-        if (wait > 0 && !finished_status(status))
-            return suspend(s, c, req, WAIT_JOB, wait, MHD_HTTP_OK);
-        json_t *job = served_job(s, r->id);
-        if (!job)
-            return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
-        return respond_json(c, MHD_HTTP_OK, job);
-    }
-    if (r->kind == ROUTE_JOB) { /* DELETE */
-        switch (queue_cancel(s->queue, r->id)) {
-        case CANCEL_NOT_FOUND:
-            return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
-        case CANCEL_FINISHED:
-            return respond_error(c, MHD_HTTP_CONFLICT, "id", "the job has already finished");
-        case CANCEL_DONE:
-            return respond_json(c, MHD_HTTP_OK, served_job(s, r->id));
-        case CANCEL_REQUESTED:
-            /* The job stops at its next frame or metric tile; give it a moment
-             * so that the answer usually shows the final state. */
-            return suspend(s, c, req, WAIT_JOB, CANCEL_WAIT_S, MHD_HTTP_ACCEPTED);
-        }
-        return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "id", "unexpected cancel result");
-    }
-    if (r->kind == ROUTE_JOB_REPORT) {
-        json_t *job = queue_job_json(s->queue, r->id, 0);
-        if (!job || !queue_job_dir(s->queue, r->id, dir, sizeof(dir), &status)) {
-            json_decref(job);
-            return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
-        }
-        json_t *device = s->ctx.device_json(s->ctx.render);
-        size_t len = 0;
-        char *html = report_job_html(job, dir, device, &len);
-        json_decref(device);
-        json_decref(job);
-        return respond_html(c, html, len);
-    }
-    if (r->kind == ROUTE_JOB_CHART) {
-        json_t *job = queue_job_json(s->queue, r->id, 0);
-        if (!job)
-            return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
-        enum MHD_Result ret =
-            json_object_get(job, RK_RESULT)
-                ? respond_chart(c, job, r, false, NULL)
-                : respond_error(c, MHD_HTTP_CONFLICT, "id", "the job has no result yet");
-        json_decref(job);
-        return ret;
-    }
-    /* Files: timings.csv and the per-capture images. */
-    if (!queue_job_dir(s->queue, r->id, dir, sizeof(dir), &status))
-        return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such job");
-    if (status != JOB_DONE)
-        return respond_error(c, MHD_HTTP_CONFLICT, "id",
-                             "the job has not finished: its files exist once it is done");
-    if (r->kind == ROUTE_JOB_TIMINGS) {
-        job_file_path(dir, JOB_FILE_TIMINGS, path, sizeof(path));
-        return respond_file(c, path, "text/csv");
-    }
-    job_image_path(dir, r->image, r->frame, path, sizeof(path));
-    if (access(path, R_OK) != 0)
-        return respond_error(c, MHD_HTTP_NOT_FOUND, "frame",
-                             "no such image: this frame was not captured, or the job has no "
-                             "reference or that metric (see result.captures)");
-    return respond_file(c, path, "image/png");
-}
-
-static enum MHD_Result post_sweep(struct http_server *s, struct MHD_Connection *c,
-                                  struct request *req)
-{
-    json_error_t jerr;
-    json_t *body = json_loadb(req->body ? req->body : "", req->len, JSON_REJECT_DUPLICATES, &jerr);
-    if (!body) {
-        struct job_error e;
-        job_error_set(&e, "body", "malformed JSON at line %d, column %d: %s", jerr.line,
-                      jerr.column, jerr.text);
-        return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&e));
-    }
-    struct sweep_spec spec;
-    struct job_error err;
-    if (!sweep_spec_parse(body, s->ctx.catalog, &spec, &err)) {
-        sweep_spec_finish(&spec);
-        json_decref(body);
-        return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
-    }
-    /* A sweep on an asset: refused now rather than at its first point (each
-     * point is pinned to the asset's hash when the sweep submits it). */
-    const json_t *asset = json_object_get(json_object_get(spec.base, "scene"), "asset");
-    if (json_is_string(asset)) {
-        struct scene_spec probe;
-        struct assets_error ae;
-        memset(&probe, 0, sizeof(probe));
-        snprintf(probe.asset, sizeof(probe.asset), "%s", json_string_value(asset));
-        if (!s->ctx.assets || !assets_resolve(s->ctx.assets, &probe, &ae)) {
-            sweep_spec_finish(&spec);
-            json_decref(body);
-            if (s->ctx.assets)
-                snprintf(ae.field, sizeof(ae.field), "base.scene.asset");
-            return s->ctx.assets ? respond_asset_error(c, &ae)
-                                 : respond_error(c, MHD_HTTP_BAD_REQUEST, "base.scene.asset",
-                                                 "this daemon has no asset store");
-        }
-    }
-    char id[24];
-    enum queue_submit_result r = sweeps_submit(s->sweeps, &spec, body, id);
-    sweep_spec_finish(&spec);
-    json_decref(body);
-    if (r == QUEUE_IO_ERROR) /* not persisted, so not accepted */
-        return respond_error(c, MHD_HTTP_INSUFFICIENT_STORAGE, "state_dir", queue_submit_error());
-    if (r != QUEUE_OK)
-        return respond_error(c, MHD_HTTP_TOO_MANY_REQUESTS, "body",
-                             "too many sweeps are waiting; retry later");
-    char url[ROUTE_URL_MAX];
-    route_sweep_url(id, url);
-    return respond_json(c, MHD_HTTP_ACCEPTED,
-                        json_pack("{s:s, s:s, s:s}", "id", id, "status", "queued", "url", url));
-}
-
-static enum MHD_Result sweep_resource(struct http_server *s, struct MHD_Connection *c,
-                                      const char *method, struct request *req)
-{
-    const struct route *r = &req->route;
-    bool get = strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
-    if (r->kind == ROUTE_SWEEP && get) {
-        double wait;
-        if (!parse_wait(c, &wait))
-            return respond_error(c, MHD_HTTP_BAD_REQUEST, "wait",
-                                 "must be a number of seconds from 0 to 3600");
-        json_t *sw = sweeps_json(s->sweeps, r->id, 0);
-        if (!sw)
-            return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such sweep");
-        if (wait > 0 && !sweep_finished(sw)) {
-            json_decref(sw);
-            return suspend(s, c, req, WAIT_SWEEP, wait, MHD_HTTP_OK);
-        }
-        links_add_sweep(sw);
-        return respond_json(c, MHD_HTTP_OK, sw);
-    }
-    if (r->kind == ROUTE_SWEEP) { /* DELETE */
-        switch (sweeps_cancel(s->sweeps, r->id)) {
-        case CANCEL_NOT_FOUND:
-            return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such sweep");
-        case CANCEL_FINISHED:
-            return respond_error(c, MHD_HTTP_CONFLICT, "id", "the sweep has already finished");
-        case CANCEL_DONE:
-            return respond_json(c, MHD_HTTP_OK, served_sweep(s, r->id));
-        case CANCEL_REQUESTED:
-            return suspend(s, c, req, WAIT_SWEEP, CANCEL_WAIT_S, MHD_HTTP_ACCEPTED);
-        }
-        return respond_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "id", "unexpected cancel result");
-    }
-    json_t *sw = sweeps_json(s->sweeps, r->id, 0);
-    if (!sw)
-        return respond_error(c, MHD_HTTP_NOT_FOUND, "id", "no such sweep");
-    enum MHD_Result ret;
-    if (r->kind == ROUTE_SWEEP_CHART) {
-        json_t *device = s->ctx.device_json(s->ctx.render);
-        ret = respond_chart(c, sw, r, true, device);
-        json_decref(device);
-    } else {
-        json_t *device = s->ctx.device_json(s->ctx.render);
-        size_t len = 0;
-        char *html = report_sweep_html(sw, device, point_job_dir, s, &len);
-        json_decref(device);
-        ret = respond_html(c, html, len);
-    }
-    json_decref(sw);
-    return ret;
-}
-
-struct asset_list_args {
-    const char *cursor;
-    int limit;
-    const char *bad, *rule;
-};
-
-static enum MHD_Result asset_list_arg(void *cls, enum MHD_ValueKind kind, const char *key,
-                                      const char *value)
-{
-    (void)kind;
-    struct asset_list_args *a = cls;
-    if (strcmp(key, "limit") == 0) {
-        char *end;
-        long v = value ? strtol(value, &end, 10) : 0;
-        if (!value || *end || end == value || v < 1 || v > STORE_LIMIT_MAX) {
-            a->bad = "limit";
-            a->rule = "must be an integer from 1 to 1000";
-            return MHD_NO;
-        }
-        a->limit = (int)v;
-    } else if (strcmp(key, "cursor") == 0) {
-        if (!value || !scene_asset_name_valid(value)) {
-            a->bad = "cursor";
-            a->rule = "must be an asset name, as the previous page's \"next\" gives it";
-            return MHD_NO;
-        }
-        a->cursor = value;
-    } else {
-        a->bad = key;
-        a->rule = "unknown argument: the asset list takes limit and cursor";
-        return MHD_NO;
-    }
-    return MHD_YES;
-}
-
-/* /v1/assets and /v1/assets/NAME (daemon/jobs/assets.h). PUT reaches here
- * only once its body is in and refused before any conversion (begin
- * answered in refuse_early, finish in on_request). */
-static enum MHD_Result asset_resource(struct http_server *s, struct MHD_Connection *c,
-                                      const char *method, struct request *req)
-{
-    if (!s->ctx.assets)
-        return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "url",
-                             "this daemon has no asset store");
-    struct assets_error e = {0};
-    json_t *body;
-    if (req->route.kind == ROUTE_ASSETS) {
-        struct asset_list_args a = {.cursor = "", .limit = STORE_LIMIT_DEFAULT};
-        MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, asset_list_arg, &a);
-        if (a.bad)
-            return respond_error(c, MHD_HTTP_BAD_REQUEST, a.bad, a.rule);
-        body = assets_list(s->ctx.assets, a.cursor, a.limit, &e);
-    } else if (req->route.asset_too_long) {
-        return respond_error(c, MHD_HTTP_BAD_REQUEST, "name",
-                             "an asset name is at most 128 bytes");
-    } else if (strcmp(method, "DELETE") == 0) {
-        body = assets_delete(s->ctx.assets, req->route.asset, &e);
-    } else {
-        body = assets_describe(s->ctx.assets, req->route.asset, &e);
-    }
-    if (!body)
-        return respond_asset_error(c, &e);
-    return respond_json(c, MHD_HTTP_OK, body);
-}
-
-/* The upload's body is in: its conversion is queued and the request waits
- * for it without a thread (connections.h), as a long-poll does. */
-static enum MHD_Result finish_upload(struct http_server *s, struct MHD_Connection *c,
-                                     struct request *req)
-{
-    struct assets_error e = {0};
-    struct asset_upload *u = req->upload;
-    req->upload = NULL;
-    uint64_t ticket = assets_upload_finish(u, &e);
-    if (!ticket)
-        return respond_asset_error(c, &e);
-    req->ticket = ticket;
-    char id[32];
-    snprintf(id, sizeof(id), "%llu", (unsigned long long)ticket);
-    if (!connections_suspend(s->conns, req->conn, WAIT_ASSET, id,
-                             assets_answer_wait_s(s->ctx.assets)))
-        return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "body",
-                             "the daemon is stopping; upload the asset again once it is back");
-    req->waiting = true;
-    return MHD_YES;
 }
 
 static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
@@ -1027,6 +294,10 @@ static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
         return respond_json(c, MHD_HTTP_OK, info_json(s));
     case ROUTE_METRICS:
         return respond_metrics(s, c);
+    case ROUTE_UI:
+        return respond_ui(c, &req->route);
+    case ROUTE_JOB_HISTORY:
+        return respond_history(s, c, &req->route);
     case ROUTE_JOBS:
         if (post) {
             if (req->too_large)
@@ -1047,15 +318,20 @@ static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
     case ROUTE_ASSETS:
     case ROUTE_ASSET:
         return asset_resource(s, c, method, req);
+    case ROUTE_ASSET_FIDELITY:
+        return post_fidelity(s, c, req);
     case ROUTE_JOB:
     case ROUTE_JOB_REPORT:
     case ROUTE_JOB_CHART:
     case ROUTE_JOB_TIMINGS:
     case ROUTE_JOB_IMAGE:
+    case ROUTE_JOB_PDIFF:
+    case ROUTE_JOB_FIDELITY:
         return job_resource(s, c, method, req);
     case ROUTE_SWEEP:
     case ROUTE_SWEEP_CHART:
     case ROUTE_SWEEP_REPORT:
+    case ROUTE_SWEEP_VERDICT:
         return sweep_resource(s, c, method, req);
     default:
         return respond_error(c, MHD_HTTP_NOT_FOUND, req->route.field ? req->route.field : "url",
@@ -1135,7 +411,8 @@ static bool refuse_early(struct http_server *s, struct MHD_Connection *c, const 
         *ret = respond_error(c, MHD_HTTP_TOO_MANY_REQUESTS, "connections", rule);
         return true;
     }
-    if (req->route.kind != ROUTE_HEALTHZ && !authorized(s, c)) {
+    /* The dashboard's files hold no data: the page asks for the token. */
+    if (req->route.kind != ROUTE_HEALTHZ && req->route.kind != ROUTE_UI && !authorized(s, c)) {
         *ret = respond_error(c, MHD_HTTP_UNAUTHORIZED, "Authorization",
                              "this daemon needs \"Authorization: Bearer <token>\"");
         return true;
@@ -1150,32 +427,8 @@ static bool refuse_early(struct http_server *s, struct MHD_Connection *c, const 
         return true;
     }
     const char *cl = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Content-Length");
-    if (req->route.kind == ROUTE_ASSET && strcmp(method, "PUT") == 0) {
-        /* The file streams to disk (assets.h): its own limit, not a job's. */
-        if (!s->ctx.assets) {
-            *ret = respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "url",
-                                 "this daemon has no asset store");
-            return true;
-        }
-        if (req->route.asset_too_long) {
-            *ret = respond_error(c, MHD_HTTP_BAD_REQUEST, "name",
-                                 "an asset name is at most 128 bytes");
-            return true;
-        }
-        uint64_t length = cl ? strtoull(cl, NULL, 10) : 0;
-        struct assets_error e = {0};
-        req->upload = assets_upload_begin(s->ctx.assets, req->route.asset, length, &e);
-        if (!req->upload) {
-            req->too_large = e.status == MHD_HTTP_CONTENT_TOO_LARGE;
-            *ret = respond_asset_error(c, &e);
-            return true;
-        }
-        /* Its body's deadline grows with its size: 1 MiB/s at least. */
-        uint64_t expect = length ? length : assets_max_bytes(s->ctx.assets);
-        connections_body_deadline(s->conns, req->conn,
-                                  s->limits.body_timeout_s + (double)expect / (1 << 20));
-        return false;
-    }
+    if (req->route.kind == ROUTE_ASSET && strcmp(method, "PUT") == 0)
+        return begin_upload(s, c, req, cl, ret); /* the file streams to disk: its own limit */
     if (cl && strtoull(cl, NULL, 10) > JOB_MAX_BODY_BYTES) {
         /* libmicrohttpd closes the connection after this answer. */
         req->too_large = true;

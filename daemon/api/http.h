@@ -11,7 +11,7 @@
 
 #include <jansson.h>
 
-#include "daemon/harness/render_state.h"
+#include "daemon/status/render_state.h"
 #include "daemon/jobs/assets.h"
 #include "daemon/jobs/queue.h"
 #include "daemon/jobs/sweeps.h"
@@ -44,6 +44,10 @@ struct http_context {
     /* The assets (/v1/assets, a job's scene.asset); NULL: none (the asset
      * endpoints answer 503 and a job naming one is refused). */
     struct assets *assets;
+    /* The Khronos reference (daemon/jobs/fidelity.h): /v1/info says
+     * whether it is there, and a fidelity job is refused (503, naming what
+     * is missing) when it is not. NULL: none. */
+    struct fidelity *fidelity;
     /* The render thread as the API sees it, without GL: what it is doing
      * (render_state.h: whether it runs, its job and phase, its last
      * progress), for /healthz and /metrics, which must stay cheap (the

@@ -7,7 +7,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "daemon/jobs/records.h"
+#include "daemon/store/records.h"
 
 void job_filter_init(struct store_query *q, enum store_kind kind)
 {
@@ -114,6 +114,12 @@ static bool add_page(struct store_query *q, const char *key, const char *value, 
         snprintf(q->after, sizeof(q->after), "%s", value);
         return true;
     }
+    if (!strcmp(key, "order")) {
+        if (strcmp(value, "oldest") && strcmp(value, "newest"))
+            return job_error_set(err, key, "must be oldest (the default) or newest");
+        q->newest = !strcmp(value, "newest");
+        return true;
+    }
     *taken = false;
     return true;
 }
@@ -129,8 +135,8 @@ bool job_filter_add(struct store_query *q, const char *key, const char *value,
     if (q->kind != STORE_JOBS) {
         char field[64];
         snprintf(field, sizeof(field), "%s", key);
-        return job_error_set(err, field, "unknown argument: the sweep list takes limit= and "
-                             "cursor=");
+        return job_error_set(err, field, "unknown argument: the sweep list takes limit=, "
+                             "cursor= and order=");
     }
     if (!strcmp(key, "technique"))
         return add_term(q, STORE_TERM_TECHNIQUE, NULL, value, key, err);
@@ -165,5 +171,5 @@ bool job_filter_add(struct store_query *q, const char *key, const char *value,
     char field[64];
     snprintf(field, sizeof(field), "%s", key);
     return job_error_set(err, field, "unknown filter: the job list takes technique=, status=, "
-                         "label.NAME=, since=, limit= and cursor=");
+                         "label.NAME=, since=, limit=, cursor= and order=");
 }

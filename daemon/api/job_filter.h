@@ -14,7 +14,7 @@
 #include <stddef.h>
 
 #include "common/json_fields.h"
-#include "daemon/jobs/store.h"
+#include "daemon/store/store.h"
 
 /* An empty question about kind: every record, the first page. */
 void job_filter_init(struct store_query *q, enum store_kind kind);

@@ -32,6 +32,12 @@ static void link_captures(const char *id, json_t *captures, bool heatmap)
             route_image_url(id, image, k, url);
             json_object_set_new(c, kind->url_key, json_string(url));
         }
+        /* Scored by PerceptualDiff against a reference: its failing pixels. */
+        json_t *pdiff = json_object_get(json_object_get(c, "metrics"), "pdiff");
+        if (!heatmap && json_is_object(pdiff) && json_is_string(json_object_get(c, "reference_file"))) {
+            route_pdiff_url(id, k, url);
+            json_object_set_new(c, "pdiff_mask_url", json_string(url));
+        }
     }
 }
 
@@ -47,6 +53,8 @@ void links_add_job(json_t *job)
     if (result) {
         route_timings_url(id, url);
         json_object_set_new(job, "timings_url", json_string(url));
+        route_history_url(id, url);
+        json_object_set_new(job, "history_url", json_string(url));
     }
     link_captures(id, json_object_get(result, RK_CAPTURES), false);
     link_captures(id, json_object_get(json_object_get(result, RK_HEATMAP), RK_CAPTURES), true);
@@ -60,6 +68,8 @@ void links_add_sweep(json_t *sweep)
     char url[ROUTE_URL_MAX];
     route_sweep_url(id, url);
     json_object_set_new(sweep, "url", json_string(url));
+    route_verdict_url(id, url);
+    json_object_set_new(sweep, "verdict_url", json_string(url));
     size_t i;
     json_t *point;
     json_array_foreach(json_object_get(sweep, "points"), i, point) {
@@ -93,7 +103,7 @@ void links_add_next(json_t *list, enum route_kind kind, const struct store_query
     if (!next || !next[0])
         return;
     /* The question as job_filter_add reads it: filters, since, limit, cursor. */
-    const char *keys[STORE_MAX_TERMS + 3], *values[STORE_MAX_TERMS + 3];
+    const char *keys[STORE_MAX_TERMS + 4], *values[STORE_MAX_TERMS + 4];
     char names[STORE_MAX_TERMS][48], since[32], limit[16];
     size_t n = 0;
     for (size_t i = 0; i < q->nterms; i++) {
@@ -110,6 +120,10 @@ void links_add_next(json_t *list, enum route_kind kind, const struct store_query
         job_filter_format_time(q->since_ms, since);
         keys[n] = "since";
         values[n++] = since;
+    }
+    if (q->newest) {
+        keys[n] = "order";
+        values[n++] = "newest";
     }
     snprintf(limit, sizeof(limit), "%d", q->limit);
     keys[n] = "limit";

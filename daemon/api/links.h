@@ -9,7 +9,7 @@
 #include <jansson.h>
 
 #include "daemon/api/routes.h"
-#include "daemon/jobs/store.h"
+#include "daemon/store/store.h"
 
 /* job.url; per capture (result.captures) url from its frame, and
  * reference_url, ssim_map_url and flip_map_url where the capture names

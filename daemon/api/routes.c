@@ -18,13 +18,20 @@ static const struct {
     [ROUTE_JOB_CHART] = {"/v1/jobs/{id}/charts/{name}", "GET, HEAD", "use GET"},
     [ROUTE_JOB_TIMINGS] = {"/v1/jobs/{id}/timings.csv", "GET, HEAD", "use GET"},
     [ROUTE_JOB_IMAGE] = {"/v1/jobs/{id}/{images}/{frame}.png", "GET, HEAD", "use GET"},
+    [ROUTE_JOB_PDIFF] = {"/v1/jobs/{id}/pdiff/{frame}.png", "GET, HEAD", "use GET"},
+    [ROUTE_JOB_HISTORY] = {"/v1/jobs/{id}/history", "GET, HEAD", "use GET"},
     [ROUTE_SWEEPS] = {"/v1/sweeps", "GET, HEAD, POST", "use GET to list sweeps or POST to start one"},
     [ROUTE_SWEEP] = {"/v1/sweeps/{id}", "GET, HEAD, DELETE", "use GET or DELETE on a sweep"},
     [ROUTE_SWEEP_CHART] = {"/v1/sweeps/{id}/charts/{name}", "GET, HEAD", "use GET"},
     [ROUTE_SWEEP_REPORT] = {"/v1/sweeps/{id}/report.html", "GET, HEAD", "use GET"},
+    [ROUTE_SWEEP_VERDICT] = {"/v1/sweeps/{id}/verdict", "GET, HEAD", "use GET"},
     [ROUTE_ASSETS] = {"/v1/assets", "GET, HEAD", "use GET to list assets; PUT /v1/assets/NAME uploads one"},
     [ROUTE_ASSET] = {"/v1/assets/{name}", "GET, HEAD, PUT, DELETE",
                      "use PUT to upload the asset's file as the body, GET or DELETE"},
+    [ROUTE_UI] = {"/ui", "GET, HEAD", "use GET"},
+    [ROUTE_JOB_FIDELITY] = {"/v1/jobs/{id}/fidelity/{file}", "GET, HEAD", "use GET"},
+    [ROUTE_ASSET_FIDELITY] = {"/v1/assets/{name}/fidelity", "POST",
+                              "use POST to compare the asset with the Khronos viewer"},
 };
 
 
@@ -98,10 +105,33 @@ static bool job_routes(const char *rest, struct route *r)
         r->kind = ROUTE_JOB_TIMINGS;
         return true;
     }
+    if (strcmp(sub, "history") == 0) {
+        r->kind = ROUTE_JOB_HISTORY;
+        return true;
+    }
     if (strncmp(sub, "charts/", 7) == 0) {
         if (!take_chart(sub + 7, r))
             return none(r, "chart", "charts are NAME.svg or NAME.png");
         r->kind = ROUTE_JOB_CHART;
+        return true;
+    }
+    if (strncmp(sub, "pdiff/", 6) == 0) {
+        if (!take_frame(sub + 6, r))
+            return none(r, "frame", "masks are K.png with K a captured frame (see result.captures)");
+        r->kind = ROUTE_JOB_PDIFF;
+        return true;
+    }
+    if (strncmp(sub, "fidelity/", 9) == 0) {
+        const char *f = sub + 9;
+        size_t n = strlen(f);
+        bool ok = n > 4 && n < sizeof(r->chart) && strcmp(f + n - 4, ".png") == 0;
+        for (size_t i = 0; ok && i < n - 4; i++)
+            ok = (f[i] >= 'a' && f[i] <= 'z') || (f[i] >= '0' && f[i] <= '9') || f[i] == '_' ||
+                 f[i] == '-';
+        if (!ok)
+            return none(r, "file", "fidelity images are NAME.png (see result.fidelity)");
+        memcpy(r->chart, f, n + 1);
+        r->kind = ROUTE_JOB_FIDELITY;
         return true;
     }
     for (int k = 0; k < JOB_IMAGE_COUNT; k++) {
@@ -136,6 +166,10 @@ static bool sweep_routes(const char *rest, struct route *r)
         r->kind = ROUTE_SWEEP_REPORT;
         return true;
     }
+    if (strcmp(sub, "verdict") == 0) {
+        r->kind = ROUTE_SWEEP_VERDICT;
+        return true;
+    }
     if (strncmp(sub, "charts/", 7) == 0) {
         if (!take_chart(sub + 7, r))
             return none(r, "chart", "charts are NAME.svg or NAME.png");
@@ -162,20 +196,31 @@ bool route_parse(const char *url, struct route *r)
         r->kind = ROUTE_SWEEPS;
     else if (strncmp(url, "/v1/sweeps/", 11) == 0)
         return sweep_routes(url + 11, r);
-    else if (strcmp(url, "/v1/assets") == 0 || strcmp(url, "/v1/assets/") == 0)
+    else if (strcmp(url, "/") == 0 || strcmp(url, "/ui") == 0 || strcmp(url, "/ui/") == 0) {
+        r->kind = ROUTE_UI;
+        snprintf(r->ui, sizeof(r->ui), "/ui/index.html");
+    } else if (strncmp(url, "/ui/", 4) == 0) {
+        /* The handler looks the file up: an unknown one is a 404 there. */
+        if (strlen(url) >= sizeof(r->ui))
+            return none(r, "url", "no such file of the dashboard");
+        r->kind = ROUTE_UI;
+        snprintf(r->ui, sizeof(r->ui), "%s", url);
+    } else if (strcmp(url, "/v1/assets") == 0 || strcmp(url, "/v1/assets/") == 0)
         r->kind = ROUTE_ASSETS;
     else if (strncmp(url, "/v1/assets/", 11) == 0) {
         /* One path segment; its rules are the handler's (a 400 naming it). */
         const char *name = url + 11;
-        if (strchr(name, '/'))
-            return none(r, "url", "no such resource: an asset is /v1/assets/NAME");
-        size_t len = strlen(name);
+        const char *slash = strchr(name, '/');
+        if (slash && (strcmp(slash, "/fidelity") != 0 || slash == name))
+            return none(r, "url", "no such resource: an asset is /v1/assets/NAME (and "
+                        "/v1/assets/NAME/fidelity)");
+        size_t len = slash ? (size_t)(slash - name) : strlen(name);
         r->asset_too_long = len > ROUTE_ASSET_NAME_MAX;
         if (r->asset_too_long)
             len = ROUTE_ASSET_NAME_MAX;
         memcpy(r->asset, name, len);
         r->asset[len] = '\0';
-        r->kind = ROUTE_ASSET;
+        r->kind = slash ? ROUTE_ASSET_FIDELITY : ROUTE_ASSET;
     }
     else
         return none(r, "url", "no such route");
@@ -214,9 +259,9 @@ bool route_method_ok(enum route_kind kind, const char *method, const char **allo
     *allow = KINDS[kind].allow;
     *rule = KINDS[kind].rule;
     if (strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0)
-        return true;
+        return kind != ROUTE_ASSET_FIDELITY;
     if (strcmp(method, "POST") == 0)
-        return kind == ROUTE_JOBS || kind == ROUTE_SWEEPS;
+        return kind == ROUTE_JOBS || kind == ROUTE_SWEEPS || kind == ROUTE_ASSET_FIDELITY;
     if (strcmp(method, "DELETE") == 0)
         return kind == ROUTE_JOB || kind == ROUTE_SWEEP || kind == ROUTE_ASSET;
     if (strcmp(method, "PUT") == 0)
@@ -252,6 +297,21 @@ void route_asset_url(const char *name, char out[ROUTE_URL_MAX + ROUTE_ASSET_NAME
 void route_image_url(const char *id, enum job_image image, int frame, char out[ROUTE_URL_MAX])
 {
     snprintf(out, ROUTE_URL_MAX, "/v1/jobs/%s/%s/%d.png", id, job_image_kind(image)->folder, frame);
+}
+
+void route_pdiff_url(const char *id, int frame, char out[ROUTE_URL_MAX])
+{
+    snprintf(out, ROUTE_URL_MAX, "/v1/jobs/%s/pdiff/%d.png", id, frame);
+}
+
+void route_history_url(const char *id, char out[ROUTE_URL_MAX])
+{
+    snprintf(out, ROUTE_URL_MAX, "/v1/jobs/%s/history", id);
+}
+
+void route_verdict_url(const char *id, char out[ROUTE_URL_MAX])
+{
+    snprintf(out, ROUTE_URL_MAX, "/v1/sweeps/%s/verdict", id);
 }
 
 /* Query arguments keep the unreserved characters of RFC 3986 and escape

@@ -22,12 +22,18 @@ enum route_kind {
     ROUTE_JOB_CHART,
     ROUTE_JOB_TIMINGS,
     ROUTE_JOB_IMAGE,
+    ROUTE_JOB_PDIFF, /* /v1/jobs/{id}/pdiff/{frame}.png: PerceptualDiff's failing pixels */
+    ROUTE_JOB_HISTORY, /* /v1/jobs/{id}/history: its workload's jobs over time */
     ROUTE_SWEEPS,
     ROUTE_SWEEP,
     ROUTE_SWEEP_CHART,
     ROUTE_SWEEP_REPORT,
+    ROUTE_SWEEP_VERDICT, /* /v1/sweeps/{id}/verdict: sweep_verdict_json */
     ROUTE_ASSETS, /* /v1/assets */
     ROUTE_ASSET,  /* /v1/assets/{name} */
+    ROUTE_UI,     /* / and /ui/...: the dashboard's files, served without the token */
+    ROUTE_ASSET_FIDELITY, /* /v1/assets/{name}/fidelity: a fidelity job */
+    ROUTE_JOB_FIDELITY,   /* /v1/jobs/{id}/fidelity/{file}.png: its images */
     ROUTE_COUNT
 };
 
@@ -37,15 +43,18 @@ enum route_kind {
 struct route {
     enum route_kind kind;
     char id[24];       /* jobs and sweeps: digits and dashes, 1 to 23 of them */
-    char chart[32];    /* charts: the name without its extension */
+    char chart[32];    /* charts: the name without its extension; ROUTE_JOB_FIDELITY:
+                        * the file's name, [a-z0-9_-] and ".png" */
     bool chart_png;    /* charts: .png (else .svg) */
     enum job_image image; /* images: which kind (common/job_files.h) */
-    int frame;         /* images: 1 to 999999999 */
+    int frame;         /* images and PerceptualDiff masks: 1 to 999999999 */
     /* ROUTE_ASSET: the name as given (up to ROUTE_ASSET_NAME_MAX bytes; a
      * longer one is cut and flagged). The handler checks it
      * (scene_asset_name_valid) so that a bad one is a 400 naming it. */
     char asset[ROUTE_ASSET_NAME_MAX + 1];
     bool asset_too_long;
+    /* ROUTE_UI: the file's URL ("/" and "/ui/" name "/ui/index.html"). */
+    char ui[64];
     /* ROUTE_NONE: what the 404 names. */
     const char *field, *message;
 };
@@ -87,6 +96,10 @@ void route_sweep_url(const char *id, char out[ROUTE_URL_MAX]);
 void route_timings_url(const char *id, char out[ROUTE_URL_MAX]);
 void route_asset_url(const char *name, char out[ROUTE_URL_MAX + ROUTE_ASSET_NAME_MAX]);
 void route_image_url(const char *id, enum job_image image, int frame, char out[ROUTE_URL_MAX]);
+/* A capture's PerceptualDiff mask, made on request. */
+void route_pdiff_url(const char *id, int frame, char out[ROUTE_URL_MAX]);
+void route_verdict_url(const char *id, char out[ROUTE_URL_MAX]);
+void route_history_url(const char *id, char out[ROUTE_URL_MAX]);
 
 /* A page of a list (kind ROUTE_JOBS or ROUTE_SWEEPS) with its n query
  * arguments, each key and value percent-encoded. malloc'ed (the query can

@@ -1,7 +1,8 @@
 #define _POSIX_C_SOURCE 200809L /* mkdtemp, setrlimit */
 /* shadebench-asset: the glTF converter the daemon runs as a child process
- * (docs/assets.md). One thread; it reads IN_FILE and writes OUT_CACHE and
- * nothing else.
+ * (docs/assets.md), and the environment maps' (a Radiance .hdr, told apart
+ * by its first bytes: env_convert.h). One thread; it reads IN_FILE and
+ * writes OUT_CACHE and nothing else.
  *
  *   shadebench-asset convert IN_FILE OUT_CACHE [--max-file-bytes N]
  *       [--max-vertices N] [--max-indices N] [--max-texture-pixels N]
@@ -23,6 +24,7 @@
 #include <unistd.h>
 
 #include "daemon/assets/asset_convert.h"
+#include "daemon/assets/env_convert.h"
 
 static int usage(void)
 {
@@ -117,6 +119,42 @@ static uint8_t *read_input(const char *path, uint64_t max, size_t *len, bool *ov
     return buf;
 }
 
+/* An environment map: decoded, written, described; frees data and out. */
+static int convert_environment(uint8_t *data, size_t len, char *out)
+{
+    struct environment_limits lim;
+    environment_limits_defaults(&lim);
+    struct environment_image env;
+    struct asset_convert_error cerr;
+    bool ok = env_convert_buffer(data, len, &lim, &env, &cerr);
+    free(data);
+    if (!ok) {
+        free(out);
+        if (cerr.status == 400 || cerr.status == 422)
+            return refuse(cerr.status, cerr.field, cerr.message);
+        fprintf(stderr, "shadebench-asset: %s: %s\n", cerr.field, cerr.message);
+        return 1;
+    }
+    char err[512];
+    ok = environment_file_write(&env, out, err, sizeof(err));
+    free(out);
+    json_t *d = ok ? environment_describe(&env, "radiance_hdr") : NULL;
+    environment_image_finish(&env);
+    if (!ok) {
+        fprintf(stderr, "shadebench-asset: %s\n", err);
+        return 1;
+    }
+    char *s = d ? json_dumps(d, JSON_COMPACT) : NULL;
+    json_decref(d);
+    if (!s) {
+        fprintf(stderr, "shadebench-asset: out of memory\n");
+        return 1;
+    }
+    printf("%s\n", s);
+    free(s);
+    return fflush(stdout) == 0 ? 0 : 1;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 4 || strcmp(argv[1], "convert") != 0)
@@ -196,6 +234,8 @@ int main(int argc, char **argv)
     if (chdir("/") != 0)
         fprintf(stderr, "shadebench-asset: cannot chdir to /: %s\n", strerror(errno));
 
+    if (env_convert_is_hdr(data, len))
+        return convert_environment(data, len, out_abs);
     struct asset a;
     struct asset_convert_error cerr;
     bool ok = asset_convert_buffer(data, len, &lim, &a, &cerr);

@@ -182,10 +182,16 @@ bool build_lights_cameras(struct ctx *c, struct asset *a, const bool *in_scene)
             copy_name(ac->name, cam, fallback);
             ac->perspective = !strcmp(json_string_value(json_object_get(cam, "type")), "perspective");
             json_t *p = json_object_get(cam, ac->perspective ? "perspective" : "orthographic");
-            ac->yfov = (float)num_or(p, "yfov", 0.8);
             ac->znear = (float)num_or(p, "znear", 0.1);
             ac->zfar = (float)num_or(p, "zfar", 0.0);
-            ac->aspect = (float)num_or(p, "aspectRatio", 0.0);
+            if (ac->perspective) {
+                ac->yfov = (float)num_or(p, "yfov", 0.8);
+                ac->aspect = (float)num_or(p, "aspectRatio", 0.0);
+            } else { /* asset.h: ymag in yfov, xmag / ymag in aspect */
+                double ymag = fabs(num_or(p, "ymag", 1.0)), xmag = fabs(num_or(p, "xmag", 1.0));
+                ac->yfov = (float)ymag;
+                ac->aspect = ymag > 0 ? (float)(xmag / ymag) : 0.0f;
+            }
             xform_point(m, origin, ac->eye);
             for (int k = 0; k < 3; k++) {
                 ac->forward[k] = (float)fwd[k];

@@ -802,8 +802,6 @@ bool check_lights_cameras(struct ctx *c)
         const char *type = json_string_value(json_object_get(cam, "type"));
         if (!type || (strcmp(type, "perspective") && strcmp(type, "orthographic")))
             return fail(c, 400, field, "type must be perspective or orthographic");
-        if (strcmp(type, "orthographic") == 0)
-            ignore(c, "orthographic cameras (drawn as perspective)");
     }
     return true;
 }

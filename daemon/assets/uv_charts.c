@@ -55,31 +55,97 @@ static double dot3(const double a[3], const double b[3])
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-/* Shelf packing of the charts (sorted tallest first) into a square of side
- * s, each padded by gutter; places them when place is set. */
-static bool shelf_fits(struct chart *ch, const uint32_t *order, uint32_t n, double s, double gutter,
-                       bool place)
+/* Skyline packing of the charts (in the given order) into a square of side
+ * s, each padded by gutter: each chart goes where its top ends lowest (then
+ * leftmost) over the skyline of those placed before, either way round;
+ * places them (and turns them) when place is set. The placements depend on
+ * the sizes alone, so a trial and the placing pass agree. sky and tmp
+ * hold 2 n + 2 segments each. */
+struct segment {
+    double x, y, w;
+};
+
+static bool skyline_fits(struct chart *ch, const uint32_t *order, uint32_t n, double s,
+                         double gutter, bool place, struct segment *sky, struct segment *tmp)
 {
-    double x = 0, y = 0, shelf = 0;
+    uint32_t ns = 1;
+    sky[0] = (struct segment){0, 0, s};
     for (uint32_t k = 0; k < n; k++) {
         struct chart *c = &ch[order[k]];
-        double pw = c->w + gutter, ph = c->h + gutter;
-        if (pw > s)
+        double best_top = INFINITY, best_x = 0, best_y = 0;
+        int best_turn = 0;
+        for (int turn = 0; turn < 2; turn++) {
+            double pw = (turn ? c->h : c->w) + gutter, ph = (turn ? c->w : c->h) + gutter;
+            for (uint32_t i = 0; i < ns; i++) {
+                double x = sky[i].x;
+                if (x + pw > s + 1e-12 * s)
+                    break;
+                double y = 0;
+                for (uint32_t j = i; j < ns && sky[j].x < x + pw - 1e-12 * s; j++)
+                    y = fmax(y, sky[j].y);
+                if (y + ph <= s && (y + ph < best_top || (y + ph == best_top && x < best_x))) {
+                    best_top = y + ph;
+                    best_x = x;
+                    best_y = y;
+                    best_turn = turn;
+                }
+            }
+        }
+        if (best_top == INFINITY)
             return false;
-        if (x + pw > s) {
-            y += shelf;
-            x = 0;
-            shelf = 0;
-        }
+        double pw = (best_turn ? c->h : c->w) + gutter;
         if (place) {
-            c->x = x + gutter / 2;
-            c->y = y + gutter / 2;
+            if (best_turn) {
+                double w = c->w;
+                c->w = c->h;
+                c->h = w;
+                c->rotated = !c->rotated;
+            }
+            c->x = best_x + gutter / 2;
+            c->y = best_y + gutter / 2;
         }
-        x += pw;
-        if (ph > shelf)
-            shelf = ph;
+        /* The new segment replaces [best_x, best_x + pw) of the skyline. */
+        struct segment put = {best_x, best_top, pw};
+        struct segment keep[2];
+        uint32_t first = ns, last = 0;
+        for (uint32_t i = 0; i < ns; i++) {
+            double a = sky[i].x, b = sky[i].x + sky[i].w;
+            if (b <= put.x || a >= put.x + put.w)
+                continue;
+            if (first == ns)
+                first = i;
+            last = i;
+        }
+        /* Left remainder of the first overlapped segment, right remainder of the last. */
+        uint32_t nk = 0;
+        if (sky[first].x < put.x)
+            keep[nk++] = (struct segment){sky[first].x, sky[first].y, put.x - sky[first].x};
+        double end = sky[last].x + sky[last].w;
+        struct segment right = {put.x + put.w, sky[last].y, end - (put.x + put.w)};
+        /* Rebuild: before first, left part, put, right part, after last. */
+        uint32_t m = 0;
+        for (uint32_t i = last + 1; i < ns; i++)
+            tmp[m++] = sky[i];
+        uint32_t w = first;
+        for (uint32_t i = 0; i < nk; i++)
+            sky[w++] = keep[i];
+        sky[w++] = put;
+        if (right.w > 1e-12 * s)
+            sky[w++] = right;
+        for (uint32_t i = 0; i < m; i++)
+            sky[w++] = tmp[i];
+        ns = w;
+        /* Merge neighbours of equal height. */
+        uint32_t r = 0;
+        for (uint32_t i = 0; i < ns; i++) {
+            if (r && sky[r - 1].y == sky[i].y)
+                sky[r - 1].w += sky[i].w;
+            else
+                sky[r++] = sky[i];
+        }
+        ns = r;
     }
-    return y + shelf <= s;
+    return true;
 }
 
 static const struct chart *sort_base;
@@ -113,6 +179,7 @@ bool uv_charts_build(const float *pos, uint32_t nv, const uint32_t *tri, uint32_
     double (*proj)[2] = malloc(ne * sizeof(*proj));
     struct chart *ch = NULL;
     uint32_t *order = NULL;
+    struct segment *sky = NULL, *sky_tmp = NULL;
     out->source = malloc(ne * sizeof(uint32_t));
     out->indices = malloc(ne * sizeof(uint32_t));
     if (!normal || !edges || !nb || !chart_of || !queue || !stamp || !newidx || !proj ||
@@ -300,17 +367,23 @@ bool uv_charts_build(const float *pos, uint32_t nv, const uint32_t *tri, uint32_
     sort_base = ch; /* one conversion per process: qsort has no context argument in C11 */
     qsort(order, nc, sizeof(uint32_t), height_desc);
     const double g = (double)UV_CHARTS_GUTTER_TEXELS / UV_CHARTS_ATLAS_TEXELS;
+    sky = malloc((2 * (size_t)nc + 2) * sizeof(*sky));
+    sky_tmp = malloc((2 * (size_t)nc + 2) * sizeof(*sky_tmp));
+    if (!sky || !sky_tmp) {
+        snprintf(err, errlen, "out of memory for uv1 charts");
+        goto done;
+    }
     double lo = sqrt(area), hi = lo;
-    for (int i = 0; i < 200 && !shelf_fits(ch, order, nc, hi, g * hi, false); i++)
+    for (int i = 0; i < 200 && !skyline_fits(ch, order, nc, hi, g * hi, false, sky, sky_tmp); i++)
         hi *= 1.5;
     for (int i = 0; i < 40; i++) {
         double mid = (lo + hi) / 2;
-        if (shelf_fits(ch, order, nc, mid, g * mid, false))
+        if (skyline_fits(ch, order, nc, mid, g * mid, false, sky, sky_tmp))
             hi = mid;
         else
             lo = mid;
     }
-    shelf_fits(ch, order, nc, hi, g * hi, true);
+    skyline_fits(ch, order, nc, hi, g * hi, true, sky, sky_tmp);
 
     out->uv = malloc((size_t)(nvout ? nvout : 1) * sizeof(*out->uv));
     if (!out->uv) {
@@ -346,6 +419,8 @@ done:
     free(proj);
     free(ch);
     free(order);
+    free(sky);
+    free(sky_tmp);
     if (!ok)
         uv_charts_free(out);
     return ok;

@@ -6,17 +6,20 @@
  * whose normals stay within 30 degrees of their chart's first triangle
  * (and agree on orientation) form one chart, projected onto that
  * triangle's plane, so texel density is the same everywhere (uv area is
- * world area times one scale per mesh); charts are packed on shelves, the
- * tallest first, each padded by a gutter of GUTTER_TEXELS at an
- * ATLAS_TEXELS-texel atlas. Vertices are duplicated only where a chart
- * boundary runs through them. Pure and GL-free: any thread, no shared
- * state. */
+ * world area times one scale per mesh); their bounding rectangles are
+ * packed on a skyline (the tallest first, each where its top ends lowest,
+ * either way round) into the smallest square that holds them, each padded
+ * by a gutter of GUTTER_TEXELS at an ATLAS_TEXELS-texel atlas: the
+ * rectangles never overlap, which OSL's raster pass relies on to keep its
+ * filtering inside each chart at every level (daemon/scene/mesh_charts.h).
+ * Vertices are duplicated only where a chart boundary runs through them.
+ * Pure and GL-free: any thread, no shared state. */
 
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
-enum { UV_CHARTS_GUTTER_TEXELS = 2, UV_CHARTS_ATLAS_TEXELS = 1024 };
+enum { UV_CHARTS_GUTTER_TEXELS = 1, UV_CHARTS_ATLAS_TEXELS = 1024 };
 
 struct uv_charts {
     uint32_t vertex_count; /* the new vertices */

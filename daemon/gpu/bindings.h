@@ -54,6 +54,7 @@
 #define SB_TEX_OSL_GEO_NORMAL 2   /* and normals */
 #define SB_TEX_OSL_GEO_ALBEDO 3   /* asset scenes: base colour and roughness baked */
 #define SB_TEX_OSL_GEO_SURFACE 4  /* and emissive and occlusion */
+#define SB_TEX_OSL_ATLAS_SPECULAR 1 /* OSL's raster pass, asset scenes under Phong: specular light */
 #define SB_TEX_POST_SRC 0    /* post effects: the colour the effect reads */
 #define SB_TEX_POST_DEPTH 1  /* the technique's depth texture */
 #define SB_TEX_POST_NORMAL 2 /* the technique's g-buffer normals, when it has them */
@@ -63,6 +64,7 @@
 /* Uniform locations, explicit so that timed code never looks a name up.
  * Arrays take one location per element. */
 #define SB_LOC_EXPOSURE 0     /* resolve: float */
+#define SB_LOC_GAMMA 1        /* resolve: float, 0 for the sRGB curve, else a plain gamma */
 #define SB_LOC_POST_PARAMS 0  /* post effects: vec4 of the effect's options */
 #define SB_LOC_POST_WEIGHTS 1 /* bloom: float[33] Gaussian weights */
 #define SB_LOC_SSAO_NOISE 1   /* ssao: float[16] rotation angles */
@@ -71,6 +73,7 @@
 /* Harness-owned units, bound before every frame's passes for the lighting
  * library (look.ibl, look.shadows): techniques leave 10 and up alone. */
 #define SB_TEX_IBL_SOURCE 10      /* setup only: the cube map being filtered */
+#define SB_TEX_ENV_MAP 11         /* the sky pass: an uploaded equirectangular environment */
 #define SB_TEX_IBL_IRRADIANCE 12  /* cube map array: environment, then each probe */
 #define SB_TEX_IBL_PREFILTERED 13 /* cube map array, roughness picks the level */
 #define SB_TEX_IBL_BRDF 14        /* the split sum's (A, B) table */
@@ -109,5 +112,6 @@
 #define SB_IMG_OSL_ATLAS 0
 #define SB_IMG_HEAT 1 /* light evaluations per pixel (r32ui) */
 #define SB_IMG_OSL_MARKS 2 /* per atlas block, the last frame the raster pass sampled it (r32i) */
+#define SB_IMG_OSL_ATLAS_SPECULAR 3 /* OSL, asset scenes under Phong: the specular plane */
 
 #endif

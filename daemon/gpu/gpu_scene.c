@@ -231,7 +231,7 @@ bool gpu_scene_init(struct gpu_scene *g, const struct scene *s, char *err, size_
     float *inst = calloc(n * INSTANCE_FLOATS, sizeof(float));
     size_t lights = (size_t)(s->light_count ? s->light_count : 1);
     /* std430 Light (shaders/common/scene_data.glsl): three vec4s. */
-    enum { LIGHT_FLOATS = 12 };
+    enum { LIGHT_FLOATS = 16 };
     float *light = calloc(lights * LIGHT_FLOATS, sizeof(float));
     g->position_scratch = calloc(lights * 4, sizeof(float));
     if (!inst || !light || !g->position_scratch) {
@@ -267,6 +267,8 @@ bool gpu_scene_init(struct gpu_scene *g, const struct scene *s, char *err, size_
             o[10] = scene_light_cone_scale(l);
             o[11] = scene_light_sin_outer(l);
         }
+        o[12] = (float)l->falloff;
+        o[13] = l->range;
     }
     glGenBuffers(1, &g->instance_buffer);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->instance_buffer);

@@ -7,10 +7,10 @@
 
 #include "common/clock.h"
 #include "daemon/gpu/glutil.h"
-#include "daemon/harness/deadline.h"
+#include "daemon/jobs/deadline.h"
 #include "daemon/harness/outputs.h"
-#include "daemon/harness/render_state.h"
-#include "daemon/harness/telemetry.h"
+#include "daemon/status/render_state.h"
+#include "daemon/status/telemetry.h"
 
 /* The pass a stopped frame was in, for the message: ", in the X pass". */
 static void where(const struct harness_run *run, char *out, size_t cap)

@@ -16,9 +16,9 @@
 #include "common/log.h"
 #include "daemon/quality/metrics.h"
 #include "common/png_io.h"
-#include "daemon/harness/deadline.h"
-#include "daemon/harness/render_state.h"
-#include "daemon/harness/telemetry.h"
+#include "daemon/jobs/deadline.h"
+#include "daemon/status/render_state.h"
+#include "daemon/status/telemetry.h"
 #include "common/result_keys.h"
 
 struct task {

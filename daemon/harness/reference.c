@@ -9,7 +9,7 @@
 #include "common/job_files.h"
 #include "common/png_io.h"
 #include "daemon/gpu/glutil.h"
-#include "daemon/harness/deadline.h"
+#include "daemon/jobs/deadline.h"
 #include "daemon/quality/flicker.h"
 
 bool frame_source_open(struct harness_run *run, struct frame_source *src, const char *what,

@@ -8,9 +8,9 @@
 #include "daemon/gpu/bindings.h"
 #include "daemon/gpu/glutil.h"
 #include "common/clock.h"
-#include "daemon/harness/deadline.h"
-#include "daemon/harness/render_state.h"
-#include "daemon/jobs/store.h"
+#include "daemon/jobs/deadline.h"
+#include "daemon/status/render_state.h"
+#include "daemon/store/store.h"
 #include "daemon/scene/asset.h"
 
 bool harness_gl_init(struct harness_gl *g, char *err, size_t errlen)
@@ -23,12 +23,12 @@ bool harness_gl_init(struct harness_gl *g, char *err, size_t errlen)
         {GL_FRAGMENT_SHADER, {"resolve.frag"}},
     };
     /* One resolve per tone map, in enum look_tonemap order. */
-    static const char *const tonemaps[3] = {"#define TONEMAP_NONE 1\n",
-                                            "#define TONEMAP_REINHARD 1\n",
-                                            "#define TONEMAP_ACES 1\n"};
+    static const char *const tonemaps[LOOK_TONEMAP_COUNT] = {
+        "#define TONEMAP_NONE 1\n", "#define TONEMAP_REINHARD 1\n", "#define TONEMAP_ACES 1\n",
+        "#define TONEMAP_SRGB 1\n", "#define TONEMAP_PBR_NEUTRAL 1\n"};
     g->targets = gpu_targets_create();
     bool ok = g->targets && gpu_frame_block_init(&g->frame_block);
-    for (int i = 0; ok && i < 3; i++)
+    for (int i = 0; ok && i < LOOK_TONEMAP_COUNT; i++)
         ok = (g->resolve_progs[i] = gl_program_build("resolve", stages, 2, tonemaps[i], err,
                                                      errlen)) != 0;
     if (!ok) {
@@ -45,7 +45,7 @@ void harness_gl_finish(struct harness_gl *g)
     gpu_targets_destroy(g->targets);
     g->targets = NULL;
     gpu_frame_block_finish(&g->frame_block);
-    for (int i = 0; i < 3; i++)
+    for (int i = 0; i < LOOK_TONEMAP_COUNT; i++)
         glDeleteProgram(g->resolve_progs[i]);
     glDeleteVertexArrays(1, &g->empty_vao);
 }
@@ -263,6 +263,32 @@ static bool load_asset(struct harness_run *run)
     return true;
 }
 
+/* look.ibl.environment {"asset": NAME}: its cache, read whole likewise. */
+static bool load_environment(struct harness_run *run)
+{
+    const struct ibl_spec *ibl = &run->spec->look.ibl;
+    if (!ibl->enabled || ibl->environment != IBL_ENV_ASSET)
+        return true;
+    if (!ibl->env_sha256[0]) {
+        snprintf(run->err, sizeof(run->err),
+                 "look.ibl.environment \"%s\": the job carries no asset_sha256 (filled in "
+                 "when the job is accepted)", ibl->env_asset);
+        return false;
+    }
+    const char *state = store_state_dir(queue_store(run->queue));
+    char path[4096], why[600];
+    snprintf(path, sizeof(path), "%s/assets/%s.sbasset", state[0] ? state : ".",
+             ibl->env_sha256);
+    struct environment_limits lim;
+    environment_limits_defaults(&lim);
+    if (!environment_file_read(&run->environment, path, &lim, why, sizeof(why))) {
+        snprintf(run->err, sizeof(run->err), "look.ibl.environment \"%s\": %s",
+                 ibl->env_asset, why);
+        return false;
+    }
+    return true;
+}
+
 bool run_prepare(struct harness_run *run, bool capture)
 {
     const struct job_spec *spec = run->spec;
@@ -271,7 +297,7 @@ bool run_prepare(struct harness_run *run, bool capture)
     run->shadow_pass = run->sky_pass = run->transparent_pass = -1;
     run_budget_init(run);
     double t0 = clock_mono_s();
-    if (!load_asset(run))
+    if (!load_asset(run) || !load_environment(run))
         return false;
     double t1 = clock_mono_s();
     char why[600];
@@ -298,7 +324,8 @@ bool run_prepare(struct harness_run *run, bool capture)
     if (!run_setup_targets(run) ||
         !look_stages_init(&run->stages, &spec->look, &run->scene, &run->gpu,
                           &run->gl->frame_block, &run->gl->caps, &run->budget, run->defines,
-                          run->err, sizeof(run->err)) ||
+                          run->environment.rgb ? &run->environment : NULL, run->err,
+                          sizeof(run->err)) ||
         !transparent_init(&run->transparent, &run->gpu, run->defines, run->err,
                           sizeof(run->err)) ||
         !run_setup_passes(run, job_spec_technique_options(spec),
@@ -337,6 +364,7 @@ void run_finish(struct harness_run *run)
         free(run->asset);
         run->asset = NULL;
     }
+    environment_image_finish(&run->environment);
     for (int i = 0; run->capture && i < run->capture_count; i++) {
         free(run->capture[i].pixels);
         free(run->capture[i].heat);
@@ -434,6 +462,8 @@ static void resolve(const struct harness_run *run)
     bool raw = run->look->debug != LOOK_DEBUG_NONE;
     glUseProgram(g->resolve_progs[raw ? LOOK_TONEMAP_NONE : run->look->tonemap]);
     glUniform1f(SB_LOC_EXPOSURE, raw ? 1.0f : (float)run->look->exposure);
+    glUniform1f(SB_LOC_GAMMA,
+                !raw && run->look->transfer == LOOK_TRANSFER_GAMMA_2_2 ? 2.2f : 0.0f);
     glActiveTexture(GL_TEXTURE0 + SB_TEX_HDR);
     glBindTexture(GL_TEXTURE_2D, run->hdr_resolved);
     glBindVertexArray(g->empty_vao);

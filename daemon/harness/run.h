@@ -19,8 +19,9 @@
 #include "daemon/gpu/gpu_scene.h"
 #include "daemon/gpu/gpu_timer.h"
 #include "daemon/gpu/pass.h"
+#include "daemon/scene/environment.h"
 #include "daemon/gpu/targets.h"
-#include "daemon/harness/interference.h"
+#include "daemon/status/interference.h"
 #include "daemon/harness/motion.h"
 #include "daemon/harness/transparent.h"
 #include "daemon/jobs/queue.h"
@@ -39,7 +40,7 @@ struct harness_gl {
     struct gpu_targets *targets;
     struct gpu_frame_block frame_block;
     GLuint empty_vao;
-    GLuint resolve_progs[3]; /* by look.tonemap: none, reinhard, aces */
+    GLuint resolve_progs[LOOK_TONEMAP_COUNT]; /* by look.tonemap (enum look_tonemap) */
     json_t *device_json;     /* the owner's: immutable once made, read by other threads */
 };
 
@@ -83,6 +84,9 @@ struct harness_run {
     /* scene.asset: the cache file's asset, read in run_prepare (never in a
      * timed region), which the scene borrows until run_finish. */
     struct asset *asset;
+    /* look.ibl.environment {"asset": ...}: its image, read likewise and
+     * kept until run_finish (the look's sky uploads it). */
+    struct environment_image environment;
     /* Asset scenes, set-up before the warm-up: reading the cache file, and
      * building the scene and its GL objects (textures with their mipmaps,
      * buffers) up to a glFinish. */

@@ -1,5 +1,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "daemon/harness/runner.h"
+#include "daemon/jobs/fidelity.h"
+#include "daemon/harness/fidelity_render.h"
 
 #include <epoxy/gl.h>
 #include <errno.h>
@@ -20,14 +22,14 @@
 #include "daemon/gpu/egl.h"
 #include "daemon/gpu/glutil.h"
 #include "daemon/gpu/targets.h"
-#include "daemon/harness/deadline.h"
+#include "daemon/jobs/deadline.h"
 #include "daemon/harness/measure.h"
 #include "daemon/harness/metrics_stage.h"
 #include "daemon/harness/outputs.h"
 #include "daemon/harness/reference.h"
-#include "daemon/harness/render_state.h"
+#include "daemon/status/render_state.h"
 #include "daemon/harness/run.h"
-#include "daemon/harness/telemetry.h"
+#include "daemon/status/telemetry.h"
 #include "daemon/harness/temporal.h"
 #include "daemon/service.h"
 
@@ -52,6 +54,15 @@ struct runner {
     struct harness_gl gl;
     double idle_rss; /* the resident set once the context was up */
 };
+
+/* The fidelity worker (daemon/jobs/fidelity.h), set once before
+ * runner_create; NULL: fidelity jobs fail saying so. */
+static struct fidelity *fidelity_worker;
+
+void runner_use_fidelity(struct fidelity *f)
+{
+    fidelity_worker = f;
+}
 
 static const char *gl_str(GLenum name)
 {
@@ -198,7 +209,7 @@ static void run_job(struct runner *r, struct job *job)
     struct harness_run run = {.gl = &r->gl, .queue = r->queue, .job = job, .spec = &job->spec};
     const struct job_spec *spec = &job->spec;
     enum job_status status = JOB_FAILED;
-    json_t *result = NULL;
+    json_t *result = NULL, *fidelity_view = NULL;
 
     LOG(LOG_INFO, "job %s: %s, %d+%d frames at %dx%d, %d run(s)", job->id, spec->technique,
         spec->warmup_frames, spec->frames, spec->scene.width, spec->scene.height,
@@ -240,6 +251,14 @@ static void run_job(struct runner *r, struct job *job)
             result = NULL;
         }
     }
+    if (result && spec->fidelity.enabled) {
+        queue_set_phase(r->queue, job, "fidelity");
+        render_state_phase("fidelity");
+        if (!(fidelity_view = fidelity_render(&run, &status))) {
+            json_decref(result);
+            result = NULL;
+        }
+    }
     if (result)
         status = JOB_DONE;
 done:;
@@ -255,7 +274,17 @@ done:;
     } else {
         LOG(LOG_INFO, "job %s rendered", id);
         run_finish(&run);
-        if (spec->reference[0]) {
+        if (spec->fidelity.enabled && !fidelity_worker) {
+            json_decref(result);
+            json_decref(fidelity_view);
+            queue_finish(r->queue, job, JOB_FAILED, "fidelity: this daemon runs no fidelity "
+                         "worker (shadebenchd --once compares nothing)", NULL);
+        } else if (spec->fidelity.enabled) {
+            /* The Khronos reference and the comparisons, on the fidelity
+             * worker; the render thread waits for it before the next job. */
+            render_state_phase("fidelity");
+            fidelity_submit(fidelity_worker, job, result, fidelity_view);
+        } else if (spec->reference[0]) {
             queue_set_phase(r->queue, job, "metrics");
             /* Still this job's until the metrics thread is done with it: the
              * render thread waits for that before the next job. */
@@ -335,6 +364,7 @@ static void *runner_main(void *arg)
     for (;;) {
         /* The metrics and files of earlier jobs finish before the next job is timed. */
         metrics_worker_wait_idle(r->metrics);
+        fidelity_wait_idle(fidelity_worker);
         if (!give_back_memory(r, &egl, err, sizeof(err))) {
             LOG(LOG_ERROR, "the render thread stops: no GL context after a large job: %s", err);
             break;

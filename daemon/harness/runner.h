@@ -9,10 +9,15 @@
 #include <stdbool.h>
 #include <stddef.h>
 
-#include "daemon/harness/render_state.h"
+#include "daemon/status/render_state.h"
 #include "daemon/jobs/queue.h"
 
 struct runner;
+
+/* The fidelity worker fidelity jobs are handed to (daemon/reference/
+ * fidelity.h); call before runner_create. */
+struct fidelity;
+void runner_use_fidelity(struct fidelity *f);
 
 /* Starts the render thread and waits until its context is up (or failed). */
 struct runner *runner_create(struct queue *q, int device, bool gl_debug,

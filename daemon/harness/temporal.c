@@ -7,7 +7,7 @@
 
 #include "common/result_keys.h"
 #include "daemon/harness/reference.h"
-#include "daemon/harness/render_state.h"
+#include "daemon/status/render_state.h"
 #include "daemon/quality/flicker.h"
 #include "daemon/quality/ghosting.h"
 

@@ -23,9 +23,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "daemon/jobs/asset_store.h"
+#include "daemon/store/asset_store.h"
 #include "daemon/jobs/queue.h"
-#include "daemon/jobs/store.h"
+#include "daemon/store/store.h"
 #include "daemon/scene/scene_spec.h"
 
 /* Conversions at once, and uploads that may stream or wait to convert at
@@ -45,10 +45,24 @@ struct assets_config {
     struct asset_run_limits run;
 };
 
-/* Why a request is refused: the HTTP status, the field and the rule; job
- * the id of the job that holds an asset (409). */
+/* Why a request is refused, by cause; the API layer answers each with its
+ * HTTP status (daemon/api/asset_handlers.c). */
+enum assets_cause {
+    ASSETS_INTERNAL,      /* the store cannot be read or written, out of memory */
+    ASSETS_INVALID,       /* a name, a body or a job's scene.asset breaks a rule */
+    ASSETS_READ_ONLY,     /* an --asset-dir asset, written over HTTP */
+    ASSETS_NOT_FOUND,     /* no asset of that name */
+    ASSETS_CONFLICT,      /* held by a queued job, still converting, or not the pinned hash */
+    ASSETS_TOO_LARGE,     /* over --max-asset-bytes */
+    ASSETS_UNCONVERTIBLE, /* the converter refused or failed on the file */
+    ASSETS_BUSY,          /* ASSETS_MAX_UPLOADS already stream or convert */
+    ASSETS_STOPPING,      /* the daemon is stopping */
+    ASSETS_NO_SPACE,      /* the state directory's disk is full */
+};
+
+/* A refusal: its cause, the field and the rule. */
 struct assets_error {
-    unsigned status;
+    enum assets_cause cause;
     char field[64];
     char message[512];
 };
@@ -79,9 +93,10 @@ json_t *assets_info_json(const struct assets *a);
  * unknown, chunked); NULL with e when refused. write: each piece of the
  * body, hashed and written to a temporary file under STATE_DIR/assets; past
  * the limit, or on a full disk, the rest is read and dropped and finish
- * answers 413 or 507. finish consumes u: queues the conversion and returns
- * its ticket (> 0), whose answer assets_ticket_take gives once
- * assets_ticket_done; 0 with e when refused. abort: the client went away. */
+ * refuses it (ASSETS_TOO_LARGE, ASSETS_NO_SPACE). finish consumes u: queues
+ * the conversion and returns its ticket (> 0), whose answer
+ * assets_ticket_take gives once assets_ticket_done; 0 with e when refused.
+ * abort: the client went away. */
 struct asset_upload;
 struct asset_upload *assets_upload_begin(struct assets *a, const char *name,
                                          uint64_t content_length, struct assets_error *e);
@@ -89,23 +104,44 @@ void assets_upload_write(struct asset_upload *u, const void *data, size_t len);
 uint64_t assets_upload_finish(struct asset_upload *u, struct assets_error *e);
 void assets_upload_abort(struct asset_upload *u);
 bool assets_ticket_done(struct assets *a, uint64_t ticket);
-/* The answer (a new reference) and its status; the ticket is released.
- * False when there is no such ticket. */
-bool assets_ticket_take(struct assets *a, uint64_t ticket, unsigned *status, json_t **body);
+/* A conversion's answer: the stored record (name, sha256, size, format,
+ * description), a new reference, and whether it replaced one of that name;
+ * or, with record NULL, the refusal. */
+struct assets_answer {
+    json_t *record;
+    bool replaced;
+    struct assets_error refusal;
+};
+/* The answer; the ticket is released. False when there is no such ticket
+ * or it is not done. */
+bool assets_ticket_take(struct assets *a, uint64_t ticket, struct assets_answer *out);
 /* The client went away: the conversion goes on, its answer is dropped. */
 void assets_ticket_drop(struct assets *a, uint64_t ticket);
 
-/* GET /v1/assets/NAME, GET /v1/assets?limit=&cursor=, DELETE
- * /v1/assets/NAME: a new reference, or NULL with e. */
+/* GET /v1/assets/NAME: the record with the converter's description; DELETE
+ * /v1/assets/NAME: what was deleted. A new reference, or NULL with e. */
 json_t *assets_describe(struct assets *a, const char *name, struct assets_error *e);
-json_t *assets_list(struct assets *a, const char *cursor, int limit, struct assets_error *e);
 json_t *assets_delete(struct assets *a, const char *name, struct assets_error *e);
+/* GET /v1/assets?limit=&cursor=: a page of records (their descriptions as
+ * counts), the cursor of the next page ("" on the last), and the
+ * --asset-dir files still converting or that failed. */
+struct assets_page {
+    json_t *items; /* a new reference */
+    char next[STORE_ASSET_NAME_CAP];
+    size_t converting, failed;
+};
+bool assets_list(struct assets *a, const char *cursor, int limit, struct assets_page *page,
+                 struct assets_error *e);
 
 /* A job's scene.asset: fills scene->asset_sha256 from the store, or
- * refuses (400 unknown name, 409 pinned hash differs or still converting). */
+ * refuses (ASSETS_INVALID: an unknown name; ASSETS_CONFLICT: the pinned hash
+ * differs, or it is still converting). */
 bool assets_resolve(struct assets *a, struct scene_spec *scene, struct assets_error *e);
+/* Every asset a job names: scene.asset, and look.ibl.environment's (and
+ * reference_look's) {"asset": NAME}, which must be an environment map. */
+bool assets_resolve_job(struct assets *a, struct job_spec *spec, struct assets_error *e);
 /* queue_submit's resolver (queue.h), ctx the assets. */
-bool assets_queue_resolver(void *ctx, struct scene_spec *scene, char *field, size_t field_cap,
+bool assets_queue_resolver(void *ctx, struct job_spec *spec, char *field, size_t field_cap,
                            char *message, size_t message_cap);
 
 #endif

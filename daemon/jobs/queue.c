@@ -5,9 +5,9 @@
 #include "common/clock.h"
 #include "common/log.h"
 #include "common/result_keys.h"
-#include "daemon/jobs/job_figures.h"
-#include "daemon/jobs/job_dir.h"
-#include "daemon/jobs/store_reserve.h"
+#include "daemon/spec/job_figures.h"
+#include "daemon/store/job_dir.h"
+#include "daemon/store/store_reserve.h"
 
 #include <errno.h>
 #include <pthread.h>
@@ -299,10 +299,10 @@ enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *sp
     /* Every job naming an asset, a sweep's points included, is pinned to the
      * asset's hash as it is accepted (daemon/jobs/assets.h). */
     struct job_spec resolved;
-    if (spec->scene.asset[0] && q->resolve_asset) {
+    if (job_spec_names_asset(spec) && q->resolve_asset) {
         char field[64], message[512];
         resolved = *spec;
-        if (!q->resolve_asset(q->resolve_ctx, &resolved.scene, field, sizeof(field), message,
+        if (!q->resolve_asset(q->resolve_ctx, &resolved, field, sizeof(field), message,
                               sizeof(message))) {
             records_set_submit_error("%s: %s", field, message);
             return QUEUE_REFUSED;
@@ -968,10 +968,14 @@ bool queue_asset_in_use(struct queue *q, const char *name, const char *sha256,
     pthread_mutex_lock(&q->lock);
     for (size_t i = 0; i < q->live.count && !used; i++) {
         const struct job *j = q->live.items[i];
-        if (job_status_finished(j->status) || !j->spec.scene.asset[0])
+        if (job_status_finished(j->status) || !job_spec_names_asset(&j->spec))
             continue;
+        const struct ibl_spec *env = &j->spec.look.ibl;
+        bool named_env = env->enabled && env->environment == IBL_ENV_ASSET;
         used = (name && strcmp(j->spec.scene.asset, name) == 0) ||
-               (sha256 && strcmp(j->spec.scene.asset_sha256, sha256) == 0);
+               (sha256 && strcmp(j->spec.scene.asset_sha256, sha256) == 0) ||
+               (named_env && name && strcmp(env->env_asset, name) == 0) ||
+               (named_env && sha256 && strcmp(env->env_sha256, sha256) == 0);
         if (used)
             snprintf(id_out, RECORD_ID_LEN, "%s", j->id);
     }

@@ -25,9 +25,9 @@
 #include <stdatomic.h>
 #include <stdbool.h>
 
-#include "daemon/jobs/job_spec.h"
-#include "daemon/jobs/records.h"
-#include "daemon/jobs/store.h"
+#include "daemon/spec/job_spec.h"
+#include "daemon/store/records.h"
+#include "daemon/store/store.h"
 
 /* id (first: store_live), spec, dir and frames_total never change once the
  * job is accepted;
@@ -154,10 +154,11 @@ bool queue_job_dir(struct queue *q, const char *id, char *dir, size_t cap,
  * no lock (the HTTP layer writes to an eventfd). Set once, before serving. */
 void queue_set_listener(struct queue *q, void (*fn)(void *ctx), void *ctx);
 
-/* scene.asset: called by queue_submit (any thread, no lock of the queue's
- * held) for a spec naming an asset; fills scene->asset_sha256, or returns
- * false with the field and the rule. Set once, before submissions start. */
-typedef bool (*queue_asset_resolver)(void *ctx, struct scene_spec *scene, char *field,
+/* scene.asset and look.ibl.environment's asset: called by queue_submit
+ * (any thread, no lock of the queue's held) for a spec naming an asset
+ * (job_spec_names_asset); fills the hashes, or returns false with the
+ * field and the rule. Set once, before submissions start. */
+typedef bool (*queue_asset_resolver)(void *ctx, struct job_spec *spec, char *field,
                                      size_t field_cap, char *message, size_t message_cap);
 void queue_set_asset_resolver(struct queue *q, queue_asset_resolver fn, void *ctx);
 /* Is a queued or running job using the asset of that name, or of that hash

@@ -14,9 +14,9 @@
 #include "common/fsutil.h"
 #include "common/log.h"
 #include "common/stats.h"
-#include "daemon/jobs/records.h"
-#include "daemon/jobs/store.h"
-#include "daemon/jobs/sweep_table.h"
+#include "daemon/store/records.h"
+#include "daemon/store/store.h"
+#include "daemon/spec/sweep_table.h"
 #include "common/result_keys.h"
 
 /* At most this many finished sweeps go at a time (retention). */

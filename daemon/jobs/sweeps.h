@@ -21,7 +21,7 @@
 #include <stdbool.h>
 
 #include "daemon/jobs/queue.h"
-#include "daemon/jobs/sweep_spec.h"
+#include "daemon/spec/sweep_spec.h"
 
 #define SWEEPS_MAX_WAITING 16
 

@@ -3,8 +3,10 @@
 
 #include <stddef.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "common/options.h"
+#include "daemon/scene/scene_spec.h" /* scene_asset_name_valid */
 
 const char *const ibl_environment_names[] = {"sky", "uniform", NULL};
 const char *const shadow_overflow_names[] = {"drop_report", "fail", NULL};
@@ -86,11 +88,74 @@ static const struct opt_hooks probe_hooks = {
     .rule = "must be a count from 0 to 32, or a list of {\"position\": [x, y, z], "
             "\"radius\": r}"};
 
+/* environment: "sky", "uniform", or {"asset": NAME} (an uploaded HDR
+ * image; "asset_sha256" pins it, as scene.asset_sha256 does). */
+static bool parse_environment(const json_t *v, const char *field, void *opts,
+                              struct job_error *err)
+{
+    struct ibl_spec *s = opts;
+    static const char rule[] = "must be \"sky\", \"uniform\" or {\"asset\": NAME} (an "
+                               "equirectangular .hdr stored with PUT /v1/assets/NAME)";
+    s->env_asset[0] = s->env_sha256[0] = '\0';
+    if (json_is_string(v)) {
+        for (int i = 0; ibl_environment_names[i]; i++)
+            if (strcmp(json_string_value(v), ibl_environment_names[i]) == 0) {
+                s->environment = i;
+                return true;
+            }
+        return job_error_set(err, field, "%s", rule);
+    }
+    static const char *const keys[] = {"asset", "asset_sha256", NULL};
+    char prefix[96];
+    snprintf(prefix, sizeof(prefix), "%s.", field);
+    if (!json_is_object(v))
+        return job_error_set(err, field, "%s", rule);
+    if (!jf_check_keys(v, prefix, keys, err))
+        return false;
+    const char *name = json_string_value(json_object_get(v, "asset"));
+    char f[96];
+    snprintf(f, sizeof(f), "%s.asset", field);
+    if (!name || !scene_asset_name_valid(name))
+        return job_error_set(err, f, "must be the name of a stored environment (GET "
+                             "/v1/assets): 1 to %d letters, digits, '.', '_' or '-', not "
+                             "starting with '.'", IBL_ENV_ASSET_NAME_MAX);
+    snprintf(s->env_asset, sizeof(s->env_asset), "%s", name);
+    json_t *h = json_object_get(v, "asset_sha256");
+    if (h) {
+        const char *hex = json_is_string(h) ? json_string_value(h) : "";
+        bool ok = strlen(hex) == 64;
+        for (int i = 0; ok && i < 64; i++)
+            ok = (hex[i] >= '0' && hex[i] <= '9') || (hex[i] >= 'a' && hex[i] <= 'f');
+        snprintf(f, sizeof(f), "%s.asset_sha256", field);
+        if (!ok)
+            return job_error_set(err, f, "must be 64 lowercase hexadecimal digits (the "
+                                 "asset's SHA-256)");
+        memcpy(s->env_sha256, hex, 65);
+    }
+    s->environment = IBL_ENV_ASSET;
+    return true;
+}
+
+static json_t *environment_json(const void *opts)
+{
+    const struct ibl_spec *s = opts;
+    if (s->environment != IBL_ENV_ASSET)
+        return json_string(ibl_environment_names[s->environment]);
+    json_t *o = json_pack("{s:s}", "asset", s->env_asset);
+    if (o && s->env_sha256[0])
+        json_object_set_new(o, "asset_sha256", json_string(s->env_sha256));
+    return o;
+}
+
+static const struct opt_hooks environment_hooks = {
+    .parse = parse_environment, .to_json = environment_json, .type = "choice_or_object",
+    .rule = "\"sky\", \"uniform\" or {\"asset\": NAME}: an uploaded equirectangular .hdr"};
+
 static const struct opt_field ibl_fields[] = {
-    {.name = "environment", .type = OPT_CHOICE, .def = IBL_ENV_SKY,
-     .choices = ibl_environment_names,
+    {.name = "environment", .type = OPT_CUSTOM, .hooks = &environment_hooks,
      .summary = "sky: an analytic sky with a sun; uniform: constant radiance (the white "
-                "furnace's)",
+                "furnace's); {\"asset\": NAME}: an uploaded equirectangular HDR image (PUT "
+                "/v1/assets/NAME.hdr), prefiltered as the sky is",
      .offset = offsetof(struct ibl_spec, environment)},
     {.name = "intensity", .type = OPT_NUMBER, .def = 1.0, .min = 0.0, .max = 1000.0,
      .summary = "scales the environment's radiance",

@@ -15,8 +15,13 @@
 enum ibl_environment {
     IBL_ENV_SKY,     /* an analytic sky with a sun, made in code */
     IBL_ENV_UNIFORM, /* constant radiance (intensity): the white furnace's */
+    IBL_ENV_ASSET,   /* an uploaded equirectangular HDR image: {"asset": NAME} */
 };
-extern const char *const ibl_environment_names[];
+extern const char *const ibl_environment_names[]; /* "sky", "uniform" (the strings) */
+
+/* An environment asset's name: as scene.asset's (scene_spec.h:
+ * SCENE_ASSET_NAME_MAX, scene_asset_name_valid). */
+#define IBL_ENV_ASSET_NAME_MAX 128
 
 #define IBL_MAX_PROBES 32
 #define IBL_MAX_BLEND 8
@@ -29,6 +34,11 @@ struct ibl_probe_spec {
 struct ibl_spec {
     bool enabled;
     int environment;  /* enum ibl_environment */
+    /* IBL_ENV_ASSET: the stored asset's name, and its SHA-256 once the job
+     * is accepted (the HTTP side looks it up, as for scene.asset), so that
+     * the result names the exact file. */
+    char env_asset[IBL_ENV_ASSET_NAME_MAX + 1];
+    char env_sha256[65];
     double intensity; /* scales the environment's radiance */
     int probes;       /* light probes capturing the scene; 0: the environment alone */
     bool placed;      /* probes given as a list (probe[]), else placed over the objects */

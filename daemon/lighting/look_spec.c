@@ -6,7 +6,9 @@
 
 static const char *const lighting_names[] = {"phong", "blinn_phong", "pbr", NULL};
 static const char *const hdr_names[] = {"rgba32f", "rgba16f", NULL};
-static const char *const tonemap_names[] = {"none", "reinhard", "aces", NULL};
+static const char *const transfer_names[] = {"srgb", "gamma_2.2", NULL};
+const char *const look_tonemap_names[] = {"none", "reinhard", "aces", "srgb", "pbr_neutral",
+                                          NULL};
 const char *const look_debug_names[] = {"none",           "shading_normal", "geometric_normal",
                                         "normal_texture", "tangent",        "bitangent",
                                         "base_color",     "metallic",       "roughness",
@@ -70,9 +72,16 @@ static const struct opt_field fields[] = {
     {.name = "exposure", .type = OPT_NUMBER, .def = 1.0, .min = 1.0 / 1024.0, .max = 1024.0,
      .summary = "scales the HDR colour in the resolve, before the tone curve",
      .offset = offsetof(struct look_spec, exposure)},
-    {.name = "tonemap", .type = OPT_CHOICE, .def = LOOK_TONEMAP_NONE, .choices = tonemap_names,
-     .summary = "the resolve's tone curve: none clamps; the curves write 8-bit sRGB",
+    {.name = "tonemap", .type = OPT_CHOICE, .def = LOOK_TONEMAP_NONE, .choices = look_tonemap_names,
+     .summary = "the resolve's tone curve: none clamps (linear, no encoding); srgb clamps and "
+                "encodes sRGB; reinhard, aces and pbr_neutral (Khronos PBR Neutral) compress "
+                "highlights, then encode sRGB",
      .offset = offsetof(struct look_spec, tonemap)},
+    {.name = "transfer", .type = OPT_CHOICE, .def = LOOK_TRANSFER_SRGB,
+     .choices = transfer_names,
+     .summary = "how the tone maps' display-referred output is encoded: srgb (IEC 61966-2-1) "
+                "or gamma_2.2 (the Khronos glTF Sample Viewer's); none is never encoded",
+     .offset = offsetof(struct look_spec, transfer)},
     {.name = "post", .type = OPT_CUSTOM, .hooks = &post_hooks,
      .summary = "post effects run on the HDR output in order (/v1/info's \"effects\")",
      .offset = offsetof(struct look_spec, post)},

@@ -18,8 +18,13 @@
 
 enum look_lighting { LOOK_PHONG, LOOK_BLINN_PHONG, LOOK_PBR };
 enum look_hdr { LOOK_HDR_RGBA32F, LOOK_HDR_RGBA16F };
-/* none: a clamp, no encoding; the curves write 8-bit sRGB. */
-enum look_tonemap { LOOK_TONEMAP_NONE, LOOK_TONEMAP_REINHARD, LOOK_TONEMAP_ACES };
+/* none: a clamp, no encoding; srgb: a clamp and the sRGB encoding, no
+ * curve; the curves write 8-bit sRGB (tone_curves.h). */
+enum look_tonemap {
+    LOOK_TONEMAP_NONE, LOOK_TONEMAP_REINHARD, LOOK_TONEMAP_ACES, LOOK_TONEMAP_SRGB,
+    LOOK_TONEMAP_PBR_NEUTRAL, LOOK_TONEMAP_COUNT
+};
+extern const char *const look_tonemap_names[]; /* the JSON spelling, by enum */
 /* A surface channel drawn in place of the lit image (none: the lit image),
  * each encoded as the Khronos glTF Sample Viewer writes its debug output
  * of the same name (docs/api.md, "look.debug"), so that the two compare
@@ -41,12 +46,17 @@ enum look_debug {
     LOOK_DEBUG_ALPHA,            /* base colour alpha (1 for opaque materials), grey */
 };
 extern const char *const look_debug_names[]; /* "none", "shading_normal", ... */
+/* How the display-referred outputs (every tone map but none) are encoded:
+ * the exact sRGB curve, or a plain gamma of 2.2, the Khronos glTF Sample
+ * Viewer's (tone_curves.h), to compare with its images. */
+enum look_transfer { LOOK_TRANSFER_SRGB, LOOK_TRANSFER_GAMMA_2_2 };
 
 struct look_spec {
     int lighting;    /* enum look_lighting */
     int hdr;         /* enum look_hdr: the format of the HDR target techniques draw into */
     double exposure; /* scales the HDR colour in the resolve, before the tone curve */
     int tonemap;     /* enum look_tonemap */
+    int transfer;    /* enum look_transfer */
     struct post_spec post;      /* effects the harness runs on the HDR output, in order */
     struct ibl_spec ibl;        /* image-based lighting (needs lighting pbr) */
     struct shadow_spec shadows; /* omni shadow maps for the point lights */

@@ -403,7 +403,10 @@ json_t *look_ibl_describe(const struct look_ibl *ibl)
     return json_pack(
         "{s:s, s:f, s:o, s:s, s:i, s:i, s:i, s:i, s:i, s:o, s:{s:i, s:i}, s:f, "
         "s:{s:f, s:f, s:f, s:f}, s:{s:f, s:f}, s:s}",
-        "environment", ibl_environment_names[ibl->spec.environment], "intensity",
+        "environment",
+        ibl->spec.environment == IBL_ENV_ASSET ? ibl->spec.env_asset
+                                               : ibl_environment_names[ibl->spec.environment],
+        "intensity",
         ibl->spec.intensity, "probes", probes, "placement", ibl->spec.placed ? "given" : "auto",
         "resolution", ibl->resolution, "prefiltered_levels", ibl->levels, "irradiance_size",
         IRRADIANCE_SIZE, "samples", ibl->spec.samples, "blend", ibl->spec.blend,

@@ -28,7 +28,10 @@ void look_defines(const struct look_spec *look, char *out, size_t cap)
                         "#define LIGHTING_%s 1\n#define PBR_MIN_ROUGHNESS %s\n#define ENV_%s 1\n"
                         "#define ENV_INTENSITY %s\n",
                         models[look->lighting], rough,
-                        look->ibl.environment == IBL_ENV_UNIFORM ? "UNIFORM" : "SKY", intensity);
+                        look->ibl.environment == IBL_ENV_UNIFORM ? "UNIFORM"
+                        : look->ibl.environment == IBL_ENV_ASSET && look->ibl.enabled ? "MAP"
+                                                                                      : "SKY",
+                        intensity);
     if (look->ibl.enabled && used > 0 && (size_t)used < cap)
         used += snprintf(out + used, cap - (size_t)used,
                          "#define LOOK_IBL 1\n#define IBL_MAX_BLEND %d\n", IBL_MAX_BLEND);
@@ -56,8 +59,8 @@ void look_defines(const struct look_spec *look, char *out, size_t cap)
 bool look_stages_init(struct look_stages *l, const struct look_spec *look,
                        const struct scene *scene, struct gpu_scene *gpu,
                        struct gpu_frame_block *frame_block, const struct gpu_caps *caps,
-                       struct gpu_budget *budget, const char *defines, char *err,
-                       size_t errlen)
+                       struct gpu_budget *budget, const char *defines,
+                       const struct environment_image *env, char *err, size_t errlen)
 {
     memset(l, 0, sizeof(*l));
     l->budget = budget;
@@ -66,8 +69,18 @@ bool look_stages_init(struct look_stages *l, const struct look_spec *look,
     l->gpu = gpu;
     double t0 = clock_mono_s();
     l->debug_on = look->debug != LOOK_DEBUG_NONE;
-    l->sky_on = scene->sky && !l->debug_on;
-    if ((l->sky_on || look->ibl.enabled) && !look_sky_init(&l->sky, defines, err, errlen))
+    /* An uploaded environment is drawn behind every scene, as a glTF
+     * viewer shows it (not behind a debug channel, which the viewer draws
+     * on its clear colour). */
+    bool env_map = look->ibl.enabled && look->ibl.environment == IBL_ENV_ASSET;
+    if (env_map && !env) {
+        snprintf(err, errlen, "look.ibl.environment: the environment \"%s\" was not loaded",
+                 look->ibl.env_asset);
+        goto fail;
+    }
+    l->sky_on = (scene->sky || env_map) && !l->debug_on;
+    if ((l->sky_on || look->ibl.enabled) &&
+        !look_sky_init(&l->sky, defines, env_map ? env : NULL, err, errlen))
         goto fail;
     if (l->debug_on && !look_debug_init(&l->debug, gpu, defines, err, errlen))
         goto fail;

@@ -44,13 +44,14 @@ struct look_stages {
 };
 
 /* Builds what the look needs for this scene (captures and filters the
- * probes: the job's setup time). On failure err names the field where one
+ * probes: the job's setup time). env: the environment image
+ * look.ibl.environment names (read by the caller), else NULL. On failure err names the field where one
  * is to blame; the look is left finished. */
 bool look_stages_init(struct look_stages *l, const struct look_spec *look,
                        const struct scene *scene, struct gpu_scene *gpu,
                        struct gpu_frame_block *frame_block, const struct gpu_caps *caps,
-                       struct gpu_budget *budget, const char *defines, char *err,
-                       size_t errlen);
+                       struct gpu_budget *budget, const char *defines,
+                       const struct environment_image *env, char *err, size_t errlen);
 /* Takes a zeroed or initialised look. */
 void look_stages_finish(struct look_stages *l);
 

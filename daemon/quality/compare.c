@@ -70,6 +70,29 @@ double metrics_memory_bytes(int width, int height, double flip_ppd)
            2.0 * width * 3.0;
 }
 
+double metrics_alpha_memory_bytes(int width, int height)
+{
+    double n = (double)width * (double)height;
+    return 2.0 * n + 2.0 * n * 3.0;
+}
+
+/* img's colours times its alpha, rounded to 8 bits: the image composited
+ * over black. An opaque image is copied as it is. */
+static bool premultiplied(const struct image *img, struct image *out)
+{
+    size_t n = (size_t)img->width * (size_t)img->height;
+    *out = (struct image){.width = img->width, .height = img->height,
+                          .rgb = malloc(n > 0 ? n * 3 : 1)};
+    if (!out->rgb)
+        return false;
+    for (size_t i = 0; i < n; i++) {
+        unsigned a = img->alpha ? img->alpha[i] : 255;
+        for (int c = 0; c < 3; c++)
+            out->rgb[3 * i + c] = (uint8_t)((img->rgb[3 * i + c] * a + 127) / 255);
+    }
+    return true;
+}
+
 json_t *metrics_compare(const struct image *ref, const struct image *test,
                         const struct metrics_options *o, const char *ssim_map_path,
                         const char *flip_map_path, const struct metrics_stop *stop, char *err,
@@ -84,6 +107,20 @@ json_t *metrics_compare(const struct image *ref, const struct image *test,
         snprintf(err, errlen, "%dx%d is %lld pixels, over the limit of %lld", ref->width,
                  ref->height, (long long)ref->width * ref->height, IMAGE_MAX_PIXELS);
         return NULL;
+    }
+    /* PerceptualDiff premultiplies itself, in float; the others read the
+     * premultiplied 8-bit copies of translucent images. */
+    const struct image *pdiff_ref = ref, *pdiff_test = test;
+    struct image pm_ref = {0}, pm_test = {0};
+    if (ref->alpha || test->alpha) {
+        if (!premultiplied(ref, &pm_ref) || !premultiplied(test, &pm_test)) {
+            image_finish(&pm_ref);
+            image_finish(&pm_test);
+            snprintf(err, errlen, "out of memory for the premultiplied images");
+            return NULL;
+        }
+        ref = &pm_ref;
+        test = &pm_test;
     }
     struct flip_task flip = {.ref = ref, .test = test, .ppd = o->flip_ppd,
                              .map_path = flip_map_path, .stop = stop};
@@ -117,7 +154,7 @@ json_t *metrics_compare(const struct image *ref, const struct image *test,
     }
     if (o->which & METRIC_PDIFF) {
         struct pdiff_result p;
-        if (!pdiff_compute(ref, test, &o->pdiff, stop, &p, err, errlen))
+        if (!pdiff_compute(pdiff_ref, pdiff_test, &o->pdiff, stop, &p, err, errlen))
             goto fail;
         json_object_set_new(out, "pdiff",
                             json_pack("{s:b, s:I, s:f, s:I}", "pass", p.pass, "failing_pixels",
@@ -157,10 +194,14 @@ json_t *metrics_compare(const struct image *ref, const struct image *test,
     }
     /* FLIP overlaps the others: the wall time of the whole comparison. */
     json_object_set_new(timing, "total", json_real((clock_mono_s() * 1e3) - start));
+    image_finish(&pm_ref);
+    image_finish(&pm_test);
     return out;
 fail:
     if (flip_threaded)
         pthread_join(flip_tid, NULL);
     json_decref(out);
+    image_finish(&pm_ref);
+    image_finish(&pm_test);
     return NULL;
 }

@@ -84,6 +84,11 @@ void pdiff_defaults(struct pdiff_options *o);
 bool pdiff_compute(const struct image *a, const struct image *b,
                    const struct pdiff_options *o, const struct metrics_stop *stop,
                    struct pdiff_result *out, char *err, size_t errlen);
+/* The same, and where failing_mask is not NULL (width x height bytes, zeroed by the
+ * caller) sets the failing pixels to 1: the mask the dashboard shows. */
+bool pdiff_compute_mask(const struct image *a, const struct image *b,
+                        const struct pdiff_options *o, const struct metrics_stop *stop,
+                        struct pdiff_result *out, uint8_t *failing_mask, char *err, size_t errlen);
 
 enum metric_kind { METRIC_SSIM = 1, METRIC_PDIFF = 2, METRIC_PSNR = 4, METRIC_FLIP = 8 };
 #define METRIC_ALL (METRIC_SSIM | METRIC_PDIFF | METRIC_PSNR | METRIC_FLIP)
@@ -110,7 +115,11 @@ bool flip_compute(const struct image *ref, const struct image *test, double ppd,
 
 /* Computes the chosen metrics of test against ref and returns them as JSON
  * (see README, "metrics"); writes the SSIM and FLIP maps where a path is
- * given. NULL on failure with err filled. */
+ * given. NULL on failure with err filled. An image with alpha
+ * (shadebench-compare's translucent PNGs) is judged premultiplied:
+ * PerceptualDiff premultiplies in float before its gamma, as perceptualdiff
+ * does, and SSIM, PSNR and FLIP see each pixel's colour times its alpha,
+ * rounded to 8 bits (the image composited over black). */
 json_t *metrics_compare(const struct image *ref, const struct image *test,
                         const struct metrics_options *o, const char *ssim_map_path,
                         const char *flip_map_path, const struct metrics_stop *stop, char *err,
@@ -119,6 +128,10 @@ json_t *metrics_compare(const struct image *ref, const struct image *test,
 /* The most memory metrics_compare uses on width x height images with the
  * given FLIP pixels per degree, the two images included. */
 double metrics_memory_bytes(int width, int height, double flip_ppd);
+
+/* What translucent images add to metrics_memory_bytes: their alpha planes
+ * and the premultiplied copies SSIM, PSNR and FLIP read. */
+double metrics_alpha_memory_bytes(int width, int height);
 
 /* Each metric's share of metrics_memory_bytes (images excluded). */
 size_t ssim_memory_bytes(int width, int height);
@@ -134,5 +147,24 @@ bool metrics_write_ssim_map(const char *path, const struct ssim_result *s, char 
                             size_t errlen);
 bool metrics_write_flip_map(const char *path, const struct flip_result *f, int width,
                             int height, char *err, size_t errlen);
+
+/* The FLIP map's ramp: its stops (r, g, b in 0..1, from 0 to 1 evenly);
+ * returns their count. /v1/info serves it, so that a page can read values
+ * back from the map. */
+int metrics_flip_ramp(const float (**stops)[3]);
+/* The colour of FLIP value v (0 to 1), as the map writes it. */
+void metrics_flip_ramp_colour(float v, uint8_t rgb[3]);
+/* The value a colour of the map stands for: the nearest point of the ramp. */
+float metrics_flip_ramp_value(const uint8_t rgb[3]);
+
+/* Difference views for people, with contrast (the reports): a FLIP map
+ * (ramp colours) with its values times gain, cut at 1; an SSIM map (grey,
+ * white = 1) with its shortfall from 1 times gain; |a - b| per channel
+ * times gain into out (malloc'ed; image_finish it), with the count of
+ * pixels that differ at all. */
+void metrics_stretch_flip_map(struct image *map, float gain);
+void metrics_stretch_ssim_map(struct image *map, float gain);
+bool metrics_abs_difference(const struct image *a, const struct image *b, float gain,
+                            struct image *out, long *differing);
 
 #endif

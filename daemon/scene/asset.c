@@ -220,9 +220,13 @@ json_t *asset_describe(const struct asset *a)
                               name_json(a->lights[i].name));
     for (uint32_t i = 0; i < a->camera_count; i++) {
         const struct asset_camera *c = &a->cameras[i];
-        if (json_array_append_new(cams, json_pack("{so ss sf}", "name", name_json(c->name),
-                                                  "type", c->perspective ? "perspective" : "orthographic",
-                                                  "yfov", (double)c->yfov)))
+        json_t *cj = c->perspective
+                         ? json_pack("{so ss sf}", "name", name_json(c->name), "type",
+                                     "perspective", "yfov", (double)c->yfov)
+                         : json_pack("{so ss sf sf}", "name", name_json(c->name), "type",
+                                     "orthographic", "xmag", (double)(c->yfov * c->aspect),
+                                     "ymag", (double)c->yfov);
+        if (json_array_append_new(cams, cj))
             goto oom;
     }
     for (uint32_t i = 0; i < a->ignored_count; i++)

@@ -151,8 +151,12 @@ struct asset_light {
 
 struct asset_camera {
     char name[ASSET_NAME_MAX];
-    bool perspective; /* else orthographic (reported, drawn as perspective at yfov) */
-    float yfov, znear, zfar, aspect; /* zfar 0: infinite; aspect 0: the file gives none */
+    bool perspective; /* else orthographic: */
+    /* Perspective: yfov (radians) and aspect (0: the file gives none).
+     * Orthographic: yfov holds ymag (the half-height) and aspect xmag /
+     * ymag, so that the cache's records stay as they were. zfar 0:
+     * infinite. */
+    float yfov, znear, zfar, aspect;
     float eye[3], forward[3], up[3]; /* world space, unit forward and up */
 };
 

@@ -322,7 +322,7 @@ static void lights_and_cameras(struct asset *a)
     snprintf(l->name, sizeof(l->name), "sun");
     l->type = ASSET_LIGHT_DIRECTIONAL;
     l->color[0] = 1.0f, l->color[1] = 0.98f, l->color[2] = 0.9f;
-    l->intensity = 60.0f; /* lux */
+    l->intensity = 2.0f; /* lux: a white surface facing it shows 2 / pi at exposure 1 */
     l->direction[0] = 0.4f, l->direction[1] = -1.0f, l->direction[2] = -0.3f;
     normalize3(l->direction);
 

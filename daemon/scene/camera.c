@@ -1,6 +1,7 @@
-/* Camera paths: static (the preset's pose), orbit (circles the bounds'
- * centre at a distance that keeps every bounding sphere in view) and
- * flythrough (a smooth closed loop above the objects, through the light
+/* Camera paths: static (the preset's pose, the asset's camera, or the pose
+ * scene.camera states, perspective or orthographic), orbit (circles the
+ * bounds' centre at a distance that keeps every bounding sphere in view)
+ * and flythrough (a smooth closed loop above the objects, through the light
  * volume, looking ahead and down). Each is a pure function of the frame
  * index: integer arithmetic first (frame mod period), then one angle. */
 #include <math.h>
@@ -96,6 +97,25 @@ static void perspective(float m[16], float inv[16], float fovy_deg, float aspect
     inv[15] = m[10] / m[14];
 }
 
+/* glTF's orthographic projection (half-extents xmag, ymag; planes n, f)
+ * and its inverse: clip = (x / xmag, y / ymag, 2 z / (n - f) + (f + n) /
+ * (n - f), 1). */
+static void orthographic(float m[16], float inv[16], float xmag, float ymag, float n, float f)
+{
+    memset(m, 0, 16 * sizeof(float));
+    m[0] = 1.0f / xmag;
+    m[5] = 1.0f / ymag;
+    m[10] = 2.0f / (n - f);
+    m[14] = (f + n) / (n - f);
+    m[15] = 1.0f;
+    memset(inv, 0, 16 * sizeof(float));
+    inv[0] = xmag;
+    inv[5] = ymag;
+    inv[10] = 0.5f * (n - f);
+    inv[14] = -0.5f * (f + n);
+    inv[15] = 1.0f;
+}
+
 bool scene_camera_moves(const struct scene *s)
 {
     return s->spec.camera != SCENE_CAMERA_STATIC && s->spec.camera_period > 1;
@@ -118,8 +138,11 @@ static void fly_eye(const struct scene *s, double a, float out[3])
 static void camera_matrices(const struct scene *s, struct scene_camera *c)
 {
     look_at(c->view, c->inv_view, c->eye, c->target, c->up);
-    perspective(c->proj, c->inv_proj, c->fovy_deg, (float)s->spec.width / (float)s->spec.height,
-                c->near_z, c->far_z);
+    if (c->orthographic)
+        orthographic(c->proj, c->inv_proj, c->xmag, c->ymag, c->near_z, c->far_z);
+    else
+        perspective(c->proj, c->inv_proj, c->fovy_deg,
+                    (float)s->spec.width / (float)s->spec.height, c->near_z, c->far_z);
     scene_mat4_mul(c->view_proj, c->proj, c->view);
 }
 
@@ -170,6 +193,11 @@ void scene_camera_at(const struct scene *s, int64_t frame, struct scene_camera *
     case SCENE_CAMERA_STATIC:
         memcpy(out->eye, r->eye, sizeof(out->eye));
         memcpy(out->target, r->target, sizeof(out->target));
+        if (r->up[0] != 0.0f || r->up[1] != 0.0f || r->up[2] != 0.0f)
+            memcpy(out->up, r->up, sizeof(out->up));
+        out->orthographic = r->orthographic;
+        out->xmag = r->xmag;
+        out->ymag = r->ymag;
         break;
     case SCENE_CAMERA_ORBIT:
         orbit_camera(s, r->orbit_azimuth + a, r->orbit_distance, out);
@@ -202,8 +230,12 @@ void scene_rig_derive(struct scene *s)
     struct scene_box fit = s->objects;
     double radius2 = 0;
     for (int k = 0; k < 3; k++) {
-        fit.min[k] = fminf(fit.min[k], s->light_volume.min[k]);
-        fit.max[k] = fmaxf(fit.max[k], s->light_volume.max[k]);
+        /* An asset's generated lights stand around it, outside: the orbit
+         * frames the asset alone. */
+        if (!s->asset) {
+            fit.min[k] = fminf(fit.min[k], s->light_volume.min[k]);
+            fit.max[k] = fmaxf(fit.max[k], s->light_volume.max[k]);
+        }
         r->centre[k] = 0.5f * (fit.min[k] + fit.max[k]);
         double half = 0.5 * ((double)fit.max[k] - fit.min[k]);
         radius2 += half * half;
@@ -242,4 +274,43 @@ void scene_rig_derive(struct scene *s)
     r->fly_height[0] = s->objects.max[1] + 1.5f;
     r->fly_height[1] = fmaxf(s->light_volume.max[1], r->fly_height[0] + 3.0f);
     r->fly_look_y = 0.5f * (s->objects.min[1] + s->objects.max[1]);
+}
+
+void scene_apply_pose(struct scene *s)
+{
+    const struct scene_camera_spec *v = &s->spec.view;
+    struct scene_rig *r = &s->rig;
+    if (!v->given)
+        return;
+    for (int k = 0; k < 3; k++) {
+        r->eye[k] = (float)v->eye[k];
+        r->target[k] = (float)v->target[k];
+        r->up[k] = (float)v->up[k];
+    }
+    if (v->yfov_deg > 0)
+        r->fovy_deg = (float)v->yfov_deg;
+    r->orthographic = v->orthographic;
+    if (v->orthographic) {
+        r->ymag = (float)v->ymag;
+        r->xmag = v->xmag > 0 ? (float)v->xmag
+                              : (float)(v->ymag * s->spec.width / (double)s->spec.height);
+    }
+    if (v->far_z > 0) {
+        r->near_z = (float)v->near_z;
+        r->far_z = (float)v->far_z;
+        return;
+    }
+    /* Derived: from just before the nearest point of the bounds' sphere to
+     * just past its farthest (a thousandth of the far plane when the eye
+     * stands inside it). */
+    double c2 = 0, radius2 = 0;
+    for (int k = 0; k < 3; k++) {
+        double c = 0.5 * ((double)s->bounds.min[k] + s->bounds.max[k]);
+        double half = 0.5 * ((double)s->bounds.max[k] - s->bounds.min[k]);
+        c2 += (v->eye[k] - c) * (v->eye[k] - c);
+        radius2 += half * half;
+    }
+    double dist = sqrt(c2), radius = fmax(sqrt(radius2), 1e-3) * 1.05;
+    r->far_z = (float)(dist + radius);
+    r->near_z = (float)fmax(1e-3 * (dist + radius), dist - radius);
 }

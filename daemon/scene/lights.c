@@ -3,6 +3,7 @@
  * builds the same lights on every run and machine. */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "daemon/scene/scene_build.h"
 
@@ -91,11 +92,16 @@ bool scene_add_sun(struct scene *s)
         return false;
     s->lights = grown;
     struct scene_light *l = &s->lights[s->light_count++];
+    /* In glTF's terms too (a directional light has no falloff, so the flag
+     * changes no pixel): colour SCENE_SUN_COLOR x light_intensity at pi lux
+     * is the shading colour, for the result's light list. */
     *l = (struct scene_light){.type = SCENE_LIGHT_DIRECTIONAL, .period = 1, .cos_inner = 1.0f,
-                              .cos_outer = 1.0f};
+                              .cos_outer = 1.0f, .falloff = SCENE_FALLOFF_GLTF,
+                              .gltf_intensity = (float)PI};
     for (int k = 0; k < 3; k++) {
         l->direction[k] = SCENE_SUN_DIRECTION[k];
         l->color[k] = SCENE_SUN_COLOR[k] * (float)s->spec.light_intensity;
+        l->gltf_color[k] = l->color[k];
     }
     return true;
 }
@@ -146,5 +152,66 @@ bool scene_place_lights(struct scene *s, float orbit)
                         : base_period;
         l->phase = (i * 37) % base_period % l->period;
     }
+    return true;
+}
+
+float scene_gltf_light_radius(float intensity, const float color[3], float range, float reach)
+{
+    if (range > 0.0f)
+        return range;
+    /* I c / (pi d^2) = SCENE_LIGHT_CUTOFF */
+    double c = fmax(color[0], fmax(color[1], color[2]));
+    double d = sqrt(fmax(intensity * c, 0.0) / (PI * SCENE_LIGHT_CUTOFF));
+    return (float)fmax(d, reach);
+}
+
+bool scene_add_rig(struct scene *s)
+{
+    const struct scene_spec *spec = &s->spec;
+    if (!spec->rig_count)
+        return true;
+    struct scene_light *grown =
+        realloc(s->lights, (size_t)(s->light_count + spec->rig_count) * sizeof(*grown));
+    if (!grown)
+        return false;
+    s->lights = grown;
+    /* A light without a range reaches at least across the bounds. */
+    double diag2 = 0;
+    for (int k = 0; k < 3; k++)
+        diag2 += pow((double)s->bounds.max[k] - s->bounds.min[k], 2);
+    float reach = (float)fmax(sqrt(diag2), 1.0);
+    for (int i = 0; i < spec->rig_count; i++) {
+        const struct scene_rig_light *r = &spec->rig[i];
+        struct scene_light *l = &s->lights[s->light_count + i];
+        memset(l, 0, sizeof(*l));
+        l->type = (enum scene_light_type)r->type;
+        l->period = 1; /* stands where the job put it */
+        l->falloff = SCENE_FALLOFF_GLTF;
+        l->range = (float)r->range;
+        l->gltf_intensity = (float)r->intensity;
+        for (int k = 0; k < 3; k++) {
+            l->centre[k] = (float)r->position[k];
+            l->direction[k] = (float)r->direction[k];
+            l->gltf_color[k] = (float)r->color[k];
+            l->color[k] = (float)(r->color[k] * r->intensity / PI);
+        }
+        if (l->type == SCENE_LIGHT_DIRECTIONAL) {
+            /* As an asset's: no position, but a centre far up-light of the
+             * bounds for the code that measures distances to lights. */
+            for (int k = 0; k < 3; k++)
+                l->centre[k] = 0.5f * (s->bounds.min[k] + s->bounds.max[k]) -
+                               4.0f * reach * l->direction[k];
+            l->radius = 16.0f * reach;
+            l->cos_inner = l->cos_outer = -1.0f;
+            continue;
+        }
+        l->radius = scene_gltf_light_radius(l->gltf_intensity, l->gltf_color, l->range, reach);
+        if (l->type == SCENE_LIGHT_SPOT) {
+            l->cos_inner = (float)cos(r->inner_cone_deg * PI / 180.0);
+            l->cos_outer = (float)cos(r->outer_cone_deg * PI / 180.0);
+        }
+    }
+    s->light_count += spec->rig_count;
+    s->rig_light_count = spec->rig_count;
     return true;
 }

@@ -155,6 +155,9 @@ bool scene_build(struct scene *out, const struct scene_spec *spec, const struct 
     out->mover = -1;
     if (!scene_add_mover(out))
         goto fail;
+    if (!scene_add_rig(out))
+        goto fail;
+    scene_apply_pose(out);
     scene_rig_derive(out);
     scene_choose_segments(out);
     if (!mesh_create_sphere(&out->meshes[SCENE_MESH_SPHERE], SCENE_SPHERE_RADIUS,
@@ -368,6 +371,14 @@ static json_t *describe_lights(const struct scene *s)
     return out;
 }
 
+static json_t *mat4_json(const float m[16])
+{
+    json_t *a = json_array();
+    for (int i = 0; a && i < 16; i++)
+        json_array_append_new(a, json_real(m[i]));
+    return a;
+}
+
 static json_t *describe_camera(const struct scene *s)
 {
     const struct scene_rig *r = &s->rig;
@@ -379,6 +390,21 @@ static json_t *describe_camera(const struct scene *s)
                           "near", (double)cam.near_z, "far", (double)cam.far_z,
                           "eye_at_frame_0", vec3_json(cam.eye), "target_at_frame_0",
                           vec3_json(cam.target));
+    /* The frame-0 camera exactly as drawn, for a renderer that must
+     * reproduce it (the glTF reference): column-major, GL clip space. */
+    json_object_set_new(o, "up_at_frame_0", vec3_json(cam.up));
+    json_object_set_new(o, "projection", json_string(cam.orthographic ? "orthographic"
+                                                                      : "perspective"));
+    json_object_set_new(o, "aspect", json_real((double)s->spec.width / s->spec.height));
+    if (cam.orthographic)
+        json_object_set_new(o, "orthographic", json_pack("{s:f, s:f}", "xmag", (double)cam.xmag,
+                                                         "ymag", (double)cam.ymag));
+    json_object_set_new(o, "view_matrix", mat4_json(cam.view));
+    json_object_set_new(o, "projection_matrix", mat4_json(cam.proj));
+    json_object_set_new(o, "source", json_string(s->spec.view.given ? "scene.camera"
+                                                 : s->asset_camera >= 0 ? "asset camera"
+                                                 : s->asset ? "framed from the bounds"
+                                                            : "preset"));
     if (s->spec.camera == SCENE_CAMERA_ORBIT)
         json_object_update_new(o, json_pack("{s:o, s:f, s:f}", "centre", vec3_json(r->centre),
                                             "distance", (double)r->orbit_distance,
@@ -391,6 +417,52 @@ static json_t *describe_camera(const struct scene *s)
                                             (double)r->fly_height[1], "look_at_height",
                                             (double)r->fly_look_y));
     return o;
+}
+
+/* The lights in glTF's terms (KHR_lights_punctual), where they have them:
+ * every light of an asset scene and scene.light_rig's, at frame 0, in
+ * order, at most SCENE_DESCRIBE_MAX_GLTF_LIGHTS. */
+#define SCENE_DESCRIBE_MAX_GLTF_LIGHTS 1024
+static json_t *describe_gltf_lights(const struct scene *s)
+{
+    json_t *list = json_array();
+    int listed = 0;
+    for (int i = 0; list && i < s->light_count; i++) {
+        const struct scene_light *l = &s->lights[i];
+        if (l->falloff != SCENE_FALLOFF_GLTF)
+            continue;
+        if (listed++ >= SCENE_DESCRIBE_MAX_GLTF_LIGHTS)
+            continue;
+        const char *source = i < s->generated_light_count ? "generated"
+                             : i < s->generated_light_count + s->asset_light_count ? "asset"
+                             : i >= s->light_count - s->rig_light_count ? "light_rig"
+                                                                         : "sun";
+        json_t *o = json_pack("{s:i, s:s, s:s, s:o, s:f, s:f}", "index", i, "source", source,
+                              "type", scene_light_type_names[l->type], "color",
+                              vec3_json(l->gltf_color), "intensity", (double)l->gltf_intensity,
+                              "radius", (double)l->radius);
+        if (l->type != SCENE_LIGHT_DIRECTIONAL) {
+            float p[3];
+            scene_light_position(s, i, 0, p);
+            json_object_set_new(o, "position", vec3_json(p));
+            json_object_set_new(o, "range", l->range > 0 ? json_real(l->range) : json_null());
+        }
+        if (l->type != SCENE_LIGHT_POINT)
+            json_object_set_new(o, "direction", vec3_json(l->direction));
+        if (l->type == SCENE_LIGHT_SPOT) {
+            json_object_set_new(o, "inner_cone_deg", json_real(acos(l->cos_inner) * 180.0 / PI));
+            json_object_set_new(o, "outer_cone_deg", json_real(acos(l->cos_outer) * 180.0 / PI));
+        }
+        json_array_append_new(list, o);
+    }
+    json_t *out = json_pack("{s:o, s:i, s:s}", "lights", list, "count", listed, "units",
+                            "KHR_lights_punctual: intensity in candela (point, spot) or lux "
+                            "(directional), colour linear; falloff 1 / d^2 times the range "
+                            "window; radius: where the light is cut (its range, or where its "
+                            "radiance off a white surface falls below 1/1024)");
+    if (out && listed > SCENE_DESCRIBE_MAX_GLTF_LIGHTS)
+        json_object_set_new(out, "truncated_to", json_integer(SCENE_DESCRIBE_MAX_GLTF_LIGHTS));
+    return out;
 }
 
 /* What an asset scene is: which asset, its size, materials by alpha mode,
@@ -413,7 +485,8 @@ static json_t *describe_asset(const struct scene *s)
     for (int t = 0; t < ASSET_TEX_SLOTS; t++)
         json_object_set_new(by_slot, asset_texture_slot_names[t], json_integer(slots[t]));
     int types[3] = {0, 0, 0};
-    for (int l = s->generated_light_count; l < s->light_count; l++)
+    for (int l = s->generated_light_count;
+         l < s->generated_light_count + s->asset_light_count; l++)
         types[s->lights[l].type]++;
     uint64_t texels = 0;
     for (uint32_t i = 0; i < a->image_count; i++)
@@ -471,6 +544,8 @@ json_t *scene_describe(const struct scene *s)
                                       (double)(SCENE_SPHERE_RADIUS *
                                                s->instances[s->mover].scale),
                                       "period", s->spec.mover_period));
+    if (out && (s->asset || s->rig_light_count))
+        json_object_set_new(out, "gltf_lights", describe_gltf_lights(s));
     if (out && s->mesh_instance_count[SCENE_MESH_TEAPOT])
         json_object_set_new(
             out, "teapot_tessellation",

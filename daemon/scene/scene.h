@@ -64,6 +64,18 @@ extern const char *const scene_light_type_names[]; /* "point", "spot", "directio
 extern const float SCENE_SUN_DIRECTION[3];
 extern const float SCENE_SUN_COLOR[3];
 
+/* How a point or spot light's strength falls with distance d:
+ *  - WINDOW, the presets' (the thesis's): (1 - d^2 / radius^2)^2, colour
+ *    the irradiance of a surface facing it up close;
+ *  - GLTF, KHR_lights_punctual's: 1 / d^2 times, with a range, the window
+ *    clamp(1 - (d / range)^4, 0, 1); colour in candela (lux for a
+ *    directional light) over pi. Asset scenes' lights and scene.light_rig
+ *    use it, so that a glTF viewer given the same lights draws the same
+ *    image. Without a range the light is cut at radius, where its
+ *    radiance off a white surface falls below SCENE_LIGHT_CUTOFF. */
+enum scene_light_falloff { SCENE_FALLOFF_WINDOW, SCENE_FALLOFF_GLTF };
+#define SCENE_LIGHT_CUTOFF (1.0 / 1024.0)
+
 struct scene_light {
     float centre[3];
     float orbit;  /* circle radius around centre, in the scene's orbit plane */
@@ -74,6 +86,12 @@ struct scene_light {
     enum scene_light_type type; /* zero: point, what every preset places */
     float direction[3];         /* spot and directional: unit, the way the light shines */
     float cos_inner, cos_outer; /* spot: cosines of the cone's inner and outer angles */
+    enum scene_light_falloff falloff;
+    float range;     /* GLTF: the file's or rig's range, 0 for none (radius is then the cut-off) */
+    /* GLTF: what the light is in glTF's terms (colour 0..1 and intensity
+     * in candela or lux; colour above is their product over pi times
+     * scene.light_intensity), for the result's light list. */
+    float gltf_color[3], gltf_intensity;
 };
 
 struct scene_box {
@@ -84,13 +102,18 @@ struct scene_box {
  * right-handed view looking down -z, clip z in [-w, w]). */
 struct scene_camera {
     float eye[3], target[3], up[3], fovy_deg, near_z, far_z;
+    bool orthographic;  /* then xmag and ymag, the view's half-extents, replace fovy_deg */
+    float xmag, ymag;
     float view[16], proj[16], view_proj[16], inv_view[16], inv_proj[16];
 };
 
 /* What the camera paths are derived from (scene_init fills it). */
 struct scene_rig {
-    float eye[3], target[3];   /* the static pose: the preset's own */
+    float eye[3], target[3];   /* the static pose: the preset's own, the asset's or scene.camera's */
+    float up[3];               /* the static pose's up ({0, 0, 0}: +y) */
     float fovy_deg, near_z, far_z;
+    bool orthographic;         /* the static pose is orthographic (never moves): */
+    float xmag, ymag;          /* its half-extents */
     float centre[3];           /* orbit: circles this, the bounds' centre... */
     float orbit_distance;      /* ...at a distance that keeps the bounds in view, */
     float orbit_elevation;     /* the static pose's elevation (radians), */
@@ -140,6 +163,7 @@ struct scene {
     int *mesh_asset_index;     /* per scene mesh: the asset's mesh index, -1 procedural */
     int asset_light_count;     /* lights[generated..]: the asset's, after the generated ones */
     int generated_light_count;
+    int rig_light_count;       /* scene.light_rig's, the last lights */
     int asset_camera;          /* the asset camera of the static pose, -1: framed from the bounds */
     /* scene.mover (mover.c): the moving sphere's instance (the last of the
      * spheres), -1 without one, and the ends of the segment its centre

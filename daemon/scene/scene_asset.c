@@ -1,25 +1,25 @@
 /* A scene from an asset (daemon/scene/asset.h): each asset mesh one scene
  * mesh and one instance, its vertices re-centred on its box's centre and
  * the instance standing there (scale 1), so that bounding spheres, shadow
- * casters and culling see each mesh where it is; the asset's bounds as the
- * light volume; its camera, or a view framing the bounds; its
- * KHR_lights_punctual lights converted to the daemon's colour scale, and
- * generated point lights in the bounds as the lights preset places them.
+ * casters and culling see each mesh where it is; its camera (up vector and
+ * orthographic projection honoured), or a view framing the bounds; its
+ * KHR_lights_punctual lights, and generated point lights around and over
+ * it, outside its bounds.
  *
- * Light conversion (documented in docs/scenes.md): a daemon light colour is
- * the irradiance a surface facing the light receives, and its attenuation
- * is a window that reaches 0 at the light's radius (no inverse square). A
- * glTF point or spot light of intensity I candela gives I lux at 1 m, so
- * its colour is color * I / SCENE_ASSET_LIGHT_UNIT; its radius is its
- * range, or with no range the distance at which the inverse-square
- * irradiance I / d^2 falls to SCENE_ASSET_LIGHT_FLOOR_LUX. A directional
- * light of E lux has colour color * E / SCENE_ASSET_LIGHT_UNIT. */
+ * Every light of an asset scene is a glTF punctual light (scene.h:
+ * SCENE_FALLOFF_GLTF; docs/scenes.md): intensity in candela (point, spot)
+ * or lux (directional), falling off as 1 / d^2 times the range window, so
+ * that the Khronos glTF Sample Viewer given the result's light list draws
+ * the same light. The shading library's light colour is then
+ * color * intensity / pi (its BRDF is pi times glTF's), times
+ * scene.light_intensity. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "daemon/scene/asset.h"
+#include "daemon/scene/mesh_charts.h"
 #include "daemon/scene/scene_build.h"
 
 static const double PI = 3.14159265358979323846;
@@ -128,11 +128,9 @@ static bool build_mesh(struct mesh *out, const struct asset_mesh *am, const floa
             d2 += o->pos[k] * o->pos[k];
         }
         r2 = fmaxf(r2, d2);
-        /* OSL's unique parametrisation is uv1, one chart over [0, 1]^2: the
-         * converter's charts have their own gutters. */
+        /* OSL's unique parametrisation is uv1; its charts' rectangles are
+         * set below (mesh_chart_rects). */
         o->uv[0] = v->uv1[0], o->uv[1] = v->uv1[1];
-        o->chart[0] = o->chart[1] = 0.0f;
-        o->chart[2] = o->chart[3] = 1.0f;
         o->tex[0] = v->uv0[0], o->tex[1] = v->uv0[1];
         o->tex[2] = v->texcoord1[0], o->tex[3] = v->texcoord1[1];
         memcpy(o->tangent, v->tangent, sizeof(o->tangent));
@@ -157,7 +155,7 @@ static bool build_mesh(struct mesh *out, const struct asset_mesh *am, const floa
                               ((double)p2->uv1[0] - p0->uv1[0]) * ((double)p1->uv1[1] - p0->uv1[1]));
     }
     out->uv_per_unit = area > 0.0 ? (float)sqrt(uv_area / area) : 1.0f;
-    return true;
+    return mesh_chart_rects(out, NULL);
 }
 
 /* The asset camera spec.asset_camera names: "" the first, digits an index,
@@ -217,8 +215,25 @@ static void static_pose(struct scene *s, int cam)
         for (int k = 0; k < 3; k++) {
             r->eye[k] = ac->eye[k];
             r->target[k] = ac->eye[k] + dist * ac->forward[k];
+            r->up[k] = ac->up[k];
         }
-        r->fovy_deg = ac->yfov > 0.0f ? (float)(ac->yfov * 180.0 / PI) : 50.0f;
+        /* The node's up, unless it lies along the view (a degenerate file). */
+        float dot = ac->up[0] * ac->forward[0] + ac->up[1] * ac->forward[1] +
+                    ac->up[2] * ac->forward[2];
+        float up2 = ac->up[0] * ac->up[0] + ac->up[1] * ac->up[1] + ac->up[2] * ac->up[2];
+        if (!(up2 > 0.5f) || fabsf(dot) > 0.999f)
+            r->up[0] = r->up[2] = 0.0f, r->up[1] = 1.0f;
+        if (ac->perspective) {
+            r->fovy_deg = ac->yfov > 0.0f ? (float)(ac->yfov * 180.0 / PI) : 50.0f;
+        } else {
+            /* The cache keeps an orthographic camera's ymag in yfov and
+             * xmag / ymag in aspect (asset.h). */
+            r->orthographic = true;
+            r->fovy_deg = 50.0f; /* unused */
+            r->ymag = ac->yfov > 0.0f ? ac->yfov : radius;
+            r->xmag = ac->aspect > 0.0f ? r->ymag * ac->aspect
+                                        : r->ymag * (float)s->spec.width / (float)s->spec.height;
+        }
         r->near_z = ac->znear > 0.0f ? ac->znear : 0.01f * dist;
         r->far_z = ac->zfar > r->near_z ? ac->zfar : dist + 2.0f * radius;
         return;
@@ -238,32 +253,47 @@ static void static_pose(struct scene *s, int cam)
     r->far_z = dist + 2.0f * radius;
 }
 
+/* The asset's bounding sphere: centre and radius (half the box's diagonal). */
+static float asset_sphere(const struct asset *a, float c[3])
+{
+    float half2 = 0.0f;
+    for (int k = 0; k < 3; k++) {
+        c[k] = 0.5f * (a->box_min[k] + a->box_max[k]);
+        float h = 0.5f * (a->box_max[k] - a->box_min[k]);
+        half2 += h * h;
+    }
+    return fmaxf(sqrtf(half2), 1e-3f);
+}
+
+/* A light of glTF colour and intensity in the shading library's terms. */
+static void set_gltf(const struct scene *s, struct scene_light *l, const float color[3],
+                     float intensity)
+{
+    l->falloff = SCENE_FALLOFF_GLTF;
+    l->gltf_intensity = (float)(intensity * s->spec.light_intensity);
+    for (int k = 0; k < 3; k++) {
+        l->gltf_color[k] = color[k];
+        l->color[k] = (float)(color[k] * l->gltf_intensity / PI);
+    }
+}
+
 /* The asset's lights, converted (see the top of this file). */
 static void convert_light(const struct scene *s, const struct asset_light *al,
                           struct scene_light *l)
 {
-    const struct asset *a = s->asset;
-    float diag2 = 0.0f, c[3];
-    for (int k = 0; k < 3; k++) {
-        float e = a->box_max[k] - a->box_min[k];
-        diag2 += e * e;
-        c[k] = 0.5f * (a->box_min[k] + a->box_max[k]);
-    }
-    float diag = fmaxf(sqrtf(diag2), 1e-3f);
+    float c[3], radius = asset_sphere(s->asset, c);
     memset(l, 0, sizeof(*l));
     l->period = 1; /* still: an asset's lights stand where the file puts them */
-    float scale = (float)(al->intensity / SCENE_ASSET_LIGHT_UNIT * s->spec.light_intensity);
-    for (int k = 0; k < 3; k++)
-        l->color[k] = al->color[k] * scale;
+    set_gltf(s, l, al->color, al->intensity);
     memcpy(l->direction, al->direction, sizeof(l->direction));
     switch (al->type) {
     case ASSET_LIGHT_POINT:
     case ASSET_LIGHT_SPOT:
         l->type = al->type == ASSET_LIGHT_SPOT ? SCENE_LIGHT_SPOT : SCENE_LIGHT_POINT;
         memcpy(l->centre, al->position, sizeof(l->centre));
-        l->radius = al->range > 0.0f
-                        ? al->range
-                        : fmaxf(1.0f, sqrtf(al->intensity / (float)SCENE_ASSET_LIGHT_FLOOR_LUX));
+        l->range = al->range > 0.0f ? al->range : 0.0f;
+        l->radius = scene_gltf_light_radius(l->gltf_intensity, l->gltf_color, l->range,
+                                            4.0f * radius);
         l->cos_inner = cosf(al->inner_cone);
         l->cos_outer = cosf(al->outer_cone);
         break;
@@ -274,11 +304,85 @@ static void convert_light(const struct scene *s, const struct asset_light *al,
          * measures distances to every light (scene_describe's counts). */
         l->type = SCENE_LIGHT_DIRECTIONAL;
         for (int k = 0; k < 3; k++)
-            l->centre[k] = c[k] - 4.0f * diag * al->direction[k];
-        l->radius = 16.0f * diag;
+            l->centre[k] = c[k] - 8.0f * radius * al->direction[k];
+        l->radius = 32.0f * radius;
         l->cos_inner = l->cos_outer = -1.0f;
         break;
     }
+}
+
+/* Generated lights around and over the asset (docs/scenes.md): the layout
+ * picks a point u of the unit cube per light (Halton, hashed, lattice or
+ * clusters, as in a preset's volume). u0 and u1 give a direction from the
+ * asset's centre, azimuth 2 pi u0 and elevation asin(0.2 + 0.75 u1) (12 to
+ * 72 degrees up); the light stands beyond the point where that ray leaves
+ * the asset's box, by a gap of (0.15 + 0.35 u2) times its range, and at
+ * least 1.5 times its orbit (0.03 R) beyond that face. So every light is
+ * outside the box, circling too, and a light of small
+ * range (scene.light_radius) hugs the surfaces near it: many small lights
+ * still overlap unevenly over the asset, as the many-lights benchmarks
+ * need. Each is a glTF point light (or a spot aimed at the centre) of range
+ * 5 R ("auto": from its farthest gap, 2.5 R beyond a box inside the sphere
+ * of radius R, every point of the asset within reach) and of intensity
+ * 30 R^2 / N x (range / 5 R)^2 candela for N lights: at "auto" range, N
+ * lights at about 2.5 R give a white surface facing the light about 0.6 of
+ * radiance, neither dark nor clipped at exposure 1; a smaller range scales
+ * the intensity with its square, so the light its nearby surfaces get stays
+ * about the same. */
+static bool place_generated(struct scene *s)
+{
+    const struct asset *a = s->asset;
+    float c[3], R = asset_sphere(a, c);
+    s->light_volume = (struct scene_box){{0, 0, 0}, {1, 1, 1}};
+    s->light_orbit_plane = SCENE_ORBIT_XZ;
+    float orbit = 0.03f * R;
+    if (!scene_place_lights(s, orbit))
+        return false;
+    int n = s->light_count;
+    float range = s->spec.light_radius > 0 ? (float)s->spec.light_radius : 5.0f * R;
+    float intensity = n ? 30.0f * R * R / (float)n * powf(range / (5.0f * R), 2.0f) : 0.0f;
+    struct scene_box box = {{c[0], c[1], c[2]}, {c[0], c[1], c[2]}};
+    for (int i = 0; i < n; i++) {
+        struct scene_light *l = &s->lights[i];
+        double az = 2.0 * PI * l->centre[0], el = asin(0.2 + 0.75 * l->centre[1]);
+        double dir[3] = {cos(el) * sin(az), sin(el), cos(el) * cos(az)};
+        /* Where the ray from the centre leaves the box, through the face
+         * across axis `face`. */
+        double exit = INFINITY;
+        int face = 1;
+        for (int k = 0; k < 3; k++) {
+            double half = 0.5 * ((double)a->box_max[k] - a->box_min[k]);
+            if (fabs(dir[k]) > 1e-9 && half / fabs(dir[k]) < exit)
+                exit = half / fabs(dir[k]), face = k;
+        }
+        double gap = range * (0.15 + 0.35 * l->centre[2]), p[3];
+        for (int k = 0; k < 3; k++)
+            p[k] = c[k] + (exit + gap) * dir[k];
+        /* At least 1.5 orbits beyond that face, so that circling (which
+         * moves a light by at most one orbit) never takes it inside. */
+        double beyond = gap * fabs(dir[face]), need = 1.5 * orbit;
+        if (beyond < need)
+            p[face] += (dir[face] < 0 ? -1.0 : 1.0) * (need - beyond);
+        for (int k = 0; k < 3; k++) {
+            l->centre[k] = (float)p[k];
+            box.min[k] = fminf(box.min[k], l->centre[k]);
+            box.max[k] = fmaxf(box.max[k], l->centre[k]);
+            if (l->type == SCENE_LIGHT_SPOT)
+                l->direction[k] = (float)-dir[k];
+        }
+        /* Pale hues: the lights vary, the materials' colours still read. */
+        float color[3];
+        scene_hsv_to_rgb(i * 0.618033988749895, 0.3, 1.0, color);
+        set_gltf(s, l, color, intensity);
+        l->range = range;
+        l->radius = range;
+    }
+    if (n)
+        s->light_volume = box;
+    else
+        s->light_volume = (struct scene_box){{a->box_min[0], a->box_min[1], a->box_min[2]},
+                                             {a->box_max[0], a->box_max[1], a->box_max[2]}};
+    return true;
 }
 
 static bool place_lights(struct scene *s)
@@ -286,26 +390,8 @@ static bool place_lights(struct scene *s)
     const struct asset *a = s->asset;
     int asset_lights = s->spec.asset_lights ? (int)a->light_count : 0;
     if (s->spec.lights == SCENE_LIGHTS_AUTO)
-        s->spec.lights = asset_lights ? 0 : SCENE_ASSET_DEFAULT_LIGHTS;
-    /* The light volume: the asset's bounds, raised above a flat asset so
-     * that generated lights do not lie in its plane. */
-    float largest = 0.0f;
-    for (int k = 0; k < 3; k++) {
-        s->light_volume.min[k] = a->box_min[k];
-        s->light_volume.max[k] = a->box_max[k];
-        largest = fmaxf(largest, a->box_max[k] - a->box_min[k]);
-    }
-    if (s->light_volume.max[1] - s->light_volume.min[1] < 0.1f * largest)
-        s->light_volume.max[1] = s->light_volume.min[1] + 0.25f * largest;
-    /* The lights preset's dynamics: circling horizontally, at 1.5 units for
-     * its 51-unit diagonal, scaled to the asset's. */
-    float d[3], diag = 0.0f;
-    for (int k = 0; k < 3; k++) {
-        d[k] = s->light_volume.max[k] - s->light_volume.min[k];
-        diag += d[k] * d[k];
-    }
-    s->light_orbit_plane = SCENE_ORBIT_XZ;
-    if (!scene_place_lights(s, 1.5f * sqrtf(diag) / 51.0f))
+        s->spec.lights = asset_lights || s->spec.rig_count ? 0 : SCENE_ASSET_DEFAULT_LIGHTS;
+    if (!place_generated(s))
         return false;
     s->generated_light_count = s->light_count;
     s->asset_light_count = asset_lights;

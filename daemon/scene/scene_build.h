@@ -35,6 +35,15 @@ bool scene_place_lights(struct scene *s, float orbit);
  * preset's own, whose colours the presets may have changed). */
 bool scene_add_sun(struct scene *s);
 
+/* lights.c: appends scene.light_rig's lights, last, in glTF's falloff
+ * (needs the bounds for the cut-off of lights without a range). */
+bool scene_add_rig(struct scene *s);
+
+/* lights.c: a glTF light's influence radius: its range, or without one
+ * where its radiance off a white surface falls below SCENE_LIGHT_CUTOFF
+ * (at least reach, a distance that covers the scene). */
+float scene_gltf_light_radius(float intensity, const float color[3], float range, float reach);
+
 /* materials.c: each instance's material from spec.materials and the
  * spec's material values; "preset" keeps what the preset set when it set
  * materials (materials_set), else it is "uniform". */
@@ -43,6 +52,10 @@ void scene_assign_materials(struct scene *s, bool preset_set);
 /* camera.c: the orbit and flythrough parameters from the bounds and the
  * static pose (needs instances, bounds and rig.eye/target/fovy/near/far). */
 void scene_rig_derive(struct scene *s);
+
+/* camera.c: scene.camera's pose, when given, over the static pose (needs
+ * the bounds: derived near and far planes reach them). */
+void scene_apply_pose(struct scene *s);
 
 /* tessellation.c: s->sphere_segments from the spec, or for "auto" from the
  * largest sphere on screen over the camera path (needs the rig). */

@@ -32,9 +32,10 @@ static const struct {
     [SCENE_PRESET_SPHERE] = {1, SCENE_LAYOUT_GRID, 10.0, SCENE_MATERIALS_UNIFORM},
     /* Lights low over the plane, so that its shading varies across it. */
     [SCENE_PRESET_PLANE] = {6, SCENE_LAYOUT_HALTON, 2.5, SCENE_MATERIALS_UNIFORM},
-    /* Eight generated point lights beside the asset's spot and directional
-     * ones, each reaching a couple of objects. */
-    [SCENE_PRESET_TEXTURED] = {8, SCENE_LAYOUT_UNIFORM, 4.0, SCENE_MATERIALS_PRESET},
+    /* Eight generated point lights around the asset, beside its spot and
+     * directional ones (their range scaled to it: scene_asset.c). */
+    [SCENE_PRESET_TEXTURED] = {8, SCENE_LAYOUT_UNIFORM, SCENE_LIGHT_RADIUS_AUTO,
+                               SCENE_MATERIALS_PRESET},
 };
 
 bool scene_spec_is_asset(const struct scene_spec *s)
@@ -193,10 +194,15 @@ static bool parse_teapot_segments(const json_t *scene, struct scene_spec *s,
     return true;
 }
 
-/* "camera": "orbit" or {"path": "orbit", "period": 240}. */
+/* "camera": "orbit", {"path": "orbit", "period": 240}, or a pose
+ * {"eye", "target", "up", "yfov_deg" | "orthographic", "near", "far"}
+ * (scene_camera_spec.c), with or without path and period. */
 static bool parse_camera(const json_t *scene, struct scene_spec *s, struct job_error *err)
 {
-    static const char *const keys[] = {"path", "period", NULL};
+    static const char *const keys[] = {"path", "period", "eye", "target", "up", "yfov_deg",
+                                       "orthographic", "near", "far", NULL};
+    static const char *const pose_keys[] = {"eye", "target", "up", "yfov_deg",
+                                            "orthographic", "near", "far", NULL};
     json_t *v = json_object_get(scene, "camera");
     int path = (int)s->camera;
     if (!v)
@@ -207,6 +213,12 @@ static bool parse_camera(const json_t *scene, struct scene_spec *s, struct job_e
             !jf_get_int(v, "period", "scene.camera.period", 1, SCENE_MAX_CAMERA_PERIOD,
                         &s->camera_period, err))
             return false;
+        s->camera = (enum scene_camera_path)path;
+        bool pose = false;
+        for (int i = 0; pose_keys[i]; i++)
+            pose = pose || json_object_get(v, pose_keys[i]);
+        memset(&s->view, 0, sizeof(s->view));
+        return !pose || scene_camera_pose_parse(v, s, err);
     } else if (json_is_string(v)) {
         if (!jf_get_choice(scene, "camera", "scene.camera", scene_camera_names, &path, err))
             return false;
@@ -214,10 +226,34 @@ static bool parse_camera(const json_t *scene, struct scene_spec *s, struct job_e
         char list[128];
         jf_list_choices(scene_camera_names, list, sizeof(list));
         return job_error_set(err, "scene.camera",
-                             "must be one of %s, or {\"path\": ..., \"period\": frames}", list);
+                             "must be one of %s, {\"path\": ..., \"period\": frames}, or a pose "
+                             "{\"eye\", \"target\", ...}", list);
     }
     s->camera = (enum scene_camera_path)path;
+    memset(&s->view, 0, sizeof(s->view));
     return true;
+}
+
+/* "light_radius": a distance, or "auto" (asset scenes: scaled to the
+ * asset's size). An asset scene without the key is "auto". */
+static bool parse_light_radius(const json_t *scene, struct scene_spec *s, struct job_error *err)
+{
+    json_t *v = json_object_get(scene, "light_radius");
+    if (!v) {
+        if (json_object_get(scene, "asset"))
+            s->light_radius = SCENE_LIGHT_RADIUS_AUTO;
+        return true;
+    }
+    if (json_is_string(v)) {
+        if (strcmp(json_string_value(v), "auto") != 0 || !scene_spec_is_asset(s))
+            return job_error_set(err, "scene.light_radius",
+                                 "must be a number from 0.01 to 1000 (\"auto\" only with "
+                                 "scene.asset or the textured preset)");
+        s->light_radius = SCENE_LIGHT_RADIUS_AUTO;
+        return true;
+    }
+    return jf_get_number(scene, "light_radius", "scene.light_radius", 0.01, 1000.0,
+                         &s->light_radius, err);
 }
 
 bool scene_asset_name_valid(const char *name)
@@ -283,7 +319,7 @@ bool scene_spec_parse(const json_t *scene, struct scene_spec *s, struct job_erro
         "teapot_segments", "tessellation_error_px", "light_speed", "light_radius", "light_intensity",
         "light_layout", "light_type", "spot_angle_deg", "sun", "materials", "specular",
         "shininess", "metallic", "roughness", "camera", "asset", "asset_sha256", "asset_camera",
-        "asset_lights", "normal_maps", "mover", NULL};
+        "asset_lights", "normal_maps", "light_rig", "mover", NULL};
     if (!jf_check_keys(scene, "scene.", keys, err))
         return false;
     int preset = (int)s->preset, layout, materials, light_type = s->light_type;
@@ -304,8 +340,7 @@ bool scene_spec_parse(const json_t *scene, struct scene_spec *s, struct job_erro
                        100.0, &s->tessellation_error_px, err) ||
         !jf_get_number(scene, "light_speed", "scene.light_speed", 0.0, 100.0, &s->light_speed,
                        err) ||
-        !jf_get_number(scene, "light_radius", "scene.light_radius", 0.01, 1000.0,
-                       &s->light_radius, err) ||
+        !parse_light_radius(scene, s, err) ||
         !jf_get_number(scene, "light_intensity", "scene.light_intensity", 0.0, 1000.0,
                        &s->light_intensity, err) ||
         !jf_get_choice(scene, "light_layout", "scene.light_layout", scene_layout_names, &layout,
@@ -328,6 +363,17 @@ bool scene_spec_parse(const json_t *scene, struct scene_spec *s, struct job_erro
         return job_error_set(err, json_object_get(scene, "asset_lights") ? "scene.asset_lights"
                                                                          : "scene.normal_maps",
                              "needs scene.asset or the textured preset");
+    /* A light rig states the lights: the generated ones and an asset's own
+     * are off unless asked for. */
+    json_t *rig = json_object_get(scene, "light_rig");
+    if (rig) {
+        if (!scene_light_rig_parse(rig, s, err))
+            return false;
+        if (!json_object_get(scene, "lights"))
+            s->lights = 0;
+        if (!json_object_get(scene, "asset_lights"))
+            s->asset_lights = false;
+    }
     if (!jf_get_bool(scene, "asset_lights", "scene.asset_lights", &s->asset_lights, err) ||
         !jf_get_bool(scene, "normal_maps", "scene.normal_maps", &s->normal_maps, err))
         return false;
@@ -354,7 +400,9 @@ json_t *scene_spec_to_json(const struct scene_spec *s)
                                                   : json_integer(s->teapot_segments));
     json_object_set_new(o, "tessellation_error_px", json_real(s->tessellation_error_px));
     json_object_set_new(o, "light_speed", json_real(s->light_speed));
-    json_object_set_new(o, "light_radius", json_real(s->light_radius));
+    json_object_set_new(o, "light_radius", s->light_radius == SCENE_LIGHT_RADIUS_AUTO
+                                               ? json_string("auto")
+                                               : json_real(s->light_radius));
     json_object_set_new(o, "light_intensity", json_real(s->light_intensity));
     json_object_set_new(o, "light_layout", json_string(scene_layout_names[s->light_layout]));
     json_object_set_new(o, "light_type", json_string(scene_light_type_names[s->light_type]));
@@ -365,9 +413,12 @@ json_t *scene_spec_to_json(const struct scene_spec *s)
     json_object_set_new(o, "shininess", json_real(s->shininess));
     json_object_set_new(o, "metallic", json_real(s->metallic));
     json_object_set_new(o, "roughness", json_real(s->roughness));
-    json_object_set_new(o, "camera", json_pack("{s:s, s:i}", "path",
-                                               scene_camera_names[s->camera], "period",
-                                               s->camera_period));
+    json_t *camera = s->view.given ? scene_camera_pose_to_json(&s->view) : json_object();
+    json_object_set_new(camera, "path", json_string(scene_camera_names[s->camera]));
+    json_object_set_new(camera, "period", json_integer(s->camera_period));
+    json_object_set_new(o, "camera", camera);
+    if (s->rig_count) /* only when given: the presets' specs stay as they were */
+        json_object_set_new(o, "light_rig", scene_light_rig_to_json(s));
     if (s->asset[0]) {
         json_object_set_new(o, "asset", json_string(s->asset));
         if (s->asset_sha256[0])

@@ -54,6 +54,36 @@ enum {
     SCENE_ASSET_DEFAULT_LIGHTS = 16,
     SCENE_ASSET_CAMERA_MAX = 64,
     SCENE_MAX_MOVER_PERIOD = 1000000,
+    /* scene.light_rig: explicit lights, at most this many. */
+    SCENE_RIG_MAX_LIGHTS = 64,
+};
+
+/* scene.light_radius "auto" (asset scenes): generated lights reach as far
+ * as the asset's size asks (scene_asset.c). */
+#define SCENE_LIGHT_RADIUS_AUTO 0.0
+
+/* scene.camera given as a pose (scene_camera_spec.c): eye, target and up,
+ * a vertical field of view or orthographic half-extents, optional near and
+ * far planes (0: derived from the scene's bounds). Replaces the preset's or
+ * the asset's static pose; a perspective pose may still orbit or fly. */
+struct scene_camera_spec {
+    bool given;
+    double eye[3], target[3], up[3];
+    double yfov_deg;       /* perspective */
+    bool orthographic;
+    double xmag, ymag;     /* orthographic half-width and half-height (glTF's); xmag 0:
+                            * ymag times the image's aspect */
+    double near_z, far_z;  /* 0: derived */
+};
+
+/* One explicit light of scene.light_rig, in glTF KHR_lights_punctual's
+ * terms and units: intensity in candela (point, spot) or lux
+ * (directional), colour linear, range 0 for none (inverse square to the
+ * cut-off, scene.h: SCENE_LIGHT_CUTOFF), cone half-angles in degrees. */
+struct scene_rig_light {
+    int type; /* enum scene_light_type (scene.h) */
+    double position[3], direction[3], color[3];
+    double intensity, range, inner_cone_deg, outer_cone_deg;
 };
 
 struct scene_spec {
@@ -100,6 +130,12 @@ struct scene_spec {
      * presets only. */
     bool mover;
     int mover_period;
+    /* scene.camera as a pose, when given (else the preset's or asset's). */
+    struct scene_camera_spec view;
+    /* scene.light_rig: lit after the generated lights, the sun and the
+     * asset's (docs/scenes.md, "Light rigs"). */
+    int rig_count;
+    struct scene_rig_light rig[SCENE_RIG_MAX_LIGHTS];
 };
 
 /* True when the scene is built through the asset path (scene.asset, or
@@ -125,5 +161,12 @@ bool scene_spec_parse(const json_t *scene, struct scene_spec *s, struct job_erro
 /* The scene as understood, every option filled in; parsing it gives the
  * same spec back. New reference. */
 json_t *scene_spec_to_json(const struct scene_spec *s);
+
+/* scene_camera_spec.c: "camera" as a pose (an object with "eye"), and
+ * "light_rig"; their JSON. Called by scene_spec_parse and _to_json. */
+bool scene_camera_pose_parse(const json_t *camera, struct scene_spec *s, struct job_error *err);
+json_t *scene_camera_pose_to_json(const struct scene_camera_spec *v);
+bool scene_light_rig_parse(const json_t *rig, struct scene_spec *s, struct job_error *err);
+json_t *scene_light_rig_to_json(const struct scene_spec *s);
 
 #endif

@@ -48,9 +48,12 @@ vec3 light_position(int i, int row)
 // Light i at Lpos on the surface point P (normal N, towards the eye V).
 // Point and spot lights: attenuation reaches exactly 0 at the light's radius,
 // and a spot's cone falloff exactly 0 at its outer angle, so culling a light
-// by its sphere or cone never changes the image. A directional light (Lpos
-// unused) is unattenuated and lights every surface facing it, from
-// -direction.
+// by its sphere or cone never changes the image. The presets' lights fall
+// off as a window (1 - d^2 / r^2)^2; glTF's (asset scenes, scene.light_rig)
+// as 1 / d^2, times clamp(1 - (d / range)^4, 0, 1) with a range
+// (KHR_lights_punctual), cut at the radius without one (daemon/scene/
+// scene.h: enum scene_light_falloff). A directional light (Lpos unused) is
+// unattenuated and lights every surface facing it, from -direction.
 vec3 light_contribution(int i, vec3 Lpos, vec3 P, vec3 N, vec3 V, Material m)
 {
     int type = light_type(i);
@@ -65,8 +68,17 @@ vec3 light_contribution(int i, vec3 Lpos, vec3 P, vec3 N, vec3 V, Material m)
         float d2 = dot(Lv, Lv);
         if (d2 >= r * r)
             return vec3(0.0);
-        att = 1.0 - d2 / (r * r);
-        att *= att;
+        if (int(lights[i].falloff.x) == LIGHT_FALLOFF_GLTF) {
+            float range = lights[i].falloff.y;
+            att = 1.0 / max(d2, 1e-8);
+            if (range > 0.0) {
+                float q = d2 / (range * range);
+                att *= clamp(1.0 - q * q, 0.0, 1.0);
+            }
+        } else {
+            att = 1.0 - d2 / (r * r);
+            att *= att;
+        }
         L = Lv * inversesqrt(d2);
         if (type == LIGHT_SPOT) {
             float cone = light_spot_falloff(i, -L);

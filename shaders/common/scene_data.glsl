@@ -27,7 +27,7 @@ Material instance_material(int id)
                     inst.material.w);
 }
 
-// std430, 48 bytes; written by daemon/gpu/gpu_scene.c in this order. The
+// std430, 64 bytes; written by daemon/gpu/gpu_scene.c in this order. The
 // type is a float holding LIGHT_POINT, LIGHT_SPOT or LIGHT_DIRECTIONAL
 // (enum scene_light_type); a point light's other fields are 0.
 struct Light {
@@ -36,7 +36,10 @@ struct Light {
     vec4 direction_type; // unit direction the light shines (spot, directional), type
     vec4 cone;           // spot: cos outer, cos inner, 1 / max(cos inner - cos outer,
                          // 1e-3) (glTF's angle scale), sin outer (for the culling)
+    vec4 falloff;        // x: LIGHT_FALLOFF_WINDOW or LIGHT_FALLOFF_GLTF (enum
+                         // scene_light_falloff), y: glTF range (0: none)
 };
+const int LIGHT_FALLOFF_WINDOW = 0, LIGHT_FALLOFF_GLTF = 1;
 const int LIGHT_POINT = 0, LIGHT_SPOT = 1, LIGHT_DIRECTIONAL = 2;
 layout(std430, binding = SB_SSBO_LIGHTS) readonly buffer LightBuffer { Light lights[]; };
 

@@ -64,8 +64,9 @@ in vec4 v_tangent; // world-space tangent, handedness in w
 #endif
 #if defined(SURFACE_VERTEX_COLOR)
 // COLOR_0, linear (white where the mesh has none): programs whose vertex
-// stage passes it (scene.vert, shadow.vert) define SURFACE_VERTEX_COLOR
-// before including this file; the others (OSL's) shade without it. It
+// stage passes it (scene.vert, shadow.vert, OSL's texgen and draw) define
+// SURFACE_VERTEX_COLOR before including this file; the others shade
+// without it. It
 // travels as COLOR_0 - 1: perspective-correct interpolation of a constant
 // is not exact, and white would come out a rounding below 1 (a mesh
 // without COLOR_0 drew differently from before it existed); 0 is exact.

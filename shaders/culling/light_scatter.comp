@@ -33,8 +33,11 @@ void main()
         return;
     vec3 apex = light_position(i, 0), world;
     float r;
-    bool everywhere = !light_bound_sphere(i, apex, world, r);
-    bool spot = light_type(i) == LIGHT_SPOT;
+    // An orthographic view (scene.camera's "orthographic") has no frusta to
+    // test cells with: every light is binned everywhere, exact but slower.
+    bool ortho = u_frame.proj[2][3] == 0.0;
+    bool everywhere = !light_bound_sphere(i, apex, world, r) || ortho;
+    bool spot = light_type(i) == LIGHT_SPOT && !ortho;
     ivec4 rect = everywhere ? ivec4(0, 0, ivec2(u_frame.viewport.xy))
                             : light_rect(LIGHT_RECT_TIGHT, world, r);
     if (rect.x >= rect.z || rect.y >= rect.w)

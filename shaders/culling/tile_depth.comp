@@ -27,8 +27,11 @@ void main()
             for (int i = 0; i < MSAA_SAMPLES; i++) {
                 float depth = msaa_fetch(u_depth, ivec2(x, y), i).r;
                 if (depth < 1.0) {
-                    // View depth from the depth-buffer value (the projection's z row).
-                    float d = u_frame.proj[3][2] / (depth * 2.0 - 1.0 + u_frame.proj[2][2]);
+                    // View depth from the depth-buffer value (the projection's z row;
+                    // an orthographic one's is linear).
+                    float d = u_frame.proj[2][3] == 0.0
+                                  ? (u_frame.proj[3][2] - (depth * 2.0 - 1.0)) / u_frame.proj[2][2]
+                                  : u_frame.proj[3][2] / (depth * 2.0 - 1.0 + u_frame.proj[2][2]);
                     lo = min(lo, d);
                     hi = max(hi, d);
                 }

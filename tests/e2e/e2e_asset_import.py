@@ -22,7 +22,9 @@ look.debug's channels):
 - a double-sided, normal-mapped plate seen from behind against the same
   plate rebuilt to face the viewer with normal, tangent and handedness
   reversed (glTF reverses a back face's normal, the normal map's too);
-every technique draws the same channel image (the look's debug pass);
+every technique draws the same channel image (the look's debug pass), and
+OSL, which bakes the material into its atlas, draws the texCoord, COLOR_0
+and transform pairs' halves alike too;
 and look.debug's channels are the viewer's encodings at known pixels:
 base_color of a COLOR_0 box, the grey checks where a mesh has no
 TEXCOORD_1, normals as n * 0.5 + 0.5, alpha 1 for opaque materials; a
@@ -106,6 +108,18 @@ def main():
                 s = ssim(shots[1], shots[0])
                 print("%s, look.debug %s: SSIM %.5f" % (name, ch, s), flush=True)
                 check(s >= PAIR_BOUND, "%s, look.debug %s: the two halves alike: SSIM %.5f" % (name, ch, s))
+
+        # Object-space shading bakes the material into its atlas and applies
+        # base colour per pixel: it reads the same texCoord sets, COLOR_0 and
+        # texture transforms, so it too draws both halves alike (before its
+        # shaders read them, 0.988, 0.998 and 0.986).
+        for name in ("texcoord1_outside", "colors", "texture_transform"):
+            shots = [frame(d, dict(JOB, technique="osl",
+                                   scene=dict(SCENE, asset="%s_%s.glb" % (name, h)))) for h in ("a", "b")]
+            s = ssim(shots[1], shots[0])
+            print("%s (osl): SSIM %.5f" % (name, s), flush=True)
+            check(s >= PAIR_BOUND, "%s, osl: the two halves render alike: SSIM %.5f >= %s"
+                  % (name, s, PAIR_BOUND))
 
         # The channels are the shared surface's: every technique draws the
         # same image of one.

@@ -12,6 +12,7 @@ neighbours take most of the CPU) must still fail."""
 
 import json
 import os
+import re
 
 import testlib
 from testlib import check
@@ -52,7 +53,8 @@ try:
           gate[0][1] > 0, "the gate case: outcome, ratio inside its interval, a real time: %s" % (gate,))
     check(gate and int(gate[0][2]["runs"]) + int(gate[0][2]["noisy_runs"]) >= 3,
           "judged on runs, not frames: %s %s" % (gate, out.stderr[-1500:]))
-    check("baseline runs:" in out.stderr and "gate:" in out.stderr, "the runs and the verdict are in the log")
+    check("baseline runs:" in out.stderr and re.search(r"^gate over \d+ baseline runs and \d+ runs here", out.stderr, re.M),
+          "the runs and the verdict, with the runs it rests on, are in the log")
 
     # Many more lights: a different job, refused unless --allow-mismatch...
     slow = cl.write("slow", dict(JOB, scene=dict(JOB["scene"], lights=250)))

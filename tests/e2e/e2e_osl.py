@@ -87,7 +87,8 @@ try:
     # their neighbours) are shaded, each with the shading its schedule asks
     # for. The same pixels as whole tiles from fewer texels, frame k still a
     # pure function of k, nothing shaded for still lights after the first
-    # frame, and a camera that outruns the one-block margin is counted.
+    # frame, and a moving camera (marking with its own frame's view before
+    # the selection) reads no stale block, at async distance 0 or 20.
     seen = dict(dyn, async_distance=20, capture_interval=10, frames=10, warmup_frames=2,
                 osl={"resolution": 64, "visibility": "seen"})
     r_whole, p_whole = capture(d, dict(seen, osl={"resolution": 64, "visibility": "all"}), "whole")
@@ -108,10 +109,15 @@ try:
     check(still["texels_shaded_per_frame"]["max"] == 0 and
           still.get("visibility", {}).get("active") is False,
           "seen, still lights: nothing shaded after the first frame, and no marking: %s" % still)
-    fly = d.run(dict(seen, frames=12, scene=dict(dyn["scene"], camera="flythrough")))
-    stale = fly.get("result", {}).get("osl", {}).get("visibility", {}).get("stale_blocks", 0)
-    check(fly["status"] == "done" and stale > 0,
-          "a flythrough outruns the margin, and the stale blocks are counted: %s" % stale)
+    for path, dist in (("flythrough", 20), ("flythrough", 0), ("orbit", 0)):
+        fly = d.run(dict(seen, frames=12, async_distance=dist,
+                         scene=dict(dyn["scene"], camera={"path": path, "period": 48})))
+        fo = fly.get("result", {}).get("osl", {})
+        check(fly["status"] == "done" and fo["visibility"]["stale_blocks"] == 0 and
+              fo["staleness"]["reads"] > 0 and fo["staleness"]["unshaded_reads"] == 0 and
+              (dist or fo["staleness"]["max"] == 0),
+              "a %s (period 48) at async distance %d reads no stale block: %s, %s" %
+              (path, dist, fo.get("visibility"), fo.get("staleness")))
 
     # Hidden objects are not reshaded: with a still camera the blocks read
     # are the first frame's, and no object without one is shaded later.

@@ -122,6 +122,12 @@ try:
     header = out.stdout.splitlines()[0] if out.stdout else ""
     check("workload" in header and "others' CPU" in header and "96x64" in out.stdout and
           "64x48" in out.stdout, "the table has workload and noise columns: %s" % out.stdout[:400])
+    # One workload hash everywhere: the JUnit name's (from the file as
+    # written) is the one history prints (from the daemon's spec).
+    junit_hash = re.search(r"#([0-9a-f]{8})", names[0]).group(1) if names else "?"
+    rows = [l for l in out.stdout.splitlines() if "64x48" in l]
+    check(rows and all("#" + junit_hash in l for l in rows),
+          "history prints the JUnit name's workload hash #%s: %s" % (junit_hash, rows))
     svg = open(os.path.join(hist, "trend.svg")).read()
     series = re.findall(r'class="series" data-series="([^"]+)"', svg)
     check(len(series) == 2 and all(s.startswith("forward#") for s in series),

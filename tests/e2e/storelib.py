@@ -1,5 +1,5 @@
 """The record store as the end-to-end tests read it: STATE_DIR/store.db, an
-SQLite database (daemon/jobs/store.h), opened with Python's own sqlite3
+SQLite database (daemon/store/store.h), opened with Python's own sqlite3
 module, read-only. Rows are read while the daemon runs (its write-ahead log
 lets readers in) or after it stopped."""
 

@@ -46,8 +46,11 @@ def check(cond, what):
 
 
 def finish(name):
-    print("%s: %d checks, %d failed" % (name, checks, failures))
-    sys.exit(1 if failures else 0)
+    """Exits 1 when a check failed, or when none was made (a test that
+    checks nothing proves nothing)."""
+    print("%s: %d checks, %d failed%s" % (name, checks, failures,
+                                          "" if checks else " (no check was made: that fails)"))
+    sys.exit(1 if failures or not checks else 0)
 
 
 class Daemon:

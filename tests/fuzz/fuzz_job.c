@@ -4,7 +4,7 @@
 #include <jansson.h>
 #include <string.h>
 
-#include "daemon/jobs/job_spec.h"
+#include "daemon/spec/job_spec.h"
 #include "tests/fuzz/fuzz.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)

@@ -6,7 +6,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "daemon/jobs/sweep_spec.h"
+#include "daemon/spec/sweep_spec.h"
 #include "tests/fuzz/fuzz.h"
 
 static void valid_job(json_t *job)

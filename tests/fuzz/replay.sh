@@ -5,7 +5,7 @@
 bin=${FUZZ_REPLAY_DIR:-tests/fuzz}
 src=${srcdir:-.}/tests/fuzz
 failed=0
-for t in job sweep png_metrics route asset_cache asset_convert; do
+for t in job sweep png_metrics route asset_cache asset_convert env_convert; do
     if "$bin/replay-$t" "$src/corpus/$t" "$src/regressions/$t"; then
         echo "PASS: replay $t"
     else

@@ -3,7 +3,7 @@
 # UndefinedBehaviorSanitizer) in build-fuzz/ and runs each for SECONDS,
 # FUZZ_JOBS of them at a time (default 2):
 #   tests/fuzz/run.sh SECONDS [TARGET...]     (targets: job sweep png_metrics route
-#                                              asset_cache asset_convert)
+#                                              asset_cache asset_convert env_convert)
 #   make fuzz FUZZ_SECONDS=600                 (the same, from a build folder)
 # tools/check runs them for 25 s, two at a time. Each starts from its seed
 # corpus (tests/fuzz/corpus/TARGET) and the inputs that once broke it
@@ -16,7 +16,7 @@ set -u
 cd "$(dirname "$0")/../.."
 seconds=${1:-60}
 [ $# -gt 0 ] && shift
-targets=${*:-job sweep png_metrics route asset_cache asset_convert}
+targets=${*:-job sweep png_metrics route asset_cache asset_convert env_convert}
 jobs=${FUZZ_JOBS:-2}
 out=${FUZZ_BUILD:-build-fuzz}
 cc=${FUZZ_CC:-clang}
@@ -83,6 +83,9 @@ fuzz_one() {
     extra=""
     if [ "$t" = asset_convert ]; then
         extra="daemon/assets/asset_convert.c daemon/assets/convert_*.c daemon/assets/uv_charts.c daemon/assets/uv_overlap.c $(pkg-config --cflags --libs assimp libjpeg)"
+    fi
+    if [ "$t" = env_convert ]; then
+        extra="daemon/assets/env_convert.c $(pkg-config --cflags --libs stb)"
     fi
     # shellcheck disable=SC2086
     if ! "$cc" $flags -fsanitize=fuzzer "tests/fuzz/fuzz_$t.c" $extra $objs $libs -o "$bin" 2>"$out/$t.build.log"; then

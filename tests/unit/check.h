@@ -21,10 +21,13 @@ static int check_count;
 
 #define CHECK_NEAR(a, b, eps) CHECK(((a) - (b)) <= (eps) && ((b) - (a)) <= (eps))
 
+/* The test's exit status: 1 when a check failed, or when none was made (a
+ * test that checks nothing proves nothing). */
 static inline int check_finish(const char *name)
 {
-    printf("%s: %d checks, %d failed\n", name, check_count, check_failures);
-    return check_failures ? 1 : 0;
+    printf("%s: %d checks, %d failed%s\n", name, check_count, check_failures,
+           check_count ? "" : " (no check was made: that fails)");
+    return check_failures || !check_count ? 1 : 0;
 }
 
 /* The whole file at path (malloc'd, *len its size), or NULL. */

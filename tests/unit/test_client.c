@@ -51,19 +51,45 @@ static void test_inconclusive_junit(void)
     CHECK(xml && strstr(xml, "<failure type=\"inconclusive\" message=\"inconclusive "
                              "(--fail-inconclusive): too noisy\"/>"));
     free(xml);
-    junit_fail(job, "job failed");
+    junit_fail(job, JUNIT_JOB_FAILED, "job failed");
     CHECK(junit_real_failures(&j) == 1);
-    /* The log names the outcome. */
+    /* A check that judged nothing: skipped, never a pass, and not an
+     * undecided timing check either (no exit status of its own). */
+    struct junit_case *q = junit_add(&j, "shadebench.forward", "forward: frame 10 quality");
+    junit_skip(q, "SKIP", "no reference technique: nothing judged");
+    CHECK(junit_judged_nothing(&j) == 1 && junit_undecided(&j) == 2 && junit_real_failures(&j) == 1);
+    CHECK(junit_write(&j, path, "s", 1.0));
+    xml = fs_read_file(path, 1 << 20, &len);
+    CHECK(xml && strstr(xml, "<skipped message=\"no reference technique: nothing judged\"/>") &&
+          strstr(xml, "<failure type=\"job_failed\" message=\"job failed\"/>") &&
+          strstr(xml, "skipped=\"2\""));
+    free(xml);
+    /* The log names the outcome, in colour only when asked. */
     FILE *f = fopen(path, "w+");
-    junit_print(&j, f);
+    junit_print(&j, f, false);
     rewind(f);
-    char buf[2048];
+    char buf[4096];
     size_t got = fread(buf, 1, sizeof(buf) - 1, f);
     buf[got] = '\0';
     fclose(f);
     CHECK(strstr(buf, "INCONCLUSIVE forward: median frame_ms") && strstr(buf, "not decided: ") &&
-          strstr(buf, "FAIL forward: job"));
+          strstr(buf, "FAIL forward: job") && strstr(buf, "failure (job_failed): job failed") &&
+          strstr(buf, "\nSKIP forward: frame 10 quality") && strstr(buf, "not judged: no reference") &&
+          !strstr(buf, "\033["));
+    f = fopen(path, "w+");
+    junit_print(&j, f, true);
+    rewind(f);
+    got = fread(buf, 1, sizeof(buf) - 1, f);
+    buf[got] = '\0';
+    fclose(f);
+    CHECK(strstr(buf, "\033[1;31mFAIL\033[0m forward: job") &&
+          strstr(buf, "\033[1;33mINCONCLUSIVE\033[0m forward: median") &&
+          strstr(buf, "\033[1;33mSKIP\033[0m forward: frame 10"));
     remove(path);
+    /* Names are unique within a file: a second case of the same name is
+     * numbered, not merged with the first by a CI system. */
+    struct junit_case *dup = junit_add(&j, "shadebench.forward", "forward: job");
+    CHECK(dup && !strcmp(dup->name, "forward: job (2)"));
     junit_finish(&j);
 }
 
@@ -139,8 +165,29 @@ static void test_workload_identity(void)
         json_decref(patch);
         json_decref(c);
     }
+    /* One hash for the file as written and the spec the daemon echoes: a
+     * field at its default (stated, or filled in by the daemon's parser)
+     * is the same workload as one left out, and the daemon's whole spec
+     * (every default filled in, numbers as reals) hashes as the file does. */
+    json_t *stated = json_deep_copy(a);
+    json_object_set_new(json_object_get(stated, "scene"), "sphere_segments", json_integer(32));
+    json_object_set_new(stated, "msaa", json_integer(1));
+    json_object_set_new(stated, "look", json_pack("{s:s}", "tonemap", "none"));
+    workload_key(stated, kb, sizeof(kb));
+    CHECK(strcmp(ka, kb) == 0);
+    json_decref(stated);
+    json_t *daemon_spec = json_loads(
+        "{\"technique\":\"osl\",\"frames\":20,\"warmup_frames\":5,\"capture_interval\":10,"
+        "\"async_distance\":0.0,\"scene\":{\"preset\":\"grid\",\"lights\":10,\"dynamic\":false,"
+        "\"width\":160,\"height\":120,\"sphere_segments\":32,\"light_speed\":1.0},"
+        "\"look\":{\"lighting\":\"phong\",\"exposure\":1.0,\"post\":[]},"
+        "\"osl\":{\"resolution\":256},\"forward\":{},\"repeat\":1,\"reference\":null,"
+        "\"timeout_s\":86400.0,\"msaa\":1,\"labels\":{}}", 0, NULL);
+    workload_key(daemon_spec, kb, sizeof(kb));
+    CHECK(strcmp(ka, kb) == 0);
+    json_decref(daemon_spec);
     workload_describe(a, da, sizeof(da));
-    static const char prefix[] = "osl osl(resolution=256) 160x120 10 lights #";
+    static const char prefix[] = "osl osl(resolution=256) grid 160x120 10 lights still #";
     CHECK(strncmp(da, prefix, strlen(prefix)) == 0 &&
           strncmp(da + strlen(prefix), ka + 4, 8) == 0 && strstr(da, ", 20 frames"));
     json_decref(a);
@@ -301,8 +348,8 @@ int main(void)
     junit_prop_num(a, "frame_ms_median", 12.5);
     junit_prop_str(a, "gl_renderer", "llvmpipe \"x\"");
     struct junit_case *b = junit_add(&j, "shadebench.forward", "forward: median frame_ms");
-    junit_fail(b, "slower by %.1f%%", 12.0);
-    junit_fail(b, "second reason");
+    junit_fail(b, JUNIT_REGRESSION, "slower by %.1f%%", 12.0);
+    junit_fail(b, JUNIT_QUALITY, "second reason");
     CHECK(junit_failures(&j) == 1 && strcmp(b->failure, "slower by 12.0%; second reason") == 0);
     const char *path = "test_client_junit.xml";
     CHECK(junit_write(&j, path, "suite & co", 3.5));
@@ -312,6 +359,8 @@ int main(void)
     CHECK(xml && strstr(xml, "<property name=\"frame_ms_median\" value=\"12.5\"/>"));
     CHECK(xml && strstr(xml, "value=\"llvmpipe &quot;x&quot;\""));
     CHECK(xml && strstr(xml, "failures=\"1\"") && strstr(xml, "name=\"suite &amp; co\""));
+    /* The failure's type is its first cause, not the class name. */
+    CHECK(xml && strstr(xml, "<failure type=\"regression\" message=\"slower by 12.0%; second reason\"/>"));
     free(xml);
     remove(path);
     junit_finish(&j);

@@ -9,9 +9,9 @@
 #include "daemon/effects/bloom/bloom_info.h"
 #include "daemon/effects/ssao/ssao_info.h"
 #include "daemon/effects/toon/toon_info.h"
-#include "daemon/jobs/job_spec.h"
+#include "daemon/spec/job_spec.h"
 #include "daemon/lighting/tone_curves.h"
-#include "daemon/jobs/sweep_spec.h"
+#include "daemon/spec/sweep_spec.h"
 #include "tests/unit/catalog_fixture.h"
 #include "tests/unit/check.h"
 

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "client/gate.h"
+#include "common/timing_series.h"
 #include "tests/unit/check.h"
 
 /* A deterministic normal generator (xorshift + Box-Muller), so that the
@@ -88,10 +89,190 @@ static void test_noise_text(void)
     CHECK(strlen(tiny) < sizeof(tiny));
 }
 
+/* n pairs: A at a_ms, B at b_ms, each with multiplicative noise cv, and
+ * the CPU others took during each side's runs. */
+static void pairs(struct gate_run *a, struct gate_run *b, size_t n, double a_ms, double b_ms,
+                  double cv, double share_a, double share_b)
+{
+    for (size_t i = 0; i < n; i++) {
+        a[i] = (struct gate_run){.ms = a_ms * exp(cv * normal()), .has_share = true,
+                                 .other_share = share_a};
+        b[i] = (struct gate_run){.ms = b_ms * exp(cv * normal()), .has_share = true,
+                                 .other_share = share_b};
+    }
+}
+
+/* ab's findings: unlike jobs see different shares of the same neighbours
+ * (a long job more of a periodic one), which compared across the pair
+ * called every pair noisy; a verdict states what it rests on and refuses
+ * too few pairs; A against A decides. */
+static void test_ab(void)
+{
+    struct gate_run a[12], b[12];
+    struct gate_verdict v;
+    char basis[200];
+    /* Unlike workloads: B takes half A's time, and its runs always see 50%
+     * of the CPU taken where A's see 10% (each side steady). */
+    pairs(a, b, 7, 20.0, 10.0, 0.01, 0.10, 0.50);
+    gate_evaluate_ab(a, b, 7, 0.95, 0.05, NOISE_TOLERANCE, &v);
+    gate_basis_text(&v, true, 7, 7, basis, sizeof(basis));
+    CHECK(v.outcome == GATE_PASS && v.used_new == 7 && v.clean_new == 7 && !v.bounded);
+    CHECK(!strcmp(basis, "over 7 pairs (none left out)"));
+    CHECK(v.r.ratio > 0.45 && v.r.ratio < 0.55);
+    /* One of A's runs disturbed against A's own typical run: that pair
+     * alone is left out, and the headline says so. */
+    a[3].other_share = 0.60;
+    gate_evaluate_ab(a, b, 7, 0.95, 0.05, NOISE_TOLERANCE, &v);
+    gate_basis_text(&v, true, 7, 7, basis, sizeof(basis));
+    CHECK(a[3].noisy && b[3].noisy && !a[2].noisy && strstr(a[3].why, "during A's"));
+    CHECK(v.outcome == GATE_PASS && v.used_new == 6 && !strcmp(basis, "over 6 pairs (1 noisy pair left out)"));
+
+    /* A drift of the whole machine: in the last four pairs the neighbours
+     * leave both sides half the CPU they left before (A 45% instead of 90%,
+     * B 25% instead of 50%), and both run twice as long. Both runs of each
+     * pair met it alike: no pair is left out. */
+    pairs(a, b, 9, 20.0, 10.0, 0.01, 0.10, 0.50);
+    for (size_t i = 5; i < 9; i++) {
+        a[i].other_share = 0.55, b[i].other_share = 0.75;
+        a[i].ms *= 2.0, b[i].ms *= 2.0;
+    }
+    gate_evaluate_ab(a, b, 9, 0.95, 0.05, NOISE_TOLERANCE, &v);
+    CHECK(v.outcome == GATE_PASS && v.used_new == 9 && !v.bounded);
+
+    /* Too few pairs: no verdict on two, whatever they say. */
+    pairs(a, b, 2, 20.0, 20.0, 0.0001, 0.05, 0.05);
+    gate_evaluate_ab(a, b, 2, 0.95, 0.05, NOISE_TOLERANCE, &v);
+    CHECK(v.outcome == GATE_INCONCLUSIVE && v.used_new == 0 && strstr(v.why, "at least 3") &&
+          strstr(v.why, "not a verdict"));
+    gate_basis_text(&v, true, 2, 2, basis, sizeof(basis));
+    CHECK(!strcmp(basis, "on too few pairs for an interval"));
+
+    /* One clean pair of seven: a bounded verdict over all seven says so,
+     * never "over 1 pairs". In the noisy six, B's run (then A's, in turn)
+     * had 40% of the CPU taken against its side's typical 5%. */
+    pairs(a, b, 7, 20.0, 60.0, 0.01, 0.05, 0.05);
+    for (size_t i = 0; i < 6; i++)
+        (i % 2 ? a : b)[i].other_share = 0.40;
+    gate_evaluate_ab(a, b, 7, 0.95, 0.05, NOISE_TOLERANCE, &v);
+    gate_basis_text(&v, true, 7, 7, basis, sizeof(basis));
+    CHECK(v.outcome == GATE_REGRESSION && v.bounded && v.clean_new == 1 && v.used_new == 7);
+    CHECK(strstr(basis, "over 7 pairs (1 clean, 6 noisy ones bounded"));
+
+    /* A against A: the same job on both sides, pairs clean, a pass over all
+     * of them (it used to say "over 0 pairs"). */
+    pairs(a, b, 5, 20.0, 20.0, 0.02, 0.03, 0.03);
+    for (size_t i = 0; i < 5; i++)
+        b[i].other_share = 0.03 + 0.01 * (double)(i % 3);
+    gate_evaluate_ab(a, b, 5, 0.95, 0.05, NOISE_TOLERANCE, &v);
+    CHECK(v.outcome == GATE_PASS && v.used_new == 5 && v.r.ratio > 0.95 && v.r.ratio < 1.05);
+
+    /* Confirmation: runs 5 and on were run to confirm a regression; all
+     * noisy, none of them enters the verdict. */
+    pairs(a, b, 8, 20.0, 30.0, 0.01, 0.05, 0.05);
+    for (size_t i = 5; i < 8; i++)
+        b[i].other_share = 0.70;
+    gate_evaluate_ab(a, b, 8, 0.95, 0.05, NOISE_TOLERANCE, &v);
+    CHECK(v.outcome == GATE_REGRESSION && !v.bounded &&
+          gate_runs_in_verdict(a, 8, 5, v.bounded) == 0 && gate_runs_in_verdict(a, 8, 0, false) == 5);
+}
+
+/* The baseline gate: new runs marked against the baseline's typical share
+ * (both measured under like conditions, or left out), the verdict's basis
+ * stated, and fresh confirming runs counted only when they enter it. */
+static void test_baseline(void)
+{
+    struct gate_run base[5], cur[8];
+    struct gate_verdict v;
+    char basis[200];
+    for (size_t i = 0; i < 5; i++)
+        base[i] = (struct gate_run){.ms = 20.0 * exp(0.01 * normal()), .has_share = true,
+                                    .other_share = 0.74};
+    for (size_t i = 0; i < 8; i++)
+        cur[i] = (struct gate_run){.ms = 20.0 * exp(0.01 * normal()), .has_share = true,
+                                   .other_share = 0.76};
+    /* Noisy alone (76% taken), like the baseline's runs: kept, a pass. */
+    gate_evaluate_baseline(base, 5, cur, 8, 0.95, 0.05, NOISE_TOLERANCE, &v);
+    gate_basis_text(&v, false, 5, 8, basis, sizeof(basis));
+    CHECK(v.outcome == GATE_PASS && v.used_old == 5 && v.used_new == 8 &&
+          !strcmp(basis, "over 5 baseline runs and 8 runs here (none left out)"));
+    /* The last three at 95%: left out against the baseline's 74%. */
+    for (size_t i = 5; i < 8; i++)
+        cur[i].other_share = 0.95, cur[i].ms *= 1.5;
+    gate_evaluate_baseline(base, 5, cur, 8, 0.95, 0.05, NOISE_TOLERANCE, &v);
+    gate_basis_text(&v, false, 5, 8, basis, sizeof(basis));
+    CHECK(cur[7].noisy && !cur[4].noisy && v.used_new == 5 &&
+          !strcmp(basis, "over 5 baseline runs and 5 runs here (3 noisy runs left out)"));
+    CHECK(gate_runs_in_verdict(cur, 8, 5, v.bounded) == 0);
+}
+
+/* The rerun policy: a regression is confirmed on a fresh set that enters
+ * its verdict; noisy confirming runs are replaced within the budget; with
+ * the budget spent and none entered, it stands unconfirmed. */
+static void test_reruns(void)
+{
+    struct gate_run runs[12];
+    for (size_t i = 0; i < 12; i++)
+        runs[i] = (struct gate_run){.ms = 30, .has_share = true, .other_share = 0.05};
+    struct gate_reruns r = {.planned = 3, .budget = 6, .decide = true, .unit = "run"};
+    struct gate_verdict reg = {.outcome = GATE_REGRESSION};
+    snprintf(reg.why, sizeof(reg.why), "slower by 50.0%%");
+    struct gate_step step;
+    gate_next(&r, runs, 3, &reg, false, &step);
+    CHECK(step.more == 3 && r.confirming && r.confirm_from == 3 && r.budget == 3 &&
+          strstr(step.say, "confirming on 3 more runs"));
+    /* The three confirming runs were all left out as noisy: replaced. */
+    runs[3].noisy = runs[4].noisy = runs[5].noisy = true;
+    gate_next(&r, runs, 6, &reg, false, &step);
+    CHECK(step.more == 3 && r.budget == 0 && strstr(step.say, "3 of the runs confirming") &&
+          !step.unconfirmed);
+    /* Those too: the budget is spent and nothing fresh entered the verdict. */
+    runs[6].noisy = runs[7].noisy = runs[8].noisy = true;
+    gate_next(&r, runs, 9, &reg, false, &step);
+    CHECK(step.more == 0 && step.unconfirmed && step.budget_spent &&
+          strstr(step.unconfirmed_why, "could not be confirmed: only 0 of the 6 runs"));
+    /* Bounded verdicts count every fresh run with figures. */
+    reg.bounded = true;
+    gate_next(&r, runs, 9, &reg, false, &step);
+    CHECK(step.more == 0 && !step.unconfirmed);
+    /* Clean confirming runs confirm it: stop, a regression. */
+    struct gate_reruns r2 = {.planned = 3, .budget = 6, .decide = true, .unit = "pair"};
+    reg.bounded = false;
+    for (size_t i = 0; i < 12; i++)
+        runs[i].noisy = false;
+    gate_next(&r2, runs, 3, &reg, false, &step);
+    gate_next(&r2, runs, 6, &reg, false, &step);
+    CHECK(step.more == 0 && !step.unconfirmed && !step.wanted_more);
+    /* A whole noisy set stops the runs for a later baseline too. */
+    struct gate_reruns r3 = {.planned = 3, .budget = 6, .decide = false, .unit = "run"};
+    runs[1].noisy = true;
+    gate_next(&r3, runs, 3, &reg, false, &step);
+    CHECK(step.more == 1 && strstr(step.say, "1 noisy run(s) left out"));
+    gate_next(&r3, runs, 4, &reg, true, &step);
+    CHECK(step.more == 0 && step.wanted_more == false);
+}
+
+/* The rule "software renderer -> frame_ms", written once and read by the
+ * gate, ab, history and the charts. */
+static void test_series_rule(void)
+{
+    CHECK(!strcmp(timing_series_for_renderer("llvmpipe (LLVM 15.0.6, 256 bits)"), "frame_ms"));
+    CHECK(!strcmp(timing_series_for_renderer("softpipe"), "frame_ms"));
+    CHECK(!strcmp(timing_series_for_renderer("Google SwiftShader"), "frame_ms"));
+    CHECK(!strcmp(timing_series_for_renderer("NVIDIA H100 80GB HBM3/PCIe/SSE2"), "gpu_ms"));
+    CHECK(!strcmp(timing_series_for_renderer(NULL), "frame_ms"));
+    json_t *dev = json_pack("{s:s}", "gl_renderer", "AMD Radeon RX 7900 XTX (radeonsi)");
+    CHECK(!strcmp(gate_default_series(dev), "gpu_ms"));
+    json_decref(dev);
+}
+
 int main(void)
 {
     test_sides();
+    test_series_rule();
+    test_reruns();
     test_noise_text();
+    test_ab();
+    test_baseline();
     /* Student's t against the tables. */
     CHECK_NEAR(student_t_quantile(0.975, 1), 12.706, 1e-3);
     CHECK_NEAR(student_t_quantile(0.975, 4), 2.776, 1e-3);
@@ -245,26 +426,21 @@ int main(void)
     CHECK(gate_mark_noisy(nr, 4, true, 0.04, 0.10) == 1 && nr[1].noisy &&
           strstr(nr[1].why, "45%") && strstr(nr[1].why, "43% less CPU left") && !nr[3].noisy &&
           !nr[2].noisy);
-    /* On a saturated machine five points matter: 15% left instead of 20%. */
-    CHECK_NEAR(gate_cpu_left_change(0.85, 0.80), -0.25, 1e-12);
-    CHECK_NEAR(gate_cpu_left_change(0.05, 0.02), -0.0306122, 1e-6);
+    /* On a saturated machine five points matter: 15% left instead of 20%
+     * (the one noise rule, common/noise.h). */
+    CHECK_NEAR(noise_cpu_left_change(0.85, 0.80), -0.25, 1e-12);
+    CHECK_NEAR(noise_cpu_left_change(0.05, 0.02), -0.0306122, 1e-6);
 
-    /* A noisy pair's B bounded by the CPU change: B left 40% of the CPU
-     * where A was left 80% could be up to twice as slow for that alone. */
+    /* A run bounded by its CPU change against a typical share: left 40% of
+     * the CPU where the typical run was left 80%, it could be up to twice
+     * as slow for that alone. */
     {
-        struct gate_run a = {.ms = 10, .has_share = true, .other_share = 0.2};
         struct gate_run b = {.ms = 30, .has_share = true, .other_share = 0.6};
-        CHECK_NEAR(gate_pair_bound_ms(&a, &b, false), 15.0, 1e-9);
-        CHECK_NEAR(gate_pair_bound_ms(&a, &b, true), 30.0, 1e-9);
-        CHECK_NEAR(gate_pair_bound_ms(&b, &a, true), 20.0, 1e-9); /* had twice the CPU */
-        CHECK_NEAR(gate_pair_bound_ms(&b, &a, false), 10.0, 1e-9);
-        b.has_share = false;
-        CHECK_NEAR(gate_pair_bound_ms(&a, &b, false), 30.0, 1e-9);
-        /* Against a typical share: the baseline gate's bound. */
-        b.has_share = true;
         CHECK_NEAR(gate_run_bound_ms(&b, true, 0.2, false), 15.0, 1e-9);
         CHECK_NEAR(gate_run_bound_ms(&b, true, 0.2, true), 30.0, 1e-9);
         CHECK_NEAR(gate_run_bound_ms(&b, false, 0.2, false), 30.0, 1e-9);
+        b.has_share = false;
+        CHECK_NEAR(gate_run_bound_ms(&b, true, 0.2, false), 30.0, 1e-9);
     }
     struct gate_run busy[2] = {{.ms = 10, .has_share = true, .other_share = 0.85},
                                {.ms = 10, .has_share = true, .other_share = 0.81}};

@@ -23,8 +23,8 @@
 #include "common/log.h"
 #include "daemon/api/connections.h"
 #include "daemon/api/http.h"
-#include "daemon/jobs/job_cost.h"
-#include "daemon/jobs/store.h"
+#include "daemon/spec/job_cost.h"
+#include "daemon/store/store.h"
 
 static atomic_bool render_up = true;
 
@@ -181,8 +181,10 @@ static void finish_next(struct queue *q, const char *expect_id)
     CHECK(job && strcmp(job->id, expect_id) == 0);
     if (!job)
         return;
-    json_t *result = json_pack("{s:s, s:i, s:[{s:i, s:s}]}", "technique", "unlit", "frames", 2,
-                               "captures", "frame", 2, "file", "frame-000002.png");
+    json_t *result = json_pack("{s:s, s:i, s:[{s:i, s:s}], s:{s:f, s:[f, f]}}", "technique",
+                               "unlit", "frames", 2, "captures", "frame", 2, "file",
+                               "frame-000002.png", "frame_ms", "median", 1.0, "median_ci95", 0.9,
+                               1.1);
     char path[PATH_MAX + 32];
     job_file_path(job->dir, JOB_FILE_RESULT, path, sizeof(path));
     CHECK(fs_write_json_atomic(path, result));
@@ -428,6 +430,25 @@ int main(void)
     CHECK(r.status == 200 && json_array_size(jobs) == 1 && !json_object_get(r.json, "next") &&
           json_array_size(jobs) == 1 && strcmp(str(json_array_get(jobs, 0), "id"), ids[2]) == 0);
     reply_finish(&r);
+    /* Newest first (the dashboard's order): the same jobs the other way
+     * round, a page at a time through next. */
+    r = request(port, "GET", "/v1/jobs?order=newest&limit=2", NULL, NULL);
+    jobs = json_object_get(r.json, "jobs");
+    CHECK(r.status == 200 && json_array_size(jobs) == 2 &&
+          strcmp(str(json_array_get(jobs, 0), "id"), ids[2]) == 0 &&
+          strcmp(str(json_array_get(jobs, 1), "id"), ids[1]) == 0);
+    next = str(r.json, "next");
+    CHECK(next && strstr(next, "order=newest"));
+    snprintf(next_path, sizeof(next_path), "%s", next ? next : "/");
+    reply_finish(&r);
+    r = request(port, "GET", next_path, NULL, NULL);
+    jobs = json_object_get(r.json, "jobs");
+    CHECK(r.status == 200 && json_array_size(jobs) == 1 && !json_object_get(r.json, "next") &&
+          strcmp(str(json_array_get(jobs, 0), "id"), ids[0]) == 0);
+    reply_finish(&r);
+    r = request(port, "GET", "/v1/jobs?order=sideways", NULL, NULL);
+    CHECK(r.status == 400 && error_field(&r) && strcmp(error_field(&r), "order") == 0);
+    reply_finish(&r);
     r = request(port, "GET", "/v1/jobs?limit=0", NULL, NULL);
     CHECK(r.status == 400 && error_field(&r) && strcmp(error_field(&r), "limit") == 0);
     reply_finish(&r);
@@ -453,6 +474,21 @@ int main(void)
     reply_finish(&r);
     r = request(port, "GET", frame_url, NULL, NULL);
     CHECK(r.status == 404 && error_field(&r) && strcmp(error_field(&r), "frame") == 0);
+    reply_finish(&r);
+    /* Its workload's history: the one done job, no change to flag. */
+    snprintf(path, sizeof(path), "/v1/jobs/%s/history", ids[0]);
+    r = request(port, "GET", path, NULL, NULL);
+    CHECK(r.status == 200 && json_array_size(json_object_get(r.json, "points")) == 1 &&
+          json_array_size(json_object_get(r.json, "changes")) == 0 &&
+          strcmp(str(json_object_get(r.json, "workload"), "technique"), "unlit") == 0 &&
+          !json_object_get(json_object_get(r.json, "workload"), "labels"));
+    reply_finish(&r);
+    r = request(port, "GET", "/v1/jobs/1-2/history", NULL, NULL);
+    CHECK(r.status == 404);
+    reply_finish(&r);
+    snprintf(path, sizeof(path), "/v1/jobs/%s/history?figure=fps", ids[0]);
+    r = request(port, "GET", path, NULL, NULL);
+    CHECK(r.status == 400 && error_field(&r) && strcmp(error_field(&r), "figure") == 0);
     reply_finish(&r);
 
     /* DELETE: a queued job is cancelled at once; a finished one is 409. */
@@ -596,6 +632,20 @@ int main(void)
     reply_finish(&r);
     r = request(port, "GET", "/healthz", NULL, NULL);
     CHECK(r.status == 200);
+    reply_finish(&r);
+    /* The dashboard's files hold no data: served without the token, which
+     * the page then asks for; an unknown file is a 404. */
+    r = request(port, "GET", "/", NULL, NULL);
+    CHECK(r.status == 200 && strstr(r.body, "/ui/app.js"));
+    reply_finish(&r);
+    r = request(port, "GET", "/ui/api.js", NULL, NULL);
+    CHECK(r.status == 200 && strstr(r.body, "Authorization"));
+    reply_finish(&r);
+    r = request(port, "GET", "/ui/nothing.js", NULL, NULL);
+    CHECK(r.status == 404);
+    reply_finish(&r);
+    r = request(port, "GET", "/v1/jobs", NULL, NULL);
+    CHECK(r.status == 401);
     reply_finish(&r);
 
     http_server_destroy(http);

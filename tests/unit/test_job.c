@@ -1,8 +1,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "daemon/jobs/job_cost.h"
-#include "daemon/jobs/job_spec.h"
+#include "daemon/spec/job_cost.h"
+#include "daemon/spec/job_spec.h"
 #include "tests/unit/catalog_fixture.h"
 #include "tests/unit/check.h"
 

@@ -4,6 +4,7 @@
 
 #include "daemon/techniques/osl/osl_atlas.h"
 #include "daemon/techniques/osl/osl_schedule.h"
+#include "daemon/scene/mesh_charts.h"
 #include "daemon/scene/scene.h"
 #include "tests/unit/check.h"
 
@@ -165,7 +166,7 @@ static void test_dilate(void)
                 p[0] = (float)x, p[1] = (float)y, p[2] = 0.0f, p[3] = 1.0f;
                 n[2] = 1.0f;
             }
-    long first = osl_dilate_geometry(pos, nrm, NULL, 0, S, 1);
+    long first = osl_dilate_geometry(pos, nrm, NULL, 0, S, 1, NULL);
     CHECK(first == 15); /* x + y == 7 (8 texels) and x + y == 8 (7) */
     for (int y = 0; y < S; y++)
         for (int x = 0; x < S; x++) {
@@ -180,10 +181,74 @@ static void test_dilate(void)
     CHECK(pos[(0 * S + 7) * 4 + 0] == 6.0f);
     /* Texel (7, 1)'s only covered neighbour was (6, 0). */
     CHECK(pos[(1 * S + 7) * 4 + 0] == 6.0f && pos[(1 * S + 7) * 4 + 1] == 0.0f);
-    CHECK(osl_dilate_geometry(pos, nrm, NULL, 0, S, 1) == 11); /* x + y == 9 and 10 */
-    CHECK(osl_dilate_geometry(pos, nrm, NULL, 0, S, 8) == 10); /* the rest, then nothing left */
+    CHECK(osl_dilate_geometry(pos, nrm, NULL, 0, S, 1, NULL) == 11); /* x + y == 9 and 10 */
+    CHECK(osl_dilate_geometry(pos, nrm, NULL, 0, S, 8, NULL) == 10); /* the rest, then nothing left */
     float none[S * S * 4] = {0}, none_n[S * S * 4] = {0};
-    CHECK(osl_dilate_geometry(none, none_n, NULL, 0, S, 4) == 0);
+    CHECK(osl_dilate_geometry(none, none_n, NULL, 0, S, 4, NULL) == 0);
+}
+
+/* Two charts side by side in an 8x8 level, their rectangles meeting at
+ * u = 0.5: chart A covers columns 0 to 2, chart B columns 4 to 7, and
+ * column 3 (inside A's rectangle) is uncovered. Filled without owners it
+ * takes the mean of both charts' edges (a seam where A's filtering reads
+ * it); with owners only A's. */
+static void test_dilate_owned(void)
+{
+    enum { S = 8 };
+    static const float rects[2][4] = {{0.0f, 0.0f, 0.5f, 1.0f}, {0.5f, 0.0f, 1.0f, 1.0f}};
+    int owner[S * S];
+    osl_chart_owners(rects, 2, S, owner);
+    CHECK(owner[0] == 0 && owner[3] == 0 && owner[4] == 1 && owner[7 * S + 7] == 1);
+    for (int pass = 0; pass < 2; pass++) {
+        float pos[S * S * 4] = {0}, nrm[S * S * 4] = {0};
+        for (int y = 0; y < S; y++)
+            for (int x = 0; x < S; x++)
+                if (x != 3) {
+                    float *q = &pos[(y * S + x) * 4];
+                    q[0] = (float)x, q[3] = 1.0f;
+                    nrm[(y * S + x) * 4 + 2] = 1.0f;
+                }
+        CHECK(osl_dilate_geometry(pos, nrm, NULL, 0, S, 1, pass ? owner : NULL) == S);
+        for (int y = 0; y < S; y++)
+            CHECK(pos[(y * S + 3) * 4] == (pass ? 2.0f : 3.0f));
+    }
+    /* A rectangle with no texel centre at this level owns nothing. */
+    static const float thin[1][4] = {{0.30f, 0.0f, 0.31f, 1.0f}};
+    osl_chart_owners(thin, 1, S, owner);
+    long owned = 0;
+    for (int i = 0; i < S * S; i++)
+        owned += owner[i] >= 0;
+    CHECK(owned == 0);
+}
+
+/* mesh_chart_rects: two triangles apart in uv are two charts with their
+ * own rectangles; a third overlapping the first's rectangle sends both to
+ * the whole square (no clamp); shared vertices join triangles. */
+static void test_chart_rects(void)
+{
+    struct mesh_vertex v[9] = {0};
+    static const float uv[9][2] = {{0.0f, 0.0f}, {0.4f, 0.0f}, {0.0f, 0.4f},  /* A */
+                                   {0.6f, 0.6f}, {1.0f, 0.6f}, {0.6f, 1.0f},  /* B */
+                                   {0.1f, 0.1f}, {0.3f, 0.1f}, {0.1f, 0.3f}}; /* C, inside A's box */
+    for (int i = 0; i < 9; i++)
+        memcpy(v[i].uv, uv[i], sizeof(uv[i]));
+    uint32_t idx[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
+    struct mesh m = {.vertices = v, .indices = idx, .vertex_count = 9, .index_count = 6};
+    struct mesh_chart_stats st;
+    CHECK(mesh_chart_rects(&m, &st) && st.charts == 2 && st.overlapping == 0);
+    CHECK(v[7].chart[0] == 0.0f && v[7].chart[2] == 1.0f); /* in no triangle: no chart */
+    CHECK(v[0].chart[0] == 0.0f && v[0].chart[2] == 0.4f && v[2].chart[3] == 0.4f);
+    CHECK(v[4].chart[0] == 0.6f && v[4].chart[1] == 0.6f && v[4].chart[2] == 1.0f);
+    m.index_count = 9;
+    CHECK(mesh_chart_rects(&m, &st) && st.charts == 3 && st.overlapping == 2);
+    CHECK(v[0].chart[0] == 0.0f && v[0].chart[2] == 1.0f && v[7].chart[3] == 1.0f);
+    CHECK(v[4].chart[0] == 0.6f);
+    /* A shared vertex joins two triangles into one chart. */
+    uint32_t joined[6] = {0, 1, 2, 1, 3, 4};
+    m.indices = joined;
+    m.index_count = 6;
+    CHECK(mesh_chart_rects(&m, &st) && st.overlapping == 0 && v[3].chart[0] == 0.0f &&
+          v[3].chart[2] == 1.0f && v[0].chart[3] == 0.6f);
 }
 
 /* Phong's radiance at P with normal N from every light at frame (the
@@ -282,6 +347,8 @@ static void test_change_bound(void)
 int main(void)
 {
     test_dilate();
+    test_dilate_owned();
+    test_chart_rects();
     test_atlas();
     test_schedule();
     test_plan();

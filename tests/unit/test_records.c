@@ -12,7 +12,7 @@
 
 #include "common/fsutil.h"
 #include "common/log.h"
-#include "daemon/jobs/records.h"
+#include "daemon/store/records.h"
 #include "tests/unit/check.h"
 
 static bool exists(const char *path)

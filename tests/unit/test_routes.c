@@ -32,6 +32,21 @@ int main(void)
     CHECK(kind_of("/v1/sweeps", &r) == ROUTE_SWEEPS && kind_of("/v1/sweeps/", &r) == ROUTE_SWEEPS);
     CHECK(kind_of("/v1/sweeps/5/charts/speed_accuracy.png", &r) == ROUTE_SWEEP_CHART && r.chart_png);
     CHECK(kind_of("/v1/sweeps/5/report.html", &r) == ROUTE_SWEEP_REPORT);
+    CHECK(kind_of("/v1/jobs/1/pdiff/100.png", &r) == ROUTE_JOB_PDIFF && r.frame == 100);
+    CHECK(kind_of("/v1/jobs/1/pdiff/x.png", &r) == ROUTE_NONE && strcmp(r.field, "frame") == 0);
+    CHECK(kind_of("/v1/jobs/1/history", &r) == ROUTE_JOB_HISTORY && strcmp(r.id, "1") == 0);
+    CHECK(kind_of("/v1/sweeps/5/verdict", &r) == ROUTE_SWEEP_VERDICT && strcmp(r.id, "5") == 0);
+    /* The dashboard: / and /ui/ are its index; any other /ui/ path is looked up. */
+    CHECK(kind_of("/", &r) == ROUTE_UI && strcmp(r.ui, "/ui/index.html") == 0);
+    CHECK(kind_of("/ui/", &r) == ROUTE_UI && strcmp(r.ui, "/ui/index.html") == 0);
+    CHECK(kind_of("/ui/app.js", &r) == ROUTE_UI && strcmp(r.ui, "/ui/app.js") == 0);
+    CHECK(kind_of("/ui/0123456789012345678901234567890123456789012345678901234567890.js", &r) ==
+          ROUTE_NONE);
+    {
+        const char *ui_allow, *ui_rule;
+        CHECK(!route_method_ok(ROUTE_UI, "POST", &ui_allow, &ui_rule) &&
+              strcmp(ui_allow, "GET, HEAD") == 0);
+    }
 
     /* The raw target: an encoded NUL anywhere, or a query of more than
      * ROUTE_MAX_QUERY_ARGS arguments, is refused naming it. */

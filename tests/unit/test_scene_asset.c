@@ -1,9 +1,11 @@
+#define _GNU_SOURCE /* M_PI */
 /* The asset -> scene mapping (daemon/scene/scene_asset.c), GL-free: the
  * textured preset's synthetic asset and small hand-made ones. Instances and
  * their ordering by alpha mode, re-centring, bounds, camera choice by index
  * and name, light conversion, the "auto" light count, errors naming the
  * field, and the scene keys' parsing. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -52,7 +54,8 @@ static void test_textured_preset(void)
             CHECK_NEAR(m->box_min[k], -m->box_max[k], 1e-4f);
         }
         /* Vertices: world position = instance + object position; tex the
-         * file's TEXCOORD_0 and _1, uv uv1, one chart, tangent and colour
+         * file's TEXCOORD_0 and _1, uv uv1 inside its chart's rectangle
+         * (mesh_chart_rects), tangent and colour
          * copied. */
         CHECK(m->vertex_count == src->vertex_count && m->index_count == src->index_count);
         for (uint32_t v = 0; v < m->vertex_count; v += 7) {
@@ -62,7 +65,8 @@ static void test_textured_preset(void)
             CHECK(m->vertices[v].tex[3] == src->vertices[v].texcoord1[1]);
             CHECK(m->vertices[v].color[2] == src->vertices[v].color[2]);
             CHECK(m->vertices[v].uv[1] == src->vertices[v].uv1[1]);
-            CHECK(m->vertices[v].chart[2] == 1.0f && m->vertices[v].chart[0] == 0.0f);
+            const float *c = m->vertices[v].chart, *uv = m->vertices[v].uv;
+            CHECK(c[0] <= uv[0] && uv[0] <= c[2] && c[1] <= uv[1] && uv[1] <= c[3]);
             CHECK(m->vertices[v].tangent[3] == src->vertices[v].tangent[3]);
         }
         CHECK(m->bound_radius > 0.0f);
@@ -72,20 +76,24 @@ static void test_textured_preset(void)
     for (int k = 0; k < 3; k++) {
         CHECK_NEAR(s.bounds.min[k], a->box_min[k], 1e-4f);
         CHECK_NEAR(s.bounds.max[k], a->box_max[k], 1e-4f);
-        CHECK(s.light_volume.min[k] == a->box_min[k]);
     }
-    /* Lights: the preset's 8 generated, then the spot and the sun. */
+    /* Lights: the preset's 8 generated, then the spot and the sun, all in
+     * glTF's falloff: colour = glTF colour x intensity / pi. */
     CHECK(s.generated_light_count == 8 && s.asset_light_count == 2 && s.light_count == 10);
     const struct scene_light *spot = &s.lights[8], *sun = &s.lights[9];
     CHECK(spot->type == SCENE_LIGHT_SPOT && sun->type == SCENE_LIGHT_DIRECTIONAL);
-    CHECK_NEAR(spot->color[0], 150.0f / 100.0f, 1e-5f);
-    CHECK_NEAR(spot->radius, sqrtf(150.0f), 1e-4f);
+    CHECK(spot->falloff == SCENE_FALLOFF_GLTF && sun->falloff == SCENE_FALLOFF_GLTF);
+    CHECK_NEAR(spot->color[0], 150.0f / (float)M_PI, 1e-4f);
+    CHECK(spot->range == 0.0f && spot->gltf_intensity == 150.0f);
+    /* No range: cut where 150 cd off white falls below 1/1024. */
+    CHECK_NEAR(spot->radius, sqrtf(150.0f * 1024.0f / (float)M_PI), 1e-2f);
     CHECK_NEAR(spot->cos_inner, cosf(0.35f), 1e-6f);
     CHECK_NEAR(spot->cos_outer, cosf(0.6f), 1e-6f);
     CHECK(spot->centre[1] == 7.0f);
-    CHECK_NEAR(sun->color[1], 0.98f * 0.6f, 1e-5f);
+    CHECK_NEAR(sun->color[1], 0.98f * 2.0f / (float)M_PI, 1e-5f);
     for (int i = 0; i < 8; i++) {
         CHECK(s.lights[i].type == SCENE_LIGHT_POINT);
+        CHECK(s.lights[i].falloff == SCENE_FALLOFF_GLTF && s.lights[i].range > 0.0f);
         for (int k = 0; k < 3; k++)
             CHECK(s.lights[i].centre[k] >= s.light_volume.min[k] &&
                   s.lights[i].centre[k] <= s.light_volume.max[k]);
@@ -156,9 +164,41 @@ static void test_user_asset(void)
     CHECK(s.instances[0].asset_material == -1 && s.instances[0].albedo[0] == 1.0f);
     CHECK(scene_all_in_view(&s));
     CHECK(!scene_has_blended(&s));
-    /* Flat asset: the light volume is raised above it. */
-    CHECK(s.light_volume.max[1] > 0.0f);
+    /* Generated lights stand around and over it, outside its bounds. */
+    for (int i = 0; i < s.light_count; i++) {
+        const float *c = s.lights[i].centre;
+        bool inside = true;
+        for (int k = 0; k < 3; k++)
+            inside = inside && c[k] >= a.box_min[k] && c[k] <= a.box_max[k];
+        CHECK(!inside && c[1] > 0.5f * (a.box_min[1] + a.box_max[1]));
+    }
     scene_finish(&s);
+    /* Every layout, lights of small range hugging the surfaces, circling:
+     * at every frame no light is inside the box. */
+    static const char *const layouts[] = {"halton", "uniform", "grid", "clustered"};
+    for (int li = 0; li < 4; li++)
+        for (int small = 0; small < 2; small++) {
+            char json[256];
+            snprintf(json, sizeof(json), "{\"asset\": \"tri\", \"lights\": 64, \"dynamic\": true, "
+                     "\"light_layout\": \"%s\"%s}", layouts[li],
+                     small ? ", \"light_radius\": 0.05" : "");
+            struct scene_spec sp;
+            spec_for(&sp, json);
+            CHECK(scene_build(&s, &sp, &a, err, sizeof(err)) && s.light_count == 64);
+            int inside_count = 0;
+            for (int i = 0; i < s.light_count; i++)
+                for (int64_t f = 0; f < 400; f += 13) {
+                    float p[3];
+                    scene_light_position(&s, i, f, p);
+                    bool inside = true;
+                    for (int k = 0; k < 3; k++)
+                        inside = inside && p[k] >= a.box_min[k] && p[k] <= a.box_max[k];
+                    inside_count += inside;
+                }
+            CHECK(inside_count == 0);
+            CHECK(s.lights[0].range == (small ? 0.05f : 5.0f * sqrtf(2.0f)));
+            scene_finish(&s);
+        }
 
     /* A point light without range, and one with; lights "auto" with asset
      * lights: none generated. */
@@ -168,9 +208,9 @@ static void test_user_asset(void)
     a.lights = l, a.light_count = 2;
     CHECK(scene_build(&s, &spec, &a, err, sizeof(err)));
     CHECK(s.light_count == 2 && s.generated_light_count == 0);
-    CHECK_NEAR(s.lights[0].radius, 20.0f, 1e-4f);
-    CHECK_NEAR(s.lights[0].color[0], 4.0f, 1e-5f);
-    CHECK(s.lights[1].radius == 3.0f);
+    CHECK_NEAR(s.lights[0].radius, sqrtf(400.0f * 1024.0f / (float)M_PI), 1e-2f);
+    CHECK_NEAR(s.lights[0].color[0], 400.0f / (float)M_PI, 1e-3f);
+    CHECK(s.lights[1].radius == 3.0f && s.lights[1].range == 3.0f);
     scene_finish(&s);
 
     /* Errors name the field. */

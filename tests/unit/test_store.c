@@ -18,10 +18,10 @@
 
 #include "common/fsutil.h"
 #include "common/log.h"
-#include "daemon/jobs/job_figures.h"
+#include "daemon/spec/job_figures.h"
 #include "daemon/jobs/queue.h"
-#include "daemon/jobs/store.h"
-#include "daemon/jobs/store_reserve.h"
+#include "daemon/store/store.h"
+#include "daemon/store/store_reserve.h"
 #include "tests/unit/catalog_fixture.h"
 #include "tests/unit/check.h"
 

@@ -1,7 +1,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "daemon/jobs/sweep_spec.h"
+#include "daemon/spec/sweep_spec.h"
 #include "tests/unit/catalog_fixture.h"
 #include "tests/unit/check.h"
 

@@ -10,7 +10,7 @@
 
 #include "common/frame_needs.h"
 #include "daemon/effects/taa/taa_info.h"
-#include "daemon/jobs/job_spec.h"
+#include "daemon/spec/job_spec.h"
 #include "daemon/scene/scene.h"
 #include "daemon/techniques/visibility_buffer/visibility_buffer_info.h"
 #include "tests/unit/catalog_fixture.h"

@@ -4,7 +4,9 @@
  * (no two triangles share a texel of a 512-texel raster, sampled inside
  * each triangle away from its edges), every uv in [0, 1], every index in
  * range, each new vertex copying an input vertex, and texel density the
- * same within cos 30 degrees across the mesh. */
+ * same within cos 30 degrees across the mesh; the skyline packing keeps the
+ * waste of the sphere, the bumpy grid and the mirrored halves at 0.45 to
+ * 0.54 (the shelves left 0.47 to 0.63). */
 #include <math.h>
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -203,9 +205,15 @@ int main(void)
     cube(&m);
     run("cube", &m, 6, 24, 0.40);
     sphere(&m, 32, 16);
-    run("sphere", &m, 0, 0, 0.80);
+    run("sphere", &m, 0, 0, 0.50);
     grid(&m, 64, 0.05);
-    run("bumpy grid", &m, 0, 0, 0.80);
+    run("bumpy grid", &m, 0, 0, 0.50);
+    /* Mirrored halves (a file would often give both the same uv): the
+     * bumps of x < 0 mirror those of x > 0; each half gets its own texels. */
+    grid(&m, 32, 0.05);
+    for (uint32_t v = 0; v < m.nv; v++)
+        m.pos[3 * v + 2] = (float)(0.05 * sin(fabs(m.pos[3 * v]) * 11.0 + m.pos[3 * v + 1] * 5.0));
+    run("mirrored halves", &m, 0, 0, 0.60);
     /* Degenerate triangles (a repeated corner) and a lone triangle. */
     grid(&m, 4, 0);
     m.tri[0] = m.tri[1];

@@ -60,8 +60,23 @@ int osl_auto_tile_size(double pixels_per_unit, double uv_per_unit, double texel_
     return size > OSL_TILE_MAX ? OSL_TILE_MAX : size;
 }
 
+void osl_chart_owners(const float (*rects)[4], int count, int size, int *owner)
+{
+    for (size_t t = 0; t < (size_t)size * size; t++)
+        owner[t] = -1;
+    for (int r = 0; r < count; r++) {
+        int x0 = (int)ceil(rects[r][0] * size - 0.5), y0 = (int)ceil(rects[r][1] * size - 0.5);
+        int x1 = (int)floor(rects[r][2] * size - 0.5), y1 = (int)floor(rects[r][3] * size - 0.5);
+        x0 = x0 < 0 ? 0 : x0, y0 = y0 < 0 ? 0 : y0;
+        x1 = x1 >= size ? size - 1 : x1, y1 = y1 >= size ? size - 1 : y1;
+        for (int y = y0; y <= y1; y++)
+            for (int x = x0; x <= x1; x++)
+                owner[(size_t)y * size + x] = r;
+    }
+}
+
 long osl_dilate_geometry(float *pos, float *nrm, float *const *extra, int extra_count, int size,
-                         int passes)
+                         int passes, const int *owner)
 {
     long filled = 0;
     for (int pass = 0; pass < passes; pass++) {
@@ -73,21 +88,26 @@ long osl_dilate_geometry(float *pos, float *nrm, float *const *extra, int extra_
                 float *p = &pos[((size_t)y * size + x) * 4];
                 if (p[3] != 0.0f)
                     continue;
+                int own = owner ? owner[(size_t)y * size + x] : -1;
                 float ps[3] = {0, 0, 0}, ns[4] = {0, 0, 0, 0}, es[4][4] = {{0}};
                 int n = 0;
+                float first[3] = {0, 0, 1}; /* a neighbour's normal, where the mean cancels */
                 for (int dy = -1; dy <= 1; dy++)
                     for (int dx = -1; dx <= 1; dx++) {
                         int qx = x + dx, qy = y + dy;
                         if ((!dx && !dy) || qx < 0 || qy < 0 || qx >= size || qy >= size)
                             continue;
                         const float *q = &pos[((size_t)qy * size + qx) * 4];
-                        if (q[3] != 1.0f)
+                        if (q[3] != 1.0f || (own >= 0 && owner[(size_t)qy * size + qx] != own))
                             continue;
                         size_t at = ((size_t)qy * size + qx) * 4;
                         for (int k = 0; k < 3; k++)
                             ps[k] += q[k];
                         for (int k = 0; k < 4; k++)
                             ns[k] += nrm[at + k];
+                        if (!n)
+                            for (int k = 0; k < 3; k++)
+                                first[k] = nrm[at + k];
                         for (int e = 0; e < extra_count && e < 4; e++)
                             for (int k = 0; k < 4; k++)
                                 es[e][k] += extra[e][at + k];
@@ -100,7 +120,7 @@ long osl_dilate_geometry(float *pos, float *nrm, float *const *extra, int extra_
                 float *m = &nrm[at];
                 for (int k = 0; k < 3; k++) {
                     p[k] = ps[k] / (float)n;
-                    m[k] = len > 0.0f ? ns[k] / len : 0.0f;
+                    m[k] = len > 1e-6f ? ns[k] / len : first[k];
                 }
                 m[3] = ns[3] / (float)n;
                 for (int e = 0; e < extra_count && e < 4; e++)

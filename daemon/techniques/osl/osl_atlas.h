@@ -37,10 +37,18 @@ int osl_auto_tile_size(double pixels_per_unit, double uv_per_unit, double texel_
  * renormalised, w averaged) and extra channels of the covered neighbours
  * and become covered (w = 1), `passes` times, each pass reading the
  * coverage the one before left. Bilinear filtering at a chart's edge then
- * reads shading of about the edge's surface instead of black. pos, nrm and
- * the extra images are size x size RGBA float images (rows of size texels);
- * returns the texels filled. */
+ * reads shading of about the edge's surface instead of black. With owner
+ * (size x size chart indices, -1 for none; may be NULL), a texel that a
+ * chart owns is filled from that chart's texels only, so that a chart's
+ * rectangle holds its own surface however near another chart lies. pos,
+ * nrm and the extra images are size x size RGBA float images (rows of size
+ * texels); returns the texels filled. */
 long osl_dilate_geometry(float *pos, float *nrm, float *const *extra, int extra_count, int size,
-                         int passes);
+                         int passes, const int *owner);
+
+/* The owner map of the given chart rectangles (u0, v0, u1, v1 each) at a
+ * size x size level: each texel whose centre lies inside rectangle r gets r
+ * (the centres osl_draw.frag clamps its samples to), the others -1. */
+void osl_chart_owners(const float (*rects)[4], int count, int size, int *owner);
 
 #endif

@@ -5,8 +5,10 @@ layout(location = 0) in vec3 a_pos;
 layout(location = 2) in vec2 a_uv;
 layout(location = 3) in vec4 a_chart;
 #if defined(SCENE_TEXTURED)
-layout(location = 4) in vec2 a_tex;
+layout(location = 4) in vec4 a_tex; // the material's TEXCOORD_0 (xy) and _1 (zw)
 layout(location = 5) in vec4 a_tangent;
+layout(location = 6) in vec4 a_color; // COLOR_0
+out vec4 v_color;
 out vec4 v_tex;     // surface.glsl's inputs, for the alpha mask
 out vec4 v_tangent;
 #endif
@@ -25,7 +27,8 @@ void main()
     Instance inst = instances[id];
     v_uv = a_uv;
 #if defined(SCENE_TEXTURED)
-    v_tex = vec4(a_tex, a_uv);
+    v_tex = a_tex;
+    v_color = a_color - 1.0; // surface.glsl adds the 1 back
     v_tangent = a_tangent;
 #endif
     v_chart = a_chart;

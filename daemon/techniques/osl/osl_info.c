@@ -18,9 +18,11 @@ static const struct opt_field options[] = {
                 "(the default) sizes each object's tile from its size on screen",
      .offset = offsetof(struct osl_options, resolution)},
     {.name = "texel_density", .type = OPT_NUMBER, .def = 0.0, .min = 0.0, .max = 16.0,
-     .summary = "with resolution \"auto\": texels per covered pixel (along each axis), "
-                "0.0625 to 16; 0 (the default): 1, or 2 under PBR lighting, whose GGX "
-                "highlights bilinear filtering of one texel a pixel flattens",
+     .summary = "with resolution \"auto\": texels per covered pixel (along each axis) at the "
+                "level each pixel reads, 0.0625 to 16 (a pixel reads 1 to 2 times this); 0 (the "
+                "default): 1, or 2 under PBR lighting, whose GGX highlights bilinear filtering "
+                "of one texel a pixel flattens, or 0.71 in asset scenes under Phong and "
+                "Blinn-Phong, where the base colour is applied per pixel",
      .offset = offsetof(struct osl_options, texel_density)},
     {.name = "reshade", .type = OPT_CHOICE, .def = OSL_RESHADE_TOUCHED,
      .choices = reshade_choices,

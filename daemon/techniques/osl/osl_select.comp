@@ -114,6 +114,7 @@ void main()
     uint inst = block_instance[b];
     if (inst == 0xffffffffu)
         return;
+    inst &= 0xffffffu; // the level above bit 24
     ivec4 held = shaded[b * 2u];
     if (u_mode == 4) {
         int key = shaded[b * 2u + 1u].x;

@@ -9,6 +9,7 @@ layout(location = 1) out vec4 out_normal;
 // raster choose the mip level): the shading normal (normal-mapped) and
 // metallic, albedo and roughness, emissive and occlusion. The lighting
 // pass then shades many objects in one dispatch without their textures.
+#define SURFACE_VERTEX_COLOR 1 // osl_texgen.vert passes COLOR_0
 #include "surface.glsl"
 layout(location = 2) out vec4 out_albedo;  // linear base colour, roughness (+ 2 double-sided)
 layout(location = 3) out vec4 out_surface; // emissive, occlusion
@@ -20,7 +21,8 @@ void main()
 #if defined(SCENE_TEXTURED)
     // Front faces: object space has no viewer; a double-sided material's
     // back is shaded as its front.
-    TexturedSurface s = material_surface(u_material, v_tex, normalize(v_normal), v_tangent, true);
+    TexturedSurface s = material_surface(u_material, v_tex, normalize(v_normal), v_tangent, true,
+                                          SURFACE_COLOR);
     out_normal = vec4(s.N, s.m.metallic);
     // A double-sided material is shaded on the side the viewer sees, which
     // object space cannot know: the lighting pass flips the normal then.

@@ -2,6 +2,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "daemon/gpu/glutil.h"
 #include "daemon/techniques/shared/depth_prepass.h"
@@ -23,6 +24,16 @@ struct culled {
     int pass_geometry, pass_edges, pass_binning, pass_shading;
 };
 
+/* The index of the pass named name in the frame's passes (the
+ * technique's own come first, in its info's order), or -1. */
+static int pass_named(const struct gpu_passes *p, const char *name)
+{
+    for (int i = 0; i < p->count; i++)
+        if (strcmp(p->names[i], name) == 0)
+            return i;
+    return -1;
+}
+
 bool culled_create(const struct technique_env *env, const struct culled_config *cfg,
                    void **state, char *err, size_t errlen)
 {
@@ -33,12 +44,19 @@ bool culled_create(const struct technique_env *env, const struct culled_config *
     }
     *state = c;
     c->cfg = *cfg;
-    bool tiles = cfg->grid.kind == LIGHT_GRID_TILES;
-    /* The deferred ones time their edge pass (MSAA) after the g-buffer. */
-    c->pass_geometry = tiles ? 0 : 1;
-    c->pass_edges = cfg->deferred ? c->pass_geometry + 1 : -1;
-    c->pass_binning = tiles ? 1 + cfg->deferred : 0;
-    c->pass_shading = 2 + cfg->deferred;
+    /* Each pass by the name the technique's info declares it under (the
+     * deferred ones time their edge pass, MSAA, after the g-buffer). */
+    c->pass_geometry = pass_named(env->passes, cfg->deferred ? "gbuffer" : "depth_prepass");
+    c->pass_edges = cfg->deferred ? pass_named(env->passes, "edges") : -1;
+    c->pass_binning = pass_named(env->passes, "binning");
+    c->pass_shading = pass_named(env->passes, cfg->deferred ? "lighting" : "shading");
+    if (c->pass_geometry < 0 || (cfg->deferred && c->pass_edges < 0) || c->pass_binning < 0 ||
+        c->pass_shading < 0) {
+        snprintf(err, errlen, "%s: its info must declare the passes %s", cfg->grid.technique,
+                 cfg->deferred ? "gbuffer, edges, binning and lighting"
+                               : "depth_prepass, binning and shading");
+        goto fail;
+    }
     c->runs = 1;
     if (!light_grid_init(&c->grid, env, &cfg->grid, err, errlen) ||
         !heat_init(&c->heat, env, err, errlen))

@@ -8,7 +8,10 @@
  *   froxels: binning, geometry, lighting or shading
  * Tiles need the frame's depth before binning; froxels need none, so they
  * bin first and their binning time stands alone. Each such technique's info
- * declares its three passes in exactly that order. Deferred lighting is one
+ * declares its passes in that order under these names: "gbuffer", "edges"
+ * (the MSAA edge pixels), "binning", "lighting" for the deferred ones (four),
+ * "depth_prepass", "binning", "shading" for the forward ones (three);
+ * culled_create finds each by its name. Deferred lighting is one
  * full-screen pass over the g-buffer; forward shading draws the objects
  * again with GL_LEQUAL against the pre-pass, so each pixel shades once.
  * Both loop over the pixel's cell (shaders/culling/light_grid.glsl). Render

@@ -14,6 +14,9 @@
   the truth is larger without clamping than with variance clipping, and
   flicker is reported beside MSAA 4's;
 - every TAA pass is timed, result.time states the rule;
+- issue 37's Done-when request (visibility buffer, TAA, the 4x truth, 8
+  temporal frames, 256 lights on an orbit) reports its cost, its accuracy
+  against the truth and its flicker;
 - bad options are answered 400 naming the field."""
 
 import math
@@ -229,6 +232,42 @@ try:
           "variance clipping ghosts less: %s < %s" % (tight.get("band_error"), loose.get("band_error")))
     check(isinstance(msaa.get("flicker"), float) and isinstance(msaa.get("ghosting"), dict),
           "MSAA 4 reports its flicker and band error beside TAA's: %s" % msaa)
+
+    # Issue 37's request as users send it (the visibility buffer with TAA,
+    # the 4x supersampled forward truth, 8 temporal frames, 256 lights on
+    # an orbit), at a quarter of this test's size and its length: it reports its cost (the
+    # estimate at submit, frame times, each pass's and the targets' bytes),
+    # its accuracy against the truth and its flicker.
+    issue = {"technique": "visibility_buffer", "look": {"post": ["taa"]},
+             "reference": {"technique": "forward", "supersample": 4}, "temporal": {"frames": 8},
+             "scene": {"preset": "lights", "lights": 256, "camera": "orbit",
+                       "width": W // 2, "height": H // 2},
+             "frames": 17, "warmup_frames": 0, "capture_interval": 17}
+    code, reply = d.json("POST", "/v1/jobs", issue)
+    check(code == 202 and reply.get("cost", {}).get("memory_bytes", 0) > 0 and
+          reply.get("cost", {}).get("temporal_bytes", 0) > 0,
+          "issue 37's request is accepted with its cost estimated: %d %s" % (code, reply))
+    done = d.wait(reply["id"]) if code == 202 else {}
+    check(done.get("status") == "done", "issue 37's request runs: %s" % done.get("error"))
+    result = done.get("result", {})
+    q, cap = result.get("quality", {}), (result.get("captures") or [{}])[-1]
+    sections = result.get("gpu_sections_ms", {})
+    check(result.get("frame_ms", {}).get("median", 0) > 0 and result.get("targets_bytes", 0) > 0 and
+          all(p in sections for p in ("visibility", "shading", "motion_vectors", "taa.resolve")),
+          "cost: frame times, targets' bytes and the visibility, shading, motion and TAA "
+          "passes timed: %s" % list(sections))
+    check(q.get("reference") == "forward" and q.get("reference_supersample") == 4 and
+          0 < q.get("worst_ssim", {}).get("value", 0) < 1 and
+          q.get("worst_flip", {}).get("mean", -1) > 0 and q.get("worst_psnr", {}).get("value", 0) > 0,
+          "accuracy against the 4x supersampled truth: %s" % q)
+    temporal = cap.get("temporal", {})
+    check(isinstance(temporal.get("flicker"), float) and
+          temporal.get("frames", [0, 0])[1] - temporal.get("frames", [0, 0])[0] == 7 and
+          isinstance(q.get("worst_flicker", {}).get("value"), float) and
+          result.get("temporal", {}).get("frames") == 8,
+          "flicker over the 8 temporal frames: %s" % temporal)
+    check("taa" in result.get("time", {}).get("reference", {}).get("antialiasing_left_out", ""),
+          "the truth leaves TAA out and says so: %s" % result.get("time"))
 
     # Bad input, named.
     base = {"frames": 40, "warmup_frames": 16, "capture_interval": 40}

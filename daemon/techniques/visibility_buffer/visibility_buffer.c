@@ -406,10 +406,10 @@ static bool vis_render(void *state, const struct technique_env *env, int64_t fra
     glClearStencil(0);
     glClear(GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
     gpu_scene_bind(env->gpu, &v->ids);
-    struct gpu_tiles t;
-    for (gpu_tiles_begin(env->budget, env->width, env->height, &t);
-         gpu_tiles_next(env->budget, &t);)
-        gpu_scene_draw(env->gpu, &v->ids);
+    /* Once, as the g-buffer's pass draws (shared/gbuffer.c): its cost is
+     * the geometry's, which screen tiles would not cut but repeat, every
+     * tile transforming and binning every triangle again. */
+    gpu_scene_draw(env->gpu, &v->ids);
     gpu_pass_end(env->passes);
 
     classify(v, env);

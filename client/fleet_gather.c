@@ -171,8 +171,11 @@ static json_t *gather_row(const char *const *dirs, int ndirs, const char *cls, c
         json_object_set_new(row, "job", json_string(key));
         json_t *rd = json_object_get(json_object_get(job, RK_RESULT), "device");
         json_t *dev = json_pack("{s:s}", "class", cls);
+        /* Which GPU the task opened, by every name it has, and why
+         * (--device allocated: the Slurm variable or cgroup it followed). */
         static const char *const keys[] = {"gl_renderer", "gl_version", "gl_vendor", "egl_device",
-                                           "egl_platform"};
+                                           "egl_platform", "bus_id", "uuid", "render_node",
+                                           "selection"};
         for (size_t k = 0; k < sizeof(keys) / sizeof(keys[0]); k++)
             if (json_object_get(rd, keys[k]))
                 json_object_set(dev, keys[k], json_object_get(rd, keys[k]));

@@ -255,7 +255,10 @@ static bool write_task_script(const char *dir, const char *daemon, char *err, si
     sh_quote(f, dir);
     fputs("\nexec ", f);
     sh_quote(f, daemon);
-    fputs(" --once \"$fleet/plan/$i.json\" --out \"$fleet/tasks/$class/$i\" >/dev/null\n", f);
+    /* The GPU Slurm gave the task, whatever the order of EGL's devices; the
+     * result's device.selection says which it opened and why. */
+    fputs(" --device allocated --once \"$fleet/plan/$i.json\" --out \"$fleet/tasks/$class/$i\" "
+          ">/dev/null\n", f);
     bool ok = fclose(f) == 0 && fs_write_atomic(path, text, len) && chmod(path, 0755) == 0;
     free(text);
     if (!ok)
@@ -597,7 +600,7 @@ int cmd_plan(const struct options *o, const char *sweep_file)
         return EXIT_ERROR;
     size_t n = json_array_size(json_object_get(plan, "points"));
     printf("%zu points in %s/plan; run each on a runner labelled LABEL with\n"
-           "  shadebenchd --once %s/plan/N.json --out %s/tasks/LABEL/N\n"
+           "  shadebenchd --device allocated --once %s/plan/N.json --out %s/tasks/LABEL/N\n"
            "for N from 0 to %zu, then: shadebench gather DIR...\n",
            n, o->out_dir, o->out_dir, o->out_dir, n ? n - 1 : 0);
     json_decref(plan);

@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* Length of the valid UTF-8 sequence at s (at most avail bytes), or 0 when
@@ -267,4 +268,89 @@ json_t *job_error_to_json(const struct job_error *err)
     jf_utf8_sanitize(e.field, sizeof(e.field));
     jf_utf8_sanitize(e.message, sizeof(e.message));
     return json_pack("{s:{s:s, s:s}}", "error", "field", e.field, "message", e.message);
+}
+
+/* The path of the value a scan is at, from its containers (keys and
+ * indices), as the specs name fields: "scene.width", "vary.frames[1]". */
+struct scan_frame {
+    bool object;
+    const char *key;
+    size_t key_len, index;
+};
+
+static void scan_path(const struct scan_frame *st, int depth, char *out, size_t cap)
+{
+    size_t used = 0;
+    out[0] = '\0';
+    for (int d = 0; d < depth && used < cap; d++) {
+        int n = st[d].object ? snprintf(out + used, cap - used, "%s%.*s", used ? "." : "",
+                                        (int)st[d].key_len, st[d].key ? st[d].key : "")
+                             : snprintf(out + used, cap - used, "[%zu]", st[d].index);
+        used += n > 0 ? (size_t)n : 0;
+    }
+}
+
+bool jf_check_numbers(const char *text, size_t len, struct job_error *err)
+{
+    enum { MAX_DEPTH = 32 };
+    struct scan_frame st[MAX_DEPTH];
+    int depth = 0, deep = 0; /* deep: levels past MAX_DEPTH, not tracked */
+    bool expect_key = false;
+    for (size_t i = 0; i < len; i++) {
+        char ch = text[i];
+        if (ch == '"') {
+            size_t start = ++i;
+            while (i < len && text[i] != '"')
+                i += text[i] == '\\' ? 2 : 1;
+            if (expect_key && depth && !deep && st[depth - 1].object) {
+                st[depth - 1].key = text + start;
+                st[depth - 1].key_len = (i < len ? i : len) - start;
+                expect_key = false;
+            }
+            continue;
+        }
+        if (ch == '{' || ch == '[') {
+            if (depth < MAX_DEPTH && !deep)
+                st[depth++] = (struct scan_frame){.object = ch == '{'};
+            else
+                deep++;
+            expect_key = ch == '{';
+        } else if (ch == '}' || ch == ']') {
+            if (deep)
+                deep--;
+            else if (depth)
+                depth--;
+        } else if (ch == ',') {
+            if (depth && !deep && st[depth - 1].object)
+                expect_key = true;
+            else if (depth && !deep)
+                st[depth - 1].index++;
+        } else if (ch == '-' || (ch >= '0' && ch <= '9')) {
+            /* A number: one whose digits are not all zero must not read as
+             * 0 (strtod underflows 1e-400 to 0, which an integer field
+             * would then take for 0). */
+            size_t start = i;
+            bool nonzero = false, exponent = false;
+            while (i < len && text[i] && strchr("0123456789+-.eE", text[i])) {
+                exponent |= text[i] == 'e' || text[i] == 'E';
+                nonzero |= !exponent && text[i] >= '1' && text[i] <= '9';
+                i++;
+            }
+            char num[400];
+            size_t n = i - start;
+            i--;
+            if (!nonzero || n >= sizeof(num))
+                continue;
+            memcpy(num, text + start, n);
+            num[n] = '\0';
+            if (strtod(num, NULL) == 0.0) {
+                char path[64];
+                scan_path(st, depth, path, sizeof(path));
+                return job_error_set(err, path[0] ? path : "body",
+                                     "%s is too small for a double and would be read as 0; "
+                                     "write 0, or a number from 1e-300", num);
+            }
+        }
+    }
+    return true;
 }

@@ -53,6 +53,12 @@ bool jf_get_object(const json_t *obj, const char *key, const char *field, json_t
 bool jf_get_choice(const json_t *obj, const char *key, const char *field,
                    const char *const *choices, int *out, struct job_error *err);
 
+/* The numbers of a JSON text (as sent, before jansson reads it): false,
+ * naming the value's path, for one whose digits are not all zero that a
+ * double cannot hold (1e-400 would be read as 0, which an integer field
+ * would take). */
+bool jf_check_numbers(const char *text, size_t len, struct job_error *err);
+
 /* Sets value (a reference it takes) at a dotted path ("a.b.c") inside obj,
  * making the objects between and replacing what is not an object. */
 void jf_set_path(json_t *obj, const char *path, json_t *value);

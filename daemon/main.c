@@ -1,10 +1,8 @@
-#define _GNU_SOURCE /* dl_iterate_phdr, RTLD_NODELETE */
+#define _POSIX_C_SOURCE 200809L
 #include <dirent.h>
-#include <dlfcn.h>
 #include <errno.h>
 #include <sys/stat.h>
 #include <getopt.h>
-#include <link.h>
 #include <limits.h>
 #include <malloc.h>
 #include <signal.h>
@@ -13,8 +11,6 @@
 #include <string.h>
 #include <sys/resource.h>
 #include <unistd.h>
-
-#include <epoxy/gl.h>
 
 #include "config.h"
 #include "daemon/gpu/egl.h"
@@ -43,7 +39,7 @@ struct options {
     const char *once;
     const char *out;
     const char *port_file;
-    int device;
+    struct device_spec device;
     int queue_size;
     int keep_jobs;
     double keep_days;
@@ -51,6 +47,7 @@ struct options {
     int max_connections_per_ip;
     double job_timeout;
     double max_job_s;
+    double max_frame_s;
     double stall_s;
     double memory_budget_mib; /* 0: the driver, the connections, and half the RAM for a job */
     char asset_dir[1024];      /* --asset-dir: read-only assets; "": none */
@@ -61,6 +58,7 @@ struct options {
     char chromium[1024], reference_viewer[1024];
     double reference_timeout, reference_memory_mib; /* 0: the defaults */
     bool list_devices;
+    bool json; /* --list-devices --json */
     bool gl_debug;
 };
 
@@ -76,6 +74,13 @@ struct options {
  * step the harness takes between two progress marks (a frame, a slice of
  * GPU work, a metric tile), far below what an operator would wait. */
 #define STALL_SECONDS_DEFAULT 60
+/* The running time a job gets when it names none: half an hour, far above
+ * what the default job takes on a 2-core CPU renderer (docs/api.md) and
+ * what every bench script's jobs take, far below the day it was, which let
+ * one mistaken job hold the render thread, and every job queued behind it,
+ * for a day. */
+#define JOB_TIMEOUT_DEFAULT 1800
+#define JOB_TIMEOUT_TEXT "1800"
 #define STALL_SECONDS_TEXT "60"
 
 static void usage(FILE *f)
@@ -86,8 +91,13 @@ static void usage(FILE *f)
             "  --listen HOST:PORT   address to serve (default 127.0.0.1:8460; port 0 = any free)\n"
             "  --state-dir DIR      where job results and frames are kept\n"
             "                       (default $STATE_DIRECTORY, else /var/lib/shadebench)\n"
-            "  --device N           use EGL device N (see --list-devices; default: first\n"
-            "                       hardware device, then software, then surfaceless)\n"
+            "  --device DEVICE      the GPU to render on (see --list-devices): an EGL index\n"
+            "                       (0), a DRM node (/dev/dri/renderD128) or /dev/nvidiaN, a\n"
+            "                       PCI bus id (0000:41:00.0), a UUID (GPU-...), allocated\n"
+            "                       (the one the batch scheduler gave: SLURM_STEP_GPUS,\n"
+            "                       SLURM_JOB_GPUS, CUDA_VISIBLE_DEVICES, ROCR_VISIBLE_DEVICES,\n"
+            "                       GPU_DEVICE_ORDINAL, the device cgroup), or auto (default:\n"
+            "                       first hardware device, then software, then surfaceless)\n"
             "  --queue-size N       jobs that may wait at once (default 64)\n"
             "  --token FILE         require \"Authorization: Bearer <token>\" with the token in\n"
             "                       FILE on every endpoint but /healthz (SIGHUP rereads it)\n"
@@ -96,10 +106,15 @@ static void usage(FILE *f)
             "  --keep-days D        remove finished jobs (and sweeps) older than D days\n"
             "                       (default " KEEP_DAYS_TEXT "; 0: keep all)\n"
             "  --job-timeout S      running time a job may take when it gives no timeout_s\n"
-            "                       (default 86400; 0: no limit)\n"
+            "                       (default " JOB_TIMEOUT_TEXT "; 0: no limit)\n"
             "  --max-job-seconds S  running time any job may take: a larger timeout_s is\n"
             "                       refused, and the default is capped to it (default 0: no\n"
             "                       limit but each job's timeout_s)\n"
+            "  --max-frame-seconds S\n"
+            "                       the longest one whole frame may hold the render thread:\n"
+            "                       a job whose frame measures more fails before timing\n"
+            "                       unless it sets accept_sliced_timing (default 2; 0: no\n"
+            "                       bound)\n"
             "  --stall-seconds S    /healthz answers 503 when the render thread, busy with a\n"
             "                       job, has made no progress for S seconds (default "
             STALL_SECONDS_TEXT "; 0: never)\n"
@@ -128,7 +143,8 @@ static void usage(FILE *f)
             "                       (default 4096)\n"
             "  --config FILE        settings file (default " DEFAULT_CONFIG " if present)\n"
             "  --port-file FILE     write the bound port to FILE once listening\n"
-            "  --list-devices       print the EGL devices and exit\n"
+            "  --list-devices       print the EGL devices with their names and exit (--json:\n"
+            "                       as JSON)\n"
             "  --once JOB.json      run one job without HTTP, then exit\n"
             "  --out DIR            with --once: where result.json, job.json, task.json and\n"
             "                       frames go (written whole: renamed into place at the end)\n"
@@ -137,13 +153,14 @@ static void usage(FILE *f)
             "  --version, --help\n\n"
             "Settings come from, in rising order: defaults, the config file (lines of\n"
             "\"key = value\": listen, state-dir, device, queue-size, token, keep-jobs,\n"
-            "keep-days, job-timeout, max-job-seconds, stall-seconds, memory-budget,\n"
-            "max-connections, max-connections-per-ip, max-asset-bytes, asset-dir,\n"
-            "asset-converter, chromium, reference-viewer, reference-timeout,\n"
+            "keep-days, job-timeout, max-job-seconds, max-frame-seconds, stall-seconds,\n"
+            "memory-budget, max-connections, max-connections-per-ip, max-asset-bytes,\n"
+            "asset-dir, asset-converter, chromium, reference-viewer, reference-timeout,\n"
             "reference-memory, log-level), the environment\n"
             "(SHADEBENCH_LISTEN, SHADEBENCH_STATE_DIR, SHADEBENCH_DEVICE,\n"
             "SHADEBENCH_QUEUE_SIZE, SHADEBENCH_TOKEN_FILE, SHADEBENCH_KEEP_JOBS,\n"
             "SHADEBENCH_KEEP_DAYS, SHADEBENCH_JOB_TIMEOUT, SHADEBENCH_MAX_JOB_SECONDS,\n"
+            "SHADEBENCH_MAX_FRAME_SECONDS, "
             "SHADEBENCH_STALL_SECONDS, SHADEBENCH_MEMORY_BUDGET,\n"
             "SHADEBENCH_MAX_CONNECTIONS, SHADEBENCH_MAX_CONNECTIONS_PER_IP,\n"
             "SHADEBENCH_MAX_ASSET_BYTES, SHADEBENCH_ASSET_DIR, SHADEBENCH_ASSET_CONVERTER,\n"
@@ -183,8 +200,9 @@ static bool apply_setting(struct options *o, const char *key, const char *value,
     else if (strcmp(key, "token") == 0 || strcmp(key, "token-file") == 0)
         snprintf(o->token_file, sizeof(o->token_file), "%s", value);
     else if (strcmp(key, "device") == 0) {
-        if (!parse_int(value, 0, 15, &o->device))
-            rule = "must be an integer from 0 to 15";
+        static char why[600];
+        if (!device_spec_parse(value, &o->device, why, sizeof(why)))
+            rule = why;
     } else if (strcmp(key, "queue-size") == 0) {
         if (!parse_int(value, 1, 100000, &o->queue_size))
             rule = "must be an integer from 1 to 100000";
@@ -197,6 +215,9 @@ static bool apply_setting(struct options *o, const char *key, const char *value,
     } else if (strcmp(key, "job-timeout") == 0) {
         if (!parse_number(value, 0, 1e7, &o->job_timeout))
             rule = "must be a number of seconds from 0 (no limit) to 10000000";
+    } else if (strcmp(key, "max-frame-seconds") == 0) {
+        if (!parse_number(value, 0, 1e6, &o->max_frame_s))
+            rule = "must be a number of seconds from 0 (no bound) to 1000000";
     } else if (strcmp(key, "max-job-seconds") == 0) {
         if (!parse_number(value, 0, 1e7, &o->max_job_s))
             rule = "must be a number of seconds from 0 (no limit) to 10000000";
@@ -289,7 +310,7 @@ static bool load_environment(struct options *o)
 {
     static const char *const keys[] = {"listen", "state-dir", "device", "queue-size",
                                        "token-file", "keep-jobs", "keep-days", "job-timeout",
-                                       "max-job-seconds", "stall-seconds", "memory-budget", "max-connections",
+                                       "max-job-seconds", "max-frame-seconds", "stall-seconds", "memory-budget", "max-connections",
                                        "max-connections-per-ip", "max-asset-bytes", "asset-dir",
                                        "asset-converter", "chromium", "reference-viewer",
                                        "reference-timeout", "reference-memory", "log-level",
@@ -351,57 +372,64 @@ static rlim_t raise_fd_limit(void)
     return rl.rlim_cur;
 }
 
-#ifdef SHADEBENCH_SANITIZERS
-static int pin_module(struct dl_phdr_info *info, size_t size, void *data)
+/* --list-devices: each EGL device with the names --device takes, opened
+ * briefly for its GL renderer and version; as text or JSON. */
+static int list_devices(bool as_json)
 {
-    (void)size, (void)data;
-    if (info->dlpi_name && info->dlpi_name[0])
-        dlopen(info->dlpi_name, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
-    return 0;
-}
-#endif
-
-/* Sanitizer builds only: Mesa unloads its driver when the GL context goes,
- * and memory that only the driver's globals pointed to then looks leaked,
- * with no module to name in a suppression. Marking every library loaded by
- * now (the driver and LLVM included) as never to be unloaded keeps it
- * reachable, so LeakSanitizer reports the daemon's own leaks only. */
-static void pin_loaded_modules(void)
-{
-#ifdef SHADEBENCH_SANITIZERS
-    dl_iterate_phdr(pin_module, NULL);
-#endif
-}
-
-static int list_devices(void)
-{
-    struct egl_device_info devs[16];
+    struct gpu_device_names devs[16];
     char err[256] = "";
     int n = egl_list_devices(devs, 16, err, sizeof(err));
+    json_t *list = json_array();
     if (n < 0) {
-        printf("no EGL device enumeration: %s\n", err);
+        if (!as_json)
+            printf("no EGL device enumeration: %s\n", err);
         n = 0;
     }
     for (int i = 0; i < n; i++) {
-        char why[512] = "";
-        const char *renderer = devs[i].renderer;
-        char gl_renderer[256] = "";
-        /* The GL renderer string is what users recognise: open each device briefly. */
-        struct egl_context *ctx = egl_context_create(i, false, why, sizeof(why));
-        pin_loaded_modules();
-        if (ctx) {
-            snprintf(gl_renderer, sizeof(gl_renderer), "%s", (const char *)glGetString(GL_RENDERER));
-            renderer = gl_renderer;
-            egl_context_destroy(ctx);
-        }
-        printf("%d: %s%s%s  renderer=%s  drm=%s  render_node=%s%s%s\n", i,
-               devs[i].software ? "software" : "hardware", devs[i].driver[0] ? "  driver=" : "",
-               devs[i].driver, renderer[0] ? renderer : "?",
-               devs[i].drm_node[0] ? devs[i].drm_node : "-",
-               devs[i].render_node[0] ? devs[i].render_node : "-",
-               ctx ? "" : "  (no GL 4.3 context: ", ctx ? "" : why);
-        if (!ctx)
-            printf(")\n");
+        char why[512] = "", version[128] = "";
+        bool opened = egl_probe_device(i, &devs[i], version, sizeof(version), why, sizeof(why));
+        json_t *j = device_names_json(&devs[i]);
+        json_object_set_new(j, "gl_version", opened ? json_string(version) : json_null());
+        json_object_set_new(j, "opens", json_boolean(opened));
+        if (!opened)
+            json_object_set_new(j, "error", json_string(why));
+        json_array_append_new(list, j);
+        if (as_json)
+            continue;
+        const struct gpu_device_names *d = &devs[i];
+        printf("%d: %s%s%s\n", i, d->renderer[0] ? d->renderer : "?",
+               d->software ? " (software)" : "", opened ? "" : " (no GL 4.3 context)");
+        printf("    vendor       %s\n", d->vendor[0] ? d->vendor : "-");
+        printf("    GL version   %s\n", opened ? version : why);
+        printf("    DRM node     %s%s%s\n", d->render_node[0] ? d->render_node : "-",
+               d->drm_node[0] ? "  " : "", d->drm_node);
+        printf("    PCI bus id   %s%s%s%s\n", d->bus_id[0] ? d->bus_id : "-",
+               d->bus_id[0] ? "  (from " : "", d->bus_id_from, d->bus_id[0] ? ")" : "");
+        printf("    UUID         %s%s%s%s\n", d->uuid[0] ? d->uuid : "-",
+               d->uuid[0] ? "  (from " : "", d->uuid_from, d->uuid[0] ? ")" : "");
+        if (d->cuda_device >= 0 || d->nvidia_minor >= 0)
+            printf("    NVIDIA       CUDA device %d, /dev/nvidia%d\n", d->cuda_device,
+                   d->nvidia_minor);
+        printf("    --device     %d", i);
+        if (d->render_node[0])
+            printf(", %s", d->render_node);
+        if (d->nvidia_minor >= 0)
+            printf(", /dev/nvidia%d", d->nvidia_minor);
+        if (d->bus_id[0])
+            printf(", %s", d->bus_id);
+        if (d->uuid[0])
+            printf(", GPU-%s", d->uuid);
+        printf("\n");
+    }
+    if (as_json) {
+        json_t *doc = json_pack("{s:o}", "devices", list);
+        if (!json_array_size(list))
+            json_object_set_new(doc, "error", json_string(err));
+        json_dumpf(doc, stdout, JSON_INDENT(2));
+        putchar('\n');
+        json_decref(doc);
+    } else {
+        json_decref(list);
     }
     return 0;
 }
@@ -419,7 +447,10 @@ static json_t *once_task_json(const char *status, int rc, double started, double
         {"job_id", "SLURM_JOB_ID"},           {"array_job_id", "SLURM_ARRAY_JOB_ID"},
         {"array_task_id", "SLURM_ARRAY_TASK_ID"}, {"restart_count", "SLURM_RESTART_COUNT"},
         {"partition", "SLURM_JOB_PARTITION"}, {"node", "SLURMD_NODENAME"},
-        {"gpus", "SLURM_JOB_GPUS"},
+        {"gpus", "SLURM_JOB_GPUS"},           {"step_gpus", "SLURM_STEP_GPUS"},
+        {"cuda_visible_devices", "CUDA_VISIBLE_DEVICES"},
+        {"rocr_visible_devices", "ROCR_VISIBLE_DEVICES"},
+        {"gpu_device_ordinal", "GPU_DEVICE_ORDINAL"},
     };
     json_t *sl = json_object();
     for (size_t i = 0; i < sizeof(slurm) / sizeof(slurm[0]); i++) {
@@ -530,7 +561,7 @@ static int run_once(const struct options *o, const struct technique_catalog *cat
     /* One job, no state directory: its record lives in memory. */
     struct store *store = store_open(NULL, err, sizeof(err));
     struct queue *q = store ? queue_create(store, 1) : NULL;
-    struct runner *r = q ? runner_create(q, o->device, o->gl_debug, err, sizeof(err)) : NULL;
+    struct runner *r = q ? runner_create(q, &o->device, o->gl_debug, err, sizeof(err)) : NULL;
     if (!r) {
         fprintf(stderr, "shadebenchd: %s\n", q || !store ? err : "out of memory");
         queue_destroy(q);
@@ -538,7 +569,6 @@ static int run_once(const struct options *o, const struct technique_catalog *cat
         record_remove_dir(partial);
         return 1;
     }
-    pin_loaded_modules();
     char id[24];
     int rc = 1;
     if (queue_submit(q, &spec, partial, id) == QUEUE_OK) {
@@ -700,12 +730,11 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
         goto out;
     }
     runner_use_fidelity(fidelity);
-    r = runner_create(q, o->device, o->gl_debug, err, sizeof(err));
+    r = runner_create(q, &o->device, o->gl_debug, err, sizeof(err));
     if (!r) {
         LOG(LOG_ERROR, "%s", err);
         goto out;
     }
-    pin_loaded_modules();
     set_max_msaa(r);
     double budget, driver;
     if (!set_memory_budget(o, &limits, &budget, &driver, err, sizeof(err))) {
@@ -726,12 +755,16 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
         LOG(LOG_ERROR, "%s", err);
         goto out;
     }
-    queue_set_asset_resolver(q, assets_queue_resolver, assets);
+    struct queue_asset_hooks hooks;
+    assets_queue_hooks(assets, &hooks);
+    queue_set_asset_hooks(q, &hooks);
     sweeps = sweeps_create(q, catalog);
     if (!sweeps) {
         LOG(LOG_ERROR, "cannot start the sweep thread");
         goto out;
     }
+    /* The resumed sweeps hold their hashes now: what nothing holds goes. */
+    assets_release_unused(assets);
     const struct http_context http_ctx = {.catalog = catalog, .queue = q, .sweeps = sweeps,
                                           .assets = assets, .fidelity = fidelity,
                                           .render_state = render_state,
@@ -774,13 +807,14 @@ out:
     http_server_destroy(http);
     sweeps_destroy(sweeps);
     if (assets)
-        queue_set_asset_resolver(q, NULL, NULL);
+        queue_set_asset_hooks(q, NULL); /* the render thread may still end a job */
     assets_destroy(assets);
     /* A stop (not a failed start): within a few seconds whatever runs
      * (systemd's stop timeout is longer): the running job is back in the
      * queue once the render thread stops it, and a frame still draining on
      * the GPU is not waited for. */
     if (rc == 0 && !runner_stop(r, STOP_RENDER_WAIT_S)) {
+        queue_store_abandoned(q);
         LOG(LOG_WARN, "the render thread is still draining GPU work after %d s; exiting without "
             "it (every job's state is stored)", STOP_RENDER_WAIT_S);
         _exit(0);
@@ -811,12 +845,13 @@ int main(int argc, char **argv)
      * jobs before it, for at most 128 MiB of free heap kept. */
     mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
     mallopt(M_TRIM_THRESHOLD, 128 * 1024 * 1024);
-    struct options o = {.device = -1, .queue_size = 64, .job_timeout = 86400,
+    struct options o = {.device = {.kind = DEVICE_SPEC_AUTO, .text = "auto"}, .queue_size = 64, .job_timeout = JOB_TIMEOUT_DEFAULT,
+                        .max_frame_s = JOB_DEFAULT_MAX_FRAME_S,
                         .stall_s = STALL_SECONDS_DEFAULT,
                         .keep_jobs = KEEP_JOBS_DEFAULT, .keep_days = KEEP_DAYS_DEFAULT};
     snprintf(o.listen, sizeof(o.listen), "127.0.0.1:8460");
     enum { OPT_LISTEN = 256, OPT_STATE, OPT_DEVICE, OPT_QUEUE, OPT_TOKEN, OPT_KEEP_JOBS,
-           OPT_KEEP_DAYS, OPT_JOB_TIMEOUT, OPT_MAX_JOB, OPT_STALL, OPT_MEMORY, OPT_MAX_CONN, OPT_MAX_CONN_IP, OPT_MAX_ASSET, OPT_ASSET_DIR, OPT_ASSET_CONV, OPT_CHROMIUM, OPT_REF_VIEWER, OPT_REF_TIMEOUT, OPT_REF_MEMORY, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_ONCE, OPT_OUT, OPT_DEBUG,
+           OPT_KEEP_DAYS, OPT_JOB_TIMEOUT, OPT_MAX_JOB, OPT_MAX_FRAME, OPT_STALL, OPT_MEMORY, OPT_MAX_CONN, OPT_MAX_CONN_IP, OPT_MAX_ASSET, OPT_ASSET_DIR, OPT_ASSET_CONV, OPT_CHROMIUM, OPT_REF_VIEWER, OPT_REF_TIMEOUT, OPT_REF_MEMORY, OPT_CONFIG, OPT_PORT_FILE, OPT_LIST, OPT_JSON, OPT_ONCE, OPT_OUT, OPT_DEBUG,
            OPT_LOG, OPT_VERSION, OPT_HELP };
     static const struct option longopts[] = {
         {"listen", required_argument, NULL, OPT_LISTEN},
@@ -828,6 +863,7 @@ int main(int argc, char **argv)
         {"keep-days", required_argument, NULL, OPT_KEEP_DAYS},
         {"job-timeout", required_argument, NULL, OPT_JOB_TIMEOUT},
         {"max-job-seconds", required_argument, NULL, OPT_MAX_JOB},
+        {"max-frame-seconds", required_argument, NULL, OPT_MAX_FRAME},
         {"stall-seconds", required_argument, NULL, OPT_STALL},
         {"memory-budget", required_argument, NULL, OPT_MEMORY},
         {"max-connections", required_argument, NULL, OPT_MAX_CONN},
@@ -842,6 +878,7 @@ int main(int argc, char **argv)
         {"config", required_argument, NULL, OPT_CONFIG},
         {"port-file", required_argument, NULL, OPT_PORT_FILE},
         {"list-devices", no_argument, NULL, OPT_LIST},
+        {"json", no_argument, NULL, OPT_JSON},
         {"once", required_argument, NULL, OPT_ONCE},
         {"out", required_argument, NULL, OPT_OUT},
         {"gl-debug", no_argument, NULL, OPT_DEBUG},
@@ -868,6 +905,7 @@ int main(int argc, char **argv)
         case OPT_KEEP_DAYS: key = "keep-days"; break;
         case OPT_JOB_TIMEOUT: key = "job-timeout"; break;
         case OPT_MAX_JOB: key = "max-job-seconds"; break;
+        case OPT_MAX_FRAME: key = "max-frame-seconds"; break;
         case OPT_STALL: key = "stall-seconds"; break;
         case OPT_MEMORY: key = "memory-budget"; break;
         case OPT_MAX_CONN: key = "max-connections"; break;
@@ -883,6 +921,7 @@ int main(int argc, char **argv)
         case OPT_CONFIG: config = optarg; config_required = true; break;
         case OPT_PORT_FILE: o.port_file = optarg; break;
         case OPT_LIST: o.list_devices = true; break;
+        case OPT_JSON: o.json = true; break;
         case OPT_ONCE: o.once = optarg; break;
         case OPT_OUT: o.out = optarg; break;
         case OPT_DEBUG: o.gl_debug = true; break;
@@ -910,8 +949,13 @@ int main(int argc, char **argv)
     }
     job_spec_set_default_timeout(o.job_timeout);
     job_spec_set_max_seconds(o.max_job_s);
+    job_spec_set_max_frame_seconds(o.max_frame_s);
+    if (o.json && !o.list_devices) {
+        fprintf(stderr, "shadebenchd: --json goes with --list-devices\n");
+        return 2;
+    }
     if (o.list_devices)
-        return list_devices();
+        return list_devices(o.json);
     if (o.once) {
         if (!o.out) {
             fprintf(stderr, "shadebenchd: --once needs --out DIR\n");

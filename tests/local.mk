@@ -6,6 +6,7 @@
 #                                   with --enable-sanitizers (build-asan/)
 #   make distcheck-quick            the tarball is complete and builds
 #   make fuzz [FUZZ_SECONDS=300]    each libFuzzer target (tests/fuzz/run.sh)
+#   make fuzz-long [FUZZ_LONG_SECONDS=1800]   the converter, routes, jobs, sweeps
 
 # GL-free unit tests in C, end-to-end tests in Python 3 (standard library
 # only) against a real daemon on a free loopback port.
@@ -41,9 +42,13 @@ UNIT_TESTS = \
 	tests/unit/test_uv_charts \
 	tests/unit/test_uv_overlap \
 	tests/unit/test_convert_matrices \
+	tests/unit/test_convert_checks \
 	tests/unit/test_light_shape \
 	tests/unit/test_temporal \
-	tests/unit/test_fidelity
+	tests/unit/test_fidelity \
+	tests/unit/test_tile_plan \
+	tests/unit/test_devices \
+	tests/unit/test_gpu_memory
 check_PROGRAMS = $(UNIT_TESTS) tests/tools/png-tool \
 	tests/fuzz/replay-job tests/fuzz/replay-sweep tests/fuzz/replay-png_metrics \
 	tests/fuzz/replay-route tests/fuzz/replay-asset_cache tests/fuzz/replay-asset_convert \
@@ -65,7 +70,17 @@ tests_unit_test_temporal_LDADD = $(CORE_LIBS)
 tests_unit_test_records_LDADD = $(CORE_LIBS)
 tests_unit_test_interference_LDADD = libsb-status.a $(CORE_LIBS)
 tests_unit_test_fidelity_LDADD = $(CORE_LIBS) -lm
+# The measuring run's tiles: GL-free logic in the GL toolkit's folder.
+tests_unit_test_tile_plan_SOURCES = tests/unit/test_tile_plan.c daemon/gpu/tile_plan.c \
+	daemon/gpu/tile_plan.h
+tests_unit_test_tile_plan_LDADD = -lm
 tests_unit_test_png_LDADD = $(CORE_LIBS)
+# The GPU's names and the scheduler's choice, over fake sysfs trees.
+tests_unit_test_devices_SOURCES = tests/unit/test_devices.c $(GPU_DEVICE_SOURCES)
+tests_unit_test_devices_LDADD = $(CORE_LIBS)
+tests_unit_test_gpu_memory_SOURCES = tests/unit/test_gpu_memory.c daemon/gpu/gpu_memory.c \
+	daemon/gpu/gpu_memory.h
+tests_unit_test_gpu_memory_LDADD = $(CORE_LIBS)
 tests_unit_test_gate_SOURCES = tests/unit/test_gate.c $(CLIENT_PURE)
 tests_unit_test_gate_LDADD = $(CORE_LIBS) -lm
 tests_unit_test_client_SOURCES = tests/unit/test_client.c $(CLIENT_PURE)
@@ -94,6 +109,10 @@ tests_unit_test_uv_overlap_LDADD = -lm
 tests_unit_test_convert_matrices_SOURCES = tests/unit/test_convert_matrices.c \
 	daemon/assets/convert_matrices.c daemon/assets/convert_internal.h
 tests_unit_test_convert_matrices_LDADD = $(JANSSON_LIBS) -lm
+# The converter's checks, on documents of up to a million nodes.
+tests_unit_test_convert_checks_SOURCES = tests/unit/test_convert_checks.c $(ASSET_CONVERT_SOURCES)
+tests_unit_test_convert_checks_CFLAGS = $(AM_CFLAGS) $(ASSIMP_CFLAGS) $(JPEG_CFLAGS)
+tests_unit_test_convert_checks_LDADD = $(CORE_LIBS) $(ASSIMP_LIBS) $(JPEG_LIBS) -lm
 tests_tools_png_tool_SOURCES = tests/tools/png_tool.c
 tests_tools_png_tool_LDADD = $(CORE_LIBS)
 noinst_HEADERS = tests/unit/check.h tests/unit/catalog_fixture.h tests/fuzz/fuzz.h
@@ -122,9 +141,9 @@ tests_fuzz_replay_asset_convert_SOURCES = tests/fuzz/fuzz_asset_convert.c tests/
 tests_fuzz_replay_asset_convert_CFLAGS = $(AM_CFLAGS) $(ASSIMP_CFLAGS) $(JPEG_CFLAGS)
 tests_fuzz_replay_asset_convert_LDADD = $(CORE_LIBS) $(ASSIMP_LIBS) $(JPEG_LIBS) -lm
 tests_fuzz_replay_env_convert_SOURCES = tests/fuzz/fuzz_env_convert.c tests/fuzz/replay.c \
-	daemon/assets/env_convert.c
-tests_fuzz_replay_env_convert_CFLAGS = $(AM_CFLAGS) $(STB_CFLAGS)
-tests_fuzz_replay_env_convert_LDADD = $(CORE_LIBS) $(STB_LIBS) -lm
+	$(ENV_CONVERT_SOURCES)
+tests_fuzz_replay_env_convert_CFLAGS = $(AM_CFLAGS) $(STB_CFLAGS) $(OPENEXR_CFLAGS)
+tests_fuzz_replay_env_convert_LDADD = $(CORE_LIBS) $(STB_LIBS) $(OPENEXR_LIBS) -lm
 if HAVE_SECCOMP
 check_PROGRAMS += tests/tools/sandbox-run
 tests_tools_sandbox_run_SOURCES = tests/tools/sandbox_run.c
@@ -138,11 +157,16 @@ endif
 E2E_TESTS = \
 	tests/e2e/e2e_fidelity.py \
 	tests/e2e/e2e_msaa.py \
+	tests/e2e/e2e_gpu.py \
 	tests/e2e/e2e_fleet.py \
 	tests/e2e/e2e_report.py \
 	tests/e2e/e2e_dashboard.py \
 	tests/e2e/e2e_faults.py \
 	tests/e2e/e2e_runaway.py \
+	tests/e2e/e2e_timing_rule.py \
+	tests/e2e/e2e_cancel_drain.py \
+	tests/e2e/e2e_pass_times.py \
+	tests/e2e/e2e_guardrails.py \
 	tests/e2e/e2e_hardening.py \
 	tests/e2e/e2e_many_lights.py \
 	tests/e2e/e2e_light_types.py \
@@ -180,6 +204,10 @@ E2E_TESTS = \
 	tests/e2e/e2e_demo.py \
 	tests/e2e/e2e_verdicts.py \
 	tests/e2e/e2e_asset_convert.py \
+	tests/e2e/e2e_orphans.py \
+	tests/e2e/e2e_asset_pins.py \
+	tests/e2e/e2e_full_disk.py \
+	tests/e2e/e2e_upload_slots.py \
 	tests/e2e/systemd_sandbox.py \
 	tests/e2e/systemd_unit.sh
 
@@ -208,7 +236,11 @@ SANITIZER_TESTS = $(UNIT_TESTS) \
 	tests/e2e/e2e_persist.py \
 	tests/e2e/e2e_badinput.py \
 	tests/e2e/e2e_asset_convert.py \
-	tests/e2e/e2e_compare_alpha.py
+	tests/e2e/e2e_compare_alpha.py \
+	tests/e2e/e2e_asset_pins.py \
+	tests/e2e/e2e_full_disk.py \
+	tests/e2e/e2e_upload_slots.py \
+	tests/e2e/e2e_gpu.py
 check-sanitizers:
 if SANITIZERS
 	$(MAKE) $(AM_MAKEFLAGS) check TESTS='$(SANITIZER_TESTS)'
@@ -229,7 +261,13 @@ distcheck-quick:
 FUZZ_SECONDS = 300
 fuzz:
 	$(SHELL) $(srcdir)/tests/fuzz/run.sh $(FUZZ_SECONDS)
-.PHONY: check-sanitizers distcheck-quick fuzz
+# The longer run (issue 34): the converter's checks, the HTTP routing and
+# the job and sweep parsers, FUZZ_LONG_SECONDS each (default 30 minutes,
+# two at a time: an hour), for a quiet machine, not CI.
+FUZZ_LONG_SECONDS = 1800
+fuzz-long:
+	$(SHELL) $(srcdir)/tests/fuzz/run.sh $(FUZZ_LONG_SECONDS) asset_convert route job sweep
+.PHONY: check-sanitizers distcheck-quick fuzz fuzz-long
 # Under --enable-sanitizers every test (and the daemons the end-to-end tests
 # start) stops at the first error; leaks inside the GL driver, LLVM and
 # fontconfig, which the daemon cannot free, are suppressed by name.

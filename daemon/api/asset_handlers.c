@@ -207,15 +207,29 @@ bool begin_upload(struct http_server *s, struct MHD_Connection *c, struct reques
                              "an asset name is at most 128 bytes");
         return true;
     }
+    /* An address's share of the upload slots, so that a slow client cannot
+     * take them all (and its body must keep up a minimum rate:
+     * connections.h). */
+    double retry_s = 0;
+    if (!connections_upload_begin(s->conns, req->conn, &retry_s)) {
+        char rule[200];
+        snprintf(rule, sizeof(rule), "this address has %u uploads streaming or converting "
+                 "already; retry after %.0f s", s->limits.uploads_per_ip, retry_s);
+        *ret = respond_retry(c, "body", rule, retry_s);
+        return true;
+    }
     uint64_t length = cl ? strtoull(cl, NULL, 10) : 0;
     struct assets_error e = {0};
     req->upload = assets_upload_begin(s->ctx.assets, req->route.asset, length, &e);
     if (!req->upload) {
         req->too_large = e.cause == ASSETS_TOO_LARGE;
-        *ret = respond_asset_error(c, &e);
+        *ret = e.cause == ASSETS_BUSY
+                   ? respond_retry(c, e.field, e.message, connections_upload_retry_s(s->conns))
+                   : respond_asset_error(c, &e);
         return true;
     }
-    /* Its body's deadline grows with its size: 1 MiB/s at least. */
+    /* Its body's deadline grows with its size: 1 MiB/s at least; a body
+     * slower than the minimum rate is cut sooner (connections.h). */
     uint64_t expect = length ? length : assets_max_bytes(s->ctx.assets);
     connections_body_deadline(s->conns, req->conn,
                               s->limits.body_timeout_s + (double)expect / (1 << 20));

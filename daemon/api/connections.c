@@ -44,6 +44,11 @@ struct conn {
     enum wake wake;
     bool stopping_answer;
     unsigned status;
+    /* An upload holding a slot (connections_upload_begin) until its answer
+     * is sent: the bytes of its current rate window. */
+    bool upload;
+    double window_start;
+    uint64_t window_bytes;
 };
 
 struct connections {
@@ -59,7 +64,7 @@ struct connections {
     wait_done_fn done;
     void *ctx;
     struct connections_config cfg;
-    unsigned long long header_timeouts, body_timeouts, waits_gone;
+    unsigned long long header_timeouts, body_timeouts, waits_gone, slow_uploads;
 };
 
 static void resume_locked(struct connections *cs, struct conn *k, enum wake why)
@@ -116,6 +121,26 @@ static double check_locked(struct connections *cs, double now, bool jobs_changed
         switch (k->state) {
         case K_HEADERS:
         case K_BODY:
+            /* An upload below the minimum rate over its window: cut, so
+             * that a slow client gives its slot back (the rest of its body
+             * would take hours at its pace). */
+            if (k->state == K_BODY && k->upload &&
+                now - k->window_start >= cs->cfg.upload_window_s) {
+                double need = cs->cfg.upload_min_rate * (now - k->window_start);
+                if ((double)k->window_bytes < need) {
+                    LOG(LOG_INFO, "an upload brought %llu bytes in %.1f s, less than the %.0f "
+                        "bytes a second an upload must keep up: its connection is closed",
+                        (unsigned long long)k->window_bytes, now - k->window_start,
+                        cs->cfg.upload_min_rate);
+                    shutdown(k->fd, SHUT_RDWR);
+                    cs->slow_uploads++;
+                    k->state = K_CUT;
+                    k->upload = false;
+                    break;
+                }
+                k->window_start = now;
+                k->window_bytes = 0;
+            }
             if (now >= k->deadline) {
                 /* The socket stays open until libmicrohttpd closes it (after
                  * CLOSED, which takes this lock): shutting it down makes its
@@ -207,6 +232,10 @@ struct connections *connections_create(const struct connections_config *cfg, wai
         return NULL;
     }
     cs->cfg = *cfg;
+    if (cs->cfg.upload_min_rate <= 0)
+        cs->cfg.upload_min_rate = CONNECTIONS_UPLOAD_MIN_RATE;
+    if (cs->cfg.upload_window_s <= 0)
+        cs->cfg.upload_window_s = CONNECTIONS_UPLOAD_WINDOW_S;
     cs->done = done;
     cs->ctx = ctx;
     cs->next_serial = 1; /* 0 is the eventfd's key */
@@ -378,6 +407,59 @@ void connections_headers_in(struct connections *cs, struct conn *k)
     pthread_mutex_unlock(&cs->lock);
 }
 
+/* Under the lock: the soonest an upload of address addr (NULL: any) is
+ * judged again, at least a second from now; a window when none streams. */
+static double upload_retry_locked(struct connections *cs, const struct sockaddr_storage *addr,
+                                  double now)
+{
+    double soonest = cs->cfg.upload_window_s;
+    for (const struct conn *o = cs->head; o; o = o->next)
+        if (o->upload && o->state == K_BODY && (!addr || same_address(&o->addr, addr))) {
+            double left = o->window_start + cs->cfg.upload_window_s - now;
+            if (left < soonest)
+                soonest = left;
+        }
+    return soonest < 1 ? 1 : soonest;
+}
+
+bool connections_upload_begin(struct connections *cs, struct conn *k, double *retry_s)
+{
+    if (!k)
+        return true;
+    double now = clock_mono_s();
+    pthread_mutex_lock(&cs->lock);
+    unsigned held = 0;
+    for (const struct conn *o = cs->head; o; o = o->next)
+        held += o != k && o->upload && k->addr.ss_family && same_address(&o->addr, &k->addr);
+    bool ok = !cs->cfg.uploads_per_ip || held < cs->cfg.uploads_per_ip;
+    if (ok) {
+        k->upload = true;
+        k->window_start = now;
+        k->window_bytes = 0;
+    } else {
+        *retry_s = upload_retry_locked(cs, &k->addr, now);
+    }
+    pthread_mutex_unlock(&cs->lock);
+    return ok;
+}
+
+void connections_upload_bytes(struct connections *cs, struct conn *k, size_t bytes)
+{
+    if (!k)
+        return;
+    pthread_mutex_lock(&cs->lock);
+    k->window_bytes += bytes;
+    pthread_mutex_unlock(&cs->lock);
+}
+
+double connections_upload_retry_s(struct connections *cs)
+{
+    pthread_mutex_lock(&cs->lock);
+    double s = upload_retry_locked(cs, NULL, clock_mono_s());
+    pthread_mutex_unlock(&cs->lock);
+    return s;
+}
+
 void connections_answering(struct connections *cs, struct conn *k)
 {
     if (!k)
@@ -402,6 +484,7 @@ void connections_request_done(struct connections *cs, struct conn *k)
     if (k->state != K_CUT && k->state != K_WAITING) {
         k->state = K_HEADERS;
         k->deadline = clock_mono_s() + cs->cfg.header_s;
+        k->upload = false; /* its answer is out: the slot is free */
     }
     pthread_mutex_unlock(&cs->lock);
 }
@@ -480,5 +563,9 @@ void connections_stats(struct connections *cs, struct connections_stats *out)
     out->header_timeouts = cs->header_timeouts;
     out->body_timeouts = cs->body_timeouts;
     out->waits_gone = cs->waits_gone;
+    out->slow_uploads = cs->slow_uploads;
+    out->uploads = 0;
+    for (const struct conn *k = cs->head; k; k = k->next)
+        out->uploads += k->upload;
     pthread_mutex_unlock(&cs->lock);
 }

@@ -13,6 +13,11 @@
  *    their request within CONNECTIONS_RESERVE_HEADER_S and are closed after
  *    one answer, so that other clients of the same address (waits held
  *    open, a local load test) cannot lock a local monitor out;
+ *  - an upload (PUT /v1/assets/NAME) holds one of the daemon's few upload
+ *    slots, so a slow one must not keep it: each must deliver at least
+ *    CONNECTIONS_UPLOAD_MIN_RATE bytes a second over every window of
+ *    CONNECTIONS_UPLOAD_WINDOW_S, or it is shut down, and an address holds
+ *    at most its per-address share of the slots at once;
  *  - long-polls (?wait=) hold no thread: the connection is suspended
  *    (MHD_suspend_connection) and one watcher thread resumes it when its job
  *    or sweep has finished, its time is up, its client has gone away
@@ -43,10 +48,19 @@ typedef bool (*wait_done_fn)(void *ctx, enum wait_kind kind, const char *id);
 #define CONNECTIONS_HEALTH_RESERVE 4
 #define CONNECTIONS_RESERVE_HEADER_S 2.0
 
+/* An upload's body must bring this many bytes a second, judged over each
+ * window (the first starts with its headers): a link of 256 kbit/s keeps
+ * up; one byte every 5 s does not. */
+#define CONNECTIONS_UPLOAD_MIN_RATE (32.0 * 1024)
+#define CONNECTIONS_UPLOAD_WINDOW_S 10.0
+
 struct connections_config {
     double header_s; /* accept (or the previous request) to complete headers */
     double body_s;   /* complete headers to complete body */
     unsigned per_ip; /* an address's connections before reserve ones (0: no limit) */
+    unsigned uploads_per_ip; /* an address's uploads at once (0: no limit) */
+    double upload_min_rate;  /* bytes a second (0: CONNECTIONS_UPLOAD_MIN_RATE) */
+    double upload_window_s;  /* seconds (0: CONNECTIONS_UPLOAD_WINDOW_S) */
 };
 
 struct connections *connections_create(const struct connections_config *cfg, wait_done_fn done,
@@ -66,6 +80,16 @@ void connections_headers_in(struct connections *cs, struct conn *k);
 /* An upload's body may take this long from now (a large asset over a slow
  * link) instead of body_s; never shorter than body_s. */
 void connections_body_deadline(struct connections *cs, struct conn *k, double seconds);
+/* An upload's headers are in: it takes one of its address's upload slots,
+ * and its body is held to the minimum rate. false when the address has its
+ * uploads_per_ip already; *retry_s then says when one may be free (the
+ * soonest its uploads are judged again). */
+bool connections_upload_begin(struct connections *cs, struct conn *k, double *retry_s);
+/* bytes more of an upload's body have come in. */
+void connections_upload_bytes(struct connections *cs, struct conn *k, size_t bytes);
+/* When an upload slot may be free (the daemon's are all taken): the soonest
+ * a streaming upload is judged again, or a window when none streams. */
+double connections_upload_retry_s(struct connections *cs);
 /* The request is complete and being answered: no deadline but libmicrohttpd's
  * idle timeout while the answer is sent. */
 void connections_answering(struct connections *cs, struct conn *k);
@@ -94,8 +118,8 @@ void connections_poke(struct connections *cs);
 void connections_stop(struct connections *cs, double grace_s);
 
 struct connections_stats {
-    size_t open, waiting;
-    unsigned long long header_timeouts, body_timeouts, waits_gone;
+    size_t open, waiting, uploads;
+    unsigned long long header_timeouts, body_timeouts, waits_gone, slow_uploads;
 };
 void connections_stats(struct connections *cs, struct connections_stats *out);
 

@@ -34,6 +34,9 @@ void http_limits_defaults(struct http_limits *l)
     l->header_timeout_s = 10;
     l->body_timeout_s = 30;
     l->idle_timeout_s = 30;
+    l->uploads_per_ip = HTTP_UPLOADS_PER_IP;
+    l->upload_min_rate = CONNECTIONS_UPLOAD_MIN_RATE;
+    l->upload_window_s = CONNECTIONS_UPLOAD_WINDOW_S;
 }
 
 /* Compares in time that depends on the expected token's length only, never
@@ -52,8 +55,16 @@ static bool authorized(struct http_server *s, struct MHD_Connection *c)
     pthread_mutex_lock(&s->token_lock);
     bool ok = !s->token || s->token[0] == '\0';
     if (!ok) {
+        /* RFC 9110: the scheme is case-insensitive ("bearer" too), and one
+         * or more spaces part it from the token. */
         const char *auth = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Authorization");
-        ok = auth && strncmp(auth, "Bearer ", 7) == 0 && token_matches(auth + 7, s->token);
+        ok = auth && strncasecmp(auth, "Bearer ", 7) == 0;
+        if (ok) {
+            auth += 7;
+            while (*auth == ' ')
+                auth++;
+            ok = token_matches(auth, s->token);
+        }
     }
     pthread_mutex_unlock(&s->token_lock);
     return ok;
@@ -79,6 +90,18 @@ bool http_server_set_token(struct http_server *s, const char *token)
  * of a wait, not an error (2,000 waits hung up made 2,000 warnings). */
 static _Thread_local bool closing_gone_client;
 
+/* The next 429's Retry-After on this thread (respond_retry), else
+ * RETRY_AFTER_DEFAULT_S. */
+static _Thread_local double next_retry_s;
+#define RETRY_AFTER_DEFAULT_S 5
+
+enum MHD_Result respond_retry(struct MHD_Connection *c, const char *field, const char *message,
+                              double retry_s)
+{
+    next_retry_s = retry_s;
+    return respond_error(c, MHD_HTTP_TOO_MANY_REQUESTS, field, message);
+}
+
 enum MHD_Result respond_text(struct MHD_Connection *c, unsigned status,
                              char *text, size_t len, const char *type)
 {
@@ -94,6 +117,14 @@ enum MHD_Result respond_text(struct MHD_Connection *c, unsigned status,
         MHD_add_response_header(resp, "Connection", "close"); /* gives the reserve slot back */
     if (status == MHD_HTTP_UNAUTHORIZED)
         MHD_add_response_header(resp, "WWW-Authenticate", "Bearer realm=\"shadebench\"");
+    if (status == MHD_HTTP_TOO_MANY_REQUESTS) {
+        /* RFC 9110: when to come back, in whole seconds. */
+        char after[24];
+        double wait = next_retry_s > 0 ? next_retry_s : RETRY_AFTER_DEFAULT_S;
+        snprintf(after, sizeof(after), "%.0f", wait < 1 ? 1 : wait + 0.5);
+        MHD_add_response_header(resp, "Retry-After", after);
+    }
+    next_retry_s = 0;
     connections_set_status(connections_of(c), status);
     enum MHD_Result ret = MHD_queue_response(c, status, resp);
     MHD_destroy_response(resp);
@@ -341,7 +372,7 @@ static enum MHD_Result dispatch(struct http_server *s, struct MHD_Connection *c,
 
 struct header_scan {
     size_t bytes;
-    int content_length, transfer_encoding;
+    int content_length, transfer_encoding, host;
 };
 
 static enum MHD_Result scan_header(void *cls, enum MHD_ValueKind kind, const char *key,
@@ -354,6 +385,8 @@ static enum MHD_Result scan_header(void *cls, enum MHD_ValueKind kind, const cha
         h->content_length++;
     else if (strcasecmp(key, "Transfer-Encoding") == 0)
         h->transfer_encoding++;
+    else if (strcasecmp(key, "Host") == 0)
+        h->host++;
     (void)value;
     return MHD_YES;
 }
@@ -382,6 +415,12 @@ static bool refuse_early(struct http_server *s, struct MHD_Connection *c, const 
         (te && strcasecmp(te, "chunked") != 0)) {
         *ret = respond_error(c, MHD_HTTP_BAD_REQUEST, "Transfer-Encoding",
                              "must be \"chunked\" alone, once, and without Content-Length");
+        return true;
+    }
+    /* RFC 9112: a request with more than one Host is a 400 (which one a
+     * proxy routed by is anyone's guess). */
+    if (h.host > 1) {
+        *ret = respond_error(c, MHD_HTTP_BAD_REQUEST, "Host", "must appear at most once");
         return true;
     }
     /* RFC 9112: an HTTP/1.1 request without Host is a 400 (a proxy's
@@ -464,6 +503,7 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
         return MHD_YES;
     }
     if (*upload_data_size && req->upload) {
+        connections_upload_bytes(s->conns, req->conn, *upload_data_size);
         assets_upload_write(req->upload, upload_data, *upload_data_size);
         *upload_data_size = 0;
         /* Past the limit (a chunked body, whose length was not known), the
@@ -646,7 +686,10 @@ struct http_server *http_server_create(const char *listen, const struct http_lim
     pthread_mutex_init(&s->token_lock, NULL);
     struct connections_config cc = {.header_s = limits->header_timeout_s,
                                     .body_s = limits->body_timeout_s,
-                                    .per_ip = limits->max_connections_per_ip};
+                                    .per_ip = limits->max_connections_per_ip,
+                                    .uploads_per_ip = limits->uploads_per_ip,
+                                    .upload_min_rate = limits->upload_min_rate,
+                                    .upload_window_s = limits->upload_window_s};
     s->conns = connections_create(&cc, wait_done, s, err, errlen);
     if (!s->conns) {
         freeaddrinfo(ai);

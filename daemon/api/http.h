@@ -27,7 +27,16 @@ struct http_limits {
     double header_timeout_s;         /* accept (or last answer) to complete headers */
     double body_timeout_s;           /* complete headers to complete body */
     double idle_timeout_s;           /* no byte either way (libmicrohttpd's own) */
+    /* Uploads (PUT /v1/assets/NAME): an address's at once (of the daemon's
+     * ASSETS_MAX_UPLOADS), and the rate each body must keep up, judged
+     * over each window (connections.h). */
+    unsigned uploads_per_ip;
+    double upload_min_rate, upload_window_s;
 };
+
+/* An address's share of the upload slots: two of the four, so that one
+ * client, however slow, leaves the others room. */
+#define HTTP_UPLOADS_PER_IP 2
 
 void http_limits_defaults(struct http_limits *l);
 

@@ -16,6 +16,7 @@
 #include "daemon/reports/report.h"
 #include "daemon/spec/job_cost.h"
 #include "daemon/jobs/fidelity.h"
+#include "daemon/jobs/job_eta.h"
 #include "daemon/spec/job_spec.h"
 
 /* A parsed job queued: its assets pinned, its 202 with the cost. */
@@ -31,23 +32,47 @@ static enum MHD_Result queue_spec(struct http_server *s, struct MHD_Connection *
         return respond_error(c, MHD_HTTP_SERVICE_UNAVAILABLE, "fidelity", msg);
     }
     struct job_spec spec = *sp;
-    /* scene.asset: pinned to the stored asset's hash here, so that the
-     * answer names the rule (400 unknown, 409 a different pinned hash);
-     * queue_submit resolves again, for the sweeps' points. */
+    struct job_error err;
+    /* Its assets (scene.asset, an environment map): resolved and pinned to
+     * the stored hashes in one step here, so that the answer names the rule
+     * (400 unknown, 409 a different pinned hash) and the asset's memory is
+     * charged to the job (job_cost.h); queue_submit pins them again until
+     * the job is live, and this pin goes after it. */
+    bool pinned = false;
     if (job_spec_names_asset(&spec)) {
         struct assets_error ae;
         if (!s->ctx.assets)
             return respond_error(c, MHD_HTTP_BAD_REQUEST,
                                  spec.scene.asset[0] ? "scene.asset" : "look.ibl.environment",
                                  "this daemon has no asset store");
-        if (!assets_resolve_job(s->ctx.assets, &spec, &ae))
+        if (!assets_pin(s->ctx.assets, &spec, false, &ae))
             return respond_asset_error(c, &ae);
+        pinned = true;
+        struct job_cost cost;
+        job_cost_estimate(&spec, &cost);
+        if (!job_cost_admit(&cost, &err)) {
+            assets_unpin(s->ctx.assets, &spec);
+            return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
+        }
+    }
+    /* Its duration on this device, where a job of its technique has run: a
+     * projection far past its timeout_s (or a frame far past the frame
+     * bound) is refused with the figures (job_eta.h). */
+    struct job_eta eta;
+    job_eta_estimate(&spec, &eta);
+    if (!job_eta_admit(&spec, &eta, &err)) {
+        if (pinned)
+            assets_unpin(s->ctx.assets, &spec);
+        return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
     }
     char id[24];
-    switch (queue_submit(s->queue, &spec, NULL, id)) {
+    enum queue_submit_result submitted = queue_submit(s->queue, &spec, NULL, id);
+    if (pinned)
+        assets_unpin(s->ctx.assets, &spec);
+    switch (submitted) {
     case QUEUE_OK:
         break;
-    case QUEUE_REFUSED: /* the asset changed since: its rule */
+    case QUEUE_REFUSED: /* held by the pin above: only an internal failure */
         return respond_error(c, MHD_HTTP_CONFLICT, "scene.asset", queue_submit_error());
     case QUEUE_FULL: {
         char msg[96];
@@ -66,8 +91,9 @@ static enum MHD_Result queue_spec(struct http_server *s, struct MHD_Connection *
     struct job_cost cost;
     job_cost_estimate(&spec, &cost);
     return respond_json(c, MHD_HTTP_ACCEPTED,
-                        json_pack("{s:s, s:s, s:s, s:o}", "id", id, "status", "queued", "url", url,
-                                  "cost", job_cost_json(&cost)));
+                        json_pack("{s:s, s:s, s:s, s:o, s:o}", "id", id, "status", "queued", "url",
+                                  url, "cost", job_cost_json(&cost), "estimate",
+                                  job_eta_json(&eta)));
 }
 
 enum MHD_Result submit_job(struct http_server *s, struct MHD_Connection *c,

@@ -1,6 +1,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "daemon/api/routes.h"
 
+#include <ctype.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -237,12 +238,19 @@ bool route_check_target(const char *target, size_t *args, const char **field,
         for (const char *p = query + 1; *p; p++)
             *args += *p == '&';
     }
-    for (const char *p = strchr(target, '%'); p; p = strchr(p + 1, '%'))
+    for (const char *p = strchr(target, '%'); p; p = strchr(p + 1, '%')) {
+        if (!isxdigit((unsigned char)p[1]) || !isxdigit((unsigned char)p[2])) {
+            /* RFC 3986: libmicrohttpd would pass "%zz" through as it is. */
+            *field = "url";
+            *message = "a percent-encoding must be '%' and two hexadecimal digits (RFC 3986)";
+            return false;
+        }
         if (p[1] == '0' && p[2] == '0') {
             *field = "url";
             *message = "must not contain an encoded NUL byte (%00), which would cut it short";
             return false;
         }
+    }
     if (*args > ROUTE_MAX_QUERY_ARGS) {
         *field = "query";
         *message = "at most 64 query arguments (filters, limit, cursor, wait, ...)";

@@ -92,6 +92,9 @@ enum MHD_Result respond_text(struct MHD_Connection *c, unsigned status,
 enum MHD_Result respond_json(struct MHD_Connection *c, unsigned status, json_t *body);
 enum MHD_Result respond_error(struct MHD_Connection *c, unsigned status,
                               const char *field, const char *message);
+/* 429 with Retry-After: retry_s (every other 429 says 5 s). */
+enum MHD_Result respond_retry(struct MHD_Connection *c, const char *field, const char *message,
+                              double retry_s);
 enum MHD_Result respond_file(struct MHD_Connection *c, const char *path,
                              const char *type);
 enum MHD_Result respond_html(struct MHD_Connection *c, char *html, size_t len);

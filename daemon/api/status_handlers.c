@@ -91,9 +91,16 @@ json_t *info_json(struct http_server *s)
     /* The asset limits (assets.h): the upload's body limit, the converter's
      * limits on what an asset may hold, and its memory, CPU and time. */
     json_t *limits = json_object_get(info, "limits");
+    /* The bound on one whole frame (measure.c): over it, a job fails before
+     * timing unless it accepts sliced timing. */
+    json_object_set_new(limits, "max_frame_seconds", json_real(job_spec_max_frame_seconds()));
     if (limits && s->ctx.assets) {
         json_t *assets = assets_info_json(s->ctx.assets);
         json_object_set(limits, "max_asset_bytes", json_object_get(assets, "max_asset_bytes"));
+        /* What an upload's client must keep to its slot (connections.h). */
+        json_object_set_new(assets, "max_uploads_per_address", json_integer(l->uploads_per_ip));
+        json_object_set_new(assets, "upload_min_bytes_per_s", json_real(l->upload_min_rate));
+        json_object_set_new(assets, "upload_rate_window_s", json_real(l->upload_window_s));
         json_object_set_new(limits, "assets", assets);
     }
     json_object_set_new(info, "maps", maps_json());
@@ -108,16 +115,22 @@ static json_t *render_json(const struct render_state *st, double stall_s)
         return json_pack("{s:s}", "state", "stopped");
     if (!st->busy)
         return json_pack("{s:s, s:f}", "state", "idle", "idle_s", st->since_progress_s);
+    /* A job that ended early is drained, not rendered: its state is final. */
     return json_pack("{s:s, s:s, s:s, s:f, s:f, s:f}", "state",
-                     render_state_stalled(st, stall_s) ? "stalled" : "busy", "job", st->job,
+                     render_state_stalled(st, stall_s) ? "stalled"
+                     : render_state_draining(st)        ? "draining"
+                                                        : "busy",
+                     "job", st->job,
                      "phase", st->phase, "busy_s", st->busy_s, "since_progress_s",
                      st->since_progress_s, "stall_seconds", stall_s);
 }
 
-/* GET /healthz: cheap (no store, no lock), and true: 503 when the render
+/* GET /healthz: cheap (no store query), and true: 503 when the render
  * thread has stopped, or has made no progress for longer than the bound
  * while a job is on it, which no other endpoint would show (a job that
- * holds the GPU for minutes still left every other answer quick). */
+ * holds the GPU for minutes still left every other answer quick); 200
+ * "disk full" while the state directory's disk is (reads served, writes
+ * refused until there is room). */
 enum MHD_Result respond_healthz(struct http_server *s, struct MHD_Connection *c)
 {
     struct render_state st;
@@ -136,6 +149,17 @@ enum MHD_Result respond_healthz(struct http_server *s, struct MHD_Connection *c)
                             json_pack("{s:s, s:s, s:o}", "status", "stalled", "message", msg,
                                       "render", render));
     }
+    /* A full disk: the daemon serves what it has (reads, results) but
+     * accepts nothing new until there is room, which it finds by itself. */
+    struct store *store = queue_store(s->queue);
+    if (store_disk_full(store) && !store_has_room(store))
+        return respond_json(
+            c, MHD_HTTP_OK,
+            json_pack("{s:s, s:s, s:o}", "status", "disk full", "message",
+                      "the state directory's disk is full: results are served, but jobs, "
+                      "sweeps and assets are refused (507) until there is room again; "
+                      "free some space and it recovers by itself",
+                      "render", render));
     return respond_json(c, MHD_HTTP_OK, json_pack("{s:s, s:o}", "status", "ok", "render", render));
 }
 
@@ -248,6 +272,13 @@ enum MHD_Result respond_metrics(struct http_server *s, struct MHD_Connection *c)
                "shadebench_http_connections_cut_total{phase=\"headers\"} %llu\n"
                "shadebench_http_connections_cut_total{phase=\"body\"} %llu\n",
             cs.header_timeouts, cs.body_timeouts);
+    fprintf(f, "# HELP shadebench_http_uploads Uploads holding a slot (streaming or converting).\n"
+               "# TYPE shadebench_http_uploads gauge\n"
+               "shadebench_http_uploads %zu\n"
+               "# HELP shadebench_http_uploads_slow_total Uploads cut for bringing their body "
+               "slower than the minimum rate.\n"
+               "# TYPE shadebench_http_uploads_slow_total counter\n"
+               "shadebench_http_uploads_slow_total %llu\n", cs.uploads, cs.slow_uploads);
     fprintf(f, "# HELP shadebench_http_waits_abandoned_total Waits ended because their client hung up.\n"
                "# TYPE shadebench_http_waits_abandoned_total counter\n"
                "shadebench_http_waits_abandoned_total %llu\n", cs.waits_gone);

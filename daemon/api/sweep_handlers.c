@@ -53,13 +53,17 @@ enum MHD_Result post_sweep(struct http_server *s, struct MHD_Connection *c,
     }
     struct sweep_spec spec;
     struct job_error err;
+    if (!jf_check_numbers(req->body ? req->body : "", req->len, &err)) {
+        json_decref(body);
+        return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
+    }
     if (!sweep_spec_parse(body, s->ctx.catalog, &spec, &err)) {
         sweep_spec_finish(&spec);
         json_decref(body);
         return respond_json(c, MHD_HTTP_BAD_REQUEST, job_error_to_json(&err));
     }
-    /* A sweep on an asset: refused now rather than at its first point (each
-     * point is pinned to the asset's hash when the sweep submits it). */
+    /* A sweep on an asset: refused now, with the rule's status, rather than
+     * at its first point; sweeps_submit pins the hash for all its points. */
     const json_t *asset = json_object_get(json_object_get(spec.base, "scene"), "asset");
     if (json_is_string(asset)) {
         struct scene_spec probe;
@@ -82,6 +86,8 @@ enum MHD_Result post_sweep(struct http_server *s, struct MHD_Connection *c,
     json_decref(body);
     if (r == QUEUE_IO_ERROR) /* not persisted, so not accepted */
         return respond_error(c, MHD_HTTP_INSUFFICIENT_STORAGE, "state_dir", queue_submit_error());
+    if (r == QUEUE_REFUSED) /* the asset was deleted since the probe above */
+        return respond_error(c, MHD_HTTP_CONFLICT, "base.scene.asset", queue_submit_error());
     if (r != QUEUE_OK)
         return respond_error(c, MHD_HTTP_TOO_MANY_REQUESTS, "body",
                              "too many sweeps are waiting; retry later");

@@ -38,7 +38,7 @@ static bool convert(const uint8_t *data, size_t len, const struct asset_limits *
     memset(err, 0, sizeof(*err));
     struct ctx c = {.lim = lim, .err = err};
     struct prim_info **infos = NULL;
-    bool *in_scene = NULL;
+    const bool *in_scene = NULL;
     const struct aiScene *sc = NULL;
     bool ok = false;
     if ((uint64_t)len > lim->max_file_bytes || len > UINT32_MAX /* assimp takes an unsigned size */) {
@@ -61,24 +61,10 @@ static bool convert(const uint8_t *data, size_t len, const struct asset_limits *
     if (ext && !opt_array(&c, ext, "lights", "extensions.KHR_lights_punctual.lights", &c.lights))
         goto done;
     if (!check_graph(&c, &scene_index) || !check_images(&c) || !check_textures_materials(&c) ||
-        !check_lights_cameras(&c) || !check_meshes(&c, scene_index, &infos))
+        !check_lights_cameras(&c) || !check_meshes(&c, &infos))
         goto done;
 
-    size_t nn = json_array_size(c.nodes);
-    in_scene = calloc(nn + 1, sizeof(bool));
-    if (!in_scene) {
-        fail(&c, 500, "nodes", "out of memory");
-        goto done;
-    }
-    json_t *roots = json_object_get(json_array_get(json_object_get(c.root, "scenes"),
-                                                   (size_t)scene_index), "nodes");
-    for (size_t i = 0; i < nn; i++) {
-        int top = (int)i;
-        while (c.parent[top] != -1)
-            top = c.parent[top];
-        for (size_t k = 0; k < json_array_size(roots); k++)
-            in_scene[i] |= json_integer_value(json_array_get(roots, k)) == top;
-    }
+    in_scene = c.in_scene;
 
     /* Stage 2: the geometry. No JoinIdenticalVertices: it would weld
      * vertices that differ only in uv1 across a chart seam; no
@@ -101,7 +87,7 @@ static bool convert(const uint8_t *data, size_t len, const struct asset_limits *
         fail(&c, 500, "file", "assimp could not import it: %s", aiGetErrorString());
         goto done;
     }
-    if (!build_meshes(&c, sc, infos, in_scene, out) || !build_materials(&c, out) ||
+    if (!build_meshes(&c, sc, infos, in_scene, scene_index, out) || !build_materials(&c, out) ||
         !build_images(&c, out) || !build_lights_cameras(&c, out, in_scene))
         goto done;
     if (c.nignored) {
@@ -122,7 +108,10 @@ done:
         for (size_t m = 0; m < json_array_size(c.meshes); m++)
             free(infos[m]);
     free(infos);
-    free(in_scene);
+    free(c.in_scene);
+    free(c.index_max);
+    free(c.level);
+    free(c.top);
     for (uint32_t i = 0; i < c.nignored; i++)
         free(c.ignored[i]);
     for (size_t i = 0; i < c.nowned; i++)

@@ -6,10 +6,13 @@
  *
  *   shadebench-asset convert IN_FILE OUT_CACHE [--max-file-bytes N]
  *       [--max-vertices N] [--max-indices N] [--max-texture-pixels N]
- *       [--max-texture-edge N] [--max-memory BYTES] [--max-cpu-seconds S]
+ *       [--max-texture-edge N] [--max-nodes N] [--max-cache-bytes N]
+ *       [--disk-room-bytes N] [--max-memory BYTES] [--max-cpu-seconds S]
  *
  * Exit 0: OUT_CACHE written, stdout one JSON object (asset_describe). Exit
- * 2: the asset is refused, stdout {"status": 400|422, "field", "message"}.
+ * 2: the asset is refused, stdout {"status": 400|422|507, "field",
+ * "message"} (507: the cache does not fit the room --disk-room-bytes says
+ * the disk has, or the disk filled while it was written).
  * Anything else (1 for usage or the converter's own failures, a signal from
  * the limits): the loader failed. */
 #include <errno.h>
@@ -30,7 +33,9 @@ static int usage(void)
 {
     fprintf(stderr, "usage: shadebench-asset convert IN_FILE OUT_CACHE [--max-file-bytes N] "
                     "[--max-vertices N] [--max-indices N] [--max-texture-pixels N] "
-                    "[--max-texture-edge N] [--max-memory BYTES] [--max-cpu-seconds S]\n");
+                    "[--max-texture-edge N] [--max-nodes N] [--max-cache-bytes N] "
+                    "[--disk-room-bytes N] [--max-memory BYTES] [--max-cpu-seconds S] "
+                    "[--radiance-copy PATH]\n");
     return 1;
 }
 
@@ -119,9 +124,27 @@ static uint8_t *read_input(const char *path, uint64_t max, size_t *len, bool *ov
     return buf;
 }
 
-/* An environment map: decoded, written, described; frees data and out. */
-static int convert_environment(uint8_t *data, size_t len, char *out)
+/* path made absolute against the working directory; malloc'ed, NULL when
+ * it cannot be. */
+static char *absolute(const char *path)
 {
+    if (path[0] == '/')
+        return strdup(path);
+    char cwd[4096];
+    if (!getcwd(cwd, sizeof(cwd)))
+        return NULL;
+    char *p = malloc(strlen(cwd) + strlen(path) + 2);
+    if (p)
+        sprintf(p, "%s/%s", cwd, path);
+    return p;
+}
+
+/* An environment map: decoded, written, described; frees data and out.
+ * An OpenEXR one is also written as a Radiance file at radiance_copy
+ * (when given), the copy the Khronos viewer reads (it reads only .hdr). */
+static int convert_environment(uint8_t *data, size_t len, char *out, const char *radiance_copy)
+{
+    const char *format = env_convert_format(data, len);
     struct environment_limits lim;
     environment_limits_defaults(&lim);
     struct environment_image env;
@@ -138,7 +161,12 @@ static int convert_environment(uint8_t *data, size_t len, char *out)
     char err[512];
     ok = environment_file_write(&env, out, err, sizeof(err));
     free(out);
-    json_t *d = ok ? environment_describe(&env, "radiance_hdr") : NULL;
+    bool copied = false;
+    if (ok && radiance_copy && strcmp(format, "openexr") == 0)
+        ok = copied = env_convert_write_radiance(&env, radiance_copy, err, sizeof(err));
+    json_t *d = ok ? environment_describe(&env, format) : NULL;
+    if (d && copied)
+        json_object_set_new(d, "viewer_copy", json_string("radiance_hdr"));
     environment_image_finish(&env);
     if (!ok) {
         fprintf(stderr, "shadebench-asset: %s\n", err);
@@ -162,9 +190,15 @@ int main(int argc, char **argv)
     const char *in = argv[2], *out = argv[3];
     struct asset_limits lim;
     asset_limits_defaults(&lim);
-    uint64_t max_memory = 0, max_cpu = 0;
+    uint64_t max_memory = 0, max_cpu = 0, disk_room = 0;
+    bool have_room = false;
+    const char *radiance_copy = NULL;
     for (int i = 4; i < argc; i += 2) {
         uint64_t v;
+        if (!strcmp(argv[i], "--radiance-copy") && i + 1 < argc) {
+            radiance_copy = argv[i + 1];
+            continue;
+        }
         if (i + 1 >= argc || !parse_u64(argv[i + 1], &v)) {
             fprintf(stderr, "shadebench-asset: %s needs a non-negative integer\n", argv[i]);
             return usage();
@@ -179,6 +213,12 @@ int main(int argc, char **argv)
             lim.max_texture_pixels = v;
         else if (!strcmp(argv[i], "--max-texture-edge") && v <= UINT32_MAX)
             lim.max_texture_edge = (uint32_t)v;
+        else if (!strcmp(argv[i], "--max-nodes") && v <= UINT32_MAX)
+            lim.max_nodes = (uint32_t)v;
+        else if (!strcmp(argv[i], "--max-cache-bytes"))
+            lim.max_cache_bytes = v;
+        else if (!strcmp(argv[i], "--disk-room-bytes"))
+            disk_room = v, have_room = true;
         else if (!strcmp(argv[i], "--max-memory"))
             max_memory = v;
         else if (!strcmp(argv[i], "--max-cpu-seconds"))
@@ -200,20 +240,12 @@ int main(int argc, char **argv)
     clock_gettime(CLOCK_REALTIME, &now);
     json_object_seed((size_t)now.tv_nsec ^ ((size_t)getpid() << 16) ^ (size_t)now.tv_sec);
 
-    /* The output's full path, taken before leaving the working directory. */
-    char *out_abs = NULL;
-    if (out[0] == '/') {
-        out_abs = strdup(out);
-    } else {
-        char cwd[4096];
-        if (getcwd(cwd, sizeof(cwd))) {
-            out_abs = malloc(strlen(cwd) + strlen(out) + 2);
-            if (out_abs)
-                sprintf(out_abs, "%s/%s", cwd, out);
-        }
-    }
-    if (!out_abs) {
-        fprintf(stderr, "shadebench-asset: cannot resolve %s\n", out);
+    /* The outputs' full paths, taken before leaving the working directory. */
+    char *out_abs = absolute(out), *copy_abs = radiance_copy ? absolute(radiance_copy) : NULL;
+    if (!out_abs || (radiance_copy && !copy_abs)) {
+        fprintf(stderr, "shadebench-asset: cannot resolve %s\n", out_abs ? radiance_copy : out);
+        free(out_abs);
+        free(copy_abs);
         return 1;
     }
     size_t len = 0;
@@ -221,6 +253,7 @@ int main(int argc, char **argv)
     uint8_t *data = read_input(in, lim.max_file_bytes, &len, &over);
     if (!data) {
         free(out_abs);
+        free(copy_abs);
         if (over) {
             char msg[160];
             snprintf(msg, sizeof(msg), "%zu bytes, the limit is %" PRIu64, len, lim.max_file_bytes);
@@ -234,8 +267,12 @@ int main(int argc, char **argv)
     if (chdir("/") != 0)
         fprintf(stderr, "shadebench-asset: cannot chdir to /: %s\n", strerror(errno));
 
-    if (env_convert_is_hdr(data, len))
-        return convert_environment(data, len, out_abs);
+    if (env_convert_format(data, len)) {
+        int rc = convert_environment(data, len, out_abs, copy_abs);
+        free(copy_abs);
+        return rc;
+    }
+    free(copy_abs);
     struct asset a;
     struct asset_convert_error cerr;
     bool ok = asset_convert_buffer(data, len, &lim, &a, &cerr);
@@ -247,11 +284,34 @@ int main(int argc, char **argv)
         fprintf(stderr, "shadebench-asset: %s: %s\n", cerr.field, cerr.message);
         return 1;
     }
+    /* The cache's size, known before a byte of it is written: over the
+     * limit, or over the room the daemon says the disk has for it (its free
+     * space less what it keeps for jobs), it is refused, not written until
+     * the disk fills. */
+    uint64_t size = asset_file_size(&a);
+    char msg[320];
+    if (size > lim.max_cache_bytes || (have_room && size > disk_room)) {
+        bool limit = size > lim.max_cache_bytes;
+        if (limit)
+            snprintf(msg, sizeof(msg), "the cache would take %" PRIu64 " bytes (its images "
+                     "decoded, its vertices expanded), the limit is %" PRIu64, size,
+                     lim.max_cache_bytes);
+        else
+            snprintf(msg, sizeof(msg), "the cache would take %" PRIu64 " bytes; the state "
+                     "directory's disk has room for %" PRIu64 " (its free space less what is "
+                     "kept for jobs)", size, disk_room);
+        asset_finish(&a);
+        free(out_abs);
+        return refuse(limit ? 422 : 507, limit ? "limits.max_cache_bytes" : "state_dir", msg);
+    }
     char err[512];
     if (!asset_file_write(&a, out_abs, err, sizeof(err))) {
+        int saved = errno;
         fprintf(stderr, "shadebench-asset: %s\n", err);
         asset_finish(&a);
         free(out_abs);
+        if (saved == ENOSPC || saved == EDQUOT)
+            return refuse(507, "state_dir", err);
         return 1;
     }
     free(out_abs);

@@ -691,26 +691,70 @@ done:
     return ok;
 }
 
+/* Where assimp put glTF node i's meshes, from its node an: assimp numbers
+ * its meshes in the order it first reads them (children before their
+ * parent's mesh) and never reads a mesh no node uses, so mesh m's
+ * primitives are found through a node that draws it, not at a position
+ * counted from the file. assimp's node tree mirrors the scene's: one node
+ * per glTF node, children in order. first[m]: the assimp index of mesh m's
+ * primitive 0 (SIZE_MAX until a node names it). */
+static bool map_meshes(struct ctx *c, const struct aiScene *sc, const struct aiNode *an, size_t i,
+                       size_t *first)
+{
+    json_t *node = json_array_get(c->nodes, i);
+    json_t *children = json_object_get(node, "children");
+    json_t *mi = json_object_get(node, "mesh");
+    size_t prims = mi ? json_array_size(json_object_get(
+                            json_array_get(c->meshes, (size_t)json_integer_value(mi)), "primitives"))
+                      : 0;
+    if (!an || an->mNumChildren != json_array_size(children) || an->mNumMeshes != prims)
+        return fail(c, 500, "nodes", "assimp's node %zu does not match the file's", i);
+    if (mi) {
+        size_t m = (size_t)json_integer_value(mi), at = an->mMeshes[0];
+        for (size_t p = 0; p < prims; p++)
+            if (an->mMeshes[p] != at + p || at + p >= sc->mNumMeshes)
+                return fail(c, 500, "meshes", "assimp's meshes of mesh %zu are not in order", m);
+        if (first[m] != SIZE_MAX && first[m] != at)
+            return fail(c, 500, "meshes", "assimp read mesh %zu twice", m);
+        first[m] = at;
+    }
+    size_t k;
+    json_t *ch;
+    json_array_foreach(children, k, ch)
+        if (!map_meshes(c, sc, an->mChildren[k], (size_t)json_integer_value(ch), first))
+            return false;
+    return true;
+}
+
 bool build_meshes(struct ctx *c, const struct aiScene *sc, struct prim_info **infos,
-                         const bool *in_scene, struct asset *a)
+                  const bool *in_scene, int64_t scene_index, struct asset *a)
 {
     size_t nm = json_array_size(c->meshes);
-    size_t *offset = calloc(nm + 1, sizeof(size_t));
+    size_t *offset = malloc((nm + 1) * sizeof(size_t));
     if (!offset)
         return fail(c, 500, "meshes", "out of memory");
-    for (size_t m = 0; m < nm; m++)
-        offset[m + 1] = offset[m] + json_array_size(json_object_get(json_array_get(c->meshes, m),
-                                                                    "primitives"));
+    for (size_t m = 0; m <= nm; m++)
+        offset[m] = SIZE_MAX;
     bool ok = false;
-    if (offset[nm] != sc->mNumMeshes) {
-        fail(c, 500, "meshes", "assimp made %u meshes of %zu primitives", sc->mNumMeshes, offset[nm]);
+    json_t *roots = json_object_get(json_array_get(json_object_get(c->root, "scenes"),
+                                                   (size_t)scene_index), "nodes");
+    size_t nroots = json_array_size(roots);
+    /* One root is assimp's root; several hang under a root of its own. */
+    const struct aiNode *top = sc->mRootNode;
+    if (!top || (nroots > 1 && top->mNumChildren != nroots)) {
+        fail(c, 500, "nodes", "assimp's scene does not have the file's %zu root nodes", nroots);
         goto done;
     }
+    for (size_t k = 0; k < nroots; k++)
+        if (!map_meshes(c, sc, nroots > 1 ? top->mChildren[k] : top,
+                        (size_t)json_integer_value(json_array_get(roots, k)), offset))
+            goto done;
     size_t count = 0;
     for (size_t i = 0; i < json_array_size(c->nodes); i++) {
         json_t *mi = json_object_get(json_array_get(c->nodes, i), "mesh");
         if (in_scene[i] && mi)
-            count += offset[json_integer_value(mi) + 1] - offset[json_integer_value(mi)];
+            count += json_array_size(json_object_get(
+                json_array_get(c->meshes, (size_t)json_integer_value(mi)), "primitives"));
     }
     if (count && !(a->meshes = calloc(count, sizeof(*a->meshes)))) {
         fail(c, 500, "meshes", "out of memory");

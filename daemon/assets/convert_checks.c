@@ -16,6 +16,10 @@
 
 /* ---- data URIs ---- */
 
+/* The standard alphabet only (RFC 2045, as RFC 2397 asks): assimp decodes
+ * the URI again with its own table, which has no URL-safe letters, so a
+ * letter it reads otherwise would give it other bytes than the ones
+ * checked here. */
 static int b64_value(uint8_t ch)
 {
     if (ch >= 'A' && ch <= 'Z')
@@ -24,9 +28,9 @@ static int b64_value(uint8_t ch)
         return ch - 'a' + 26;
     if (ch >= '0' && ch <= '9')
         return ch - '0' + 52;
-    if (ch == '+' || ch == '-')
+    if (ch == '+')
         return 62;
-    if (ch == '/' || ch == '_')
+    if (ch == '/')
         return 63;
     return -1;
 }
@@ -61,19 +65,24 @@ static bool decode_uri(struct ctx *c, const char *uri, const char *field, struct
         return fail(c, 400, field, "data: URI has no type/subtype media type");
     const uint8_t *p = (const uint8_t *)comma + 1;
     size_t n = strlen((const char *)p);
+    /* Whole groups of four, '=' only as the last one or two (assimp refuses
+     * any other length, and reads an '=' inside as a letter). */
+    size_t pad = n >= 1 && p[n - 1] == '=' ? (n >= 2 && p[n - 2] == '=' ? 2 : 1) : 0;
+    if (n % 4)
+        return fail(c, 400, field, "data: URI's base64 text is %zu characters, not a multiple of 4",
+                    n);
     uint8_t *buf = malloc(n / 4 * 3 + 3);
     if (!buf)
         return fail(c, 500, field, "out of memory");
     size_t o = 0;
     uint32_t acc = 0;
     int bits = 0;
-    for (size_t i = 0; i < n; i++) {
-        if (p[i] == '=')
-            break;
+    for (size_t i = 0; i < n - pad; i++) {
         int v = b64_value(p[i]);
         if (v < 0) {
             free(buf);
-            return fail(c, 400, field, "data: URI has a byte that is not base64 at %zu", i);
+            return fail(c, 400, field, "data: URI has a byte that is not base64 (standard "
+                        "alphabet, '=' only at the end) at %zu", i);
         }
         acc = (acc << 6) | (uint32_t)v;
         bits += 6;
@@ -233,6 +242,14 @@ bool check_buffers(struct ctx *c)
             snprintf(field, sizeof(field), "buffers[%zu].byteLength", i);
             return fail(c, 400, field, "byteLength %" PRId64 " but only %" PRIu64 " bytes of data",
                         blen, s.len);
+        }
+        /* A data URI holds the buffer exactly (the glTF validator's
+         * BUFFER_EMBEDDED_BYTELENGTH_MISMATCH; assimp refuses it too); the
+         * GLB chunk may carry up to 3 bytes of padding. */
+        if (uri && (uint64_t)blen != s.len) {
+            snprintf(field, sizeof(field), "buffers[%zu].byteLength", i);
+            return fail(c, 400, field, "byteLength %" PRId64 " but the data URI holds %" PRIu64
+                        " bytes", blen, s.len);
         }
         s.len = (uint64_t)blen;
         c->buffers[i] = s;
@@ -479,11 +496,22 @@ static bool check_primitive(struct ctx *c, size_t m, size_t p, json_t *prim, str
             return fail(c, 400, f, "indices must be an unsigned SCALAR accessor");
         if (ia.stride != (uint64_t)component_size(ia.ctype))
             return fail(c, 400, f, "an index accessor's bufferView must not have a byteStride");
-        for (uint64_t k = 0; k < ia.count; k++) {
-            uint32_t x = read_index(&ia, k);
-            if (x >= pa.count)
-                return fail(c, 400, f, "index %" PRIu64 " is %u, POSITION has %" PRIu64 " vertices",
-                            k, x, pa.count);
+        /* An accessor's largest index is read once, however many
+         * primitives share it. */
+        if (c->index_max[idx] < 0) {
+            uint32_t most = 0;
+            for (uint64_t k = 0; k < ia.count; k++) {
+                uint32_t x = read_index(&ia, k);
+                most = x > most ? x : most;
+            }
+            c->index_max[idx] = most;
+        }
+        if ((uint64_t)c->index_max[idx] >= pa.count) {
+            uint64_t k = 0;
+            while (read_index(&ia, k) < pa.count)
+                k++;
+            return fail(c, 400, f, "index %" PRIu64 " is %u, POSITION has %" PRIu64 " vertices",
+                        k, read_index(&ia, k), pa.count);
         }
         n = ia.count;
         pi->indices = ia.count;
@@ -505,6 +533,9 @@ bool check_graph(struct ctx *c, int64_t *scene_index)
         !opt_array(c, c->root, "scenes", "scenes", &scenes))
         return false;
     size_t n = json_array_size(c->nodes);
+    if (n > c->lim->max_nodes)
+        return fail(c, 422, "limits.max_nodes", "%zu nodes, the limit is %u", n,
+                    c->lim->max_nodes);
     if (n && !(c->parent = malloc(n * sizeof(int))))
         return fail(c, 500, "nodes", "out of memory");
     for (size_t i = 0; i < n; i++)
@@ -544,17 +575,36 @@ bool check_graph(struct ctx *c, int64_t *scene_index)
         if (lp && !get_index(c, lp, "light", field, true, json_array_size(c->lights), &idx))
             return false;
     }
-    /* Depth bounded and no cycle: walk up from each node. A cycle has no
-     * root, so its walk runs past MAX_NODE_DEPTH too. */
+    /* Depth bounded and no cycle, in one pass: each node's level (1 for a
+     * root) from its nearest ancestor whose level is known, so that every
+     * node is climbed through once whatever the shape (a million roots, or
+     * a deep chain); a cycle has no root, so its climb runs past
+     * MAX_NODE_DEPTH. top[] is each node's root. */
+    if (n && (!(c->level = calloc(n, sizeof(int))) || !(c->top = malloc(n * sizeof(int)))))
+        return fail(c, 500, "nodes", "out of memory");
     for (size_t i = 0; i < n; i++) {
-        int depth = 0;
-        for (int p = c->parent[i]; p != -1; p = c->parent[p])
-            if (++depth > MAX_NODE_DEPTH) {
-                char field[64];
-                snprintf(field, sizeof(field), "nodes[%zu]", i);
-                return fail(c, 422, field, "the node hierarchy is deeper than %d levels (or a cycle)",
-                            MAX_NODE_DEPTH);
-            }
+        int chain[MAX_NODE_DEPTH + 1];
+        int len = 0, p = (int)i;
+        while (p != -1 && !c->level[p]) {
+            if (len == MAX_NODE_DEPTH + 1)
+                break;
+            chain[len++] = p;
+            p = c->parent[p];
+        }
+        if (!len)
+            continue;
+        int above = p == -1 ? 0 : c->level[p];
+        if (len == MAX_NODE_DEPTH + 1 || above + len > MAX_NODE_DEPTH) {
+            char field[64];
+            snprintf(field, sizeof(field), "nodes[%zu]", i);
+            return fail(c, 422, field, "the node hierarchy is deeper than %d levels (or a cycle)",
+                        MAX_NODE_DEPTH);
+        }
+        int top = p == -1 ? chain[len - 1] : c->top[p];
+        for (int k = len - 1; k >= 0; k--) {
+            c->level[chain[k]] = above + (len - k);
+            c->top[chain[k]] = top;
+        }
     }
     if (!json_array_size(scenes))
         return fail(c, 422, "scenes", "no scene");
@@ -576,71 +626,94 @@ bool check_graph(struct ctx *c, int64_t *scene_index)
         if (c->parent[json_integer_value(r)] != -1)
             return fail(c, 400, field, "nodes[%zu] is not a root node", k);
     }
+    /* The nodes the scene draws: those whose root it lists. */
+    bool *listed = calloc(n + 1, sizeof(bool));
+    if (!listed || !(c->in_scene = calloc(n + 1, sizeof(bool)))) {
+        free(listed);
+        return fail(c, 500, "nodes", "out of memory");
+    }
+    json_array_foreach(roots, k, r)
+        listed[json_integer_value(r)] = true;
+    for (size_t i = 0; i < n; i++)
+        c->in_scene[i] = listed[c->top[i]];
+    free(listed);
     return true;
 }
 
-/* Counts what the scene instances against the limits, before any import. */
-bool check_meshes(struct ctx *c, int64_t scene_index, struct prim_info ***infos)
+/* Counts what the scene instances against the limits, before any import:
+ * each mesh's primitives summed once, then each node adds its mesh's sums
+ * (linear in primitives plus nodes, however many nodes share a mesh). */
+bool check_meshes(struct ctx *c, struct prim_info ***infos)
 {
-    size_t nm = json_array_size(c->meshes);
+    size_t nm = json_array_size(c->meshes), na = json_array_size(c->accessors);
     *infos = nm ? calloc(nm, sizeof(**infos)) : NULL;
-    if (nm && !*infos)
-        return fail(c, 500, "meshes", "out of memory");
+    struct mesh_sums {
+        uint64_t meshes, triangles, vertices, indices;
+    } *sums = calloc(nm + 1, sizeof(*sums));
+    bool ok = false;
+    if ((nm && !*infos) || !sums || !(c->index_max = malloc((na + 1) * sizeof(int64_t)))) {
+        fail(c, 500, "meshes", "out of memory");
+        goto out;
+    }
+    for (size_t k = 0; k < na; k++)
+        c->index_max[k] = -1;
     for (size_t m = 0; m < nm; m++) {
         json_t *mesh = json_array_get(c->meshes, m);
         char field[64];
         snprintf(field, sizeof(field), "meshes[%zu]", m);
         json_t *prims;
         if (!json_is_object(mesh) || !opt_array(c, mesh, "primitives", field, &prims) ||
-            !json_array_size(prims))
-            return fail(c, 400, field, "must be an object with primitives");
+            !json_array_size(prims)) {
+            fail(c, 400, field, "must be an object with primitives");
+            goto out;
+        }
         (*infos)[m] = calloc(json_array_size(prims), sizeof(struct prim_info));
-        if (!(*infos)[m])
-            return fail(c, 500, field, "out of memory");
-        for (size_t p = 0; p < json_array_size(prims); p++)
-            if (!check_primitive(c, m, p, json_array_get(prims, p), &(*infos)[m][p]))
-                return false;
-    }
-    /* Every node of the scene: instances of each mesh. */
-    json_t *roots = json_object_get(json_array_get(json_object_get(c->root, "scenes"),
-                                                   (size_t)scene_index), "nodes");
-    uint64_t vertices = 0, indices = 0, meshes = 0, triangles = 0;
-    for (size_t i = 0; i < json_array_size(c->nodes); i++) {
-        int top = (int)i;
-        while (c->parent[top] != -1)
-            top = c->parent[top];
-        bool in_scene = false;
-        for (size_t k = 0; k < json_array_size(roots); k++)
-            in_scene |= json_integer_value(json_array_get(roots, k)) == top;
-        json_t *mi = json_object_get(json_array_get(c->nodes, i), "mesh");
-        if (!in_scene || !mi)
-            continue;
-        size_t m = (size_t)json_integer_value(mi);
-        json_t *prims = json_object_get(json_array_get(c->meshes, m), "primitives");
+        if (!(*infos)[m]) {
+            fail(c, 500, field, "out of memory");
+            goto out;
+        }
         for (size_t p = 0; p < json_array_size(prims); p++) {
             struct prim_info *pi = &(*infos)[m][p];
+            if (!check_primitive(c, m, p, json_array_get(prims, p), pi))
+                goto out;
             if (!pi->triangles)
                 continue;
-            meshes++;
-            triangles += pi->triangles;
+            sums[m].meshes++;
+            sums[m].triangles += pi->triangles;
             /* Generated uv1 gives each triangle its own three vertices, and
              * so do flat normals where the file has none. */
-            vertices += pi->has_uv1 && pi->has_normal ? pi->vertices : 3 * pi->triangles;
-            indices += 3 * pi->triangles;
+            sums[m].vertices += pi->has_uv1 && pi->has_normal ? pi->vertices : 3 * pi->triangles;
+            sums[m].indices += 3 * pi->triangles;
         }
     }
-    if (meshes > c->lim->max_meshes)
-        return fail(c, 422, "limits.max_meshes", "%" PRIu64 " mesh instances, the limit is %u",
-                    meshes, c->lim->max_meshes);
-    if (vertices > c->lim->max_vertices)
-        return fail(c, 422, "limits.max_vertices", "%" PRIu64 " vertices, the limit is %" PRIu64,
-                    vertices, c->lim->max_vertices);
-    if (indices > c->lim->max_indices)
-        return fail(c, 422, "limits.max_indices", "%" PRIu64 " indices, the limit is %" PRIu64,
-                    indices, c->lim->max_indices);
-    if (!triangles)
-        return fail(c, 422, "meshes", "the scene has no triangles");
-    return true;
+    /* Every node of the scene: instances of each mesh. */
+    struct mesh_sums all = {0};
+    for (size_t i = 0; i < json_array_size(c->nodes); i++) {
+        json_t *mi = json_object_get(json_array_get(c->nodes, i), "mesh");
+        if (!c->in_scene[i] || !mi)
+            continue;
+        const struct mesh_sums *s = &sums[json_integer_value(mi)];
+        all.meshes += s->meshes;
+        all.triangles += s->triangles;
+        all.vertices += s->vertices;
+        all.indices += s->indices;
+    }
+    if (all.meshes > c->lim->max_meshes)
+        fail(c, 422, "limits.max_meshes", "%" PRIu64 " mesh instances, the limit is %u",
+             all.meshes, c->lim->max_meshes);
+    else if (all.vertices > c->lim->max_vertices)
+        fail(c, 422, "limits.max_vertices", "%" PRIu64 " vertices, the limit is %" PRIu64,
+             all.vertices, c->lim->max_vertices);
+    else if (all.indices > c->lim->max_indices)
+        fail(c, 422, "limits.max_indices", "%" PRIu64 " indices, the limit is %" PRIu64,
+             all.indices, c->lim->max_indices);
+    else if (!all.triangles)
+        fail(c, 422, "meshes", "the scene has no triangles");
+    else
+        ok = true;
+out:
+    free(sums);
+    return ok;
 }
 
 bool check_images(struct ctx *c)
@@ -688,6 +761,12 @@ bool check_images(struct ctx *c)
         if (w > c->lim->max_texture_edge || h > c->lim->max_texture_edge)
             return fail(c, 422, "limits.max_texture_edge", "images[%zu] is %ux%u, the limit is %u",
                         i, w, h, c->lim->max_texture_edge);
+        /* What the header claims, against what the bytes can hold: a
+         * 16x16 JPEG that declares 8192x8192 is refused here, before a
+         * decoder pads it out to 256 MiB. */
+        char why[320];
+        if (!image_size_honest(c->images[i], w, h, why, sizeof(why)))
+            return fail(c, 400, field, "%s", why);
         pixels += (uint64_t)w * h;
         if (pixels > c->lim->max_texture_pixels)
             return fail(c, 422, "limits.max_texture_pixels",

@@ -5,7 +5,10 @@
 #include "daemon/assets/convert_internal.h"
 
 #include <jpeglib.h>
+/* After jpeglib.h, which it needs. */
+#include <jerror.h>
 #include <png.h>
+#include <inttypes.h>
 #include <setjmp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,16 +29,9 @@ static uint32_t be32(const uint8_t *p)
     return (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3];
 }
 
-/* Width and height from the PNG IHDR or the first JPEG SOF marker. */
-bool image_size(struct span s, uint32_t *w, uint32_t *h)
+/* The first JPEG frame header (SOFn): its marker, height and width. */
+static bool jpeg_frame(struct span s, uint8_t *marker, uint32_t *w, uint32_t *h)
 {
-    if (is_png(s)) {
-        if (memcmp(s.data + 12, "IHDR", 4) != 0)
-            return false;
-        *w = be32(s.data + 16);
-        *h = be32(s.data + 20);
-        return true;
-    }
     size_t i = 2;
     while (i + 4 <= s.len) {
         if (s.data[i] != 0xFF)
@@ -56,6 +52,7 @@ bool image_size(struct span s, uint32_t *w, uint32_t *h)
         if (sof) {
             if (i + 9 > s.len)
                 return false;
+            *marker = m;
             *h = (uint32_t)s.data[i + 5] << 8 | s.data[i + 6];
             *w = (uint32_t)s.data[i + 7] << 8 | s.data[i + 8];
             return true;
@@ -64,6 +61,67 @@ bool image_size(struct span s, uint32_t *w, uint32_t *h)
     }
     return false;
 }
+
+/* Width and height from the PNG IHDR or the first JPEG SOF marker. */
+bool image_size(struct span s, uint32_t *w, uint32_t *h)
+{
+    if (is_png(s)) {
+        if (memcmp(s.data + 12, "IHDR", 4) != 0)
+            return false;
+        *w = be32(s.data + 16);
+        *h = be32(s.data + 20);
+        return true;
+    }
+    uint8_t marker;
+    return jpeg_frame(s, &marker, w, h);
+}
+
+/* deflate's best ratio (a run of one byte: 258 bytes a 2-bit code, plus the
+ * block headers): no honest PNG holds more raw bytes per stored byte. */
+#define DEFLATE_MAX_RATIO 1032
+
+bool image_size_honest(struct span s, uint32_t w, uint32_t h, char *why, size_t cap)
+{
+    uint64_t can_hold; /* pixels the bytes can hold, as a width at most w */
+    if (is_png(s)) {
+        /* The filtered rows: a filter byte and the row's bits, each row. */
+        uint8_t depth = s.len > 24 ? s.data[24] : 8, type = s.len > 25 ? s.data[25] : 6;
+        unsigned channels = type == 2 ? 3 : type == 4 ? 2 : type == 6 ? 4 : 1;
+        uint64_t row = 1 + ((uint64_t)w * channels * (depth ? depth : 8) + 7) / 8;
+        uint64_t raw = row * h, most = s.len * (uint64_t)DEFLATE_MAX_RATIO;
+        if (raw <= most)
+            return true;
+        can_hold = most / row * w;
+        snprintf(why, cap, "the PNG's header says %ux%u, but its %" PRIu64 " bytes can inflate "
+                 "to at most %" PRIu64 " of its %" PRIu64 " bytes of rows (deflate's best is "
+                 "%d:1): about %" PRIu64 " pixels", w, h, s.len, most, raw, DEFLATE_MAX_RATIO,
+                 can_hold);
+        return false;
+    }
+    uint8_t marker = 0;
+    uint32_t fw, fh;
+    if (!jpeg_frame(s, &marker, &fw, &fh))
+        return true; /* image_size refuses it */
+    /* Arithmetic coding (SOF9 and up) could describe a flat image of any
+     * size in a few bytes, lossless and hierarchical frames are not what
+     * glTF viewers read: baseline, extended and progressive Huffman only. */
+    if (marker != 0xC0 && marker != 0xC1 && marker != 0xC2) {
+        snprintf(why, cap, "JPEG frame type SOF%d is not supported (baseline and progressive "
+                 "Huffman-coded JPEG only, as browsers read them)", marker - 0xC0);
+        return false;
+    }
+    /* Huffman coding spends at least one bit on each 8x8 block's DC term,
+     * in every frame type it has, and the component of the largest
+     * sampling factors has a block for each 8x8 pixels. */
+    uint64_t blocks = ((uint64_t)w + 7) / 8 * (((uint64_t)h + 7) / 8);
+    if (blocks <= s.len * 8)
+        return true;
+    snprintf(why, cap, "the JPEG's header says %ux%u (%" PRIu64 " blocks of 8x8), but its %"
+             PRIu64 " bytes can code at most %" PRIu64 " blocks (a bit each at the least)", w, h,
+             blocks, s.len, s.len * 8);
+    return false;
+}
+
 /* ---- images ---- */
 
 static bool decode_png(struct ctx *c, struct span s, struct asset_image *im, const char *field)
@@ -104,10 +162,14 @@ static void jpeg_fail(j_common_ptr cinfo)
     longjmp(e->jump, 1);
 }
 
+/* Warnings are quiet, but for data that ends before the image does:
+ * libjpeg would pad the missing scans and hand back a whole image of what
+ * the file never held. */
 static void jpeg_quiet(j_common_ptr cinfo, int level)
 {
-    (void)cinfo;
-    (void)level;
+    int code = cinfo->err->msg_code;
+    if (level < 0 && (code == JWRN_JPEG_EOF || code == JWRN_HIT_MARKER))
+        jpeg_fail(cinfo);
 }
 
 static bool decode_jpeg(struct ctx *c, struct span s, struct asset_image *im, const char *field)

@@ -45,6 +45,9 @@ struct ctx {
     json_t *accessors, *views, *meshes, *nodes, *materials, *textures, *samplers, *lights,
         *cameras, *imgs;
     int *parent;          /* per node, -1 for none */
+    int *level, *top;     /* per node: 1 for a root, its root (check_graph) */
+    bool *in_scene;       /* per node (and one more): drawn by the scene (check_graph) */
+    int64_t *index_max;   /* per accessor: its largest index once read, else -1 */
     char *ignored[MAX_IGNORED];
     uint32_t nignored;
 };
@@ -91,13 +94,15 @@ bool check_buffers(struct ctx *c);
 bool check_accessors(struct ctx *c);
 /* Accessor i checked against its bufferView, described in a. */
 bool check_accessor(struct ctx *c, size_t i, struct accessor *a);
+/* The node forest, its depth, and which nodes the scene draws (in_scene),
+ * in time linear in the nodes. */
 bool check_graph(struct ctx *c, int64_t *scene_index);
 bool check_images(struct ctx *c);
 bool check_textures_materials(struct ctx *c);
 bool check_lights_cameras(struct ctx *c);
 /* Counts what the scene instances against the limits; infos[m][p] per
  * primitive, allocated here, freed by the caller. */
-bool check_meshes(struct ctx *c, int64_t scene_index, struct prim_info ***infos);
+bool check_meshes(struct ctx *c, struct prim_info ***infos);
 
 /* ---- world matrices, column-major as glTF stores them (convert_matrices.c) ---- */
 
@@ -115,6 +120,10 @@ void xform_normal(const double n[9], const double in[3], double out[3]);
 bool is_png(struct span s);
 bool is_jpeg(struct span s);
 bool image_size(struct span s, uint32_t *w, uint32_t *h);
+/* Whether s's bytes can honestly hold a w x h image (a lower bound on its
+ * compressed size: deflate's best ratio, a bit per JPEG block) and its JPEG
+ * frame type is one we read; else why, for a 400. */
+bool image_size_honest(struct span s, uint32_t w, uint32_t h, char *why, size_t cap);
 /* Decodes every image the checks passed into a->images. */
 bool build_images(struct ctx *c, struct asset *a);
 
@@ -123,6 +132,6 @@ bool build_images(struct ctx *c, struct asset *a);
 bool build_materials(struct ctx *c, struct asset *a);
 bool build_lights_cameras(struct ctx *c, struct asset *a, const bool *in_scene);
 bool build_meshes(struct ctx *c, const struct aiScene *sc, struct prim_info **infos,
-                  const bool *in_scene, struct asset *a);
+                  const bool *in_scene, int64_t scene_index, struct asset *a);
 
 #endif

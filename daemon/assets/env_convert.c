@@ -1,4 +1,5 @@
-/* An uploaded Radiance .hdr into an environment image: see env_convert.h.
+/* An uploaded Radiance .hdr into an environment image, and an image back
+ * into a Radiance file: see env_convert.h.
  * The format (Greg Ward's RGBE, as stb_image reads it): text header lines
  * from "#?RADIANCE" (or "#?RGBE") to an empty line, then "-Y H +X W", then
  * H scanlines of W pixels, each either flat (4 bytes a pixel) or, when the
@@ -8,13 +9,17 @@
 #define _POSIX_C_SOURCE 200809L
 #include "daemon/assets/env_convert.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <stb_image.h>
+
+#include "daemon/assets/env_exr.h"
 
 static bool fail(struct asset_convert_error *e, int status, const char *field, const char *fmt,
                  ...) __attribute__((format(printf, 4, 5)));
@@ -30,9 +35,14 @@ static bool fail(struct asset_convert_error *e, int status, const char *field, c
     return false;
 }
 
-bool env_convert_is_hdr(const uint8_t *data, size_t len)
+static bool is_hdr(const uint8_t *data, size_t len)
 {
     return len >= 2 && data[0] == '#' && data[1] == '?';
+}
+
+const char *env_convert_format(const uint8_t *data, size_t len)
+{
+    return is_hdr(data, len) ? "radiance_hdr" : env_exr_is(data, len) ? "openexr" : NULL;
 }
 
 /* One header line at *pos (without its newline) into line; false at the
@@ -136,6 +146,8 @@ static bool walk_pixels(const uint8_t *data, size_t len, size_t pos, uint32_t w,
 bool env_convert_buffer(const uint8_t *data, size_t len, const struct environment_limits *lim,
                         struct environment_image *out, struct asset_convert_error *e)
 {
+    if (env_exr_is(data, len))
+        return env_exr_decode(data, len, lim, out, e);
     memset(out, 0, sizeof(*out));
     memset(e, 0, sizeof(*e));
     uint32_t w, h;
@@ -176,4 +188,84 @@ bool env_convert_buffer(const uint8_t *data, size_t len, const struct environmen
     out->width = w;
     out->height = h;
     return true;
+}
+
+/* One pixel as RGBE: the largest channel's exponent shared (frexp), each
+ * mantissa to 8 bits, as Ward's float2rgbe. */
+static void rgbe(const float *p, uint8_t out[4])
+{
+    float v = p[0] > p[1] ? p[0] : p[1];
+    v = v > p[2] ? v : p[2];
+    if (!(v > 1e-32f)) {
+        memset(out, 0, 4);
+        return;
+    }
+    int ex;
+    float scale = frexpf(v, &ex) * 256.0f / v;
+    for (int c = 0; c < 3; c++)
+        out[c] = (uint8_t)(p[c] * scale);
+    out[3] = (uint8_t)(ex + 128);
+}
+
+/* One channel of a scanline, run-length coded: runs of 3 or more equal
+ * bytes as runs, the rest as literals (at most 128 a record). */
+static void rle_channel(const uint8_t *v, uint32_t n, FILE *f)
+{
+    uint32_t i = 0;
+    while (i < n) {
+        uint32_t j = i;
+        while (j < n && v[j] == v[i] && j - i < 127)
+            j++;
+        if (j - i >= 3) {
+            fputc(128 + (int)(j - i), f);
+            fputc(v[i], f);
+            i = j;
+            continue;
+        }
+        uint32_t k = i;
+        while (k < n && k - i < 128 && !(k + 2 < n && v[k] == v[k + 1] && v[k] == v[k + 2]))
+            k++;
+        fputc((int)(k - i), f);
+        fwrite(v + i, 1, k - i, f);
+        i = k;
+    }
+}
+
+bool env_convert_write_radiance(const struct environment_image *img, const char *path, char *err,
+                                size_t errlen)
+{
+    FILE *f = fopen(path, "wb");
+    uint8_t *line = malloc((size_t)img->width * 4), *chan = malloc(img->width);
+    if (!f || !line || !chan) {
+        snprintf(err, errlen, "cannot write %s: %s", path, f ? "out of memory" : strerror(errno));
+        if (f)
+            fclose(f);
+        free(line);
+        free(chan);
+        return false;
+    }
+    fprintf(f, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y %u +X %u\n", img->height, img->width);
+    bool rle = img->width >= 8 && img->width < 32768;
+    for (uint32_t y = 0; y < img->height; y++) {
+        for (uint32_t x = 0; x < img->width; x++)
+            rgbe(img->rgb + ((size_t)y * img->width + x) * 3, line + (size_t)x * 4);
+        if (!rle) {
+            fwrite(line, 4, img->width, f);
+            continue;
+        }
+        uint8_t head[4] = {2, 2, (uint8_t)(img->width >> 8), (uint8_t)(img->width & 255)};
+        fwrite(head, 1, 4, f);
+        for (int c = 0; c < 4; c++) {
+            for (uint32_t x = 0; x < img->width; x++)
+                chan[x] = line[(size_t)x * 4 + (size_t)c];
+            rle_channel(chan, img->width, f);
+        }
+    }
+    free(line);
+    free(chan);
+    bool ok = fflush(f) == 0 && !ferror(f) && fsync(fileno(f)) == 0;
+    ok = fclose(f) == 0 && ok;
+    if (!ok)
+        snprintf(err, errlen, "cannot write %s: %s", path, strerror(errno));
+    return ok;
 }

@@ -1,31 +1,28 @@
+#define _POSIX_C_SOURCE 200809L
 #include "daemon/gpu/budget.h"
 
 #include <limits.h>
 #include <math.h>
 #include <string.h>
+#include <time.h>
 
 #include "common/clock.h"
 
 /* A wait asks the stop predicate this often. */
 #define WAIT_STEP_NS 5000000ull
 #define BAND_ROWS 64
-/* A piece's first run, which measures it, is drawn in this many tiles. */
-#define MEASURE_TILES 16
 
-static double slice_s = GPU_BUDGET_SLICE_S, free_s = GPU_BUDGET_FREE_S, max_fraction = 1.0;
+static double slice_s = GPU_BUDGET_SLICE_S, max_fraction = 1.0, debug_stall_s;
 
-void gpu_budget_configure(double slice, double free_below, double largest_fraction)
+void gpu_budget_configure(double slice, double largest_fraction)
 {
     slice_s = slice;
-    free_s = free_below;
-    max_fraction = largest_fraction;
+    max_fraction = largest_fraction > 0 && largest_fraction <= 1 ? largest_fraction : 1.0;
 }
 
-void gpu_budget_limits(double *slice, double *free_below)
-{
-    *slice = slice_s;
-    *free_below = free_s;
-}
+double gpu_budget_slice(void) { return slice_s; }
+
+void gpu_budget_debug_stall(double stall) { debug_stall_s = stall > 0 ? stall : 0; }
 
 void gpu_budget_init(struct gpu_budget *b, bool (*stop)(void *ctx), void *ctx)
 {
@@ -33,6 +30,21 @@ void gpu_budget_init(struct gpu_budget *b, bool (*stop)(void *ctx), void *ctx)
     b->stop = stop;
     b->ctx = ctx;
     b->loop_slot = -1;
+    b->frame.largest_pass = -1;
+}
+
+void gpu_budget_forget(struct gpu_budget *b)
+{
+    memset(b->piece, 0, sizeof(b->piece));
+}
+
+void gpu_budget_frame(struct gpu_budget *b)
+{
+    if (!b)
+        return;
+    b->nseen = 0;
+    b->frames_begun++;
+    b->frame = (struct gpu_budget_frame){.largest_pass = -1};
 }
 
 static bool should_stop(struct gpu_budget *b)
@@ -46,6 +58,11 @@ bool gpu_budget_wait(struct gpu_budget *b, GLsync fence)
 {
     if (!fence)
         return !gpu_budget_stopped(b);
+    if (b && debug_stall_s > 0 && b->frames_begun == 1) {
+        struct timespec ts = {(time_t)debug_stall_s,
+                              (long)((debug_stall_s - (double)(time_t)debug_stall_s) * 1e9)};
+        nanosleep(&ts, NULL);
+    }
     for (;;) {
         GLenum r = glClientWaitSync(fence, GL_SYNC_FLUSH_COMMANDS_BIT,
                                     b ? WAIT_STEP_NS : UINT64_MAX);
@@ -92,71 +109,156 @@ static struct gpu_budget_piece *piece(struct gpu_budget *b, const char *site, in
     *slot = free_slot >= 0 ? free_slot : GPU_BUDGET_KEYS - 1;
     struct gpu_budget_piece *p = &b->piece[*slot];
     if (free_slot >= 0)
-        *p = (struct gpu_budget_piece){.site = site, .nth = nth, .unit_s = -1.0,
+        *p = (struct gpu_budget_piece){.site = site, .nth = nth, .pass = -1, .unit_s = -1.0,
                                        .whole_s = -1.0};
     return p;
 }
 
-/* What a run of the piece over `units` pixels or items should cost, from
- * its first run; < 0 before that. */
-static double estimate_s(const struct gpu_budget_piece *p, double units)
+/* A measured piece's run over `units` pixels or items cut into tiles that
+ * each take about a slice: a tile pays the fixed cost whatever its size, so
+ * each carries work of at least half a slice. 1: whole. */
+static int tiles_for(const struct gpu_budget_piece *p, double units)
 {
-    return p->unit_s < 0.0 ? -1.0 : p->unit_s * units;
+    double work = p->unit_s * units, per_tile = slice_s - p->fixed_s;
+    if (per_tile < slice_s / 2)
+        per_tile = slice_s / 2;
+    double n = ceil(work / per_tile);
+    return n < 1 ? 1 : n > 1e6 ? 1000000 : (int)n;
 }
 
-static bool cheap(const struct gpu_budget_piece *p, double units)
+/* The tiles of a run that is not measured: none (whole) or some, by mode. */
+static int planned_tiles(struct gpu_budget_piece *p, enum gpu_budget_mode mode, double units)
 {
-    double s = estimate_s(p, units);
-    return s >= 0.0 && s < free_s;
+    int n = 1;
+    if (mode == GPU_BUDGET_SLICED) {
+        if (p->tiles <= 0)
+            p->tiles = tiles_for(p, units);
+        n = p->tiles;
+    } else if (p->fixed_s + p->unit_s * units >= slice_s) {
+        n = tiles_for(p, units);
+    }
+    /* Tests: every piece that is cut at all in at least 1 / max_fraction tiles. */
+    int least = (int)ceil(1.0 / max_fraction);
+    if (max_fraction < 1.0 && n < least)
+        n = least;
+    return n;
 }
 
-static bool loop_cheap(const struct gpu_budget_piece *p)
+static void begin(struct gpu_budget *b, const char *site, int w, int h, bool range,
+                  struct gpu_tiles *t)
 {
-    return p->whole_s >= 0.0 && p->whole_s < free_s;
+    *t = (struct gpu_tiles){.slot = -1, .w = w, .h = h, .first = true, .tw = w, .th = h,
+                            .range = range};
+    if (!b || b->stopped || b->mode == GPU_BUDGET_WHOLE || (double)w * h <= 0)
+        return;
+    struct gpu_budget_piece *p = piece(b, site, &t->slot);
+    if (p->unit_s < 0.0) {
+        /* Measured alone: what earlier passes left in flight is not its cost. */
+        t->sliced = t->measuring = true;
+        bool query = b->use_queries && !range;
+        tile_plan_init(&t->plan, w, h, slice_s, !query);
+        if (query)
+            glGenQueries(1, &t->query);
+        gpu_budget_sync(b);
+        t->begun = clock_mono_s();
+        if (b->timer)
+            p->pass = gpu_timer_last_section(b->timer);
+        return;
+    }
+    t->ntiles = planned_tiles(p, b->mode, (double)w * h);
+    t->sliced = t->ntiles > 1;
 }
 
 void gpu_tiles_begin_at(struct gpu_budget *b, const char *site, int w, int h,
                         struct gpu_tiles *t)
 {
-    *t = (struct gpu_tiles){.slot = -1, .w = w, .h = h, .first = true, .tw = w, .th = h};
-    if (!b || b->stopped)
-        return;
-    struct gpu_budget_piece *p = piece(b, site, &t->slot);
-    t->sliced = !cheap(p, (double)w * h);
-    /* Measured alone: what earlier passes left in flight is not its cost. */
-    if (t->sliced && p->unit_s < 0.0)
-        gpu_budget_sync(b);
-    t->prev_done = clock_mono_s();
+    begin(b, site, w, h, false, t);
 }
 
 void gpu_range_begin_at(struct gpu_budget *b, const char *site, int n, struct gpu_tiles *t)
 {
-    gpu_tiles_begin_at(b, site, n, 1, t);
-    t->range = true;
+    begin(b, site, n, 1, true, t);
 }
 
-/* Tile `slot` of the ring has finished by now: what it cost. The GPU had
- * it from when it was submitted or, if busy then, from when the tile before
- * it finished; a tile found finished when first asked counts the whole
- * span, an upper bound. */
-static void tile_done(struct gpu_tiles *t, int slot, double now)
+/* A measuring run's last tile: waited for alone, and what it cost (its
+ * submission, then its GPU time). A dispatch (a range) counts its whole
+ * round trip as work: a software renderer runs it at the fence. */
+static bool measure_tile(struct gpu_budget *b, struct gpu_budget_piece *p, struct gpu_tiles *t)
 {
-    double from = t->submit[slot] > t->prev_done ? t->submit[slot] : t->prev_done;
-    t->total_s += now - from;
-    t->prev_done = now;
+    double cpu = clock_mono_s() - t->cur_submit;
+    if (t->query)
+        glEndQuery(GL_TIME_ELAPSED);
+    GLsync fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    glFlush();
+    if (!gpu_budget_wait(b, fence))
+        return false;
+    double wall = clock_mono_s() - t->cur_submit;
+    double gpu = wall - cpu;
+    if (t->query) {
+        GLuint64 ns = 0;
+        glGetQueryObjectui64v(t->query, GL_QUERY_RESULT, &ns);
+        /* Longer than the tile's whole round trip is impossible: a driver's
+         * fault (llvmpipe answers the first query after compute work with
+         * the time since boot); the wall clock stands in. */
+        double q = (double)ns / 1e9;
+        /* Tests: the stalled first frame is a slow GPU's too (the wall
+         * clock has the stall in it already). */
+        if (q <= wall)
+            gpu = q + (b->frames_begun == 1 ? debug_stall_s : 0.0);
+    }
+    if (t->range)
+        tile_plan_done(&t->plan, 0.0, wall);
+    else
+        tile_plan_done(&t->plan, cpu, gpu);
+    /* What the frame's measured pieces have cost whole so far: once past
+     * the bound, a whole frame cannot fit it. */
+    double so_far = tile_plan_whole_s(&t->plan);
+    if (b->give_up_s > 0 && b->frame.whole_s + so_far > b->give_up_s) {
+        b->stopped = b->over = true;
+        /* Cut short: what it has cost so far names it. */
+        if (so_far > b->frame.largest_s) {
+            b->frame.largest_s = so_far;
+            b->frame.largest_pass = p->pass;
+        }
+        return false;
+    }
+    return true;
 }
 
-/* Waits for the oldest tile in the ring and measures it. */
-static bool retire(struct gpu_budget *b, struct gpu_budget_piece *p, struct gpu_tiles *t)
+/* The end of a sliced run: the scissor off, the ring's tiles left queued
+ * (a measuring run has none), the measure kept. */
+static void tiles_end(struct gpu_budget *b, struct gpu_budget_piece *p, struct gpu_tiles *t,
+                      bool go)
 {
-    int slot = t->oldest;
-    bool go = gpu_budget_wait(b, t->fence[slot]);
-    t->fence[slot] = NULL;
-    (void)p;
-    tile_done(t, slot, clock_mono_s());
-    t->oldest = (t->oldest + 1) % GPU_TILES_IN_FLIGHT;
-    t->in_flight--;
-    return go;
+    if (!t->range)
+        glDisable(GL_SCISSOR_TEST);
+    t->done = true;
+    if (t->query) {
+        glDeleteQueries(1, &t->query);
+        t->query = 0;
+    }
+    while (t->in_flight > 0) {
+        glDeleteSync(t->fence[t->oldest]);
+        t->fence[t->oldest] = NULL;
+        t->oldest = (t->oldest + 1) % GPU_TILES_IN_FLIGHT;
+        t->in_flight--;
+    }
+    if (t->measuring && go) {
+        p->fixed_s = tile_plan_fixed_s(&t->plan);
+        p->unit_s = tile_plan_unit_max_s(&t->plan);
+        p->whole_s = tile_plan_whole_s(&t->plan);
+        b->frame.measured_s += clock_mono_s() - t->begun;
+        b->frame.whole_s += p->whole_s;
+        b->frame.fixed_s += t->range ? 0.0 : p->fixed_s;
+        if (p->whole_s > b->frame.largest_s) {
+            b->frame.largest_s = p->whole_s;
+            b->frame.largest_pass = p->pass;
+        }
+    }
+    if (t->tiles > 1) {
+        b->pieces_sliced++;
+        b->frame.sliced_runs++;
+    }
 }
 
 bool gpu_tiles_next(struct gpu_budget *b, struct gpu_tiles *t)
@@ -171,48 +273,49 @@ bool gpu_tiles_next(struct gpu_budget *b, struct gpu_tiles *t)
     struct gpu_budget_piece *p = &b->piece[t->slot];
     bool go = !should_stop(b);
     if (!t->first) {
-        /* The tile just drawn joins the ring; the oldest is waited for once
-         * the ring is full, so that the GPU always has tiles queued and at
-         * most GPU_TILES_IN_FLIGHT are in flight. */
-        int slot = (t->oldest + t->in_flight) % GPU_TILES_IN_FLIGHT;
-        t->fence[slot] = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
-        t->submit[slot] = t->cur_submit;
-        t->px[slot] = t->drawn_px;
-        t->in_flight++;
-        glFlush();
-        if (t->in_flight == GPU_TILES_IN_FLIGHT)
-            go = retire(b, p, t);
-    }
-    if (!go || t->y >= t->h) {
-        if (!t->range)
-            glDisable(GL_SCISSOR_TEST);
-        t->done = true;
-        /* The piece's first run waits for its last tiles, to learn its whole
-         * cost; later runs leave them queued. */
-        bool measure = go && p->unit_s < 0.0;
-        while (t->in_flight > 0) {
-            if (measure) {
-                go = retire(b, p, t) && go;
-            } else {
-                glDeleteSync(t->fence[t->oldest]);
+        if (t->measuring) {
+            go = measure_tile(b, p, t) && go;
+        } else {
+            /* The tile just drawn joins the ring; the oldest is waited for
+             * once the ring is full, so that the GPU always has tiles queued
+             * and at most GPU_TILES_IN_FLIGHT are in flight. */
+            int slot = (t->oldest + t->in_flight) % GPU_TILES_IN_FLIGHT;
+            t->fence[slot] = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+            t->in_flight++;
+            glFlush();
+            if (t->in_flight == GPU_TILES_IN_FLIGHT) {
+                go = gpu_budget_wait(b, t->fence[t->oldest]) && go;
                 t->fence[t->oldest] = NULL;
                 t->oldest = (t->oldest + 1) % GPU_TILES_IN_FLIGHT;
                 t->in_flight--;
             }
         }
-        if (measure && go && (double)t->w * t->h > 0)
-            p->unit_s = t->total_s / ((double)t->w * t->h);
-        b->pieces_sliced += t->tiles > 1;
+    }
+    if (t->measuring) {
+        struct tile_rect r;
+        if (!go || !tile_plan_next(&t->plan, &r)) {
+            tiles_end(b, p, t, go);
+            return false;
+        }
+        if (!t->range) {
+            glEnable(GL_SCISSOR_TEST);
+            glScissor(r.x, r.y, r.w, r.h);
+        }
+        t->tx = r.x, t->ty = r.y, t->tw = r.w, t->th = r.h;
+        t->drawn_px = r.w * r.h;
+        t->tiles++;
+        t->first = false;
+        t->cur_submit = clock_mono_s();
+        if (t->query)
+            glBeginQuery(GL_TIME_ELAPSED, t->query);
+        return true;
+    }
+    if (!go || t->y >= t->h) {
+        tiles_end(b, p, t, go);
         return false;
     }
-    /* Equal tiles, as many as the piece's cost measured whole asks for
-     * (MEASURE_TILES on its first run, while it is measured). */
-    double whole = estimate_s(p, (double)t->w * t->h);
-    double n = whole < 0.0 ? MEASURE_TILES : ceil(whole / slice_s);
-    if (n < 1.0 / max_fraction)
-        n = ceil(1.0 / max_fraction);
-    double want = ceil((double)t->w * t->h / n);
-    long long area = want < 1.0 ? 1 : (long long)want;
+    double want = ceil((double)t->w * t->h / t->ntiles);
+    long long area = want < 1.0 ? 1 : want > 1e15 ? (long long)1e15 : (long long)want;
     int x = t->x, y = t->y, tw, th;
     if (t->x == 0 && area >= t->w) {
         long long rows = area / t->w;
@@ -243,18 +346,61 @@ bool gpu_tiles_next(struct gpu_budget *b, struct gpu_tiles *t)
     return true;
 }
 
+void gpu_dispatch_indirect_at(struct gpu_budget *b, const char *site, GLintptr offset,
+                              GLint base_loc, GLint end_loc, int groups_x_max)
+{
+    bool whole = !b || b->stopped || b->mode == GPU_BUDGET_WHOLE;
+    if (whole) {
+        glUniform1ui(base_loc, 0u);
+        glUniform1ui(end_loc, UINT_MAX);
+        glDispatchComputeIndirect(offset);
+        return;
+    }
+    /* Untimed or sliced: the count the GPU wrote, read back once the work
+     * before has finished (that wait asks the stop predicate too). */
+    GLuint groups[3] = {0, 0, 0};
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
+    if (!gpu_budget_sync(b))
+        return;
+    glGetBufferSubData(GL_DISPATCH_INDIRECT_BUFFER, offset, sizeof(groups), groups);
+    double n = (double)groups[0] * groups[1] * groups[2];
+    if (n <= 0)
+        return;
+    if (n > INT_MAX)
+        n = INT_MAX;
+    if (groups_x_max < 1)
+        groups_x_max = 65535;
+    struct gpu_tiles t;
+    for (gpu_range_begin_at(b, site, (int)n, &t); gpu_tiles_next(b, &t);) {
+        GLuint count = (GLuint)t.tw;
+        GLuint gx = count < (GLuint)groups_x_max ? count : (GLuint)groups_x_max;
+        GLuint gy = (count + gx - 1) / gx;
+        glUniform1ui(base_loc, (GLuint)t.tx);
+        glUniform1ui(end_loc, (GLuint)(t.tx + t.tw));
+        glDispatchCompute(gx, gy, 1);
+    }
+}
+
 void gpu_loop_begin_at(struct gpu_budget *b, const char *site)
 {
     if (!b)
         return;
     struct gpu_budget_piece *p = piece(b, site, &b->loop_slot);
     b->loop_calls = 0;
-    if (loop_cheap(p)) {
-        p->every = INT_MAX;
+    b->loop_measuring = false;
+    if (b->mode == GPU_BUDGET_WHOLE ||
+        (b->mode == GPU_BUDGET_ADAPTIVE && p->whole_s >= 0.0 && p->whole_s < slice_s)) {
+        p->every = p->every > 0 ? p->every : 1;
+        b->loop_calls = INT_MIN; /* no checkpoint this run */
         return;
     }
-    if (p->every <= 0 || p->every == INT_MAX) {
+    if (p->whole_s < 0.0) {
+        /* Its first run: checkpoints from every call on, doubling while the
+         * chunks stay short, and its cost whole. */
+        b->loop_measuring = true;
         p->every = 1;
+        if (b->timer)
+            p->pass = gpu_timer_last_section(b->timer);
         gpu_budget_sync(b);
     }
     b->loop_t0 = clock_mono_s();
@@ -268,18 +414,32 @@ bool gpu_loop_step(struct gpu_budget *b)
      * the CPU, which no wait would notice. */
     if (should_stop(b))
         return false;
+    if (b->loop_calls < 0)
+        return true;
     struct gpu_budget_piece *p = &b->piece[b->loop_slot];
-    if (p->every == INT_MAX || ++b->loop_calls % p->every != 0)
+    if (++b->loop_calls % p->every != 0)
         return true;
     double t0 = clock_mono_s();
     bool go = gpu_budget_sync(b);
     double dt = clock_mono_s() - t0;
     /* Keep a chunk's GPU work near the aim: what the wait took is what the
-     * chunk left unfinished, a lower bound of its cost. */
-    if (dt < slice_s / 4 && p->every < INT_MAX / 4)
-        p->every *= 2;
-    else if (dt > slice_s * 2 && p->every > 1)
-        p->every /= 2;
+     * chunk left unfinished, a lower bound of its cost. A sliced timed run
+     * keeps the chunks its measure gave. */
+    if (b->mode != GPU_BUDGET_SLICED || b->loop_measuring) {
+        if (dt < slice_s / 4 && p->every < INT_MAX / 4)
+            p->every *= 2;
+        else if (dt > slice_s * 2 && p->every > 1)
+            p->every /= 2;
+    }
+    double so_far = clock_mono_s() - b->loop_t0;
+    if (go && b->loop_measuring && b->give_up_s > 0 && b->frame.whole_s + so_far > b->give_up_s) {
+        b->stopped = b->over = true;
+        go = false;
+        if (so_far > b->frame.largest_s) {
+            b->frame.largest_s = so_far;
+            b->frame.largest_pass = p->pass;
+        }
+    }
     return go;
 }
 
@@ -288,9 +448,22 @@ void gpu_loop_end(struct gpu_budget *b)
     if (!b || b->loop_slot < 0)
         return;
     struct gpu_budget_piece *p = &b->piece[b->loop_slot];
-    if (p->every != INT_MAX && gpu_budget_sync(b)) {
-        p->whole_s = clock_mono_s() - b->loop_t0;
-        b->pieces_sliced += b->loop_calls > p->every;
+    if (b->loop_calls >= 0 && gpu_budget_sync(b)) {
+        double took = clock_mono_s() - b->loop_t0;
+        if (b->loop_measuring) {
+            p->whole_s = took;
+            b->frame.measured_s += took;
+            b->frame.whole_s += took;
+            b->frame.fixed_s += took; /* a loop of draws: per light or face, not per pixel */
+            if (took > b->frame.largest_s) {
+                b->frame.largest_s = took;
+                b->frame.largest_pass = p->pass;
+            }
+        }
+        if (b->loop_calls > p->every) {
+            b->pieces_sliced++;
+            b->frame.sliced_runs++;
+        }
     }
     b->loop_slot = -1;
 }

@@ -73,3 +73,21 @@ json_t *gpu_caps_json(const struct gpu_caps *c)
     json_object_set_new(j, "max_msaa", json_integer(c->max_msaa));
     return j;
 }
+
+static bool gl_has_extension(const char *name, void *ctx)
+{
+    (void)ctx;
+    return epoxy_has_gl_extension(name);
+}
+
+static void gl_get_integers(unsigned pname, int *values, void *ctx)
+{
+    (void)ctx;
+    glGetIntegerv((GLenum)pname, values);
+}
+
+void gpu_memory_sample_gl(struct gpu_memory_sample *out)
+{
+    const struct gpu_memory_reader reader = {gl_has_extension, gl_get_integers, NULL};
+    gpu_memory_read(&reader, out);
+}

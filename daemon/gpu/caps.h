@@ -9,6 +9,8 @@
 #include <jansson.h>
 #include <stdbool.h>
 
+#include "daemon/gpu/gpu_memory.h"
+
 struct gpu_caps {
     int max_texture_size, max_renderbuffer_size, max_viewport[2];
     int max_color_attachments, max_draw_buffers, max_texture_units;
@@ -30,5 +32,9 @@ struct gpu_caps {
 void gpu_caps_query(struct gpu_caps *c);
 /* New reference. */
 json_t *gpu_caps_json(const struct gpu_caps *c);
+
+/* GPU memory now, through GL (gpu_memory.h's reader over glGetIntegerv).
+ * Render thread, context current; outside every timed region. */
+void gpu_memory_sample_gl(struct gpu_memory_sample *out);
 
 #endif

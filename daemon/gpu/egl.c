@@ -1,6 +1,12 @@
-#define _POSIX_C_SOURCE 200809L
+#define _GNU_SOURCE /* dl_iterate_phdr, RTLD_NODELETE (sanitizer builds) */
 #include "daemon/gpu/egl.h"
 
+#include "config.h"
+
+#ifdef SHADEBENCH_SANITIZERS
+#include <dlfcn.h>
+#include <link.h>
+#endif
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>
 #include <stdio.h>
@@ -8,6 +14,7 @@
 #include <string.h>
 
 #include "common/log.h"
+#include "daemon/gpu/device_allocated.h"
 
 /* Newer than the EGL headers libepoxy 1.5 ships with. */
 #ifndef EGL_DRM_RENDER_NODE_FILE_EXT
@@ -20,6 +27,15 @@
 #define EGL_RENDERER_EXT 0x335F
 #endif
 
+#ifndef EGL_DEVICE_UUID_EXT
+#define EGL_DEVICE_UUID_EXT 0x335C
+#endif
+#ifndef EGL_CUDA_DEVICE_NV
+#define EGL_CUDA_DEVICE_NV 0x323A
+#endif
+typedef EGLBoolean (*query_device_binary_fn)(EGLDeviceEXT device, EGLint name, EGLint max_size,
+                                              void *value, EGLint *size);
+
 enum { MAX_DEVICES = 16 };
 
 struct egl_context {
@@ -29,6 +45,13 @@ struct egl_context {
     char device[192];
     char version[64];
     char vendor[64];
+    /* Every EGL device with its names, the one opened (-1: surfaceless),
+     * what was asked and why this one. */
+    struct gpu_device_names devices[MAX_DEVICES];
+    int device_count, selected;
+    struct device_spec asked;
+    enum device_spec_kind matched_by;
+    char why[800];
 };
 
 static bool has_word(const char *list, const char *word)
@@ -51,6 +74,14 @@ static void copy_str(char *dst, size_t cap, const char *src)
     snprintf(dst, cap, "%s", src ? src : "");
 }
 
+/* Where sysfs and procfs are read: the real ones, or a fake tree that the
+ * tests name (device_sysfs.h). */
+static const char *sysfs_root(void)
+{
+    const char *root = getenv("SHADEBENCH_SYSFS_ROOT");
+    return root ? root : "";
+}
+
 static int query_devices(EGLDeviceEXT *devices, char *err, size_t errlen)
 {
     const char *ext = client_extensions();
@@ -67,35 +98,70 @@ static int query_devices(EGLDeviceEXT *devices, char *err, size_t errlen)
     return n;
 }
 
-static void describe_device(EGLDeviceEXT dev, int index, struct egl_device_info *info)
+static void describe_device(EGLDeviceEXT dev, int index, struct gpu_device_names *d)
 {
-    memset(info, 0, sizeof(*info));
-    info->index = index;
+    device_names_init(d, index);
     const char *ext = eglQueryDeviceStringEXT(dev, EGL_EXTENSIONS);
-    copy_str(info->extensions, sizeof(info->extensions), ext);
-    info->software = has_word(ext, "EGL_MESA_device_software");
+    d->software = has_word(ext, "EGL_MESA_device_software");
     if (has_word(ext, "EGL_EXT_device_drm"))
-        copy_str(info->drm_node, sizeof(info->drm_node),
+        copy_str(d->drm_node, sizeof(d->drm_node),
                  eglQueryDeviceStringEXT(dev, EGL_DRM_DEVICE_FILE_EXT));
     if (has_word(ext, "EGL_EXT_device_drm_render_node"))
-        copy_str(info->render_node, sizeof(info->render_node),
+        copy_str(d->render_node, sizeof(d->render_node),
                  eglQueryDeviceStringEXT(dev, EGL_DRM_RENDER_NODE_FILE_EXT));
-    if (has_word(ext, "EGL_EXT_device_persistent_id"))
-        copy_str(info->driver, sizeof(info->driver),
-                 eglQueryDeviceStringEXT(dev, EGL_DRIVER_NAME_EXT));
-    if (has_word(ext, "EGL_EXT_device_query_name"))
-        copy_str(info->renderer, sizeof(info->renderer),
-                 eglQueryDeviceStringEXT(dev, EGL_RENDERER_EXT));
+    if (has_word(ext, "EGL_EXT_device_persistent_id")) {
+        copy_str(d->driver, sizeof(d->driver), eglQueryDeviceStringEXT(dev, EGL_DRIVER_NAME_EXT));
+        /* Newer than libepoxy 1.5's table: looked up by name. */
+        query_device_binary_fn binary =
+            (query_device_binary_fn)eglGetProcAddress("eglQueryDeviceBinaryEXT");
+        unsigned char uuid[16];
+        EGLint size = 0;
+        if (binary && binary(dev, EGL_DEVICE_UUID_EXT, 16, uuid, &size) && size == 16) {
+            device_uuid_from_bytes(uuid, d->uuid, sizeof(d->uuid));
+            copy_str(d->uuid_from, sizeof(d->uuid_from), "EGL_EXT_device_persistent_id");
+        }
+    }
+    if (has_word(ext, "EGL_EXT_device_query_name")) {
+        copy_str(d->vendor, sizeof(d->vendor), eglQueryDeviceStringEXT(dev, EGL_VENDOR));
+        copy_str(d->renderer, sizeof(d->renderer), eglQueryDeviceStringEXT(dev, EGL_RENDERER_EXT));
+    }
+    EGLAttrib cuda = -1;
+    if (has_word(ext, "EGL_NV_device_cuda") && eglQueryDeviceAttribEXT(dev, EGL_CUDA_DEVICE_NV, &cuda))
+        d->cuda_device = (int)cuda;
     eglGetError(); /* a string the driver lacks is not an error worth keeping */
+    device_names_from_sysfs(d, sysfs_root());
 }
 
-int egl_list_devices(struct egl_device_info *out, int max, char *err, size_t errlen)
+int egl_list_devices(struct gpu_device_names *out, int max, char *err, size_t errlen)
 {
     EGLDeviceEXT devices[MAX_DEVICES];
     int n = query_devices(devices, err, errlen);
     for (int i = 0; i < n && i < max; i++)
         describe_device(devices[i], i, &out[i]);
     return n < max ? n : max;
+}
+
+#ifdef SHADEBENCH_SANITIZERS
+static int pin_module(struct dl_phdr_info *info, size_t size, void *data)
+{
+    (void)size, (void)data;
+    if (info->dlpi_name && info->dlpi_name[0])
+        dlopen(info->dlpi_name, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
+    return 0;
+}
+#endif
+
+/* Sanitizer builds only: Mesa unloads its driver when the GL context goes
+ * (a brief one for --list-devices or a start-up error, or the daemon's
+ * own), and memory that only the driver's globals pointed to then looks
+ * leaked, with no module to name in a suppression. Marking every library
+ * loaded by now (the driver and LLVM included) as never to be unloaded
+ * keeps it reachable, so LeakSanitizer reports the daemon's own leaks only. */
+static void pin_loaded_modules(void)
+{
+#ifdef SHADEBENCH_SANITIZERS
+    dl_iterate_phdr(pin_module, NULL);
+#endif
 }
 
 static bool init_context(struct egl_context *ctx, EGLDisplay display, bool debug,
@@ -146,6 +212,7 @@ static bool init_context(struct egl_context *ctx, EGLDisplay display, bool debug
         snprintf(err, errlen, "eglMakeCurrent failed (0x%x)", eglGetError());
         goto fail;
     }
+    pin_loaded_modules();
     if (epoxy_gl_version() < 43) {
         snprintf(err, errlen, "OpenGL %d.%d is too old: 4.3 is needed",
                  epoxy_gl_version() / 10, epoxy_gl_version() % 10);
@@ -163,24 +230,87 @@ fail:
     return false;
 }
 
-static bool try_device(struct egl_context *ctx, EGLDeviceEXT dev, int index,
-                       bool debug, char *err, size_t errlen)
+static bool try_device(struct egl_context *ctx, EGLDeviceEXT dev, int index, bool debug,
+                       char *err, size_t errlen)
 {
-    struct egl_device_info info;
-    describe_device(dev, index, &info);
+    const struct gpu_device_names *d = &ctx->devices[index];
     EGLDisplay dpy = eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, dev, NULL);
     if (!init_context(ctx, dpy, debug, err, errlen)) {
         LOG(LOG_INFO, "EGL device %d: %s", index, err);
         return false;
     }
+    ctx->selected = index;
     copy_str(ctx->platform, sizeof(ctx->platform), "device");
-    const char *node = info.render_node[0] ? info.render_node : info.drm_node;
-    snprintf(ctx->device, sizeof(ctx->device), "device %d%s%s%s", index,
-             node[0] ? " " : "", node, info.software ? " (software)" : "");
+    const char *node = d->render_node[0] ? d->render_node : d->drm_node;
+    snprintf(ctx->device, sizeof(ctx->device), "device %d%s%s%s%s%s", index, node[0] ? " " : "",
+             node, d->bus_id[0] ? " (" : "", d->bus_id, d->bus_id[0] ? ")" : "");
+    if (d->software)
+        snprintf(ctx->device + strlen(ctx->device), sizeof(ctx->device) - strlen(ctx->device),
+                 " (software)");
     return true;
 }
 
-struct egl_context *egl_context_create(int device, bool debug, char *err,
+/* Opens dev briefly for GL_VENDOR, GL_RENDERER (where EGL had no names)
+ * and GL_VERSION, and closes it again. */
+static bool probe_names(EGLDeviceEXT dev, struct gpu_device_names *d, char *gl_version,
+                        size_t cap, char *why, size_t whylen)
+{
+    struct egl_context probe = {.display = EGL_NO_DISPLAY, .context = EGL_NO_CONTEXT};
+    EGLDisplay dpy = eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, dev, NULL);
+    if (!init_context(&probe, dpy, false, why, whylen))
+        return false;
+    if (!d->vendor[0])
+        copy_str(d->vendor, sizeof(d->vendor), (const char *)glGetString(GL_VENDOR));
+    if (!d->renderer[0])
+        copy_str(d->renderer, sizeof(d->renderer), (const char *)glGetString(GL_RENDERER));
+    if (gl_version)
+        copy_str(gl_version, cap, (const char *)glGetString(GL_VERSION));
+    eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    eglDestroyContext(dpy, probe.context);
+    eglTerminate(dpy);
+    return true;
+}
+
+static const char *env_get(const char *name, void *unused)
+{
+    (void)unused;
+    return getenv(name);
+}
+
+/* Auto: hardware first, then software, then surfaceless. A lab box with a
+ * GPU must never silently fall back to a CPU renderer just because the
+ * software device is listed first. */
+static bool open_auto(struct egl_context *ctx, EGLDeviceEXT *devices, bool debug, char *why,
+                      size_t whylen)
+{
+    for (int pass = 0; pass < 2; pass++)
+        for (int i = 0; i < ctx->device_count; i++) {
+            if (ctx->devices[i].software != (pass == 1))
+                continue;
+            if (try_device(ctx, devices[i], i, debug, why, whylen)) {
+                snprintf(ctx->why + strlen(ctx->why), sizeof(ctx->why) - strlen(ctx->why),
+                         "%sthe first %s EGL device that gave an OpenGL 4.3 core context%s",
+                         ctx->why[0] ? ": " : "", pass ? "software" : "hardware",
+                         pass ? " (no hardware device did)" : "");
+                return true;
+            }
+        }
+    if (has_word(client_extensions(), "EGL_MESA_platform_surfaceless")) {
+        EGLDisplay dpy = eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA,
+                                                  EGL_DEFAULT_DISPLAY, NULL);
+        if (init_context(ctx, dpy, debug, why, whylen)) {
+            copy_str(ctx->platform, sizeof(ctx->platform), "surfaceless");
+            copy_str(ctx->device, sizeof(ctx->device), "EGL_MESA_platform_surfaceless");
+            snprintf(ctx->why + strlen(ctx->why), sizeof(ctx->why) - strlen(ctx->why),
+                     "%sno EGL device gave a context: EGL_MESA_platform_surfaceless",
+                     ctx->why[0] ? ": " : "");
+            return true;
+        }
+    }
+    return false;
+}
+
+struct egl_context *egl_context_create(const struct device_spec *spec, bool debug, char *err,
                                        size_t errlen)
 {
     struct egl_context *ctx = calloc(1, sizeof(*ctx));
@@ -190,53 +320,82 @@ struct egl_context *egl_context_create(int device, bool debug, char *err,
     }
     ctx->display = EGL_NO_DISPLAY;
     ctx->context = EGL_NO_CONTEXT;
+    ctx->selected = -1;
+    ctx->asked = *spec;
     const char *ext = client_extensions();
     bool platform_device = has_word(ext, "EGL_EXT_platform_device");
 
     EGLDeviceEXT devices[MAX_DEVICES];
-    char why[256] = "";
+    char why[1024] = "";
     int n = platform_device ? query_devices(devices, why, sizeof(why)) : -1;
-    if (device >= 0) {
-        if (n < 0) {
-            snprintf(err, errlen, "--device %d: EGL device platform unavailable: %s",
-                     device, platform_device ? why : "no EGL_EXT_platform_device");
+    for (int i = 0; i < n; i++)
+        describe_device(devices[i], i, &ctx->devices[i]);
+    ctx->device_count = n > 0 ? n : 0;
+
+    struct device_spec named = *spec;
+    const char *asked = spec->kind == DEVICE_SPEC_ALLOCATED ? "allocated"
+                        : spec->kind == DEVICE_SPEC_AUTO    ? "auto"
+                                                            : spec->text;
+    if (spec->kind == DEVICE_SPEC_ALLOCATED) {
+        struct device_allocation a;
+        if (!device_allocated(env_get, NULL, sysfs_root(), &a, why, sizeof(why))) {
+            snprintf(err, errlen, "--device allocated: %s", why);
             goto fail;
         }
-        if (device >= n) {
-            snprintf(err, errlen, "--device %d: only %d EGL device(s) found", device, n);
-            goto fail;
-        }
-        if (!try_device(ctx, devices[device], device, debug, why, sizeof(why))) {
-            snprintf(err, errlen, "--device %d: %s", device, why);
-            goto fail;
-        }
-        return ctx;
+        copy_str(ctx->why, sizeof(ctx->why), a.why);
+        named = a.named ? a.spec : (struct device_spec){.kind = DEVICE_SPEC_AUTO};
     }
-    /* Hardware first: a lab box with a GPU must never silently fall back to
-     * a CPU renderer just because the software device is listed first. */
-    for (int pass = 0; pass < 2; pass++)
-        for (int i = 0; i < n; i++) {
-            struct egl_device_info info;
-            describe_device(devices[i], i, &info);
-            if (info.software != (pass == 1))
-                continue;
-            if (try_device(ctx, devices[i], i, debug, why, sizeof(why)))
-                return ctx;
-        }
-    if (has_word(ext, "EGL_MESA_platform_surfaceless")) {
-        EGLDisplay dpy = eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA,
-                                                  EGL_DEFAULT_DISPLAY, NULL);
-        if (init_context(ctx, dpy, debug, why, sizeof(why))) {
-            copy_str(ctx->platform, sizeof(ctx->platform), "surfaceless");
-            copy_str(ctx->device, sizeof(ctx->device), "EGL_MESA_platform_surfaceless");
+    ctx->matched_by = named.kind;
+    if (named.kind == DEVICE_SPEC_AUTO) {
+        if (open_auto(ctx, devices, debug, why, sizeof(why)))
             return ctx;
-        }
+        snprintf(err, errlen, "no EGL device or surfaceless platform gave an OpenGL 4.3 "
+                 "core context (last error: %s)", why[0] ? why : "none tried");
+        goto fail;
     }
-    snprintf(err, errlen, "no EGL device or surfaceless platform gave an OpenGL 4.3 "
-             "core context (last error: %s)", why[0] ? why : "none tried");
+    if (n < 0) {
+        snprintf(err, errlen, "--device %s: EGL device platform unavailable: %s", asked,
+                 platform_device ? why : "no EGL_EXT_platform_device");
+        goto fail;
+    }
+    char list[2048];
+    int index = device_spec_match(&named, ctx->devices, ctx->device_count, list, sizeof(list));
+    if (index < 0) {
+        /* Name what there is by its renderer too: the daemon does not
+         * start, so opening each device briefly costs nothing that runs. */
+        for (int i = 0; i < ctx->device_count; i++)
+            if (!ctx->devices[i].renderer[0])
+                probe_names(devices[i], &ctx->devices[i], NULL, 0, why, sizeof(why));
+        device_spec_match(&named, ctx->devices, ctx->device_count, list, sizeof(list));
+        snprintf(err, errlen, "--device %s: %s", asked, list);
+        goto fail;
+    }
+    if (!try_device(ctx, devices[index], index, debug, why, sizeof(why))) {
+        snprintf(err, errlen, "--device %s: EGL device %d gave no context: %s", asked, index, why);
+        goto fail;
+    }
+    if (spec->kind != DEVICE_SPEC_ALLOCATED)
+        snprintf(ctx->why, sizeof(ctx->why), "--device %s: EGL device %d has that %s", asked,
+                 index, named.kind == DEVICE_SPEC_INDEX ? "index"
+                        : named.kind == DEVICE_SPEC_NODE ? "device node"
+                        : named.kind == DEVICE_SPEC_BUS_ID ? "PCI bus id" : "UUID");
+    return ctx;
 fail:
     free(ctx);
     return NULL;
+}
+
+bool egl_probe_device(int index, struct gpu_device_names *d, char *gl_version, size_t cap,
+                      char *why, size_t whylen)
+{
+    EGLDeviceEXT devices[MAX_DEVICES];
+    int n = query_devices(devices, why, whylen);
+    if (index >= n) {
+        if (n >= 0)
+            snprintf(why, whylen, "no EGL device %d", index);
+        return false;
+    }
+    return probe_names(devices[index], d, gl_version, cap, why, whylen);
 }
 
 void egl_context_destroy(struct egl_context *ctx)
@@ -256,3 +415,38 @@ const char *egl_context_platform(const struct egl_context *ctx) { return ctx->pl
 const char *egl_context_device(const struct egl_context *ctx) { return ctx->device; }
 const char *egl_context_egl_version(const struct egl_context *ctx) { return ctx->version; }
 const char *egl_context_egl_vendor(const struct egl_context *ctx) { return ctx->vendor; }
+
+void egl_context_describe(const struct egl_context *ctx, json_t *device)
+{
+    json_t *all = json_array();
+    for (int i = 0; i < ctx->device_count; i++) {
+        struct gpu_device_names d = ctx->devices[i];
+        /* Only the opened device's GL strings are known: the others are
+         * not opened, so that a daemon never claims memory on a GPU that
+         * another task was given. */
+        if (i == ctx->selected) {
+            if (!d.vendor[0])
+                copy_str(d.vendor, sizeof(d.vendor), (const char *)glGetString(GL_VENDOR));
+            if (!d.renderer[0])
+                copy_str(d.renderer, sizeof(d.renderer), (const char *)glGetString(GL_RENDERER));
+        }
+        json_t *j = device_names_json(&d);
+        json_object_set_new(j, "selected", json_boolean(i == ctx->selected));
+        if (i == ctx->selected) {
+            static const char *const keys[] = {"software", "drm_node", "render_node", "bus_id",
+                                               "uuid"};
+            for (size_t k = 0; k < sizeof(keys) / sizeof(keys[0]); k++)
+                json_object_set(device, keys[k], json_object_get(j, keys[k]));
+        }
+        json_array_append_new(all, j);
+    }
+    json_object_set_new(device, "egl_device_index",
+                        ctx->selected >= 0 ? json_integer(ctx->selected) : json_null());
+    const char *asked = ctx->asked.kind == DEVICE_SPEC_AUTO        ? "auto"
+                        : ctx->asked.kind == DEVICE_SPEC_ALLOCATED ? "allocated"
+                                                                   : ctx->asked.text;
+    json_object_set_new(device, "selection",
+                        json_pack("{s:s, s:s, s:s}", "asked", asked, "matched_by",
+                                  device_spec_kind_name(ctx->matched_by), "why", ctx->why));
+    json_object_set_new(device, "egl_devices", all);
+}

@@ -1,12 +1,24 @@
 #include "daemon/gpu/gpu_timer.h"
 
 #include <stdlib.h>
+#include <string.h>
 
 #include "common/clock.h"
 
+/* A section may be entered more than once in a frame (a technique's first
+ * pass, opened by the harness before the technique draws and again by the
+ * technique itself after the look's shadow pass): each entry is timed on its
+ * own, and the section's time is their sum. */
+#define ENTRIES (2 * GPU_TIMER_MAX_SECTIONS)
+
+/* One frame's queries. With timestamps, stamp[e] is written where entry e
+ * begins and stamp[entries] where the frame ends: entry e took stamp[e + 1]
+ * - stamp[e], and the entries add up to the frame's span exactly. Without,
+ * each entry is a GL_TIME_ELAPSED query of its own. */
 struct ring_slot {
-    GLuint queries[GPU_TIMER_MAX_SECTIONS];
-    bool issued[GPU_TIMER_MAX_SECTIONS];
+    GLuint queries[ENTRIES + 1];
+    int section[ENTRIES]; /* the section each entry timed */
+    int entries;
     int64_t frame; /* -1 when nothing is waiting to be read */
 };
 
@@ -17,9 +29,11 @@ struct gpu_timer {
     int last;    /* the section begun last, -1 before any */
     struct ring_slot ring[GPU_TIMER_RING];
     double *ms; /* frames * sections */
+    bool timestamps; /* the driver answers GL_TIMESTAMP (bits > 0) */
     unsigned char *implausible; /* per frame: sections whose answer was impossible */
     int64_t stalls;
     double created_s; /* clock_mono_s */
+    bool paused;
 };
 
 struct gpu_timer *gpu_timer_create(int sections, int64_t frames)
@@ -42,8 +56,11 @@ struct gpu_timer *gpu_timer_create(int sections, int64_t frames)
     t->created_s = clock_mono_s();
     t->current = -1;
     t->last = -1;
+    GLint bits = 0;
+    glGetQueryiv(GL_TIMESTAMP, GL_QUERY_COUNTER_BITS, &bits);
+    t->timestamps = bits > 0;
     for (int i = 0; i < GPU_TIMER_RING; i++) {
-        glGenQueries(sections, t->ring[i].queries);
+        glGenQueries(ENTRIES + 1, t->ring[i].queries);
         t->ring[i].frame = -1;
     }
     return t;
@@ -54,69 +71,99 @@ void gpu_timer_destroy(struct gpu_timer *t)
     if (!t)
         return;
     for (int i = 0; i < GPU_TIMER_RING; i++)
-        glDeleteQueries(t->sections, t->ring[i].queries);
+        glDeleteQueries(ENTRIES + 1, t->ring[i].queries);
     free(t->ms);
     free(t->implausible);
     free(t);
+}
+
+static GLuint64 result_of(struct gpu_timer *t, GLuint query)
+{
+    GLint available = 0;
+    glGetQueryObjectiv(query, GL_QUERY_RESULT_AVAILABLE, &available);
+    if (!available)
+        t->stalls++;
+    GLuint64 ns = 0;
+    glGetQueryObjectui64v(query, GL_QUERY_RESULT, &ns);
+    return ns;
 }
 
 static void read_slot(struct gpu_timer *t, struct ring_slot *slot)
 {
     if (slot->frame < 0)
         return;
-    for (int s = 0; s < t->sections; s++) {
-        if (!slot->issued[s])
-            continue;
-        GLint available = 0;
-        glGetQueryObjectiv(slot->queries[s], GL_QUERY_RESULT_AVAILABLE, &available);
-        if (!available)
-            t->stalls++;
-        GLuint64 ns = 0;
-        glGetQueryObjectui64v(slot->queries[s], GL_QUERY_RESULT, &ns);
-        double ms = (double)ns / 1e6;
-        if (ms > (clock_mono_s() - t->created_s) * 1e3) {
-            t->implausible[slot->frame]++;
-            ms = 0.0;
+    double *ms = &t->ms[slot->frame * t->sections];
+    double since = (clock_mono_s() - t->created_s) * 1e3;
+    for (int s = 0; s < t->sections; s++)
+        ms[s] = 0.0;
+    GLuint64 prev = slot->entries && t->timestamps ? result_of(t, slot->queries[0]) : 0;
+    for (int e = 0; e < slot->entries; e++) {
+        double v;
+        if (t->timestamps) {
+            GLuint64 next = result_of(t, slot->queries[e + 1]);
+            v = next >= prev ? (double)(next - prev) / 1e6 : -1.0;
+            prev = next > prev ? next : prev;
+        } else {
+            v = (double)result_of(t, slot->queries[e]) / 1e6;
         }
-        t->ms[slot->frame * t->sections + s] = ms;
+        if (v < 0 || v > since) {
+            t->implausible[slot->frame]++;
+            v = 0.0;
+        }
+        ms[slot->section[e]] += v;
     }
     slot->frame = -1;
 }
 
+void gpu_timer_pause(struct gpu_timer *t, bool paused)
+{
+    if (t)
+        t->paused = paused;
+}
+
 void gpu_timer_begin_frame(struct gpu_timer *t)
 {
+    if (t->paused)
+        return;
     struct ring_slot *slot = &t->ring[t->next_frame % GPU_TIMER_RING];
     read_slot(t, slot);
-    for (int s = 0; s < t->sections; s++)
-        slot->issued[s] = false;
+    slot->entries = 0;
     slot->frame = t->next_frame < t->frames ? t->next_frame : -1;
     t->current = -1;
-    gpu_timer_section(t, 0);
 }
 
 void gpu_timer_section(struct gpu_timer *t, int s)
 {
-    if (s == t->current || s < 0 || s >= t->sections)
+    if (t->paused && s >= 0 && s < t->sections)
+        t->last = s; /* where the frame is, for messages */
+    if (t->paused || s == t->current || s < 0 || s >= t->sections)
         return;
     t->last = s;
     struct ring_slot *slot = &t->ring[t->next_frame % GPU_TIMER_RING];
-    if (t->current >= 0)
+    if (t->current >= 0 && !t->timestamps)
         glEndQuery(GL_TIME_ELAPSED);
-    /* A section entered twice in one frame would need two queries; keep the
-     * first and leave later work to the section that is running. */
-    if (slot->issued[s]) {
-        t->current = -1;
+    t->current = -1;
+    /* Past the entries a frame holds (never, with the passes declared):
+     * later work goes to the section that ran last. */
+    if (slot->entries >= ENTRIES)
         return;
-    }
-    glBeginQuery(GL_TIME_ELAPSED, slot->queries[s]);
-    slot->issued[s] = true;
+    if (t->timestamps)
+        glQueryCounter(slot->queries[slot->entries], GL_TIMESTAMP);
+    else
+        glBeginQuery(GL_TIME_ELAPSED, slot->queries[slot->entries]);
+    slot->section[slot->entries++] = s;
     t->current = s;
 }
 
 void gpu_timer_end_frame(struct gpu_timer *t)
 {
-    if (t->current >= 0)
+    if (t->paused)
+        return;
+    struct ring_slot *slot = &t->ring[t->next_frame % GPU_TIMER_RING];
+    if (t->current >= 0 && !t->timestamps)
         glEndQuery(GL_TIME_ELAPSED);
+    if (slot->entries && t->timestamps)
+        glQueryCounter(slot->queries[slot->entries], GL_TIMESTAMP);
     t->current = -1;
     t->next_frame++;
 }
@@ -125,6 +172,15 @@ void gpu_timer_drain(struct gpu_timer *t)
 {
     for (int i = 0; i < GPU_TIMER_RING; i++)
         read_slot(t, &t->ring[i]);
+}
+
+void gpu_timer_restart(struct gpu_timer *t, int64_t next)
+{
+    gpu_timer_drain(t);
+    memset(t->ms, 0, (size_t)t->frames * (size_t)t->sections * sizeof(double));
+    memset(t->implausible, 0, (size_t)t->frames);
+    t->next_frame = next > 0 ? next : 0;
+    t->stalls = 0;
 }
 
 double gpu_timer_ms(const struct gpu_timer *t, int64_t f, int s)
@@ -138,6 +194,8 @@ double gpu_timer_ms(const struct gpu_timer *t, int64_t f, int s)
         sum += t->ms[f * t->sections + i];
     return sum;
 }
+
+bool gpu_timer_timestamps(const struct gpu_timer *t) { return t->timestamps; }
 
 int64_t gpu_timer_stalls(const struct gpu_timer *t) { return t->stalls; }
 

@@ -9,6 +9,8 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include <epoxy/gl.h>
+
 #include "common/job_files.h"
 #include "common/png_io.h"
 #include "daemon/harness/reference.h"
@@ -131,6 +133,12 @@ json_t *fidelity_render(struct harness_run *run, enum job_status *status)
     json_t *view = json_pack("{s:i, s:o, s:o, s:o, s:o, s:o}", "frame", k, "view",
                              floats(cam.view, 16), "projection", floats(cam.proj, 16), "eye",
                              floats(cam.eye, 3), "lights", lights, "channels", channels);
+    /* The rasteriser's sub-pixel precision: where an edge passes within a
+     * fraction of a pixel of pixel centres, the two renderers' coverage
+     * differs by it (docs/assets.md, "What still differs"). */
+    GLint subpixel_bits = 0;
+    glGetIntegerv(GL_SUBPIXEL_BITS, &subpixel_bits);
+    json_object_set_new(view, "subpixel_bits", json_integer(subpixel_bits));
     /* The lit image: the captured frame. */
     job_image_path(run->job->dir, JOB_IMAGE_FRAME, k, path, sizeof(path));
     json_object_set_new(channels, "lit", json_pack("{s:s}", "source", path));

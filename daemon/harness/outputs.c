@@ -135,51 +135,165 @@ static json_t *nonfinite_summary(const struct harness_run *run)
                      "clamps an overflowing write leaves it");
 }
 
-/* The heat maps as PNG on a colour ramp from 0 (black) to the frame's
- * largest count (white), with each frame's mean and max: result.heatmap. */
+/* The heat maps' one scale, the same for every job and technique, so that
+ * a colour means one count everywhere: log2(1 + n) / log2(1 + 65,536)
+ * onto a ramp from black (0) through blue, cyan, green and yellow to white
+ * (65,536, the most lights a scene holds). Below each map, a legend strip:
+ * a grey row, then the ramp from 0 to 65,536 across the width with black
+ * ticks at 1, 4, 16, ... 65,536 (every power of 4). */
+#define HEAT_SCALE_MAX ((double)SCENE_MAX_LIGHTS)
+#define HEAT_LEGEND_TICKS 9 /* 4^0 .. 4^8 */
+
+static const float heat_ramp[6][3] = {{0, 0, 0}, {0, 0, 1}, {0, 1, 1},
+                                      {0, 1, 0}, {1, 1, 0}, {1, 1, 1}};
+
+static double heat_position(double count)
+{
+    double t = log2(1.0 + count) / log2(1.0 + HEAT_SCALE_MAX);
+    return t < 0 ? 0 : t > 1 ? 1 : t;
+}
+
+static void heat_colour(double t, uint8_t *rgba)
+{
+    double x = 5.0 * t;
+    int seg = x >= 5.0 ? 4 : (int)x;
+    float f = (float)(x - seg);
+    for (int ch = 0; ch < 3; ch++)
+        rgba[ch] = (uint8_t)(255.0f * (heat_ramp[seg][ch] +
+                                       f * (heat_ramp[seg + 1][ch] - heat_ramp[seg][ch])) + 0.5f);
+    rgba[3] = 255;
+}
+
+static int heat_legend_rows(int height)
+{
+    int rows = height / 12;
+    return 1 + (rows < 4 ? 4 : rows > 24 ? 24 : rows);
+}
+
+/* The legend under the map, in the bottom-first rows glReadPixels order
+ * gives (so that png_write_gl_rgba puts it below): rows 0 .. legend - 2
+ * the ramp with its ticks, the top row grey. */
+static void heat_legend(uint8_t *rgba, int width, int legend)
+{
+    for (int y = 0; y < legend; y++)
+        for (int x = 0; x < width; x++) {
+            uint8_t *px = &rgba[((size_t)y * width + x) * 4];
+            if (y == legend - 1) {
+                px[0] = px[1] = px[2] = 128, px[3] = 255;
+                continue;
+            }
+            heat_colour(width > 1 ? (double)x / (width - 1) : 0.0, px);
+        }
+    /* Ticks: the lower half of the strip, black, at every power of 4. */
+    for (int i = 0; i < HEAT_LEGEND_TICKS; i++) {
+        int x = (int)(heat_position(pow(4.0, i)) * (width - 1) + 0.5);
+        for (int y = 0; y < (legend - 1) / 2 + 1 && y < legend - 1; y++) {
+            uint8_t *px = &rgba[((size_t)y * width + x) * 4];
+            px[0] = px[1] = px[2] = 0;
+        }
+    }
+}
+
+/* The heat maps as PNG on the one scale above, with each frame's mean and
+ * max: result.heatmap. */
 static json_t *write_heatmaps(struct harness_run *run)
 {
-    static const float ramp[6][3] = {{0, 0, 0}, {0, 0, 1}, {0, 1, 1}, {0, 1, 0}, {1, 1, 0}, {1, 1, 1}};
-    size_t n = (size_t)run->env.width * (size_t)run->env.height;
-    uint8_t *rgba = malloc(n * 4);
+    int w = run->env.width, h = run->env.height, legend = heat_legend_rows(h);
+    size_t n = (size_t)w * (size_t)h;
+    uint8_t *rgba = malloc((n + (size_t)w * legend) * 4);
     json_t *list = json_array();
     if (!rgba) {
         snprintf(run->err, sizeof(run->err), "out of memory for the heat map");
         goto fail;
     }
+    /* glReadPixels order: the bottom row first, so the legend goes first. */
+    heat_legend(rgba, w, legend);
+    uint8_t *map = rgba + (size_t)w * legend * 4;
     for (int c = 0; c < run->captured; c++) {
         const uint32_t *count = run->capture[c].heat;
         double sum = 0;
         uint32_t max = 0;
         for (size_t i = 0; i < n; i++)
             sum += count[i], max = count[i] > max ? count[i] : max;
-        for (size_t i = 0; i < n; i++) {
-            float t = max ? 5.0f * (float)count[i] / (float)max : 0.0f;
-            int seg = t >= 5.0f ? 4 : (int)t;
-            float f = t - (float)seg;
-            for (int ch = 0; ch < 3; ch++)
-                rgba[i * 4 + ch] = (uint8_t)(255.0f * (ramp[seg][ch] + f * (ramp[seg + 1][ch] - ramp[seg][ch])) + 0.5f);
-            rgba[i * 4 + 3] = 255;
-        }
+        for (size_t i = 0; i < n; i++)
+            heat_colour(heat_position(count[i]), &map[i * 4]);
         int k = run->capture[c].frame;
         char name[JOB_IMAGE_NAME_MAX], path[PATH_MAX + JOB_IMAGE_NAME_MAX];
         job_image_name(JOB_IMAGE_HEATMAP, k, name);
         job_file_path(run->job->dir, name, path, sizeof(path));
-        if (!png_write_gl_rgba(path, rgba, run->env.width, run->env.height, run->err,
-                               sizeof(run->err)))
+        if (!png_write_gl_rgba(path, rgba, w, h + legend, run->err, sizeof(run->err)))
             goto fail;
-        json_array_append_new(list, json_pack("{s:i, s:s, s:f, s:i, s:i}", "frame", k,
+        json_array_append_new(list, json_pack("{s:i, s:s, s:f, s:i}", "frame", k,
                                               job_image_kind(JOB_IMAGE_HEATMAP)->file_key, name,
-                                              "mean", sum / (double)n, "max", (int)max,
-                                              "scale_max", (int)max));
+                                              "mean", sum / (double)n, "max", (int)max));
     }
     free(rgba);
-    return json_pack("{s:s, s:s, s:o}", "unit", "light evaluations per pixel", "ramp",
-                     "black (0), blue, cyan, green, yellow, white (scale_max)", RK_CAPTURES, list);
+    json_t *ticks = json_array();
+    for (int i = 0; i < HEAT_LEGEND_TICKS; i++)
+        json_array_append_new(ticks, json_integer((json_int_t)pow(4.0, i)));
+    return json_pack(
+        "{s:s, s:s, s:{s:s, s:f, s:s, s:i, s:i, s:o}, s:o}", "unit",
+        "light evaluations per pixel", "ramp",
+        "black (0), blue, cyan, green, yellow, white (scale.max)", "scale", "kind",
+        "log2(1 + count) / log2(1 + max), the same for every job", "max", HEAT_SCALE_MAX,
+        "legend", "below the map: a grey row, then the ramp from 0 (left) to max (right) with "
+                  "black ticks at the counts in ticks",
+        "map_rows", h, "legend_rows", legend, "ticks", ticks, RK_CAPTURES, list);
 fail:
     free(rgba);
     json_decref(list);
     return NULL;
+}
+
+/* result.timing: how the timed frames were drawn and the figures that
+ * decided it (measure.c). */
+static json_t *outputs_timing_json(const struct harness_run *run)
+{
+    const struct run_timing_rule *rule = run->rule;
+    int n = run->spec->frames, whole = 0;
+    for (int i = 0; i < n; i++)
+        whole += run->drawn_whole[i] != 0;
+    bool sliced = rule->mode == GPU_BUDGET_SLICED;
+    json_t *o = json_pack(
+        "{s:s, s:i, s:i, s:f, s:b, s:i, s:o, s:o, s:o, s:s}", "rule", sliced ? "sliced" : "whole",
+        "frames_whole", whole, "frames_sliced", n - whole, "limit_s", rule->limit_s,
+        "accept_sliced_timing", run->spec->accept_sliced_timing, "measuring_runs",
+        rule->measuring_frames, "first_frame_estimate_s",
+        rule->estimate_s[0] >= 0 ? json_real(rule->estimate_s[0]) : json_null(),
+        "second_estimate_s", rule->estimate_s[1] >= 0 ? json_real(rule->estimate_s[1]) : json_null(),
+        "whole_frame_s", rule->whole_frame_s >= 0 ? json_real(rule->whole_frame_s) : json_null(),
+        "how",
+        "the job's first run draws its first warm-up frame in slices (each piece measured: a "
+        "one-pixel probe for what every tile pays, samples, then tiles sized by the dearest "
+        "pixel) and, when that says a whole frame fits limit_s, its second warm-up frame whole "
+        "(whole_frame_s; with fewer warm-up frames, frames of the harness's own stand in); the "
+        "timed frames are drawn whole when that took at most limit_s (the guard then adds "
+        "nothing to them), and else, only with accept_sliced_timing, in the tiles the measure "
+        "gives (every figure marked sliced); a measure over the limit is taken again once; "
+        "decided once a job, for all its runs");
+    /* For the duration estimate (job_eta.h): what of a frame scales with
+     * its pixels. */
+    json_object_set_new(o, "pixel_share", json_real(rule->pixel_share));
+    json_object_set_new(o, "largest_piece",
+                        json_pack("{s:s, s:f}", "pass", rule->largest[0] ? rule->largest : "",
+                                  "whole_s", rule->largest_s));
+    return o;
+}
+
+void outputs_mark_sliced(json_t *result)
+{
+    static const char *const series[] = {RK_FRAME_MS, RK_GPU_MS, RK_CPU_MS};
+    json_object_set_new(result, "sliced", json_true());
+    for (size_t i = 0; i < sizeof(series) / sizeof(series[0]); i++) {
+        json_t *s = json_object_get(result, series[i]);
+        if (json_is_object(s))
+            json_object_set_new(s, "sliced", json_true());
+    }
+    const char *key;
+    json_t *v;
+    json_object_foreach(json_object_get(result, "gpu_sections_ms"), key, v)
+        if (json_is_object(v))
+            json_object_set_new(v, "sliced", json_true());
 }
 
 /* The captured frames as PNG files, each with its figures. */
@@ -228,14 +342,14 @@ static bool write_timings(struct harness_run *run, const double *gpu, const int 
     for (int o = 0; o < sections; o++)
         used += (size_t)snprintf(csv + used, cap - used, ",gpu_%s_ms",
                                  run->passes.names[order[o]]);
-    used += (size_t)snprintf(csv + used, cap - used, "\n");
+    used += (size_t)snprintf(csv + used, cap - used, ",drawn_whole\n");
     for (int i = 0; i < n; i++) {
         used += (size_t)snprintf(csv + used, cap - used, "%d,%.6f,%.6f,%.6f", i + 1, gpu[i],
                                  run->cpu_ms[i], run->frame_ms[i]);
         for (int o = 0; o < sections; o++)
             used += (size_t)snprintf(csv + used, cap - used, ",%.6f",
                                      gpu_timer_ms(run->timer, w0 + i, order[o]));
-        used += (size_t)snprintf(csv + used, cap - used, "\n");
+        used += (size_t)snprintf(csv + used, cap - used, ",%d\n", run->drawn_whole[i] ? 1 : 0);
     }
     job_file_path(run->job->dir, JOB_FILE_TIMINGS, path, sizeof(path));
     bool ok = fs_write_atomic(path, csv, used);
@@ -281,8 +395,8 @@ json_t *outputs_write(struct harness_run *run)
         "subtracted from wall_s (wall_s_including_captures keeps it), and PNG "
         "encoding happens after the last timed frame",
         "timing_method",
-        "gpu_ms: GL_TIME_ELAPSED per frame from a ring of 8 queries read back a ring "
-        "later; cpu_ms: CLOCK_MONOTONIC around the frame's submission and glFlush; "
+        "gpu_ms: the frame's GPU time, the sum of its passes (gpu_sections_ms; see "
+        "gpu_pass_timing), from a ring of 8 frames of queries read back a ring later; cpu_ms: CLOCK_MONOTONIC around the frame's submission and glFlush; "
         "frame_ms: CLOCK_MONOTONIC between frame starts with at most 2 frames in "
         "flight (fence-bounded, as a swap chain), readback time excluded",
         "timer_query_stalls", (json_int_t)gpu_timer_stalls(run->timer), "device",
@@ -296,25 +410,47 @@ json_t *outputs_write(struct harness_run *run)
                             outputs_stats_json(sec, (size_t)n));
     }
     json_object_set_new(result, "gpu_sections_ms", by_section);
-    double slice_s, free_s;
-    gpu_budget_limits(&slice_s, &free_s);
+    json_object_set_new(
+        result, "gpu_pass_timing",
+        json_pack("{s:s, s:s}", "method",
+                  gpu_timer_timestamps(run->timer) ? "timestamps" : "elapsed", "rule",
+                  gpu_timer_timestamps(run->timer)
+                      ? "a GL_TIMESTAMP at each pass's start and at the frame's end: a pass is "
+                        "the time from its start to the next pass's, so that the passes of a "
+                        "frame add up to its gpu_ms exactly and no pass absorbs another's work"
+                      : "a GL_TIME_ELAPSED query a pass (the driver has no GL_TIMESTAMP); "
+                        "gpu_ms is their sum"));
     json_object_set_new(result, "gpu_budget",
-                        json_pack("{s:f, s:f, s:I, s:I, s:s}", "slice_s", slice_s,
-                                  "whole_below_s", free_s, "pieces_sliced",
-                                  (json_int_t)run->budget.pieces_sliced, "waits",
+                        json_pack("{s:f, s:I, s:I, s:s}", "slice_s", gpu_budget_slice(),
+                                  "pieces_sliced", (json_int_t)run->pieces_sliced, "waits",
                                   (json_int_t)run->budget.waits, "rule",
-                                  "a pass's work (or a loop of draws) that measured whole_below_s "
-                                  "or more runs in tiles of about slice_s, waited for in turn, so "
-                                  "that a cancel, a timeout or a stop acts within about a slice; "
-                                  "each piece is measured in tiles in its first run (the first "
-                                  "warm-up frame); pieces_sliced counts the runs drawn in more "
-                                  "than one tile, warm-up frames included"));
+                                  "untimed work (each run's measuring frame, the look's set-up, "
+                                  "the reference) is drawn in tiles of about slice_s wherever "
+                                  "a piece's measure says it takes a slice or more, so that a "
+                                  "cancel, a timeout or a stop acts within about a slice; the "
+                                  "timed frames are drawn as result.timing says; pieces_sliced "
+                                  "counts the runs of a piece drawn in more than one tile in "
+                                  "the timed frames"));
+    json_object_set_new(result, "timing", outputs_timing_json(run));
+    if (run->rule && run->rule->mode == GPU_BUDGET_SLICED)
+        outputs_mark_sliced(result);
     json_object_set_new(result, "timer_query_implausible",
                         json_integer((json_int_t)gpu_timer_implausible(run->timer, w0)));
     json_object_set_new(result, "look", look_spec_to_json(&spec->look));
+    if (run->look == &run->look_unlit)
+        json_object_set_new(result, "look_not_made",
+                            json_pack("{s:b, s:b, s:s}", "shadows", spec->look.shadows.enabled,
+                                      "ibl", spec->look.ibl.enabled, "why",
+                                      "the technique reads no light: neither the look's shadow "
+                                      "maps nor its probes are made for it"));
     json_object_set_new(result, RK_NONFINITE, nonfinite_summary(run));
     look_stages_describe(&run->stages, result);
     json_object_set_new(result, "targets_bytes", json_real(gpu_targets_bytes(run->gl->targets)));
+    bool software = json_is_true(json_object_get(run->gl->device_json, "software"));
+    json_object_set_new(result, "compile", gl_build_log_json(&run->builds));
+    json_object_set_new(result, "gpu_memory",
+                        gpu_memory_run_json(run->gpu_memory, gpu_targets_bytes(run->gl->targets),
+                                            software));
     json_object_set_new(result, "msaa", run_msaa_json(run));
     json_t *time = run_time_json(run);
     if (time)

@@ -24,5 +24,9 @@ json_t *outputs_write(struct harness_run *run);
 /* Statistics of a series of per-frame figures, as the result reports them
  * (mean, median, spread, percentiles, the median's 95% interval). */
 json_t *outputs_stats_json(const double *v, size_t n);
+/* A job timed in slices (accept_sliced_timing): result.sliced and every
+ * timing series and pass marked "sliced": true, so that no reader takes
+ * them for whole frames. */
+void outputs_mark_sliced(json_t *result);
 
 #endif

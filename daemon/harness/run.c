@@ -140,7 +140,9 @@ bool run_setup_passes(struct harness_run *run, const void *options, int64_t time
 {
     const struct technique *tech = run->tech;
     int post_passes = post_spec_pass_names(&run->look->post, NULL, 0);
-    int look_passes = (run->stages.shadows != NULL) + run->stages.sky_on + run->stages.debug_on +
+    int look_passes = (run->stages.shadows != NULL &&
+                       !(tech->info->flags & TECHNIQUE_READS_NO_LIGHT)) +
+                      run->stages.sky_on + run->stages.debug_on +
                       (run->transparent.count > 0);
     /* What the technique and the chain need of time. */
     run->needs = (struct frame_needs){0};
@@ -155,10 +157,16 @@ bool run_setup_passes(struct harness_run *run, const void *options, int64_t time
         snprintf(run->err, sizeof(run->err), "cannot create GPU timer queries");
         return false;
     }
+    /* A technique that reads no light draws no shadow pass: the maps, if a
+     * reference needs them, are drawn in the reference's frames. */
+    struct look_shadows *shadows = run->stages.shadows;
+    if (tech->info->flags & TECHNIQUE_READS_NO_LIGHT)
+        run->stages.shadows = NULL;
     bool fits = gpu_passes_init(&run->passes, run->timer, tech->info->passes,
                                 run->gl->caps.debug_groups) &&
                 look_stages_add_passes(&run->stages, &run->passes, &run->shadow_pass,
                                        &run->sky_pass);
+    run->stages.shadows = shadows;
     run->transparent_pass = -1;
     if (fits && run->transparent.count > 0 &&
         (run->transparent_pass = gpu_passes_add(&run->passes, "transparent")) < 0)
@@ -294,6 +302,15 @@ bool run_prepare(struct harness_run *run, bool capture)
     const struct job_spec *spec = run->spec;
     int n = spec->frames;
     run->look = &spec->look;
+    if ((run->tech->info->flags & TECHNIQUE_READS_NO_LIGHT) && !spec->reference[0]) {
+        /* The cost floor pays only for what it draws: no shadow maps, no
+         * probes it would never read (with a reference, they are made for
+         * the reference, which draws them in its own frames). */
+        run->look_unlit = spec->look;
+        run->look_unlit.shadows.enabled = false;
+        run->look_unlit.ibl.enabled = false;
+        run->look = &run->look_unlit;
+    }
     run->shadow_pass = run->sky_pass = run->transparent_pass = -1;
     run_budget_init(run);
     double t0 = clock_mono_s();
@@ -309,7 +326,8 @@ bool run_prepare(struct harness_run *run, bool capture)
     run->capture_count = capture ? job_spec_capture_count(spec) : 0;
     run->cpu_ms = calloc((size_t)n, sizeof(double));
     run->frame_ms = calloc((size_t)n, sizeof(double));
-    if (!run->cpu_ms || !run->frame_ms) {
+    run->drawn_whole = calloc((size_t)n, 1);
+    if (!run->cpu_ms || !run->frame_ms || !run->drawn_whole) {
         snprintf(run->err, sizeof(run->err), "out of memory preparing the job");
         return false;
     }
@@ -322,7 +340,7 @@ bool run_prepare(struct harness_run *run, bool capture)
         run->scene_upload_ms = (clock_mono_s() - t1) * 1e3;
     }
     if (!run_setup_targets(run) ||
-        !look_stages_init(&run->stages, &spec->look, &run->scene, &run->gpu,
+        !look_stages_init(&run->stages, run->look, &run->scene, &run->gpu,
                           &run->gl->frame_block, &run->gl->caps, &run->budget, run->defines,
                           run->environment.rgb ? &run->environment : NULL, run->err,
                           sizeof(run->err)) ||
@@ -343,6 +361,16 @@ bool run_prepare(struct harness_run *run, bool capture)
     return true;
 }
 
+bool run_recreate_technique(struct harness_run *run)
+{
+    run->tech->destroy(run->state);
+    run->state = NULL;
+    /* Its planes come from the target pool by name: the post chain's and
+     * the captures' views of them stay valid. */
+    memset(&run->products, 0, sizeof(run->products));
+    return run->tech->create(&run->env, &run->state, run->err, sizeof(run->err));
+}
+
 void run_finish(struct harness_run *run)
 {
     if (run->tech && run->state)
@@ -351,6 +379,7 @@ void run_finish(struct harness_run *run)
     look_stages_finish(&run->stages);
     transparent_finish(&run->transparent);
     motion_vectors_finish(&run->motion);
+    gl_build_log_free(&run->builds);
     free(run->hdr_scratch);
     free(run->motion_scratch);
     post_chain_destroy(run->post);
@@ -372,6 +401,7 @@ void run_finish(struct harness_run *run)
     free(run->capture);
     free(run->cpu_ms);
     free(run->frame_ms);
+    free(run->drawn_whole);
     for (int i = 0; i < RUN_FRAMES_IN_FLIGHT; i++)
         if (run->fences[i])
             glDeleteSync(run->fences[i]);
@@ -490,8 +520,12 @@ bool run_frame(struct harness_run *run, int64_t k, bool timed)
     run->last_frame = k;
     gpu_timer_begin_frame(run->timer);
     bool ok = look_stages_before(&run->stages, &run->passes, run->shadow_pass, k, timed, run->err,
-                                 sizeof(run->err)) &&
-              run->tech->render(run->state, &run->env, k, run->err, sizeof(run->err));
+                                 sizeof(run->err));
+    /* The technique's first pass is timed from here: work it submits before
+     * its first gpu_pass_begin (OSL's lighting dispatch) counts to it, not
+     * to the look's shadow pass before it. */
+    gpu_timer_section(run->timer, 0);
+    ok = ok && run->tech->render(run->state, &run->env, k, run->err, sizeof(run->err));
     if (!ok && gpu_budget_stopped(&run->budget)) {
         /* Abandoned where it was told to stop: nothing more is drawn. */
         gpu_timer_end_frame(run->timer);

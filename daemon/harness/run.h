@@ -17,6 +17,7 @@
 #include "daemon/effects/post_chain.h"
 #include "daemon/gpu/caps.h"
 #include "daemon/gpu/gpu_scene.h"
+#include "daemon/gpu/glutil.h"
 #include "daemon/gpu/gpu_timer.h"
 #include "daemon/gpu/pass.h"
 #include "daemon/scene/environment.h"
@@ -71,14 +72,36 @@ struct run_capture {
     } motion;
 };
 
+/* How a job's timed frames are drawn, decided once per job in its first
+ * run (measure.c) and followed by its later runs: whole (the guard never
+ * touches them) or, for a job that accepted sliced timing, in the tiles its
+ * measure gave. With the figures that decided it, for the result and for
+ * the failure of a job whose whole frame is over the bound. */
+struct run_timing_rule {
+    bool decided;
+    enum gpu_budget_mode mode;  /* GPU_BUDGET_WHOLE or GPU_BUDGET_SLICED */
+    double limit_s;             /* job_spec_max_frame_seconds(); 0: no bound */
+    int measuring_frames;       /* frames drawn in slices to measure it (1 or 2) */
+    double estimate_s[2];       /* each measuring frame's cost drawn whole; -1: none */
+    double whole_frame_s;       /* the deciding frame, drawn whole; -1: none drawn */
+    double pixel_share;         /* of the last measured frame's cost, the pixels' work */
+    char largest[64];           /* the dearest piece's pass, by the measure */
+    double largest_s;
+    /* The measures of the first run's pieces, lent to the later runs. */
+    struct gpu_budget_piece pieces[GPU_BUDGET_KEYS];
+};
+
 struct harness_run {
     struct harness_gl *gl;
     struct queue *queue;
     struct job *job;
     const struct job_spec *spec;
     const struct technique *tech;
-    /* The look this run renders with: the job's, or its reference_look. */
+    /* The look this run renders with: the job's, or its reference_look, or
+     * (a technique that reads no light) look_unlit, that look without its
+     * shadow maps and probes. */
     const struct look_spec *look;
+    struct look_spec look_unlit;
     struct scene scene;
     bool scene_ok;
     /* scene.asset: the cache file's asset, read in run_prepare (never in a
@@ -141,11 +164,21 @@ struct harness_run {
     struct run_capture *capture;
     float *hdr_scratch; /* physically based looks: one HDR frame, for the statistics */
     float *motion_scratch; /* motion vectors drawn: one frame's (RG), for their statistics */
+    /* The job's timing rule (its owner: the job's first run decides it). */
+    struct run_timing_rule *rule;
+    bool measuring; /* drawing the harness's measuring frames (for messages) */
     /* Figures of the timed frames. */
+    unsigned char *drawn_whole; /* per timed frame: no piece of it drawn in tiles */
+    int64_t pieces_sliced;      /* runs of a piece drawn in tiles in the timed frames */
     double *cpu_ms;
     double *frame_ms;
     double wall_s, capture_s;
     struct interference_sample interference[2]; /* start and end of the timed region */
+    /* The costs beside the frame times: the programs the set-up and warm-up
+     * built (glutil.h), and GPU memory before the set-up, after it and
+     * after the frames (gpu_memory.h). */
+    struct gl_build_log builds;
+    struct gpu_memory_sample gpu_memory[3];
     GLsync fences[RUN_FRAMES_IN_FLIGHT];
     char err[1024];
 };
@@ -157,6 +190,10 @@ struct harness_run {
 bool run_prepare(struct harness_run *run, bool capture);
 /* Frees what run_prepare and the frames made. Takes a run in any state. */
 void run_finish(struct harness_run *run);
+/* The technique made anew (a frame it was abandoned in may have left its
+ * state half-updated: OSL's first shading cut short would read as done).
+ * False with run->err. */
+bool run_recreate_technique(struct harness_run *run);
 
 /* The output targets and the technique's env for run->look over the run's
  * scene (the reference calls it with the measured run's scene). */

@@ -42,7 +42,7 @@
 struct runner {
     struct queue *queue;
     struct metrics_worker *metrics;
-    int device;
+    struct device_spec device;
     bool gl_debug;
     pthread_t thread;
     pthread_mutex_t lock;
@@ -81,6 +81,11 @@ static json_t *collect_device(struct egl_context *egl, const struct gpu_caps *ca
                           "max_texture_size", caps->max_texture_size, "max_renderbuffer_size",
                           caps->max_renderbuffer_size);
     json_object_set_new(d, "caps", gpu_caps_json(caps));
+    egl_context_describe(egl, d);
+    struct gpu_memory_sample memory;
+    gpu_memory_sample_gl(&memory);
+    json_object_set_new(d, "gpu_memory_at_start",
+                        gpu_memory_sample_json(&memory, json_is_true(json_object_get(d, "software"))));
     return d;
 }
 
@@ -89,10 +94,21 @@ static bool prepare_and_measure(struct harness_run *run, bool capture, int run_i
                                 enum job_status *status)
 {
     render_state_phase("setup");
-    if (run_prepare(run, capture)) {
+    /* The costs beside the frame times (glutil.h, gpu_memory.h): the
+     * programs built in the set-up and warm-up, and GPU memory around them. */
+    gpu_memory_sample_gl(&run->gpu_memory[0]);
+    gl_build_log_begin(&run->builds);
+    bool prepared = run_prepare(run, capture), measured = false;
+    if (prepared) {
+        gpu_memory_sample_gl(&run->gpu_memory[1]);
         render_state_phase("rendering");
-        return measure_run(run, run_index, status);
+        measured = measure_run(run, run_index, status);
+        gpu_memory_sample_gl(&run->gpu_memory[2]);
     }
+    gl_build_timed_region(false);
+    gl_build_log_end();
+    if (prepared)
+        return measured;
     /* Told to stop while the look's set-up (image-based lighting's probes)
      * ran: say why, as the timed loop would. */
     bool cancelled = atomic_load(&run->job->cancel);
@@ -153,10 +169,13 @@ static bool repeat_runs(struct runner *r, struct harness_run *first, json_t *res
     if (ok)
         json_object_set_new(json_array_get(runs, 0), RK_INTERFERENCE,
                             json_deep_copy(json_object_get(result, RK_INTERFERENCE)));
+    if (ok)
+        json_object_set_new(json_array_get(runs, 0), "compile_ms",
+                            json_real(first->builds.compile_ms + first->builds.link_ms));
     int done = 1;
     while (ok && done < planned && !(spec->repeat_auto && stats_is_stable(med, (size_t)done, 0.025))) {
         struct harness_run extra = {.gl = &r->gl, .queue = r->queue, .job = first->job, .spec = spec,
-                            .tech = first->tech};
+                            .tech = first->tech, .rule = first->rule};
         ok = prepare_and_measure(&extra, false, done, status);
         if (ok) {
             for (int i = 0; i < n; i++)
@@ -170,6 +189,8 @@ static bool repeat_runs(struct runner *r, struct harness_run *first, json_t *res
             json_array_append_new(runs, run_summary(done + 1, extra.wall_s, f, g, c));
             json_object_set_new(json_array_get(runs, done), RK_INTERFERENCE,
                                 interference_json(&extra.interference[0], &extra.interference[1]));
+            json_object_set_new(json_array_get(runs, done), "compile_ms",
+                                json_real(extra.builds.compile_ms + extra.builds.link_ms));
             done++;
         } else {
             char why[900];
@@ -190,6 +211,8 @@ static bool repeat_runs(struct runner *r, struct harness_run *first, json_t *res
         json_object_set_new(result, RK_REPEAT, rep);
         json_object_set_new(result, RK_RUNS, runs);
         runs = NULL;
+        if (first->rule->mode == GPU_BUDGET_SLICED)
+            outputs_mark_sliced(result);
         queue_progress(r->queue, first->job, planned * n);
         char path[PATH_MAX + 16];
         job_file_path(first->job->dir, JOB_FILE_RESULT, path, sizeof(path));
@@ -204,9 +227,31 @@ static bool repeat_runs(struct runner *r, struct harness_run *first, json_t *res
     return ok;
 }
 
+/* A job that ended early (cancelled, stopped, failed) may leave work on
+ * the GPU: the frames in flight of a whole frame, a tile of a sliced one.
+ * It finishes here, before the job's objects go and the next job starts;
+ * /healthz shows the thread draining that job, not rendering it, and the
+ * wait is bounded by the frame bound (measure.c), well within the stall
+ * bound. */
+static void drain(const char *id, enum job_status status)
+{
+    render_state_phase(status == JOB_CANCELLED ? RENDER_PHASE_DRAINING_CANCELLED
+                                               : RENDER_PHASE_DRAINING_FAILED);
+    double t0 = clock_mono_s();
+    GLsync fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    glClientWaitSync(fence, GL_SYNC_FLUSH_COMMANDS_BIT, UINT64_MAX);
+    glDeleteSync(fence);
+    double took = clock_mono_s() - t0;
+    LOG(took > 0.5 ? LOG_INFO : LOG_DEBUG, "job %s: the GPU finished its last work %.2f s after "
+        "it ended", id, took);
+}
+
 static void run_job(struct runner *r, struct job *job)
 {
-    struct harness_run run = {.gl = &r->gl, .queue = r->queue, .job = job, .spec = &job->spec};
+    /* Decided in the first run, followed by the others (measure.c). */
+    struct run_timing_rule rule = {0};
+    struct harness_run run = {.gl = &r->gl, .queue = r->queue, .job = job, .spec = &job->spec,
+                              .rule = &rule};
     const struct job_spec *spec = &job->spec;
     enum job_status status = JOB_FAILED;
     json_t *result = NULL, *fidelity_view = NULL;
@@ -270,6 +315,7 @@ done:;
          * next job starts. */
         LOG(LOG_WARN, "job %s %s: %s", id, job_status_name(status), run.err);
         queue_finish(r->queue, job, status, run.err, result);
+        drain(id, status);
         run_finish(&run);
     } else {
         LOG(LOG_INFO, "job %s rendered", id);
@@ -315,11 +361,19 @@ static bool give_back_memory(struct runner *r, struct egl_context **egl, char *e
     if (before < r->idle_rss + RUNNER_TRIM_ABOVE_BYTES)
         return true;
     double renew_s = 0;
-    if (gpu_targets_bytes(r->gl.targets) > RUNNER_KEEP_TARGETS_BYTES) {
+    bool renew = gpu_targets_bytes(r->gl.targets) > RUNNER_KEEP_TARGETS_BYTES;
+    if (!renew) {
+        /* The heap first; what it cannot give back is the driver's (an
+         * asset's textures, which llvmpipe kept: 100 MiB after a job on
+         * four 2048x2048 maps), and goes with the context. */
+        malloc_trim(0);
+        renew = telemetry_rss_bytes() >= r->idle_rss + RUNNER_TRIM_ABOVE_BYTES;
+    }
+    if (renew) {
         double t0 = clock_mono_s();
         harness_gl_finish(&r->gl);
         egl_context_destroy(*egl);
-        *egl = egl_context_create(r->device, r->gl_debug, err, errlen);
+        *egl = egl_context_create(&r->device, r->gl_debug, err, errlen);
         if (!*egl || !harness_gl_init(&r->gl, err, errlen))
             return false;
         renew_s = clock_mono_s() - t0;
@@ -338,7 +392,7 @@ static void *runner_main(void *arg)
 {
     struct runner *r = arg;
     char err[512] = "";
-    struct egl_context *egl = egl_context_create(r->device, r->gl_debug, err, sizeof(err));
+    struct egl_context *egl = egl_context_create(&r->device, r->gl_debug, err, sizeof(err));
     pthread_mutex_lock(&r->lock);
     if (egl && !harness_gl_init(&r->gl, err, sizeof(err))) {
         egl_context_destroy(egl);
@@ -389,7 +443,7 @@ static void *runner_main(void *arg)
     return NULL;
 }
 
-struct runner *runner_create(struct queue *q, int device, bool gl_debug,
+struct runner *runner_create(struct queue *q, const struct device_spec *device, bool gl_debug,
                              char *err, size_t errlen)
 {
     struct runner *r = calloc(1, sizeof(*r));
@@ -404,13 +458,17 @@ struct runner *runner_create(struct queue *q, int device, bool gl_debug,
         free(r);
         return NULL;
     }
-    r->device = device;
+    r->device = *device;
     r->gl_debug = gl_debug;
-    /* Tests draw everything in tiles of a tiny slice, however cheap: the
-     * pixels must not change. */
+    /* Tests cut every piece that is drawn in tiles into tiles of a tiny
+     * slice, at least four, however cheap (with a job that accepts sliced
+     * timing, every piece of its timed frames): the pixels must not change. */
     const char *slice_ms = getenv("SHADEBENCH_SLICE_MS");
     if (slice_ms && atof(slice_ms) > 0)
-        gpu_budget_configure(atof(slice_ms) / 1e3, 0.0, 0.25);
+        gpu_budget_configure(atof(slice_ms) / 1e3, 0.25);
+    const char *stall_ms = getenv("SHADEBENCH_DEBUG_STALL_FIRST_FRAME_MS");
+    if (stall_ms && atof(stall_ms) > 0)
+        gpu_budget_debug_stall(atof(stall_ms) / 1e3);
     atomic_init(&r->alive, false);
     pthread_mutex_init(&r->lock, NULL);
     pthread_cond_init(&r->ready_cond, NULL);

@@ -9,6 +9,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "daemon/gpu/device_names.h"
 #include "daemon/status/render_state.h"
 #include "daemon/jobs/queue.h"
 
@@ -19,8 +20,9 @@ struct runner;
 struct fidelity;
 void runner_use_fidelity(struct fidelity *f);
 
-/* Starts the render thread and waits until its context is up (or failed). */
-struct runner *runner_create(struct queue *q, int device, bool gl_debug,
+/* Starts the render thread and waits until its context is up on the
+ * device that device names (egl.h), or failed. */
+struct runner *runner_create(struct queue *q, const struct device_spec *device, bool gl_debug,
                              char *err, size_t errlen);
 /* Stops the queue and waits up to wait_s for the render thread to end: the
  * running job stops at once and is put back in the queue, but what the GPU

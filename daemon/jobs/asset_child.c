@@ -4,6 +4,7 @@
  * under its limits and time-out, and the cache it writes (assets.h). */
 #include "daemon/jobs/assets_impl.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <poll.h>
@@ -13,10 +14,12 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include <sys/statvfs.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
+#include "common/child.h"
 #include "common/clock.h"
 #include "common/fsutil.h"
 #include "common/log.h"
@@ -39,10 +42,12 @@ static void add_arg(char **argv, int *argc, char (*store)[32], const char *flag,
  * child gets the limits as flags (the converter checks them as it reads)
  * and as rlimits set before exec (a converter that ignores them is still
  * bounded), a process group of its own (so the time-out kills what it
- * started), nice 10 (so the render thread keeps its core) and no file
- * descriptor of the daemon's but stdin (/dev/null), stdout (the pipe) and
- * stderr (the log). */
-static void convert(struct assets *a, const char *in, const char *out, struct conversion *c)
+ * started), death with the daemon (PR_SET_PDEATHSIG: a daemon killed with
+ * SIGKILL leaves no converter running), nice 10 (so the render thread
+ * keeps its core) and no file descriptor of the daemon's but stdin
+ * (/dev/null), stdout (the pipe) and stderr (the log): common/child.h. */
+static void convert(struct assets *a, const char *in, const char *out, const char *radiance_copy,
+                    struct conversion *c)
 {
     memset(c, 0, sizeof(*c));
     c->outcome = CONV_FAILED;
@@ -59,46 +64,41 @@ static void convert(struct assets *a, const char *in, const char *out, struct co
     add_arg(argv, &argc, nums, "--max-indices", l->max_indices);
     add_arg(argv, &argc, nums, "--max-texture-pixels", l->max_texture_pixels);
     add_arg(argv, &argc, nums, "--max-texture-edge", l->max_texture_edge);
+    add_arg(argv, &argc, nums, "--max-nodes", l->max_nodes);
+    add_arg(argv, &argc, nums, "--max-cache-bytes", l->max_cache_bytes);
+    /* The room the cache may take: the disk's free space less what is kept
+     * for jobs (ASSETS_HEADROOM), as an upload's own bytes are checked. */
+    struct statvfs vfs;
+    if (statvfs(a->dir, &vfs) == 0) {
+        uint64_t avail = (uint64_t)vfs.f_bavail * vfs.f_frsize;
+        add_arg(argv, &argc, nums, "--disk-room-bytes",
+                avail > ASSETS_HEADROOM ? avail - ASSETS_HEADROOM : 0);
+    }
     if (a->cfg.run.memory_bytes)
         add_arg(argv, &argc, nums, "--max-memory", a->cfg.run.memory_bytes);
     add_arg(argv, &argc, nums, "--max-cpu-seconds", a->cfg.run.cpu_s);
+    argv[argc++] = "--radiance-copy";
+    argv[argc++] = (char *)radiance_copy;
     argv[argc] = NULL;
 
-    int pipefd[2] = {-1, -1}, devnull = -1;
+    int pipefd[2] = {-1, -1};
     char *text = NULL;
     size_t len = 0;
-    if (pipe2(pipefd, O_CLOEXEC) != 0 || (devnull = open("/dev/null", O_RDONLY | O_CLOEXEC)) < 0) {
+    if (pipe2(pipefd, O_CLOEXEC) != 0) {
         snprintf(c->why, sizeof(c->why), "cannot start it: %s", strerror(errno));
         goto out;
     }
-    struct rlimit mem = {a->cfg.run.memory_bytes, a->cfg.run.memory_bytes};
-    struct rlimit cpu = {a->cfg.run.cpu_s, a->cfg.run.cpu_s + 5};
-    sigset_t none;
-    sigemptyset(&none);
-    pid_t pid = fork();
+    /* Run from the worker thread, which lives as long as the daemon: the
+     * converter's PR_SET_PDEATHSIG follows it (common/child.h). */
+    struct child_spec spec = {.argv = argv, .stdout_fd = pipefd[1], .stderr_fd = -1,
+                              .address_space = a->cfg.run.memory_bytes,
+                              .cpu_s = a->cfg.run.cpu_s, .nice = 10};
+    char why[200];
+    pid_t pid = child_spawn(&spec, why, sizeof(why));
     if (pid < 0) {
-        snprintf(c->why, sizeof(c->why), "cannot start it: %s", strerror(errno));
+        snprintf(c->why, sizeof(c->why), "%s", why);
         goto out;
     }
-    if (pid == 0) {
-        /* The child of a threaded process: async-signal-safe calls only. */
-        setpgid(0, 0);
-        struct sigaction dfl = {.sa_handler = SIG_DFL};
-        sigaction(SIGPIPE, &dfl, NULL); /* the daemon ignores it */
-        sigprocmask(SIG_SETMASK, &none, NULL); /* and blocks SIGTERM for sigwait */
-        if (dup2(devnull, 0) < 0 || dup2(pipefd[1], 1) < 0)
-            _exit(127);
-        closefrom(3);
-        if (mem.rlim_cur)
-            setrlimit(RLIMIT_AS, &mem);
-        setrlimit(RLIMIT_CPU, &cpu);
-        setpriority(PRIO_PROCESS, 0, 10);
-        execv(argv[0], argv);
-        _exit(127);
-    }
-    /* Its own process group from the parent's side too: whichever of the
-     * two runs first, a kill of -pid after this reaches it. */
-    setpgid(pid, pid);
     close(pipefd[1]);
     pipefd[1] = -1;
     pthread_mutex_lock(&a->lock);
@@ -154,8 +154,7 @@ static void convert(struct assets *a, const char *in, const char *out, struct co
         }
         if (stopping || timed_out || clock_mono_s() >= deadline) {
             timed_out = !stopping;
-            kill(-pid, SIGKILL);
-            kill(pid, SIGKILL);
+            child_kill(pid);
             waitpid(pid, &status, 0);
             break;
         }
@@ -208,8 +207,22 @@ out:
         close(pipefd[0]);
     if (pipefd[1] >= 0)
         close(pipefd[1]);
-    if (devnull >= 0)
-        close(devnull);
+}
+
+/* What a converter killed while it wrote left: its cache's temporary
+ * (asset_file_write's OUT.XXXXXX beside convert-SHA.sbasset). */
+static void remove_partial_cache(struct assets *a, const char *sha)
+{
+    char prefix[128];
+    int n = snprintf(prefix, sizeof(prefix), "convert-%s.%s.", sha, ASSET_CACHE_EXT);
+    DIR *d = opendir(a->dir);
+    if (!d)
+        return;
+    struct dirent *de;
+    while ((de = readdir(d)))
+        if (strncmp(de->d_name, prefix, (size_t)n) == 0 && unlinkat(dirfd(d), de->d_name, 0) == 0)
+            LOG(LOG_INFO, "assets: removed %s/%s, left by the converter", a->dir, de->d_name);
+    closedir(d);
 }
 
 /* The cache and description of sha, converting in when they are not there
@@ -219,6 +232,7 @@ bool asset_ensure_cache(struct assets *a, const char *sha, const char *in, json_
                         struct assets_error *e)
 {
     char cache[PATH_MAX + 80], desc[PATH_MAX + 80], tmp[PATH_MAX + 120];
+    char copy[PATH_MAX + 80], tmp_copy[PATH_MAX + 120];
     asset_path(a, sha, ASSET_CACHE_EXT, cache, sizeof(cache));
     asset_path(a, sha, "json", desc, sizeof(desc));
     /* A cache an older shadebench wrote (another layout) is converted anew. */
@@ -226,32 +240,46 @@ bool asset_ensure_cache(struct assets *a, const char *sha, const char *in, json_
         return true;
     snprintf(tmp, sizeof(tmp), "%s/convert-%s.%s", a->dir, sha, ASSET_CACHE_EXT);
     unlink(tmp);
+    /* The converter writes an OpenEXR environment's Radiance copy (the
+     * Khronos viewer reads only .hdr) here; it becomes SHA256.hdr. */
+    snprintf(tmp_copy, sizeof(tmp_copy), "%s/convert-%s.hdr", a->dir, sha);
+    unlink(tmp_copy);
     struct conversion c;
     double t0 = clock_mono_s();
-    convert(a, in, tmp, &c);
+    convert(a, in, tmp, tmp_copy, &c);
     LOG(LOG_INFO, "assets: converted %s in %.2f s: %s", in, clock_mono_s() - t0,
         c.outcome == CONV_OK ? "ok" : c.outcome == CONV_BAD ? "refused" : c.why);
     if (c.outcome == CONV_BAD) {
         json_int_t st = json_integer_value(json_object_get(c.out, "status"));
         const char *field = json_string_value(json_object_get(c.out, "field"));
         const char *message = json_string_value(json_object_get(c.out, "message"));
-        asset_refuse(e, st == 400 ? ASSETS_INVALID : ASSETS_UNCONVERTIBLE, field ? field : "body",
-                     "%s", message ? message : "the converter refused the asset");
+        enum assets_cause cause = st == 400   ? ASSETS_INVALID
+                                  : st == 507 ? ASSETS_NO_SPACE
+                                              : ASSETS_UNCONVERTIBLE;
+        asset_refuse(e, cause, field ? field : "body", "%s",
+                     message ? message : "the converter refused the asset");
         json_decref(c.out);
         unlink(tmp);
+        unlink(tmp_copy);
         return false;
     }
     if (c.outcome == CONV_FAILED) {
         asset_refuse(e, ASSETS_UNCONVERTIBLE, "body",
                      "the asset loader failed on this file (%s)", c.why);
         unlink(tmp);
+        remove_partial_cache(a, sha);
+        unlink(tmp_copy);
         return false;
     }
-    if (!file_exists(tmp) || rename(tmp, cache) != 0) {
+    /* The copy first: the cache file is what says the work is done. */
+    asset_path(a, sha, "hdr", copy, sizeof(copy));
+    if (!file_exists(tmp) || (file_exists(tmp_copy) && rename(tmp_copy, copy) != 0) ||
+        rename(tmp, cache) != 0) {
         asset_refuse(e, ASSETS_UNCONVERTIBLE, "body",
                      "the asset loader said it succeeded but wrote no cache file");
         json_decref(c.out);
         unlink(tmp);
+        unlink(tmp_copy);
         return false;
     }
     if (!fs_write_json_atomic(desc, c.out)) {

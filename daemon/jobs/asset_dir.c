@@ -118,6 +118,8 @@ static bool has_asset_ext(const char *name, char ext[8])
         return snprintf(ext, 8, "gltf"), true;
     if (dot && strcasecmp(dot, ".hdr") == 0)
         return snprintf(ext, 8, "hdr"), true;
+    if (dot && strcasecmp(dot, ".exr") == 0)
+        return snprintf(ext, 8, "exr"), true;
     return false;
 }
 

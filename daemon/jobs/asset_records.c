@@ -27,8 +27,6 @@ bool file_exists(const char *path)
     return stat(path, &st) == 0 && S_ISREG(st.st_mode);
 }
 
-/* Under a->lock: the files of a hash no name points at, no conversion is
- * working on and no queued or running job is pinned to. */
 void asset_release_files_locked(struct assets *a, const char *sha)
 {
     if (!asset_store_sha256_valid(sha) || strcmp(a->busy_sha, sha) == 0)
@@ -36,10 +34,12 @@ void asset_release_files_locked(struct assets *a, const char *sha)
     for (struct task *t = a->tasks; t; t = t->next)
         if (strcmp(t->sha256, sha) == 0)
             return;
+    if (asset_pin_find_locked(a, NULL, sha))
+        return;
     char job[RECORD_ID_LEN];
     if (store_asset_hash_refs(a->store, sha) != 0 || queue_asset_in_use(a->queue, NULL, sha, job))
         return;
-    static const char *const exts[] = {"glb", "gltf", "hdr", ASSET_CACHE_EXT, "json"};
+    static const char *const exts[] = {"glb", "gltf", "hdr", "exr", ASSET_CACHE_EXT, "json"};
     for (size_t i = 0; i < sizeof(exts) / sizeof(exts[0]); i++) {
         char path[PATH_MAX + 80];
         asset_path(a, sha, exts[i], path, sizeof(path));
@@ -119,9 +119,8 @@ bool asset_put_record_locked(struct assets *a, const struct task *t, const json_
     return ok;
 }
 
-/* Under a->lock: a name of --asset-dir that is not ready answers here. */
-static bool dir_not_ready_locked(struct assets *a, const char *name, const char *field,
-                                 struct assets_error *e)
+bool asset_dir_not_ready_locked(struct assets *a, const char *name, const char *field,
+                                struct assets_error *e)
 {
     struct dir_entry *d = asset_dir_find(a, name);
     if (d && d->state == DIR_PENDING) {
@@ -147,7 +146,7 @@ json_t *assets_describe(struct assets *a, const char *name, struct assets_error 
         return NULL;
     }
     pthread_mutex_lock(&a->lock);
-    bool not_ready = dir_not_ready_locked(a, name, "name", e);
+    bool not_ready = asset_dir_not_ready_locked(a, name, "name", e);
     pthread_mutex_unlock(&a->lock);
     if (not_ready)
         return NULL;
@@ -218,6 +217,13 @@ json_t *assets_delete(struct assets *a, const char *name, struct assets_error *e
                      "to end (DELETE /v1/jobs/%s)", job, name, job);
         goto out;
     }
+    /* A sweep that runs on it, or a job being accepted on it this moment. */
+    if (asset_pin_find_locked(a, name, NULL)) {
+        asset_refuse(e, ASSETS_CONFLICT, "name",
+                     "a queued or running sweep (or a job being accepted) uses %s: cancel the "
+                     "sweep or wait for it to end (GET /v1/sweeps?status=running)", name);
+        goto out;
+    }
     char err[PATH_MAX + 300];
     if (!store_asset_delete(a->store, name, err, sizeof(err))) {
         asset_refuse(e, ASSETS_INTERNAL, "store", "%.480s", err);
@@ -239,7 +245,7 @@ static bool resolve_name(struct assets *a, const char *name, char sha[65], bool 
                          const char *field, const char *sha_field, struct assets_error *e)
 {
     pthread_mutex_lock(&a->lock);
-    bool not_ready = dir_not_ready_locked(a, name, field, e);
+    bool not_ready = asset_dir_not_ready_locked(a, name, field, e);
     pthread_mutex_unlock(&a->lock);
     if (not_ready)
         return false;
@@ -258,7 +264,7 @@ static bool resolve_name(struct assets *a, const char *name, char sha[65], bool 
     else if (is_environment != environment)
         asset_refuse(e, ASSETS_INVALID, field,
                      environment ? "%s is a glTF scene, not an environment map (an "
-                                   "equirectangular .hdr)"
+                                   "equirectangular .hdr or .exr)"
                                  : "%s is an environment map: name it in "
                                    "look.ibl.environment {\"asset\": ...}, not scene.asset",
                      name);
@@ -279,32 +285,4 @@ bool assets_resolve(struct assets *a, struct scene_spec *scene, struct assets_er
         return true;
     return resolve_name(a, scene->asset, scene->asset_sha256, false, "scene.asset",
                         "scene.asset_sha256", e);
-}
-
-bool assets_resolve_job(struct assets *a, struct job_spec *spec, struct assets_error *e)
-{
-    if (!assets_resolve(a, &spec->scene, e))
-        return false;
-    struct ibl_spec *looks[2] = {&spec->look.ibl, &spec->reference_look.ibl};
-    for (int i = 0; i < 2; i++)
-        if (looks[i]->enabled && looks[i]->environment == IBL_ENV_ASSET &&
-            !resolve_name(a, looks[i]->env_asset, looks[i]->env_sha256, true,
-                          i ? "reference_look.ibl.environment.asset"
-                            : "look.ibl.environment.asset",
-                          i ? "reference_look.ibl.environment.asset_sha256"
-                            : "look.ibl.environment.asset_sha256",
-                          e))
-            return false;
-    return true;
-}
-
-bool assets_queue_resolver(void *ctx, struct job_spec *spec, char *field, size_t field_cap,
-                           char *message, size_t message_cap)
-{
-    struct assets_error e;
-    if (assets_resolve_job(ctx, spec, &e))
-        return true;
-    snprintf(field, field_cap, "%s", e.field);
-    snprintf(message, message_cap, "%s", e.message);
-    return false;
 }

@@ -178,7 +178,8 @@ uint64_t assets_upload_finish(struct asset_upload *u, struct assets_error *e)
     }
     if (u->bytes == 0) {
         asset_refuse(e, ASSETS_INVALID, "body",
-                     "the body must be the asset's .glb, .gltf or .hdr file; it is empty");
+                     "the body must be the asset's .glb, .gltf, .hdr or .exr file; it is "
+                     "empty");
         goto refuse;
     }
     close(u->fd);
@@ -198,11 +199,13 @@ uint64_t assets_upload_finish(struct asset_upload *u, struct assets_error *e)
     snprintf(t->name, sizeof(t->name), "%s", u->name);
     snprintf(t->path, sizeof(t->path), "%s", u->tmp);
     /* A binary glTF starts with its magic, a Radiance image with "#?"
-     * (an environment map); anything else is given to the converter as
-     * JSON glTF. */
-    snprintf(t->ext, sizeof(t->ext), "%s", memcmp(u->magic, "glTF", 4) == 0 ? "glb"
-                                           : memcmp(u->magic, "#?", 2) == 0 ? "hdr"
-                                                                             : "gltf");
+     * and an OpenEXR one with 76 2f 31 01 (environment maps); anything
+     * else is given to the converter as JSON glTF. */
+    snprintf(t->ext, sizeof(t->ext), "%s",
+             memcmp(u->magic, "glTF", 4) == 0 ? "glb"
+             : memcmp(u->magic, "#?", 2) == 0 ? "hdr"
+             : memcmp(u->magic, "\x76\x2f\x31\x01", 4) == 0 ? "exr"
+                                                          : "gltf");
     t->size = u->bytes;
     pthread_mutex_lock(&a->lock);
     if (a->stopping) {

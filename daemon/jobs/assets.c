@@ -17,6 +17,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "common/child.h"
 #include "common/fsutil.h"
 #include "common/log.h"
 
@@ -76,10 +77,11 @@ static void *worker(void *arg)
     return NULL;
 }
 
-/* Temporaries of a run that stopped (uploads, conversions), and files of
- * hashes no name points at (a crash between a delete's row and its
- * files). */
-static void sweep_state_dir(struct assets *a)
+/* Without hashes: the temporaries of a run that stopped (uploads,
+ * conversions and the cache the converter was writing), at start-up before
+ * anything new is made. With hashes: the files of hashes no name points at
+ * and nothing holds (a crash between a delete's row and its files). */
+static void sweep_state_dir(struct assets *a, bool hashes)
 {
     DIR *d = opendir(a->dir);
     if (!d)
@@ -90,17 +92,25 @@ static void sweep_state_dir(struct assets *a)
         char path[PATH_MAX + 300];
         snprintf(path, sizeof(path), "%s/%s", a->dir, n);
         if (strncmp(n, "upload-", 7) == 0 || strncmp(n, "convert-", 8) == 0 || strstr(n, ".tmp")) {
-            unlink(path);
+            if (!hashes && unlink(path) == 0)
+                LOG(LOG_INFO, "assets: removed %s, left by an earlier run", path);
             continue;
         }
         char sha[65];
-        if (strlen(n) > 65 && n[64] == '.') {
+        if (hashes && strlen(n) > 65 && n[64] == '.') {
             memcpy(sha, n, 64);
             sha[64] = '\0';
-            asset_release_files_locked(a, sha); /* no other thread yet */
+            asset_release_files_locked(a, sha);
         }
     }
     closedir(d);
+}
+
+void assets_release_unused(struct assets *a)
+{
+    pthread_mutex_lock(&a->lock);
+    sweep_state_dir(a, true);
+    pthread_mutex_unlock(&a->lock);
 }
 
 static bool find_converter(const struct assets_config *cfg, char *out, size_t cap, char *err,
@@ -156,7 +166,7 @@ struct assets *assets_create(const struct assets_config *cfg, struct store *stor
     if (a->asset_dir[0] && !scan_asset_dir(a, err, errlen))
         goto fail;
     drop_gone_dir_rows(a);
-    sweep_state_dir(a);
+    sweep_state_dir(a, false); /* no other thread yet */
     for (int i = 0; i < ASSETS_WORKERS; i++) {
         if (pthread_create(&a->workers[i], NULL, worker, a) != 0) {
             snprintf(err, errlen, "cannot start the asset thread");
@@ -176,10 +186,8 @@ void assets_destroy(struct assets *a)
         return;
     pthread_mutex_lock(&a->lock);
     a->stopping = true;
-    if (a->child > 0) {
-        kill(-a->child, SIGKILL);
-        kill(a->child, SIGKILL);
-    }
+    if (a->child > 0)
+        child_kill(a->child);
     pthread_cond_broadcast(&a->work);
     pthread_mutex_unlock(&a->lock);
     for (int i = 0; i < a->nworkers; i++)
@@ -198,6 +206,7 @@ void assets_destroy(struct assets *a)
         free(t);
     }
     free(a->dir_entries);
+    free(a->pins);
     pthread_cond_destroy(&a->work);
     pthread_mutex_destroy(&a->lock);
     free(a);

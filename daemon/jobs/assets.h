@@ -71,9 +71,9 @@ struct assets;
 
 /* Scans --asset-dir (names only: the files are hashed and converted on the
  * worker, so a large folder never delays the start), drops the rows of
- * files that left it, removes leftover temporaries and files no name
- * points at. Call after queue_load (a queued job's pinned hash keeps its
- * files). NULL with err. */
+ * files that left it, removes the temporaries an earlier process left
+ * (uploads, conversions); assets_release_unused removes the files no name
+ * points at once the jobs and sweeps hold what they need. NULL with err. */
 struct assets *assets_create(const struct assets_config *cfg, struct store *store,
                              struct queue *queue, char *err, size_t errlen);
 /* Kills a running conversion, ends the worker, answers waiting uploads
@@ -135,13 +135,31 @@ bool assets_list(struct assets *a, const char *cursor, int limit, struct assets_
 
 /* A job's scene.asset: fills scene->asset_sha256 from the store, or
  * refuses (ASSETS_INVALID: an unknown name; ASSETS_CONFLICT: the pinned hash
- * differs, or it is still converting). */
+ * differs, or it is still converting). Pins nothing: a probe. */
 bool assets_resolve(struct assets *a, struct scene_spec *scene, struct assets_error *e);
-/* Every asset a job names: scene.asset, and look.ibl.environment's (and
- * reference_look's) {"asset": NAME}, which must be an environment map. */
-bool assets_resolve_job(struct assets *a, struct job_spec *spec, struct assets_error *e);
-/* queue_submit's resolver (queue.h), ctx the assets. */
-bool assets_queue_resolver(void *ctx, struct job_spec *spec, char *field, size_t field_cap,
-                           char *message, size_t message_cap);
+
+/* Pins (asset_pins.c): every asset a job names (scene.asset, and
+ * look.ibl.environment's and reference_look's {"asset": NAME}, which must be
+ * an environment map) resolved to its hash and the hash pinned in one step,
+ * under the assets' lock, so that no DELETE or replacing PUT
+ * comes between: while pinned, the name cannot be deleted (ASSETS_CONFLICT)
+ * and the hash's files stay whatever replaces the name. Fills
+ * scene->asset_sha256 (unless given) and asset_bytes (what a job on it
+ * holds in memory, for its cost). A given asset_sha256 other than the
+ * name's hash is accepted while a pin of that name and hash is held (a
+ * sweep's, whose points all run on the hash it was accepted with), or, with
+ * restore (a sweep resumed at start-up), while the hash's files are there;
+ * else ASSETS_CONFLICT. Each pin is let go with assets_unpin. */
+bool assets_pin(struct assets *a, struct job_spec *spec, bool restore, struct assets_error *e);
+void assets_unpin(struct assets *a, const struct job_spec *spec);
+/* A job on the asset has finished: its hash's files go if nothing else
+ * holds them (the name was deleted or replaced meanwhile). */
+void assets_job_ended(struct assets *a, const struct job_spec *spec);
+/* The queue's hooks (queue.h) for these, ctx a. */
+void assets_queue_hooks(struct assets *a, struct queue_asset_hooks *out);
+/* Start-up, once the queue's jobs and the sweeps are loaded (and have
+ * pinned what they hold): the files of hashes that nothing holds and no
+ * name points at (a crash between a delete's row and its files). */
+void assets_release_unused(struct assets *a);
 
 #endif

@@ -62,6 +62,13 @@ struct asset_upload {
     int io_errno;
 };
 
+/* A hash pinned under a name (asset_pins.c): count holders. */
+struct asset_pin {
+    char name[STORE_ASSET_NAME_CAP];
+    char sha256[65];
+    unsigned count;
+};
+
 struct assets {
     struct assets_config cfg;
     char state_dir[PATH_MAX], asset_dir[PATH_MAX], asset_dir_real[PATH_MAX];
@@ -83,6 +90,8 @@ struct assets {
     bool stopping;
     struct dir_entry *dir_entries;
     size_t ndir;
+    struct asset_pin *pins; /* submissions' and sweeps' pins */
+    size_t npins, pins_cap;
     void (*listener)(void *ctx);
     void *listener_ctx;
     pthread_t workers[ASSETS_WORKERS];
@@ -107,8 +116,15 @@ void asset_path(const struct assets *a, const char *sha, const char *ext, char *
                 size_t cap);
 bool file_exists(const char *path);
 /* Under a->lock: the files of a hash no name points at, no conversion is
- * working on and no queued or running job is pinned to. */
+ * working on, and no pin or queued or running job holds. */
 void asset_release_files_locked(struct assets *a, const char *sha);
+/* Under a->lock: a name of --asset-dir that is not ready answers here. */
+bool asset_dir_not_ready_locked(struct assets *a, const char *name, const char *field,
+                                struct assets_error *e);
+
+/* asset_pins.c */
+/* Under a->lock: the pin of that name and hash (either may be NULL: any). */
+struct asset_pin *asset_pin_find_locked(struct assets *a, const char *name, const char *sha);
 /* Under a->lock: the record of name now points at sha. The files of the
  * hash it pointed at before go when nothing else needs them. *replaced:
  * the name had a record. */

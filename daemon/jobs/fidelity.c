@@ -86,6 +86,11 @@ json_t *fidelity_page_request(const struct job_spec *spec, const json_t *view,
         ibl = look->ibl.intensity;
         file = look->ibl.environment == IBL_ENV_ASSET;
     }
+    /* The viewer maps a panorama as shadebench does (its dirToUV: u = 0.5 +
+     * atan2(z, x) / 2 pi, the image's centre at +x; environment.glsl), so
+     * it is given no rotation of its own (its UI's default is 90 degrees,
+     * which put an environment's +x at +z: a white ball under
+     * hdr_gen.sky_and_ground, lit SSIM 0.808 -> 0.980 from the front). */
     json_t *ch = json_array();
     for (int i = 0; i < nchannels; i++)
         json_array_append_new(ch, json_string(channels[i]));
@@ -97,7 +102,7 @@ json_t *fidelity_page_request(const struct job_spec *spec, const json_t *view,
                           json_object_get(view, "eye"), "lights",
                           json_object_get(view, "lights"), "exposure", exposure, "tonemap",
                           tonemap, "ibl_intensity", ibl, "environment_file", file,
-                          "environment_rotation_deg", 90, "render_environment", file, "clear", 0,
+                          "environment_rotation_deg", 0, "render_environment", file, "clear", 0,
                           0, 0, 255, "channels", ch);
     if (!r)
         snprintf(err, errlen, "out of memory for the reference's request");
@@ -116,7 +121,7 @@ void fidelity_cache_key(const json_t *page_request, const struct job_spec *spec,
     struct reference_sampler sampler;
     job_sampler(spec, &sampler);
     json_t *k = json_pack("{s:s, s:s, s:o, s:s, s:s, s:o}", "viewer",
-                          REFERENCE_VIEWER_PACKAGE "@" REFERENCE_VIEWER_VERSION, "page", "1",
+                          REFERENCE_VIEWER_PACKAGE "@" REFERENCE_VIEWER_VERSION, "page", "3",
                           "ibl_sampler", reference_sampler_to_json(&sampler),
                           "asset", spec->scene.asset_sha256, "environment",
                           spec->look.ibl.enabled ? spec->look.ibl.env_sha256 : "", "request",
@@ -518,10 +523,13 @@ static bool finish_fidelity(struct fidelity *f, struct task *t, enum job_status 
                      "directory", spec->scene.asset, spec->scene.asset_sha256);
             goto out;
         }
+        /* The Radiance file: the upload, or an OpenEXR upload's copy. */
         if (spec->look.ibl.enabled && spec->look.ibl.environment == IBL_ENV_ASSET &&
-            !asset_store_original_path(f->state_dir, spec->look.ibl.env_sha256, "hdr", env,
-                                       sizeof(env))) {
-            snprintf(err, errlen, "look.ibl.environment: no file for %s", spec->look.ibl.env_sha256);
+            (!asset_store_original_path(f->state_dir, spec->look.ibl.env_sha256, "hdr", env,
+                                        sizeof(env)) ||
+             access(env, R_OK) != 0)) {
+            snprintf(err, errlen, "look.ibl.environment: no Radiance file of %s for the viewer "
+                     "(%s)", spec->look.ibl.env_sha256, env);
             goto out;
         }
         json_object_set(page, "channels", todo);
@@ -671,6 +679,22 @@ static bool finish_fidelity(struct fidelity *f, struct task *t, enum job_status 
                                       json_object_get(page, "ibl_intensity"), "environment_file",
                                       json_object_get(page, "environment_file"), "ibl_sampler",
                                       reference_sampler_to_json(&sampler)));
+    /* The nodes whose mirrored matrix the page restated for the viewer
+     * (page.js: restateMirroredMatrices), what it changed in the viewer
+     * (page.js: viewer_patches), and each rasteriser's sub-pixel
+     * precision. */
+    json_t *restated = json_object_get(cost, "mirrored_matrices_restated");
+    json_object_set_new(fid, "mirrored_matrices_restated",
+                        json_is_array(restated) ? json_incref(restated) : json_array());
+    json_t *patches = json_object_get(cost, "viewer_patches");
+    json_object_set_new(fid, "viewer_patches",
+                        json_is_array(patches) ? json_incref(patches) : json_array());
+    json_object_set_new(fid, "subpixel_bits",
+                        json_pack("{s:O, s:O}", "shadebench",
+                                  json_object_get(t->view, "subpixel_bits") ?
+                                      json_object_get(t->view, "subpixel_bits") : json_null(),
+                                  "khronos", json_object_get(cost, "subpixel_bits") ?
+                                      json_object_get(cost, "subpixel_bits") : json_null()));
     if (lit)
         json_object_set_new(fid, "lit_transfer",
                             json_string(spec->look.tonemap == LOOK_TONEMAP_NONE

@@ -5,11 +5,14 @@
 #include "common/clock.h"
 #include "common/log.h"
 #include "common/result_keys.h"
+#include "daemon/spec/job_cost.h"
 #include "daemon/spec/job_figures.h"
+#include "daemon/jobs/job_eta.h"
 #include "daemon/store/job_dir.h"
 #include "daemon/store/store_reserve.h"
 
 #include <errno.h>
+#include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -48,10 +51,10 @@ struct queue {
     void *needed_ctx;
     pthread_mutex_t repair;    /* one repair of a damaged result.json at a time */
     pthread_mutex_t retention; /* one retention pass at a time */
-    /* scene.asset's resolver (queue_set_asset_resolver); set before
-     * submissions start, read without the lock. */
-    queue_asset_resolver resolve_asset;
-    void *resolve_ctx;
+    /* scene.asset's pins (queue_set_asset_hooks); hooks_lock is held while
+     * one is called, so that none runs once they are unset. */
+    pthread_mutex_t hooks_lock;
+    struct queue_asset_hooks hooks;
 };
 
 /* A job's state as taken under the lock, written after it is released. The
@@ -204,6 +207,7 @@ struct queue *queue_create(struct store *store, int max_queued)
     pthread_mutex_init(&q->guard, NULL);
     pthread_mutex_init(&q->repair, NULL);
     pthread_mutex_init(&q->retention, NULL);
+    pthread_mutex_init(&q->hooks_lock, NULL);
     q->max_queued = max_queued;
     q->store = store;
     return q;
@@ -244,6 +248,7 @@ void queue_destroy(struct queue *q)
         job_free(q->live.items[i]);
     store_live_finish(&q->live);
     pthread_mutex_destroy(&q->retention);
+    pthread_mutex_destroy(&q->hooks_lock);
     pthread_mutex_destroy(&q->repair);
     pthread_mutex_destroy(&q->guard);
     pthread_cond_destroy(&q->changed);
@@ -288,27 +293,116 @@ static struct job *job_new(void)
         return NULL;
     atomic_init(&job->cancel, false);
     atomic_init(&job->frames_done, 0);
+    atomic_init(&job->frames_began, 0.0);
     return job;
+}
+
+static enum queue_submit_result submit_pinned(struct queue *q, const struct job_spec *spec,
+                                              const char *dir_override, char id_out[24]);
+
+static bool pin_spec(struct queue *q, struct job_spec *spec, bool restore, bool *pinned)
+{
+    char field[64] = "", message[512] = "";
+    pthread_mutex_lock(&q->hooks_lock);
+    bool ok = !q->hooks.pin || q->hooks.pin(q->hooks.ctx, spec, restore, field, sizeof(field),
+                                            message, sizeof(message));
+    *pinned = ok && q->hooks.pin;
+    pthread_mutex_unlock(&q->hooks_lock);
+    if (!ok)
+        records_set_submit_error("%s: %s", field, message);
+    return ok;
+}
+
+static void unpin_spec(struct queue *q, const struct job_spec *spec)
+{
+    pthread_mutex_lock(&q->hooks_lock);
+    if (q->hooks.unpin)
+        q->hooks.unpin(q->hooks.ctx, spec);
+    pthread_mutex_unlock(&q->hooks_lock);
+}
+
+/* A sweep's scene alone, as a spec that names nothing else. */
+bool queue_asset_pin(struct queue *q, struct scene_spec *scene, bool restore)
+{
+    struct job_spec spec;
+    memset(&spec, 0, sizeof(spec));
+    spec.scene = *scene;
+    bool pinned;
+    bool ok = pin_spec(q, &spec, restore, &pinned);
+    *scene = spec.scene;
+    return ok;
+}
+
+void queue_asset_unpin(struct queue *q, const struct scene_spec *scene)
+{
+    struct job_spec spec;
+    memset(&spec, 0, sizeof(spec));
+    spec.scene = *scene;
+    unpin_spec(q, &spec);
+}
+
+/* The asset's pin of a submission, resolved and pinned in one step; false
+ * with queue_submit_error's text when refused. The job's cost is admitted
+ * again with the asset's memory (job_cost.h: a sweep's point too). */
+static bool pin_asset(struct queue *q, struct job_spec *spec, bool *pinned)
+{
+    if (!pin_spec(q, spec, false, pinned))
+        return false;
+    struct job_cost cost;
+    struct job_error err;
+    job_cost_estimate(spec, &cost);
+    if (!job_cost_admit(&cost, &err)) {
+        records_set_submit_error("%s: %s", err.field, err.message);
+        return false;
+    }
+    return true;
+}
+
+static void unpin_asset(struct queue *q, const struct job_spec *spec, bool pinned)
+{
+    if (pinned)
+        unpin_spec(q, spec);
+}
+
+/* A job on an asset has finished: its hash may go (queue_asset_hooks). */
+static void asset_ended(struct queue *q, const struct job_spec *spec)
+{
+    if (!job_spec_names_asset(spec))
+        return;
+    pthread_mutex_lock(&q->hooks_lock);
+    if (q->hooks.ended)
+        q->hooks.ended(q->hooks.ctx, spec);
+    pthread_mutex_unlock(&q->hooks_lock);
 }
 
 enum queue_submit_result queue_submit(struct queue *q, const struct job_spec *spec,
                                       const char *dir_override, char id_out[24])
 {
-    char why[PATH_MAX + 300] = "";
     records_set_submit_error("%s", "");
     /* Every job naming an asset, a sweep's points included, is pinned to the
-     * asset's hash as it is accepted (daemon/jobs/assets.h). */
+     * asset's hash in the step that resolves it, and stays pinned until it
+     * is live or refused (daemon/jobs/assets.h). */
     struct job_spec resolved;
-    if (job_spec_names_asset(spec) && q->resolve_asset) {
-        char field[64], message[512];
+    bool pinned = false;
+    if (job_spec_names_asset(spec)) {
         resolved = *spec;
-        if (!q->resolve_asset(q->resolve_ctx, &resolved, field, sizeof(field), message,
-                              sizeof(message))) {
-            records_set_submit_error("%s: %s", field, message);
+        bool ok = pin_asset(q, &resolved, &pinned);
+        if (!ok) {
+            unpin_asset(q, &resolved, pinned);
             return QUEUE_REFUSED;
         }
         spec = &resolved;
     }
+    enum queue_submit_result res = submit_pinned(q, spec, dir_override, id_out);
+    unpin_asset(q, spec, pinned);
+    return res;
+}
+
+/* queue_submit once its asset, if any, is pinned. */
+static enum queue_submit_result submit_pinned(struct queue *q, const struct job_spec *spec,
+                                              const char *dir_override, char id_out[24])
+{
+    char why[PATH_MAX + 300] = "";
     if (!queue_room_to_accept(q, "job"))
         return QUEUE_IO_ERROR;
     pthread_mutex_lock(&q->lock);
@@ -463,6 +557,8 @@ void queue_progress(struct queue *q, struct job *job, int frames_done)
 {
     (void)q;
     atomic_store_explicit(&job->frames_done, frames_done, memory_order_relaxed);
+    if (frames_done > 0 && atomic_load_explicit(&job->frames_began, memory_order_relaxed) == 0)
+        atomic_store_explicit(&job->frames_began, clock_unix_s(), memory_order_relaxed);
 }
 
 void queue_set_phase(struct queue *q, struct job *job, const char *phase)
@@ -476,6 +572,7 @@ void queue_finish(struct queue *q, struct job *job, enum job_status status,
                   const char *error, json_t *result)
 {
     struct snapshot snap;
+    struct job_spec ended_spec = job->spec; /* the job may leave memory below */
     pthread_mutex_lock(&q->lock);
     /* Stopped by SIGTERM, not by anyone's wish: it runs again, first, on the
      * next start. */
@@ -509,6 +606,7 @@ void queue_finish(struct queue *q, struct job *job, enum job_status status,
         job->started = 0;
         job->error[0] = '\0';
         atomic_store(&job->frames_done, 0);
+        atomic_store(&job->frames_began, 0.0);
         atomic_store(&job->cancel, false);
         job->requeue_on_stop = false;
         json_decref(result);
@@ -516,6 +614,8 @@ void queue_finish(struct queue *q, struct job *job, enum job_status status,
     } else {
         job->status = status;
         job->finished = next.finished;
+        if (status == JOB_DONE && result && job->started > 0)
+            job_eta_observe_result(&job->spec, result, next.finished - job->started);
         if (error)
             snprintf(job->error, sizeof(job->error), "%s", error);
         json_decref(job->result);
@@ -536,6 +636,8 @@ void queue_finish(struct queue *q, struct job *job, enum job_status status,
         LOG(LOG_INFO, "job %s: stopped by the daemon's exit; back to the head of the queue",
             job->id);
     job_free(gone);
+    if (!requeue)
+        asset_ended(q, &ended_spec);
     apply_retention(q, false);
 }
 
@@ -557,10 +659,45 @@ void queue_stop(struct queue *q)
     pthread_mutex_unlock(&q->lock);
 }
 
+void queue_store_abandoned(struct queue *q)
+{
+    struct snapshot snaps[8];
+    int n = 0;
+    pthread_mutex_lock(&q->lock);
+    for (size_t i = 0; i < q->live.count && n < 8; i++) {
+        struct job *job = q->live.items[i];
+        if (job->status != JOB_RUNNING)
+            continue;
+        /* What queue_finish would store: a DELETE's cancel stays cancelled,
+         * a job stopped by the daemon goes back to the queue. */
+        struct job_state next = state_of(job);
+        if (job->user_cancel) {
+            next.status = JOB_CANCELLED;
+            next.finished = clock_unix_s();
+            next.error = "cancelled (the daemon stopped while its render thread was still "
+                         "letting go of it)";
+        } else {
+            next.status = JOB_QUEUED;
+            next.phase = NULL;
+            next.started = 0;
+            next.error = "";
+            next.frames_done = 0;
+        }
+        snaps[n].job = job;
+        snaps[n].seq = store_version_take(&job->version);
+        row_of(job, &next, NULL, &snaps[n].row);
+        n++;
+    }
+    pthread_mutex_unlock(&q->lock);
+    for (int i = 0; i < n; i++)
+        write_snapshot(q, &snaps[i], NULL, 0);
+}
+
 enum queue_cancel_result queue_cancel(struct queue *q, const char *id)
 {
     enum queue_cancel_result res = CANCEL_NOT_FOUND;
     struct snapshot snap = {0};
+    struct job_spec ended_spec = {0}; /* a queued job's, cancelled: its assets may go */
     pthread_mutex_lock(&q->lock);
     struct job *job = find_locked(q, id);
     if (!job) {
@@ -577,6 +714,7 @@ enum queue_cancel_result queue_cancel(struct queue *q, const char *id)
         job->finished = clock_unix_s();
         snprintf(job->error, sizeof(job->error), "cancelled before it started");
         q->queued--;
+        ended_spec = job->spec;
         snapshot_locked(job, &snap);
         res = CANCEL_DONE;
         pthread_cond_broadcast(&q->changed);
@@ -594,6 +732,7 @@ enum queue_cancel_result queue_cancel(struct queue *q, const char *id)
     pthread_mutex_unlock(&q->lock);
     if (snap.job)
         write_snapshot(q, &snap, NULL, 0);
+    asset_ended(q, &ended_spec);
     return res;
 }
 
@@ -629,10 +768,41 @@ static json_t *state_json(const char *id, const char *technique, double created,
     return o;
 }
 
+/* A queued or running job's estimate (job_eta.h): the whole job's, and
+ * while it runs the time left by the frames it has drawn. */
+static json_t *estimate_json(const struct job *job, const struct job_state *st)
+{
+    struct job_eta e;
+    job_eta_estimate(&job->spec, &e);
+    json_t *o = json_pack("{s:o}", "estimate", job_eta_json(&e));
+    if (st->status != JOB_RUNNING)
+        return o;
+    double began = atomic_load(&job->frames_began), now = clock_unix_s();
+    int done = st->frames_done;
+    /* The first counted frame marks when frames began: the rate is over
+     * the frames after it. */
+    double left = began > 0 ? job_eta_left(done - 1, job->frames_total - 1, now - began) : -1;
+    if (left >= 0)
+        json_object_set_new(o, "seconds_left",
+                            json_pack("{s:f, s:s}", "frames", left, "rule",
+                                      "the frames left of every run at the rate of the frames "
+                                      "drawn since the first; the reference and metrics, if "
+                                      "any, come on top"));
+    else if (e.known && st->started > 0)
+        json_object_set_new(o, "seconds_left",
+                            json_pack("{s:f, s:s}", "estimate",
+                                      fmax(0.0, e.duration_s - (now - st->started)), "rule",
+                                      "before its first frame: the estimate less the time it "
+                                      "has run"));
+    return o;
+}
+
 static json_t *live_json_locked(const struct job *job, bool full)
 {
     struct job_state st = state_of(job);
     json_t *o = state_json(job->id, job->spec.technique, job->created, &st, job->frames_total);
+    if (o && (st.status == JOB_QUEUED || st.status == JOB_RUNNING))
+        json_object_update_new(o, estimate_json(job, &st));
     if (o && full) {
         json_object_set_new(o, "spec", job_spec_to_json(&job->spec));
         if (job->result)
@@ -955,10 +1125,11 @@ static void apply_retention(struct queue *q, bool startup)
     free(ids);
 }
 
-void queue_set_asset_resolver(struct queue *q, queue_asset_resolver fn, void *ctx)
+void queue_set_asset_hooks(struct queue *q, const struct queue_asset_hooks *hooks)
 {
-    q->resolve_asset = fn;
-    q->resolve_ctx = ctx;
+    pthread_mutex_lock(&q->hooks_lock);
+    q->hooks = hooks ? *hooks : (struct queue_asset_hooks){0};
+    pthread_mutex_unlock(&q->hooks_lock);
 }
 
 bool queue_asset_in_use(struct queue *q, const char *name, const char *sha256,

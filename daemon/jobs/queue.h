@@ -39,6 +39,9 @@ struct job {
     enum job_status status;
     const char *phase; /* while running: "rendering", "reference" or "metrics" */
     atomic_int frames_done;
+    /* When its first frame was counted done (clock_unix_s; 0 before): the
+     * time left is read from the frames drawn since (job_eta_left). */
+    _Atomic double frames_began;
     int frames_total;
     atomic_bool cancel;
     char error[1024];
@@ -113,7 +116,8 @@ bool queue_room_to_accept(struct queue *q, const char *what);
 /* Render thread: blocks until a job is queued (marks it running) or the
  * queue is stopping (returns NULL). */
 struct job *queue_next(struct queue *q);
-/* Render thread, from the timed loop: an atomic store, no lock. */
+/* Render thread, from the timed loop: an atomic store, no lock (and, at
+ * the first frame counted, the time, once). */
 void queue_progress(struct queue *q, struct job *job, int frames_done);
 /* phase must be a string literal. */
 void queue_set_phase(struct queue *q, struct job *job, const char *phase);
@@ -125,6 +129,13 @@ void queue_finish(struct queue *q, struct job *job, enum job_status status,
 /* No more jobs start; a running job is asked to stop at its next frame and
  * will be requeued, unless a DELETE had already asked to cancel it. */
 void queue_stop(struct queue *q);
+
+/* At exit, when the render thread has not let go of its job in time (after
+ * queue_stop): stores the running job as it would have ended, cancelled
+ * when a DELETE asked for it, else queued again, so that a restart does not
+ * find it running and call it interrupted. The render thread may still
+ * finish it meanwhile: the store keeps the newer of the two. */
+void queue_store_abandoned(struct queue *q);
 
 enum queue_cancel_result { CANCEL_DONE, CANCEL_REQUESTED, CANCEL_FINISHED, CANCEL_NOT_FOUND };
 enum queue_cancel_result queue_cancel(struct queue *q, const char *id);
@@ -154,13 +165,34 @@ bool queue_job_dir(struct queue *q, const char *id, char *dir, size_t cap,
  * no lock (the HTTP layer writes to an eventfd). Set once, before serving. */
 void queue_set_listener(struct queue *q, void (*fn)(void *ctx), void *ctx);
 
-/* scene.asset and look.ibl.environment's asset: called by queue_submit
- * (any thread, no lock of the queue's held) for a spec naming an asset
- * (job_spec_names_asset); fills the hashes, or returns false with the
- * field and the rule. Set once, before submissions start. */
-typedef bool (*queue_asset_resolver)(void *ctx, struct job_spec *spec, char *field,
-                                     size_t field_cap, char *message, size_t message_cap);
-void queue_set_asset_resolver(struct queue *q, queue_asset_resolver fn, void *ctx);
+/* The pins of the assets a job names (daemon/jobs/assets.h: scene.asset and
+ * look.ibl.environment's), so that no accepted job loses its asset:
+ * queue_submit calls pin for a spec naming an asset (job_spec_names_asset;
+ * any thread, no lock of the queue's held), which resolves each name to its
+ * hash (filling the hashes and scene.asset_bytes) and pins it in one
+ * step, or returns false with the field and the rule; once the job is live
+ * (its queued or running state protects the hash from then on:
+ * queue_asset_in_use) or refused, unpin lets that pin go. ended is called
+ * once a job on an asset has finished (cancelled, failed, done), with no
+ * lock of the queue's held, so that a hash no name points at any more goes
+ * with the last job pinned to it. The hooks are called under a lock of
+ * their own, so that once queue_set_asset_hooks(q, NULL) returns none is
+ * running or will run. */
+struct queue_asset_hooks {
+    bool (*pin)(void *ctx, struct job_spec *spec, bool restore, char *field, size_t field_cap,
+                char *message, size_t message_cap);
+    void (*unpin)(void *ctx, const struct job_spec *spec);
+    void (*ended)(void *ctx, const struct job_spec *spec);
+    void *ctx;
+};
+void queue_set_asset_hooks(struct queue *q, const struct queue_asset_hooks *hooks);
+/* A sweep's pin, through the same hooks, held for the sweep's life (all its
+ * points run on that hash) until queue_asset_unpin. restore: a sweep
+ * resumed at start-up, whose hash may have no name any more, pinned while
+ * its files are there. false with queue_submit_error's text when refused;
+ * true with nothing pinned when no hooks are set. */
+bool queue_asset_pin(struct queue *q, struct scene_spec *scene, bool restore);
+void queue_asset_unpin(struct queue *q, const struct scene_spec *scene);
 /* Is a queued or running job using the asset of that name, or of that hash
  * (either may be NULL)? *id_out gets the first such job's id. Any thread. */
 bool queue_asset_in_use(struct queue *q, const char *name, const char *sha256,

@@ -38,6 +38,10 @@ struct sweep {
     char adopt_job[RECORD_ID_LEN];
     atomic_bool cancel; /* DELETE */
     double created, started, finished;
+    /* base.scene.asset's pin, held from acceptance to the end (queue.h's
+     * queue_asset_pin), so that every point runs on one hash. */
+    struct scene_spec asset;
+    bool asset_pinned;
     /* Under the sweeps' lock: ordered writes, as for jobs (queue.h). */
     struct store_version version;
 };
@@ -195,6 +199,30 @@ static void changed_locked(struct sweeps *s, struct sweep *sw, struct snapshot *
 {
     snapshot_locked(sw, snap);
     pthread_cond_broadcast(&s->changed);
+}
+
+/* base.scene's asset and pinned hash, if it names one. */
+static bool base_asset(const json_t *base, struct scene_spec *out)
+{
+    json_t *scene = json_object_get(base, "scene");
+    const char *name = json_string_value(json_object_get(scene, "asset"));
+    const char *sha = json_string_value(json_object_get(scene, "asset_sha256"));
+    memset(out, 0, sizeof(*out));
+    if (!name || strlen(name) >= sizeof(out->asset))
+        return false;
+    snprintf(out->asset, sizeof(out->asset), "%s", name);
+    if (sha && strlen(sha) < sizeof(out->asset_sha256))
+        snprintf(out->asset_sha256, sizeof(out->asset_sha256), "%s", sha);
+    return true;
+}
+
+/* The sweep's pin goes (it ended, or was never accepted). */
+static void unpin_sweep(struct sweeps *s, struct sweep *sw)
+{
+    if (!sw->asset_pinned)
+        return;
+    sw->asset_pinned = false;
+    queue_asset_unpin(s->queue, &sw->asset);
 }
 
 static struct sweep *sweep_new(void)
@@ -423,6 +451,8 @@ static void run_sweep(struct sweeps *s, struct sweep *sw)
             json_array_size(sw->points));
     changed_locked(s, sw, &snap);
     pthread_mutex_unlock(&s->lock);
+    if (!stopped) /* before the write, after which it may leave memory */
+        unpin_sweep(s, sw);
     write_snapshot(s, &snap, NULL, 0);
     apply_retention(s);
 }
@@ -640,11 +670,20 @@ static void load_unfinished(void *ctx, const struct store_row *stored)
         snprintf(sw->current_job, sizeof(sw->current_job), "%s", current);
         snprintf(sw->adopt_job, sizeof(sw->adopt_job), "%s", current);
     }
+    /* Its hash again, though the name may point elsewhere now (replaced
+     * while it ran): its files are still there until the start-up's
+     * release, which comes after this. A hash gone fails its next point. */
+    if (base_asset(sw->spec.base, &sw->asset) && sw->asset.asset_sha256[0]) {
+        sw->asset_pinned = queue_asset_pin(s->queue, &sw->asset, true);
+        if (!sw->asset_pinned)
+            LOG(LOG_WARN, "sweep %s: %s", row.id, queue_submit_error());
+    }
     pthread_mutex_lock(&s->lock);
     bool inserted = store_live_insert(&s->live, sw);
     pthread_mutex_unlock(&s->lock);
     if (!inserted) {
         LOG(LOG_ERROR, "sweep %s: out of memory loading it; it resumes on the next start", row.id);
+        unpin_sweep(s, sw);
         sweep_free(sw);
     }
 }
@@ -738,8 +777,10 @@ void sweeps_destroy(struct sweeps *s)
         if (s->live.count == before)
             i++;
     }
-    for (size_t i = 0; i < s->live.count; i++)
+    for (size_t i = 0; i < s->live.count; i++) {
+        unpin_sweep(s, s->live.items[i]);
         sweep_free(s->live.items[i]);
+    }
     store_live_finish(&s->live);
     pthread_cond_destroy(&s->changed);
     pthread_mutex_destroy(&s->lock);
@@ -771,6 +812,24 @@ enum queue_submit_result sweeps_submit(struct sweeps *s, struct sweep_spec *spec
     bool made_dir = false, inserted = false;
     if (!sw || !(sw->body = json_deep_copy(body)) || !(sw->points = json_array()))
         goto fail;
+    /* On an asset: its hash pinned for the whole sweep, and written into the
+     * base (its points' and the stored spec's), so that a replacing PUT
+     * meanwhile changes none of its points. */
+    if (base_asset(spec->base, &sw->asset)) {
+        if (!queue_asset_pin(s->queue, &sw->asset, false)) {
+            sweep_free(sw);
+            pthread_mutex_lock(&s->lock);
+            s->reserved--;
+            pthread_mutex_unlock(&s->lock);
+            return QUEUE_REFUSED;
+        }
+        sw->asset_pinned = true;
+        json_t *hash = json_string(sw->asset.asset_sha256);
+        json_object_set(json_object_get(spec->base, "scene"), "asset_sha256", hash);
+        json_object_set(json_object_get(json_object_get(sw->body, "base"), "scene"),
+                        "asset_sha256", hash);
+        json_decref(hash);
+    }
     if (!record_create_dir(store_record_kind(s->store, STORE_SWEEPS), NULL, sw->id, sw->dir,
                            sizeof(sw->dir), why, sizeof(why)))
         goto fail;
@@ -824,6 +883,8 @@ fail:
         if (rmdir(sw->dir) != 0)
             LOG(LOG_WARN, "cannot remove %s: %s", sw->dir, strerror(errno));
     }
+    if (sw)
+        unpin_sweep(s, sw);
     sweep_free(sw);
     pthread_mutex_lock(&s->lock);
     s->reserved--;
@@ -899,6 +960,8 @@ enum queue_cancel_result sweeps_cancel(struct sweeps *s, const char *id)
 {
     enum queue_cancel_result r = CANCEL_NOT_FOUND;
     struct snapshot snap = {0};
+    struct scene_spec unpinned;
+    bool unpin = false;
     pthread_mutex_lock(&s->lock);
     struct sweep *sw = find_locked(s, id);
     if (sw) {
@@ -909,6 +972,9 @@ enum queue_cancel_result sweeps_cancel(struct sweeps *s, const char *id)
             sw->finished = clock_unix_s();
             snprintf(sw->error, sizeof(sw->error), "cancelled before it started");
             r = CANCEL_DONE;
+            unpinned = sw->asset;
+            unpin = sw->asset_pinned;
+            sw->asset_pinned = false;
             changed_locked(s, sw, &snap);
         } else {
             atomic_store(&sw->cancel, true);
@@ -916,6 +982,8 @@ enum queue_cancel_result sweeps_cancel(struct sweeps *s, const char *id)
         }
     }
     pthread_mutex_unlock(&s->lock);
+    if (unpin) /* never while holding the sweeps' lock (queue.h) */
+        queue_asset_unpin(s->queue, &unpinned);
     if (snap.sw)
         write_snapshot(s, &snap, NULL, 0);
     if (!sw) {

@@ -187,17 +187,23 @@ static bool capture(struct look_ibl *ibl, struct filters *f, const struct look_i
         fd.counts[1] = s->light_count;
         fd.counts[2] = s->instance_count;
         gpu_frame_block_update(env->frame_block, &fd);
-        if (probe) {
-            /* The cube's faces are rotations, but draw both sides anyway:
-             * a probe may stand where back faces show (the teapot's rim). */
+        /* A face of a probe among many lights can take seconds: in tiles
+         * (bounded submissions, daemon/gpu/budget.h). */
+        struct gpu_tiles t;
+        for (gpu_tiles_begin(budget, res, res, &t); gpu_tiles_next(budget, &t);) {
+            if (probe) {
+                /* The cube's faces are rotations, but draw both sides
+                 * anyway: a probe may stand where back faces show (the
+                 * teapot's rim). */
+                glEnable(GL_DEPTH_TEST);
+                glDepthFunc(GL_LESS);
+                glDisable(GL_CULL_FACE);
+                gpu_scene_bind(env->gpu, &f->capture);
+                gpu_scene_draw(env->gpu, &f->capture);
+            }
             glEnable(GL_DEPTH_TEST);
-            glDepthFunc(GL_LESS);
-            glDisable(GL_CULL_FACE);
-            gpu_scene_bind(env->gpu, &f->capture);
-            gpu_scene_draw(env->gpu, &f->capture);
+            look_sky_draw(env->sky);
         }
-        glEnable(GL_DEPTH_TEST);
-        look_sky_draw(env->sky);
         gpu_loop_step(budget);
     }
     gpu_loop_end(budget);
@@ -318,6 +324,12 @@ struct look_ibl *look_ibl_create(const struct look_ibl_env *env, char *err, size
                     env->budget ? env->budget->ctx : NULL);
     budget.progress = env->budget ? env->budget->progress : NULL;
     for (int layer = 0; layer < layers; layer++) {
+        /* Each probe draws the same pieces: measured once (the first
+         * probe: the environment before it draws no scene), drawn by that
+         * measure after. */
+        gpu_budget_frame(&budget);
+        if (layer == 1)
+            gpu_budget_forget(&budget);
         phase_begin(&phase);
         bool captured = capture(ibl, &f, env, layer ? &ibl->probe[layer - 1] : NULL, &budget);
         phase_end(&phase, &ibl->capture_ms, &ibl->gpu_capture_ms);

@@ -104,6 +104,63 @@ function setLights(json, lights) {
     json.extensions.KHR_lights_punctual = { lights: list };
 }
 
+// The viewer reads a node's matrix as translation, rotation and scale
+// (gltfNode.applyMatrix: gl-matrix's getScaling, the columns' lengths, then
+// getRotation of what is left), so a matrix whose determinant is negative,
+// a mirror, loses its reflection: the scale comes back positive and the
+// rotation is read from an improper matrix (KhronosGroup/glTF-Sample-Viewer
+// issue 351). glTF says such a matrix MUST be decomposable into TRS: a
+// negative scale. So each mirrored matrix is handed to the viewer as the
+// same transform spelt as translation, rotation and a scale whose x is
+// negative (the product is the matrix; which axis carries the sign does not
+// change it). Returns the indices of the nodes restated.
+function restateMirroredMatrices(json) {
+    const restated = [];
+    (json.nodes || []).forEach((node, i) => {
+        const m = node.matrix;
+        if (!m || m.length !== 16 || m[3] !== 0 || m[7] !== 0 || m[11] !== 0 || m[15] !== 1)
+            return;
+        const c = [[m[0], m[1], m[2]], [m[4], m[5], m[6]], [m[8], m[9], m[10]]];
+        const det = c[0][0] * (c[1][1] * c[2][2] - c[1][2] * c[2][1])
+                  - c[1][0] * (c[0][1] * c[2][2] - c[0][2] * c[2][1])
+                  + c[2][0] * (c[0][1] * c[1][2] - c[0][2] * c[1][1]);
+        if (!(det < 0)) return;
+        const s = c.map((col) => Math.hypot(col[0], col[1], col[2]));
+        if (!(s[0] > 0 && s[1] > 0 && s[2] > 0)) return;
+        s[0] = -s[0];
+        // r[row][col], a proper rotation.
+        const r = [0, 1, 2].map((row) => [0, 1, 2].map((col) => c[col][row] / s[col]));
+        const tr = r[0][0] + r[1][1] + r[2][2];
+        let q;
+        if (tr > 0) {
+            const k = 0.5 / Math.sqrt(tr + 1);
+            q = [(r[2][1] - r[1][2]) * k, (r[0][2] - r[2][0]) * k, (r[1][0] - r[0][1]) * k, 0.25 / k];
+        } else if (r[0][0] > r[1][1] && r[0][0] > r[2][2]) {
+            const k = 2 * Math.sqrt(1 + r[0][0] - r[1][1] - r[2][2]);
+            q = [0.25 * k, (r[0][1] + r[1][0]) / k, (r[0][2] + r[2][0]) / k, (r[2][1] - r[1][2]) / k];
+        } else if (r[1][1] > r[2][2]) {
+            const k = 2 * Math.sqrt(1 + r[1][1] - r[0][0] - r[2][2]);
+            q = [(r[0][1] + r[1][0]) / k, 0.25 * k, (r[1][2] + r[2][1]) / k, (r[0][2] - r[2][0]) / k];
+        } else {
+            const k = 2 * Math.sqrt(1 + r[2][2] - r[0][0] - r[1][1]);
+            q = [(r[0][2] + r[2][0]) / k, (r[1][2] + r[2][1]) / k, 0.25 * k, (r[1][0] - r[0][1]) / k];
+        }
+        const ql = Math.hypot(q[0], q[1], q[2], q[3]);
+        delete node.matrix;
+        node.translation = [m[12], m[13], m[14]];
+        node.rotation = q.map((v) => v / ql);
+        node.scale = s;
+        restated.push(i);
+    });
+    return restated;
+}
+
+// The viewer's world bitangent (its vertex shader, 1.1.0), and the same
+// turned by the model matrix's handedness (sbRender's shaderSource).
+const BITANGENT_W = "vec3 bitangentW=cross(normalW,tangentW)*a_tangent.w;";
+const BITANGENT_W_MIRRORED = "vec3 bitangentW=cross(normalW,tangentW)*a_tangent.w" +
+    "*(determinant(mat3(u_ModelMatrix))<0.0?-1.0:1.0);";
+
 // A Radiance picture of constant radiance 1 (RGBE 128,128,128,129), for a
 // uniform environment: the viewer needs one even to light with none.
 function uniformHdr() {
@@ -129,6 +186,36 @@ window.sbRender = async function (req) {
     const gl = canvas.getContext("webgl2", { antialias: false, alpha: false, depth: true,
                                              preserveDrawingBuffer: true, powerPreference: "default" });
     if (!gl) throw new Error("no WebGL 2 context");
+    // No anisotropic filtering: the viewer asks for 16x on every mipmapped
+    // texture, shadebench never (its sample pattern is each driver's own),
+    // and textures seen at an angle would differ by the filter alone.
+    // Each change made to the viewer is listed in the answer (viewer_patches).
+    const patches = [];
+    const getExtension = gl.getExtension.bind(gl);
+    gl.getExtension = (name) => {
+        if (name !== "EXT_texture_filter_anisotropic") return getExtension(name);
+        if (!patches.includes("no_anisotropic_filtering")) patches.push("no_anisotropic_filtering");
+        return null;
+    };
+    // The tangent frame of a mirrored node. glTF states the bitangent of
+    // the mesh's own attributes, cross(normal, tangent.xyz) * tangent.w,
+    // a direction in the mesh's space that the node's matrix M carries
+    // like the tangent: M * B. The viewer's vertex shader takes the cross
+    // of the normal and tangent already in world space, which under a
+    // mirror (det M < 0) is -M * B: the normal map's green channel turned
+    // over, unlike the same mesh with the node baked into its vertices
+    // (MikkTSpace's handedness turns with the mirrored UV layout; the
+    // viewer draws that one as M * B). So the world cross is multiplied by
+    // the sign of the model matrix's determinant, as shadebench's
+    // converter turns w (convert_build.c).
+    const shaderSource = gl.shaderSource.bind(gl);
+    gl.shaderSource = (shader, src) => {
+        if (src.includes(BITANGENT_W)) {
+            src = src.replace(BITANGENT_W, BITANGENT_W_MIRRORED);
+            if (!patches.includes("mirrored_bitangent")) patches.push("mirrored_bitangent");
+        }
+        shaderSource(shader, src);
+    };
     const view = new GltfView(gl);
     const state = view.createState();
     const loader = new ResourceLoader(view, "./viewer/libs/");
@@ -136,6 +223,7 @@ window.sbRender = async function (req) {
     const parts = req.asset.endsWith(".gltf")
         ? { json: JSON.parse(new TextDecoder().decode(file)), bin: undefined } : glbSplit(file);
     setLights(parts.json, req.lights);
+    const restated = restateMirroredMatrices(parts.json);
     state.gltf = await loader.loadGltf(glbJoin(parts.json, parts.bin));
     state.sceneIndex = state.gltf.scene === undefined ? 0 : state.gltf.scene;
     gl.finish();
@@ -177,6 +265,8 @@ window.sbRender = async function (req) {
         out.push({ name, render_ms: performance.now() - c0, rgba: base64(px) });
     }
     return { load_ms: t1 - t0, environment_ms: t2 - t1, channels: out,
+             mirrored_matrices_restated: restated, viewer_patches: patches,
+             subpixel_bits: gl.getParameter(gl.SUBPIXEL_BITS),
              renderer: gl.getParameter(gl.RENDERER), version: gl.getParameter(gl.VERSION) };
 };
 window.sbReady = true;

@@ -435,6 +435,20 @@ int main(int argc, char **argv)
                        json_string_value(json_object_get(version, "product")), "webgl_renderer",
                        json_string_value(json_object_get(val, "renderer")), "webgl_version",
                        json_string_value(json_object_get(val, "version")));
+    if (answer) {
+        /* What the page changed in the file for the viewer (page.js:
+         * restateMirroredMatrices) and in the viewer itself (its
+         * viewer_patches), and its rasteriser's precision. */
+        json_t *restated = json_object_get(val, "mirrored_matrices_restated");
+        json_object_set_new(answer, "mirrored_matrices_restated",
+                            json_is_array(restated) ? json_incref(restated) : json_array());
+        json_t *patches = json_object_get(val, "viewer_patches");
+        json_object_set_new(answer, "viewer_patches",
+                            json_is_array(patches) ? json_incref(patches) : json_array());
+        json_t *bits = json_object_get(val, "subpixel_bits");
+        if (json_is_integer(bits))
+            json_object_set(answer, "subpixel_bits", bits);
+    }
     size_t i;
     json_t *ch;
     json_array_foreach(chans, i, ch) {

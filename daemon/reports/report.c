@@ -475,7 +475,8 @@ static void summary_html(struct html *h, const json_t *verdict)
     if (!json_array_size(rows))
         return;
     add(h, "<h2>Which technique wins where</h2><table><tr><th class=\"l\">workload</th>"
-           "<th>reference, ms [95%%]</th><th class=\"l\">fastest</th><th>ms</th>"
+           "<th>reference, ms [95%%]</th><th class=\"l\">wins</th>"
+           "<th class=\"l\">fastest swept point</th><th>ms</th>"
            "<th>ratio to the reference [95%%]</th><th class=\"l\">fastest passing "
            "PerceptualDiff</th><th>ms</th><th>ratio [95%%]</th></tr>");
     size_t i;
@@ -488,6 +489,14 @@ static void summary_html(struct html *h, const json_t *verdict)
         escaped(h, str(w, "reference"));
         add(h, " %.3f [%.3f, %.3f]</td>", json_number_value(json_object_get(w, "reference_ms")),
             json_number_value(json_array_get(ci, 0)), json_number_value(json_array_get(ci, 1)));
+        json_t *win = json_object_get(w, "winner");
+        add(h, "<td class=\"l\"><b>");
+        escaped(h, str(win, "technique"));
+        add(h, "</b>%s</td>", json_is_true(json_object_get(win, "reference"))
+                                  ? " (the reference)"
+                              : json_is_true(json_object_get(win, "tied_with_reference"))
+                                  ? "<br>not told apart from the reference"
+                                  : "");
         summary_point(h, json_object_get(w, "fastest"));
         summary_point(h, json_object_get(w, "fastest_passing"));
         add(h, "</tr>");

@@ -460,6 +460,16 @@ json_t *sweep_verdict_json(const json_t *sweep, const char *series)
         }
         if (fastest)
             json_object_set_new(o, "fastest", against(&v, fastest, ref));
+        /* Who wins, the reference included: the reference when it is
+         * measurably faster than the fastest point (a sweep of one
+         * technique against a faster reference has no swept winner). */
+        const struct sv_point *win = !fastest || (ref && sv_faster(ref, fastest)) ? ref : fastest;
+        json_object_set_new(
+            o, "winner",
+            json_pack("{s:s, s:O?, s:f, s:b, s:b}", "technique", win->technique, "values",
+                      win == ref ? NULL : json_object_get(win->row, "values"), "ms", win->ms,
+                      "reference", win == ref,
+                      "tied_with_reference", ref && win != ref && !sv_faster(win, ref)));
         if (fastest_passing)
             json_object_set_new(o, "fastest_passing", against(&v, fastest_passing, ref));
         json_array_append_new(vs, o);

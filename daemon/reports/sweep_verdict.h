@@ -93,7 +93,9 @@ bool sv_faster(const struct sv_point *a, const struct sv_point *b);
  *  "against_reference": [{"workload", "reference", "reference_ms",
  *  "reference_ci": [lo, hi], "fastest": {"technique", "values", "ms",
  *  "ratio", "ratio_ci": [lo, hi], "distinguishable", "tied_with": [...]},
- *  "fastest_passing": {...}}].
+ *  "fastest_passing": {...}, "winner": {"technique", "values" (null for
+ *  the reference), "ms", "reference" (the reference is measurably faster
+ *  than every point), "tied_with_reference"}}].
  * New reference. */
 json_t *sweep_verdict_json(const json_t *sweep, const char *series);
 

@@ -62,11 +62,15 @@ void asset_limits_defaults(struct asset_limits *lim)
     lim->max_images = 4096;
     lim->max_lights = 1024;
     lim->max_cameras = 1024;
+    /* A million empty nodes (10 MB of GLB) took the converter 2.4 GB in
+     * assimp's node tree: 2^18 of them take at most about 630 MB. */
+    lim->max_nodes = 1u << 18;
+    lim->max_cache_bytes = 2ull << 30;
 }
 
 json_t *asset_limits_to_json(const struct asset_limits *lim)
 {
-    return json_pack("{sI sI sI sI sI sI sI sI sI sI}",
+    return json_pack("{sI sI sI sI sI sI sI sI sI sI sI sI}",
                      "max_file_bytes", (json_int_t)lim->max_file_bytes,
                      "max_vertices", (json_int_t)lim->max_vertices,
                      "max_indices", (json_int_t)lim->max_indices,
@@ -76,7 +80,9 @@ json_t *asset_limits_to_json(const struct asset_limits *lim)
                      "max_materials", (json_int_t)lim->max_materials,
                      "max_images", (json_int_t)lim->max_images,
                      "max_lights", (json_int_t)lim->max_lights,
-                     "max_cameras", (json_int_t)lim->max_cameras);
+                     "max_cameras", (json_int_t)lim->max_cameras,
+                     "max_nodes", (json_int_t)lim->max_nodes,
+                     "max_cache_bytes", (json_int_t)lim->max_cache_bytes);
 }
 
 void asset_finish(struct asset *a)
@@ -142,6 +148,8 @@ json_t *asset_describe(const struct asset *a)
         colored += m->has_color;
         why[m->uv1_origin <= ASSET_UV1_GENERATED_OVERLAP ? m->uv1_origin : 0]++;
         waste_weighted += (double)m->uv1_waste * (m->index_count / 3);
+        if (i >= ASSET_DESCRIBE_LIST_MAX)
+            continue; /* counted above, listed no further */
         json_t *attrs = json_pack("[s]", "POSITION");
         json_t *o = json_pack("{so si sI sI ss sf ss}", "name", name_json(m->name),
                 "material", (int)m->material, "vertices", (json_int_t)m->vertex_count,
@@ -165,7 +173,7 @@ json_t *asset_describe(const struct asset *a)
             json_array_append_new(attrs, json_string("COLOR_0"));
         json_object_set_new(o, "attributes", attrs);
     }
-    for (uint32_t i = 0; i < a->material_count; i++) {
+    for (uint32_t i = 0; i < a->material_count && i < ASSET_DESCRIBE_LIST_MAX; i++) {
         const struct asset_material *m = &a->materials[i];
         json_t *slots = json_array();
         if (!slots)
@@ -210,7 +218,8 @@ json_t *asset_describe(const struct asset *a)
     for (uint32_t i = 0; i < a->image_count; i++) {
         const struct asset_image *im = &a->images[i];
         pixels += (uint64_t)im->width * im->height;
-        if (json_array_append_new(texs, json_pack("{so sI sI}", "name", name_json(im->name),
+        if (i < ASSET_DESCRIBE_LIST_MAX &&
+            json_array_append_new(texs, json_pack("{so sI sI}", "name", name_json(im->name),
                                                   "width", (json_int_t)im->width,
                                                   "height", (json_int_t)im->height)))
             goto oom;
@@ -258,6 +267,16 @@ json_t *asset_describe(const struct asset *a)
         json_object_set_new(root, "vertex_colors", json_integer(colored)) ||
         json_object_set_new(root, "ignored", ign))
         goto oom_after;
+    /* What the lists leave out (counted in the totals above). */
+    if (a->mesh_count > ASSET_DESCRIBE_LIST_MAX)
+        json_object_set_new(root, "mesh_list_omitted",
+                            json_integer(a->mesh_count - ASSET_DESCRIBE_LIST_MAX));
+    if (a->material_count > ASSET_DESCRIBE_LIST_MAX)
+        json_object_set_new(root, "materials_omitted",
+                            json_integer(a->material_count - ASSET_DESCRIBE_LIST_MAX));
+    if (a->image_count > ASSET_DESCRIBE_LIST_MAX)
+        json_object_set_new(root, "textures_omitted",
+                            json_integer(a->image_count - ASSET_DESCRIBE_LIST_MAX));
     return root;
 oom:
     json_decref(meshes);
@@ -323,13 +342,15 @@ static bool host_is_little_endian(void)
 /* -- writing: a FILE with a sticky error -- */
 
 struct writer {
-    FILE *f;
+    FILE *f; /* NULL: count the bytes only (asset_file_size) */
     bool failed;
+    uint64_t bytes;
 };
 
 static void w_bytes(struct writer *w, const void *p, size_t n)
 {
-    if (!w->failed && n && fwrite(p, 1, n, w->f) != n)
+    w->bytes += n;
+    if (w->f && !w->failed && n && fwrite(p, 1, n, w->f) != n)
         w->failed = true;
 }
 static void w_u32(struct writer *w, uint32_t v)
@@ -447,6 +468,13 @@ static void write_body(struct writer *w, const struct asset *a)
     w_bytes(w, TRAILER, TRAILER_SIZE);
 }
 
+uint64_t asset_file_size(const struct asset *a)
+{
+    struct writer w = {NULL, false, 0};
+    write_body(&w, a);
+    return w.bytes;
+}
+
 bool asset_file_write(const struct asset *a, const char *path, char *err, size_t errlen)
 {
     if (!host_is_little_endian()) {
@@ -474,7 +502,7 @@ bool asset_file_write(const struct asset *a, const char *path, char *err, size_t
         close(fd);
         goto fail;
     }
-    struct writer w = {fdopen(fd, "wb"), false};
+    struct writer w = {fdopen(fd, "wb"), false, 0};
     if (!w.f) {
         snprintf(err, errlen, "asset cache: %s: %s", tmp, strerror(errno));
         close(fd);
@@ -507,9 +535,11 @@ bool asset_file_write(const struct asset *a, const char *path, char *err, size_t
     }
     free(tmp);
     return true;
-fail:
+fail:;
+    int saved = errno; /* the writer's, for the caller (ENOSPC: no room) */
     unlink(tmp);
     free(tmp);
+    errno = saved;
     return false;
 }
 

@@ -184,6 +184,8 @@ struct asset_limits {
     uint64_t max_texture_pixels;       /* all images together */
     uint32_t max_texture_edge;         /* one image's width or height */
     uint32_t max_meshes, max_materials, max_images, max_lights, max_cameras;
+    uint32_t max_nodes; /* the file's nodes (assimp takes about 2.4 KB for each) */
+    uint64_t max_cache_bytes; /* the cache file the conversion writes (and a job reads whole) */
 };
 
 /* The daemon's defaults: 256 MiB files, 16 M vertices and 48 M indices,
@@ -195,6 +197,9 @@ json_t *asset_limits_to_json(const struct asset_limits *lim);
 /* The cache file: writes a into path (through a temporary and a rename, so
  * a reader never sees half a file). */
 bool asset_file_write(const struct asset *a, const char *path, char *err, size_t errlen);
+/* The bytes asset_file_write would write, counted without writing: the
+ * converter checks them against its limit and the disk's room first. */
+uint64_t asset_file_size(const struct asset *a);
 /* Reads a cache file, checking it against lim; out is finished on failure. */
 bool asset_file_read(struct asset *out, const char *path, const struct asset_limits *lim,
                      char *err, size_t errlen);
@@ -211,8 +216,14 @@ void asset_finish(struct asset *a);
 /* What the loader found, for PUT and GET /v1/assets/NAME: meshes,
  * triangles, vertices, materials (alpha modes, which slots have textures),
  * textures and their sizes, lights by type, cameras by name, bounds, uv1
- * (from the file or generated, and the texel waste), ignored features. New
+ * (from the file or generated, and the texel waste), ignored features. The
+ * per-mesh, per-material and per-texture lists hold the first
+ * ASSET_DESCRIBE_LIST_MAX (the rest counted in the totals and in
+ * mesh_list_omitted, materials_omitted, textures_omitted), so that the
+ * description of an asset within the limits stays small (60,000 meshes
+ * made 11 MB, past what the daemon reads of the converter's answer). New
  * reference, or NULL when out of memory. */
+#define ASSET_DESCRIBE_LIST_MAX 1024
 json_t *asset_describe(const struct asset *a);
 
 #endif

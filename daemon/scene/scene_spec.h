@@ -116,6 +116,11 @@ struct scene_spec {
      * and a gate never compares two different scenes. */
     char asset[SCENE_ASSET_NAME_MAX + 1];
     char asset_sha256[65];
+    /* What the asset takes in memory while a job renders it (its cache read
+     * in, its textures and geometry uploaded), filled in with the hash when
+     * the job is accepted, for the job's cost (daemon/spec/job_cost.h); 0
+     * until then. Not part of the spec's JSON. */
+    double asset_bytes;
     /* Asset scenes (scene.asset or the textured preset): which of the
      * asset's cameras the static pose is ("" its first; digits an index,
      * else a name), whether its KHR_lights_punctual lights are used, and

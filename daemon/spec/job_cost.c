@@ -9,13 +9,13 @@
  * context each), rounded up:
  *  - the harness's own: HDR colour (16 in rgba32f, 8 in rgba16f), depth 4
  *    and the 8-bit resolve 4;
- *  - a technique's planes: 0 (unlit, forward, osl) to 4 (forward_plus,
- *    clustered_forward) and 28 (the deferred family's g-buffers, with pbr);
- *    the estimate cannot tell them apart without GL, so it takes the most;
+ *  - a technique's planes, as its info declares them (planes_bpp: 0 for
+ *    unlit, forward and osl, the heat map's 4 for forward_plus and
+ *    clustered_forward, the g-buffer and the heat map for the deferred
+ *    family, 24 to 48 by their layout, the look and the scene);
  *  - a post effect's: bloom 64, ssao 36, toon 32 in rgba32f; each is taken
  *    at bloom's, halved in rgba16f. */
 #define HARNESS_BPP(hdr) ((hdr) + 8.0)
-#define TECHNIQUE_PLANES_BPP 32.0
 #define POST_EFFECT_BPP(hdr) ((hdr) * 4.0)
 /* A captured frame: RGBA8 in memory, and its light-count map (uint32) for
  * the techniques that publish one. */
@@ -57,12 +57,19 @@ static double hdr_bytes(const struct look_spec *look)
  * output: those take hdr + 8 bytes a sample, and the planes scale by the
  * samples too. Samples as asked: a driver that gives more (llvmpipe: 4 for
  * 2) takes more, which no GL-free estimate can know. */
-static double look_targets_bpp(const struct look_spec *look, int msaa)
+static double look_targets_bpp(const struct job_spec *spec, int technique,
+                               const struct look_spec *look, int msaa)
 {
     double hdr = hdr_bytes(look);
     double samples = msaa > 1 ? msaa : 1;
-    return HARNESS_BPP(hdr) + (msaa > 1 ? (hdr + 8.0) * samples : 0.0) +
-           TECHNIQUE_PLANES_BPP * samples + look->post.count * POST_EFFECT_BPP(hdr);
+    const struct technique_info *info =
+        spec->catalog && technique >= 0 ? spec->catalog->infos[technique] : NULL;
+    double planes = info && info->planes_bpp
+                        ? info->planes_bpp(spec->options[technique].bytes, look,
+                                           scene_spec_is_asset(&spec->scene), (int)samples)
+                        : 0.0;
+    return HARNESS_BPP(hdr) + (msaa > 1 ? (hdr + 8.0) * samples : 0.0) + planes +
+           look->post.count * POST_EFFECT_BPP(hdr);
 }
 
 void job_cost_estimate(const struct job_spec *spec, struct job_cost *out)
@@ -71,14 +78,16 @@ void job_cost_estimate(const struct job_spec *spec, struct job_cost *out)
     int captures = job_spec_capture_count(spec);
     bool reference = spec->reference[0] != '\0';
     *out = (struct job_cost){0};
-    out->targets_bytes = pixels * look_targets_bpp(&spec->look, spec->msaa);
+    out->targets_bytes =
+        pixels * look_targets_bpp(spec, spec->technique_index, &spec->look, spec->msaa);
     out->look_bytes = ibl_bytes(&spec->look.ibl) + shadow_bytes(&spec->look.shadows);
     out->captures_bytes = captures * pixels * CAPTURE_BPP;
     if (reference) {
         /* Its planes, should its look need more than the job's, and the
          * frame it reads back; its captures go straight to PNG. */
-        double extra = look_targets_bpp(&spec->reference_look, spec->msaa) -
-                       look_targets_bpp(&spec->look, spec->msaa);
+        double extra =
+            look_targets_bpp(spec, spec->reference_index, &spec->reference_look, spec->msaa) -
+            look_targets_bpp(spec, spec->technique_index, &spec->look, spec->msaa);
         out->reference_bytes = pixels * ((extra > 0 ? extra : 0) + 4.0) +
                                ibl_bytes(&spec->reference_look.ibl) +
                                shadow_bytes(&spec->reference_look.shadows);
@@ -87,7 +96,9 @@ void job_cost_estimate(const struct job_spec *spec, struct job_cost *out)
         double n2 = (double)spec->reference_supersample * spec->reference_supersample;
         if (n2 > 1)
             out->reference_bytes +=
-                pixels * n2 * (look_targets_bpp(&spec->reference_look, spec->msaa) + 4.0);
+                pixels * n2 *
+                (look_targets_bpp(spec, spec->reference_index, &spec->reference_look, spec->msaa) +
+                 4.0);
         /* temporal.frames: the technique's frames of one capture point are
          * kept while the reference's are drawn, with one of the reference's. */
         if (spec->temporal_frames)
@@ -97,9 +108,12 @@ void job_cost_estimate(const struct job_spec *spec, struct job_cost *out)
     }
     out->series_bytes = (double)spec->frames * job_spec_runs(spec) * SERIES_DOUBLES_PER_FRAME *
                         sizeof(double);
+    /* The asset's decoded textures and geometry, what its upload's size
+     * says nothing of (a 2 KB file can decode to gigabytes). */
+    out->asset_bytes = spec->scene.asset_bytes;
     out->memory_bytes = out->targets_bytes + out->look_bytes + out->captures_bytes +
                         out->reference_bytes + out->metrics_bytes + out->series_bytes +
-                        out->temporal_bytes;
+                        out->temporal_bytes + out->asset_bytes;
     out->frames_total = (double)(spec->frames + spec->warmup_frames) * job_spec_runs(spec);
     out->pixel_frames = pixels * out->frames_total;
     /* "auto" (an asset scene's default) is counted at the most it can be. */
@@ -125,6 +139,7 @@ void job_cost_estimate(const struct job_spec *spec, struct job_cost *out)
          spec->reference_supersample > 1 ? "reference.supersample" : "reference"},
         {out->temporal_bytes, "temporal.frames"},
         {out->series_bytes, "frames"},
+        {out->asset_bytes, "scene.asset"},
     };
     out->memory_field = parts[0].field;
     double most = parts[0].bytes;
@@ -148,6 +163,8 @@ json_t *job_cost_json(const struct job_cost *c)
                           c->metric_pixels);
     if (c->temporal_bytes > 0)
         json_object_set_new(o, "temporal_bytes", json_real(c->temporal_bytes));
+    if (c->asset_bytes > 0)
+        json_object_set_new(o, "asset_bytes", json_real(c->asset_bytes));
     return o;
 }
 
@@ -158,9 +175,11 @@ bool job_cost_admit(const struct job_cost *c, struct job_error *err)
         return true;
     return job_error_set(err, c->memory_field,
                          "the job would take about %.0f MiB (framebuffers %.0f, captures %.0f, "
-                         "shadows and probes %.0f, reference and metrics %.0f), more than the "
-                         "%.0f MiB a job may take (/v1/info: memory.job_bytes)",
+                         "shadows and probes %.0f, reference and metrics %.0f, the asset's "
+                         "textures and geometry %.0f), more than the %.0f MiB a job may take "
+                         "(/v1/info: memory.job_bytes)",
                          c->memory_bytes / 1048576.0, c->targets_bytes / 1048576.0,
                          c->captures_bytes / 1048576.0, c->look_bytes / 1048576.0,
-                         (c->reference_bytes + c->metrics_bytes) / 1048576.0, limit / 1048576.0);
+                         (c->reference_bytes + c->metrics_bytes) / 1048576.0,
+                         c->asset_bytes / 1048576.0, limit / 1048576.0);
 }

@@ -32,6 +32,8 @@ struct job_cost {
     double metrics_bytes;   /* the metrics stage's images and maps (with a reference) */
     double series_bytes;    /* per-frame figures: CPU, frame and GPU times of every pass */
     double temporal_bytes;  /* temporal.frames: one capture point's frames of the technique */
+    double asset_bytes;     /* scene.asset: its cache read in, its textures and geometry
+                             * uploaded (scene.asset_bytes, known once the asset is pinned) */
     double memory_bytes;    /* their sum */
     const char *memory_field; /* the job field that drives the largest part */
     /* Work, in units no rate turns into seconds without the device: the

@@ -34,6 +34,9 @@ json_t *job_figures(const json_t *result)
                                    "value");
     if (json_is_number(ssim))
         json_object_set(o, RK_WORST_SSIM, ssim);
+    /* Timed in slices (accept_sliced_timing): never read as whole frames. */
+    if (json_is_true(json_object_get(result, "sliced")))
+        json_object_set_new(o, "sliced", json_true());
     json_t *dev = json_object_get(result, "device");
     static const char *const keep[] = {"gl_renderer", "gl_version"};
     for (int k = 0; k < 2; k++)

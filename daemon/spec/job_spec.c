@@ -69,8 +69,11 @@ static bool alias_target(const struct technique_catalog *c, int alias, int *tech
     return *technique >= 0 && *opt;
 }
 
-static double default_timeout_s, max_job_s;
+static double default_timeout_s, max_job_s, max_frame_s = JOB_DEFAULT_MAX_FRAME_S;
 static int max_msaa;
+
+void job_spec_set_max_frame_seconds(double seconds) { max_frame_s = seconds > 0 ? seconds : 0; }
+double job_spec_max_frame_seconds(void) { return max_frame_s; }
 
 void job_spec_set_max_msaa(int samples) { max_msaa = samples > 0 ? samples : 0; }
 int job_spec_max_msaa(void) { return max_msaa; }
@@ -105,8 +108,8 @@ void job_spec_defaults(struct job_spec *out, const struct technique_catalog *tec
         snprintf(out->technique, sizeof(out->technique), "%s",
                  techniques->infos[techniques->baseline]->name);
     out->reference_index = -1;
-    out->frames = 300;
-    out->warmup_frames = 10;
+    out->frames = JOB_DEFAULT_FRAMES;
+    out->warmup_frames = JOB_DEFAULT_WARMUP_FRAMES;
     out->capture_interval = 0;
     scene_spec_defaults(&out->scene);
     look_spec_defaults(&out->look);
@@ -352,7 +355,8 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
     static const char *const fixed[] = {"technique", "frames", "warmup_frames",
                                         "capture_interval", "scene", "look", "reference",
                                         "reference_look", "metrics", "repeat", "labels",
-                                        "timeout_s", "temporal", "msaa", "fidelity"};
+                                        "timeout_s", "temporal", "msaa", "fidelity",
+                                        "accept_sliced_timing"};
     enum { NFIXED = sizeof(fixed) / sizeof(fixed[0]) };
     /* Every technique's options live under its own name; an alias is known
      * when the catalogue has the option it stands for. */
@@ -482,7 +486,9 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
                  &out->capture_interval, err) ||
         !jf_get_number(body, "timeout_s", "timeout_s", 0.0, 1e7, &out->timeout_s, err) ||
         !apply_max_seconds(body, out, err) ||
-        !jf_get_int(body, "msaa", "msaa", 1, 8, &out->msaa, err))
+        !jf_get_int(body, "msaa", "msaa", 1, 8, &out->msaa, err) ||
+        !jf_get_bool(body, "accept_sliced_timing", "accept_sliced_timing",
+                     &out->accept_sliced_timing, err))
         return false;
     if (out->msaa & (out->msaa - 1))
         return job_error_set(err, "msaa", "must be 1, 2, 4 or 8 (samples a pixel)");
@@ -602,6 +608,11 @@ bool job_spec_parse_text(const char *text, size_t len,
         return job_error_set(err, "body", "malformed JSON at line %d, column %d: %s",
                     jerr.line, jerr.column, jerr.text);
     }
+    if (!jf_check_numbers(text, len, err)) {
+        json_decref(body);
+        job_spec_defaults(out, techniques);
+        return false;
+    }
     bool ok = job_spec_parse(body, techniques, out, err);
     json_decref(body);
     return ok;
@@ -685,6 +696,10 @@ json_t *job_spec_to_json(const struct job_spec *spec)
         json_object_set_new(out, "temporal", json_pack("{s:i}", "frames", spec->temporal_frames));
     json_object_set_new(out, "timeout_s", json_real(spec->timeout_s));
     json_object_set_new(out, "msaa", json_integer(spec->msaa));
+    /* Only when set, so that the specs of whole-timed jobs read (and hash)
+     * as they always did. */
+    if (spec->accept_sliced_timing)
+        json_object_set_new(out, "accept_sliced_timing", json_true());
     if (spec->reference[0])
         json_object_set_new(out, "metrics", metrics_to_json(&spec->metrics));
     if (spec->reference_look_given)

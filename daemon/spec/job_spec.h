@@ -18,6 +18,12 @@
 #include "daemon/techniques/catalog.h"
 
 #define JOB_MAX_BODY_BYTES (64 * 1024)
+/* What a job that names neither gets: sized for a first try on any
+ * renderer (at the default 1080x720 over the grid's 10 lights, seconds to
+ * a minute on a 2-core CPU renderer: docs/api.md); a benchmark names its
+ * own. */
+#define JOB_DEFAULT_FRAMES 60
+#define JOB_DEFAULT_WARMUP_FRAMES 5
 #define JOB_MAX_CAPTURE_BYTES (1024.0 * 1024.0 * 1024.0)
 #define JOB_MAX_CAPTURES 1000
 
@@ -79,6 +85,10 @@ struct job_spec {
     int msaa;                      /* samples a pixel of the output (1, 2, 4, 8); the
                                     * reference renders at the same count */
     struct fidelity_spec fidelity; /* compared with the Khronos viewer (fidelity_spec.h) */
+    /* A whole frame over the render thread's bound (job_spec_max_frame_seconds)
+     * is timed in slices, every figure marked so, instead of failing before
+     * timing ("accept_sliced_timing": true; false by default). */
+    bool accept_sliced_timing;
 };
 
 /* The timeout_s a job gets when it names none (--job-timeout). Set once at
@@ -92,6 +102,14 @@ double job_spec_default_timeout(void);
  * before any thread parses jobs. */
 void job_spec_set_max_seconds(double seconds);
 double job_spec_max_seconds(void);
+
+/* The longest one whole frame may hold the render thread, seconds
+ * (--max-frame-seconds; default JOB_DEFAULT_MAX_FRAME_S): a job whose frame
+ * measures more fails before timing unless it accepts sliced timing
+ * (daemon/harness/measure.c). Set once at start-up, before any job runs. */
+#define JOB_DEFAULT_MAX_FRAME_S 2.0
+void job_spec_set_max_frame_seconds(double seconds);
+double job_spec_max_frame_seconds(void);
 
 /* The most MSAA samples the device renders (gpu_caps.max_msaa), so that a
  * job over it is refused naming msaa at submission; 0 (the default, before

@@ -216,7 +216,7 @@ static json_t *point_defaults(const struct sweep_spec *s, json_t *job)
     if (!ci || json_integer_value(ci) == 0) {
         json_t *frames = json_object_get(job, "frames");
         json_object_set_new(job, "capture_interval",
-                            json_integer(frames ? json_integer_value(frames) : 300));
+                            json_integer(frames ? json_integer_value(frames) : JOB_DEFAULT_FRAMES));
     }
     if (s->kind == SWEEP_FIND && s->criterion == CRITERION_STABLE && !json_object_get(job, "repeat"))
         json_object_set_new(job, "repeat", json_pack("{s:b, s:i}", "auto", 1, "max", 10));
@@ -259,7 +259,8 @@ static bool check_as_point(const json_t *job, const struct technique_catalog *te
     json_t *ci = json_object_get(point, "capture_interval"), *nf = json_object_get(point, "frames");
     if (!ci || (json_is_integer(ci) && json_integer_value(ci) == 0))
         json_object_set_new(point, "capture_interval",
-                            json_integer(json_is_integer(nf) ? json_integer_value(nf) : 300));
+                            json_integer(json_is_integer(nf) ? json_integer_value(nf)
+                                                        : JOB_DEFAULT_FRAMES));
     bool ok = check_point(point, techniques, field, err);
     json_decref(point);
     return ok;

@@ -44,6 +44,14 @@ json_t *sweep_table_row(const json_t *job, json_t *values)
     }
     if (rep)
         json_object_set(row, RK_STABLE, json_object_get(rep, RK_STABLE));
+    /* A point timed in slices (accept_sliced_timing) says so, and its
+     * timing cells too, so that no chart or verdict reads it beside whole
+     * frames unmarked (sweep_table_result names the mix). */
+    if (json_is_true(json_object_get(r, "sliced"))) {
+        json_object_set_new(row, "sliced", json_true());
+        for (int k = 0; k < 3; k++)
+            json_object_set_new(json_object_get(row, series[k]), "sliced", json_true());
+    }
     /* Execution time of the timed frames, over runs: what the thesis tabled. */
     json_t *runs = json_object_get(r, RK_RUNS);
     size_t nruns = runs ? json_array_size(runs) : 1;
@@ -95,6 +103,28 @@ json_t *sweep_table_result(const struct sweep_spec *spec, const json_t *points)
             json_array_append(passing, json_object_get(row, "values"));
     }
     json_t *res = json_pack("{s:o}", "pdiff_passing", passing);
+    /* Timing rules: a table that mixes points timed in slices with points
+     * timed whole says so, with the sliced points' values. */
+    json_t *sliced = json_array();
+    size_t timed = 0;
+    json_array_foreach(points, i, row) {
+        if (json_object_get(row, RK_FRAME_MS))
+            timed++;
+        if (json_is_true(json_object_get(row, "sliced")))
+            json_array_append(sliced, json_object_get(row, "values"));
+    }
+    if (json_array_size(sliced) > 0)
+        json_object_set_new(res, "timing_rules",
+                            json_pack("{s:s, s:o}", "warning",
+                                      json_array_size(sliced) < timed
+                                          ? "some points were timed in slices "
+                                            "(accept_sliced_timing) and others whole: their "
+                                            "times do not compare"
+                                          : "every point was timed in slices "
+                                            "(accept_sliced_timing)",
+                                      "sliced_points", sliced));
+    else
+        json_decref(sliced);
     if (spec->nparams == 1) {
         json_t *values;
         json_array_foreach(passing, i, values) {

@@ -17,6 +17,7 @@
  * single atomic store. GL-free. */
 
 #include <stdbool.h>
+#include <string.h>
 
 #include "daemon/store/records.h"
 
@@ -28,6 +29,15 @@ struct render_state {
     double busy_s;            /* busy: seconds since the job began on the thread */
     double since_progress_s;  /* busy: seconds since the last progress; idle: idle time */
 };
+
+/* The phases of a job that ended early while what the GPU still has of it
+ * finishes (runner.c): /healthz calls the thread "draining" then. */
+#define RENDER_PHASE_DRAINING_CANCELLED "draining a cancelled job"
+#define RENDER_PHASE_DRAINING_FAILED "draining a failed job"
+static inline bool render_state_draining(const struct render_state *s)
+{
+    return s->busy && s->phase && strncmp(s->phase, "draining", 8) == 0;
+}
 
 /* Render thread: a job begins (phase: a string literal such as "setup"),
  * changes phase (counts as progress), ends (the thread is idle). */

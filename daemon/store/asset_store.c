@@ -44,7 +44,8 @@ bool asset_store_original_path(const char *state_dir, const char *sha256, const 
                                char *out, size_t cap)
 {
     if (!asset_store_sha256_valid(sha256) ||
-        (strcmp(ext, "glb") != 0 && strcmp(ext, "gltf") != 0 && strcmp(ext, "hdr") != 0)) {
+        (strcmp(ext, "glb") != 0 && strcmp(ext, "gltf") != 0 && strcmp(ext, "hdr") != 0 &&
+         strcmp(ext, "exr") != 0)) {
         if (cap)
             out[0] = '\0';
         return false;

@@ -35,8 +35,10 @@ bool asset_store_sha256_valid(const char *sha256);
  * fit or the hash is not 64 lowercase hex digits (so that no spec can make
  * the render thread open another path). */
 bool asset_store_cache_path(const char *state_dir, const char *sha256, char *out, size_t cap);
-/* STATE_DIR/assets/SHA256.EXT, ext "glb", "gltf" or "hdr" (an environment
- * map: its cache file holds the decoded image, daemon/scene/environment.h). */
+/* STATE_DIR/assets/SHA256.EXT, ext "glb", "gltf", "hdr" or "exr" (an
+ * environment map: its cache file holds the decoded image,
+ * daemon/scene/environment.h; an OpenEXR one's SHA256.hdr is its Radiance
+ * copy for the Khronos viewer, which reads only .hdr). */
 bool asset_store_original_path(const char *state_dir, const char *sha256, const char *ext,
                                char *out, size_t cap);
 /* STATE_DIR/assets. */

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/statvfs.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -299,7 +300,9 @@ static bool open_writer(struct store *s, bool *damaged, char *err, size_t errlen
              STORE_SCHEMA_VERSION);
     if (v < STORE_SCHEMA_VERSION && v > 0)
         LOG(LOG_INFO, "store: %s: schema %d to %d", s->path, v, STORE_SCHEMA_VERSION);
-    if (!exec(s, s->writer, sql, err, errlen)) {
+    /* Written only when it changes: a store opened as it is writes nothing
+     * (a full disk's start, store_open). */
+    if (v != STORE_SCHEMA_VERSION && !exec(s, s->writer, sql, err, errlen)) {
         *damaged = damaged_code(sqlite3_extended_errcode(s->writer));
         sqlite3_exec(s->writer, "ROLLBACK", NULL, NULL, NULL);
         return false;
@@ -410,6 +413,15 @@ static void note_last_ids(struct store *s)
         reader_give(s, db);
 }
 
+/* Less free space than the store's reserve holds: too little to open a
+ * store, and what the reserve can give back is needed. */
+static bool disk_nearly_full(const char *state_dir)
+{
+    struct statvfs vfs;
+    return statvfs(state_dir, &vfs) == 0 &&
+           (uint64_t)vfs.f_bavail * vfs.f_frsize < STORE_RESERVE_BYTES;
+}
+
 struct store *store_open(const char *state_dir, char *err, size_t errlen)
 {
     struct store *s = calloc(1, sizeof(*s));
@@ -428,7 +440,24 @@ struct store *store_open(const char *state_dir, char *err, size_t errlen)
     pthread_mutex_init(&s->pool_lock, NULL);
     pthread_cond_init(&s->pool_free, NULL);
     bool damaged;
-    if (!open_writer(s, &damaged, err, errlen)) {
+    bool opened = open_writer(s, &damaged, err, errlen);
+    if (!opened && !damaged && !s->memory && disk_nearly_full(s->state_dir)) {
+        /* A disk another user filled while the daemon was down: the
+         * reserve's room (store_reserve.h) is what lets the store open (its
+         * log and shared memory take a little), so it is given back, and the
+         * daemon starts as on a full disk: reads served, nothing new
+         * accepted (507) until the room can be taken again, which
+         * store_reserve_ready tries each second. */
+        close_writer(s);
+        s->reserve = store_reserve_open(s->state_dir);
+        if (s->reserve && store_reserve_release(s->reserve)) {
+            LOG(LOG_WARN, "store: %s; the disk of %s is full: the store's reserve is given "
+                "back so that it opens; nothing is accepted until there is room again", err,
+                s->state_dir);
+            opened = open_writer(s, &damaged, err, errlen);
+        }
+    }
+    if (!opened) {
         close_writer(s);
         if (!damaged)
             goto fail;
@@ -444,11 +473,12 @@ struct store *store_open(const char *state_dir, char *err, size_t errlen)
     }
     note_last_ids(s);
     reap_noted(s);
-    if (!s->memory)
+    if (!s->memory && !s->reserve)
         s->reserve = store_reserve_open(s->state_dir);
     return s;
 
 fail:
+    store_reserve_close(s->reserve);
     pthread_cond_destroy(&s->pool_free);
     pthread_mutex_destroy(&s->pool_lock);
     pthread_mutex_destroy(&s->write_lock);

@@ -16,6 +16,8 @@
 #include "common/frame_needs.h"
 #include "common/options.h"
 
+struct look_spec;
+
 /* Bytes of one technique's options struct, stored inline in a job spec. */
 #define TECHNIQUE_OPTIONS_BYTES OPT_MAX_BYTES
 /* Named passes a technique may declare (the harness adds its own). */
@@ -32,6 +34,10 @@ enum technique_flag {
      * drop (result.<name>.overflow.frames), so a sweep's no_overflow
      * criterion can judge it. */
     TECHNIQUE_BOUNDED_LIGHT_LISTS = 1u << 1,
+    /* It reads no light: the harness makes neither the look's shadow maps
+     * nor its probes for it, so that it pays only for what it draws (the
+     * cost floor). */
+    TECHNIQUE_READS_NO_LIGHT = 1u << 2,
 };
 
 struct technique_info {
@@ -48,6 +54,12 @@ struct technique_info {
      * (common/frame_needs.h: history frames, jitter, motion vectors), as
      * effects declare it; NULL for none (every frame drawn afresh). */
     void (*needs)(const void *opts, struct frame_needs *out);
+    /* Bytes a pixel of the planes it draws beside the harness's output
+     * (g-buffers, the heat map), every MSAA sample counted, for its options,
+     * the look and whether the scene is textured: what the memory estimate
+     * (daemon/jobs/job_cost.h) charges it. NULL: none. */
+    double (*planes_bpp)(const void *options, const struct look_spec *look, bool textured,
+                         int samples);
 };
 
 /* Every registered technique's info, in registry order (the order of

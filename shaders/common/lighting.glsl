@@ -54,39 +54,46 @@ vec3 light_position(int i, int row)
 // (KHR_lights_punctual), cut at the radius without one (daemon/scene/
 // scene.h: enum scene_light_falloff). A directional light (Lpos unused) is
 // unattenuated and lights every surface facing it, from -direction.
+// How much of light i reaches P (0: none; before the surface and shadows)
+// and its direction L from P.
+float light_reach(int i, vec3 Lpos, vec3 P, out vec3 L)
+{
+    int type = light_type(i);
+    if (type == LIGHT_DIRECTIONAL) {
+        L = -lights[i].direction_type.xyz;
+        return 1.0;
+    }
+    vec3 Lv = Lpos - P;
+    float r = lights[i].color_radius.w;
+    float d2 = dot(Lv, Lv);
+    L = vec3(0.0, 0.0, 1.0);
+    if (d2 >= r * r)
+        return 0.0;
+    float att;
+    if (int(lights[i].falloff.x) == LIGHT_FALLOFF_GLTF) {
+        float range = lights[i].falloff.y;
+        att = 1.0 / max(d2, 1e-8);
+        if (range > 0.0) {
+            float q = d2 / (range * range);
+            att *= clamp(1.0 - q * q, 0.0, 1.0);
+        }
+    } else {
+        att = 1.0 - d2 / (r * r);
+        att *= att;
+    }
+    L = Lv * inversesqrt(d2);
+    if (type == LIGHT_SPOT)
+        att *= max(light_spot_falloff(i, -L), 0.0);
+    return att;
+}
+
 vec3 light_contribution(int i, vec3 Lpos, vec3 P, vec3 N, vec3 V, Material m)
 {
     int type = light_type(i);
     vec3 L;
-    float att;
-    if (type == LIGHT_DIRECTIONAL) {
-        L = -lights[i].direction_type.xyz;
-        att = 1.0;
-    } else {
-        vec3 Lv = Lpos - P;
-        float r = lights[i].color_radius.w;
-        float d2 = dot(Lv, Lv);
-        if (d2 >= r * r)
-            return vec3(0.0);
-        if (int(lights[i].falloff.x) == LIGHT_FALLOFF_GLTF) {
-            float range = lights[i].falloff.y;
-            att = 1.0 / max(d2, 1e-8);
-            if (range > 0.0) {
-                float q = d2 / (range * range);
-                att *= clamp(1.0 - q * q, 0.0, 1.0);
-            }
-        } else {
-            att = 1.0 - d2 / (r * r);
-            att *= att;
-        }
-        L = Lv * inversesqrt(d2);
-        if (type == LIGHT_SPOT) {
-            float cone = light_spot_falloff(i, -L);
-            if (cone <= 0.0)
-                return vec3(0.0);
-            att *= cone;
-        }
-    }
+    float att = light_reach(i, Lpos, P, L);
+    if (att <= 0.0)
+        return vec3(0.0);
     float nl = dot(N, L);
     if (nl <= 0.0)
         return vec3(0.0);

@@ -5,7 +5,10 @@ file or generated with its waste and why, a TEXCOORD_1 whose charts
 overlap caught, each texture's uv set and transform, the vertex
 attributes, COLOR_0, ignored features), decoded texels read
 back from the cache file, no cache left by a refusal, and the process
-limits. No daemon, no GL."""
+limits; issue 34's hostile files (a JPEG or PNG whose header lies about
+its size, an unused mesh, node chains of 256 and 257 levels, bad base64, a
+data URI longer than byteLength, a million root nodes, 60,000 mesh nodes
+under a CPU-time limit). No daemon, no GL."""
 
 import json
 import os
@@ -17,6 +20,7 @@ import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gltf_gen  # noqa: E402
+import testlib  # noqa: E402
 from testlib import check, finish  # noqa: E402
 
 CONVERTER = os.environ.get("SHADEBENCH_ASSET", "./shadebench-asset")
@@ -136,7 +140,8 @@ def check_good(name, entry, doc, cache):
 def main():
     tmp = tempfile.mkdtemp(prefix="e2e_assets.")
     try:
-        manifest = gltf_gen.build_all(tmp)
+        manifest = gltf_gen.build_all(tmp, hostile_big=True,
+                                      cpu_seconds=int(60 * testlib.TIME_SCALE))
         check(len(manifest) >= 20, "generator wrote %d assets" % len(manifest))
         for entry in manifest:
             name = entry["file"]
@@ -148,6 +153,13 @@ def main():
                 continue
             if rc == 0:
                 check(os.path.exists(cache), "%s: cache written" % name)
+                # The daemon reads at most 1 MiB of it (ASSETS_MAX_STDOUT).
+                check(len(out) < (1 << 20), "%s: the description is %d bytes, under 1 MiB"
+                      % (name, len(out)))
+                if doc and doc.get("meshes", 0) > 1024:
+                    check(len(doc.get("mesh_list", [])) == 1024 and
+                          doc.get("mesh_list_omitted") == doc["meshes"] - 1024,
+                          "%s: the mesh list holds 1024 meshes and counts the rest" % name)
                 check_good(name, entry, doc, cache)
             else:
                 check(doc is not None and set(doc) == {"status", "field", "message"},

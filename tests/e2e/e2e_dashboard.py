@@ -85,7 +85,7 @@ try:
         check(d.wait(job_id)["status"] == "done", "job %s done" % job_id)
     sw = d.wait_sweep(sweep_id)
     check(sw["status"] == "done", "sweep done")
-    long_job = d.submit({"technique": "forward", "frames": 1000000, "warmup_frames": 0,
+    long_job = d.submit({"technique": "forward", "frames": 1000000, "warmup_frames": 0, "timeout_s": 0,
                          "scene": {"width": 32, "height": 24, "sphere_segments": 8}})
     deadline = time.time() + 60 * T
     while d.json("GET", "/v1/jobs/" + long_job)[1]["progress"]["frames_done"] < 1 and time.time() < deadline:

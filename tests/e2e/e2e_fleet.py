@@ -113,6 +113,13 @@ def test_two_devices_against_daemon(cluster, tmp):
               "array_task_id" in slurm and "job_id" in slurm)
         if not check(ok, "each row names its device, node and Slurm ids: %s" % dev):
             break
+        # --device allocated: the row says which device the task opened and
+        # why (the test cluster's gres, File=/dev/null, is no GPU device).
+        sel = dev.get("selection", {})
+        if not check(sel.get("asked") == "allocated" and "SLURM_" in sel.get("why", "") and
+                     "the default choice" in sel.get("why", "") and "bus_id" in dev,
+                     "each row records the device it opened and why: %s" % sel):
+            break
     with open(os.path.join(fleet, "table.csv")) as f:
         head = f.readline()
     check(head.startswith("device,node,gl_renderer,"), "the CSV has a device column: %s" % head)

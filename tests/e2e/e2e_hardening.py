@@ -264,6 +264,28 @@ try:
                                b"Transfer-Encoding: chunked\r\n\r\n{}")
     check(status == 400 and body["error"]["field"] == "Transfer-Encoding",
           "Content-Length with chunks: 400 JSON (%s %s)" % (status, body))
+    # Issue 34's small ones: two Host headers, a percent-encoding that is
+    # not one, a number a double cannot hold in an integer field.
+    status, body = raw(d.port, b"GET /v1/jobs HTTP/1.1\r\nHost: x\r\nHost: y\r\n\r\n")
+    check(status == 400 and body["error"]["field"] == "Host",
+          "two Host headers: 400 naming Host (%s %s)" % (status, body))
+    status, body = raw(d.port, b"GET /v1/jobs?status=%zz HTTP/1.1\r\nHost: x\r\n\r\n")
+    check(status == 400 and body["error"]["field"] == "url",
+          "%%zz in a query: 400 naming url (%s %s)" % (status, body))
+    status, body = raw(d.port, b"GET /v1/jobs/%4 HTTP/1.1\r\nHost: x\r\n\r\n")
+    check(status == 400 and body["error"]["field"] == "url",
+          "a cut percent-encoding in the path: 400 naming url (%s %s)" % (status, body))
+    # Fields where 0 is a valid value, so that reading the number as 0
+    # would have been accepted.
+    for text, field in ((b'{"warmup_frames": 1e-400}', "warmup_frames"),
+                        (b'{"scene": {"light_speed": -1E-999}}', "scene.light_speed")):
+        status, body = d.json("POST", "/v1/jobs", text)
+        check(status == 400 and body.get("error", {}).get("field") == field,
+              "%s: 400 naming %s, not read as 0 (%s %s)" % (text, field, status, body))
+    status, body = d.json("POST", "/v1/sweeps", b'{"base": {"frames": 2}, "vary": '
+                                                b'{"warmup_frames": [1, 1e-400]}}')
+    check(status == 400 and body.get("error", {}).get("field") == "vary.warmup_frames[1]",
+          "a sweep's 1e-400: 400 naming vary.warmup_frames[1] (%s %s)" % (status, body))
     status, body = raw(d.port, b"GET /healthz HTTP/1.1\r\nHost: x\r\nX-Big: " + b"a" * 9000 +
                        b"\r\n\r\n")
     check(status == 431 and body["error"]["field"] == "headers",
@@ -337,6 +359,12 @@ try:
     check(status == 200, "a 3000-byte token is accepted")
     status, _ = d.json("GET", "/v1/info", headers={"Authorization": "Bearer " + token[:-1]})
     check(status == 401, "a token one byte short is refused")
+    # RFC 9110: the scheme is case-insensitive.
+    for scheme in ("bearer ", "BEARER ", "Bearer  "):
+        status, _ = d.json("GET", "/v1/info", headers={"Authorization": scheme + token})
+        check(status == 200, "the scheme written %r is accepted" % scheme)
+    status, _ = d.json("GET", "/v1/info", headers={"Authorization": "Basic " + token})
+    check(status == 401, "another scheme is refused")
 finally:
     testlib.stop_and_check(d)
 with open(token_file, "w") as f:
@@ -468,7 +496,7 @@ try:
           order.index(named[0]) >= order.index(seen[-1]),
           "a timeout names the phase the job was in (%s): %s" % (seen, body.get("error")))
     status, info = d.json("GET", "/v1/info")
-    check(info["limits"].get("default_job_timeout_s") == 86400, "the default timeout is in /v1/info")
+    check(info["limits"].get("default_job_timeout_s") == 1800, "the default timeout (1800 s) is in /v1/info")
 finally:
     testlib.stop_and_check(d)
 testlib.finish("e2e_hardening")

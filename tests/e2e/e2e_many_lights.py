@@ -163,8 +163,12 @@ try:
                          "clustered_deferred overflowing with fallback")
     ov = done.get("result", {}).get("clustered_deferred", {}).get("overflow", {})
     check(ov.get("frames") == 4 and ov.get("cells_per_frame", {}).get("max", 0) > 0
-          and ov.get("lights_dropped_per_frame", {}).get("max", 0) > 0 and ov.get("first_frame") == 1,
+          and ov.get("entries_unlisted_per_frame", {}).get("max", 0) > 0
+          and ov.get("first_frame") == 1,
           "fallback counts the overflow per frame: %s" % ov)
+    check(ov.get("lights_dropped_per_frame", {}).get("max", -1) == 0,
+          "fallback drops no light, and the counter says so: %s"
+          % ov.get("lights_dropped_per_frame"))
     for tech in ("clustered_forward", "clustered_deferred"):
         done = d.run(job(tech, 256, dict(tiny, overflow="fail")))
         err = done.get("error") or ""
@@ -237,25 +241,40 @@ try:
     ov = done.get("result", {}).get("clustered_forward", {}).get("overflow", {})
     check(ov.get("frames") == 0 and ov.get("first_frame") is None, "no overflow at defaults: %s" % ov)
 
-    # The heat map grows with the light count and is served beside the frames.
-    means = []
+    # The heat map grows with the light count and is served beside the frames,
+    # on one absolute scale (the same colour is the same count in every job:
+    # 16 lights never reach white, which per-image scaling gave the largest
+    # count of any map), with the scale in the result and a legend strip
+    # under the map.
+    means, legends = [], []
     for lights in (16, 256):
         done = d.run(job("clustered_deferred", lights, frames=2, capture=1, reference=None))
         heat = done.get("result", {}).get("heatmap", {})
         caps = heat.get("captures", [])
-        check(len(caps) == 2 and heat.get("unit") and heat.get("ramp"),
-              "heat map per capture: %s" % heat)
+        scale = heat.get("scale") or {}
+        check(len(caps) == 2 and heat.get("unit") and heat.get("ramp") and
+              scale.get("max") == 65536 and scale.get("map_rows") == 120 and
+              scale.get("ticks", [None])[-1] == 65536,
+              "heat map per capture, on the one scale: %s" % heat)
         if caps:
             means.append(caps[-1]["mean"])
             path = os.path.join(d.tmp, "heat%d.png" % lights)
-            check(d.download(caps[-1]["url"], path) == 200 and
-                  (testlib.png_info(path) or {}).get("width") == 160,
-                  "heat map PNG served at %s" % caps[-1]["url"])
-            check(caps[-1]["max"] >= caps[-1]["mean"] > 0 and caps[-1]["scale_max"] == caps[-1]["max"],
-                  "heat map figures: %s" % caps[-1])
+            info = testlib.png_info(path) if d.download(caps[-1]["url"], path) == 200 else None
+            check(info and info.get("width") == 160 and
+                  info.get("height") == 120 + scale.get("legend_rows", -1),
+                  "heat map PNG served at %s, the legend under the map: %s" % (caps[-1]["url"], info))
+            check(caps[-1]["max"] >= caps[-1]["mean"] > 0, "heat map figures: %s" % caps[-1])
+            if info:
+                w, h, px = testlib.png_pixels(path)
+                legends.append(px[120 * w:])
+                whites = sum(1 for p in px[:120 * w] if p == (255, 255, 255))
+                check(lights != 16 or whites == 0,
+                      "16 lights stay far from white on the absolute scale: %d white pixels" % whites)
             status, _, _ = d.request("GET", "/v1/jobs/%s/heatmap/99.png" % done["id"])
             check(status == 404, "no heat map for an uncaptured frame: %d" % status)
     check(len(means) == 2 and means[1] > 2 * means[0], "heat grows with the lights: %s" % means)
+    check(len(legends) == 2 and legends[0] == legends[1] and legends[0],
+          "the legend strip is the same in every map")
     done = d.run(job("forward", 16, frames=2, capture=1, reference=None))
     check("heatmap" not in done.get("result", {}), "forward publishes no heat map")
 

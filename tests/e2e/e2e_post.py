@@ -118,7 +118,8 @@ try:
           "bloom's passes have GPU time")
     status, _, csv = d.request("GET", "/v1/jobs/%s/timings.csv" % bloom_r.get("_id"))
     header = csv.decode().splitlines()[0].split(",") if status == 200 else []
-    check(header[4:] == ["gpu_%s_ms" % p for p in want], "timings.csv has each pass: %s" % header)
+    check(header[4:] == ["gpu_%s_ms" % p for p in want] + ["drawn_whole"],
+          "timings.csv has each pass, then drawn_whole: %s" % header)
     if bloomed:
         darker = sum(1 for a, b in zip(base, bloomed) if any(y < x for x, y in zip(a, b)))
         changed = [a != b for a, b in zip(base, bloomed)]

@@ -20,7 +20,11 @@ computed by hand (64x64 images, a frame or two each):
   {"asset": ...} draws it behind the scene (its hot spot straight ahead
   along +x, its sky above); an environment named as scene.asset (and a
   glTF named as the environment) is refused naming the field; deleted, its
-  files go;
+  files go; the same map as OpenEXR (half floats, zlib; float and tiled;
+  Y alone) uploads, is described with the Radiance copy the Khronos viewer
+  reads, and renders as the .hdr does (every pixel within 2 levels); a cut
+  .exr and one whose data window claims 100000 x 50000 pixels are refused
+  422 the same way;
 - an asset scene's look defaults to tonemap pbr_neutral."""
 
 import math
@@ -267,6 +271,7 @@ def check_environment(d):
               "the spec pins the environment's hash: %s" % env)
     testlib.rejects(d, dict(BASE, technique="forward", scene={"asset": "sky.hdr"}),
                     "scene.asset")
+    check_openexr(d, look, cam, px if done.get("status") == "done" else None)
     # Deleted, its files go: the upload, the cache and the description.
     status, body = d.json("GET", "/v1/assets/sky.hdr")
     sha = body.get("sha256", "")
@@ -278,6 +283,55 @@ def check_environment(d):
                             look={"lighting": "pbr",
                                   "ibl": {"environment": {"asset": "quad.glb"}}}),
                     "look.ibl.environment.asset")
+
+
+def check_openexr(d, look, cam, hdr_pixels):
+    """The same sky as OpenEXR: described, its Radiance copy written,
+    rendered as the .hdr is; a truncated and a huge one refused."""
+    variants = (("sky.exr", {}), ("sky_float.exr", {"compression": "none", "pixel_type": "float"}),
+                ("sky_tiled.exr", {"compression": "zips", "tile": (16, 8)}),
+                ("sky_grey.exr", {"channels": "Y"}))
+    for name, kw in variants:
+        status, body = d.json("PUT", "/v1/assets/" + name, hdr_gen.sky_and_ground_exr(**kw))
+        desc = body.get("description", {})
+        check(status == 201 and desc.get("kind") == "environment" and body.get("format") == "exr"
+              and desc.get("format") == "openexr" and desc.get("viewer_copy") == "radiance_hdr"
+              and (desc.get("width"), desc.get("height")) == (64, 32),
+              "an OpenEXR image (%s) uploads as an environment with a Radiance copy for the "
+              "viewer: %s %s" % (kw or "half, zip", status, body))
+        sha = body.get("sha256", "")
+        copy = os.path.join(d.state, "assets", sha + ".hdr")
+        check(os.path.exists(copy) and open(copy, "rb").read(2) == b"#?",
+              "%s: its Radiance copy is in the store (%s)" % (name, copy))
+    if hdr_pixels is not None:
+        for name in ("sky.exr", "sky_tiled.exr"):
+            exr_look = dict(look, ibl=dict(look["ibl"], environment={"asset": name}))
+            done = d.run(dict(BASE, technique="forward", look=exr_look,
+                              scene={"preset": "sphere", "width": W, "height": H, "camera": cam}))
+            if check(done.get("status") == "done", "a look with %s renders: %s"
+                     % (name, done.get("error"))):
+                px = capture(d, done, name)
+                worst = max(max(abs(a - b) for a, b in zip(p, q)) for p, q in zip(px, hdr_pixels))
+                check(worst <= 2, "%s renders as the same .hdr does: largest difference %d levels"
+                      % (name, worst))
+    good = hdr_gen.sky_and_ground_exr()
+    status, body = d.json("PUT", "/v1/assets/cut.exr", good[:len(good) * 2 // 3])
+    err = body.get("error", {})
+    check(status == 422 and err.get("field") == "body" and "truncated" in err.get("message", ""),
+          "a truncated .exr is refused 422 saying so: %s %s" % (status, err))
+    huge = hdr_gen.exr_bytes(8, 2, lambda x, y: (1, 1, 1), header_size=(100000, 50000))
+    status, body = d.json("PUT", "/v1/assets/huge.exr", huge)
+    err = body.get("error", {})
+    check(status == 422 and err.get("field") == "limits.max_environment_edge",
+          "an .exr whose data window claims 100000 x 50000 pixels is refused 422 from its "
+          "header: %s %s" % (status, err))
+    status, body = d.json("GET", "/v1/assets/sky.exr")
+    sha = body.get("sha256", "")
+    status, _ = d.json("DELETE", "/v1/assets/sky.exr")
+    left = [f for f in os.listdir(os.path.join(d.state, "assets")) if f.startswith(sha)]
+    check(status == 200 and sha and not left,
+          "a deleted OpenEXR environment leaves none of its files (the copy too): %s %s"
+          % (status, left))
 
 
 def main():

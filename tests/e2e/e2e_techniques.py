@@ -103,8 +103,8 @@ try:
               "%s: result times every declared pass, then resolve: %s" % (name, sections))
         status, _, csv = d.request("GET", "/v1/jobs/%s/timings.csv" % done.get("id"))
         header = csv.decode().splitlines()[0].split(",") if status == 200 else []
-        check(header[4:] == ["gpu_%s_ms" % p for p in t["passes"] + ["resolve"]],
-              "%s: timings.csv has a column per pass: %s" % (name, header))
+        check(header[4:] == ["gpu_%s_ms" % p for p in t["passes"] + ["resolve"]] + ["drawn_whole"],
+              "%s: timings.csv has a column per pass, then drawn_whole: %s" % (name, header))
         if name != "unlit":
             ssim = result.get("quality", {}).get("worst_ssim", {}).get("value", 0)
             check(ssim >= SSIM_BOUND, "%s agrees with forward: SSIM %.5f >= %s" % (name, ssim, SSIM_BOUND))

@@ -715,8 +715,12 @@ def colors_asset(as_attribute):
         cols = None
         if as_attribute:
             cols = (list(rgba8) * n, 5121, "VEC4") if k == 0 else (list(rgbf) * n, 5126, "VEC3")
+        # At y 0.95 the boxes' horizontal edges fall 0.08 px or more from
+        # the pixel centres' rows at 160x120 (at 0.9 their lower edges lay
+        # 0.013 px above row 80's: the viewer's rasteriser, which snaps
+        # vertices to 1/16 px, covered that row and llvmpipe did not).
         g.node(mesh=g.mesh(geom, material=mat, uv1=False, colors=cols, name=name), name=name,
-               translation=[-1.2 + 2.4 * k, 0.9, 0])
+               translation=[-1.2 + 2.4 * k, 0.95, 0])
     fidelity_scene(g)
     return g
 
@@ -841,6 +845,243 @@ def fidelity_pairs():
 
 # ---- bad assets ----
 
+# ---- the fidelity set: every feature above in one asset ----
+#
+# One asset holding one object per feature the pairs state (the node
+# transforms, the texCoord sets inside and outside [0, 1], COLOR_0, a
+# texture transform, a sphere without normals, a double-sided plate from
+# behind), each in a cell of its own, so that one Khronos reference render
+# (tests/e2e/e2e_fidelity.py, bench/bench_fidelity.py) holds every feature
+# to the viewer: the test crops each object's rectangle from both images.
+
+FIDELITY_SET_CELL = 3.0   # a cell's edge (units): the largest object fits
+FIDELITY_SET_COLUMNS = 4
+# An explicit scene.camera pose framing the 4 x 3 cells (the asset's own
+# camera is the same pose).
+FIDELITY_SET_CAMERA = {"eye": [0.0, 0.0, 21.0], "target": [0.0, 0.0, 0.0], "up": [0, 1, 0],
+                       "yfov_deg": 30.0}
+
+
+def _node_matrix(node):
+    """A node's local transform as (3x3 rows, translation)."""
+    m = node.get("matrix")
+    if m:
+        return [[m[0], m[4], m[8]], [m[1], m[5], m[9]], [m[2], m[6], m[10]]], [m[12], m[13], m[14]]
+    return trs(node.get("translation", (0, 0, 0)), node.get("rotation", (0, 0, 0, 1)),
+               node.get("scale", (1, 1, 1)))
+
+
+def world_boxes(g):
+    """{root node name: (min xyz, max xyz)}: each root subtree's world
+    bounds, from its meshes' POSITION bounds through the node transforms."""
+    doc = g.doc
+    out = {}
+
+    def walk(i, xf, box):
+        node = doc["nodes"][i]
+        xf = compose(xf, _node_matrix(node))
+        if "mesh" in node:
+            for prim in doc["meshes"][node["mesh"]]["primitives"]:
+                acc = doc["accessors"][prim["attributes"]["POSITION"]]
+                lo, hi = acc["min"], acc["max"]
+                for k in range(8):
+                    c = [hi[a] if k >> a & 1 else lo[a] for a in range(3)]
+                    w = [sum(xf[0][r][q] * c[q] for q in range(3)) + xf[1][r] for r in range(3)]
+                    for a in range(3):
+                        box[0][a] = min(box[0][a], w[a])
+                        box[1][a] = max(box[1][a], w[a])
+        for child in node.get("children", []):
+            walk(child, xf, box)
+    identity = ([[1, 0, 0], [0, 1, 0], [0, 0, 1]], [0, 0, 0])
+    for i in doc["scenes"][0]["nodes"]:
+        box = [[1e30] * 3, [-1e30] * 3]
+        walk(i, identity, box)
+        if box[0][0] <= box[1][0]:
+            out[doc["nodes"][i].get("name", str(i))] = box
+    return out
+
+
+def _cell_centre(k, rows):
+    cols = FIDELITY_SET_COLUMNS
+    return [FIDELITY_SET_CELL * (k % cols - (cols - 1) / 2),
+            FIDELITY_SET_CELL * ((rows - 1) / 2 - k // cols), 0.0]
+
+
+def merge_into(g, src, place, prefix):
+    """Copies src's buffers, images, textures, samplers, materials, meshes
+    and nodes into g (cameras and lights left out), each root node that
+    draws something named prefix + its name and moved by place(node)."""
+    d, sd = g.doc, src.doc
+    src.finish_buffer()
+    while len(g.bin) % 4:
+        g.bin.append(0)
+    base = len(g.bin)
+    g.bin += src.bin
+    off = {k: len(d.get(k, [])) for k in ("bufferViews", "accessors", "images", "textures",
+                                          "samplers", "materials", "meshes", "nodes")}
+    for v in sd.get("bufferViews", []):
+        d["bufferViews"].append(dict(v, byteOffset=v.get("byteOffset", 0) + base))
+    for a in sd.get("accessors", []):
+        d["accessors"].append(dict(a, bufferView=a["bufferView"] + off["bufferViews"]))
+    for im in sd.get("images", []):
+        g._list("images").append(dict(im, bufferView=im["bufferView"] + off["bufferViews"]))
+    for sm in sd.get("samplers", []):
+        g._list("samplers").append(dict(sm))
+    for t in sd.get("textures", []):
+        t2 = dict(t, source=t["source"] + off["images"])
+        if "sampler" in t:
+            t2["sampler"] = t["sampler"] + off["samplers"]
+        g._list("textures").append(t2)
+
+    def retex(v):
+        if isinstance(v, dict):
+            v = {k: retex(x) for k, x in v.items()}
+            if "index" in v and isinstance(v["index"], int):
+                v["index"] += off["textures"]
+        return v
+    for m in sd.get("materials", []):
+        m2 = {k: retex(v) if k.endswith("Texture") else v for k, v in m.items()}
+        if "pbrMetallicRoughness" in m:
+            m2["pbrMetallicRoughness"] = {k: retex(v) if k.endswith("Texture") else v
+                                          for k, v in m["pbrMetallicRoughness"].items()}
+        g._list("materials").append(m2)
+    for mesh in sd.get("meshes", []):
+        prims = []
+        for prim in mesh["primitives"]:
+            p2 = dict(prim, attributes={k: a + off["accessors"] for k, a in prim["attributes"].items()})
+            if "indices" in prim:
+                p2["indices"] = prim["indices"] + off["accessors"]
+            if "material" in prim:
+                p2["material"] = prim["material"] + off["materials"]
+            prims.append(p2)
+        d["meshes"].append(dict(mesh, primitives=prims))
+    for node in sd["nodes"]:
+        n2 = {k: v for k, v in node.items() if k not in ("camera", "extensions")}
+        if "mesh" in node:
+            n2["mesh"] = node["mesh"] + off["meshes"]
+        if "children" in node:
+            n2["children"] = [c + off["nodes"] for c in node["children"]]
+        d["nodes"].append(n2)
+    for i in sd["scenes"][0]["nodes"]:
+        node = d["nodes"][i + off["nodes"]]
+        if "mesh" in node or "children" in node:
+            node["name"] = prefix + node.get("name", "")
+            place(node)
+            d["scenes"][0]["nodes"].append(i + off["nodes"])
+    used = [e for e in sd.get("extensionsUsed", []) if e != "KHR_lights_punctual"]
+    for e in used:
+        if e not in g._list("extensionsUsed"):
+            d["extensionsUsed"].append(e)
+
+
+# The objects in cell order, by the root node names fidelity_set_asset
+# gives them, and what each states.
+FIDELITY_SET_FEATURES = [
+    ("transforms.rotated0", "a quarter turn about x (node matrix; generated tangents)"),
+    ("transforms.scaled0", "rotation with scale (1, 2.2, 0.6) (file tangents)"),
+    ("transforms.mirrored0", "a mirrored sphere, scale -1 in x (file tangents)"),
+    ("transforms.mirrored_cube0", "a mirrored cube, -1.3 in y (generated tangents)"),
+    ("transforms.nested0", "a child's scale under a rotated parent"),
+    ("texcoord1_outside.box", "base colour, occlusion, emissive on TEXCOORD_1 outside [0, 1]"),
+    ("texcoord1_inside.box", "the same on TEXCOORD_1 inside [0, 1]"),
+    ("texture_transform.box", "KHR_texture_transform with a texCoord override"),
+    ("colors.bytes", "COLOR_0, unsigned-byte VEC4"),
+    ("colors.floats", "COLOR_0, float VEC3"),
+    ("flat_normals.ball", "a sphere without NORMAL (flat normals)"),
+    ("back_face.plate", "a double-sided normal-mapped plate from behind"),
+]
+
+
+def project_box(box, width, height, camera=FIDELITY_SET_CAMERA, pad=1):
+    """The pixel rectangle (x0, y0, x1, y1), top row 0, exclusive ends,
+    covering a world box seen by camera (a scene.camera pose with
+    yfov_deg) in a width x height image, padded by pad pixels and clipped."""
+    eye, target = camera["eye"], camera["target"]
+    f = normalized([t - e for t, e in zip(target, eye)])
+    up = camera.get("up", [0, 1, 0])
+    r = normalized([f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2], f[0] * up[1] - f[1] * up[0]])
+    u = [r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]]
+    t = math.tan(math.radians(camera["yfov_deg"]) / 2)
+    xs, ys = [], []
+    for k in range(8):
+        c = [box[1][a] if k >> a & 1 else box[0][a] for a in range(3)]
+        v = [c[a] - eye[a] for a in range(3)]
+        z = sum(v[a] * f[a] for a in range(3))
+        x = sum(v[a] * r[a] for a in range(3)) / (z * t * width / height)
+        y = sum(v[a] * u[a] for a in range(3)) / (z * t)
+        xs.append((x * 0.5 + 0.5) * width)
+        ys.append((0.5 - y * 0.5) * height)
+    return (max(0, int(math.floor(min(xs))) - pad), max(0, int(math.floor(min(ys))) - pad),
+            min(width, int(math.ceil(max(xs))) + pad), min(height, int(math.ceil(max(ys))) + pad))
+
+
+def crop_png(image, rect):
+    """An opaque PNG of rect (x0, y0, x1, y1, exclusive ends) of image, a
+    (width, height, pixels) as testlib.png_pixels reads one."""
+    w, _, px = image
+    x0, y0, x1, y1 = rect
+    rows = [bytes(c for x in range(x0, x1) for c in (*px[y * w + x][:3], 255))
+            for y in range(y0, y1)]
+    return png_bytes(x1 - x0, y1 - y0, rows)
+
+
+def fidelity_set_rects(width, height, camera=FIDELITY_SET_CAMERA):
+    """{feature name: pixel rectangle} of fidelity_set_asset's objects."""
+    boxes = world_boxes(fidelity_set_asset())
+    return {name: project_box(boxes[name], width, height, camera) for name, _ in FIDELITY_SET_FEATURES}
+
+
+def fidelity_set_asset(baked=False):
+    """FIDELITY_SET_FEATURES' objects in a 4 x 3 grid of cells facing +z
+    (each object's node moved to its cell's centre, rotation and scale
+    kept), seen by FIDELITY_SET_CAMERA, lit by a point light and a sun in
+    glTF's units. baked: the transforms' half with its nodes baked into the
+    vertices (transforms_asset(True)); the rest is the same either way."""
+    g = Gltf()
+    names = [n for n, _ in FIDELITY_SET_FEATURES]
+    rows = (len(names) + FIDELITY_SET_COLUMNS - 1) // FIDELITY_SET_COLUMNS
+
+    def place(node):
+        name = node["name"]
+        case = name.split(".", 1)[1]
+        if name.startswith("transforms.") and baked:
+            # Identity nodes over vertices the chain moved: the node moves
+            # them on by the cell's offset from where the chain put them.
+            chain = next(c for n, _, _, c in NODE_CASES if n == case)
+            xf = chain[0]
+            for inner in chain[1:]:
+                xf = compose(xf, inner)
+            k = names.index(name + "0")
+            node["translation"] = [a - b for a, b in zip(_cell_centre(k, rows), xf[1])]
+            return
+        c = _cell_centre(names.index(name), rows)
+        if "matrix" in node:
+            m = list(node["matrix"])
+            m[12:15] = c
+            node["matrix"] = m
+        else:
+            node["translation"] = c
+    parts = [("transforms.", transforms_asset(baked)),
+             ("texcoord1_outside.", texcoord_asset(1, False)),
+             ("texcoord1_inside.", texcoord_asset(1, True)),
+             ("texture_transform.", texture_transform_asset(True)),
+             ("colors.", colors_asset(True)),
+             ("flat_normals.", flat_asset(False)),
+             ("back_face.", back_face_asset(True))]
+    for prefix, src in parts:
+        merge_into(g, src, place, prefix)
+    cam = FIDELITY_SET_CAMERA
+    g.doc["cameras"] = [{"type": "perspective", "name": "set",
+                         "perspective": {"yfov": math.radians(cam["yfov_deg"]), "znear": 0.5,
+                                         "zfar": 100, "aspectRatio": 4 / 3}}]
+    g.node(camera=0, name="view", translation=list(cam["eye"]))
+    pl = g.light(type="point", name="lamp", color=[1, 0.9, 0.8], intensity=900, range=60)
+    dl = g.light(type="directional", name="sun", color=[0.8, 0.85, 1], intensity=4)
+    g.node(name="lamp", translation=[3.0, 5.0, 12.0], extensions={"KHR_lights_punctual": {"light": pl}})
+    g.node(name="sun", rotation=axis_angle([1, 0.4, 0], -50), extensions={"KHR_lights_punctual": {"light": dl}})
+    return g
+
+
 def bad_accessor_oob():
     g = textured(normal_map=False)
     g.doc["accessors"][0]["count"] += 10  # POSITION runs past its bufferView
@@ -914,7 +1155,139 @@ def bad_mode(mode):
     return g.glb()
 
 
-def build_all(out, realistic=False, big_maps=False):
+# ---- hostile assets (issue 34): what a red team sent ----
+
+def lying_jpeg(edge=8192):
+    """The 16x16 JPEG whose frame header declares edge x edge: libjpeg pads
+    the missing scans, so a 2 KB file would decode to edge^2 x 4 bytes."""
+    jpg = bytearray(SOLID16_JPEG)
+    sof = jpg.index(b"\xff\xc0")
+    jpg[sof + 5:sof + 9] = struct.pack(">HH", edge, edge)
+    return bytes(jpg)
+
+
+def lying_png(edge=8192):
+    """A PNG whose IHDR declares edge x edge over one row of data."""
+    def chunk(kind, data):
+        body = kind + data
+        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body) & 0xFFFFFFFF)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", edge, edge, 8, 6, 0, 0, 0))
+            + chunk(b"IDAT", zlib.compress(b"\0" * (edge * 4 + 1), 9)) + chunk(b"IEND", b""))
+
+
+def image_asset(images, mime):
+    """A cube whose material names each of images (bytes) as a texture."""
+    g = Gltf()
+    slots = ["baseColorTexture", "metallicRoughnessTexture"]
+    pbr = {}
+    extra = {}
+    for k, data in enumerate(images):
+        t = g.texture(g.image(data, mime=mime))
+        if k < 2:
+            pbr[slots[k]] = {"index": t}
+        elif k == 2:
+            extra["emissiveTexture"] = {"index": t}
+        else:
+            extra["occlusionTexture"] = {"index": t}
+    m = g.material(pbrMetallicRoughness=pbr, **extra)
+    g.node(mesh=g.mesh(cube(), material=m, uv1=False))
+    return g
+
+
+def unused_mesh_asset():
+    """A valid glTF with a mesh no node uses (glTF allows it)."""
+    g = Gltf()
+    g.node(mesh=g.mesh(cube(), uv1=False, name="used"))
+    g.mesh(grid(2), uv1=False, name="spare")
+    return g
+
+
+def node_chain_asset(levels):
+    """A mesh at the bottom of a chain of levels nodes (the root is level 1)."""
+    g = Gltf()
+    mesh = g.mesh(cube(), uv1=False)
+    g.node(root=True)
+    for i in range(1, levels):
+        g.node(root=False)
+        g.doc["nodes"][i - 1]["children"] = [i]
+    g.doc["nodes"][levels - 1]["mesh"] = mesh
+    return g
+
+
+def data_uri_asset(mutate):
+    """The textured-less cube as .gltf with its buffer as a data URI; mutate
+    (doc) changes it."""
+    g = Gltf()
+    g.node(mesh=g.mesh(cube(), uv1=False))
+    doc = json.loads(g.gltf_data_uri())
+    mutate(doc)
+    return json.dumps(doc).encode()
+
+
+def bad_base64_unpadded(doc):
+    uri = doc["buffers"][0]["uri"]
+    doc["buffers"][0]["uri"] = uri.rstrip("=") + "A"  # a length no base64 text has
+
+
+def bad_base64_inner_pad(doc):
+    head, data = doc["buffers"][0]["uri"].split(",", 1)
+    doc["buffers"][0]["uri"] = head + "," + data[:8] + "=" + data[9:]
+
+
+def data_longer_than_bytelength(doc):
+    head, data = doc["buffers"][0]["uri"].split(",", 1)
+    doc["buffers"][0]["uri"] = head + "," + base64.b64encode(base64.b64decode(data) +
+                                                             b"\0" * 16).decode()
+
+
+def many_nodes_asset(roots, mesh_nodes=1):
+    """mesh_nodes root nodes instancing one triangle, then empty root nodes
+    up to roots in all; the JSON written directly (a million nodes)."""
+    tri = struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0)
+    doc = {"asset": {"version": "2.0"}, "scene": 0,
+           "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+           "buffers": [{"byteLength": len(tri)}],
+           "bufferViews": [{"buffer": 0, "byteLength": len(tri)}],
+           "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                          "min": [0, 0, 0], "max": [1, 1, 0]}]}
+    head = json.dumps(doc, separators=(",", ":"))[:-1]
+    nodes = ",".join(['{"mesh":0,"translation":[%d,0,0]}' % i for i in range(mesh_nodes)] +
+                     ["{}"] * (roots - mesh_nodes))
+    scene = ",".join(str(i) for i in range(roots))
+    js = ('%s,"nodes":[%s],"scenes":[{"nodes":[%s]}]}' % (head, nodes, scene)).encode()
+    return rebuild_glb_json(js, tri)
+
+
+def rebuild_glb_json(js, binary):
+    js += b" " * (-len(js) % 4)
+    binary = bytes(binary) + b"\0" * (-len(binary) % 4)
+    out = struct.pack("<I I", len(js), 0x4E4F534A) + js
+    out += struct.pack("<I I", len(binary), 0x004E4942) + binary
+    return b"glTF" + struct.pack("<I I", 2, 12 + len(out)) + out
+
+
+def hostile_all(write):
+    """The hostile files of issue 34 that are small enough for every run;
+    write(name, data, **expect) as build_all's."""
+    write("lying_jpeg.glb", image_asset([lying_jpeg()], "image/jpeg").glb(), exit=2, status=400,
+          field="images[0]")
+    write("lying_jpeg4.glb", image_asset([lying_jpeg()] * 4, "image/jpeg").glb(), exit=2,
+          status=400, field="images[0]")
+    write("lying_png.glb", image_asset([lying_png()], "image/png").glb(), exit=2, status=400,
+          field="images[0]")
+    write("unused_mesh.glb", unused_mesh_asset().glb(), exit=0,
+          expect={"meshes": 1, "triangles": 12})
+    write("chain_256.glb", node_chain_asset(256).glb(), exit=0, expect={"meshes": 1})
+    write("chain_257.glb", node_chain_asset(257).glb(), exit=2, status=422, field="nodes[256]")
+    write("base64_unpadded.gltf", data_uri_asset(bad_base64_unpadded), exit=2, status=400,
+          field="buffers[0].uri")
+    write("base64_inner_pad.gltf", data_uri_asset(bad_base64_inner_pad), exit=2, status=400,
+          field="buffers[0].uri")
+    write("data_longer.gltf", data_uri_asset(data_longer_than_bytelength), exit=2, status=400,
+          field="buffers[0].byteLength")
+
+
+def build_all(out, realistic=False, big_maps=False, hostile_big=False, cpu_seconds=60):
     os.makedirs(out, exist_ok=True)
     manifest = []
 
@@ -1018,6 +1391,16 @@ def build_all(out, realistic=False, big_maps=False):
           args=["--max-vertices", "10"])
     write("over_file_bytes.glb", good, exit=2, status=422, field="limits.max_file_bytes",
           args=["--max-file-bytes", "100"])
+    hostile_all(write)
+    if hostile_big:
+        # Checked in time linear in the nodes (issue 34: each took the old
+        # converter minutes, quadratic in nodes times roots), under a CPU
+        # limit that minutes would run past.
+        cpu = ["--max-cpu-seconds", str(cpu_seconds)]
+        write("roots_1m.glb", many_nodes_asset(1000000), exit=2, status=422,
+              field="limits.max_nodes", args=cpu)
+        write("mesh_nodes_60k.glb", many_nodes_asset(60000, 60000), exit=0,
+              expect={"meshes": 60000, "triangles": 60000}, args=cpu)
     with open(os.path.join(out, "manifest.json"), "w") as f:
         json.dump(manifest, f, indent=1)
     return manifest

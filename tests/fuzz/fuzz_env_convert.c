@@ -1,5 +1,6 @@
 /* The environment map converter (env_convert_buffer: a Radiance .hdr's
- * header, its scanline walk, stb_image) on any bytes. Invariants: it never
+ * header, its scanline walk, stb_image; an OpenEXR image's header, chunk
+ * extents and OpenEXRCore's decoders) on any bytes. Invariants: it never
  * crashes or over-allocates (libFuzzer's RSS limit: the size limits are
  * read from the header before anything is decoded); a refusal names a
  * field and a message and leaves the image empty; what it accepts is within
@@ -28,7 +29,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 img.height <= lim.max_edge && (uint64_t)img.width * img.height <= lim.max_pixels);
     for (size_t i = 0; i < (size_t)img.width * img.height * 3; i++)
         FUZZ_ASSERT(isfinite(img.rgb[i]) && img.rgb[i] >= 0.0f);
-    json_t *d = environment_describe(&img, "radiance_hdr");
+    json_t *d = environment_describe(&img, env_convert_format(data, size));
     FUZZ_ASSERT(d != NULL);
     json_decref(d);
     environment_image_finish(&img);

@@ -2,7 +2,9 @@
  * every path maps to one kind; a resource's id holds only digits and
  * dashes, its frame is positive, its chart name has no path characters;
  * every refusal names a field and a message; every kind has a label and an
- * Allow header. */
+ * Allow header; the raw target's checks refuse any '%' without two hex
+ * digits (issue 34). */
+#include <ctype.h>
 #include <string.h>
 
 #include "daemon/api/routes.h"
@@ -18,6 +20,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     char url[4097];
     memcpy(url, data + 1, size - 1);
     url[size - 1] = '\0';
+    /* The raw target's checks (on_uri): a refusal names a field and a
+     * rule, and a '%' without two hexadecimal digits is always refused. */
+    size_t args;
+    const char *field = NULL, *target_rule = NULL;
+    bool target_ok = route_check_target(url, &args, &field, &target_rule);
+    FUZZ_ASSERT(target_ok || (field && field[0] && target_rule && target_rule[0]));
+    for (const char *p = strchr(url, '%'); p; p = strchr(p + 1, '%')) {
+        bool hex = isxdigit((unsigned char)p[1]) && isxdigit((unsigned char)p[2]);
+        FUZZ_ASSERT(hex || !target_ok);
+    }
     struct route r;
     bool found = route_parse(url, &r);
     FUZZ_ASSERT(found == (r.kind != ROUTE_NONE));

@@ -85,7 +85,7 @@ fuzz_one() {
         extra="daemon/assets/asset_convert.c daemon/assets/convert_*.c daemon/assets/uv_charts.c daemon/assets/uv_overlap.c $(pkg-config --cflags --libs assimp libjpeg)"
     fi
     if [ "$t" = env_convert ]; then
-        extra="daemon/assets/env_convert.c $(pkg-config --cflags --libs stb)"
+        extra="daemon/assets/env_convert.c daemon/assets/env_exr.c $(pkg-config --cflags --libs stb OpenEXR)"
     fi
     # shellcheck disable=SC2086
     if ! "$cc" $flags -fsanitize=fuzzer "tests/fuzz/fuzz_$t.c" $extra $objs $libs -o "$bin" 2>"$out/$t.build.log"; then

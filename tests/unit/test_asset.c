@@ -165,7 +165,7 @@ int main(void)
           lim.max_images == 4096 && lim.max_lights == 1024 && lim.max_cameras == 1024);
     json_t *lj = asset_limits_to_json(&lim);
     CHECK(lj && json_integer_value(json_object_get(lj, "max_texture_edge")) == 8192 &&
-          json_object_size(lj) == 10);
+          json_object_size(lj) == 12);
     json_decref(lj);
     CHECK(strcmp(asset_texture_slot_names[ASSET_TEX_EMISSIVE], "emissive") == 0);
     CHECK(strcmp(asset_alpha_mode_names[ASSET_ALPHA_BLEND], "blend") == 0);

@@ -202,6 +202,33 @@ static void test_technique_sweep(const json_t *llvmpipe)
     json_decref(sw);
 }
 
+/* A sweep of OSL against a reference that is faster than every point (the
+ * dashboard's demo sweep: forward 10.5 ms, OSL 47 and 74): the reference
+ * wins, however fast the fastest swept point is among its own. */
+static void test_reference_wins(const json_t *llvmpipe)
+{
+    json_t *points = json_array();
+    json_array_append_new(points, trow("osl", "{\"async_distance\":0}", 74, 70, 78, 0.9986, 0, "done"));
+    json_array_append_new(points, trow("osl", "{\"async_distance\":20}", 47, 45, 49, 0.9984, 0, "done"));
+    json_array_append_new(points, trow("forward", "{\"technique\":\"forward\"}", 10.5, 9.3, 12,
+                                       -1, 0, "done"));
+    json_t *sw = tsweep(points, "done", 3, "async_distance");
+    json_t *v = sweep_verdict_json(sw, "frame_ms");
+    json_t *w = json_array_get(json_object_get(v, "against_reference"), 0);
+    json_t *win = json_object_get(w, "winner");
+    CHECK(win && !strcmp(json_string_value(json_object_get(win, "technique")), "forward") &&
+          json_is_true(json_object_get(win, "reference")) &&
+          json_is_null(json_object_get(win, "values")));
+    CHECK(!strcmp(json_string_value(json_object_get(json_object_get(w, "fastest"), "technique")),
+                  "osl"));
+    json_decref(v);
+    size_t hl = 0;
+    char *html = report_sweep_html(sw, llvmpipe, NULL, NULL, &hl);
+    CHECK(html && strstr(html, "<b>forward</b> (the reference)"));
+    free(html);
+    json_decref(sw);
+}
+
 /* Crossovers and ratios stated only where the intervals support them. */
 static void test_noise_in_verdicts(const json_t *llvmpipe)
 {
@@ -226,6 +253,10 @@ static void test_noise_in_verdicts(const json_t *llvmpipe)
           json_real_value(json_array_get(json_object_get(fp, "ratio_ci"), 1)) > 1);
     /* The fastest (d 5, 40 [35, 45]) is measurably faster: stated. */
     CHECK(json_is_true(json_object_get(json_object_get(w, "fastest"), "distinguishable")));
+    /* ... and so it wins the workload, the reference included. */
+    json_t *win = json_object_get(w, "winner");
+    CHECK(win && !strcmp(json_string_value(json_object_get(win, "technique")), "osl") &&
+          json_is_false(json_object_get(win, "reference")));
     CHECK(json_integer_value(json_object_get(json_object_get(v, "largest_pdiff_pass"), "value")) == 20);
     json_decref(v);
     /* Noisy points (the report adds each point job's interference). */
@@ -514,6 +545,7 @@ int main(void)
 
     test_technique_sweep(llvmpipe);
     test_noise_in_verdicts(llvmpipe);
+    test_reference_wins(llvmpipe);
     test_partial_sweep(llvmpipe);
     test_crowded_labels(llvmpipe);
     test_job_report(llvmpipe);

@@ -85,7 +85,7 @@ static void test_look(void)
 
     /* reference_look is a whole look read over the defaults. */
     CHECK(parse("{\"look\": {\"post\": [\"bloom\"], \"lighting\": \"blinn_phong\"}, "
-                "\"reference\": \"forward\", \"capture_interval\": 300, \"reference_look\": {}}",
+                "\"reference\": \"forward\", \"capture_interval\": 60, \"reference_look\": {}}",
                 &spec, &err));
     CHECK(spec.reference_look_given && spec.reference_look.post.count == 0);
     CHECK(spec.reference_look.lighting == LOOK_PHONG && spec.look.lighting == LOOK_BLINN_PHONG);

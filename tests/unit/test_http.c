@@ -227,8 +227,11 @@ int main(void)
     asset_run_limits_defaults(&acfg.run);
     struct assets *assets = q ? assets_create(&acfg, store, q, err, sizeof(err)) : NULL;
     CHECK(assets != NULL);
-    if (assets)
-        queue_set_asset_resolver(q, assets_queue_resolver, assets);
+    if (assets) {
+        struct queue_asset_hooks hooks;
+        assets_queue_hooks(assets, &hooks);
+        queue_set_asset_hooks(q, &hooks);
+    }
     const struct http_context ctx = {.catalog = &catalog, .queue = q, .sweeps = sweeps,
                                      .assets = assets,
                                      .render_state = fake_state, .device_json = fake_device,
@@ -650,7 +653,7 @@ int main(void)
 
     http_server_destroy(http);
     sweeps_destroy(sweeps);
-    queue_set_asset_resolver(q, NULL, NULL);
+    queue_set_asset_hooks(q, NULL);
     assets_destroy(assets);
     queue_stop(q);
     queue_destroy(q);

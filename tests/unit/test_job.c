@@ -1,7 +1,9 @@
 #include <stdlib.h>
+#include <math.h>
 #include <string.h>
 
 #include "daemon/spec/job_cost.h"
+#include "daemon/jobs/job_eta.h"
 #include "daemon/spec/job_spec.h"
 #include "tests/unit/catalog_fixture.h"
 #include "tests/unit/check.h"
@@ -36,8 +38,8 @@ static void test_cost(void)
     CHECK(parse("{\"technique\":\"unlit\",\"frames\":1,\"warmup_frames\":0,"
                 "\"scene\":{\"width\":32,\"height\":32}}", &spec, &err));
     job_cost_estimate(&spec, &small);
-    /* 24 bytes a pixel of the harness's (rgba32f), 32 of a technique's planes. */
-    CHECK(small.targets_bytes == 32.0 * 32 * (24 + 32) && small.captures_bytes == 0 &&
+    /* 24 bytes a pixel of the harness's (rgba32f); unlit declares no planes. */
+    CHECK(small.targets_bytes == 32.0 * 32 * 24 && small.captures_bytes == 0 &&
           small.reference_bytes == 0 && small.metrics_bytes == 0 && small.look_bytes == 0);
     CHECK(small.memory_bytes > small.targets_bytes && strcmp(small.memory_field, "scene.width") == 0);
     CHECK(parse("{\"technique\":\"unlit\",\"frames\":1,\"warmup_frames\":0,"
@@ -49,7 +51,7 @@ static void test_cost(void)
                 "\"look\":{\"hdr\":\"rgba16f\",\"post\":[\"bloom\"]},"
                 "\"scene\":{\"width\":256,\"height\":256}}", &spec, &err));
     job_cost_estimate(&spec, &cost);
-    CHECK(cost.targets_bytes == 256.0 * 256 * (16 + 32 + 32) && cost.captures_bytes > 0 &&
+    CHECK(cost.targets_bytes == 256.0 * 256 * (16 + 32) && cost.captures_bytes > 0 &&
           cost.reference_bytes > 0 && cost.metrics_bytes > 0);
     CHECK(strcmp(cost.memory_field, "capture_interval") == 0); /* 64 captures lead */
     json_t *j = job_cost_json(&cost);
@@ -87,6 +89,97 @@ static void test_cost(void)
             "\"scene\":{\"width\":64,\"height\":64}}", "look.ibl.resolution");
     CHECK(parse("{\"scene\":{\"width\":64,\"height\":64}}", &spec, &err));
     job_cost_set_memory_limit(0);
+}
+
+/* Each technique is charged the planes its info declares (planes_bpp), not
+ * the 32 bytes a pixel every technique was charged when the estimate could
+ * not tell them apart: none for forward, the heat map for forward_plus,
+ * the g-buffer by its layout, the look and MSAA for the deferred family. */
+static void test_cost_planes(void)
+{
+    struct job_spec spec;
+    struct job_error err;
+    struct job_cost c;
+    const char *const techs[] = {"forward", "forward_plus", "deferred", "clustered_deferred"};
+    double bytes[4];
+    for (int i = 0; i < 4; i++) {
+        char text[256];
+        snprintf(text, sizeof(text), "{\"technique\":\"%s\",\"scene\":{\"width\":100,"
+                 "\"height\":100}}", techs[i]);
+        CHECK(parse(text, &spec, &err));
+        job_cost_estimate(&spec, &c);
+        bytes[i] = c.targets_bytes / 1e4;
+    }
+    /* The harness's 24 (rgba32f); the heat map 4; the g-buffer under Phong
+     * with octahedral normals: albedo 4, normal 8, material 8. */
+    CHECK(bytes[0] == 24 && bytes[1] == 28 && bytes[2] == 24 + 20 + 4 && bytes[3] == bytes[2]);
+    CHECK(parse("{\"technique\":\"deferred\",\"look\":{\"lighting\":\"pbr\"},"
+                "\"deferred\":{\"gbuffer\":{\"normal\":\"float3\"}},"
+                "\"scene\":{\"width\":100,\"height\":100}}", &spec, &err));
+    job_cost_estimate(&spec, &c);
+    CHECK(c.targets_bytes / 1e4 == 24 + (4 + 16 + 16) + 4);
+    CHECK(parse("{\"technique\":\"deferred\",\"msaa\":4,"
+                "\"scene\":{\"width\":100,\"height\":100}}", &spec, &err));
+    job_cost_estimate(&spec, &c);
+    /* Multisampled output (16 + 8) x 4, the g-buffer and its edge stencil x 4. */
+    CHECK(c.targets_bytes / 1e4 == 24 + 24 * 4 + (20 + 4) * 4 + 4);
+}
+
+/* The duration estimate (job_eta.h): none before a job of the technique
+ * ran; then scaled from it by pixels and frames; a projection far past the
+ * timeout_s or a frame far past the frame bound refused naming the field. */
+static void test_eta(void)
+{
+    struct job_spec spec;
+    struct job_error err;
+    struct job_eta e;
+    job_eta_reset();
+    CHECK(parse("{\"technique\":\"forward\",\"frames\":100,\"warmup_frames\":0,"
+                "\"timeout_s\":600,\"scene\":{\"width\":100,\"height\":100,\"lights\":10}}",
+                &spec, &err));
+    job_eta_estimate(&spec, &e);
+    CHECK(!e.known && json_is_null(job_eta_json(&e)) && job_eta_admit(&spec, &e, &err));
+    /* 10,000 pixels and 10 lights at 10 ms a frame: 100 timed frames and, with
+     * no warm-up, 2 of the harness's own, the measured one counted twice:
+     * 103 frames in 1.5 s. */
+    job_eta_observe("forward", 1e4, 10, 0.010, 1.0, 103, 1.5);
+    job_eta_observe("deferred", 1e4, 10, 0.5, 1.0, 103, 60);
+    job_eta_estimate(&spec, &e);
+    CHECK(e.known && fabs(e.frame_s - 0.010) < 1e-12);
+    /* 100 frames and 3 measuring ones, and the 0.47 s beyond them. */
+    CHECK(fabs(e.duration_s - (103 * 0.010 + 0.47)) < 1e-9);
+    CHECK(job_eta_admit(&spec, &e, &err));
+    /* Four times the pixels, frames past what the timeout allows. */
+    CHECK(parse("{\"technique\":\"forward\",\"frames\":100000,\"warmup_frames\":0,"
+                "\"timeout_s\":600,\"scene\":{\"width\":200,\"height\":200,\"lights\":10}}",
+                &spec, &err));
+    job_eta_estimate(&spec, &e);
+    CHECK(fabs(e.frame_s - 0.040) < 1e-12);
+    CHECK(!job_eta_admit(&spec, &e, &err) && strcmp(err.field, "timeout_s") == 0 &&
+          strstr(err.message, "projected to take"));
+    /* 8000x8000: a frame far past the bound, unless sliced timing is accepted. */
+    CHECK(parse("{\"technique\":\"forward\",\"timeout_s\":0,"
+                "\"scene\":{\"width\":8000,\"height\":8000,\"lights\":10}}", &spec, &err));
+    job_eta_estimate(&spec, &e);
+    CHECK(!job_eta_admit(&spec, &e, &err) && strcmp(err.field, "scene.width") == 0 &&
+          strstr(err.message, "64.0 s"));
+    spec.accept_sliced_timing = true;
+    CHECK(job_eta_admit(&spec, &e, &err));
+    /* The nearest in lights; the light ratio's square root. */
+    CHECK(parse("{\"technique\":\"forward\",\"scene\":{\"width\":100,\"height\":100,"
+                "\"lights\":43}}", &spec, &err));
+    job_eta_estimate(&spec, &e);
+    CHECK(fabs(e.frame_s - 0.010 * 2.0) < 1e-12);
+    /* A frame half of whose cost no pixel pays: that half stays. */
+    job_eta_reset();
+    job_eta_observe("forward", 1e4, 10, 0.010, 0.5, 103, 1.5);
+    CHECK(parse("{\"technique\":\"forward\",\"scene\":{\"width\":200,\"height\":200,"
+                "\"lights\":10}}", &spec, &err));
+    job_eta_estimate(&spec, &e);
+    CHECK(fabs(e.frame_s - (0.005 + 0.005 * 4)) < 1e-12);
+    /* Seconds left by the frames drawn. */
+    CHECK(job_eta_left(0, 10, 5) < 0 && fabs(job_eta_left(4, 10, 2.0) - 3.0) < 1e-12);
+    job_eta_reset();
 }
 
 /* --max-job-seconds: a job's own timeout_s above it (or 0, no limit) is
@@ -203,7 +296,7 @@ int main(void)
 
     CHECK(parse("{}", &spec, &err));
     CHECK(strcmp(spec.technique, "forward") == 0);
-    CHECK(spec.frames == 300 && spec.warmup_frames == 10 && spec.capture_interval == 0);
+    CHECK(spec.frames == 60 && spec.warmup_frames == 5 && spec.capture_interval == 0);
     CHECK(spec.scene.width == 1080 && spec.scene.height == 720 && spec.scene.lights == 10);
     CHECK(!spec.scene.dynamic);
     {
@@ -490,6 +583,8 @@ int main(void)
     CHECK(e != NULL);
     json_decref(e);
     test_cost();
+    test_cost_planes();
+    test_eta();
     test_max_seconds();
     return check_finish("test_job");
 }

@@ -7,7 +7,7 @@
 
 static struct image make(int w, int h, uint8_t r, uint8_t g, uint8_t b)
 {
-    struct image img = {w, h, malloc((size_t)w * (size_t)h * 3)};
+    struct image img = {w, h, malloc((size_t)w * (size_t)h * 3), NULL};
     for (int i = 0; i < w * h; i++)
         img.rgb[i * 3] = r, img.rgb[i * 3 + 1] = g, img.rgb[i * 3 + 2] = b;
     return img;

@@ -56,13 +56,17 @@ function summaryTable(verdict) {
   if (!rows.length)
     return el('p.muted', 'No workload has a timed reference to compare with.');
   return el('table.list.summary#sweep-summary',
-    el('thead', el('tr', ['workload', 'reference (ms)', 'fastest', 'its time (ms)', 'ratio to the reference [95%]',
+    el('thead', el('tr', ['workload', 'reference (ms)', 'wins', 'fastest swept point', 'its time (ms)', 'ratio to the reference [95%]',
       'tied with', 'fastest passing PerceptualDiff', 'its ratio'].map((h) => el('th', h)))),
     el('tbody', rows.map((w) => {
-      const f = w.fastest || {}, p = w.fastest_passing || {};
+      const f = w.fastest || {}, p = w.fastest_passing || {}, win = w.winner || {};
       return el('tr',
         el('td', w.workload || 'all points'),
         el('td', `${w.reference || ''} ${num(w.reference_ms)} `, el('small.muted', interval(w.reference_ci))),
+        el('td.winner', el('b', win.technique || '–'),
+          win.values ? el('div.small.muted', valuesText(win.values)) : null,
+          win.reference ? el('div.small', 'the reference') : null,
+          win.tied_with_reference ? el('div.small', 'not told apart from the reference') : null),
         el('td', el('b', f.technique || '–'), f.values ? el('div.small.muted', valuesText(f.values)) : null),
         el('td.num', num(f.ms)),
         el('td', { className: f.distinguishable ? (f.ratio < 1 ? 'good' : 'bad') : 'muted' }, ratioText(f),

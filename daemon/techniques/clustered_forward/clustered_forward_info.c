@@ -15,6 +15,14 @@ static bool check(void *opts, const char *prefix, struct job_error *err)
     return cluster_grid_check(o->cluster.grid, prefix, err);
 }
 
+/* What job_cost charges: the heat map (the depth pre-pass writes the harness's depth). */
+static double planes_bpp(const void *options, const struct look_spec *look, bool textured,
+                         int samples)
+{
+    (void)options, (void)look, (void)textured, (void)samples;
+    return HEAT_MAP_BPP;
+}
+
 const struct technique_info clustered_forward_info = {
     .name = "clustered_forward",
     .summary = "froxel light lists (compute), depth pre-pass, forward shading over each "
@@ -24,4 +32,5 @@ const struct technique_info clustered_forward_info = {
                 .size = sizeof(struct clustered_forward_options),
                 .check = check},
     .flags = TECHNIQUE_BOUNDED_LIGHT_LISTS,
+    .planes_bpp = planes_bpp,
 };

@@ -15,9 +15,18 @@ static const struct opt_field options[] = {
     {0},
 };
 
+/* What job_cost charges: its g-buffer and the heat map. */
+static double planes_bpp(const void *options, const struct look_spec *look, bool textured,
+                         int samples)
+{
+    const struct deferred_options *o = options;
+    return gbuffer_planes_bpp(&o->gbuffer, look, textured, samples) + HEAT_MAP_BPP;
+}
+
 const struct technique_info deferred_info = {
     .name = "deferred",
     .summary = "g-buffer, then each light added over the pixels its bound covers (seed 001)",
     .passes = passes,
     .options = {.fields = options, .size = sizeof(struct deferred_options)},
+    .planes_bpp = planes_bpp,
 };

@@ -11,6 +11,14 @@ static const struct opt_field options[] = {
     {0},
 };
 
+/* What job_cost charges: the heat map (the depth pre-pass writes the harness's depth). */
+static double planes_bpp(const void *options, const struct look_spec *look, bool textured,
+                         int samples)
+{
+    (void)options, (void)look, (void)textured, (void)samples;
+    return HEAT_MAP_BPP;
+}
+
 const struct technique_info forward_plus_info = {
     .name = "forward_plus",
     .summary = "depth pre-pass, per-tile light lists with depth bounds (compute), forward "
@@ -18,4 +26,5 @@ const struct technique_info forward_plus_info = {
     .passes = passes,
     .options = {.fields = options, .size = sizeof(struct forward_plus_options)},
     .flags = TECHNIQUE_BOUNDED_LIGHT_LISTS,
+    .planes_bpp = planes_bpp,
 };

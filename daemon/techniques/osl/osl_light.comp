@@ -126,7 +126,8 @@ ivec2 level_origin(int l, ivec2 size0)
 // does, so that texture detail finer than the texels stays sharp.
 layout(rgba16f, binding = SB_IMG_OSL_ATLAS_SPECULAR) writeonly uniform image2D u_atlas_specular;
 
-// light_contribution's (lighting.glsl) terms, apart: diffuse += C att N.L,
+// light_contribution's (lighting.glsl) terms, apart (light_reach its
+// falloff, the presets' window or glTF's inverse square): diffuse += C att N.L,
 // specular += C att spec s; the base colour left out.
 void shade_split(vec3 P, vec3 N, float metallic, vec4 albedo, int row, out vec3 diffuse,
                  out vec3 specular)
@@ -143,26 +144,9 @@ void shade_split(vec3 P, vec3 N, float metallic, vec4 albedo, int row, out vec3 
     FOR_EACH_LIGHT(i)
         int type = light_type(i);
         vec3 L;
-        float att;
-        if (type == LIGHT_DIRECTIONAL) {
-            L = -lights[i].direction_type.xyz;
-            att = 1.0;
-        } else {
-            vec3 Lv = light_position(i, row) - P;
-            float r = lights[i].color_radius.w;
-            float d2 = dot(Lv, Lv);
-            if (d2 >= r * r)
-                continue;
-            att = 1.0 - d2 / (r * r);
-            att *= att;
-            L = Lv * inversesqrt(d2);
-            if (type == LIGHT_SPOT) {
-                float cone = light_spot_falloff(i, -L);
-                if (cone <= 0.0)
-                    continue;
-                att *= cone;
-            }
-        }
+        float att = light_reach(i, light_position(i, row), P, L);
+        if (att <= 0.0)
+            continue;
         float nl = dot(N, L);
         if (nl <= 0.0)
             continue;
@@ -186,8 +170,9 @@ void shade_split(vec3 P, vec3 N, float metallic, vec4 albedo, int row, out vec3 
 
 uniform int u_work_count;
 uniform int u_groups_x;
-// The dispatch may cover a range of the blocks only (bounded submissions,
-// daemon/gpu/budget.h): groups [u_group_base, u_group_end).
+// The dispatch may cover a range of the blocks (or, with OSL_BLOCK_LIST, of
+// the listed slots) only (bounded submissions, daemon/gpu/budget.h): groups
+// [u_group_base, u_group_end).
 uniform uint u_group_base;
 uniform uint u_group_end;
 
@@ -201,8 +186,10 @@ uniform int u_blocks_x; // the atlas's width in blocks
 void main()
 {
 #ifdef OSL_BLOCK_LIST
-    uint slot = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
-    if (slot >= dispatch.w)
+    // Whole: u_group_base 0, u_group_end past every slot; in ranges where
+    // the harness slices (gpu_dispatch_indirect, daemon/gpu/budget.h).
+    uint slot = u_group_base + gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+    if (slot >= dispatch.w || slot >= u_group_end)
         return;
     uvec2 entry = list[slot];
     uint owner = block_instance[entry.x];

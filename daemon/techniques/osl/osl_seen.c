@@ -229,7 +229,9 @@ void osl_seen_light_pass(struct osl *o, const struct technique_env *env, int64_t
     osl_bind_light_inputs(o, env);
     osl_seen_bind(o);
     glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, o->stats_buf);
-    glDispatchComputeIndirect(0);
+    /* Whole in timed frames; in ranges where the harness slices (the
+     * first shading of every seen block, in the measuring frame). */
+    gpu_dispatch_indirect(env->budget, 0, o->group_base_loc, o->group_end_loc, o->groups_x_max);
     glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
 }

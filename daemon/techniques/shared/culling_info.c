@@ -1,5 +1,7 @@
 #include "daemon/techniques/shared/culling_info.h"
 
+#include "daemon/lighting/look_spec.h"
+
 #include <math.h>
 #include <stdio.h>
 
@@ -100,4 +102,18 @@ bool light_rect(int kind, const float world_centre[3], float radius, const float
     tangent_range(c[0], c[2], radius, proj[0], proj[8], &nx0, &nx1);
     tangent_range(c[1], c[2], radius, proj[5], proj[9], &ny0, &ny1);
     return to_pixels(nx0, nx1, ny0, ny1, w, h, rect);
+}
+
+double gbuffer_planes_bpp(const struct gbuffer_options *opt, const struct look_spec *look,
+                          bool textured, int samples)
+{
+    /* The formats gbuffer_init picks: albedo 4 bytes (rgba8 or one float);
+     * normal RGBA32F (float3), else two channels (RG16_SNORM where the
+     * device renders to it, else RG32F: the larger is charged); material
+     * RGBA32F under PBR, else RG32F; surface RGBA16F in textured scenes;
+     * with MSAA the edge stencil (DEPTH24_STENCIL8). */
+    double normal = opt->normal == GBUFFER_NORMAL_FLOAT3 ? 16.0 : 8.0;
+    double material = look->lighting == LOOK_PBR ? 16.0 : 8.0;
+    double per_sample = 4.0 + normal + material + (textured ? 8.0 : 0.0) + (samples > 1 ? 4.0 : 0.0);
+    return per_sample * (samples > 1 ? samples : 1);
 }

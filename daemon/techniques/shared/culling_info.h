@@ -47,6 +47,15 @@ struct gbuffer_options {
                 "decimal digits: two a channel, 100 levels, what fits a float)",                  \
      .offset = offsetof(opts_type, member.albedo)}
 
+/* Bytes a pixel of a g-buffer (daemon/techniques/shared/gbuffer.c): albedo,
+ * normal, material (and surface in textured scenes) a sample each, and with
+ * MSAA the edge stencil; and of the light-count heat map a light-culling
+ * technique publishes (one sample). For technique_info.planes_bpp. */
+struct look_spec;
+double gbuffer_planes_bpp(const struct gbuffer_options *opt, const struct look_spec *look,
+                          bool textured, int samples);
+#define HEAT_MAP_BPP 4.0
+
 /* How the deferred technique bounds the pixels each light shades. */
 enum light_bounds {
     LIGHT_BOUNDS_SCISSOR_TIGHT, /* the screen rectangle of the sphere's silhouette */

@@ -534,13 +534,22 @@ json_t *light_grid_describe(struct light_grid *g)
     for (int k = 1; k <= n; k++)
         v[k - 1] = g->stats[k].overflow_cells;
     json_object_set_new(ov, "cells_per_frame", mean_max(v, n));
+    /* What happened: under fallback a cell whose list overflowed shades
+     * with every light, so no light is dropped; what its list could not
+     * hold is counted as unlisted entries. Under fail the job fails. */
+    bool fallback = tiles || g->cfg.overflow == CLUSTER_OVERFLOW_FALLBACK;
     for (int k = 1; k <= n; k++)
         v[k - 1] = g->stats[k].lights_dropped;
+    json_object_set_new(ov, "entries_unlisted_per_frame", mean_max(v, n));
+    for (int k = 1; k <= n; k++)
+        v[k - 1] = fallback ? 0.0 : g->stats[k].lights_dropped;
     json_object_set_new(ov, "lights_dropped_per_frame", mean_max(v, n));
     json_object_set_new(ov, "policy",
-                        json_string(tiles || g->cfg.overflow == CLUSTER_OVERFLOW_FALLBACK
-                                        ? "overflowed cells shade with every light"
-                                        : "the job fails"));
+                        json_string(fallback ? "overflowed cells shade with every light: no "
+                                               "light is dropped (cells_per_frame counts those "
+                                               "cells, entries_unlisted_per_frame the list "
+                                               "entries they could not hold)"
+                                             : "the job fails"));
     json_object_set_new(out, RK_OVERFLOW, ov);
     struct stats st;
     stats_compute(g->bin_ms + 1, (size_t)n, &st);

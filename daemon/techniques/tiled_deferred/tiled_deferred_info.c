@@ -18,6 +18,14 @@ static const struct opt_field options[] = {
     {0},
 };
 
+/* What job_cost charges: its g-buffer and the heat map. */
+static double planes_bpp(const void *options, const struct look_spec *look, bool textured,
+                         int samples)
+{
+    const struct tiled_deferred_options *o = options;
+    return gbuffer_planes_bpp(&o->gbuffer, look, textured, samples) + HEAT_MAP_BPP;
+}
+
 const struct technique_info tiled_deferred_info = {
     .name = "tiled_deferred",
     .summary = "g-buffer, per-tile depth bounds and light lists, one lighting pass looping "
@@ -25,4 +33,5 @@ const struct technique_info tiled_deferred_info = {
     .passes = passes,
     .options = {.fields = options, .size = sizeof(struct tiled_deferred_options)},
     .flags = TECHNIQUE_BOUNDED_LIGHT_LISTS,
+    .planes_bpp = planes_bpp,
 };

@@ -7,4 +7,5 @@ const struct technique_info unlit_info = {
     .name = "unlit",
     .summary = "forward's geometry and passes, flat colour, no lights: the cost floor",
     .passes = passes,
+    .flags = TECHNIQUE_READS_NO_LIGHT,
 };

@@ -26,6 +26,16 @@ static bool check(void *opts, const char *prefix, struct job_error *err)
     return cluster_grid_check(o->cluster.grid, prefix, err);
 }
 
+/* What job_cost charges: the ids (64 bits a sample at most, RG32UI: whether
+ * 32 fit is known only with the scene) and the key target (depth and
+ * stencil, 8 bytes a sample), every sample counted. */
+static double planes_bpp(const void *options, const struct look_spec *look, bool textured,
+                         int samples)
+{
+    (void)options, (void)look, (void)textured;
+    return (8.0 + 8.0) * (samples > 0 ? samples : 1);
+}
+
 const struct technique_info visibility_buffer_info = {
     .name = "visibility_buffer",
     .summary = "visibility buffer (Burns and Hunt 2013): instance and triangle ids and depth "
@@ -37,6 +47,7 @@ const struct technique_info visibility_buffer_info = {
                 .size = sizeof(struct visibility_buffer_options),
                 .check = check},
     .flags = TECHNIQUE_BOUNDED_LIGHT_LISTS,
+    .planes_bpp = planes_bpp,
 };
 
 int vis_triangle_bits(long long instances, long long max_triangles)

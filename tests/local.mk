@@ -44,6 +44,7 @@ UNIT_TESTS = \
 	tests/unit/test_convert_matrices \
 	tests/unit/test_convert_checks \
 	tests/unit/test_light_shape \
+	tests/unit/test_temporal \
 	tests/unit/test_fidelity \
 	tests/unit/test_tile_plan \
 	tests/unit/test_devices \
@@ -65,6 +66,7 @@ tests_unit_test_metrics_LDADD = $(CORE_LIBS)
 tests_unit_test_flicker_LDADD = $(CORE_LIBS)
 tests_unit_test_sweep_LDADD = $(CORE_LIBS)
 tests_unit_test_effects_LDADD = $(CORE_LIBS)
+tests_unit_test_temporal_LDADD = $(CORE_LIBS)
 tests_unit_test_records_LDADD = $(CORE_LIBS)
 tests_unit_test_interference_LDADD = libsb-status.a $(CORE_LIBS)
 tests_unit_test_fidelity_LDADD = $(CORE_LIBS) -lm
@@ -187,6 +189,8 @@ E2E_TESTS = \
 	tests/e2e/e2e_assets.py \
 	tests/e2e/e2e_scene.py \
 	tests/e2e/e2e_post.py \
+	tests/e2e/e2e_taa.py \
+	tests/e2e/e2e_visibility.py \
 	tests/e2e/e2e_badinput.py \
 	tests/e2e/e2e_pbr.py \
 	tests/e2e/e2e_client.py \

@@ -38,6 +38,10 @@ struct effect_env {
     const char *normal_defines;
     /* Bounded submissions: effect_draw_fullscreen draws in tiles. */
     struct gpu_budget *budget;
+    /* The harness's motion vectors (RG16F, pixels this frame minus the
+     * frame before: daemon/harness/motion.h), drawn before the chain every
+     * frame when an effect's needs ask for them; else 0. */
+    GLuint motion_tex;
 };
 
 struct effect {
@@ -46,10 +50,15 @@ struct effect {
      * region; may take any GL state. opts is the effect's options struct. */
     bool (*create)(const struct effect_env *env, const void *opts, void **state, char *err,
                    size_t errlen);
-    /* One frame: reads src, writes dst_fbo (full size). Timed: no
-     * allocation, no readback, no uniform lookups by name. Leaves every
-     * sampler unit it bound to a sampler object unbound again. */
-    void (*run)(void *state, const struct effect_env *env, GLuint src, GLuint dst_fbo);
+    /* One frame: reads src, writes dst_fbo (full size). time says which
+     * frame, whether the history an effect keeps restarts at it (it then
+     * reads none: frame k is a pure function of k) and the projection's
+     * jitter. Timed: no allocation, no readback, no uniform lookups by
+     * name. Leaves every sampler unit it bound to a sampler object unbound
+     * again. False with err when the frame cannot be made (the job fails
+     * with it). */
+    bool (*run)(void *state, const struct effect_env *env, const struct gpu_frame_time *time,
+                GLuint src, GLuint dst_fbo, char *err, size_t errlen);
     /* Frees what create made (pool planes stay in the pool). Accepts NULL. */
     void (*destroy)(void *state);
 };

@@ -15,12 +15,22 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "common/frame_needs.h"
 #include "common/options.h"
 
 /* Effects the registry may hold. */
 #define EFFECT_REGISTRY_MAX 16
 /* Named passes one effect instance may run in a frame. */
 #define EFFECT_MAX_PASSES 6
+
+/* What an effect is, for the parts of the daemon that must choose among
+ * effects without naming them. */
+enum effect_flag {
+    /* It anti-aliases (TAA): a job's reference, the supersampled truth it
+     * approximates, renders the job's look without it unless the job gives
+     * a reference_look. */
+    EFFECT_ANTIALIASING = 1u << 0,
+};
 
 struct effect_info {
     const char *name;
@@ -34,6 +44,11 @@ struct effect_info {
      * suffixes ("bright", "blur_h", ...); returns how many (at most
      * EFFECT_MAX_PASSES). */
     int (*active_passes)(const void *opts, const char **out);
+    /* Optional: what one instance with these options needs of time
+     * (common/frame_needs.h: history frames, jitter, motion vectors); NULL
+     * for none. */
+    void (*needs)(const void *opts, struct frame_needs *out);
+    unsigned flags; /* enum effect_flag */
 };
 
 /* Every registered effect's info, in registry order (the order of

@@ -156,6 +156,7 @@ bool post_chain_build(struct post_chain *c, GLuint normal_tex, bool normal_octah
             .empty_vao = c->empty_vao,
             .linear_sampler = c->linear_sampler,
             .normal_defines = c->normal_defines,
+            .motion_tex = frame->motion,
         };
         first += ops->info->active_passes(post_effect_options(post, i), active);
         c->count = i + 1;
@@ -184,14 +185,23 @@ void post_chain_destroy(struct post_chain *c)
     free(c);
 }
 
-GLuint post_chain_run(struct post_chain *c)
+bool post_chain_run(struct post_chain *c, const struct gpu_frame_time *time, GLuint *out,
+                    char *err, size_t errlen)
 {
     GLuint cur = c->frame.color;
     for (int i = 0; i < c->count; i++) {
-        c->fx[i].ops->run(c->fx[i].state, &c->fx[i].env, cur, c->plane_fbo[i & 1]);
+        char why[512] = "";
+        if (!c->fx[i].ops->run(c->fx[i].state, &c->fx[i].env, time, cur, c->plane_fbo[i & 1],
+                               why, sizeof(why))) {
+            snprintf(err, errlen, "look.post %s at frame %lld: %s", c->fx[i].label,
+                     (long long)time->frame, why[0] ? why : "failed");
+            *out = cur;
+            return false;
+        }
         cur = c->plane[i & 1];
     }
-    return cur;
+    *out = cur;
+    return true;
 }
 
 bool post_chain_count_nonfinite(struct post_chain *c, GLuint tex, struct post_nonfinite *out,

@@ -28,6 +28,7 @@ struct post_frame {
     GLuint color, depth;         /* the technique's HDR output and depth texture */
     struct gpu_targets *targets; /* the pool the chain and its effects take planes from */
     struct gpu_budget *budget;   /* bounded submissions (daemon/gpu/budget.h) */
+    GLuint motion;               /* the harness's motion vectors, or 0 (effect_env) */
 };
 
 /* NaN and infinite pixels (any of R, G, B) in one frame's HDR colour. */
@@ -56,10 +57,12 @@ bool post_chain_build(struct post_chain *c, GLuint normal_tex, bool normal_octah
 /* Frees what create made. Accepts NULL. */
 void post_chain_destroy(struct post_chain *c);
 
-/* Runs every effect on the technique's output; returns the HDR colour the
- * resolve reads (the output itself when the chain is empty). Timed: no
+/* Runs every effect on the technique's output at time; *out is the HDR
+ * colour the resolve reads (the output itself when the chain is empty).
+ * False with err, naming the effect, when one could not run. Timed: no
  * allocation, no uniform lookups. */
-GLuint post_chain_run(struct post_chain *c);
+bool post_chain_run(struct post_chain *c, const struct gpu_frame_time *time, GLuint *out,
+                    char *err, size_t errlen);
 
 /* Counts the non-finite (and, in a 16-bit target, overflowed) pixels of
  * tex (the frame's size) with a compute pass and reads the counters back. Stalls: outside every

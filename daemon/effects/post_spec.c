@@ -104,3 +104,26 @@ int post_spec_pass_names(const struct post_spec *p, char (*names)[POST_PASS_NAME
     }
     return n;
 }
+
+void post_spec_needs(const struct post_spec *p, struct frame_needs *out)
+{
+    for (int i = 0; i < p->count; i++) {
+        const struct effect_info *e = effect_infos[p->effects[i].effect];
+        if (!e->needs)
+            continue;
+        struct frame_needs n = {0};
+        e->needs(post_effect_options(p, i), &n);
+        frame_needs_merge(out, &n);
+    }
+}
+
+int post_spec_drop_antialiasing(struct post_spec *p)
+{
+    int kept = 0;
+    for (int i = 0; i < p->count; i++)
+        if (!(effect_infos[p->effects[i].effect]->flags & EFFECT_ANTIALIASING))
+            p->effects[kept++] = p->effects[i];
+    int dropped = p->count - kept;
+    p->count = kept;
+    return dropped;
+}

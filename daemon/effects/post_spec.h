@@ -57,4 +57,12 @@ void post_effect_label(const struct post_spec *p, int i, char *buf, size_t cap);
  * (cap entries); returns how many the chain needs (which may exceed cap). */
 int post_spec_pass_names(const struct post_spec *p, char (*names)[POST_PASS_NAME_BYTES], int cap);
 
+/* What the chain needs of time: every effect's needs merged into out
+ * (which the caller starts, zeroed or with the technique's). */
+void post_spec_needs(const struct post_spec *p, struct frame_needs *out);
+
+/* Drops the entries whose effect anti-aliases (EFFECT_ANTIALIASING): the
+ * chain a supersampled reference renders. Returns how many it dropped. */
+int post_spec_drop_antialiasing(struct post_spec *p);
+
 #endif

@@ -6,3 +6,4 @@
 include $(srcdir)/daemon/effects/bloom/local.mk
 include $(srcdir)/daemon/effects/toon/local.mk
 include $(srcdir)/daemon/effects/ssao/local.mk
+include $(srcdir)/daemon/effects/taa/local.mk

@@ -36,6 +36,12 @@
  * and glTF's default material after them (shaders/common/surface.glsl). */
 #define SB_SSBO_MATERIALS 19
 #define SB_SSBO_SHADOW_SUNS 20 /* per directional light's map: its projection */
+#define SB_SSBO_PREV_INSTANCES 21 /* per instance: its position and scale the frame before (motion vectors) */
+/* The visibility buffer's copy of every mesh's vertices and indices, and per mesh
+ * where its own begin and its material (daemon/techniques/visibility_buffer/). */
+#define SB_SSBO_VIS_VERTICES 22
+#define SB_SSBO_VIS_INDICES 23
+#define SB_SSBO_VIS_MESHES 24
 
 /* Texture units. */
 #define SB_TEX_HDR 0
@@ -53,6 +59,7 @@
 #define SB_TEX_POST_DEPTH 1  /* the technique's depth texture */
 #define SB_TEX_POST_NORMAL 2 /* the technique's g-buffer normals, when it has them */
 #define SB_TEX_POST_AUX 3    /* an effect's own intermediate (bloom level, occlusion) */
+#define SB_TEX_POST_MOTION 4 /* the harness's motion vectors (an effect that needs them: TAA) */
 
 /* Uniform locations, explicit so that timed code never looks a name up.
  * Arrays take one location per element. */
@@ -95,6 +102,9 @@
  * attributes the drawn mesh has (bit 0 TEXCOORD_0, 1 TEXCOORD_1, 2 COLOR_0),
  * set by gpu_scene_draw where the program reads it. */
 #define SB_LOC_MESH_ATTRIBUTES 6  /* int */
+/* The visibility buffer's material passes: the window depth of the material
+ * key a full-screen draw stands at (vis_key.vert). */
+#define SB_LOC_VIS_KEY 7          /* float */
 #define SB_LOC_IBL_FACE 0         /* filters: int, the cube face written */
 #define SB_LOC_IBL_PARAMS 1       /* filters: vec4 (roughness or lod, 1 / size, samples, source size) */
 

@@ -274,6 +274,27 @@ bool gpu_scene_init(struct gpu_scene *g, const struct scene *s, char *err, size_
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->instance_buffer);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(n * INSTANCE_FLOATS * sizeof(float)), inst,
                  GL_STATIC_DRAW);
+    /* The positions the frame before: the same as now until something moves. */
+    float *prev = calloc(n ? n * 4 : 4, sizeof(float));
+    if (!prev) {
+        free(inst);
+        free(light);
+        snprintf(err, errlen, "out of memory for scene buffers");
+        gpu_scene_finish(g);
+        return false;
+    }
+    for (size_t i = 0; i < n; i++)
+        memcpy(&prev[i * 4], &inst[i * INSTANCE_FLOATS], 4 * sizeof(float));
+    glGenBuffers(1, &g->prev_instance_buffer);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->prev_instance_buffer);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)((n ? n : 1) * 4 * sizeof(float)), prev,
+                 s->mover >= 0 ? GL_STREAM_DRAW : GL_STATIC_DRAW);
+    free(prev);
+    g->instances_frame = INT64_MIN;
+    if (s->mover >= 0) {
+        g->instance_rows = inst; /* kept: each frame uploads them */
+        inst = NULL;
+    }
     glGenBuffers(1, &g->light_buffer);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->light_buffer);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(lights * LIGHT_FLOATS * sizeof(float)), light,
@@ -303,6 +324,8 @@ void gpu_scene_finish(struct gpu_scene *g)
     free(g->vbo);
     free(g->ebo);
     glDeleteBuffers(1, &g->instance_buffer);
+    glDeleteBuffers(1, &g->prev_instance_buffer);
+    free(g->instance_rows);
     glDeleteBuffers(1, &g->light_buffer);
     glDeleteBuffers(1, &g->position_buffer);
     free(g->position_scratch);
@@ -343,6 +366,36 @@ void gpu_scene_set_light_rows(struct gpu_scene *g, const int64_t *frames, int ro
     g->uploaded_frame = rows == 1 ? frames[0] : INT64_MIN;
 }
 
+void gpu_scene_set_frame(struct gpu_scene *g, int64_t frame)
+{
+    const struct scene *s = g->scene;
+    if (s->mover < 0 || g->instances_frame == frame)
+        return;
+    enum { INSTANCE_FLOATS = 12 };
+    float now[4], before[4];
+    scene_instance_at(s, s->mover, frame, now);
+    scene_instance_at(s, s->mover, frame - 1, before);
+    memcpy(&g->instance_rows[(size_t)s->mover * INSTANCE_FLOATS], now, sizeof(now));
+    size_t n = (size_t)s->instance_count;
+    /* Orphaned, not overwritten: a frame still in flight keeps its rows. */
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->instance_buffer);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(n * INSTANCE_FLOATS * sizeof(float)),
+                 g->instance_rows, GL_STREAM_DRAW);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->prev_instance_buffer);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(n * 4 * sizeof(float)), NULL,
+                 GL_STREAM_DRAW);
+    float *prev = glMapBufferRange(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(n * 4 * sizeof(float)),
+                                   GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT);
+    if (prev) {
+        for (size_t i = 0; i < n; i++)
+            memcpy(&prev[i * 4], &g->instance_rows[i * INSTANCE_FLOATS], 4 * sizeof(float));
+        memcpy(&prev[(size_t)s->mover * 4], before, sizeof(before));
+        glUnmapBuffer(GL_SHADER_STORAGE_BUFFER);
+    }
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    g->instances_frame = frame;
+}
+
 struct scene_program gpu_scene_program(const struct gpu_scene *g, GLuint prog)
 {
     (void)g;
@@ -358,6 +411,7 @@ void gpu_scene_bind(const struct gpu_scene *g, const struct scene_program *p)
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_INSTANCES, g->instance_buffer);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHTS, g->light_buffer);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_LIGHT_POSITIONS, g->position_buffer);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_PREV_INSTANCES, g->prev_instance_buffer);
     if (g->material_buffer)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SB_SSBO_MATERIALS, g->material_buffer);
 }
@@ -413,6 +467,19 @@ void gpu_scene_draw_mesh(const struct gpu_scene *g, const struct scene_program *
         base += s->mesh_instance_count[m];
     if (s->mesh_instance_count[mesh])
         draw_mesh(g, p, mesh, base);
+    glBindVertexArray(0);
+}
+
+void gpu_scene_draw_instance(const struct gpu_scene *g, const struct scene_program *p,
+                             int instance)
+{
+    const struct scene *s = g->scene;
+    int m = s->instances[instance].mesh;
+    gpu_scene_bind_material(g, m, p->material);
+    glUniform1i(p->instance_base, instance);
+    glBindVertexArray(g->vao[m]);
+    glDrawElementsInstanced(GL_TRIANGLES, (GLsizei)s->meshes[m].index_count, GL_UNSIGNED_INT,
+                            NULL, 1);
     glBindVertexArray(0);
 }
 

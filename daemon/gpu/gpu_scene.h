@@ -40,6 +40,14 @@ struct gpu_scene {
         int attributes; /* the file's: bit 0 TEXCOORD_0, 1 TEXCOORD_1, 2 COLOR_0 */
         GLuint tex[5], sampler[5];
     } *mesh_material; /* per scene mesh; NULL without an asset */
+    /* Scenes with a mover (scene.mover): the instance rows kept here, so
+     * that each frame's upload orphans the buffer rather than waiting for a
+     * frame in flight; every instance's position and scale the frame
+     * before (SB_SSBO_PREV_INSTANCES, for motion vectors; the current ones
+     * in scenes without a mover); the frame uploaded (INT64_MIN: none). */
+    float *instance_rows;
+    GLuint prev_instance_buffer;
+    int64_t instances_frame;
 };
 
 /* Which meshes gpu_scene_draw draws: the techniques' passes draw opaque and
@@ -54,6 +62,11 @@ void gpu_scene_finish(struct gpu_scene *g);
  * camera is not the scene's business here: the harness puts each frame's in
  * the frame block (daemon/gpu/pass.h). */
 void gpu_scene_set_light_rows(struct gpu_scene *g, const int64_t *frames, int rows);
+
+/* Puts the instances where they are at frame (the harness calls it before
+ * each frame's passes) and the frame before's positions in the previous
+ * rows; nothing in a scene where nothing moves. */
+void gpu_scene_set_frame(struct gpu_scene *g, int64_t frame);
 
 /* A program that reads the scene, with the uniforms the scene sets. */
 struct scene_program {
@@ -86,6 +99,10 @@ void gpu_scene_draw(const struct gpu_scene *g, const struct scene_program *p);
 /* One mesh of the scene (its instances), material bound: the transparent
  * pass's draw, in its own order. */
 void gpu_scene_draw_mesh(const struct gpu_scene *g, const struct scene_program *p, int mesh);
+/* One instance (its mesh's draw of one), material bound: the harness's
+ * motion vectors of a moving instance. */
+void gpu_scene_draw_instance(const struct gpu_scene *g, const struct scene_program *p,
+                             int instance);
 /* Binds mesh's material (asset meshes; nothing for procedural ones): for
  * passes that draw meshes their own way (the shadow casters). */
 void gpu_scene_bind_material(const struct gpu_scene *g, int mesh, GLint material_loc);

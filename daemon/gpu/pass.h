@@ -39,7 +39,10 @@ void gpu_pass_begin(const struct gpu_passes *p, int pass, GLuint fbo, int w, int
 void gpu_pass_end(const struct gpu_passes *p);
 
 /* The per-frame uniform block (std140), bound at SB_UBO_FRAME for every
- * program: shaders/common/frame.glsl declares the same layout. */
+ * program: shaders/common/frame.glsl declares the same layout. proj and
+ * everything made from it carry this frame's jitter (the projection's
+ * sub-pixel offset, 0 unless a stage asks for it: common/frame_needs.h);
+ * unjittered_view_proj and prev_view_proj are without it, for motion. */
 struct gpu_frame_data {
     float view[16], proj[16], view_proj[16];
     float inv_view[16], inv_proj[16], inv_view_proj[16];
@@ -47,6 +50,20 @@ struct gpu_frame_data {
     float viewport[4]; /* width, height, 1/width, 1/height */
     float clip[4];     /* near, far */
     int32_t counts[4]; /* frame (low 31 bits), lights, instances */
+    float unjittered_view_proj[16]; /* this frame's, without the jitter */
+    float prev_view_proj[16];       /* the frame before's, without its jitter */
+    float jitter[4];                /* pixels: this frame's offset (xy), the frame before's (zw) */
+};
+
+/* What the harness tells a frame's stages of time (the frame contract):
+ * the frame's index, whether a history kept from the frames before must be
+ * dropped at it (the first frame an instance draws, and history_frames
+ * before each captured frame, so that frame k stays a pure function of k),
+ * and this frame's jitter in pixels. Valid during the frame. */
+struct gpu_frame_time {
+    int64_t frame;
+    bool restart;
+    float jitter[2];
 };
 
 struct gpu_frame_block {

@@ -59,6 +59,29 @@ static json_t *hdr_stats_json(const struct hdr_stats *s)
                      "mean", s->mean[0], s->mean[1], s->mean[2], "min", s->min, "max", s->max);
 }
 
+/* The motion vectors' figures at a capture: their mean, the longest, and
+ * the pixels that moved. */
+static void read_motion(struct harness_run *run, struct run_capture *cap)
+{
+    int w = run->env.width, h = run->env.height;
+    const float *m = run->motion_scratch;
+    glBindTexture(GL_TEXTURE_2D, run->motion.tex);
+    glGetTexImage(GL_TEXTURE_2D, 0, GL_RG, GL_FLOAT, run->motion_scratch);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    double sum[2] = {0, 0}, max2 = 0;
+    long long moving = 0, n = (long long)w * h;
+    for (long long p = 0; p < n; p++) {
+        double x = m[2 * p], y = m[2 * p + 1], l2 = x * x + y * y;
+        sum[0] += x, sum[1] += y;
+        max2 = l2 > max2 ? l2 : max2;
+        moving += l2 > 0;
+    }
+    cap->motion.mean[0] = sum[0] / (double)n;
+    cap->motion.mean[1] = sum[1] / (double)n;
+    cap->motion.max = sqrt(max2);
+    cap->motion.moving = moving;
+}
+
 bool outputs_read_capture(struct harness_run *run, int k)
 {
     struct run_capture *cap = &run->capture[run->captured];
@@ -71,6 +94,8 @@ bool outputs_read_capture(struct harness_run *run, int k)
     if (!post_chain_count_nonfinite(run->post, run->hdr_resolved, &cap->nonfinite, run->err,
                                     sizeof(run->err)))
         return false;
+    if (run->motion_scratch)
+        read_motion(run, cap);
     if (cap->heat) {
         glBindTexture(GL_TEXTURE_2D, run->products.heat_tex);
         glGetTexImage(GL_TEXTURE_2D, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, cap->heat);
@@ -293,6 +318,11 @@ static json_t *write_captures(struct harness_run *run)
                                   nonfinite_json(&cap->nonfinite));
         if (run->hdr_scratch)
             json_object_set_new(entry, "hdr", hdr_stats_json(&cap->hdr));
+        if (run->motion_scratch)
+            json_object_set_new(entry, "motion",
+                                json_pack("{s:[f, f], s:f, s:I}", "mean_px", cap->motion.mean[0],
+                                          cap->motion.mean[1], "max_px", cap->motion.max,
+                                          "moving_pixels", (json_int_t)cap->motion.moving));
         json_array_append_new(captures, entry);
     }
     return captures;
@@ -422,6 +452,9 @@ json_t *outputs_write(struct harness_run *run)
                         gpu_memory_run_json(run->gpu_memory, gpu_targets_bytes(run->gl->targets),
                                             software));
     json_object_set_new(result, "msaa", run_msaa_json(run));
+    json_t *time = run_time_json(run);
+    if (time)
+        json_object_set_new(result, "time", time);
     json_object_set_new(result, RK_STARTED_UNIX, json_real(run->job->started));
     if (heatmap)
         json_object_set(result, RK_HEATMAP, heatmap);

@@ -80,6 +80,7 @@ bool frame_source_frame(struct harness_run *run, struct frame_source *src, int64
         return false;
     }
     rr->err[0] = '\0';
+    bool drawn = true;
     if (fresh || !rr->state) {
         /* The post chain's effects are built anew for each instance: from
          * the normals it publishes. */
@@ -91,8 +92,15 @@ bool frame_source_frame(struct harness_run *run, struct frame_source *src, int64
             drop_instance(src);
             return false;
         }
+        /* A new instance keeps no history: it draws the frames its history
+         * reaches back to first (from the restart needs.history_frames
+         * before frame k), as the timed run drew them before frame k. */
+        rr->drawn = false;
+        for (int64_t j = k - rr->needs.history_frames; drawn && j < k; j++)
+            drawn = run_frame(rr, j, false);
     }
-    bool drawn = run_frame(rr, k, false);
+    if (drawn)
+        drawn = run_frame(rr, k, false);
     if (!drawn && gpu_budget_stopped(&rr->budget)) {
         drop_instance(src);
         if (atomic_load(&run->job->cancel)) {
@@ -131,6 +139,7 @@ void frame_source_close(struct frame_source *src)
     drop_instance(src);
     post_chain_destroy(src->rr.post);
     src->rr.post = NULL;
+    motion_vectors_finish(&src->rr.motion);
     gpu_timer_destroy(src->rr.timer);
     src->rr.timer = NULL;
     free(src->big);

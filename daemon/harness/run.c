@@ -144,8 +144,14 @@ bool run_setup_passes(struct harness_run *run, const void *options, int64_t time
                        !(tech->info->flags & TECHNIQUE_READS_NO_LIGHT)) +
                       run->stages.sky_on + run->stages.debug_on +
                       (run->transparent.count > 0);
+    /* What the technique and the chain need of time. */
+    run->needs = (struct frame_needs){0};
+    if (tech->info->needs)
+        tech->info->needs(options, &run->needs);
+    post_spec_needs(&run->look->post, &run->needs);
+    run->motion_pass = -1;
     run->timer = gpu_timer_create(technique_pass_count(tech) + look_passes + post_passes + 1 +
-                                      (run->env.samples > 1),
+                                      (run->env.samples > 1) + run->needs.motion_vectors,
                                   timed_frames);
     if (!run->timer) {
         snprintf(run->err, sizeof(run->err), "cannot create GPU timer queries");
@@ -165,6 +171,17 @@ bool run_setup_passes(struct harness_run *run, const void *options, int64_t time
     if (fits && run->transparent.count > 0 &&
         (run->transparent_pass = gpu_passes_add(&run->passes, "transparent")) < 0)
         fits = false;
+    if (fits && run->env.samples > 1 &&
+        (run->msaa_pass = gpu_passes_add(&run->passes, "msaa_resolve")) < 0)
+        fits = false;
+    if (fits && run->needs.motion_vectors) {
+        if ((run->motion_pass = gpu_passes_add(&run->passes, "motion_vectors")) < 0)
+            fits = false;
+        else if (!motion_vectors_init(&run->motion, run->env.targets, run->env.gpu,
+                                      run->hdr_depth, run->env.width, run->env.height,
+                                      run->defines, run->err, sizeof(run->err)))
+            return false;
+    }
     /* The chain's passes now; its effects are built once the technique exists. */
     const struct post_frame frame = {
         .width = run->env.width,
@@ -174,10 +191,8 @@ bool run_setup_passes(struct harness_run *run, const void *options, int64_t time
         .depth = run->hdr_depth,
         .targets = run->env.targets,
         .budget = &run->budget,
+        .motion = run->motion.tex,
     };
-    if (fits && run->env.samples > 1 &&
-        (run->msaa_pass = gpu_passes_add(&run->passes, "msaa_resolve")) < 0)
-        fits = false;
     if (fits && !(run->post = post_chain_create(&frame, &run->look->post, &run->passes, run->err,
                                                 sizeof(run->err))))
         return false;
@@ -209,6 +224,8 @@ static bool alloc_captures(struct harness_run *run)
      * pixels (what the roughness clamp keeps out), mean and peak. */
     if (run->look->lighting == LOOK_PBR &&
         !(run->hdr_scratch = malloc(pixels * 4 * sizeof(float))))
+        return false;
+    if (run->motion_pass >= 0 && !(run->motion_scratch = malloc(pixels * 2 * sizeof(float))))
         return false;
     return true;
 }
@@ -361,8 +378,10 @@ void run_finish(struct harness_run *run)
     run->state = NULL;
     look_stages_finish(&run->stages);
     transparent_finish(&run->transparent);
+    motion_vectors_finish(&run->motion);
     gl_build_log_free(&run->builds);
     free(run->hdr_scratch);
+    free(run->motion_scratch);
     post_chain_destroy(run->post);
     gpu_timer_destroy(run->timer);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -391,12 +410,30 @@ void run_finish(struct harness_run *run)
     gl_error_take("teardown", drop, sizeof(drop));
 }
 
-/* A still camera's block is the same every frame, so only a moving one is
- * rebuilt. */
-void run_frame_data(const struct harness_run *run, int64_t k, struct gpu_frame_data *d)
+/* m (a projection, or a view-projection) followed by the jitter: every
+ * clip-space x and y moves by its offset times w (an orthographic
+ * projection's too), so that the image moves by jitter pixels. The jitter
+ * is a translation applied after m, so a view-projection takes it the same
+ * way as the projection. */
+static void jitter_matrix(float m[16], const float jitter[2], int w, int h)
+{
+    float dx = 2.0f * jitter[0] / (float)w, dy = 2.0f * jitter[1] / (float)h;
+    for (int c = 0; c < 4; c++) {
+        m[c * 4 + 0] += dx * m[c * 4 + 3];
+        m[c * 4 + 1] += dy * m[c * 4 + 3];
+    }
+}
+
+/* A still, unjittered camera's block is the same every frame, so only a
+ * moving or jittered one is rebuilt. */
+void run_frame_data(const struct harness_run *run, int64_t k, const float jitter[2],
+                    const float prev_jitter[2], struct gpu_frame_data *d)
 {
     const struct scene *s = run->env.scene;
-    if (d->viewport[0] != 0 && !scene_camera_moves(s)) {
+    bool jittered = jitter[0] != 0.0f || jitter[1] != 0.0f;
+    bool moves = scene_camera_moves(s);
+    if (d->viewport[0] != 0 && !moves && !jittered && d->jitter[0] == 0.0f &&
+        d->jitter[1] == 0.0f) {
         d->counts[0] = (int32_t)(k & 0x7fffffff);
         return;
     }
@@ -407,7 +444,22 @@ void run_frame_data(const struct harness_run *run, int64_t k, struct gpu_frame_d
     memcpy(d->view_proj, cam.view_proj, sizeof(d->view_proj));
     memcpy(d->inv_view, cam.inv_view, sizeof(d->inv_view));
     memcpy(d->inv_proj, cam.inv_proj, sizeof(d->inv_proj));
+    memcpy(d->unjittered_view_proj, cam.view_proj, sizeof(d->unjittered_view_proj));
+    if (jittered) {
+        jitter_matrix(d->proj, jitter, run->env.width, run->env.height);
+        jitter_matrix(d->view_proj, jitter, run->env.width, run->env.height);
+        mat4_invert(d->proj, d->inv_proj);
+    }
     mat4_invert(d->view_proj, d->inv_view_proj);
+    if (moves) {
+        struct scene_camera before;
+        scene_camera_at(s, k - 1, &before);
+        memcpy(d->prev_view_proj, before.view_proj, sizeof(d->prev_view_proj));
+    } else {
+        memcpy(d->prev_view_proj, cam.view_proj, sizeof(d->prev_view_proj));
+    }
+    d->jitter[0] = jitter[0], d->jitter[1] = jitter[1];
+    d->jitter[2] = prev_jitter[0], d->jitter[3] = prev_jitter[1];
     d->eye[0] = cam.eye[0], d->eye[1] = cam.eye[1], d->eye[2] = cam.eye[2], d->eye[3] = 1.0f;
     d->viewport[0] = (float)run->env.width;
     d->viewport[1] = (float)run->env.height;
@@ -418,6 +470,13 @@ void run_frame_data(const struct harness_run *run, int64_t k, struct gpu_frame_d
     d->counts[1] = s->light_count;
     d->counts[2] = s->instance_count;
     d->counts[3] = 0;
+}
+
+bool run_history_restarts(const struct harness_run *run, int64_t k)
+{
+    int h = run->needs.history_frames;
+    return !run->drawn || k != run->last_frame + 1 ||
+           (h > 0 && technique_env_captures(&run->env, k + h));
 }
 
 /* HDR output to the 8-bit image, timed as a pass of every frame so that
@@ -446,8 +505,19 @@ static void resolve(const struct harness_run *run)
 bool run_frame(struct harness_run *run, int64_t k, bool timed)
 {
     gpu_budget_frame(&run->budget);
-    run_frame_data(run, k, &run->frame_data);
+    /* Time: the frame, whether histories restart at it, the jitter. */
+    struct gpu_frame_time *t = &run->time;
+    float prev_jitter[2];
+    frame_jitter(run->needs.jitter_length, k - 1, prev_jitter);
+    t->frame = k;
+    t->restart = run_history_restarts(run, k);
+    frame_jitter(run->needs.jitter_length, k, t->jitter);
+    run->env.time = t;
+    run_frame_data(run, k, t->jitter, prev_jitter, &run->frame_data);
     gpu_frame_block_update(&run->gl->frame_block, &run->frame_data);
+    gpu_scene_set_frame(run->env.gpu, k);
+    run->drawn = true;
+    run->last_frame = k;
     gpu_timer_begin_frame(run->timer);
     bool ok = look_stages_before(&run->stages, &run->passes, run->shadow_pass, k, timed, run->err,
                                  sizeof(run->err));
@@ -469,10 +539,59 @@ bool run_frame(struct harness_run *run, int64_t k, bool timed)
                          run->frame_data.eye);
     if (run->msaa_pass >= 0)
         run_msaa_resolve(run);
-    run->hdr_resolved = post_chain_run(run->post);
-    resolve(run);
+    if (run->motion_pass >= 0)
+        motion_vectors_draw(&run->motion, &run->passes, run->motion_pass, run->env.gpu);
+    if (ok)
+        ok = post_chain_run(run->post, t, &run->hdr_resolved, run->err, sizeof(run->err));
+    if (ok)
+        resolve(run);
     gpu_timer_end_frame(run->timer);
     return ok;
+}
+
+static json_t *needs_json(const struct frame_needs *n)
+{
+    return json_pack("{s:i, s:o, s:b}", "history_frames", n->history_frames, "jitter",
+                     n->jitter_length
+                         ? json_pack("{s:s, s:i}", "sequence",
+                                     "Halton (2, 3) from index 1, centred on the pixel", "length",
+                                     n->jitter_length)
+                         : json_null(),
+                     "motion_vectors", n->motion_vectors);
+}
+
+json_t *run_time_json(const struct harness_run *run)
+{
+    const struct job_spec *spec = run->spec;
+    struct frame_needs ref = {0};
+    int dropped = 0;
+    if (spec->reference[0]) {
+        job_spec_needs(spec, true, &ref);
+        struct post_spec all = spec->look.post;
+        dropped = spec->reference_look_given ? 0 : post_spec_drop_antialiasing(&all);
+    }
+    const struct frame_needs *n = &run->needs;
+    if (!n->history_frames && !n->jitter_length && !n->motion_vectors && !ref.history_frames &&
+        !ref.jitter_length && !ref.motion_vectors && !dropped)
+        return NULL;
+    json_t *o = needs_json(n);
+    json_object_set_new(
+        o, "rule",
+        json_string("frame k is a pure function of k: every history starts afresh at the first "
+                    "frame an instance draws and history_frames frames before each captured "
+                    "frame; the timed run draws those frames in its warm-up and timed frames, "
+                    "and the reference and the temporal frames, which start a new instance at "
+                    "a captured frame, draw the history_frames frames before it first"));
+    if (spec->reference[0]) {
+        json_t *r = needs_json(&ref);
+        if (dropped)
+            json_object_set_new(r, "antialiasing_left_out",
+                                json_string("the reference renders the job's look without its "
+                                            "anti-aliasing effects (taa): it is the truth they "
+                                            "approximate; give reference_look to choose"));
+        json_object_set_new(o, "reference", r);
+    }
+    return o;
 }
 
 int run_pass_order(const struct harness_run *run, int *order)

@@ -23,6 +23,7 @@
 #include "daemon/scene/environment.h"
 #include "daemon/gpu/targets.h"
 #include "daemon/status/interference.h"
+#include "daemon/harness/motion.h"
 #include "daemon/harness/transparent.h"
 #include "daemon/jobs/queue.h"
 #include "daemon/look/look.h"
@@ -63,6 +64,12 @@ struct run_capture {
     struct post_nonfinite nonfinite; /* of the HDR colour the resolve read */
     struct hdr_stats hdr;            /* physically based looks (run->hdr_scratch set) */
     uint32_t *heat;                  /* light evaluations per pixel, when published */
+    /* The harness's motion vectors at that frame, when drawn: their mean
+     * (pixels), the longest, and the pixels that moved at all. */
+    struct {
+        double mean[2], max;
+        long long moving;
+    } motion;
 };
 
 /* How a job's timed frames are drawn, decided once per job in its first
@@ -135,6 +142,18 @@ struct harness_run {
      * resolve (msaa_pass) writes from the technique's multisampled output. */
     GLuint hdr_fbo, hdr_color, hdr_depth;
     int msaa_pass; /* -1 at msaa 1 */
+    /* The frame contract's time (common/frame_needs.h, gpu/pass.h): what
+     * the technique and the post chain need, merged; the harness's motion
+     * vectors where they are read (motion_pass -1 otherwise); whether the
+     * instance has drawn a frame and which it drew last (the next frame
+     * after a gap, or the first, restarts every history); this frame's
+     * time, as the technique and the effects are told it. */
+    struct frame_needs needs;
+    struct motion_vectors motion;
+    int motion_pass;
+    bool drawn;
+    int64_t last_frame;
+    struct gpu_frame_time time;
     struct technique_env env;
     struct technique_products products;
     char defines[512];
@@ -144,6 +163,7 @@ struct harness_run {
     int capture_count, captured;
     struct run_capture *capture;
     float *hdr_scratch; /* physically based looks: one HDR frame, for the statistics */
+    float *motion_scratch; /* motion vectors drawn: one frame's (RG), for their statistics */
     /* The job's timing rule (its owner: the job's first run decides it). */
     struct run_timing_rule *rule;
     bool measuring; /* drawing the harness's measuring frames (for messages) */
@@ -204,11 +224,23 @@ bool run_build_post_chain(struct harness_run *run);
  * DELETE, or the daemon stopping) or ran out of time. */
 void run_budget_init(struct harness_run *run);
 
-/* The per-frame block for frame k: camera, viewport and counts. */
-void run_frame_data(const struct harness_run *run, int64_t k, struct gpu_frame_data *d);
+/* The per-frame block for frame k: camera (jittered by jitter, in
+ * pixels; prev_jitter is the frame before's), the unjittered camera of
+ * frame k and of frame k - 1, viewport and counts. */
+void run_frame_data(const struct harness_run *run, int64_t k, const float jitter[2],
+                    const float prev_jitter[2], struct gpu_frame_data *d);
+/* Whether frame k starts every history afresh: the instance's first frame,
+ * one after a gap, and the frame needs.history_frames before each captured
+ * frame (so that frame k is a pure function of k). */
+bool run_history_restarts(const struct harness_run *run, int64_t k);
 /* One frame of every stage, from the look's before-passes to the resolve,
  * between the timer's begin and end of frame. Timed. */
 bool run_frame(struct harness_run *run, int64_t k, bool timed);
+
+/* The result's "time" object: what the technique and the look's chain
+ * (and the reference's) need of time, and how frame k stays a pure
+ * function of k; NULL when neither needs anything. */
+json_t *run_time_json(const struct harness_run *run);
 
 /* Passes in the order a frame runs them (the shadow pass first); returns
  * the count. */

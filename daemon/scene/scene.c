@@ -150,6 +150,11 @@ bool scene_build(struct scene *out, const struct scene_spec *spec, const struct 
     }
     scene_assign_materials(out, materials_set);
     compute_bounds(out);
+    /* After the bounds, which frame the camera without it: the mover
+     * crosses what the camera already sees. */
+    out->mover = -1;
+    if (!scene_add_mover(out))
+        goto fail;
     if (!scene_add_rig(out))
         goto fail;
     scene_apply_pose(out);
@@ -531,6 +536,14 @@ json_t *scene_describe(const struct scene *s)
                             describe_camera(s), "bounds", box_json(&s->bounds), "sky", s->sky);
     if (out && s->asset)
         json_object_set_new(out, "asset", describe_asset(s));
+    if (out && s->mover >= 0)
+        json_object_set_new(out, "mover",
+                            json_pack("{s:i, s:o, s:o, s:f, s:i}", "instance", s->mover, "from",
+                                      vec3_json(s->mover_from), "to", vec3_json(s->mover_to),
+                                      "radius",
+                                      (double)(SCENE_SPHERE_RADIUS *
+                                               s->instances[s->mover].scale),
+                                      "period", s->spec.mover_period));
     if (out && (s->asset || s->rig_light_count))
         json_object_set_new(out, "gltf_lights", describe_gltf_lights(s));
     if (out && s->mesh_instance_count[SCENE_MESH_TEAPOT])

@@ -165,6 +165,12 @@ struct scene {
     int generated_light_count;
     int rig_light_count;       /* scene.light_rig's, the last lights */
     int asset_camera;          /* the asset camera of the static pose, -1: framed from the bounds */
+    /* scene.mover (mover.c): the moving sphere's instance (the last of the
+     * spheres), -1 without one, and the ends of the segment its centre
+     * slides along, there and back every spec.mover_period frames. Its
+     * instance's pos is where it stands at frame 0. */
+    int mover;
+    float mover_from[3], mover_to[3];
 };
 
 /* An asset's KHR_lights_punctual lights in the daemon's colour scale
@@ -200,6 +206,16 @@ void scene_light_position(const struct scene *s, int light, int64_t frame,
 void scene_camera_at(const struct scene *s, int64_t frame, struct scene_camera *out);
 /* True when the camera path moves (every frame needs its own camera). */
 bool scene_camera_moves(const struct scene *s);
+
+/* Instance i's world position (xyz) and scale (w) at frame (any integer):
+ * its pos and scale, but for the mover, which slides (mover.c). */
+void scene_instance_at(const struct scene *s, int i, int64_t frame, float out[4]);
+/* Where the mover (scene.mover) stands on a width x height image seen by
+ * camera c at frame: its centre in window pixels (x, y from the bottom
+ * left) and the semi-major axis of its silhouette (scene_sphere_radius_px);
+ * false without a mover or when it lies behind the camera. */
+bool scene_mover_disc(const struct scene *s, int64_t frame, const struct scene_camera *c,
+                      int width, int height, float out[3]);
 
 /* Bounding sphere of instance i in world space. */
 float scene_instance_bound(const struct scene *s, int i);

@@ -61,6 +61,11 @@ void scene_apply_pose(struct scene *s);
  * largest sphere on screen over the camera path (needs the rig). */
 void scene_choose_segments(struct scene *s);
 
+/* mover.c: with spec.mover, inserts the moving sphere after the last
+ * sphere instance (instances stay grouped by mesh) and sets its path
+ * across s->objects (needs the bounds). Returns false when out of memory. */
+bool scene_add_mover(struct scene *s);
+
 /* Column-major 4x4 helpers (camera.c). */
 void scene_mat4_mul(float out[16], const float a[16], const float b[16]);
 void scene_mat4_transform(const float m[16], const float p[3], float w, float out[4]);

@@ -78,6 +78,34 @@ void scene_spec_defaults(struct scene_spec *s)
     s->camera_period = 360;
     s->asset_lights = true;
     s->normal_maps = true;
+    s->mover = false;
+    s->mover_period = 120;
+}
+
+/* "mover": true, false, or {"period": frames}. */
+static bool parse_mover(const json_t *scene, struct scene_spec *s, struct job_error *err)
+{
+    static const char *const keys[] = {"period", NULL};
+    json_t *v = json_object_get(scene, "mover");
+    if (!v)
+        return true;
+    if (json_is_boolean(v)) {
+        s->mover = json_is_true(v);
+    } else if (json_is_object(v)) {
+        if (!jf_check_keys(v, "scene.mover.", keys, err) ||
+            !jf_get_int(v, "period", "scene.mover.period", 2, SCENE_MAX_MOVER_PERIOD,
+                        &s->mover_period, err))
+            return false;
+        s->mover = true;
+    } else {
+        return job_error_set(err, "scene.mover",
+                             "must be true, false or {\"period\": frames} (2 to %d)",
+                             SCENE_MAX_MOVER_PERIOD);
+    }
+    if (s->mover && scene_spec_is_asset(s))
+        return job_error_set(err, "scene.mover", "needs a procedural preset (not scene.asset "
+                             "or the textured preset)");
+    return true;
 }
 
 /* "lights": a count, or "auto" (asset scenes: 0 when the asset has lights,
@@ -291,7 +319,7 @@ bool scene_spec_parse(const json_t *scene, struct scene_spec *s, struct job_erro
         "teapot_segments", "tessellation_error_px", "light_speed", "light_radius", "light_intensity",
         "light_layout", "light_type", "spot_angle_deg", "sun", "materials", "specular",
         "shininess", "metallic", "roughness", "camera", "asset", "asset_sha256", "asset_camera",
-        "asset_lights", "normal_maps", "light_rig", NULL};
+        "asset_lights", "normal_maps", "light_rig", "mover", NULL};
     if (!jf_check_keys(scene, "scene.", keys, err))
         return false;
     int preset = (int)s->preset, layout, materials, light_type = s->light_type;
@@ -327,7 +355,8 @@ bool scene_spec_parse(const json_t *scene, struct scene_spec *s, struct job_erro
         !jf_get_number(scene, "shininess", "scene.shininess", 1.0, 4096.0, &s->shininess, err) ||
         !jf_get_number(scene, "metallic", "scene.metallic", 0.0, 1.0, &s->metallic, err) ||
         !jf_get_number(scene, "roughness", "scene.roughness", 0.0, 1.0, &s->roughness, err) ||
-        !parse_camera(scene, s, err) || !parse_asset_camera(scene, s, err))
+        !parse_camera(scene, s, err) || !parse_asset_camera(scene, s, err) ||
+        !parse_mover(scene, s, err))
         return false;
     if ((json_object_get(scene, "asset_lights") || json_object_get(scene, "normal_maps")) &&
         !scene_spec_is_asset(s))
@@ -395,6 +424,8 @@ json_t *scene_spec_to_json(const struct scene_spec *s)
         if (s->asset_sha256[0])
             json_object_set_new(o, "asset_sha256", json_string(s->asset_sha256));
     }
+    if (s->mover) /* written only when on: the other specs are unchanged */
+        json_object_set_new(o, "mover", json_pack("{s:i}", "period", s->mover_period));
     if (scene_spec_is_asset(s)) {
         /* Written only for asset scenes, so the presets' specs (and the
          * stored records compared against them) are unchanged. */

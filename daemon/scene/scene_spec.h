@@ -53,6 +53,7 @@ enum {
     SCENE_LIGHTS_AUTO = -1,
     SCENE_ASSET_DEFAULT_LIGHTS = 16,
     SCENE_ASSET_CAMERA_MAX = 64,
+    SCENE_MAX_MOVER_PERIOD = 1000000,
     /* scene.light_rig: explicit lights, at most this many. */
     SCENE_RIG_MAX_LIGHTS = 64,
 };
@@ -128,6 +129,12 @@ struct scene_spec {
     char asset_camera[SCENE_ASSET_CAMERA_MAX + 1];
     bool asset_lights;
     bool normal_maps;
+    /* "mover": a sphere that slides to and fro across the objects, once
+     * there and back every mover_period frames (daemon/scene/mover.c):
+     * object motion, for motion vectors and TAA's ghosting. Procedural
+     * presets only. */
+    bool mover;
+    int mover_period;
     /* scene.camera as a pose, when given (else the preset's or asset's). */
     struct scene_camera_spec view;
     /* scene.light_rig: lit after the generated lights, the sun and the

@@ -132,6 +132,16 @@ const void *job_spec_technique_options(const struct job_spec *spec)
     return spec->technique_index >= 0 ? spec->options[spec->technique_index].bytes : NULL;
 }
 
+void job_spec_needs(const struct job_spec *spec, bool reference, struct frame_needs *out)
+{
+    *out = (struct frame_needs){0};
+    int t = reference ? spec->reference_index : spec->technique_index;
+    const struct technique_info *info = t >= 0 ? spec->catalog->infos[t] : NULL;
+    if (info && info->needs)
+        info->needs(spec->options[t].bytes, out);
+    post_spec_needs(reference ? &spec->reference_look.post : &spec->look.post, out);
+}
+
 const void *job_spec_reference_options(const struct job_spec *spec)
 {
     return spec->reference_index >= 0 ? spec->options[spec->reference_index].bytes : NULL;
@@ -431,6 +441,9 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
      * reference_look is a whole look, read over the defaults. */
     json_t *ref_look;
     out->reference_look = out->look;
+    /* ...less its anti-aliasing effects (TAA): the reference is the truth
+     * they approximate, supersampled or not. */
+    post_spec_drop_antialiasing(&out->reference_look.post);
     if (!jf_get_object(body, "reference_look", "reference_look", &ref_look, err))
         return false;
     if (ref_look) {
@@ -533,6 +546,28 @@ bool job_spec_parse(const json_t *body, const struct technique_catalog *techniqu
     if (out->capture_interval > out->frames)
         return job_error_set(err, "capture_interval",
                     "must be 0 (no captures) or at most frames (%d)", out->frames);
+    /* Frame k is a pure function of k: a history starts afresh its length
+     * before each captured frame, which a capture closer than that to the
+     * one before would cut short. */
+    struct frame_needs needs, ref_needs = {0};
+    job_spec_needs(out, false, &needs);
+    if (out->reference[0])
+        job_spec_needs(out, true, &ref_needs);
+    int history = needs.history_frames > ref_needs.history_frames ? needs.history_frames
+                                                                  : ref_needs.history_frames;
+    if (history && job_spec_capture_count(out) > 1 && out->capture_interval <= history)
+        return job_error_set(err, "capture_interval",
+                    "must be more than the %d frames of history the technique and look.post "
+                    "keep (frame k is a pure function of k: each history starts afresh %d "
+                    "frames before each captured frame), or capture one frame",
+                    history, history);
+    if (needs.history_frames && job_spec_capture_count(out) > 0 &&
+        out->capture_interval - 1 + out->warmup_frames < needs.history_frames)
+        return job_error_set(err, "warmup_frames",
+                    "must be at least %d: the first captured frame (%d) needs the %d frames of "
+                    "history the technique and look.post keep drawn before it",
+                    needs.history_frames - out->capture_interval + 1, out->capture_interval,
+                    needs.history_frames);
     if (job_spec_capture_count(out) > JOB_MAX_CAPTURES)
         return job_error_set(err, "capture_interval", "would capture %d frames; at most %d a job",
                              job_spec_capture_count(out), JOB_MAX_CAPTURES);

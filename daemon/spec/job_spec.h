@@ -135,6 +135,10 @@ void job_spec_defaults(struct job_spec *out, const struct technique_catalog *tec
 const void *job_spec_technique_options(const struct job_spec *spec);
 const void *job_spec_reference_options(const struct job_spec *spec);
 
+/* What the job's technique and look.post (reference: its reference and
+ * reference_look.post) need of time (common/frame_needs.h). */
+void job_spec_needs(const struct job_spec *spec, bool reference, struct frame_needs *out);
+
 /* The canonical dotted path of a top-level job field that is an alias of a
  * technique's option ("async_distance" is "osl.async_distance"), or NULL.
  * A job may give either, or both with the same value; sweeps vary either. */

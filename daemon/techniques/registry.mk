@@ -12,3 +12,4 @@ include $(srcdir)/daemon/techniques/tiled_deferred/local.mk
 include $(srcdir)/daemon/techniques/forward_plus/local.mk
 include $(srcdir)/daemon/techniques/clustered_forward/local.mk
 include $(srcdir)/daemon/techniques/clustered_deferred/local.mk
+include $(srcdir)/daemon/techniques/visibility_buffer/local.mk

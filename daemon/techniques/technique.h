@@ -76,6 +76,10 @@ struct technique_env {
      * loops (gpu_loop_*), and render returns false, err "stopped", once
      * gpu_budget_stopped. */
     struct gpu_budget *budget;
+    /* The frame contract's time during render (gpu/pass.h): the frame,
+     * whether a history the technique keeps (its info's needs) restarts at
+     * it, and the projection's jitter (already in the frame block). */
+    const struct gpu_frame_time *time;
 };
 
 /* After a pass drew in tiles or took checkpoints: false, err "stopped",

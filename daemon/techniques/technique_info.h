@@ -13,6 +13,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "common/frame_needs.h"
 #include "common/options.h"
 
 struct look_spec;
@@ -49,6 +50,10 @@ struct technique_info {
      * check names fields under the prefix it is handed, "<name>". */
     struct opt_table options;
     unsigned flags; /* enum technique_flag */
+    /* Optional: what the technique with these options needs of time
+     * (common/frame_needs.h: history frames, jitter, motion vectors), as
+     * effects declare it; NULL for none (every frame drawn afresh). */
+    void (*needs)(const void *opts, struct frame_needs *out);
     /* Bytes a pixel of the planes it draws beside the harness's output
      * (g-buffers, the heat map), every MSAA sample counted, for its options,
      * the look and whether the scene is textured: what the memory estimate

@@ -55,8 +55,13 @@ layout(binding = SB_TEX_MATERIAL_OCCLUSION) uniform sampler2D u_material_occlusi
 layout(binding = SB_TEX_MATERIAL_EMISSIVE) uniform sampler2D u_material_emissive; // sRGB
 layout(location = SB_LOC_MATERIAL) uniform int u_material;
 
+// SURFACE_NO_VARYINGS: a program that rebuilds the attributes itself (the
+// visibility buffer's shading) reads none of the vertex stage's, and gets
+// material_surface_grad and surface_shade_all_lights alone.
+#if !defined(SURFACE_NO_VARYINGS)
 in vec4 v_tex;     // TEXCOORD_0 (xy), TEXCOORD_1 (zw): scene.vert
 in vec4 v_tangent; // world-space tangent, handedness in w
+#endif
 #if defined(SURFACE_VERTEX_COLOR)
 // COLOR_0, linear (white where the mesh has none): programs whose vertex
 // stage passes it (scene.vert, shadow.vert, OSL's texgen and draw) define
@@ -184,6 +189,7 @@ TexturedSurface material_surface(int row, vec4 uvs, vec3 N, vec4 tangent, bool f
     return material_surface(row, uvs, N, tangent, front, vec4(1.0));
 }
 
+#if !defined(SURFACE_NO_VARYINGS)
 TexturedSurface surface_here(vec3 N)
 {
     TexturedSurface s = material_surface(u_material, v_tex, N, v_tangent, gl_FrontFacing, SURFACE_COLOR);
@@ -262,6 +268,7 @@ vec3 surface_debug_here(vec3 N)
 #endif
 }
 #endif
+#endif // !SURFACE_NO_VARYINGS
 
 vec3 surface_shade_all_lights(vec3 P, TexturedSurface s)
 {

@@ -131,6 +131,8 @@ try:
     for tech in culling:
         done = matches(d, job(tech, sun_only), "%s, the sun alone" % tech,
                        identical=tech in ("forward_plus", "clustered_forward"))
+        if tech == "visibility_buffer":
+            continue  # publishes no heat map (its default loops over every light, as forward)
         h = heat(done)
         check(h.get("max") == 1 and h.get("mean", 0) > 0.5,
               "%s: the sun is one evaluation on every surface pixel: %s" % (tech, h))

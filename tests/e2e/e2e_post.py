@@ -79,7 +79,7 @@ try:
     # option is refused naming look.post[i].option.
     status, info = d.json("GET", "/v1/info")
     effects = {e["name"]: e for e in info.get("effects", [])}
-    check(set(effects) == {"bloom", "toon", "ssao"}, "info lists the effects: %s" % list(effects))
+    check(set(effects) == {"bloom", "toon", "ssao", "taa"}, "info lists the effects: %s" % list(effects))
     bad = {"integer": lambda o: int(o["max"]) + 1, "number": lambda o: "x",
            "boolean": lambda o: "yes", "choice": lambda o: "no_such_choice"}
     for name, e in effects.items():

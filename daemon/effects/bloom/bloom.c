@@ -130,8 +130,11 @@ static void bind(GLuint unit, GLuint tex)
     glBindTexture(GL_TEXTURE_2D, tex);
 }
 
-static void bloom_run(void *state, const struct effect_env *env, GLuint src, GLuint dst_fbo)
+static bool bloom_run(void *state, const struct effect_env *env,
+                      const struct gpu_frame_time *time, GLuint src, GLuint dst_fbo, char *err,
+                      size_t errlen)
 {
+    (void)time, (void)err, (void)errlen;
     struct bloom *b = state;
     const struct gpu_passes *ps = env->passes;
     int n = b->nlevels;
@@ -189,6 +192,7 @@ static void bloom_run(void *state, const struct effect_env *env, GLuint src, GLu
     effect_draw_fullscreen(env, b->composite_prog);
     glBindSampler(SB_TEX_POST_AUX, 0);
     gpu_pass_end(ps);
+    return true;
 }
 
 const struct effect effect_bloom = {

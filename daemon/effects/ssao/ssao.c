@@ -73,8 +73,11 @@ fail:
     return false;
 }
 
-static void ssao_run(void *state, const struct effect_env *env, GLuint src, GLuint dst_fbo)
+static bool ssao_run(void *state, const struct effect_env *env,
+                     const struct gpu_frame_time *time, GLuint src, GLuint dst_fbo, char *err,
+                     size_t errlen)
 {
+    (void)time, (void)err, (void)errlen;
     struct ssao *s = state;
     gpu_pass_begin(env->passes, s->pass_ao, s->ao_fbo, env->width, env->height);
     glActiveTexture(GL_TEXTURE0 + SB_TEX_POST_DEPTH);
@@ -93,6 +96,7 @@ static void ssao_run(void *state, const struct effect_env *env, GLuint src, GLui
     glBindTexture(GL_TEXTURE_2D, s->ao);
     effect_draw_fullscreen(env, s->apply_prog);
     gpu_pass_end(env->passes);
+    return true;
 }
 
 const struct effect effect_ssao = {

@@ -57,8 +57,11 @@ static bool toon_create(const struct effect_env *env, const void *opts, void **s
     return true;
 }
 
-static void toon_run(void *state, const struct effect_env *env, GLuint src, GLuint dst_fbo)
+static bool toon_run(void *state, const struct effect_env *env,
+                     const struct gpu_frame_time *time, GLuint src, GLuint dst_fbo, char *err,
+                     size_t errlen)
 {
+    (void)time, (void)err, (void)errlen;
     struct toon *t = state;
     gpu_pass_begin(env->passes, t->pass, dst_fbo, env->width, env->height);
     glActiveTexture(GL_TEXTURE0 + SB_TEX_POST_SRC);
@@ -67,6 +70,7 @@ static void toon_run(void *state, const struct effect_env *env, GLuint src, GLui
     glBindTexture(GL_TEXTURE_2D, env->depth_tex);
     effect_draw_fullscreen(env, t->prog);
     gpu_pass_end(env->passes);
+    return true;
 }
 
 const struct effect effect_toon = {

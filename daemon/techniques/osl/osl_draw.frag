@@ -53,7 +53,9 @@ ivec2 level_origin(int l)
 // Asset scenes under Phong: the specular light beside the diffuse in u_atlas
 // (osl_light.comp's shade_split).
 uniform sampler2D u_atlas_specular;
+in vec3 v_normal;
 vec3 g_specular = vec3(0.0); // atlas_sample's second plane, summed
+vec3 g_normal;               // the pixel's normal-mapped normal
 #endif
 
 vec3 atlas_sample(vec2 uv, vec2 tile_at, float size)
@@ -77,9 +79,14 @@ vec3 atlas_sample(vec2 uv, vec2 tile_at, float size)
     return vec3(0.0); // a moving camera's marking pass writes no colour
 #else
 #if defined(OSL_SPLIT)
-    g_specular += texture(u_atlas_specular, atlas_uv).rgb;
-#endif
+    // The diffuse light at this pixel's normal from its direction and
+    // colour shares (osl_light.comp's shade_split).
+    vec4 spec = texture(u_atlas_specular, atlas_uv), dir = texture(u_atlas, atlas_uv);
+    g_specular += spec.rgb;
+    return 3.0 * vec3(dir.w, spec.a, 1.0 - dir.w - spec.a) * max(dot(g_normal, dir.xyz), 0.0);
+#else
     return texture(u_atlas, atlas_uv).rgb;
+#endif
 #endif
 }
 
@@ -125,18 +132,15 @@ void main()
 #if defined(OSL_SPLIT) && !defined(OSL_MARK_ONLY)
     // The base colour, occlusion and emissive at the pixel, as forward's
     // material_surface samples them.
-    SurfaceMaterial sm = materials[u_material];
-    vec4 tdx = dFdx(v_tex), tdy = dFdy(v_tex);
-    vec3 base = sm.base_color.rgb * SURFACE_COLOR.rgb;
-    if (material_has(sm, SLOT_BASE_COLOR))
-        base *= MATERIAL_SAMPLE(u_material_base_color, sm, SLOT_BASE_COLOR, v_tex, tdx, tdy).rgb;
-    float occlusion = 1.0;
-    if (material_has(sm, SLOT_OCCLUSION))
-        occlusion = 1.0 + sm.params.w *
-                              (MATERIAL_SAMPLE(u_material_occlusion, sm, SLOT_OCCLUSION, v_tex, tdx, tdy).r - 1.0);
-    vec3 emissive = sm.emissive_cutoff.rgb;
-    if (material_has(sm, SLOT_EMISSIVE))
-        emissive *= MATERIAL_SAMPLE(u_material_emissive, sm, SLOT_EMISSIVE, v_tex, tdx, tdy).rgb;
+    // The normal too: the diffuse light is applied at the pixel's
+    // normal-mapped normal (atlas_sample).
+    TexturedSurface ts = material_surface_grad(u_material, v_tex, dFdx(v_tex), dFdy(v_tex),
+                                               normalize(v_normal), v_tangent, gl_FrontFacing,
+                                               SURFACE_COLOR);
+    vec3 base = ts.m.albedo;
+    float occlusion = ts.occlusion;
+    vec3 emissive = ts.emissive;
+    g_normal = ts.N;
 #endif
     surface_alpha_clip();
     vec3 sum = vec3(0.0);

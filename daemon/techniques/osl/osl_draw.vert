@@ -8,7 +8,9 @@ layout(location = 3) in vec4 a_chart;
 layout(location = 4) in vec4 a_tex; // the material's TEXCOORD_0 (xy) and _1 (zw)
 layout(location = 5) in vec4 a_tangent;
 layout(location = 6) in vec4 a_color; // COLOR_0
+layout(location = 1) in vec3 a_normal;
 out vec4 v_color;
+out vec3 v_normal;  // the pixel's normal (normal-mapped in osl_draw.frag), as forward's
 out vec4 v_tex;     // surface.glsl's inputs, for the alpha mask
 out vec4 v_tangent;
 #endif
@@ -30,6 +32,7 @@ void main()
     v_tex = a_tex;
     v_color = a_color - 1.0; // surface.glsl adds the 1 back
     v_tangent = a_tangent;
+    v_normal = a_normal; // uniform scale, no rotation: object normal is world normal
 #endif
     v_chart = a_chart;
     v_tile = tiles[id];

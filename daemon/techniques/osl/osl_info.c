@@ -21,8 +21,8 @@ static const struct opt_field options[] = {
      .summary = "with resolution \"auto\": texels per covered pixel (along each axis) at the "
                 "level each pixel reads, 0.0625 to 16 (a pixel reads 1 to 2 times this); 0 (the "
                 "default): 1, or 2 under PBR lighting, whose GGX highlights bilinear filtering "
-                "of one texel a pixel flattens, or 0.71 in asset scenes under Phong and "
-                "Blinn-Phong, where the base colour is applied per pixel",
+                "of one texel a pixel flattens, or 0.5 in asset scenes under Phong and "
+                "Blinn-Phong, where the base colour and the normal are applied per pixel",
      .offset = offsetof(struct osl_options, texel_density)},
     {.name = "reshade", .type = OPT_CHOICE, .def = OSL_RESHADE_TOUCHED,
      .choices = reshade_choices,

@@ -137,8 +137,21 @@ static bool decode_chunk(exr_context_t ctx, exr_decode_pipeline_t *dec, bool *st
     if (rc != EXR_ERR_SUCCESS)
         return fail(e, 422, "body", "corrupt: chunk %d of %d: %s", chunk + 1, chunks, why(s, rc));
     *started = true;
-    for (int i = 0; i < dec->channel_count; i++)
-        dec->channels[i].decode_to_ptr = NULL;
+    /* Every channel decodes somewhere: the ones not read into a scratch
+     * plane. OpenEXRCore 3.1's unpackers write through a channel whose
+     * decode_to_ptr is NULL in some layouts (fuzz_env_convert: channels B,
+     * Y and R under ZIPS wrote to address 0). */
+    float *scratch = calloc((size_t)ci->width * (size_t)ci->height, sizeof(float));
+    if (!scratch)
+        return fail(e, 422, "body", "out of memory decoding chunk %d of %d", chunk + 1, chunks);
+    for (int i = 0; i < dec->channel_count; i++) {
+        exr_coding_channel_info_t *cc = &dec->channels[i];
+        cc->decode_to_ptr = (uint8_t *)scratch;
+        cc->user_pixel_stride = (int32_t)sizeof(float);
+        cc->user_line_stride = (int32_t)(ci->width * sizeof(float));
+        cc->user_bytes_per_element = sizeof(float);
+        cc->user_data_type = EXR_PIXEL_FLOAT;
+    }
     /* Y alone goes to red; green and blue are copied after. */
     for (int c = 0; c < (grey ? 1 : 3); c++) {
         exr_coding_channel_info_t *cc = &dec->channels[index[c]];
@@ -151,6 +164,7 @@ static bool decode_chunk(exr_context_t ctx, exr_decode_pipeline_t *dec, bool *st
     rc = exr_decoding_choose_default_routines(ctx, 0, dec);
     if (rc == EXR_ERR_SUCCESS)
         rc = exr_decoding_run(ctx, 0, dec);
+    free(scratch);
     if (rc != EXR_ERR_SUCCESS)
         return fail(e, 422, "body", "corrupt: chunk %d of %d does not decode: %s", chunk + 1,
                     chunks, why(s, rc));

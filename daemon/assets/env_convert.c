@@ -21,10 +21,7 @@
 
 #include "daemon/assets/env_exr.h"
 
-static bool fail(struct asset_convert_error *e, int status, const char *field, const char *fmt,
-                 ...) __attribute__((format(printf, 4, 5)));
-static bool fail(struct asset_convert_error *e, int status, const char *field, const char *fmt,
-                 ...)
+bool env_fail(struct asset_convert_error *e, int status, const char *field, const char *fmt, ...)
 {
     e->status = status;
     snprintf(e->field, sizeof(e->field), "%s", field);
@@ -70,26 +67,26 @@ static bool read_header(const uint8_t *data, size_t len, uint32_t *w, uint32_t *
     size_t pos = 0;
     if (!next_line(data, len, &pos, line) ||
         (strcmp(line, "#?RADIANCE") != 0 && strcmp(line, "#?RGBE") != 0))
-        return fail(e, 422, "body", "not a Radiance HDR image: the first line must be "
+        return env_fail(e, 422, "body", "not a Radiance HDR image: the first line must be "
                     "#?RADIANCE or #?RGBE");
     for (;;) {
         if (!next_line(data, len, &pos, line))
-            return fail(e, 422, "body", "the Radiance header ends before its empty line (a "
+            return env_fail(e, 422, "body", "the Radiance header ends before its empty line (a "
                         "truncated file, or a header line over 512 bytes)");
         if (!line[0])
             break;
         if (strncmp(line, "FORMAT=", 7) == 0 && strcmp(line + 7, "32-bit_rle_rgbe") != 0)
-            return fail(e, 422, "body", "FORMAT=%.64s: only 32-bit_rle_rgbe is read",
+            return env_fail(e, 422, "body", "FORMAT=%.64s: only 32-bit_rle_rgbe is read",
                         line + 7);
     }
     long hh = 0, ww = 0;
     char tail;
     if (!next_line(data, len, &pos, line) ||
         sscanf(line, "-Y %ld +X %ld%c", &hh, &ww, &tail) != 2)
-        return fail(e, 422, "body", "the resolution line must be \"-Y height +X width\" (the "
+        return env_fail(e, 422, "body", "the resolution line must be \"-Y height +X width\" (the "
                     "usual orientation; others are not read)");
     if (hh <= 0 || ww <= 0 || hh > 0x7fffffffL || ww > 0x7fffffffL)
-        return fail(e, 422, "body", "the resolution line gives %ld x %ld pixels", ww, hh);
+        return env_fail(e, 422, "body", "the resolution line gives %ld x %ld pixels", ww, hh);
     *w = (uint32_t)ww;
     *h = (uint32_t)hh;
     *start = pos;
@@ -107,34 +104,34 @@ static bool walk_pixels(const uint8_t *data, size_t len, size_t pos, uint32_t w,
     for (uint32_t y = 0; y < h; y++) {
         if (!rle) {
             if (len - pos < (size_t)w * 4)
-                return fail(e, 422, "body", "truncated: the pixels end in scanline %u of %u "
+                return env_fail(e, 422, "body", "truncated: the pixels end in scanline %u of %u "
                             "(%zu bytes short)", y + 1, h, (size_t)w * 4 - (len - pos));
             pos += (size_t)w * 4;
             continue;
         }
         if (len - pos < 4)
-            return fail(e, 422, "body", "truncated: the pixels end before scanline %u of %u",
+            return env_fail(e, 422, "body", "truncated: the pixels end before scanline %u of %u",
                         y + 1, h);
         if (data[pos] != 2 || data[pos + 1] != 2 ||
             ((uint32_t)data[pos + 2] << 8 | data[pos + 3]) != w)
-            return fail(e, 422, "body", "corrupt: scanline %u of %u does not start as a "
+            return env_fail(e, 422, "body", "corrupt: scanline %u of %u does not start as a "
                         "run-length coded one", y + 1, h);
         pos += 4;
         for (int channel = 0; channel < 4; channel++)
             for (uint32_t x = 0; x < w;) {
                 if (pos >= len)
-                    return fail(e, 422, "body", "truncated: the pixels end in scanline %u of "
+                    return env_fail(e, 422, "body", "truncated: the pixels end in scanline %u of "
                                 "%u", y + 1, h);
                 unsigned count = data[pos++];
                 bool run = count > 128;
                 if (run)
                     count -= 128;
                 if (count == 0 || x + count > w)
-                    return fail(e, 422, "body", "corrupt: a run in scanline %u of %u goes past "
+                    return env_fail(e, 422, "body", "corrupt: a run in scanline %u of %u goes past "
                                 "its %u pixels", y + 1, h, w);
                 size_t bytes = run ? 1 : count;
                 if (len - pos < bytes)
-                    return fail(e, 422, "body", "truncated: the pixels end in scanline %u of "
+                    return env_fail(e, 422, "body", "truncated: the pixels end in scanline %u of "
                                 "%u", y + 1, h);
                 pos += bytes;
                 x += count;
@@ -156,31 +153,31 @@ bool env_convert_buffer(const uint8_t *data, size_t len, const struct environmen
         return false;
     /* The limits from the header, before a byte is decoded. */
     if (w > lim->max_edge || h > lim->max_edge)
-        return fail(e, 422, "limits.max_environment_edge", "%u x %u pixels: an environment's "
+        return env_fail(e, 422, "limits.max_environment_edge", "%u x %u pixels: an environment's "
                     "width and height must be at most %u", w, h, lim->max_edge);
     if ((uint64_t)w * h > lim->max_pixels)
-        return fail(e, 422, "limits.max_environment_pixels", "%u x %u is %llu pixels (%llu "
+        return env_fail(e, 422, "limits.max_environment_pixels", "%u x %u is %llu pixels (%llu "
                     "bytes decoded): the limit is %llu pixels", w, h,
                     (unsigned long long)w * h, (unsigned long long)w * h * 12,
                     (unsigned long long)lim->max_pixels);
     if (len > (size_t)0x7fffffff)
-        return fail(e, 422, "body", "the file is over 2 GiB");
+        return env_fail(e, 422, "body", "the file is over 2 GiB");
     if (!walk_pixels(data, len, start, w, h, e))
         return false;
     int x = 0, y = 0, comp = 0;
     float *rgb = stbi_loadf_from_memory(data, (int)len, &x, &y, &comp, 3);
     if (!rgb)
-        return fail(e, 422, "body", "the Radiance image does not decode: %s",
+        return env_fail(e, 422, "body", "the Radiance image does not decode: %s",
                     stbi_failure_reason() ? stbi_failure_reason() : "unknown reason");
     if ((uint32_t)x != w || (uint32_t)y != h) {
         stbi_image_free(rgb);
-        return fail(e, 422, "body", "the decoder read %d x %d pixels where the header says "
+        return env_fail(e, 422, "body", "the decoder read %d x %d pixels where the header says "
                     "%u x %u", x, y, w, h);
     }
     size_t n = (size_t)w * h * 3;
     if (!(out->rgb = malloc(n * sizeof(float)))) {
         stbi_image_free(rgb);
-        return fail(e, 500, "body", "out of memory for %u x %u pixels", w, h);
+        return env_fail(e, 500, "body", "out of memory for %u x %u pixels", w, h);
     }
     for (size_t i = 0; i < n; i++)
         out->rgb[i] = isfinite(rgb[i]) && rgb[i] > 0 ? rgb[i] : 0.0f;

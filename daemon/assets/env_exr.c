@@ -20,19 +20,6 @@ struct source {
     char last_error[256]; /* OpenEXRCore's last message */
 };
 
-static bool fail(struct asset_convert_error *e, int status, const char *field, const char *fmt,
-                 ...) __attribute__((format(printf, 4, 5)));
-static bool fail(struct asset_convert_error *e, int status, const char *field, const char *fmt,
-                 ...)
-{
-    e->status = status;
-    snprintf(e->field, sizeof(e->field), "%s", field);
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(e->message, sizeof(e->message), fmt, ap);
-    va_end(ap);
-    return false;
-}
 
 bool env_exr_is(const uint8_t *data, size_t len)
 {
@@ -99,7 +86,7 @@ static bool pick_channels(const exr_attr_chlist_t *ch, int index[3], bool *grey,
                 used += (size_t)snprintf(names + used, sizeof(names) - used, "%s%s",
                                          i ? ", " : "",
                                          ch->entries[i].name.str ? ch->entries[i].name.str : "?");
-            return fail(e, 422, "body", "the OpenEXR image has no R, G and B channels (nor Y): "
+            return env_fail(e, 422, "body", "the OpenEXR image has no R, G and B channels (nor Y): "
                         "its channels are %s", ch->num_channels ? names : "none");
         }
         index[0] = index[1] = index[2] = y;
@@ -108,7 +95,7 @@ static bool pick_channels(const exr_attr_chlist_t *ch, int index[3], bool *grey,
     for (int c = 0; c < 3; c++) {
         const exr_attr_chlist_entry_t *en = &ch->entries[index[c]];
         if (en->x_sampling != 1 || en->y_sampling != 1)
-            return fail(e, 422, "body", "the OpenEXR channel %s is subsampled (%d x %d): only "
+            return env_fail(e, 422, "body", "the OpenEXR channel %s is subsampled (%d x %d): only "
                         "full-resolution channels are read", en->name.str, en->x_sampling,
                         en->y_sampling);
     }
@@ -124,18 +111,18 @@ static bool decode_chunk(exr_context_t ctx, exr_decode_pipeline_t *dec, bool *st
                          struct source *s, int chunk, int chunks, struct asset_convert_error *e)
 {
     if (ci->data_offset > s->len || ci->packed_size > s->len - ci->data_offset)
-        return fail(e, 422, "body", "truncated: chunk %d of %d (rows %lld to %lld) ends %llu "
+        return env_fail(e, 422, "body", "truncated: chunk %d of %d (rows %lld to %lld) ends %llu "
                     "bytes past the file's end", chunk + 1, chunks, (long long)row,
                     (long long)row + ci->height - 1,
                     (unsigned long long)(ci->data_offset + ci->packed_size - s->len));
     if (row < 0 || col < 0 || ci->height <= 0 || ci->width <= 0 ||
         row + ci->height > (int64_t)out->height || col + ci->width > (int64_t)out->width)
-        return fail(e, 422, "body", "corrupt: chunk %d of %d lies outside the data window",
+        return env_fail(e, 422, "body", "corrupt: chunk %d of %d lies outside the data window",
                     chunk + 1, chunks);
     exr_result_t rc = *started ? exr_decoding_update(ctx, 0, ci, dec)
                                : exr_decoding_initialize(ctx, 0, ci, dec);
     if (rc != EXR_ERR_SUCCESS)
-        return fail(e, 422, "body", "corrupt: chunk %d of %d: %s", chunk + 1, chunks, why(s, rc));
+        return env_fail(e, 422, "body", "corrupt: chunk %d of %d: %s", chunk + 1, chunks, why(s, rc));
     *started = true;
     /* Every channel decodes somewhere: the ones not read into a scratch
      * plane. OpenEXRCore 3.1's unpackers write through a channel whose
@@ -143,7 +130,7 @@ static bool decode_chunk(exr_context_t ctx, exr_decode_pipeline_t *dec, bool *st
      * Y and R under ZIPS wrote to address 0). */
     float *scratch = calloc((size_t)ci->width * (size_t)ci->height, sizeof(float));
     if (!scratch)
-        return fail(e, 422, "body", "out of memory decoding chunk %d of %d", chunk + 1, chunks);
+        return env_fail(e, 422, "body", "out of memory decoding chunk %d of %d", chunk + 1, chunks);
     for (int i = 0; i < dec->channel_count; i++) {
         exr_coding_channel_info_t *cc = &dec->channels[i];
         cc->decode_to_ptr = (uint8_t *)scratch;
@@ -166,7 +153,7 @@ static bool decode_chunk(exr_context_t ctx, exr_decode_pipeline_t *dec, bool *st
         rc = exr_decoding_run(ctx, 0, dec);
     free(scratch);
     if (rc != EXR_ERR_SUCCESS)
-        return fail(e, 422, "body", "corrupt: chunk %d of %d does not decode: %s", chunk + 1,
+        return env_fail(e, 422, "body", "corrupt: chunk %d of %d does not decode: %s", chunk + 1,
                     chunks, why(s, rc));
     if (grey)
         for (int y = 0; y < ci->height; y++)
@@ -187,21 +174,21 @@ static bool decode_part(exr_context_t ctx, struct source *s, const struct enviro
     if ((rc = exr_get_storage(ctx, 0, &storage)) != EXR_ERR_SUCCESS ||
         (rc = exr_get_data_window(ctx, 0, &dw)) != EXR_ERR_SUCCESS ||
         (rc = exr_get_channels(ctx, 0, &ch)) != EXR_ERR_SUCCESS || !ch)
-        return fail(e, 422, "body", "the OpenEXR header is incomplete: %s", why(s, rc));
+        return env_fail(e, 422, "body", "the OpenEXR header is incomplete: %s", why(s, rc));
     if (storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED)
-        return fail(e, 422, "body", "a deep OpenEXR image is not an environment map: only "
+        return env_fail(e, 422, "body", "a deep OpenEXR image is not an environment map: only "
                     "scanline and tiled images are read");
     int64_t w = (int64_t)dw.max.x - dw.min.x + 1, h = (int64_t)dw.max.y - dw.min.y + 1;
     if (w <= 0 || h <= 0)
-        return fail(e, 422, "body", "the OpenEXR data window is empty (%lld x %lld)",
+        return env_fail(e, 422, "body", "the OpenEXR data window is empty (%lld x %lld)",
                     (long long)w, (long long)h);
     /* The limits from the header, before a byte is decoded. */
     if (w > lim->max_edge || h > lim->max_edge)
-        return fail(e, 422, "limits.max_environment_edge", "%lld x %lld pixels: an "
+        return env_fail(e, 422, "limits.max_environment_edge", "%lld x %lld pixels: an "
                     "environment's width and height must be at most %u", (long long)w,
                     (long long)h, lim->max_edge);
     if ((uint64_t)w * (uint64_t)h > lim->max_pixels)
-        return fail(e, 422, "limits.max_environment_pixels", "%lld x %lld is %llu pixels "
+        return env_fail(e, 422, "limits.max_environment_pixels", "%lld x %lld is %llu pixels "
                     "(%llu bytes decoded): the limit is %llu pixels", (long long)w, (long long)h,
                     (unsigned long long)(w * h), (unsigned long long)(w * h * 12),
                     (unsigned long long)lim->max_pixels);
@@ -215,22 +202,22 @@ static bool decode_part(exr_context_t ctx, struct source *s, const struct enviro
         exr_tile_level_mode_t level;
         exr_tile_round_mode_t round;
         if ((rc = exr_get_tile_descriptor(ctx, 0, &tw, &th, &level, &round)) != EXR_ERR_SUCCESS)
-            return fail(e, 422, "body", "the OpenEXR tile description: %s", why(s, rc));
+            return env_fail(e, 422, "body", "the OpenEXR tile description: %s", why(s, rc));
         /* A tile is decoded whole: its size is bounded as the image is. */
         if (tw == 0 || th == 0 || tw > lim->max_edge || th > lim->max_edge ||
             (uint64_t)tw * th > lim->max_pixels)
-            return fail(e, 422, "limits.max_environment_pixels", "OpenEXR tiles of %u x %u "
+            return env_fail(e, 422, "limits.max_environment_pixels", "OpenEXR tiles of %u x %u "
                         "pixels: a tile is bounded as the image is (edges at most %u, %llu "
                         "pixels)", tw, th, lim->max_edge, (unsigned long long)lim->max_pixels);
     } else if ((rc = exr_get_scanlines_per_chunk(ctx, 0, &lines)) != EXR_ERR_SUCCESS ||
                lines <= 0) {
-        return fail(e, 422, "body", "the OpenEXR compression's lines per chunk: %s",
+        return env_fail(e, 422, "body", "the OpenEXR compression's lines per chunk: %s",
                     why(s, rc));
     }
     out->width = (uint32_t)w;
     out->height = (uint32_t)h;
     if (!(out->rgb = calloc((size_t)w * (size_t)h * 3, sizeof(float))))
-        return fail(e, 500, "body", "out of memory for %lld x %lld pixels", (long long)w,
+        return env_fail(e, 500, "body", "out of memory for %lld x %lld pixels", (long long)w,
                     (long long)h);
     exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
     bool started = false, ok = true;
@@ -240,7 +227,7 @@ static bool decode_part(exr_context_t ctx, struct source *s, const struct enviro
             exr_chunk_info_t ci;
             int y = dw.min.y + k * lines;
             if ((rc = exr_read_scanline_chunk_info(ctx, 0, y, &ci)) != EXR_ERR_SUCCESS)
-                ok = fail(e, 422, "body", "truncated or corrupt: chunk %d of %d (from row %d): "
+                ok = env_fail(e, 422, "body", "truncated or corrupt: chunk %d of %d (from row %d): "
                           "%s", k + 1, chunks, k * lines, why(s, rc));
             else
                 ok = decode_chunk(ctx, &dec, &started, &ci, 0, (int64_t)k * lines, index, grey,
@@ -253,7 +240,7 @@ static bool decode_part(exr_context_t ctx, struct source *s, const struct enviro
             exr_chunk_info_t ci;
             if ((rc = exr_read_tile_chunk_info(ctx, 0, k % across, k / across, 0, 0, &ci)) !=
                 EXR_ERR_SUCCESS)
-                ok = fail(e, 422, "body", "truncated or corrupt: tile %d of %d: %s", k + 1,
+                ok = env_fail(e, 422, "body", "truncated or corrupt: tile %d of %d: %s", k + 1,
                           chunks, why(s, rc));
             else
                 ok = decode_chunk(ctx, &dec, &started, &ci, (int64_t)(k % across) * tw,
@@ -277,7 +264,7 @@ bool env_exr_decode(const uint8_t *data, size_t len, const struct environment_li
     memset(out, 0, sizeof(*out));
     memset(e, 0, sizeof(*e));
     if (!env_exr_is(data, len))
-        return fail(e, 422, "body", "not an OpenEXR image: it must start with 76 2f 31 01");
+        return env_fail(e, 422, "body", "not an OpenEXR image: it must start with 76 2f 31 01");
     struct source s = {.data = data, .len = len};
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
     init.user_data = &s;
@@ -288,13 +275,13 @@ bool env_exr_decode(const uint8_t *data, size_t len, const struct environment_li
     exr_result_t rc = exr_start_read(&ctx, "upload.exr", &init);
     if (rc != EXR_ERR_SUCCESS) {
         exr_finish(&ctx);
-        return fail(e, 422, "body", "the OpenEXR header does not read (a truncated or corrupt "
+        return env_fail(e, 422, "body", "the OpenEXR header does not read (a truncated or corrupt "
                     "file): %s", why(&s, rc));
     }
     int parts = 0;
     bool ok = exr_get_count(ctx, &parts) == EXR_ERR_SUCCESS && parts >= 1
                   ? decode_part(ctx, &s, lim, out, e)
-                  : fail(e, 422, "body", "the OpenEXR file has no image part");
+                  : env_fail(e, 422, "body", "the OpenEXR file has no image part");
     exr_finish(&ctx);
     if (!ok) {
         environment_image_finish(out);

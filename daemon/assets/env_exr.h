@@ -22,6 +22,11 @@
 #include "daemon/scene/environment.h"
 
 /* True when data starts with OpenEXR's magic number (76 2f 31 01). */
+/* An environment's refusal: e filled with the status, the field and the
+ * message; returns false (env_convert.c, for both decoders). */
+bool env_fail(struct asset_convert_error *e, int status, const char *field, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+
 bool env_exr_is(const uint8_t *data, size_t len);
 
 /* Decodes data into out (environment_image_finish frees it); false with

@@ -54,7 +54,7 @@ args = ap.parse_args()
 
 TECHS = [("forward", "forward", None), ("deferred", "deferred", None),
          ("clustered_deferred", "clustered_deferred", None),
-         ("visibility_buffer", "visibility_buffer", None),
+         ("visibility_buffer", "visibility_buffer", {"lights": "all"}),
          ("visibility_buffer_clustered", "visibility_buffer", {"lights": "clustered"})]
 GBUFFER = ("deferred", "clustered_deferred")
 VIS = ("visibility_buffer", "visibility_buffer_clustered")

@@ -3,8 +3,8 @@
   normal, metallic-roughness and emissive maps, a masked fence, a glass
   pane, point, spot and directional lights), at MSAA 1 and 4: SSIM >=
   0.9999 and PerceptualDiff passes;
-- the clustered lights (the froxel grid) and 64-bit ids draw the same image
-  as every light and 32-bit ids;
+- by default through the clustered lights (the froxel grid); every light
+  (forward's loop) and 64-bit ids draw the same image;
 - its passes are timed, and it keeps fewer bytes a pixel than the
   g-buffer of clustered_deferred under the same look (result figures)."""
 
@@ -70,9 +70,11 @@ try:
                       "every declared pass is timed: %s" % passes)
                 check(vb.get("ids", "").startswith("r32ui") and vb.get("bytes_per_pixel") == 8.0,
                       "32-bit ids and depth: 8 bytes a pixel: %s" % vb)
+                check(vb.get("lights") == "clustered" and "grid" in vb,
+                      "the froxel grid's lights by default, described: %s" % sorted(vb))
 
-    # The froxel grid's lights and 64-bit ids draw what every light does.
-    for options, what, msaa in (({"lights": "clustered"}, "clustered lights", 4),
+    # Every light (forward's loop) and 64-bit ids draw what the froxel grid's lights do.
+    for options, what, msaa in (({"lights": "all"}, "every light", 4),
                                 ({"ids": "wide"}, "64-bit ids", 1)):
         result = run(d, dict(JOB, technique="visibility_buffer", msaa=msaa,
                              visibility_buffer=options, reference="forward",
@@ -81,8 +83,8 @@ try:
         agrees(result, "%s at msaa %d" % (what, msaa))
         vb = result.get("visibility_buffer", {})
         if options.get("lights"):
-            check(vb.get("lights") == "clustered" and "grid" in vb,
-                  "the grid is described: %s" % sorted(vb))
+            check(vb.get("lights") == "all" and "grid" not in vb,
+                  "every light, no grid: %s" % sorted(vb))
         else:
             check(vb.get("ids", "").startswith("rg32ui"), "wide ids: %s" % vb.get("ids"))
 

@@ -164,6 +164,7 @@ E2E_TESTS = \
 	tests/e2e/e2e_faults.py \
 	tests/e2e/e2e_runaway.py \
 	tests/e2e/e2e_timing_rule.py \
+	tests/e2e/e2e_timing_settle.py \
 	tests/e2e/e2e_cancel_drain.py \
 	tests/e2e/e2e_pass_times.py \
 	tests/e2e/e2e_guardrails.py \

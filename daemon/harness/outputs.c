@@ -255,12 +255,14 @@ static json_t *outputs_timing_json(const struct harness_run *run)
         whole += run->drawn_whole[i] != 0;
     bool sliced = rule->mode == GPU_BUDGET_SLICED;
     json_t *o = json_pack(
-        "{s:s, s:i, s:i, s:f, s:b, s:i, s:o, s:o, s:o, s:s}", "rule", sliced ? "sliced" : "whole",
+        "{s:s, s:i, s:i, s:f, s:b, s:i, s:o, s:o, s:o, s:o, s:s}", "rule", sliced ? "sliced" : "whole",
         "frames_whole", whole, "frames_sliced", n - whole, "limit_s", rule->limit_s,
         "accept_sliced_timing", run->spec->accept_sliced_timing, "measuring_runs",
         rule->measuring_frames, "first_frame_estimate_s",
         rule->estimate_s[0] >= 0 ? json_real(rule->estimate_s[0]) : json_null(),
         "second_estimate_s", rule->estimate_s[1] >= 0 ? json_real(rule->estimate_s[1]) : json_null(),
+        "settling_frame_s",
+        rule->settling_frame_s >= 0 ? json_real(rule->settling_frame_s) : json_null(),
         "whole_frame_s", rule->whole_frame_s >= 0 ? json_real(rule->whole_frame_s) : json_null(),
         "how",
         "the job's first run draws its first warm-up frame in slices (each piece measured: a "
@@ -269,8 +271,10 @@ static json_t *outputs_timing_json(const struct harness_run *run)
         "(whole_frame_s; with fewer warm-up frames, frames of the harness's own stand in); the "
         "timed frames are drawn whole when that took at most limit_s (the guard then adds "
         "nothing to them), and else, only with accept_sliced_timing, in the tiles the measure "
-        "gives (every figure marked sliced); a measure over the limit is taken again once; "
-        "decided once a job, for all its runs");
+        "gives (every figure marked sliced); a measure over the limit is taken again once; a "
+        "measure given up at 4 times the limit is followed by the frame drawn through in "
+        "slices, unjudged (settling_frame_s: work done once, such as OSL's first shading, "
+        "must not decide), and a new measure; decided once a job, for all its runs");
     /* For the duration estimate (job_eta.h): what of a frame scales with
      * its pixels. */
     json_object_set_new(o, "pixel_share", json_real(rule->pixel_share));

@@ -121,8 +121,6 @@ bool frame_source_frame(struct harness_run *run, struct frame_source *src, int64
         glBindFramebuffer(GL_READ_FRAMEBUFFER, rr->ldr_fbo);
         glReadPixels(0, 0, w * n, h * n, GL_RGBA, GL_UNSIGNED_BYTE, n > 1 ? src->big : pixels);
     }
-    if (fresh)
-        drop_instance(src);
     if (!drawn || gl_error_take("reference rendering", rr->err, sizeof(rr->err))) {
         snprintf(run->err, sizeof(run->err), "%s %s failed: %.900s", what, tech->info->name,
                  rr->err);

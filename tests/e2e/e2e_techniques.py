@@ -22,7 +22,10 @@ testlib.skip_without_egl()
 
 SSIM_BOUND = 0.995
 SCENE = {"width": 160, "height": 120, "dynamic": True}
-JOB = {"frames": 4, "warmup_frames": 1, "capture_interval": 4, "scene": SCENE}
+# Frame 2 captured: a timed frame after the harness's own and the warm-up
+# has moved the lights and the camera (every SSIM here is frame 4's to the
+# fifth digit, OSL's orbit 0.99937 against 0.99946).
+JOB = {"frames": 2, "warmup_frames": 1, "capture_interval": 2, "scene": SCENE}
 # Still lights for the checks at OSL's defaults (the defaults and PBR; 256
 # texels an object before auto tiles became the default): OSL shades its atlas once instead of every frame (3 s a
 # job instead of 10 here). Moving lights are checked on every technique in

@@ -16,6 +16,7 @@
 #include "common/png_io.h"
 #include "common/result_keys.h"
 #include "daemon/reports/diff_views.h"
+#include "daemon/spec/sweep_spec.h" /* sweep_thesis_size */
 
 /* Points of a sweep that get thumbnails: enough to see how the image
  * changes, few enough that the page stays a reasonable size. */
@@ -706,12 +707,25 @@ static json_t *with_interference(const json_t *sweep, report_job_dir_fn job_dir,
  * frames per scene and technique (mean, median, standard deviation over the
  * runs), the factor between the two techniques, PerceptualDiff at 22.6
  * degrees and the SSIM range. */
-static void thesis_tables(struct html *h, const json_t *points)
+static void thesis_tables(struct html *h, const json_t *spec, const json_t *points)
 {
-    add(h, "<h2>The thesis's experiment on this device (its chapter 4)</h2>"
-           "<table><tr><th class=\"l\">scene</th><th class=\"l\">technique</th><th>runs</th>"
+    struct thesis_size size;
+    struct job_error err;
+    if (!sweep_thesis_size(spec, &size, &err)) /* the sweep was accepted: never */
+        size = (struct thesis_size){1, 1080, 720, 256};
+    add(h, "<h2>The thesis's experiment on this device (its chapter 4)</h2>");
+    if (size.scale == 1)
+        add(h, "<p>At the thesis's size: %dx%d, OSL's tiles %d texels a side.</p>", size.width,
+            size.height, size.osl_resolution);
+    else
+        add(h, "<p>Smaller than the thesis's (scale %g): %dx%d, OSL's tiles %d texels a side, "
+               "against the thesis's 1080x720 and 256 (the same texels per pixel).</p>",
+            size.scale, size.width, size.height, size.osl_resolution);
+    add(h, "<table><tr><th class=\"l\">scene</th><th class=\"l\">technique</th><th>runs</th>"
            "<th>mean execution time (s)</th><th>median (s)</th><th>standard deviation</th>"
            "<th>OSL / forward</th><th>PerceptualDiff (22.6&deg;)</th><th>worst SSIM</th></tr>");
+    char osl_label[32];
+    snprintf(osl_label, sizeof(osl_label), "OSL (%d, async 20)", size.osl_resolution);
     for (int dynamic = 1; dynamic >= 0; dynamic--) {
         const json_t *rows[2] = {NULL, NULL}; /* forward, osl */
         size_t i;
@@ -731,7 +745,7 @@ static void thesis_tables(struct html *h, const json_t *points)
             double mean = json_number_value(json_object_get(wall, RK_MEAN));
             add(h, "<tr><td class=\"l\">%s lights</td><td class=\"l\">%s</td><td>%lld</td>"
                    "<td>%.3f</td><td>%.3f</td><td>%.3f</td>",
-                dynamic ? "moving" : "still", t ? "OSL (256, async 20)" : "forward",
+                dynamic ? "moving" : "still", t ? osl_label : "forward",
                 (long long)json_integer_value(json_object_get(wall, RK_RUNS)), mean,
                 json_number_value(json_object_get(wall, RK_MEDIAN)),
                 json_number_value(json_object_get(wall, RK_STDDEV)));
@@ -776,7 +790,7 @@ char *report_sweep_html(const json_t *posted, const json_t *device, report_job_d
     json_decref(verdict);
     json_t *points = json_object_get(sweep, "points");
     if (strcmp(str(sweep, "preset"), "thesis") == 0)
-        thesis_tables(&h, points);
+        thesis_tables(&h, json_object_get(sweep, "spec"), points);
     json_t *base_ref =
         json_object_get(json_object_get(json_object_get(sweep, "spec"), "base"), "reference");
     if (json_is_object(base_ref)) /* {"technique", "supersample"} */

@@ -456,30 +456,56 @@ static bool parse_criterion(const char *text, struct sweep_spec *s, char *why, s
     return true;
 }
 
+bool sweep_thesis_size(const json_t *body, struct thesis_size *out, struct job_error *err)
+{
+    /* Powers of two, so that OSL's tiles stay a power of two (from 32). */
+    static const double scales[] = {1, 0.5, 0.25, 0.125};
+    double scale = 1;
+    json_t *v = json_object_get(body, "scale");
+    if (v) {
+        scale = json_is_number(v) ? json_number_value(v) : 0;
+        size_t i = 0;
+        while (i < sizeof(scales) / sizeof(scales[0]) && scale != scales[i])
+            i++;
+        if (i == sizeof(scales) / sizeof(scales[0]))
+            return job_error_set(err, "scale", "must be 1, 0.5, 0.25 or 0.125 (the thesis's "
+                                 "1080x720 frame and OSL's 256-texel tiles shrink alike)");
+    }
+    out->scale = scale;
+    out->width = (int)(1080 * scale);
+    out->height = (int)(720 * scale);
+    out->osl_resolution = (int)(256 * scale);
+    return true;
+}
+
 /* The thesis's experiment (chapter 3.3): forward and OSL (256 texels an
  * object, whole tiles: the thesis's OSL, pinned since the defaults moved on;
  * async distance 20) with still and moving lights on the grid at
  * 1080x720, repeated, captures judged with SSIM and PerceptualDiff at 22.6
  * degrees. frames, warmup_frames and repeat may be lowered to fit a slow
- * machine. */
+ * machine, and scale shrinks the frame and OSL's tiles alike (the same
+ * texels per pixel as the thesis's). */
 static json_t *thesis_sweep(const json_t *body, struct job_error *err)
 {
-    static const char *const keys[] = {"preset", "frames", "warmup_frames", "repeat", NULL};
+    static const char *const keys[] = {"preset", "frames", "warmup_frames", "repeat", "scale",
+                                       NULL};
     int n = 300, warmup = 10, repeat = 5;
+    struct thesis_size size;
     if (!jf_check_keys(body, "", keys, err) ||
         !jf_get_int(body, "frames", "frames", 1, 100000, &n, err) ||
         !jf_get_int(body, "warmup_frames", "warmup_frames", 0, 10000, &warmup, err) ||
-        !jf_get_int(body, "repeat", "repeat", 1, 1000, &repeat, err))
+        !jf_get_int(body, "repeat", "repeat", 1, 1000, &repeat, err) ||
+        !sweep_thesis_size(body, &size, err))
         return NULL;
     json_t *base = json_pack(
         "{s:s, s:i, s:i, s:i, s:{s:i, s:f, s:s}, s:i, s:s, s:{s:b, s:{s:f}, s:b, s:b},"
         " s:{s:s, s:i, s:b, s:i, s:i}}",
         "technique", "forward", "frames", n, "warmup_frames", warmup, "capture_interval",
-        n >= 3 ? n / 3 : n, "osl", "resolution", 256, "async_distance", 20.0, "visibility", "all",
-        "repeat", repeat,
+        n >= 3 ? n / 3 : n, "osl", "resolution", size.osl_resolution, "async_distance", 20.0,
+        "visibility", "all", "repeat", repeat,
         "reference", "forward", "metrics",
         "ssim", 1, "pdiff", "fov", 22.6, "psnr", 0, "flip", 0, "scene", "preset", "grid", "lights",
-        10, "dynamic", 0, "width", 1080, "height", 720);
+        10, "dynamic", 0, "width", size.width, "height", size.height);
     return json_pack("{s:o, s:{s:[b, b], s:[s, s]}}", "base", base, "vary", "scene.dynamic", 0, 1,
                      "technique", "forward", "osl");
 }

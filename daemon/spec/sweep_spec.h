@@ -49,6 +49,16 @@ struct sweep_spec {
     const struct technique_catalog *catalog; /* the one parsed with: it outlives the sweep */
 };
 
+/* The thesis preset's size at its body's "scale" (1, 0.5, 0.25 or 0.125; 1
+ * when absent): the frame (1080x720 at 1) and OSL's tiles (256 texels a
+ * side at 1) shrink alike, keeping the thesis's texels per pixel. false
+ * with err naming "scale" for any other value. */
+struct thesis_size {
+    double scale;
+    int width, height, osl_resolution;
+};
+bool sweep_thesis_size(const json_t *body, struct thesis_size *out, struct job_error *err);
+
 /* Fills out, or returns false with err naming the field and out holding
  * nothing (sweep_spec_finish on it is harmless). */
 bool sweep_spec_parse(const json_t *body, const struct technique_catalog *techniques, struct sweep_spec *out,

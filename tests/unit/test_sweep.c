@@ -43,6 +43,49 @@ static void rejects(const char *text, const char *field)
     sweep_spec_finish(&s);
 }
 
+/* The thesis preset as posted: its four points (forward and OSL, still and
+ * moving lights) each a valid job with the thesis's settings at this size. */
+static void thesis_points(const char *text, int width, int height, int resolution, int frames,
+                          int warmup, int repeat)
+{
+    struct sweep_spec s;
+    struct job_error err;
+    bool ok = parse(text, &s, &err);
+    CHECK(ok && s.thesis && s.kind == SWEEP_VARY && s.npoints == 4);
+    if (!ok || s.npoints != 4) {
+        fprintf(stderr, "  for %s: %s %s\n", text, err.field, err.message);
+        sweep_spec_finish(&s);
+        return;
+    }
+    int seen = 0;
+    for (size_t i = 0; i < 4; i++) {
+        json_t *values, *job = sweep_point_job(&s, i, &values);
+        json_t *scene = json_object_get(job, "scene"), *osl = json_object_get(job, "osl");
+        const char *technique = json_string_value(json_object_get(job, "technique"));
+        bool moving = json_is_true(json_object_get(scene, "dynamic"));
+        seen |= 1 << (2 * !strcmp(technique, "osl") + moving);
+        CHECK(json_integer_value(json_object_get(scene, "width")) == width &&
+              json_integer_value(json_object_get(scene, "height")) == height &&
+              !strcmp(json_string_value(json_object_get(scene, "preset")), "grid") &&
+              json_integer_value(json_object_get(scene, "lights")) == 10);
+        CHECK(json_integer_value(json_object_get(osl, "resolution")) == resolution &&
+              json_number_value(json_object_get(osl, "async_distance")) == 20 &&
+              !strcmp(json_string_value(json_object_get(osl, "visibility")), "all"));
+        CHECK(json_number_value(json_object_get(
+                  json_object_get(json_object_get(job, "metrics"), "pdiff"), "fov")) == 22.6 &&
+              !strcmp(json_string_value(json_object_get(job, "reference")), "forward"));
+        CHECK(json_integer_value(json_object_get(job, "frames")) == frames &&
+              json_integer_value(json_object_get(job, "warmup_frames")) == warmup &&
+              json_integer_value(json_object_get(job, "repeat")) == repeat);
+        struct job_spec spec;
+        CHECK(job_spec_parse(job, techniques, &spec, &err));
+        json_decref(job);
+        json_decref(values);
+    }
+    CHECK(seen == 15); /* each technique with still and moving lights */
+    sweep_spec_finish(&s);
+}
+
 int main(void)
 {
     struct bisect_result r;
@@ -386,6 +429,32 @@ int main(void)
         json_decref(job);
         json_decref(values);
         sweep_spec_finish(&s);
+    }
+    /* The thesis preset: its own settings at 1080x720, or smaller at a
+     * scale that shrinks the frame and OSL's tiles alike. */
+    thesis_points("{\"preset\":\"thesis\"}", 1080, 720, 256, 300, 10, 5);
+    thesis_points("{\"preset\":\"thesis\",\"scale\":1,\"frames\":60,\"repeat\":3}", 1080, 720,
+                  256, 60, 10, 3);
+    thesis_points("{\"preset\":\"thesis\",\"scale\":0.5}", 540, 360, 128, 300, 10, 5);
+    thesis_points("{\"preset\":\"thesis\",\"scale\":0.25,\"frames\":1,\"warmup_frames\":0,"
+                  "\"repeat\":2}", 270, 180, 64, 1, 0, 2);
+    thesis_points("{\"preset\":\"thesis\",\"scale\":0.125}", 135, 90, 32, 300, 10, 5);
+    rejects("{\"preset\":\"thesis\",\"scale\":0.3}", "scale");
+    rejects("{\"preset\":\"thesis\",\"scale\":2}", "scale");
+    rejects("{\"preset\":\"thesis\",\"scale\":0.0625}", "scale");
+    rejects("{\"preset\":\"thesis\",\"scale\":\"0.5\"}", "scale");
+    rejects("{\"preset\":\"thesis\",\"scale\":null}", "scale");
+    rejects("{\"preset\":\"thesis\",\"width\":270}", "width");
+    {
+        struct thesis_size size;
+        struct job_error err;
+        json_t *body = json_pack("{s:s}", "preset", "thesis");
+        CHECK(sweep_thesis_size(body, &size, &err) && size.scale == 1 && size.width == 1080 &&
+              size.height == 720 && size.osl_resolution == 256);
+        json_object_set_new(body, "scale", json_real(0.25));
+        CHECK(sweep_thesis_size(body, &size, &err) && size.scale == 0.25 && size.width == 270 &&
+              size.height == 180 && size.osl_resolution == 64);
+        json_decref(body);
     }
     return check_finish("test_sweep");
 }

@@ -671,6 +671,11 @@ static int serve(const struct options *o, const struct technique_catalog *catalo
         limits.max_connections = (unsigned)o->max_connections;
     if (o->max_connections_per_ip)
         limits.max_connections_per_ip = (unsigned)o->max_connections_per_ip;
+    /* Tests only: a shorter window over which an upload must keep up the
+     * minimum rate, so that e2e_upload_slots sees a slow one cut sooner. */
+    const char *window = getenv("SHADEBENCH_DEBUG_UPLOAD_WINDOW_S");
+    if (window && atof(window) > 0)
+        limits.upload_window_s = atof(window);
     rlim_t fds = raise_fd_limit();
     if (fds != RLIM_INFINITY && limits.max_connections + 64 > fds) {
         LOG(LOG_WARN, "--max-connections %u lowered to %u: only %llu file descriptors allowed",

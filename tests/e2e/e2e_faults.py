@@ -33,9 +33,13 @@ testlib.skip_without_egl()
 
 S = testlib.TIME_SCALE
 TINY = {"technique": "unlit", "frames": 1, "warmup_frames": 0, "scene": {"width": 32, "height": 32}}
-# Writes 30 PNG captures once its frames are done: more than a full disk holds.
-CAPTURES = {"technique": "unlit", "frames": 100, "warmup_frames": 0, "capture_interval": 4,
-            "scene": {"width": 256, "height": 256}}
+# Writes 25 PNG captures once its frames are done: more than a full disk holds.
+# Its frames run long enough for the test to fill the disk meanwhile (a
+# poll and a few milliseconds): 200 frames of coarse spheres (64 triangles,
+# not the grid's 1,024) take 0.8 s or more (4 to 8 ms a frame at load 6;
+# 100 of the full grid took 4.3 s, and three such jobs run here).
+CAPTURES = {"technique": "unlit", "frames": 200, "warmup_frames": 0, "capture_interval": 8,
+            "scene": {"width": 256, "height": 256, "sphere_segments": 8}}
 
 
 def log_text(d):

@@ -440,7 +440,11 @@ try:
     check(mem.get("budget_bytes", 0) > mem.get("metrics_bytes", 0) > 0 and
           info.get("limits", {}).get("max_captures") == 1000,
           "/v1/info states the memory budget by part: %s" % mem)
-    job = d.submit({"frames": 12, "warmup_frames": 0, "capture_interval": 1, "reference": "forward",
+    # Six captures: the metrics phase lasts about 3 s at load 7 (0.5 s a
+    # capture; twelve made the rendering and reference phases before it take
+    # 9 s), and a job that scored them all before it looked at the cancel
+    # would end done, not cancelled.
+    job = d.submit({"frames": 6, "warmup_frames": 0, "capture_interval": 1, "reference": "forward",
                     "scene": {"width": 1024, "height": 1024, "lights": 2, "sphere_segments": 8}})
     deadline = time.time() + 120 * S
     phase = None

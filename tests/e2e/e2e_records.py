@@ -24,7 +24,15 @@ from testlib import check
 testlib.skip_without_egl()
 SMALL = {"frames": 2, "warmup_frames": 0, "scene": {"width": 32, "height": 32}}
 WITH_REF = dict(SMALL, capture_interval=2, reference="forward")
-SLOW_BASE = {"frames": 100, "warmup_frames": 0, "scene": {"width": 64, "height": 48}}
+# A first point long enough for a stop to land inside it: the stop takes
+# effect about half a second after the test sees the point run (70 to 135
+# frames of these at load 6), and 800 frames of coarse spheres (64
+# triangles, not the grid's 1,024) take 2 s or more (2.5 to 6 ms a frame).
+# The resumed sweep's other points are short: before, three points of 100
+# frames of the full grid took 7 s each.
+SLOW_BASE = {"frames": 800, "warmup_frames": 0,
+             "scene": {"width": 64, "height": 48, "sphere_segments": 8}}
+RESUMED_FRAMES = [800, 2, 3]
 
 
 def read(path, mode="r"):
@@ -177,7 +185,7 @@ try:
           (storelib.row(state, storelib.SWEEPS, done_sweep["id"]) or {}).get("status") == "done",
           "it is stored")
     jobs_before = len(second.json("GET", "/v1/jobs")[1]["jobs"])
-    resumed_id = post_sweep(second, {"base": SLOW_BASE, "vary": {"scene.lights": [1, 2, 3]}})
+    resumed_id = post_sweep(second, {"base": SLOW_BASE, "vary": {"frames": RESUMED_FRAMES}})
     check(wait_for(lambda: second.json("GET", "/v1/sweeps/" + resumed_id)[1].get("current_job")
                    and second.json("GET", "/v1/jobs/" + second.json("GET", "/v1/sweeps/" + resumed_id)[1]
                                    .get("current_job", "x"))[1].get("status") == "running"),
@@ -189,6 +197,8 @@ stored = storelib.row(state, storelib.SWEEPS, resumed_id) or {}
 on_disk = dict(stored.get("extra") or {}, status=stored.get("status"))
 # Stopped mid-point (the usual case), it names the point job to adopt; stopped
 # between points, it has none and resumes with the next point.
+print("the sweep stopped %s" % ("in point job %s" % on_disk["current_job"]
+                                 if on_disk.get("current_job") else "between points"))
 check(on_disk["status"] == "queued",
       "the sweep stopped by SIGTERM is stored as queued: %s" % on_disk.get("status"))
 
@@ -200,7 +210,7 @@ try:
     resumed = third.wait_sweep(resumed_id)
     check(resumed["status"] == "done", "the SIGTERMed sweep resumes and finishes: %s" % resumed.get("error"))
     rows = resumed.get("points", [])
-    check([r["values"]["scene.lights"] for r in rows] == [1, 2, 3] and all(r["status"] == "done" for r in rows),
+    check([r["values"]["frames"] for r in rows] == RESUMED_FRAMES and all(r["status"] == "done" for r in rows),
           "every point once, in order: %s" % [(r["values"], r["status"]) for r in rows])
     jobs_after = third.json("GET", "/v1/jobs")[1]["jobs"]
     check(len(jobs_after) == jobs_before + 3 and len({r["job"] for r in rows}) == 3,

@@ -132,8 +132,11 @@ try:
     # The third point renders long enough to be seen running: the render
     # thread starts it only once the second point's finish (and the
     # retention pass that follows it) has returned, so the first two point
-    # jobs are checked after retention had its chance at them.
-    status, reply = d.json("POST", "/v1/sweeps", {"base": TINY, "vary": {"frames": [1, 1, 400]},
+    # jobs are checked after retention had its chance at them. 600 frames
+    # of coarse spheres (64 triangles, not the grid's 1,024): a second or
+    # more (2 to 6 ms a frame at load 8; 400 of the full grid took 19 s).
+    coarse = dict(TINY, scene=dict(TINY["scene"], sphere_segments=8))
+    status, reply = d.json("POST", "/v1/sweeps", {"base": coarse, "vary": {"frames": [1, 1, 600]},
                                                  "time_reference": False})
     seen, deadline = None, time.time() + 60 * testlib.TIME_SCALE
     while time.time() < deadline:

@@ -151,65 +151,67 @@ tests_tools_sandbox_run_CFLAGS = $(AM_CFLAGS) $(SECCOMP_CFLAGS)
 tests_tools_sandbox_run_LDADD = $(SECCOMP_LIBS)
 endif
 
-# Longest first (tools/check prints each test's time): make -j starts them
-# in this order, so the short ones fill in beside the long ones instead of
-# one long test running alone at the end.
+# Longest first (tools/check prints each test's time; re-ordered from the
+# run of 2026-11-27 after the wave-5 trims), and the ones that mostly wait
+# (e2e_fleet, e2e_timing_rule) early: make -j starts them in this order, so
+# the short ones fill in beside the long ones instead of one long test
+# running alone at the end.
 E2E_TESTS = \
-	tests/e2e/e2e_fidelity.py \
+	tests/e2e/e2e_osl.py \
 	tests/e2e/e2e_msaa.py \
-	tests/e2e/e2e_gpu.py \
 	tests/e2e/e2e_fleet.py \
-	tests/e2e/e2e_report.py \
-	tests/e2e/e2e_dashboard.py \
-	tests/e2e/e2e_faults.py \
-	tests/e2e/e2e_runaway.py \
+	tests/e2e/e2e_many_lights.py \
+	tests/e2e/e2e_ab.py \
+	tests/e2e/e2e_fidelity.py \
 	tests/e2e/e2e_timing_rule.py \
+	tests/e2e/e2e_hardening.py \
+	tests/e2e/e2e_sweep.py \
+	tests/e2e/e2e_report.py \
+	tests/e2e/e2e_techniques.py \
+	tests/e2e/e2e_gate.py \
+	tests/e2e/e2e_runaway.py \
+	tests/e2e/e2e_post.py \
+	tests/e2e/e2e_reference_temporal.py \
+	tests/e2e/e2e_taa.py \
+	tests/e2e/e2e_light_types.py \
+	tests/e2e/e2e_faults.py \
+	tests/e2e/e2e_scene.py \
+	tests/e2e/e2e_integrity.py \
+	tests/e2e/e2e_store.py \
+	tests/e2e/e2e_guardrails.py \
 	tests/e2e/e2e_timing_settle.py \
+	tests/e2e/e2e_records.py \
+	tests/e2e/e2e_textured.py \
+	tests/e2e/e2e_charts.py \
+	tests/e2e/e2e_visibility.py \
+	tests/e2e/e2e_metrics.py \
+	tests/e2e/e2e_verdicts.py \
+	tests/e2e/e2e_load.py \
+	tests/e2e/e2e_asset_pins.py \
+	tests/e2e/e2e_client.py \
+	tests/e2e/e2e_dashboard.py \
 	tests/e2e/e2e_cancel_drain.py \
 	tests/e2e/e2e_pass_times.py \
-	tests/e2e/e2e_guardrails.py \
-	tests/e2e/e2e_hardening.py \
-	tests/e2e/e2e_many_lights.py \
-	tests/e2e/e2e_light_types.py \
-	tests/e2e/e2e_techniques.py \
-	tests/e2e/e2e_textured.py \
-	tests/e2e/e2e_asset_render.py \
-	tests/e2e/e2e_asset_import.py \
-	tests/e2e/e2e_scene_view.py \
-	tests/e2e/e2e_load.py \
-	tests/e2e/e2e_osl.py \
-	tests/e2e/e2e_osl_assets.py \
-	tests/e2e/e2e_ab.py \
-	tests/e2e/e2e_sweep.py \
-	tests/e2e/e2e_records.py \
-	tests/e2e/e2e_store.py \
-	tests/e2e/e2e_integrity.py \
-	tests/e2e/e2e_gate.py \
-	tests/e2e/e2e_charts.py \
-	tests/e2e/e2e_http.py \
-	tests/e2e/e2e_assets.py \
-	tests/e2e/e2e_scene.py \
-	tests/e2e/e2e_post.py \
-	tests/e2e/e2e_taa.py \
-	tests/e2e/e2e_visibility.py \
-	tests/e2e/e2e_badinput.py \
-	tests/e2e/e2e_pbr.py \
-	tests/e2e/e2e_client.py \
-	tests/e2e/e2e_metrics.py \
-	tests/e2e/e2e_reference_temporal.py \
-	tests/e2e/e2e_persist.py \
-	tests/e2e/ssim_skimage.py \
-	tests/e2e/e2e_history.py \
-	tests/e2e/e2e_compare_alpha.py \
 	tests/e2e/e2e_client_verdicts.py \
-	tests/e2e/e2e_demo.py \
-	tests/e2e/e2e_verdicts.py \
-	tests/e2e/e2e_asset_convert.py \
-	tests/e2e/e2e_orphans.py \
-	tests/e2e/e2e_asset_pins.py \
-	tests/e2e/e2e_full_disk.py \
-	tests/e2e/e2e_upload_slots.py \
 	tests/e2e/systemd_sandbox.py \
+	tests/e2e/e2e_http.py \
+	tests/e2e/e2e_history.py \
+	tests/e2e/e2e_scene_view.py \
+	tests/e2e/e2e_persist.py \
+	tests/e2e/e2e_full_disk.py \
+	tests/e2e/e2e_asset_import.py \
+	tests/e2e/e2e_asset_convert.py \
+	tests/e2e/e2e_gpu.py \
+	tests/e2e/e2e_osl_assets.py \
+	tests/e2e/e2e_asset_render.py \
+	tests/e2e/e2e_assets.py \
+	tests/e2e/e2e_upload_slots.py \
+	tests/e2e/e2e_pbr.py \
+	tests/e2e/e2e_badinput.py \
+	tests/e2e/e2e_demo.py \
+	tests/e2e/ssim_skimage.py \
+	tests/e2e/e2e_orphans.py \
+	tests/e2e/e2e_compare_alpha.py \
 	tests/e2e/systemd_unit.sh
 
 # The folders' layers (docs/architecture.md), read from the includes.

@@ -340,10 +340,12 @@ static void prune_cache(const struct fidelity *f)
     struct cache_entry *list = NULL;
     struct dirent *e;
     while ((e = readdir(d))) {
-        if (e->d_name[0] == '.' || strlen(e->d_name) >= sizeof(list->name))
+        size_t len = strlen(e->d_name);
+        if (e->d_name[0] == '.' || len >= sizeof(list->name))
             continue;
         char p[PATH_MAX + 120];
-        snprintf(p, sizeof(p), "%s/%s", root, e->d_name);
+        if (snprintf(p, sizeof(p), "%s/%s", root, e->d_name) >= (int)sizeof(p))
+            continue;
         struct stat st;
         if (stat(p, &st) != 0 || !S_ISDIR(st.st_mode))
             continue;
@@ -357,7 +359,7 @@ static void prune_cache(const struct fidelity *f)
                 break;
             list = l;
         }
-        snprintf(list[n].name, sizeof(list[n].name), "%s", e->d_name);
+        memcpy(list[n].name, e->d_name, len + 1); /* len < sizeof(name), checked above */
         list[n++].mtime = (double)st.st_mtime;
     }
     closedir(d);

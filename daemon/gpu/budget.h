@@ -92,9 +92,8 @@ struct gpu_budget {
     enum gpu_budget_mode mode;
     /* A measured tile's GPU time is read from a GL_TIME_ELAPSED query (set
      * only where no timer section is open: the harness's measuring frames,
-     * with the run's timer paused, on a device whose queries time all of a
-     * draw: not llvmpipe's, harness/run.h); else from the wall clock, which
-     * on a loaded machine adds every round trip's wait. */
+     * with the run's timer paused); else from the wall clock, which on a
+     * loaded machine adds every round trip's wait. */
     bool use_queries;
     /* A measuring run gives up (stops the budget, over set) once what its
      * pieces have cost so far, counted whole, passes this many seconds (0:

@@ -290,10 +290,9 @@ static bool measure_first_frames(struct harness_run *run, int run_index, int *co
     struct gpu_budget *b = &run->budget;
     b->timer = run->timer;
     b->mode = GPU_BUDGET_ADAPTIVE;
-    /* The pass timer rests: the measured tiles time themselves (with
-     * queries where they time the whole draw). */
+    /* The pass timer rests: the measured tiles time themselves. */
     gpu_timer_pause(run->timer, true);
-    b->use_queries = harness_gl_elapsed_queries_whole(run->gl);
+    b->use_queries = true;
     run->measuring = true;
     bool ok = decide(run, run_index, consumed, status);
     run->measuring = false;

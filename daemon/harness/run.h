@@ -49,19 +49,6 @@ struct harness_gl {
 bool harness_gl_init(struct harness_gl *g, char *err, size_t errlen);
 void harness_gl_finish(struct harness_gl *g);
 
-/* Whether a GL_TIME_ELAPSED query around a draw times all of its work on
- * this device, so that the budget may time its measured tiles with one
- * (budget.h: use_queries). A software renderer's does not: llvmpipe
- * answered 0.12 s for the tiles of a forward frame (256 lights, 1080x720)
- * that took 4.05 s drawn whole, so that its untimed work was cut into tiles
- * thirty times a slice and the measure never saw a frame over the bound.
- * There the work runs on the CPU once flushed, and the wall clock of a tile
- * waited for alone is what it cost. */
-static inline bool harness_gl_elapsed_queries_whole(const struct harness_gl *g)
-{
-    return !json_is_true(json_object_get(g->device_json, "software"));
-}
-
 /* HDR statistics of one captured frame. */
 struct hdr_stats {
     long long nonfinite; /* pixels with a NaN or infinite R, G or B */

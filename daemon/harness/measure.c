@@ -217,10 +217,12 @@ static bool decide(struct harness_run *run, int run_index, int *consumed,
     rule->estimate_s[0] = rule->estimate_s[1] = rule->whole_frame_s = rule->settling_frame_s = -1;
     double give_up = limit > 0 && !run->spec->accept_sliced_timing ? 4 * limit : 0;
     bool whole = false, gave_up = false;
-    /* m: 0 the first measure; after a give-up, 1 draws the frame through
-     * and 2 measures again; else 1 is the second measure. */
-    for (int m = 0, e = 0; m < (gave_up ? 3 : 2) && !whole; m++) {
-        bool settling = gave_up && m == 1;
+    /* Two measures; after a give-up (at the first or the second), the next
+     * frame draws the frame through and one more measures it. e: the next
+     * of the two estimate slots (a third measure overwrites the second). */
+    int settle_at = -1;
+    for (int m = 0, e = 0; m < (settle_at >= 0 ? settle_at + 2 : 2) && !whole; m++) {
+        bool settling = m == settle_at;
         /* The settling frame keeps what the given-up one measured (its
          * pieces drawn in tiles of a slice); a measure starts afresh. */
         if (m >= 1 && !settling)
@@ -237,9 +239,11 @@ static bool decide(struct harness_run *run, int run_index, int *consumed,
              * moment's load or work done once, which the next measure tells. */
             if (gave_up)
                 return refuse_whole(run, true);
-            rule->estimate_s[e++] = b->frame.whole_s;
+            rule->estimate_s[e < 2 ? e : 1] = b->frame.whole_s;
+            e++;
             b->stopped = b->over = false;
             gave_up = true;
+            settle_at = m + 1;
             /* The frame was abandoned: what it left half-done (OSL's first
              * shading) must not pass for done in the next. */
             if (!gpu_budget_sync(b))
@@ -254,15 +258,14 @@ static bool decide(struct harness_run *run, int run_index, int *consumed,
             rule->settling_frame_s = took;
             continue;
         }
-        rule->estimate_s[e] = whole_estimate(b, took);
+        double estimate = rule->estimate_s[e < 2 ? e : 1] = whole_estimate(b, took);
+        e++;
         /* The pixels' work: the measured pieces' cost above what every tile
          * pays; the rest of the frame (submission, geometry, loops of draws,
          * the waits between) does not grow with the pixels. */
-        rule->pixel_share = rule->estimate_s[e] > 0
-                                ? (b->frame.whole_s - b->frame.fixed_s) / rule->estimate_s[e]
-                                : 1.0;
-        whole = limit <= 0 || rule->estimate_s[e] <= limit;
-        e++;
+        rule->pixel_share =
+            estimate > 0 ? (b->frame.whole_s - b->frame.fixed_s) / estimate : 1.0;
+        whole = limit <= 0 || estimate <= limit;
     }
     b->give_up_s = 0;
     if (whole) {

@@ -81,9 +81,10 @@ struct run_timing_rule {
     bool decided;
     enum gpu_budget_mode mode;  /* GPU_BUDGET_WHOLE or GPU_BUDGET_SLICED */
     double limit_s;             /* job_spec_max_frame_seconds(); 0: no bound */
-    int measuring_frames;       /* frames drawn in slices to measure it (1 to 3) */
+    int measuring_frames;       /* frames drawn in slices to measure it (1 to 4) */
     double estimate_s[2];       /* the measures' cost drawn whole (a given-up one: what it
-                                 * came to when given up); -1: none */
+                                 * came to when given up; a third overwrites the second);
+                                 * -1: none */
     double settling_frame_s;    /* after a give-up, what drawing the frame through in slices,
                                  * unjudged, took; -1: none */
     double whole_frame_s;       /* the deciding frame, drawn whole; -1: none drawn */

@@ -833,6 +833,24 @@ out:
 
 int main(int argc, char **argv)
 {
+    /* Measurement integrity, set before any thread starts: glibc raises its
+     * mmap and trim thresholds as it frees large blocks, and the first job
+     * after a larger one then ran its frames up to 3 times slower (the heap
+     * top trimmed and faulted back in every frame). Fixed thresholds keep a
+     * job's timings independent of the jobs before it, for at most 128 MiB
+     * of free heap kept. And one arena, so that those thresholds govern
+     * every allocation: the render thread's own arena is a chain of 64 MiB
+     * heaps, and glibc unmaps a heap whose memory is all free whatever the
+     * trim threshold, so llvmpipe's vertex buffer of a draw (28 MiB for the
+     * default scene) now and then landed in a fresh heap, unmapped at its
+     * free and faulted back in at the next draw: 7,100 page faults a time,
+     * 0 to 85,000 in the 20 timed frames of a 160x120 job, with no larger
+     * job before it, as the other threads' allocations happened to lie
+     * (e2e_integrity's bound of 20,000 failed on it). With one arena: 9 to
+     * 48 in the same jobs. */
+    mallopt(M_ARENA_MAX, 1);
+    mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
+    mallopt(M_TRIM_THRESHOLD, 128 * 1024 * 1024);
     /* Built before any thread starts, then read-only: every registered
      * technique and effect checked once. */
     static struct technique_catalog catalog;
@@ -843,13 +861,6 @@ int main(int argc, char **argv)
         fprintf(stderr, "shadebenchd: %s\n", catalog_err);
         return 1;
     }
-    /* Measurement integrity: glibc raises its mmap and trim thresholds as it
-     * frees large blocks, and the first job after a larger one then ran its
-     * frames up to 3 times slower (the heap top trimmed and faulted back in
-     * every frame). Fixed thresholds keep a job's timings independent of the
-     * jobs before it, for at most 128 MiB of free heap kept. */
-    mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
-    mallopt(M_TRIM_THRESHOLD, 128 * 1024 * 1024);
     struct options o = {.device = {.kind = DEVICE_SPEC_AUTO, .text = "auto"}, .queue_size = 64, .job_timeout = JOB_TIMEOUT_DEFAULT,
                         .max_frame_s = JOB_DEFAULT_MAX_FRAME_S,
                         .stall_s = STALL_SECONDS_DEFAULT,

@@ -21,6 +21,7 @@
 #include "daemon/status/telemetry.h"
 #include "daemon/spec/job_cost.h"
 #include "daemon/spec/job_spec.h"
+#include "common/crash_report.h"
 #include "common/log.h"
 #include "daemon/jobs/queue.h"
 #include "daemon/harness/runner.h"
@@ -851,6 +852,7 @@ int main(int argc, char **argv)
     mallopt(M_ARENA_MAX, 1);
     mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
     mallopt(M_TRIM_THRESHOLD, 128 * 1024 * 1024);
+    crash_report_install("shadebenchd");
     /* Built before any thread starts, then read-only: every registered
      * technique and effect checked once. */
     static struct technique_catalog catalog;

@@ -195,6 +195,7 @@ E2E_TESTS = \
 	tests/e2e/e2e_client_verdicts.py \
 	tests/e2e/systemd_sandbox.py \
 	tests/e2e/e2e_http.py \
+	tests/e2e/e2e_crash_report.py \
 	tests/e2e/e2e_history.py \
 	tests/e2e/e2e_scene_view.py \
 	tests/e2e/e2e_persist.py \

@@ -175,6 +175,7 @@ static double check_locked(struct connections *cs, double now, bool jobs_changed
 
 static void *watcher_main(void *arg)
 {
+    pthread_setname_np(pthread_self(), "sb-watcher"); /* named in crash reports, top, gdb */
     struct connections *cs = arg;
     struct epoll_event ev[64];
     double next = clock_mono_s(), last_sweep_check = 0;

@@ -1,4 +1,5 @@
-#define _POSIX_C_SOURCE 200809L
+/* pthread_setname_np. */
+#define _GNU_SOURCE
 #include "daemon/harness/metrics_stage.h"
 
 #include <errno.h>
@@ -193,6 +194,7 @@ static void run_task(struct metrics_worker *w, struct task *t)
 
 static void *worker_main(void *arg)
 {
+    pthread_setname_np(pthread_self(), "sb-metrics"); /* named in crash reports, top, gdb */
     struct metrics_worker *w = arg;
     pthread_mutex_lock(&w->lock);
     for (;;) {

@@ -1,4 +1,5 @@
-#define _POSIX_C_SOURCE 200809L
+/* pthread_setname_np. */
+#define _GNU_SOURCE
 #include "daemon/harness/runner.h"
 #include "daemon/jobs/fidelity.h"
 #include "daemon/harness/fidelity_render.h"
@@ -390,6 +391,7 @@ static bool give_back_memory(struct runner *r, struct egl_context **egl, char *e
 
 static void *runner_main(void *arg)
 {
+    pthread_setname_np(pthread_self(), "sb-render"); /* named in crash reports, top, gdb */
     struct runner *r = arg;
     char err[512] = "";
     struct egl_context *egl = egl_context_create(&r->device, r->gl_debug, err, sizeof(err));

@@ -50,6 +50,7 @@ void assets_notify(struct assets *a)
 
 static void *worker(void *arg)
 {
+    pthread_setname_np(pthread_self(), "sb-assets"); /* named in crash reports, top, gdb */
     struct assets *a = arg;
     pthread_mutex_lock(&a->lock);
     for (;;) {

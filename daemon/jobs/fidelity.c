@@ -747,6 +747,7 @@ static void finish_task(struct fidelity *f, struct task *t)
 
 static void *worker_main(void *arg)
 {
+    pthread_setname_np(pthread_self(), "sb-fidelity"); /* named in crash reports, top, gdb */
     struct fidelity *f = arg;
     pthread_mutex_lock(&f->lock);
     for (;;) {

@@ -1,4 +1,5 @@
-#define _POSIX_C_SOURCE 200809L
+/* pthread_setname_np. */
+#define _GNU_SOURCE
 #include "daemon/jobs/sweeps.h"
 
 #include <errno.h>
@@ -459,6 +460,7 @@ static void run_sweep(struct sweeps *s, struct sweep *sw)
 
 static void *sweeps_main(void *arg)
 {
+    pthread_setname_np(pthread_self(), "sb-sweeps"); /* named in crash reports, top, gdb */
     struct sweeps *s = arg;
     pthread_mutex_lock(&s->lock);
     for (;;) {

@@ -22,7 +22,7 @@ static const char *program_name = "shadebench";
 
 static void put(const char *s) { (void)!write(STDERR_FILENO, s, strlen(s)); }
 
-/* Decimal, without stdio (not async-signal-safe). */
+/* Decimal, without stdio (which is not async-signal-safe). */
 static void put_long(long v)
 {
     char buf[24], *p = buf + sizeof(buf);

@@ -91,7 +91,11 @@ class Daemon:
         if not self.log.closed:
             self.log.flush()
         with open(self.log_path) as f:
-            sys.stdout.write(f.read()[-6000:])
+            text = f.read()
+        # A crash report (common/crash_report.h) whole, with what led to it.
+        crash = text.rfind(": fatal SIG")
+        start = max(0, min(len(text) - 6000, crash - 3000)) if crash >= 0 else len(text) - 6000
+        sys.stdout.write(text[max(0, start):])
 
     def alive(self):
         return self.proc.poll() is None

@@ -66,14 +66,19 @@ static void sleep_ms(long ms)
 /* Until the server holds exactly n connections (at most 10 s): a
  * connection is counted once the server has taken it, which a loaded
  * machine may do late. */
-static bool wait_connections(struct http_server *http, size_t n)
+static bool wait_connections_ms(struct http_server *http, size_t n, int ms)
 {
-    for (int i = 0; i < 1000; i++) {
+    for (int i = 0; i < ms / 10; i++) {
         if (http_server_open_connections(http) == n)
             return true;
         sleep_ms(10);
     }
     return false;
+}
+
+static bool wait_connections(struct http_server *http, size_t n)
+{
+    return wait_connections_ms(http, n, 10000);
 }
 
 static int connect_to(int port)
@@ -546,8 +551,9 @@ int main(void)
      * slot held by a hog, which it then must refuse past. A refused hog is
      * opened again until all of them hold. */
     bool full = false;
-    for (int round = 0; round < 20 && !full; round++) {
-        full = wait_connections(http, 3 + CONNECTIONS_HEALTH_RESERVE);
+    /* At most 10 s for the first fill, 1 s for each refill after it. */
+    for (int round = 0; round < 10 && !full; round++) {
+        full = wait_connections_ms(http, 3 + CONNECTIONS_HEALTH_RESERVE, round ? 1000 : 10000);
         sleep_ms(50); /* a refusal's close reaches the hog */
         for (int i = 0; i < 3 + CONNECTIONS_HEALTH_RESERVE; i++)
             if (!hog_held(hogs[i])) {
